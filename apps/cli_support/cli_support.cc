@@ -1,0 +1,89 @@
+#include "cli_support.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "robomach/common/errors.h"
+#include "robomach/io/csv_table.h"
+
+namespace robomach::apps {
+
+std::string ExitCodeHelp() {
+  return "Exit codes: 0 success; 3 outputs written but the result is flagged (see stderr); "
+         "64 bad command line; 65 bad input data; 66 input file missing or unreadable; "
+         "70 internal error; 73 an output could not be written.";
+}
+
+int RunGuarded(const std::string& tool, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const NoInputError& e) {
+    std::cerr << tool << ": " << e.what() << '\n';
+    return kExitNoInput;
+  } catch (const InputError& e) {
+    std::cerr << tool << ": " << e.what() << '\n';
+    return kExitDataError;
+  } catch (const OutputError& e) {
+    std::cerr << tool << ": " << e.what() << '\n';
+    return kExitCantCreate;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << tool << ": " << e.what() << '\n';
+    return kExitUsage;
+  } catch (const std::exception& e) {
+    std::cerr << tool << ": internal error: " << e.what() << '\n';
+    return kExitSoftware;
+  }
+}
+
+void RequireReadableFile(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw NoInputError(path + ": " + what + " not found");
+  if (fs::is_directory(path, ec)) throw NoInputError(path + ": " + what + " is a directory, expected a file");
+  std::ifstream in(path);
+  if (!in) throw NoInputError(path + ": " + what + " cannot be read");
+}
+
+ProgressLine::ProgressLine(std::string tool, std::string what, long total)
+    : tool_(std::move(tool)),
+      what_(std::move(what)),
+      total_(total),
+      tty_(::isatty(2) != 0),
+      active_(total >= 200),
+      start_(std::chrono::steady_clock::now()) {}
+
+void ProgressLine::Update(long done) {
+  if (!active_ || total_ <= 0) return;
+  const int decile = static_cast<int>(10 * done / total_);
+  if (decile == last_decile_) return;
+  last_decile_ = decile;
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  if (tty_) {
+    std::cerr << '\r' << tool_ << ": " << what_ << ' ' << done << '/' << total_ << " (" << s << " s)"
+              << std::flush;
+  } else {
+    std::cerr << tool_ << ": " << what_ << ' ' << done << '/' << total_ << " (" << s << " s)\n";
+  }
+}
+
+void ProgressLine::Finish() {
+  if (active_ && tty_) std::cerr << '\n';
+}
+
+void Warn(const std::string& tool, const std::string& message) {
+  std::cerr << tool << ": warning: " << message << '\n';
+}
+
+std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text) {
+  const size_t eq = text.find('=');
+  double v = 0.0;
+  if (eq == std::string::npos || eq == 0 || !io::ParseFiniteNumber(text.substr(eq + 1), &v)) {
+    throw std::invalid_argument(option + " " + text + ": expected NAME=VALUE with a number, e.g. m6_kg=30");
+  }
+  return {text.substr(0, eq), v};
+}
+
+}  // namespace robomach::apps

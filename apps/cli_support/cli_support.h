@@ -1,0 +1,64 @@
+#pragma once
+
+// Shared by the command-line tools: exit codes (style.md §2.13), the error
+// boundary, progress lines and small parsing helpers. CLI11 stays out of
+// this header so that only each app's own file pays its compile time.
+
+#include <chrono>
+#include <functional>
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace robomach::apps {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFlagged = 3;     // outputs written, result flagged
+inline constexpr int kExitUsage = 64;      // EX_USAGE
+inline constexpr int kExitDataError = 65;  // EX_DATAERR
+inline constexpr int kExitNoInput = 66;    // EX_NOINPUT
+inline constexpr int kExitSoftware = 70;   // EX_SOFTWARE
+inline constexpr int kExitCantCreate = 73; // EX_CANTCREAT
+
+/// The exit-code table for --help footers.
+std::string ExitCodeHelp();
+
+/// Runs `body` and maps exceptions to exit codes with one message on stderr
+/// prefixed by the tool name: InputError -> 65, OutputError -> 73,
+/// std::invalid_argument (bad option values) -> 64, anything else -> 70.
+int RunGuarded(const std::string& tool, const std::function<int()>& body);
+
+/// @throws InputError "path: no such file" if `path` is not a readable file;
+/// RunGuarded maps it to 66.
+void RequireReadableFile(const std::string& path, const std::string& what);
+
+/// A missing input file (exit 66).
+class NoInputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Progress on stderr: one line per ~10 % (or a \r-updated line on a TTY),
+/// only for long jobs.
+class ProgressLine {
+ public:
+  ProgressLine(std::string tool, std::string what, long total);
+  void Update(long done);
+  void Finish();
+
+ private:
+  std::string tool_, what_;
+  long total_;
+  int last_decile_{-1};
+  bool tty_;
+  bool active_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+/// Prints "tool: warning: message" on stderr.
+void Warn(const std::string& tool, const std::string& message);
+
+/// Splits "NAME=VALUE"; @throws std::invalid_argument naming the option.
+std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text);
+
+}  // namespace robomach::apps

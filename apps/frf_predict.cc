@@ -1,0 +1,239 @@
+// frf-predict: pose-dependent tool-tip FRFs, modes and plots of a robot
+// model at the postures of a posture file.
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cli_support.h"
+#include "robomach/common/errors.h"
+#include "robomach/common/units.h"
+#include "robomach/dynamics/posture_dynamics.h"
+#include "robomach/dynamics/tool_tip_frf.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/csv_table.h"
+#include "robomach/io/posture_file.h"
+#include "robomach/io/prediction_files.h"
+#include "robomach/io/robot_config.h"
+#include "robomach/report/frf_plot.h"
+#include "robomach/report/posture_json.h"
+
+namespace robomach::apps {
+namespace {
+
+constexpr char kTool[] = "frf-predict";
+
+Eigen::VectorXd ReadFrequencyFile(const std::string& path) {
+  const io::CsvTable t = io::CsvTable::ReadFile(path);
+  t.RequireColumn("freq_hz");
+  Eigen::VectorXd f(t.num_rows());
+  for (int r = 0; r < t.num_rows(); ++r) {
+    f(r) = t.Number(r, "freq_hz");
+    if (f(r) < 0.0) throw t.ErrorAt(r, "freq_hz", "expected a frequency >= 0");
+    if (r > 0 && !(f(r) > f(r - 1))) {
+      throw t.ErrorAt(r, "freq_hz", "frequencies must be strictly increasing");
+    }
+  }
+  if (f.size() == 0) throw InputError({path, 0, 0}, "no frequency lines");
+  return f;
+}
+
+report::Figure PostureFigure(const std::vector<const io::PosturePrediction*>& preds,
+                             const std::vector<const dynamics::PostureDynamics*>& dyn,
+                             const std::string& title) {
+  report::Figure fig(static_cast<int>(preds.size()), 2, 760, 340);
+  fig.title = title;
+  for (size_t p = 0; p < preds.size(); ++p) {
+    std::vector<report::FrfCurve> curves;
+    for (int a = 0; a < 3; ++a) {
+      report::FrfCurve c;
+      c.freq_hz = preds[p]->freq_hz;
+      c.receptance.resize(c.freq_hz.size());
+      for (Eigen::Index i = 0; i < c.freq_hz.size(); ++i) c.receptance(i) = preds[p]->H[i](a, a);
+      c.label = std::string("H") + "xyz"[a] + "xyz"[a];
+      c.color = report::PaletteColor(a);
+      curves.push_back(std::move(c));
+    }
+    std::vector<double> fn;
+    for (const auto& m : dyn[p]->modes) fn.push_back(m.freq_hz);
+    report::FillFrfPanels(curves, fn, "posture " + preds[p]->pose_id + ": tool-tip receptance",
+                          &fig.at(static_cast<int>(p), 0), &fig.at(static_cast<int>(p), 1));
+    fig.at(static_cast<int>(p), 1).title = "phase";
+  }
+  return fig;
+}
+
+int Run(int argc, char** argv) {
+  CLI::App app{
+      "frf-predict: pose-dependent tool-tip frequency response of a robot model.\n"
+      "Reads a robot config and a posture file (formats.md §1); writes the 3x3 tool-tip\n"
+      "receptance per posture (formats.md §3), the modal table (§4), per-posture details\n"
+      "(JSON) and plots (PNG)."};
+  app.footer(ExitCodeHelp());
+  std::string robot_path, postures_path, out_path, modes_path, plot_path, plot_dir, details_path,
+      freq_file, directions = "all", method = "modal";
+  double fmin_hz = 0.625, fmax_hz = 500.0, df_hz = 0.625;
+  std::vector<std::string> sets, adds;
+  bool verbose = false;
+  app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
+  app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
+  app.add_option("--out", out_path, "predicted FRFs, CSV receptance [m/N]; stdout if omitted");
+  app.add_option("--modes", modes_path, "modal table CSV: freq_hz, damping_ratio, modal_mass_kg, ux,uy,uz");
+  app.add_option("--details", details_path, "per-posture JSON: J, cond(J), M_q, K_q, C_q, Cartesian M, K, C, compliance, modes");
+  app.add_option("--plot", plot_path, "one PNG sheet with all postures (magnitude and phase)");
+  app.add_option("--plot-dir", plot_dir, "folder for one PNG per posture (<pose_id>.png)");
+  app.add_option("--fmin-hz", fmin_hz, "lowest frequency line [Hz]")->capture_default_str();
+  app.add_option("--fmax-hz", fmax_hz, "highest frequency line [Hz]")->capture_default_str();
+  app.add_option("--df-hz", df_hz, "frequency step [Hz]")->capture_default_str();
+  app.add_option("--freq-file", freq_file, "CSV with a freq_hz column; replaces --fmin-hz/--fmax-hz/--df-hz");
+  app.add_option("--directions", directions,
+                 "response/excitation pairs to write, e.g. xx,yy,xy, or 'all'")->capture_default_str();
+  app.add_option("--method", method, "modal (superposition) or direct (solve per line)")
+      ->check(CLI::IsMember({"modal", "direct"}))->capture_default_str();
+  app.add_option("--set", sets, "override a model parameter, NAME=VALUE in its unit (e.g. m6_kg=30.2)");
+  app.add_option("--add", adds, "switch on an effect by name with its default parameters (e.g. tip_mass)");
+  app.add_flag("--verbose", verbose, "list model parameters and ignored input columns on stderr");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+
+  return RunGuarded(kTool, [&]() -> int {
+    RequireReadableFile(robot_path, "robot config");
+    RequireReadableFile(postures_path, "posture file");
+    if (!freq_file.empty()) RequireReadableFile(freq_file, "frequency file");
+    const io::DirectionPairs pairs = io::ParseDirectionPairs(directions);
+    Eigen::VectorXd freq_hz;
+    if (!freq_file.empty()) {
+      freq_hz = ReadFrequencyFile(freq_file);
+    } else {
+      if (!(fmin_hz >= 0.0) || !(fmax_hz > fmin_hz) || !(df_hz > 0.0)) {
+        throw std::invalid_argument("expected 0 <= --fmin-hz < --fmax-hz and --df-hz > 0");
+      }
+      const long n = static_cast<long>(std::floor((fmax_hz - fmin_hz) / df_hz + 1e-9)) + 1;
+      if (n > 10'000'000) throw std::invalid_argument("more than 1e7 frequency lines: raise --df-hz");
+      freq_hz = Eigen::VectorXd::LinSpaced(n, fmin_hz, fmin_hz + (n - 1) * df_hz);
+    }
+
+    io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
+    for (const std::string& name : adds) {
+      cfg.description.effects.push_back({name, {}});
+    }
+    if (!adds.empty()) {
+      const dynamics::ParameterSet old = cfg.parameters;
+      cfg.parameters = dynamics::DefaultParameters(cfg.description);
+      for (const auto& s : old.specs()) cfg.parameters.Set(s.name, old.Get(s.name));
+    }
+    for (const std::string& s : sets) {
+      const auto [name, value] = ParseAssignment("--set", s);
+      cfg.parameters.Set(name, value);
+    }
+    if (verbose) {
+      for (const auto& s : cfg.parameters.specs()) {
+        std::cerr << kTool << ": parameter " << s.name << " = " << cfg.parameters.Get(s.name) << " "
+                  << s.unit << '\n';
+      }
+    }
+    const auto model = cfg.Build();
+    const std::vector<io::Posture> postures =
+        io::ReadPostureFile(postures_path, model->num_joints());
+
+    bool flagged = false;
+    dynamics::PostureEvaluator evaluator(model);
+    std::vector<io::PosturePrediction> preds;
+    std::vector<dynamics::PostureDynamics> dyns;
+    ProgressLine progress(kTool, "postures", static_cast<long>(postures.size()));
+    for (size_t p = 0; p < postures.size(); ++p) {
+      const io::Posture& pose = postures[p];
+      for (int j : model->chain().JointsOutsideLimits(pose.q)) {
+        const auto& lim = model->chain().limits()[j];
+        std::ostringstream msg;
+        msg << postures_path << ":" << pose.line << ": posture " << pose.id << ": joint " << j + 1
+            << " at " << RadToDeg(pose.q(j)) << " deg is outside its limits [" << RadToDeg(lim.lower)
+            << ", " << RadToDeg(lim.upper) << "] deg";
+        Warn(kTool, msg.str());
+        flagged = true;
+      }
+      dynamics::PostureDynamics d = evaluator.Evaluate(pose.q);
+      if (d.near_singular) {
+        std::ostringstream msg;
+        msg << postures_path << ":" << pose.line << ": posture " << pose.id
+            << " is near a singularity (condition number of J " << d.jacobian_condition
+            << "); the FRF is computed in joint space and stays valid, but the Cartesian M, K, C "
+               "are not reported";
+        Warn(kTool, msg.str());
+        flagged = true;
+      }
+      io::PosturePrediction pred;
+      pred.pose_id = pose.id;
+      pred.freq_hz = freq_hz;
+      pred.H = method == "direct" ? dynamics::ReceptanceDirect(d.system, freq_hz)
+                                  : dynamics::Receptance(d, freq_hz);
+      for (const auto& h : pred.H) {
+        if (!h.allFinite()) {
+          throw std::runtime_error("non-finite receptance at posture " + pose.id);
+        }
+      }
+      preds.push_back(std::move(pred));
+      dyns.push_back(std::move(d));
+      progress.Update(static_cast<long>(p + 1));
+    }
+    progress.Finish();
+
+    // Every output is complete before it appears (formats.md §4).
+    if (out_path.empty()) {
+      io::WritePredictedFrfCsv(std::cout, preds, pairs);
+    } else {
+      io::WritePredictedFrfCsv(out_path, preds, pairs);
+    }
+    std::vector<std::string> ids;
+    std::vector<std::vector<dynamics::Mode>> modes;
+    for (size_t p = 0; p < postures.size(); ++p) {
+      ids.push_back(postures[p].id);
+      modes.push_back(dyns[p].modes);
+    }
+    if (!modes_path.empty()) io::WriteModalTableCsv(modes_path, ids, modes);
+    if (!details_path.empty()) {
+      nlohmann::json j;
+      j["robot"] = robot_path;
+      nlohmann::json params;
+      for (const auto& s : model->parameters().specs()) params[s.name] = model->parameters().Get(s.name);
+      j["parameters"] = params;
+      j["postures"] = nlohmann::json::array();
+      for (size_t p = 0; p < postures.size(); ++p) j["postures"].push_back(report::PostureToJson(ids[p], dyns[p]));
+      io::WriteFileAtomically(details_path, report::DumpJson(j));
+    }
+    if (!plot_path.empty()) {
+      constexpr size_t kMaxSheet = 12;
+      std::vector<const io::PosturePrediction*> pp;
+      std::vector<const dynamics::PostureDynamics*> dd;
+      for (size_t p = 0; p < std::min(preds.size(), kMaxSheet); ++p) {
+        pp.push_back(&preds[p]);
+        dd.push_back(&dyns[p]);
+      }
+      if (preds.size() > kMaxSheet) {
+        Warn(kTool, "the sheet shows the first 12 of " + std::to_string(preds.size()) +
+                        " postures; use --plot-dir for one picture per posture");
+      }
+      PostureFigure(pp, dd, "robomach frf-predict: " + robot_path).SavePng(plot_path);
+    }
+    if (!plot_dir.empty()) {
+      io::EnsureDirectory(plot_dir);
+      for (size_t p = 0; p < preds.size(); ++p) {
+        PostureFigure({&preds[p]}, {&dyns[p]}, "robomach frf-predict: " + robot_path)
+            .SavePng((std::filesystem::path(plot_dir) / (preds[p].pose_id + ".png")).string());
+      }
+    }
+    return flagged ? kExitFlagged : kExitOk;
+  });
+}
+
+}  // namespace
+}  // namespace robomach::apps
+
+int main(int argc, char** argv) { return robomach::apps::Run(argc, argv); }

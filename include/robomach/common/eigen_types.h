@@ -1,0 +1,13 @@
+#pragma once
+
+#include <Eigen/Core>
+
+namespace robomach {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Matrix6Xd = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // Jacobians
+using Matrix3Xd = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+// Eigen::Vector3d, Matrix3d, Matrix3cd, VectorXcd are used as they are.
+
+}  // namespace robomach

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace robomach {
+
+/// Where in a user's file something was found. Lines and columns are 1-based;
+/// 0 means unknown.
+struct SourceLocation {
+  std::string path;
+  int line{0};
+  int column{0};
+  /// "path", "path:line" or "path:line:column".
+  std::string ToString() const;
+};
+
+/// Malformed or out-of-range user data. what() == "path:line[:col]: message".
+class InputError : public std::runtime_error {
+ public:
+  InputError(SourceLocation where, const std::string& message);
+  const SourceLocation& where() const { return where_; }
+  /// The message without the location prefix.
+  const std::string& message() const { return message_; }
+
+ private:
+  SourceLocation where_;
+  std::string message_;
+};
+
+/// An output file could not be created, written or renamed into place.
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace robomach
+
+/// Debug-only check of an internal invariant (a robomach bug, not bad input).
+#ifdef NDEBUG
+#define ROBOMACH_ASSERT(cond) ((void)0)
+#else
+#include <cassert>
+#define ROBOMACH_ASSERT(cond) assert(cond)
+#endif

@@ -1,0 +1,95 @@
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "robomach/common/eigen_types.h"
+#include "robomach/dynamics/parameters.h"
+
+namespace robomach::dynamics {
+
+class RobotModel;
+
+/// The linear system about a posture, in generalised coordinates
+/// z = [q (n joints); extra DOFs of effects]:
+/// <pre>
+///   M z'' + C z' + K z = Bᵀ F,      x_T = B z,
+/// </pre>
+/// F the force at the tool tip and x_T its translation, both in B.
+/// Without effects M = M_q, K = K_q, B = J_v (the first three rows of J_BT).
+/// The damping is C = alpha K + beta M + C_extra: Rayleigh damping of the
+/// whole assembled system plus what effects add explicitly (C_extra).
+struct AssembledSystem {
+  Eigen::MatrixXd M;        // [kg, kg·m, kg·m²]
+  Eigen::MatrixXd K;        // [N/m, N, N·m per rad]
+  Eigen::MatrixXd C_extra;  // non-proportional damping added by effects
+  Eigen::MatrixXd C;        // total damping, set after all effects
+  Matrix3Xd B;              // tool-tip translation per generalised coordinate
+  int num_joints{0};
+};
+
+/// What an effect may read about the posture being evaluated.
+struct EffectContext {
+  const RobotModel& model;
+  const Eigen::VectorXd& q;         // [rad]
+  const Eigen::Isometry3d& X_BT;    // TCP pose
+  const Matrix6Xd& J_BT;            // TCP Jacobian, rows [v; ω]
+};
+
+/// A physical effect added to the base robot model: joint-space terms and/or
+/// extra degrees of freedom coupled to the robot. An effect is one small
+/// file under src/dynamics/effects/ that ends with
+/// `ROBOMACH_REGISTER_EFFECT(file_stem, Class)`; CMake collects the files, so no
+/// other edit is needed.
+class Effect {
+ public:
+  virtual ~Effect() = default;
+  /// Name used in configs and on the command line, e.g. "tip_mass".
+  virtual std::string name() const = 0;
+  /// One line: what physical effect this models, and the reference.
+  virtual std::string description() const = 0;
+  /// Parameters with unprefixed names ("mass_kg"); the model exposes them
+  /// as "<effect>.<name>".
+  virtual std::vector<ParameterSpec> parameters() const = 0;
+  /// Extra generalised coordinates this effect adds (0 for joint-space terms).
+  virtual int num_extra_dofs(std::span<const double> /*values*/) const { return 0; }
+  /// Adds the effect's terms to `system`. Extra DOFs occupy indices
+  /// [first_extra_dof, first_extra_dof + num_extra_dofs()); the matrices are
+  /// already sized for them and zero there.
+  virtual void Contribute(const EffectContext& context, std::span<const double> values,
+                          int first_extra_dof, AssembledSystem* system) const = 0;
+};
+
+/// Registry of the effect library, filled at start-up.
+class EffectRegistry {
+ public:
+  using Factory = std::function<std::shared_ptr<const Effect>()>;
+  static EffectRegistry& Instance();
+  void Register(Factory factory);
+  /// @throws std::invalid_argument "unknown effect 'x'; available: ...".
+  std::shared_ptr<const Effect> Create(std::string_view name) const;
+  std::vector<std::string> Names() const;
+
+ private:
+  std::vector<std::pair<std::string, Factory>> factories_;
+};
+
+}  // namespace robomach::dynamics
+
+/// Registers an effect. Use it once per effect file, at global scope, with
+/// the file's stem: in src/dynamics/effects/tip_mass.cc,
+/// `ROBOMACH_REGISTER_EFFECT(tip_mass, robomach::dynamics::TipMassEffect)`.
+/// CMake generates the list of registration calls from the file names, so no
+/// other file changes; explicit calls cannot be dropped by the linker the way
+/// unused static initialisers in a static library are.
+#define ROBOMACH_REGISTER_EFFECT(file_stem, QualifiedClass)                          \
+  void RobomachRegisterEffect_##file_stem(::robomach::dynamics::EffectRegistry& r) { \
+    r.Register([] { return std::make_shared<const QualifiedClass>(); });             \
+  }

@@ -1,0 +1,93 @@
+#pragma once
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "robomach/common/eigen_types.h"
+#include "robomach/dynamics/effect.h"
+#include "robomach/dynamics/robot_model.h"
+
+namespace robomach::dynamics {
+
+/// Above this condition number of J_BT the Cartesian matrices are not formed.
+/// M_X = J⁻ᵀ M_q J⁻¹ amplifies relative errors by about cond(J)², so at
+/// cond = 1e5 a double-precision result keeps only ~1e-6 relative accuracy
+/// (eps · 1e10), and its entries grow as 1/σ_min²: beyond that they are noise.
+inline constexpr double kNearSingularCondition = 1e5;
+
+/// One vibration mode of the assembled system.
+struct Mode {
+  double freq_hz{0.0};         // undamped natural frequency [Hz]
+  double damping_ratio{0.0};   // [-]
+  /// Effective mass at the tool tip along shape_T [kg]: 1/|p_T|² for the
+  /// mass-normalised mode; infinite if the mode does not move the tip.
+  double modal_mass_kg{0.0};
+  Eigen::Vector3d shape_T{Eigen::Vector3d::Zero()};  // unit tool-tip translation, largest entry > 0
+  Eigen::Vector3d p_T{Eigen::Vector3d::Zero()};      // B φ of the mass-normalised mode [1/√kg]
+  Eigen::VectorXd phi;                               // mass-normalised mode shape (φᵀMφ = 1)
+};
+
+/// Poles and residues of the tool-tip receptance,
+/// H(ω) = Σ_k R_k / (iω − λ_k) over all 2N state-space poles. Exact for any
+/// damping, proportional or not.
+struct ComplexModalModel {
+  Eigen::VectorXcd poles;             // λ_k [rad/s]
+  std::vector<Eigen::Matrix3cd> residues;
+};
+
+struct PostureOptions {
+  bool cartesian{true};  // form M_X, K_X, C_X (n == 6 and not near-singular)
+  bool modes{true};      // undamped modes and damping ratios
+};
+
+/// Everything that depends on the posture q. Plain data, cheap to copy.
+struct PostureDynamics {
+  Eigen::VectorXd q;                   // [rad]
+  Eigen::Isometry3d X_BT{Eigen::Isometry3d::Identity()};
+  Matrix6Xd J_BT;                      // TCP Jacobian, rows [v; ω]
+  AssembledSystem system;              // joints first, then effect DOFs
+  double jacobian_condition{NAN};      // σ_max/σ_min of J_BT (meters and radians mixed, as is)
+  bool near_singular{false};           // jacobian_condition > kNearSingularCondition
+  bool proportional_damping{true};     // C_extra == 0
+  /// Cartesian matrices at T, in B, [v; ω]; NaN when near singular or n != 6.
+  Matrix6d M_X, K_X, C_X;
+  Eigen::Matrix3d static_compliance;   // H_T(0) = B K⁻¹ Bᵀ [m/N]
+  std::vector<Mode> modes;             // ascending frequency
+
+  /// Joint-space blocks of the assembled system (n × n).
+  Eigen::MatrixXd M_q() const { return system.M.topLeftCorner(system.num_joints, system.num_joints); }
+  Eigen::MatrixXd K_q() const { return system.K.topLeftCorner(system.num_joints, system.num_joints); }
+  Eigen::MatrixXd C_q() const { return system.C.topLeftCorner(system.num_joints, system.num_joints); }
+};
+
+/// Evaluates postures of one model with reusable KDL solvers and buffers.
+/// Not thread-safe: use one evaluator per thread (they may share the model).
+class PostureEvaluator {
+ public:
+  explicit PostureEvaluator(std::shared_ptr<const RobotModel> model);
+  ~PostureEvaluator();
+  PostureEvaluator(const PostureEvaluator&) = delete;
+  PostureEvaluator& operator=(const PostureEvaluator&) = delete;
+
+  /// @throws std::invalid_argument if q has the wrong size or is not finite;
+  ///   std::runtime_error if the assembled mass matrix is not positive
+  ///   definite (a bad model, not a bad posture).
+  PostureDynamics Evaluate(const Eigen::VectorXd& q, const PostureOptions& options = {});
+
+  const RobotModel& model() const { return *model_; }
+
+ private:
+  struct Workspace;
+  std::shared_ptr<const RobotModel> model_;
+  std::unique_ptr<Workspace> ws_;
+};
+
+/// Convenience: a one-off evaluation.
+PostureDynamics EvaluatePosture(std::shared_ptr<const RobotModel> model, const Eigen::VectorXd& q,
+                                const PostureOptions& options = {});
+
+}  // namespace robomach::dynamics

@@ -1,0 +1,66 @@
+#pragma once
+
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "robomach/common/errors.h"
+
+namespace robomach::io {
+
+/// A CSV file as formats.md defines it: UTF-8, comma separated, one header
+/// row naming the columns, `#` comment lines, `# key: value` metadata before
+/// the header. Columns are found by name. Every accessor that fails throws
+/// InputError naming the file, the line and the column, e.g.
+/// `tracker.csv:17: column fy_N: expected a number, got "12,5" (decimal comma?)`.
+class CsvTable {
+ public:
+  /// @throws InputError if the file cannot be read, has no header, or a data
+  ///   row has more cells than the header.
+  static CsvTable ReadFile(const std::string& path);
+  /// Parses text; `path` is used in messages only.
+  static CsvTable Parse(std::string_view text, const std::string& path);
+
+  const std::string& path() const { return path_; }
+  /// `# key: value` comments before the header, keys lower-cased.
+  const std::map<std::string, std::string>& metadata() const { return metadata_; }
+  const std::vector<std::string>& header() const { return header_; }
+  int header_line() const { return header_line_; }
+  int num_rows() const { return static_cast<int>(rows_.size()); }
+  /// 1-based line number of data row `row` in the file.
+  int line(int row) const { return lines_[row]; }
+
+  bool HasColumn(std::string_view name) const { return ColumnIndex(name) >= 0; }
+  int ColumnIndex(std::string_view name) const;
+  /// @throws InputError "path:header_line: missing required column 'name'".
+  void RequireColumn(std::string_view name) const;
+  /// Header columns not in `known`, in file order.
+  std::vector<std::string> UnknownColumns(const std::vector<std::string>& known) const;
+
+  /// Raw cell text (trimmed); "" for a missing trailing cell.
+  const std::string& Cell(int row, int column) const;
+  /// Non-empty text of a required column.
+  std::string Text(int row, std::string_view column) const;
+  /// A finite number; empty, nan, inf or text is an error.
+  double Number(int row, std::string_view column) const;
+  /// True if the cell is empty (for optional columns).
+  bool IsEmpty(int row, std::string_view column) const;
+  /// An InputError located at the row and column.
+  InputError ErrorAt(int row, std::string_view column, const std::string& message) const;
+  InputError ErrorAtRow(int row, const std::string& message) const;
+
+ private:
+  std::string path_;
+  std::map<std::string, std::string> metadata_;
+  std::vector<std::string> header_;
+  int header_line_{0};
+  std::vector<std::vector<std::string>> rows_;
+  std::vector<int> lines_;
+};
+
+/// Parses a decimal or exponent-form number. Returns false for anything
+/// else, including nan and inf.
+bool ParseFiniteNumber(std::string_view text, double* value);
+
+}  // namespace robomach::io

@@ -1,0 +1,39 @@
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/dynamics/posture_dynamics.h"
+
+namespace robomach::io {
+
+/// The tool-tip FRFs of one posture on one frequency grid.
+struct PosturePrediction {
+  std::string pose_id;
+  Eigen::VectorXd freq_hz;
+  std::vector<Eigen::Matrix3cd> H;  // [m/N] per line, in B
+};
+
+/// Which response/excitation pairs to write, e.g. {{0,0},{1,1},{0,1}}.
+using DirectionPairs = std::vector<std::pair<int, int>>;
+/// All nine pairs.
+DirectionPairs AllDirectionPairs();
+/// @throws std::invalid_argument for a malformed list such as "xx,yq".
+DirectionPairs ParseDirectionPairs(const std::string& text);
+
+/// Writes predicted FRFs in the long CSV format of formats.md §3,
+/// `# quantity: receptance`, one file for all postures.
+void WritePredictedFrfCsv(const std::string& path, const std::vector<PosturePrediction>& predictions,
+                          const DirectionPairs& pairs);
+void WritePredictedFrfCsv(std::ostream& os, const std::vector<PosturePrediction>& predictions,
+                          const DirectionPairs& pairs);
+
+/// Writes the modal table of formats.md §4:
+/// pose_id,mode,freq_hz,damping_ratio,modal_mass_kg,ux,uy,uz.
+void WriteModalTableCsv(const std::string& path, const std::vector<std::string>& pose_ids,
+                        const std::vector<std::vector<dynamics::Mode>>& modes);
+
+}  // namespace robomach::io

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "robomach/dynamics/parameters.h"
+#include "robomach/dynamics/robot_model.h"
+
+namespace robomach::io {
+
+/// A robot config file read into a description and its parameter values.
+struct RobotConfig {
+  dynamics::RobotDescription description;
+  dynamics::ParameterSet parameters;   // defaults, then the file's `parameters:` overrides
+  std::string path;
+  std::shared_ptr<const dynamics::RobotModel> Build() const {
+    return dynamics::RobotModel::Build(description, parameters);
+  }
+};
+
+/// Reads a robot config (see config/kr210.yaml for the documented schema):
+/// `robot:` with `urdf`, `base_link`, `tip_frame` (and optional
+/// `joint_names`), or `dh:` with a modified-DH table; `joint_stiffness_Nm_per_rad`;
+/// `damping` (`alpha_s`, `beta_per_s`); `end_effector` (bodies in the tip
+/// frame, `tcp_m`, `spindle_nose_m`, and the reference `m6_kg`, `d6_m`,
+/// which must agree with the geometry); optional
+/// `spindle_toolholder_interface`, `hammer_test`, `effects` and
+/// `parameters` (values by parameter name, as calibration writes them).
+/// Unknown keys are rejected. Paths are relative to the config's folder.
+/// @throws InputError with `file:line:col` for any problem.
+RobotConfig LoadRobotConfig(const std::string& path);
+
+/// The `parameters:` block that reproduces `parameters` where they differ
+/// from the description's defaults (all of them if `all`), as YAML text.
+std::string ParametersYaml(const dynamics::ParameterSet& parameters,
+                           const dynamics::ParameterSet& defaults, bool all = false);
+
+}  // namespace robomach::io

@@ -1,0 +1,66 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "robomach/common/errors.h"
+
+namespace robomach::io {
+
+/// A YAML node that knows its file and position, so every error names
+/// `file:line:col` (yaml-cpp marks are 0-based; we add 1, style.md §3).
+/// Maps remember which keys were read; RejectUnknownKeys() reports the rest.
+class YamlDoc {
+ public:
+  /// @throws InputError if the file is missing or not valid YAML.
+  static YamlDoc LoadFile(const std::string& path);
+  static YamlDoc LoadString(const std::string& text, const std::string& path);
+
+  const std::string& path() const { return *path_; }
+  SourceLocation location() const;
+  /// Dotted key path from the document root, for messages ("robot.urdf").
+  const std::string& key_path() const { return key_path_; }
+  InputError Error(const std::string& message) const;
+
+  bool IsMap() const { return node_.IsMap(); }
+  bool IsSequence() const { return node_.IsSequence(); }
+  bool IsNull() const { return !node_ || node_.IsNull(); }
+  bool Has(const std::string& key) const;
+  /// @throws InputError "file:line:col: missing key 'x' in 'parent'".
+  YamlDoc operator[](const std::string& key) const;
+  /// Keys of a map in file order.
+  std::vector<std::string> Keys() const;
+  int size() const;               // sequence length
+  YamlDoc at(int index) const;    // sequence element
+
+  double Number() const;
+  double PositiveNumber() const;
+  double NumberInRange(double lo, double hi, bool include_lo = true, bool include_hi = true) const;
+  int Int() const;
+  int IntInRange(int lo, int hi) const;
+  bool Bool() const;
+  std::string String() const;
+  /// A sequence of numbers; `expected_size` < 0 accepts any length.
+  std::vector<double> Numbers(int expected_size = -1) const;
+  std::vector<std::string> Strings() const;
+
+  /// Marks `key` as known without reading it.
+  void MarkUsed(const std::string& key) const;
+  /// @throws InputError at the first key of this map never read or marked.
+  void RejectUnknownKeys() const;
+
+ private:
+  YamlDoc(YAML::Node node, std::shared_ptr<const std::string> path, std::string key_path);
+  YAML::Node node_;
+  std::shared_ptr<const std::string> path_;
+  std::string key_path_;
+  std::shared_ptr<std::vector<std::string>> used_keys_;
+};
+
+/// Resolves a path given inside a config file relative to that file's folder.
+std::string ResolveRelative(const std::string& config_path, const std::string& relative);
+
+}  // namespace robomach::io

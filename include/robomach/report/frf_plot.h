@@ -1,0 +1,28 @@
+#pragma once
+
+#include <complex>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/report/plot.h"
+
+namespace robomach::report {
+
+/// One FRF curve for a magnitude/phase plot.
+struct FrfCurve {
+  Eigen::VectorXd freq_hz;
+  Eigen::VectorXcd receptance;  // [m/N]
+  std::string label;            // e.g. "Hxx"
+  Rgb color;
+  bool dashed{false};
+};
+
+/// Fills a magnitude panel (log |H| in m/N) and a phase panel (degrees, -180..180)
+/// with `curves` and marks `mode_freq_hz` as labelled vertical lines.
+/// The frequency axis is logarithmic when it spans more than two decades.
+void FillFrfPanels(const std::vector<FrfCurve>& curves, const std::vector<double>& mode_freq_hz,
+                   const std::string& title, Axes* magnitude, Axes* phase);
+
+}  // namespace robomach::report

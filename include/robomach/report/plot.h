@@ -1,0 +1,74 @@
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace robomach::report {
+
+/// An RGB colour, 0..255 per channel.
+struct Rgb {
+  unsigned char r{0}, g{0}, b{0};
+};
+
+/// Colours that stay distinct for colour-blind readers (Okabe and Ito 2008).
+Rgb PaletteColor(int i);
+
+/// One curve of a plot.
+struct Series {
+  std::vector<double> x;
+  std::vector<double> y;
+  std::string label;       // shown in the legend if not empty
+  Rgb color;
+  int thickness{2};        // [px]
+  bool dashed{false};
+  bool markers{false};     // small circles at the points instead of a line
+};
+
+/// A labelled vertical line (a mode frequency, a limit).
+struct VerticalMarker {
+  double x{0.0};
+  std::string label;
+  Rgb color{120, 120, 120};
+};
+
+/// One panel: axes with labelled ticks, grid, curves, legend. Units belong
+/// in the axis labels ("frequency [Hz]").
+struct Axes {
+  std::string title;
+  std::string x_label;
+  std::string y_label;
+  bool log_x{false};
+  bool log_y{false};
+  /// Fixed ranges; NaN means "from the data".
+  double x_min{NAN}, x_max{NAN}, y_min{NAN}, y_max{NAN};
+  std::vector<Series> series;
+  std::vector<VerticalMarker> markers;
+  /// Fixed y ticks (e.g. every 90° for phase); empty = automatic.
+  std::vector<double> y_ticks;
+};
+
+/// A figure of rows × cols panels rendered to PNG.
+class Figure {
+ public:
+  Figure(int rows, int cols, int panel_width_px = 900, int panel_height_px = 380);
+  Axes& at(int row, int col) { return axes_[row * cols_ + col]; }
+  std::string title;
+  /// Renders and writes atomically (formats.md §4).
+  /// @throws OutputError if the file cannot be written.
+  void SavePng(const std::string& path) const;
+  /// Encoded PNG bytes.
+  std::vector<unsigned char> EncodePng() const;
+
+ private:
+  int rows_, cols_, panel_w_, panel_h_;
+  std::vector<Axes> axes_;
+};
+
+/// "Nice" tick positions for a linear axis (steps of 1, 2 or 5 × 10^k).
+std::vector<double> LinearTicks(double lo, double hi, int target_count = 6);
+/// Decades (and 2, 5 within them when few decades) for a log axis.
+std::vector<double> LogTicks(double lo, double hi);
+
+}  // namespace robomach::report

@@ -1,0 +1,42 @@
+# Finds robomach's dependencies and makes imported targets for the ones that
+# ship none (style.md §4). Used both in-tree and by robomachConfig.cmake.
+include(CMakeFindDependencyMacro)
+find_dependency(Eigen3 3.3 NO_MODULE)
+find_dependency(orocos_kdl)
+if(NOT TARGET robomach_dep::kdl)
+  add_library(robomach_dep::kdl INTERFACE IMPORTED)
+  find_library(ROBOMACH_KDL_LIBRARY NAMES orocos-kdl REQUIRED)
+  set_target_properties(robomach_dep::kdl PROPERTIES
+    INTERFACE_LINK_LIBRARIES "${ROBOMACH_KDL_LIBRARY};Eigen3::Eigen"
+    INTERFACE_INCLUDE_DIRECTORIES "${orocos_kdl_INCLUDE_DIRS}")
+endif()
+find_dependency(urdfdom)
+find_dependency(console_bridge)
+if(NOT TARGET robomach_dep::urdfdom)
+  add_library(robomach_dep::urdfdom INTERFACE IMPORTED)
+  set_target_properties(robomach_dep::urdfdom PROPERTIES
+    INTERFACE_LINK_LIBRARIES "${urdfdom_LIBRARIES};${console_bridge_LIBRARIES}"
+    INTERFACE_INCLUDE_DIRECTORIES "${urdfdom_INCLUDE_DIRS}")
+endif()
+find_dependency(yaml-cpp)
+find_dependency(Ceres)
+find_dependency(NLopt)
+if(NOT TARGET robomach_dep::nlopt)
+  add_library(robomach_dep::nlopt INTERFACE IMPORTED)
+  set_target_properties(robomach_dep::nlopt PROPERTIES
+    INTERFACE_LINK_LIBRARIES "${NLOPT_LIBRARIES}"
+    INTERFACE_INCLUDE_DIRECTORIES "${NLOPT_INCLUDE_DIRS}")
+endif()
+# The minimal Debian OpenCV packages ship no CMake config.
+if(NOT TARGET robomach_dep::opencv)
+  find_path(ROBOMACH_OPENCV_INCLUDE_DIR opencv2/core.hpp PATH_SUFFIXES opencv4 REQUIRED)
+  find_library(ROBOMACH_OPENCV_CORE opencv_core REQUIRED)
+  find_library(ROBOMACH_OPENCV_IMGPROC opencv_imgproc REQUIRED)
+  find_library(ROBOMACH_OPENCV_IMGCODECS opencv_imgcodecs REQUIRED)
+  add_library(robomach_dep::opencv INTERFACE IMPORTED)
+  set_target_properties(robomach_dep::opencv PROPERTIES
+    INTERFACE_LINK_LIBRARIES "${ROBOMACH_OPENCV_IMGCODECS};${ROBOMACH_OPENCV_IMGPROC};${ROBOMACH_OPENCV_CORE}"
+    INTERFACE_INCLUDE_DIRECTORIES "${ROBOMACH_OPENCV_INCLUDE_DIR}")
+endif()
+find_dependency(nlohmann_json)
+find_package(Threads REQUIRED)

@@ -1,0 +1,66 @@
+#include "robomach/dynamics/parameters.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace robomach::dynamics {
+namespace {
+std::string Num(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+}  // namespace
+
+void ParameterSet::Add(ParameterSpec spec) {
+  if (Has(spec.name)) throw std::invalid_argument("parameter '" + spec.name + "' defined twice");
+  if (!(spec.lower <= spec.default_value && spec.default_value <= spec.upper)) {
+    throw std::invalid_argument("parameter '" + spec.name + "': default " +
+                                Num(spec.default_value) + " " + spec.unit + " is outside [" +
+                                Num(spec.lower) + ", " + Num(spec.upper) + "]");
+  }
+  specs_.push_back(std::move(spec));
+  values_.conservativeResize(specs_.size());
+  values_(values_.size() - 1) = specs_.back().default_value;
+}
+
+int ParameterSet::IndexOf(std::string_view name) const {
+  for (size_t i = 0; i < specs_.size(); ++i) {
+    if (specs_[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::string ParameterSet::NameList() const {
+  std::string s;
+  for (const auto& p : specs_) s += (s.empty() ? "" : ", ") + p.name;
+  return s;
+}
+
+const ParameterSpec& ParameterSet::spec(std::string_view name) const {
+  const int i = IndexOf(name);
+  if (i < 0) {
+    throw std::invalid_argument("unknown parameter '" + std::string(name) + "'; known: " +
+                                NameList());
+  }
+  return specs_[i];
+}
+
+double ParameterSet::Get(std::string_view name) const {
+  spec(name);
+  return values_(IndexOf(name));
+}
+
+void ParameterSet::Set(std::string_view name, double value) {
+  const ParameterSpec& s = spec(name);
+  if (!std::isfinite(value) || value < s.lower || value > s.upper) {
+    throw std::invalid_argument("parameter '" + s.name + "': " + Num(value) + " " + s.unit +
+                                " is outside its bounds [" + Num(s.lower) + ", " + Num(s.upper) +
+                                "]");
+  }
+  values_(IndexOf(name)) = value;
+}
+
+}  // namespace robomach::dynamics

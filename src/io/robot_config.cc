@@ -1,0 +1,254 @@
+#include "robomach/io/robot_config.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "robomach/common/units.h"
+#include "robomach/dynamics/effect.h"
+#include "robomach/io/urdf_loader.h"
+#include "robomach/io/yaml_doc.h"
+#include "robomach/kinematics/modified_dh.h"
+
+namespace robomach::io {
+namespace {
+
+using kinematics::Inertial;
+
+Eigen::Vector3d Vec3(const YamlDoc& node) {
+  const auto v = node.Numbers(3);
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+// [Ixx Iyy Izz Ixy Ixz Iyz] about the COM, as the reference YAML writes it.
+Eigen::Matrix3d Inertia6(const YamlDoc& node) {
+  const auto v = node.Numbers(6);
+  Eigen::Matrix3d I;
+  I << v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2];
+  return I;
+}
+
+Inertial ReadInertial(const YamlDoc& node) {
+  Inertial b;
+  b.mass = node["mass_kg"].Number();
+  b.com = Vec3(node["com_m"]);
+  const YamlDoc inertia = node["inertia_kgm2"];
+  b.inertia_com = Inertia6(inertia);
+  if (auto problem = kinematics::CheckInertial(b)) throw inertia.Error(*problem);
+  return b;
+}
+
+Eigen::Isometry3d ReadPose(const YamlDoc& node, const std::string& xyz_key,
+                           const std::string& rpy_key) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  if (node.Has(xyz_key)) X.translation() = Vec3(node[xyz_key]);
+  else node.MarkUsed(xyz_key);
+  if (node.Has(rpy_key)) {
+    const Eigen::Vector3d rpy = Vec3(node[rpy_key]);
+    // URDF convention: fixed-axis roll, pitch, yaw: R = Rz(y) Ry(p) Rx(r).
+    X.linear() = (Eigen::AngleAxisd(DegToRad(rpy(2)), Eigen::Vector3d::UnitZ()) *
+                  Eigen::AngleAxisd(DegToRad(rpy(1)), Eigen::Vector3d::UnitY()) *
+                  Eigen::AngleAxisd(DegToRad(rpy(0)), Eigen::Vector3d::UnitX()))
+                     .toRotationMatrix();
+  } else {
+    node.MarkUsed(rpy_key);
+  }
+  return X;
+}
+
+kinematics::SerialChain ReadDh(const YamlDoc& dh) {
+  std::vector<kinematics::ModifiedDhRow> rows;
+  const YamlDoc links = dh["links"];
+  for (int i = 0; i < links.size(); ++i) {
+    const YamlDoc l = links.at(i);
+    kinematics::ModifiedDhRow r;
+    r.joint_name = l.Has("joint") ? l["joint"].String() : "joint_" + std::to_string(i + 1);
+    l.MarkUsed("joint");
+    r.alpha_prev = DegToRad(l["alpha_prev_deg"].Number());
+    r.a_prev = l["a_prev_m"].Number();
+    r.d = l["d_m"].Number();
+    r.theta_offset = l.Has("theta_offset_deg") ? DegToRad(l["theta_offset_deg"].Number()) : 0.0;
+    l.MarkUsed("theta_offset_deg");
+    if (l.Has("lower_deg") || l.Has("upper_deg")) {
+      r.limits.lower = DegToRad(l["lower_deg"].Number());
+      const YamlDoc up = l["upper_deg"];
+      r.limits.upper = DegToRad(up.Number());
+      if (!(r.limits.lower < r.limits.upper)) throw up.Error("expected upper_deg > lower_deg");
+      r.limits.bounded = true;
+    }
+    l.MarkUsed("lower_deg");
+    l.MarkUsed("upper_deg");
+    r.inertial = ReadInertial(l);
+    l.RejectUnknownKeys();
+    rows.push_back(r);
+  }
+  if (rows.empty()) throw links.Error("expected at least one link");
+  const Eigen::Isometry3d X_B0 = ReadPose(dh, "base_xyz_m", "base_rpy_deg");
+  const Eigen::Isometry3d X_nT = ReadPose(dh, "tip_xyz_m", "tip_rpy_deg");
+  dh.RejectUnknownKeys();
+  return kinematics::BuildModifiedDhChain(rows, X_B0, X_nT, "base", "tip");
+}
+
+void ReadNumericSection(const YamlDoc& section, const std::string& prefix,
+                        std::map<std::string, double>* out) {
+  for (const std::string& key : section.Keys()) {
+    const YamlDoc v = section[key];
+    if (v.IsSequence()) continue;  // lists such as hammer_test.directions are informational
+    (*out)[prefix + "." + key] = v.Number();
+  }
+}
+
+std::string FormatNumber(double v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+RobotConfig LoadRobotConfig(const std::string& path) {
+  const YamlDoc doc = YamlDoc::LoadFile(path);
+  if (!doc.IsMap()) throw doc.Error("expected a robot config (a YAML map)");
+  RobotConfig cfg;
+  cfg.path = path;
+  dynamics::RobotDescription& d = cfg.description;
+  d.source = path;
+
+  const YamlDoc robot = doc["robot"];
+  if (robot.Has("dh")) {
+    d.arm = ReadDh(robot["dh"]);
+  } else {
+    const YamlDoc urdf = robot["urdf"];
+    const std::string urdf_path = ResolveRelative(path, urdf.String());
+    const std::string base = robot["base_link"].String();
+    const std::string tip = robot["tip_frame"].String();
+    d.arm = LoadUrdfChain(urdf_path, base, tip);
+  }
+  if (robot.Has("joint_names")) {
+    const YamlDoc jn = robot["joint_names"];
+    if (jn.Strings() != d.arm.joint_names()) {
+      std::string have;
+      for (const auto& n : d.arm.joint_names()) have += (have.empty() ? "" : ", ") + n;
+      throw jn.Error("the chain's joints are [" + have + "]");
+    }
+  }
+  robot.MarkUsed("joint_names");
+  robot.RejectUnknownKeys();
+  const int n = d.arm.num_joints();
+
+  const YamlDoc kq = doc["joint_stiffness_Nm_per_rad"];
+  const auto kv = kq.Numbers(n);
+  d.joint_stiffness = Eigen::Map<const Eigen::VectorXd>(kv.data(), n);
+  for (int j = 0; j < n; ++j) {
+    if (!(kv[j] > 0.0)) throw kq.at(j).Error("expected a joint stiffness > 0");
+  }
+
+  const YamlDoc damping = doc["damping"];
+  d.alpha = damping["alpha_s"].NumberInRange(0.0, 0.1);
+  d.beta = damping["beta_per_s"].NumberInRange(0.0, 1e3);
+  damping.RejectUnknownKeys();
+
+  const YamlDoc ee = doc["end_effector"];
+  if (ee.Has("bodies")) {
+    const YamlDoc bodies = ee["bodies"];
+    for (int i = 0; i < bodies.size(); ++i) {
+      const YamlDoc b = bodies.at(i);
+      dynamics::EndEffectorBody body;
+      body.name = b["name"].String();
+      body.inertial = ReadInertial(b);
+      b.RejectUnknownKeys();
+      d.end_effector.bodies.push_back(body);
+    }
+  }
+  ee.MarkUsed("bodies");
+  d.end_effector.p_tcp = Vec3(ee["tcp_m"]);
+  if (ee.Has("spindle_nose_m")) d.end_effector.p_spindle_nose = Vec3(ee["spindle_nose_m"]);
+  else d.end_effector.p_spindle_nose = d.end_effector.p_tcp;
+  ee.MarkUsed("spindle_nose_m");
+  // m6_kg and d6_m document the reference values; they must match the
+  // geometry (a calibrated value goes under `parameters:` instead).
+  const double m6 = dynamics::ReferenceM6(d);
+  const double d6 = dynamics::ReferenceD6(d);
+  if (ee.Has("m6_kg")) {
+    const YamlDoc node = ee["m6_kg"];
+    if (std::abs(node.Number() - m6) > 1e-6 * std::max(1.0, m6)) {
+      throw node.Error("the last link and the end-effector bodies weigh " + FormatNumber(m6) +
+                       " kg; m6_kg must state that reference (put a calibrated m6 under "
+                       "'parameters: m6_kg')");
+    }
+  }
+  if (ee.Has("d6_m")) {
+    const YamlDoc node = ee["d6_m"];
+    if (std::abs(node.Number() - d6) > 1e-6) {
+      throw node.Error("the geometry puts the tool tip " + FormatNumber(d6) +
+                       " m from the wrist centre along the last joint axis; d6_m must state "
+                       "that reference (put a calibrated d6 under 'parameters: d6_m')");
+    }
+  }
+  ee.MarkUsed("m6_kg");
+  ee.MarkUsed("d6_m");
+  ee.RejectUnknownKeys();
+
+  for (const char* section : {"spindle_toolholder_interface", "hammer_test"}) {
+    if (doc.Has(section)) ReadNumericSection(doc[section], section, &d.extra_values);
+    doc.MarkUsed(section);
+  }
+
+  if (doc.Has("effects")) {
+    const YamlDoc effects = doc["effects"];
+    for (int i = 0; i < effects.size(); ++i) {
+      const YamlDoc e = effects.at(i);
+      dynamics::EffectConfig ec;
+      const YamlDoc name = e["name"];
+      ec.name = name.String();
+      std::shared_ptr<const dynamics::Effect> effect;
+      try {
+        effect = dynamics::EffectRegistry::Instance().Create(ec.name);
+      } catch (const std::invalid_argument& ex) {
+        throw name.Error(ex.what());
+      }
+      for (const auto& spec : effect->parameters()) {
+        if (e.Has(spec.name)) ec.values[spec.name] = e[spec.name].Number();
+        e.MarkUsed(spec.name);
+      }
+      e.RejectUnknownKeys();
+      d.effects.push_back(ec);
+    }
+  }
+  doc.MarkUsed("effects");
+
+  try {
+    cfg.parameters = dynamics::DefaultParameters(d);
+  } catch (const std::invalid_argument& ex) {
+    throw InputError({path, 0, 0}, ex.what());
+  }
+  if (doc.Has("parameters")) {
+    const YamlDoc params = doc["parameters"];
+    for (const std::string& key : params.Keys()) {
+      const YamlDoc v = params[key];
+      try {
+        cfg.parameters.Set(key, v.Number());
+      } catch (const std::invalid_argument& ex) {
+        throw v.Error(ex.what());
+      }
+    }
+  }
+  doc.MarkUsed("parameters");
+  doc.RejectUnknownKeys();
+  return cfg;
+}
+
+std::string ParametersYaml(const dynamics::ParameterSet& p, const dynamics::ParameterSet& defaults,
+                           bool all) {
+  std::ostringstream s;
+  s << "parameters:\n";
+  for (const auto& spec : p.specs()) {
+    const double v = p.Get(spec.name);
+    if (!all && defaults.Has(spec.name) && defaults.Get(spec.name) == v) continue;
+    s << "  " << spec.name << ": " << FormatNumber(v) << "   # [" << spec.unit << "] "
+      << spec.description << "\n";
+  }
+  return s.str();
+}
+
+}  // namespace robomach::io

@@ -1,0 +1,155 @@
+#include "robomach/io/urdf_loader.h"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include "robomach/common/errors.h"
+
+namespace robomach::io {
+namespace {
+
+// urdfdom reports its reasons only through console_bridge (style.md §3):
+// capture them while parsing so the InputError can say what was wrong.
+class CaptureConsoleBridge final : public console_bridge::OutputHandler {
+ public:
+  CaptureConsoleBridge() { console_bridge::useOutputHandler(this); }
+  ~CaptureConsoleBridge() override { console_bridge::restorePreviousOutputHandler(); }
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) messages.push_back(text);
+  }
+  std::vector<std::string> messages;
+};
+
+// 1-based line of the first `<tag ... name="name"`, 0 if not found.
+int FindElementLine(const std::string& xml, const std::string& tag, const std::string& name) {
+  const std::string needle = "name=\"" + name + "\"";
+  size_t pos = 0;
+  while ((pos = xml.find("<" + tag, pos)) != std::string::npos) {
+    const size_t end = xml.find('>', pos);
+    if (end != std::string::npos && xml.substr(pos, end - pos).find(needle) != std::string::npos) {
+      return 1 + static_cast<int>(std::count(xml.begin(), xml.begin() + pos, '\n'));
+    }
+    ++pos;
+  }
+  return 0;
+}
+
+KDL::Vector ToKdl(const urdf::Vector3& v) { return KDL::Vector(v.x, v.y, v.z); }
+KDL::Rotation ToKdl(const urdf::Rotation& r) { return KDL::Rotation::Quaternion(r.x, r.y, r.z, r.w); }
+KDL::Frame ToKdl(const urdf::Pose& p) { return KDL::Frame(ToKdl(p.rotation), ToKdl(p.position)); }
+
+}  // namespace
+
+kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string& base_link,
+                                      const std::string& tip_link) {
+  std::ifstream in(path);
+  if (!in) throw InputError({path, 0, 0}, "cannot open URDF file for reading");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string xml = ss.str();
+
+  urdf::ModelInterfaceSharedPtr model;
+  {
+    CaptureConsoleBridge capture;
+    model = urdf::parseURDF(xml);
+    if (!model) {
+      std::string reason;
+      for (const auto& m : capture.messages) reason += (reason.empty() ? "" : "; ") + m;
+      if (reason.empty()) reason = "urdfdom gave no reason";
+      throw InputError({path, 0, 0}, "not a valid URDF model: " + reason);
+    }
+  }
+  auto link_error = [&](const std::string& role, const std::string& name) {
+    std::string names;
+    for (const auto& [n, l] : model->links_) names += (names.empty() ? "" : ", ") + n;
+    return InputError({path, 0, 0}, role + " link '" + name + "' is not in the URDF; its links: " +
+                                        names);
+  };
+  if (!model->getLink(base_link)) throw link_error("base", base_link);
+  if (!model->getLink(tip_link)) throw link_error("tip", tip_link);
+
+  // Walk from the tip up to the base.
+  std::vector<urdf::LinkConstSharedPtr> links;
+  for (urdf::LinkConstSharedPtr l = model->getLink(tip_link); l; l = l->getParent()) {
+    links.push_back(l);
+    if (l->name == base_link) break;
+  }
+  if (links.back()->name != base_link) {
+    throw InputError({path, 0, 0},
+                     "tip link '" + tip_link + "' is not below base link '" + base_link + "'");
+  }
+  std::reverse(links.begin(), links.end());
+
+  KDL::Chain chain;
+  std::vector<std::string> names;
+  std::vector<kinematics::JointLimits> limits;
+  for (size_t i = 1; i < links.size(); ++i) {
+    const urdf::LinkConstSharedPtr& link = links[i];
+    const urdf::JointConstSharedPtr& j = link->parent_joint;
+    const int line = FindElementLine(xml, "joint", j->name);
+    const KDL::Frame F = ToKdl(j->parent_to_joint_origin_transform);
+    KDL::Joint joint(j->name, KDL::Joint::None);
+    switch (j->type) {
+      case urdf::Joint::FIXED:
+        break;
+      case urdf::Joint::REVOLUTE:
+      case urdf::Joint::CONTINUOUS: {
+        const KDL::Vector axis = ToKdl(j->axis);
+        if (axis.Norm() < 1e-9) throw InputError({path, line, 0}, "joint '" + j->name + "' has a zero axis");
+        joint = KDL::Joint(j->name, F.p, F.M * (axis / axis.Norm()), KDL::Joint::RotAxis);
+        kinematics::JointLimits lim;
+        if (j->type == urdf::Joint::REVOLUTE && j->limits) {
+          lim.lower = j->limits->lower;
+          lim.upper = j->limits->upper;
+          lim.bounded = true;
+          if (!(lim.lower < lim.upper)) {
+            throw InputError({path, line, 0}, "joint '" + j->name + "': lower limit " +
+                                                  std::to_string(lim.lower) +
+                                                  " rad is not below upper limit " +
+                                                  std::to_string(lim.upper) +
+                                                  " rad (a <limit> without lower/upper reads as 0/0)");
+          }
+        }
+        names.push_back(j->name);
+        limits.push_back(lim);
+        break;
+      }
+      default:
+        throw InputError({path, line, 0}, "joint '" + j->name +
+                                              "': only revolute, continuous and fixed joints are "
+                                              "supported");
+    }
+    kinematics::Inertial b;
+    if (link->inertial) {
+      const urdf::Inertial& u = *link->inertial;
+      const KDL::Frame Fi = ToKdl(u.origin);
+      kinematics::Inertial local;
+      local.mass = u.mass;
+      local.inertia_com << u.ixx, u.ixy, u.ixz, u.ixy, u.iyy, u.iyz, u.ixz, u.iyz, u.izz;
+      Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) X.linear()(r, c) = Fi.M(r, c);
+        X.translation()(r) = Fi.p(r);
+      }
+      if (auto problem = kinematics::CheckInertial(local)) {
+        throw InputError({path, FindElementLine(xml, "link", link->name), 0},
+                         "link '" + link->name + "': inertial is not physical: " + *problem);
+      }
+      b = kinematics::TransformInertial(local, X);
+    }
+    chain.addSegment(KDL::Segment(link->name, joint, F, kinematics::ToKdl(b)));
+  }
+  if (names.empty()) {
+    throw InputError({path, 0, 0}, "no movable joint between '" + base_link + "' and '" +
+                                       tip_link + "'");
+  }
+  return kinematics::SerialChain(std::move(chain), std::move(names), std::move(limits), base_link,
+                                 tip_link);
+}
+
+}  // namespace robomach::io

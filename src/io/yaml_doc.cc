@@ -1,0 +1,182 @@
+#include "robomach/io/yaml_doc.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "robomach/io/csv_table.h"
+
+namespace robomach::io {
+
+YamlDoc::YamlDoc(YAML::Node node, std::shared_ptr<const std::string> path, std::string key_path)
+    : node_(std::move(node)),
+      path_(std::move(path)),
+      key_path_(std::move(key_path)),
+      used_keys_(std::make_shared<std::vector<std::string>>()) {}
+
+YamlDoc YamlDoc::LoadFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError({path, 0, 0}, "cannot open file for reading");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return LoadString(text, path);
+}
+
+YamlDoc YamlDoc::LoadString(const std::string& text, const std::string& path) {
+  try {
+    YAML::Node root = YAML::Load(text);
+    return YamlDoc(root, std::make_shared<const std::string>(path), "");
+  } catch (const YAML::Exception& e) {
+    throw InputError({path, e.mark.line + 1, e.mark.column + 1},
+                     "not valid YAML: " + e.msg);
+  }
+}
+
+SourceLocation YamlDoc::location() const {
+  if (!node_ || node_.Mark().is_null()) return {*path_, 0, 0};
+  const YAML::Mark m = node_.Mark();
+  return {*path_, m.line + 1, m.column + 1};
+}
+
+InputError YamlDoc::Error(const std::string& message) const {
+  const std::string prefix = key_path_.empty() ? "" : key_path_ + ": ";
+  return InputError(location(), prefix + message);
+}
+
+bool YamlDoc::Has(const std::string& key) const {
+  return node_.IsMap() && node_[key] && !node_[key].IsNull();
+}
+
+YamlDoc YamlDoc::operator[](const std::string& key) const {
+  if (!node_.IsMap()) throw Error("expected a map with key '" + key + "'");
+  used_keys_->push_back(key);
+  YAML::Node child = node_[key];
+  if (!child) {
+    throw InputError(location(), "missing key '" + key + "'" +
+                                     (key_path_.empty() ? "" : " in '" + key_path_ + "'"));
+  }
+  return YamlDoc(child, path_, key_path_.empty() ? key : key_path_ + "." + key);
+}
+
+std::vector<std::string> YamlDoc::Keys() const {
+  std::vector<std::string> keys;
+  if (!node_.IsMap()) throw Error("expected a map");
+  for (const auto& kv : node_) keys.push_back(kv.first.as<std::string>());
+  return keys;
+}
+
+int YamlDoc::size() const {
+  if (!node_.IsSequence()) throw Error("expected a list");
+  return static_cast<int>(node_.size());
+}
+
+YamlDoc YamlDoc::at(int index) const {
+  if (!node_.IsSequence()) throw Error("expected a list");
+  return YamlDoc(node_[index], path_, key_path_ + "[" + std::to_string(index) + "]");
+}
+
+double YamlDoc::Number() const {
+  if (!node_.IsScalar()) throw Error("expected a number");
+  double v = 0.0;
+  if (!ParseFiniteNumber(node_.Scalar(), &v)) {
+    throw Error("expected a finite number, got \"" + node_.Scalar() + "\"");
+  }
+  return v;
+}
+
+double YamlDoc::PositiveNumber() const {
+  const double v = Number();
+  if (!(v > 0.0)) throw Error("expected a number > 0, got " + node_.Scalar());
+  return v;
+}
+
+double YamlDoc::NumberInRange(double lo, double hi, bool include_lo, bool include_hi) const {
+  const double v = Number();
+  const bool ok_lo = include_lo ? v >= lo : v > lo;
+  const bool ok_hi = include_hi ? v <= hi : v < hi;
+  if (!ok_lo || !ok_hi) {
+    throw Error("expected a number in " + std::string(include_lo ? "[" : "(") +
+                std::to_string(lo) + ", " + std::to_string(hi) + (include_hi ? "]" : ")") +
+                ", got " + node_.Scalar());
+  }
+  return v;
+}
+
+int YamlDoc::Int() const {
+  const double v = Number();
+  if (v != std::floor(v) || std::abs(v) > 1e9) {
+    throw Error("expected a whole number, got " + node_.Scalar());
+  }
+  return static_cast<int>(v);
+}
+
+int YamlDoc::IntInRange(int lo, int hi) const {
+  const int v = Int();
+  if (v < lo || v > hi) {
+    throw Error("expected a whole number in [" + std::to_string(lo) + ", " +
+                std::to_string(hi) + "], got " + node_.Scalar());
+  }
+  return v;
+}
+
+bool YamlDoc::Bool() const {
+  if (node_.IsScalar()) {
+    const std::string& s = node_.Scalar();
+    if (s == "true" || s == "yes" || s == "on") return true;
+    if (s == "false" || s == "no" || s == "off") return false;
+  }
+  throw Error("expected true or false");
+}
+
+std::string YamlDoc::String() const {
+  if (!node_.IsScalar()) throw Error("expected a text value");
+  return node_.Scalar();
+}
+
+std::vector<double> YamlDoc::Numbers(int expected_size) const {
+  if (!node_.IsSequence()) throw Error("expected a list of numbers");
+  if (expected_size >= 0 && static_cast<int>(node_.size()) != expected_size) {
+    throw Error("expected a list of " + std::to_string(expected_size) + " numbers, got " +
+                std::to_string(node_.size()));
+  }
+  std::vector<double> out;
+  for (int i = 0; i < static_cast<int>(node_.size()); ++i) out.push_back(at(i).Number());
+  return out;
+}
+
+std::vector<std::string> YamlDoc::Strings() const {
+  if (!node_.IsSequence()) throw Error("expected a list of names");
+  std::vector<std::string> out;
+  for (int i = 0; i < static_cast<int>(node_.size()); ++i) out.push_back(at(i).String());
+  return out;
+}
+
+void YamlDoc::MarkUsed(const std::string& key) const { used_keys_->push_back(key); }
+
+void YamlDoc::RejectUnknownKeys() const {
+  if (!node_.IsMap()) return;
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (std::find(used_keys_->begin(), used_keys_->end(), key) != used_keys_->end()) continue;
+    std::string known;
+    std::vector<std::string> sorted = *used_keys_;
+    std::sort(sorted.begin(), sorted.end());
+    sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+    for (const auto& k : sorted) known += (known.empty() ? "" : ", ") + k;
+    const YAML::Mark m = kv.first.Mark();
+    throw InputError({*path_, m.line + 1, m.column + 1},
+                     "unknown key '" + key + "'" +
+                         (key_path_.empty() ? "" : " in '" + key_path_ + "'") +
+                         "; known keys: " + known);
+  }
+}
+
+std::string ResolveRelative(const std::string& config_path, const std::string& relative) {
+  namespace fs = std::filesystem;
+  const fs::path rel(relative);
+  if (rel.is_absolute()) return relative;
+  const fs::path base = fs::path(config_path).parent_path();
+  return (base / rel).lexically_normal().string();
+}
+
+}  // namespace robomach::io

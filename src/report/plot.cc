@@ -1,0 +1,296 @@
+#include "robomach/report/plot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "robomach/common/errors.h"
+#include "robomach/io/atomic_file.h"
+
+namespace robomach::report {
+namespace {
+
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+constexpr double kFontScale = 0.5;
+const cv::Scalar kBlack(0, 0, 0);
+const cv::Scalar kGrid(225, 225, 225);
+
+cv::Scalar ToCv(Rgb c) { return cv::Scalar(c.b, c.g, c.r); }
+
+std::string TickLabel(double v, bool log) {
+  char buf[32];
+  if (v == 0.0) return "0";
+  const double a = std::abs(v);
+  if (log || a >= 1e5 || a < 1e-3) {
+    std::snprintf(buf, sizeof(buf), "%.0e", v);
+    // "1e-07" -> "1e-7"
+    std::string s(buf);
+    const size_t e = s.find('e');
+    if (e != std::string::npos) {
+      std::string mant = s.substr(0, e), ex = s.substr(e + 1);
+      bool neg = ex[0] == '-';
+      ex = ex.substr(1);
+      while (ex.size() > 1 && ex[0] == '0') ex = ex.substr(1);
+      if (log && mant == "1") return "1e" + std::string(neg ? "-" : "") + ex;
+      return mant + "e" + (neg ? "-" : "") + ex;
+    }
+    return s;
+  }
+  std::snprintf(buf, sizeof(buf), "%.6g", v);
+  return buf;
+}
+
+void PutText(cv::Mat& img, const std::string& s, cv::Point p, double scale = kFontScale,
+             cv::Scalar color = kBlack, int thickness = 1) {
+  cv::putText(img, s, p, kFont, scale, color, thickness, cv::LINE_AA);
+}
+
+cv::Size TextSize(const std::string& s, double scale = kFontScale, int thickness = 1) {
+  int base = 0;
+  return cv::getTextSize(s, kFont, scale, thickness, &base);
+}
+
+// Text rotated by 90° (reading upwards), centred at `centre`.
+void PutVerticalText(cv::Mat& img, const std::string& s, cv::Point centre) {
+  const cv::Size sz = TextSize(s);
+  cv::Mat t(sz.height + 8, sz.width + 4, CV_8UC3, cv::Scalar(255, 255, 255));
+  PutText(t, s, cv::Point(2, sz.height + 2));
+  cv::Mat r;
+  cv::rotate(t, r, cv::ROTATE_90_COUNTERCLOCKWISE);
+  const int x0 = std::clamp(centre.x - r.cols / 2, 0, img.cols - r.cols);
+  const int y0 = std::clamp(centre.y - r.rows / 2, 0, img.rows - r.rows);
+  r.copyTo(img(cv::Rect(x0, y0, r.cols, r.rows)));
+}
+
+void DashedLine(cv::Mat& img, cv::Point a, cv::Point b, cv::Scalar c, int thickness) {
+  const double len = std::hypot(b.x - a.x, b.y - a.y);
+  const int n = std::max(1, static_cast<int>(len / 8.0));
+  for (int i = 0; i < n; i += 2) {
+    const double t0 = static_cast<double>(i) / n, t1 = std::min(1.0, static_cast<double>(i + 1) / n);
+    cv::line(img, a + (b - a) * t0, a + (b - a) * t1, c, thickness, cv::LINE_AA);
+  }
+}
+
+struct Range {
+  double lo, hi;
+};
+
+Range DataRange(const Axes& ax, bool x_axis) {
+  const bool log = x_axis ? ax.log_x : ax.log_y;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Series& s : ax.series) {
+    for (double v : x_axis ? s.x : s.y) {
+      if (!std::isfinite(v) || (log && v <= 0.0)) continue;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  }
+  if (x_axis) {
+    for (const auto& m : ax.markers) {
+      if (std::isfinite(m.x) && (!log || m.x > 0)) {
+        lo = std::min(lo, m.x);
+        hi = std::max(hi, m.x);
+      }
+    }
+  }
+  if (!std::isfinite(lo)) return {log ? 0.1 : 0.0, log ? 10.0 : 1.0};
+  if (lo == hi) {
+    if (log) return {lo / 2, hi * 2};
+    const double d = lo == 0.0 ? 1.0 : std::abs(lo) * 0.1;
+    return {lo - d, hi + d};
+  }
+  if (!log && !x_axis) {
+    const double pad = 0.05 * (hi - lo);
+    return {lo - pad, hi + pad};
+  }
+  if (log && !x_axis) return {lo / 1.3, hi * 1.3};
+  return {lo, hi};
+}
+
+void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area) {
+  const int left = 80, right = 20, top = 28, bottom = 48;
+  const cv::Rect plot(area.x + left, area.y + top, area.width - left - right,
+                      area.height - top - bottom);
+  Range xr = DataRange(ax, true), yr = DataRange(ax, false);
+  if (std::isfinite(ax.x_min)) xr.lo = ax.x_min;
+  if (std::isfinite(ax.x_max)) xr.hi = ax.x_max;
+  if (std::isfinite(ax.y_min)) yr.lo = ax.y_min;
+  if (std::isfinite(ax.y_max)) yr.hi = ax.y_max;
+  auto tx = [&](double v) {
+    const double t = ax.log_x ? (std::log10(v) - std::log10(xr.lo)) / (std::log10(xr.hi) - std::log10(xr.lo))
+                              : (v - xr.lo) / (xr.hi - xr.lo);
+    return plot.x + t * plot.width;
+  };
+  auto ty = [&](double v) {
+    const double t = ax.log_y ? (std::log10(v) - std::log10(yr.lo)) / (std::log10(yr.hi) - std::log10(yr.lo))
+                              : (v - yr.lo) / (yr.hi - yr.lo);
+    return plot.y + plot.height - t * plot.height;
+  };
+  // Grid and ticks.
+  const auto xt = ax.log_x ? LogTicks(xr.lo, xr.hi) : LinearTicks(xr.lo, xr.hi);
+  const auto yt = !ax.y_ticks.empty() ? ax.y_ticks : ax.log_y ? LogTicks(yr.lo, yr.hi)
+                                                               : LinearTicks(yr.lo, yr.hi, 5);
+  for (double v : xt) {
+    const int x = static_cast<int>(std::lround(tx(v)));
+    if (x < plot.x - 1 || x > plot.x + plot.width + 1) continue;
+    cv::line(img, {x, plot.y}, {x, plot.y + plot.height}, kGrid, 1);
+    const std::string s = TickLabel(v, ax.log_x);
+    const cv::Size sz = TextSize(s);
+    PutText(img, s, {x - sz.width / 2, plot.y + plot.height + 18});
+  }
+  for (double v : yt) {
+    if (v < std::min(yr.lo, yr.hi) - 1e-12 * std::abs(yr.hi) || v > std::max(yr.lo, yr.hi) + 1e-12 * std::abs(yr.hi)) continue;
+    const int y = static_cast<int>(std::lround(ty(v)));
+    cv::line(img, {plot.x, y}, {plot.x + plot.width, y}, kGrid, 1);
+    const std::string s = TickLabel(v, ax.log_y);
+    const cv::Size sz = TextSize(s);
+    PutText(img, s, {plot.x - sz.width - 6, y + sz.height / 2});
+  }
+  // Curves, clipped to the plot area.
+  cv::Mat roi = img(plot);
+  for (const Series& s : ax.series) {
+    std::vector<cv::Point> pts;
+    auto flush = [&] {
+      if (pts.size() >= 2 && !s.markers) {
+        if (s.dashed) {
+          for (size_t i = 1; i < pts.size(); ++i) DashedLine(roi, pts[i - 1], pts[i], ToCv(s.color), s.thickness);
+        } else {
+          cv::polylines(roi, pts, false, ToCv(s.color), s.thickness, cv::LINE_AA);
+        }
+      }
+      pts.clear();
+    };
+    const size_t n = std::min(s.x.size(), s.y.size());
+    for (size_t i = 0; i < n; ++i) {
+      const bool ok = std::isfinite(s.x[i]) && std::isfinite(s.y[i]) &&
+                      (!ax.log_x || s.x[i] > 0) && (!ax.log_y || s.y[i] > 0);
+      if (!ok) {
+        flush();
+        continue;
+      }
+      const double px = std::clamp(tx(s.x[i]) - plot.x, -1e4, 1e4);
+      const double py = std::clamp(ty(s.y[i]) - plot.y, -1e4, 1e4);
+      const cv::Point p(static_cast<int>(std::lround(px)), static_cast<int>(std::lround(py)));
+      if (s.markers) cv::circle(roi, p, 3, ToCv(s.color), cv::FILLED, cv::LINE_AA);
+      pts.push_back(p);
+    }
+    flush();
+  }
+  // Vertical markers with labels.
+  int label_row = 0;
+  for (const auto& m : ax.markers) {
+    if (!std::isfinite(m.x) || m.x < std::min(xr.lo, xr.hi) || m.x > std::max(xr.lo, xr.hi)) continue;
+    const int x = static_cast<int>(std::lround(tx(m.x)));
+    DashedLine(img, {x, plot.y}, {x, plot.y + plot.height}, ToCv(m.color), 1);
+    if (!m.label.empty()) {
+      PutText(img, m.label, {x + 3, plot.y + 14 + 14 * (label_row++ % 3)}, 0.4, ToCv(m.color));
+    }
+  }
+  cv::rectangle(img, plot, kBlack, 1);
+  // Labels and title.
+  const cv::Size xs = TextSize(ax.x_label);
+  PutText(img, ax.x_label, {plot.x + plot.width / 2 - xs.width / 2, area.y + area.height - 8});
+  PutVerticalText(img, ax.y_label, {area.x + 14, plot.y + plot.height / 2});
+  if (!ax.title.empty()) {
+    PutText(img, ax.title, {plot.x, area.y + 19}, 0.55, kBlack, 1);
+  }
+  // Legend, top right inside the plot.
+  int ly = plot.y + 8;
+  int width = 0;
+  for (const Series& s : ax.series) width = std::max(width, TextSize(s.label).width);
+  const int lx = plot.x + plot.width - width - 50;
+  bool any = false;
+  for (const Series& s : ax.series) any = any || !s.label.empty();
+  if (any) {
+    int count = 0;
+    for (const Series& s : ax.series) count += !s.label.empty();
+    cv::rectangle(img, cv::Rect(lx - 6, ly - 2, width + 54, 18 * count + 6), cv::Scalar(255, 255, 255), cv::FILLED);
+    cv::rectangle(img, cv::Rect(lx - 6, ly - 2, width + 54, 18 * count + 6), cv::Scalar(180, 180, 180), 1);
+    for (const Series& s : ax.series) {
+      if (s.label.empty()) continue;
+      if (s.dashed) DashedLine(img, {lx, ly + 9}, {lx + 36, ly + 9}, ToCv(s.color), s.thickness);
+      else if (s.markers) cv::circle(img, {lx + 18, ly + 9}, 3, ToCv(s.color), cv::FILLED);
+      else cv::line(img, {lx, ly + 9}, {lx + 36, ly + 9}, ToCv(s.color), s.thickness, cv::LINE_AA);
+      PutText(img, s.label, {lx + 42, ly + 14}, 0.45);
+      ly += 18;
+    }
+  }
+}
+
+}  // namespace
+
+Rgb PaletteColor(int i) {
+  static const Rgb kColors[] = {{0, 114, 178},  {213, 94, 0},  {0, 158, 115}, {204, 121, 167},
+                                {230, 159, 0},  {86, 180, 233}, {0, 0, 0},     {240, 228, 66}};
+  return kColors[((i % 8) + 8) % 8];
+}
+
+std::vector<double> LinearTicks(double lo, double hi, int target_count) {
+  if (hi < lo) std::swap(lo, hi);
+  const double span = hi - lo;
+  if (!(span > 0) || !std::isfinite(span)) return {lo};
+  const double raw = span / std::max(1, target_count);
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = mag;
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (m * mag >= raw) {
+      step = m * mag;
+      break;
+    }
+  }
+  std::vector<double> t;
+  for (double v = std::ceil(lo / step) * step; v <= hi + 1e-9 * step; v += step) {
+    t.push_back(std::abs(v) < 1e-12 * step ? 0.0 : v);
+  }
+  return t;
+}
+
+std::vector<double> LogTicks(double lo, double hi) {
+  if (hi < lo) std::swap(lo, hi);
+  std::vector<double> t;
+  const int d0 = static_cast<int>(std::floor(std::log10(lo)));
+  const int d1 = static_cast<int>(std::ceil(std::log10(hi)));
+  const bool fine = d1 - d0 <= 3;
+  for (int d = d0; d <= d1; ++d) {
+    for (double m : fine ? std::vector<double>{1, 2, 5} : std::vector<double>{1}) {
+      const double v = m * std::pow(10.0, d);
+      if (v >= lo * (1 - 1e-9) && v <= hi * (1 + 1e-9)) t.push_back(v);
+    }
+  }
+  return t;
+}
+
+Figure::Figure(int rows, int cols, int panel_width_px, int panel_height_px)
+    : rows_(rows), cols_(cols), panel_w_(panel_width_px), panel_h_(panel_height_px), axes_(rows * cols) {
+  if (rows < 1 || cols < 1) throw std::invalid_argument("Figure: needs at least one panel");
+}
+
+std::vector<unsigned char> Figure::EncodePng() const {
+  const int title_h = title.empty() ? 0 : 34;
+  cv::Mat img(rows_ * panel_h_ + title_h, cols_ * panel_w_, CV_8UC3, cv::Scalar(255, 255, 255));
+  if (!title.empty()) {
+    const cv::Size sz = TextSize(title, 0.7, 2);
+    PutText(img, title, {img.cols / 2 - sz.width / 2, 24}, 0.7, kBlack, 2);
+  }
+  for (int r = 0; r < rows_; ++r) {
+    for (int c = 0; c < cols_; ++c) {
+      RenderAxes(img, axes_[r * cols_ + c], cv::Rect(c * panel_w_, title_h + r * panel_h_, panel_w_, panel_h_));
+    }
+  }
+  std::vector<unsigned char> png;
+  if (!cv::imencode(".png", img, png)) throw OutputError("PNG encoding failed");
+  return png;
+}
+
+void Figure::SavePng(const std::string& path) const {
+  const std::vector<unsigned char> png = EncodePng();
+  io::WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+}
+
+}  // namespace robomach::report
