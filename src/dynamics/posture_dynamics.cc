@@ -92,7 +92,7 @@ PostureDynamics PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const Postu
   const auto& sv = svd.singularValues();
   out.jacobian_condition = sv(0) / sv(sv.size() - 1);
   if (!std::isfinite(out.jacobian_condition)) out.jacobian_condition = INFINITY;
-  out.near_singular = !(out.jacobian_condition <= kNearSingularCondition) || n != 6;
+  out.near_singular = !(out.jacobian_condition <= kNearSingularCondition);
 
   out.M_X.setConstant(NAN);
   out.K_X.setConstant(NAN);
