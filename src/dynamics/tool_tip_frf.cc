@@ -52,18 +52,21 @@ std::vector<Eigen::Matrix3cd> ReceptanceModal(const PostureDynamics& d,
   std::vector<Eigen::Matrix3cd> H(freq_hz.size());
   for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
     const double w = HzToRadPerSec(freq_hz(i));
-    Eigen::Matrix<cd, 6, 1> acc = Eigen::Matrix<cd, 6, 1>::Zero();
+    const double w_sq = w * w;
+    // 1/(a + ib) = (a − ib)/(a² + b²), accumulated in real arithmetic.
+    Eigen::Matrix<double, 6, 1> re = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Matrix<double, 6, 1> im = Eigen::Matrix<double, 6, 1>::Zero();
     for (int k = 0; k < nm; ++k) {
-      const cd g = 1.0 / cd(w2(k) - w * w, c(k) * w);
-      acc += g * P.col(k).cast<cd>();
+      const double a = w2(k) - w_sq, b = c(k) * w;
+      const double inv = 1.0 / (a * a + b * b);
+      re.noalias() += (a * inv) * P.col(k);
+      im.noalias() -= (b * inv) * P.col(k);
     }
     Eigen::Matrix3cd& h = H[i];
-    h(0, 0) = acc(0);
-    h(1, 1) = acc(1);
-    h(2, 2) = acc(2);
-    h(0, 1) = h(1, 0) = acc(3);
-    h(0, 2) = h(2, 0) = acc(4);
-    h(1, 2) = h(2, 1) = acc(5);
+    const int idx[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+    for (int r = 0; r < 3; ++r) {
+      for (int col = 0; col < 3; ++col) h(r, col) = cd(re(idx[r][col]), im(idx[r][col]));
+    }
   }
   return H;
 }

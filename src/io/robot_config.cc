@@ -5,6 +5,7 @@
 
 #include "robomach/common/units.h"
 #include "robomach/dynamics/effect.h"
+#include "robomach/io/number_format.h"
 #include "robomach/io/urdf_loader.h"
 #include "robomach/io/yaml_doc.h"
 #include "robomach/kinematics/modified_dh.h"
@@ -97,12 +98,7 @@ void ReadNumericSection(const YamlDoc& section, const std::string& prefix,
   }
 }
 
-std::string FormatNumber(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
+std::string FormatNumber(double v) { return FormatDouble(v); }
 
 }  // namespace
 

@@ -22,6 +22,9 @@ void FillFrfPanels(const std::vector<FrfCurve>& curves, const std::vector<double
   mag->y_label = "|H| [m/N]";
   mag->log_y = true;
   mag->log_x = log_x;
+  // Low frequencies are flat (static compliance) and leave the lower left
+  // corner free; the mode labels use the top of the panel.
+  mag->legend = Axes::LegendPosition::kBottomLeft;
   phase->x_label = "frequency [Hz]";
   phase->y_label = "phase [deg]";
   phase->log_x = log_x;

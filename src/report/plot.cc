@@ -27,7 +27,7 @@ std::string TickLabel(double v, bool log) {
   char buf[32];
   if (v == 0.0) return "0";
   const double a = std::abs(v);
-  if (log || a >= 1e5 || a < 1e-3) {
+  if (a >= 1e5 || a < 1e-3) {
     std::snprintf(buf, sizeof(buf), "%.0e", v);
     // "1e-07" -> "1e-7"
     std::string s(buf);
@@ -189,7 +189,9 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area) {
     const int x = static_cast<int>(std::lround(tx(m.x)));
     DashedLine(img, {x, plot.y}, {x, plot.y + plot.height}, ToCv(m.color), 1);
     if (!m.label.empty()) {
-      PutText(img, m.label, {x + 3, plot.y + 14 + 14 * (label_row++ % 3)}, 0.4, ToCv(m.color));
+      const int w = TextSize(m.label, 0.4).width;
+      const int lx = x + 3 + w > plot.x + plot.width ? x - 3 - w : x + 3;  // keep it inside
+      PutText(img, m.label, {lx, plot.y + 14 + 14 * (label_row++ % 3)}, 0.4, ToCv(m.color));
     }
   }
   cv::rectangle(img, plot, kBlack, 1);
@@ -201,15 +203,16 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area) {
     PutText(img, ax.title, {plot.x, area.y + 19}, 0.55, kBlack, 1);
   }
   // Legend, top right inside the plot.
-  int ly = plot.y + 8;
   int width = 0;
   for (const Series& s : ax.series) width = std::max(width, TextSize(s.label).width);
-  const int lx = plot.x + plot.width - width - 50;
-  bool any = false;
-  for (const Series& s : ax.series) any = any || !s.label.empty();
-  if (any) {
-    int count = 0;
-    for (const Series& s : ax.series) count += !s.label.empty();
+  int count = 0;
+  for (const Series& s : ax.series) count += !s.label.empty();
+  using LP = Axes::LegendPosition;
+  const bool at_right = ax.legend == LP::kTopRight || ax.legend == LP::kBottomRight;
+  const bool at_top = ax.legend == LP::kTopRight || ax.legend == LP::kTopLeft;
+  const int lx = at_right ? plot.x + plot.width - width - 50 : plot.x + 14;
+  int ly = at_top ? plot.y + 8 : plot.y + plot.height - 18 * count - 10;
+  if (count > 0) {
     cv::rectangle(img, cv::Rect(lx - 6, ly - 2, width + 54, 18 * count + 6), cv::Scalar(255, 255, 255), cv::FILLED);
     cv::rectangle(img, cv::Rect(lx - 6, ly - 2, width + 54, 18 * count + 6), cv::Scalar(180, 180, 180), 1);
     for (const Series& s : ax.series) {

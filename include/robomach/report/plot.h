@@ -47,6 +47,8 @@ struct Axes {
   std::vector<VerticalMarker> markers;
   /// Fixed y ticks (e.g. every 90° for phase); empty = automatic.
   std::vector<double> y_ticks;
+  enum class LegendPosition { kTopRight, kTopLeft, kBottomLeft, kBottomRight };
+  LegendPosition legend{LegendPosition::kTopRight};
 };
 
 /// A figure of rows × cols panels rendered to PNG.

@@ -1,0 +1,52 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "robomach/common/units.h"
+#include "robomach/io/posture_file.h"
+#include "test_support.h"
+
+namespace robomach::io {
+namespace {
+
+using robomach::testing::CaptureError;
+using robomach::testing::TempDir;
+using robomach::testing::WriteText;
+using ::testing::HasSubstr;
+
+TEST(PostureFile, ReadsDegreesAndRadiansPerJointAndRoundTrips) {
+  const std::string dir = TempDir("posture_ok");
+  const std::string path = WriteText(dir + "/p.csv",
+                                     "# comment\npose_id,q2_rad,q1_deg,q3_deg,note\nA,-1.5,30,90,x\n");
+  const auto p = ReadPostureFile(path, 3);
+  ASSERT_EQ(p.size(), 1u);
+  EXPECT_EQ(p[0].id, "A");
+  EXPECT_DOUBLE_EQ(p[0].q(0), DegToRad(30));
+  EXPECT_DOUBLE_EQ(p[0].q(1), -1.5);
+  EXPECT_EQ(p[0].line, 3);
+  WritePostureFile(dir + "/out.csv", p);
+  const auto back = ReadPostureFile(dir + "/out.csv", 3);
+  EXPECT_LE((back[0].q - p[0].q).norm(), 1e-15);
+}
+
+TEST(PostureFile, BadInputGetsLocatedMessages) {
+  const std::string dir = TempDir("posture_bad");
+  auto err = [&](const std::string& text, int n) {
+    const std::string path = WriteText(dir + "/p.csv", text);
+    return CaptureError([&] { ReadPostureFile(path, n); });
+  };
+  EXPECT_THAT(err("pose_id,q1_deg,q2_deg\nA,1,2\n", 3),
+              HasSubstr("p.csv:1: missing column q3_deg (or q3_rad): the robot has 3 joints"));
+  EXPECT_THAT(err("pose_id,q1_deg,q2_deg,q3_deg\nA,1,2,3\n", 2),
+              HasSubstr("p.csv:1: the file has joint columns up to q3 but the robot has 2 joints"));
+  EXPECT_THAT(err("pose_id,q1_deg,q1_rad\nA,1,2\n", 1),
+              HasSubstr("joint 1 is given twice, as q1_deg and q1_rad; keep one"));
+  EXPECT_THAT(err("pose_id,q1_deg\nP2,1\nP2,3\n", 1),
+              HasSubstr("p.csv:3: pose_id \"P2\" appears twice (first on line 2)"));
+  EXPECT_THAT(err("pose_id,q1_deg\nP1,abc\n", 1),
+              HasSubstr("p.csv:2: column q1_deg: expected a number, got \"abc\""));
+  EXPECT_THAT(err("pose_id,q1_deg\n,1\n", 1), HasSubstr("p.csv:2: column pose_id: expected a value"));
+  EXPECT_THAT(err("pose_id,q1_deg\n", 1), HasSubstr("no postures"));
+}
+
+}  // namespace
+}  // namespace robomach::io

@@ -1,0 +1,90 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "robomach/io/robot_config.h"
+#include "test_support.h"
+
+namespace robomach::io {
+namespace {
+
+using robomach::testing::CaptureError;
+using robomach::testing::SourcePath;
+using robomach::testing::TempDir;
+using robomach::testing::WriteText;
+using ::testing::HasSubstr;
+
+// The shipped config with `from` replaced by `to`, written next to a copy of
+// the URDF so the relative path still resolves.
+std::string Variant(const std::string& name, const std::string& from, const std::string& to) {
+  std::ifstream in(SourcePath("config/kr210.yaml"));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  const size_t pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  text.replace(pos, from.size(), to);
+  const std::string dir = TempDir("config_" + name);
+  std::ifstream urdf(SourcePath("config/kr210_r2700_2.urdf"));
+  std::stringstream u;
+  u << urdf.rdbuf();
+  WriteText(dir + "/kr210_r2700_2.urdf", u.str());
+  return WriteText(dir + "/robot.yaml", text);
+}
+
+TEST(RobotConfig, UnknownKeysAreRejectedWithLineColumnAndTheKnownKeys) {
+  const std::string p = Variant("unknown", "  alpha_s: 1.0e-4", "  alpha_s: 1.0e-4\n  gamma: 3");
+  EXPECT_THAT(CaptureError([&] { LoadRobotConfig(p); }),
+              HasSubstr("robot.yaml:31:3: unknown key 'gamma' in 'damping'; known keys: alpha_s, beta_per_s"));
+}
+
+TEST(RobotConfig, BadValuesAreLocated) {
+  EXPECT_THAT(CaptureError([&] {
+                LoadRobotConfig(Variant("kq", "[3.3479e+6, 3.1318e+6,", "[3.3479e+6, abc,"));
+              }),
+              HasSubstr("robot.yaml:26:41: joint_stiffness_Nm_per_rad[1]: expected a finite number, got \"abc\""));
+  EXPECT_THAT(CaptureError([&] {
+                LoadRobotConfig(Variant("kq5", "3.3479e+6, 3.1318e+6, 4.2895e+6, 2.4787e+5, 6.4292e+5, 1.8847e+5]",
+                                        "3.3479e+6, 3.1318e+6, 4.2895e+6, 2.4787e+5, 6.4292e+5]"));
+              }),
+              HasSubstr("joint_stiffness_Nm_per_rad: expected a list of 6 numbers, got 5"));
+  EXPECT_THAT(CaptureError([&] {
+                LoadRobotConfig(Variant("inertia", "[0.256, 0.256, 0.062,", "[0.256, 0.01, 0.062,"));
+              }),
+              HasSubstr("violate the triangle inequality"));
+  EXPECT_THAT(CaptureError([&] { LoadRobotConfig(Variant("m6", "m6_kg: 29.05", "m6_kg: 31")); }),
+              HasSubstr("weigh 29.05 kg; m6_kg must state that reference"));
+  EXPECT_THAT(CaptureError([&] { LoadRobotConfig(Variant("tip", "tip_frame: tool0", "tip_frame: tool9")); }),
+              HasSubstr("tip link 'tool9' is not in the URDF"));
+  EXPECT_THAT(CaptureError([&] {
+                LoadRobotConfig(Variant("param", "\nhammer_test:", "\nparameters:\n  m6_kg: -4\nhammer_test:"));
+              }),
+              HasSubstr("parameter 'm6_kg': -4 kg is outside its bounds"));
+  EXPECT_THAT(CaptureError([&] {
+                LoadRobotConfig(Variant("effect", "\nhammer_test:", "\neffects:\n  - name: tip_mas\nhammer_test:"));
+              }),
+              HasSubstr("unknown effect 'tip_mas'; available: "));
+}
+
+TEST(RobotConfig, MalformedYamlIsLocated) {
+  const std::string dir = TempDir("config_yaml");
+  const std::string p = WriteText(dir + "/r.yaml", "robot:\n  urdf: [a, b\n");
+  EXPECT_THAT(CaptureError([&] { LoadRobotConfig(p); }), HasSubstr("r.yaml:3:1: not valid YAML"));
+}
+
+TEST(RobotConfig, ParametersAndEffectsRoundTripThroughYaml) {
+  const std::string p = Variant("roundtrip", "\nhammer_test:",
+                                "\neffects:\n  - name: tip_mass\n    mass_kg: 0.02\n"
+                                "parameters:\n  m6_kg: 30.5\nhammer_test:");
+  const RobotConfig cfg = LoadRobotConfig(p);
+  EXPECT_DOUBLE_EQ(cfg.parameters.Get("m6_kg"), 30.5);
+  EXPECT_DOUBLE_EQ(cfg.parameters.Get("tip_mass.mass_kg"), 0.02);
+  const std::string yaml = ParametersYaml(cfg.parameters, dynamics::DefaultParameters(cfg.description));
+  EXPECT_THAT(yaml, HasSubstr("  m6_kg: 30.5   # [kg]"));
+  EXPECT_THAT(yaml, ::testing::Not(HasSubstr("d6_m")));
+}
+
+}  // namespace
+}  // namespace robomach::io
