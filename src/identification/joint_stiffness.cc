@@ -184,7 +184,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
   Eigen::MatrixXd info = Eigen::MatrixXd::Zero(n, n);
   for (int c = 0; c < m; ++c) info.noalias() += B[c].transpose() * B[c];
   res.determination.assign(n, Determination::kDetermined);
-  std::vector<int> barely, confounded, free;
+  std::vector<int> barely, confounded, free, diverged, vague;
   const double u = options.undetermined_relative_std;
   for (int j = 0; j < n; ++j) {
     // Even with every other joint known, σ(x_j) = 1/√I_jj.
@@ -206,7 +206,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
 
   // (i) Exact linear least squares in x for the free joints, the others at
   // the prior (x = 1).
-  const int p = static_cast<int>(free.size());
+  int p = static_cast<int>(free.size());
   Eigen::VectorXd theta = Eigen::VectorXd::Zero(n);  // θ = log(k/k0); 0 = prior
   res.linear_start = Eigen::VectorXd::Constant(n, kNaN);
   if (p > 0) {
@@ -235,7 +235,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
   // (iii) Ceres in θ. Cases in `excluded` are left out (robust second pass).
   std::vector<bool> excluded(m, false);
   ceres::Solver::Summary summary;
-  auto solve = [&](bool robust) -> bool {
+  auto solve = [&](bool robust, bool covariance) -> bool {
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
     po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
@@ -266,10 +266,24 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     so.gradient_tolerance = 1e-14;
     ceres::Solve(so, problem.get(), &summary);
     res.iterations += static_cast<int>(summary.iterations.size());
-    if (robust) return true;
+    if (!covariance) return true;
     // (v) covariance of θ on the final problem.
     ceres::Covariance::Options co;
     co.algorithm_type = ceres::DENSE_SVD;
+    {
+      int rows = 0;
+      for (int c = 0; c < m; ++c) rows += excluded[c] ? 0 : 3;
+      Eigen::MatrixXd J(rows, p);
+      int r0 = 0;
+      for (int c = 0; c < m; ++c) {
+        if (excluded[c]) continue;
+        for (int a = 0; a < p; ++a) J.block<3, 1>(r0, a) = B[c].col(free[a]) * std::exp(-theta(free[a]));
+        r0 += 3;
+      }
+      const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(J).singularValues();
+      // Ceres' own bound (min_reciprocal_condition_number) with margin.
+      if (!(sv.size() > 0 && sv(sv.size() - 1) > 1e-12 * sv(0))) return false;
+    }
     ceres::Covariance cov(co);
     std::vector<std::pair<const double*, const double*>> blocks{{theta.data(), theta.data()}};
     Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
@@ -293,13 +307,34 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
       return r.squaredNorm();
     };
     if (options.loss != RobustLoss::kNone) {
-      solve(true);
+      solve(true, false);
       for (int c = 0; c < m; ++c) excluded[c] = normalized2(c) > threshold;
       // Never drop so many cases that fewer equations than unknowns remain.
       const int kept = static_cast<int>(std::count(excluded.begin(), excluded.end(), false));
       if (3 * kept <= p) std::fill(excluded.begin(), excluded.end(), false);
     }
-    cov_ok = solve(false);
+    // A joint whose stiffness runs away from the prior by more than 1000×
+    // (its compliance heads for 0 because the data ask for a negative one)
+    // is not determined by these cases: hold it at the prior and solve again.
+    // A prior off by 1000× is not a plausible robot config.
+    const double kMaxLogRatio = std::log(1e3);
+    for (;;) {
+      solve(false, false);
+      std::vector<int> runaway;
+      for (int j : free) {
+        if (!(std::abs(theta(j)) <= kMaxLogRatio)) runaway.push_back(j);
+      }
+      if (runaway.empty() || static_cast<int>(runaway.size()) == p) break;
+      for (int j : runaway) {
+        theta(j) = 0.0;
+        free.erase(std::find(free.begin(), free.end(), j));
+        diverged.push_back(j);
+      }
+      p = static_cast<int>(free.size());
+    }
+    // Ceres logs through glog when the covariance is rank-deficient; a
+    // rank check first keeps such noise off the user's terminal.
+    cov_ok = solve(false, true);
     switch (summary.termination_type) {
       case ceres::CONVERGENCE: res.status = FitStatus::kConverged; break;
       case ceres::NO_CONVERGENCE: res.status = FitStatus::kNotConverged; break;
@@ -363,9 +398,14 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
   res.correlation = Eigen::MatrixXd::Constant(n, n, kNaN);
   for (int j : barely) res.determination[j] = Determination::kNotDetermined;
   for (int j : confounded) res.determination[j] = Determination::kNotDetermined;
+  for (int j : diverged) res.determination[j] = Determination::kNotDetermined;
   for (int j : free) {
     const double s = std::sqrt(std::max(cov_theta(j, j), 0.0));
-    if (!std::isfinite(s)) continue;
+    if (!std::isfinite(s)) {
+      res.determination[j] = Determination::kNotDetermined;
+      confounded.push_back(j);
+      continue;
+    }
     res.relative_std(j) = s;
     // Delta method for σ_k; the interval is exact for log-normal θ.
     res.std_dev(j) = k_hat(j) * s;
@@ -373,7 +413,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     res.upper_95(j) = k_hat(j) * std::exp(kZ95 * s);
     if (s > options.undetermined_relative_std) {
       res.determination[j] = Determination::kNotDetermined;
-      confounded.push_back(j);
+      vague.push_back(j);
     } else if (s > options.weak_relative_std) {
       res.determination[j] = Determination::kWeak;
     }
@@ -425,6 +465,13 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     }
     res.advice.push_back(s.str());
   }
+  for (int j : diverged) {
+    res.advice.push_back(
+        "joint " + std::to_string(j + 1) +
+        " is not determined: the fit drives its stiffness to infinity (the cases ask for a negative "
+        "compliance), so its effect is lost in the noise or in inconsistent cases; check the outliers, "
+        "then " + MomentAdvice(j, n));
+  }
   if (!confounded.empty()) {
     res.advice.push_back(
         "joint" + std::string(confounded.size() > 1 ? "s " : " ") + JointList(confounded) +
@@ -433,6 +480,11 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
         (confounded.size() > 1 ? "their" : "its") +
         " compliance with other joints'. Add postures with different joint angles (arm reach, "
         "elbow and wrist angles) and load cases with other rope directions");
+  }
+  for (int j : vague) {
+    res.advice.push_back("joint " + std::to_string(j + 1) + " is not determined (±" +
+                         Fixed(100.0 * res.relative_std(j), 0) + " % at 1 sigma): " +
+                         MomentAdvice(j, n) + ", and check for outliers");
   }
   for (int j : res.weakly_identified) {
     res.advice.push_back("joint " + std::to_string(j + 1) + " is weakly determined (±" +
