@@ -235,6 +235,8 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
   // (iii) Ceres in θ. Cases in `excluded` are left out (robust second pass).
   std::vector<bool> excluded(m, false);
   ceres::Solver::Summary summary;
+  // Covariance of θ from ceres::Covariance (zero rows for held joints).
+  Eigen::MatrixXd cov_theta = Eigen::MatrixXd::Constant(n, n, kNaN);
   auto solve = [&](bool robust, bool covariance) -> bool {
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
@@ -286,18 +288,16 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     }
     ceres::Covariance cov(co);
     std::vector<std::pair<const double*, const double*>> blocks{{theta.data(), theta.data()}};
-    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
     if (!cov.Compute(blocks, problem.get())) return false;
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Cr(n, n);
     cov.GetCovarianceBlock(theta.data(), theta.data(), Cr.data());
-    res.correlation = Cr;  // temporarily the covariance of θ
+    cov_theta = Cr;
     return true;
   };
 
   if (p == 0) {
     res.status = FitStatus::kFailed;
     res.solver_message = "no joint stiffness can be determined from these load cases";
-    res.correlation = Eigen::MatrixXd::Constant(n, n, kNaN);
   } else {
     bool cov_ok = true;
     const double threshold = ChiSquare3UpperQuantile(options.outlier_false_alarm / m);
@@ -343,7 +343,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     res.solver_message = summary.message;
     if (!cov_ok) {
       res.solver_message += "; the covariance could not be computed (rank-deficient Jacobian)";
-      res.correlation = Eigen::MatrixXd::Constant(n, n, kNaN);
+      cov_theta.setConstant(kNaN);
     }
     // Outlier flags at the solution; with a robust loss they are the cases
     // the robust pass excluded.
@@ -394,7 +394,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
   res.relative_std = Eigen::VectorXd::Constant(n, kInf);
   res.lower_95 = Eigen::VectorXd::Zero(n);
   res.upper_95 = Eigen::VectorXd::Constant(n, kInf);
-  Eigen::MatrixXd cov_theta = res.correlation * (inflate * inflate);
+  cov_theta *= inflate * inflate;
   res.correlation = Eigen::MatrixXd::Constant(n, n, kNaN);
   for (int j : barely) res.determination[j] = Determination::kNotDetermined;
   for (int j : confounded) res.determination[j] = Determination::kNotDetermined;
