@@ -91,8 +91,11 @@ TrackerFile ReadTrackerFile(const std::string& path, int num_joints) {
   std::vector<std::string> qcols(num_joints);
   std::vector<bool> is_deg(num_joints);
   for (int j = 0; j < num_joints; ++j) {
-    const std::string deg = "q" + std::to_string(j + 1) + "_deg";
-    const std::string rad = "q" + std::to_string(j + 1) + "_rad";
+    // std::string(1, 'q') + ...: "q" + std::to_string() trips GCC 12's
+    // -Wrestrict false positive (GCC bug 105329).
+    const std::string stem = std::string(1, 'q') + std::to_string(j + 1);
+    const std::string deg = stem + "_deg";
+    const std::string rad = stem + "_rad";
     if (t.HasColumn(deg) && t.HasColumn(rad)) {
       throw HeaderError(t, rad, "joint " + std::to_string(j + 1) + " is also given as " + deg +
                                     "; keep one");

@@ -218,6 +218,26 @@ TEST(IdentifyJointStiffness, DegenerateCampaignFlagsJointsItCannotSee) {
   EXPECT_THAT(all, HasSubstr("moment about the tool axis"));
 }
 
+// Joint 6 loaded through a bracket but watched by a target on the tool axis:
+// the target does not move when joint 6 turns, whatever the load. The
+// advice must point at the target, not at the load.
+TEST(IdentifyJointStiffness, TargetOnToolAxisIsNamedAsTheCause) {
+  const auto model = Kr210();
+  CampaignOptions o;
+  o.p_target_tip = Eigen::Vector3d(0.0, 0.0, 0.2);  // on the tool axis
+  const auto cases = ToLoadCases(SeedCampaign(2, 12, o));
+  const JointStiffnessResult r = IdentifyJointStiffness(*model, cases);
+  EXPECT_EQ(r.determination[5], Determination::kNotDetermined);
+  EXPECT_LT(r.max_target_lever(5), 1e-9);  // exactly on the axis, up to rounding
+  std::string all;
+  for (const auto& a : r.advice) all += a + "\n";
+  EXPECT_THAT(all, HasSubstr("tracker target barely moves when it turns"));
+  EXPECT_THAT(all, HasSubstr("off the tool axis, tx_mm/ty_mm"));
+  // The other joints are still determined, and their values are unaffected
+  // by holding joint 6 (it has no effect on this target).
+  for (int j = 0; j < 5; ++j) EXPECT_NE(r.determination[j], Determination::kNotDetermined) << j + 1;
+}
+
 // A stated noise 5× too small: the residuals show it, and the standard
 // deviations are scaled up by √(χ²/dof) ≈ 5 instead of being overconfident.
 TEST(IdentifyJointStiffness, UnderstatedNoiseInflatesCovariance) {
