@@ -126,7 +126,9 @@ void CheckValid(const IdentificationOptions& o) {
 double ChiSquare3UpperQuantile(double p) {
   if (!(p > 0.0 && p < 1.0)) throw std::invalid_argument("ChiSquare3UpperQuantile: p outside (0, 1)");
   // Survival function of χ²₃: erfc(√(x/2)) + √(2x/π) e^(−x/2)
-  // [Abramowitz & Stegun 1964, 26.4.4 with ν = 3]. It decreases strictly, so
+  // (the odd-ν closed form of [Abramowitz & Stegun 1964, ch. 26] with ν = 3,
+  // M. Abramowitz, I. A. Stegun, Handbook of Mathematical Functions, NBS).
+  // It decreases strictly, so
   // bisection on [0, 2000] (sf(2000) < 1e-400) converges to machine precision.
   auto sf = [](double x) {
     return std::erfc(std::sqrt(0.5 * x)) + std::sqrt(2.0 * x / 3.14159265358979323846) * std::exp(-0.5 * x);
@@ -452,12 +454,14 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     const bool unloaded = res.max_joint_torque(j) < 0.1 * tmax;
     const bool unseen = res.max_target_lever(j) < 0.1 * lmax;
     s << "joint " << j + 1 << " is not determined: ";
-    if (unloaded || !unseen) {
+    if (tmax == 0.0) {
+      s << "no load case loads the robot (every force is zero)";
+    } else if (unloaded || !unseen) {
       s << "it is barely loaded (largest moment about its axis " << Fixed(res.max_joint_torque(j), 1)
         << " N·m, against " << Fixed(tmax, 1) << " N·m on the most loaded joint): "
         << MomentAdvice(j, n);
     }
-    if (unseen) {
+    if (unseen && tmax > 0.0) {
       s << (unloaded || !unseen ? "; and the" : "the") << " tracker target barely moves when it turns "
         << "(largest lever " << Fixed(1e3 * res.max_target_lever(j), 1)
         << " mm): place the target farther from joint " << j + 1 << "'s axis"

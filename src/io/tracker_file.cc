@@ -175,6 +175,9 @@ TrackerFile ReadTrackerFile(const std::string& path, int num_joints) {
       }
     } else {
       m.force = Eigen::Vector3d(t.Number(r, "fx_N"), t.Number(r, "fy_N"), t.Number(r, "fz_N"));
+      if (m.force->norm() == 0.0) {
+        throw t.ErrorAt(r, "fx_N", "the force is zero (fx_N, fy_N, fz_N are all 0): a load case needs a load");
+      }
     }
     m.p_load_tip = OptionalPoint(t, r, kLoadPointCols);
     m.p_target_tip = OptionalPoint(t, r, kTargetCols);

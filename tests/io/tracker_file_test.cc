@@ -171,6 +171,10 @@ TEST(TrackerFile, ErrorsNameFileLineAndColumn) {
                                 6);
               }),
               HasSubstr("partial.csv:1:18: column lx_mm: the load point needs all of lx_mm, ly_mm, lz_mm"));
+  EXPECT_THAT(CaptureError([&] {
+                ReadTrackerFile(File(dir, "zero.csv", kForceHeader + "C1,P1,0,-90,90,0,45,0,0,0,0,0,0,-0.5,0,0,0\n"), 6);
+              }),
+              HasSubstr("zero.csv:2: column fx_N: the force is zero"));
   EXPECT_THAT(CaptureError([&] { ReadTrackerFile(File(dir, "empty.csv", kForceHeader), 6); }),
               HasSubstr("empty.csv: no load cases"));
 }

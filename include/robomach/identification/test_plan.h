@@ -61,11 +61,14 @@ struct TestPlan {
 /// directions (downward, within max_rope_angle of vertical, reaching the
 /// floor from a load point at least min_load_height above it) that maximise
 /// log det of the Fisher information of log-stiffness at the model's
-/// stiffness (D-optimal design, [Atkinson & Donev 1992, ch. 9]): greedy
-/// selection followed by exchange passes over the random candidate set.
+/// stiffness (D-optimal design [Atkinson & Donev 1992]): greedy selection
+/// followed by Fedorov-style exchange passes over the random candidate set.
 /// Each chosen posture gets `directions_per_posture` directions and every
 /// mass. Deterministic for a given seed.
 /// @throws std::invalid_argument for invalid options.
+///
+/// - [Atkinson & Donev 1992] A. C. Atkinson, A. N. Donev, Optimum
+///   Experimental Designs, Oxford University Press, 1992.
 TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& options);
 
 }  // namespace robomach::identification
