@@ -172,6 +172,15 @@ int RunPlan(const io::RobotConfig& cfg, int num_postures, double noise_mm, unsig
   csv << "# masses_kg:";
   for (double m : masses_kg) csv << " " << io::FormatDouble(m);
   csv << "\n";
+  auto point = [&](const char* key, const std::optional<Eigen::Vector3d>& p) {
+    csv << "# " << key << ": ";
+    if (!p) csv << "tcp";
+    else csv << io::FormatDouble(MToMm(p->x())) << "," << io::FormatDouble(MToMm(p->y())) << ","
+             << io::FormatDouble(MToMm(p->z()));
+    csv << "\n";
+  };
+  point("load_point_mm", load_point);
+  point("target_mm", target);
   for (int j = 0; j < model->num_joints(); ++j) {
     csv << "# expected_std_kq" << j + 1 << "_Nm_per_rad: " << io::FormatDouble(plan.expected_std_dev(j)) << "\n";
   }

@@ -49,7 +49,7 @@ int Run(int argc, char** argv) {
       "force (large-displacement equilibrium with the config's joint stiffness), tracker readings\n"
       "with Gaussian noise, optional gross outliers. Seeded: the same options give the same file."};
   app.footer(ExitCodeHelp());
-  std::string robot_path, out_path, postures_path, masses = "10,20,30", load_point = "150,0,100",
+  std::string robot_path, out_path, postures_path, plan_path, masses = "10,20,30", load_point = "150,0,100",
                                                    target = "0,120,50", form = "rope";
   std::vector<std::string> pulleys{"1600,-1200,0", "1600,1200,0"}, sets;
   int num_postures = 12, outliers = 0;
@@ -58,6 +58,9 @@ int Run(int argc, char** argv) {
   app.add_option("--robot", robot_path, "robot config YAML; its joint stiffness is the truth")->required();
   app.add_option("--out", out_path, "tracker CSV to write (stdout if omitted)");
   app.add_option("--postures", postures_path, "posture file CSV (formats.md §1); default: random postures");
+  app.add_option("--plan-file", plan_path,
+                 "a plan from kq-identify --plan: its postures and pulleys (and load point and target "
+                 "unless given here)");
   app.add_option("--num-postures", num_postures, "number of random postures (without --postures)")
       ->capture_default_str();
   app.add_option("--min-reach-mm", min_reach_mm,
@@ -89,6 +92,10 @@ int Run(int argc, char** argv) {
     if (num_postures < 1) throw std::invalid_argument("--num-postures: expected at least 1");
     RequireReadableFile(robot_path, "robot config");
     if (!postures_path.empty()) RequireReadableFile(postures_path, "posture file");
+    if (!plan_path.empty()) RequireReadableFile(plan_path, "plan file");
+    if (!plan_path.empty() && !postures_path.empty()) {
+      throw std::invalid_argument("--plan-file and --postures exclude each other");
+    }
     io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
     for (const std::string& s : sets) {
       const auto [name, value] = ParseAssignment("--set", s);
@@ -118,7 +125,36 @@ int Run(int argc, char** argv) {
 
     std::vector<std::string> ids;
     std::vector<Eigen::VectorXd> qs;
-    if (!postures_path.empty()) {
+    std::vector<std::vector<Eigen::Vector3d>> plan_pulleys;
+    if (!plan_path.empty()) {
+      // The plan CSV of kq-identify --plan: one row per posture and rope
+      // direction, rows of one posture together.
+      const io::CsvTable t = io::CsvTable::ReadFile(plan_path);
+      t.RequireColumn("pose_id");
+      for (int r = 0; r < t.num_rows(); ++r) {
+        const std::string id = t.Text(r, "pose_id");
+        if (ids.empty() || ids.back() != id) {
+          for (const auto& seen : ids) {
+            if (seen == id) throw t.ErrorAt(r, "pose_id", "rows of posture " + id + " must be adjacent");
+          }
+          Eigen::VectorXd q(model->num_joints());
+          for (int j = 0; j < q.size(); ++j) q(j) = DegToRad(t.Number(r, "q" + std::to_string(j + 1) + "_deg"));
+          ids.push_back(id);
+          qs.push_back(q);
+          plan_pulleys.emplace_back();
+        }
+        plan_pulleys.back().emplace_back(MmToM(t.Number(r, "pulley_x_mm")), MmToM(t.Number(r, "pulley_y_mm")),
+                                         MmToM(t.Number(r, "pulley_z_mm")));
+      }
+      if (ids.empty()) throw InputError({plan_path, 0, 0}, "no postures in the plan");
+      const auto& meta = t.metadata();
+      if (app.count("--load-point-mm") == 0 && meta.count("load_point_mm")) {
+        o.p_load_tip = ParsePointMm(plan_path + ": load_point_mm", meta.at("load_point_mm"));
+      }
+      if (app.count("--target-mm") == 0 && meta.count("target_mm")) {
+        o.p_target_tip = ParsePointMm(plan_path + ": target_mm", meta.at("target_mm"));
+      }
+    } else if (!postures_path.empty()) {
       for (const auto& p : io::ReadPostureFile(postures_path, model->num_joints())) {
         ids.push_back(p.id);
         qs.push_back(p.q);
@@ -128,7 +164,10 @@ int Run(int argc, char** argv) {
       for (size_t p = 0; p < qs.size(); ++p) ids.push_back("P" + std::to_string(p + 1));
     }
     std::vector<int> bad;
-    const auto ms = identification::SimulateCampaign(*model, ids, qs, model->joint_stiffness(), o, &bad);
+    const auto ms = plan_pulleys.empty()
+                        ? identification::SimulateCampaign(*model, ids, qs, model->joint_stiffness(), o, &bad)
+                        : identification::SimulateCampaign(*model, ids, qs, plan_pulleys,
+                                                           model->joint_stiffness(), o, &bad);
 
     std::vector<std::pair<std::string, std::string>> meta{
         {"generator", "tracker-synth (robomach)"},
@@ -148,7 +187,7 @@ int Run(int argc, char** argv) {
       io::WriteTrackerFile(out_path, ms, meta);
     }
     std::cerr << kTool << ": " << ms.size() << " load cases (" << ids.size() << " postures x "
-              << o.pulleys.size() << " rope directions x " << o.masses_kg.size() << " masses)"
+              << (plan_pulleys.empty() ? o.pulleys.size() : plan_pulleys[0].size()) << " rope directions x " << o.masses_kg.size() << " masses)"
               << (bad.empty() ? "" : "; outliers: " + bad_ids) << "\n";
     return kExitOk;
   });
