@@ -99,6 +99,13 @@ std::vector<TrackerMeasurement> SimulateCampaign(
                                     " coincides with the load point at posture " + pose_ids[p]);
       }
       const Eigen::Vector3d d = rope.normalized();
+      if (!(d.z() < 0.0)) {
+        std::ostringstream msg;
+        msg << "SimulateCampaign: pulley " << u + 1 << " is not below the load point at posture "
+            << pose_ids[p] << " (load point z = " << k.p_BL.z() << " m, pulley z = " << pulleys[p][u].z()
+            << " m): a rope to a floor pulley pulls downwards";
+        throw std::invalid_argument(msg.str());
+      }
       for (double mkg : o.masses_kg) {
         LoadCase lc = base;
         lc.force = mkg * kStandardGravity * d;
