@@ -13,6 +13,8 @@ namespace robomach::identification {
 namespace {
 
 Eigen::Vector3d Noise(std::mt19937& rng, double sigma) {
+  // std::normal_distribution requires sigma > 0; zero noise is exact readings.
+  if (!(sigma > 0.0)) return Eigen::Vector3d::Zero();
   std::normal_distribution<double> nd(0.0, sigma);
   const double a = nd(rng), b = nd(rng), c = nd(rng);  // fixed evaluation order
   return {a, b, c};
