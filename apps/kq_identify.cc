@@ -379,6 +379,13 @@ int Run(int argc, char** argv) {
       std::vector<std::string> out_ids;
       for (int c : r.outliers) out_ids.push_back(r.residuals[c].case_id);
       j["outliers"] = out_ids;
+      j["residuals"] = nlohmann::json::array();
+      for (const auto& x : r.residuals) {
+        j["residuals"].push_back({{"case_id", x.case_id},
+                                  {"residual_mm", {MToMm(x.residual.x()), MToMm(x.residual.y()), MToMm(x.residual.z())}},
+                                  {"r_over_sigma", x.normalized},
+                                  {"outlier", x.outlier}});
+      }
       io::WriteFileAtomically(json_path, report::DumpJson(j));
     }
     PrintReport(r, std::cerr);
