@@ -65,7 +65,7 @@ struct JointStiffnessResult {
   int num_cases{0};
   int num_joints{0};
   Eigen::VectorXd joint_stiffness;      // [N·m/rad]; a not-determined joint keeps the prior
-  Eigen::VectorXd std_dev;              // 1 sigma [N·m/rad]; +inf if not determined
+  Eigen::VectorXd std_dev;              // 1 sigma [N·m/rad]; +inf for a joint held at the prior
   Eigen::VectorXd lower_95, upper_95;   // 95 % interval [N·m/rad] (log-normal, from log k)
   Eigen::VectorXd relative_std;         // σ(log k) ≈ σ_k / k [-]
   Eigen::MatrixXd correlation;          // of the stiffnesses (NaN rows for undetermined joints)
@@ -95,17 +95,27 @@ struct JointStiffnessResult {
 
 /// Identifies the diagonal joint stiffness K_q from load cases.
 ///
-/// Steps: (i) the exact linear least-squares start in the compliances
-/// c_i = 1/k_i of model (1) of compliance_model.h, weighted by σ_D =
-/// √2·tracker_noise; (ii) joints whose relative standard deviation at the
-/// prior (the model's stiffness) exceeds `undetermined_relative_std` are held
-/// at the prior; (iii) Ceres solves the weighted problem in θ_i = log k_i
-/// (positivity), with the optional robust loss; (iv) outliers are flagged
-/// against the χ²(3) bound, and with a robust loss the fit is repeated
-/// without them; (v) ceres::Covariance gives the covariance of θ.
+/// Steps: (i) joints the data cannot see are found at the prior (the
+/// model's stiffness): a joint whose relative standard deviation would exceed
+/// `undetermined_relative_std` even with all others known ("barely loaded" or
+/// "target barely moves"), or whose marginal one does (only a combination
+/// with other joints is determined), is held at the prior; (ii) the exact
+/// linear least-squares start in the compliances c_i = 1/k_i of model (1) of
+/// compliance_model.h, weighted by σ_D = √2·tracker_noise; (iii) Ceres solves
+/// the weighted problem in θ_i = log(k_i/k0_i) (positivity), first with the
+/// optional robust loss; (iv) outliers are flagged against the χ²(3) bound,
+/// and with a robust loss the plain fit is repeated without them; a joint
+/// driven more than 1000× away from the prior is held and the fit repeated;
+/// (v) ceres::Covariance gives the covariance of θ, scaled by χ²/dof when the
+/// residuals are clearly larger than the stated noise. Joints are then
+/// classified by σ(θ_i) against `weak_relative_std` and
+/// `undetermined_relative_std`, and `advice` says what to add to the tests.
 ///
 /// Numerical trouble is reported in the result's status, never thrown.
 /// @param model  robot model; its joint stiffness is the prior and scale.
+/// @param cases  load cases; absent load points and targets are the TCP.
+/// @param progress  called with (cases evaluated, total) while the per-case
+///   kinematics are evaluated.
 /// @throws std::invalid_argument for invalid options, no cases, or a case
 ///   whose q has the wrong size or a non-finite value.
 JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
