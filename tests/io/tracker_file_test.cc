@@ -194,6 +194,35 @@ TEST(KqYaml, MergedConfigLoadsWithIdentifiedStiffness) {
   }
 }
 
+// The `parameters:` form of kq.yaml appended to a robot config overrides
+// its stiffness: LoadRobotConfig reads the pasted block back (5 significant
+// digits written: 5e-6 relative).
+TEST(KqYaml, PastedParametersBlockOverridesConfigStiffness) {
+  const std::string dir = TempDir("kq_paste");
+  identification::JointStiffnessResult r;
+  r.status = identification::FitStatus::kConverged;
+  r.num_joints = 6;
+  r.joint_stiffness.resize(6);
+  r.joint_stiffness << 3.2e6, 3.05e6, 4.1e6, 2.6e5, 6.1e5, 1.95e5;
+  r.std_dev = r.lower_95 = r.upper_95 = r.relative_std = r.joint_stiffness;
+  r.correlation = Eigen::MatrixXd::Identity(6, 6);
+  r.determination.assign(6, identification::Determination::kDetermined);
+  KqYamlOptions o;
+  o.as_parameters = true;
+  const std::string out = dir + "/robot.yaml";
+  // A copy of the config that stays valid in `dir` (urdf path rewritten),
+  // with the kq.yaml text pasted at the end.
+  const std::string base = MergeJointStiffness(testing::SourcePath("config/kr210.yaml"),
+                                               LoadRobotConfig(testing::SourcePath("config/kr210.yaml"))
+                                                   .description.joint_stiffness,
+                                               out);
+  WriteText(out, base + "\n" + JointStiffnessYaml(r, o));
+  const auto model = LoadRobotConfig(out).Build();
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_NEAR(model->joint_stiffness()(j), r.joint_stiffness(j), 5e-6 * r.joint_stiffness(j));
+  }
+}
+
 TEST(KqYaml, YamlHasPasteableEntriesAndMarksUndeterminedJoints) {
   identification::JointStiffnessResult r;
   r.status = identification::FitStatus::kConverged;
