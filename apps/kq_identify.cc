@@ -351,9 +351,7 @@ int Run(int argc, char** argv) {
     }
     if (!residuals_path.empty()) WriteResidualsCsv(residuals_path, r, cases);
     if (!plot_path.empty()) {
-      PlotResiduals(plot_path, r,
-                    std::sqrt(identification::ChiSquare3UpperQuantile(opt.outlier_false_alarm / r.num_cases)),
-                    "kq-identify: " + tracker_path);
+      PlotResiduals(plot_path, r, r.outlier_threshold, "kq-identify: " + tracker_path);
     }
     if (!json_path.empty()) {
       nlohmann::json j;

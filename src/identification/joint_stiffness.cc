@@ -302,14 +302,28 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     res.solver_message = "no joint stiffness can be determined from these load cases";
   } else {
     bool cov_ok = true;
-    const double threshold = ChiSquare3UpperQuantile(options.outlier_false_alarm / m);
+    const double chi2_bound = ChiSquare3UpperQuantile(options.outlier_false_alarm / m);
     auto normalized2 = [&](int c) {
       Eigen::Vector3d r = y[c];
       for (int j = 0; j < n; ++j) r -= B[c].col(j) * std::exp(-theta(j));
       return r.squaredNorm();
     };
+    // Outliers are judged against the stated noise, or against the noise the
+    // residuals show if that is larger: a robust scale from the median of
+    // the squared normalised residuals (the median of χ²₃ is 2.365974), which
+    // a few gross outliers do not move. Otherwise an understated noise would
+    // make every case an "outlier".
+    auto outlier_threshold = [&]() {
+      std::vector<double> v(m);
+      for (int c = 0; c < m; ++c) v[c] = normalized2(c);
+      std::nth_element(v.begin(), v.begin() + m / 2, v.end());
+      res.robust_noise_ratio = std::sqrt(v[m / 2] / 2.365974);
+      return chi2_bound * std::max(1.0, res.robust_noise_ratio * res.robust_noise_ratio);
+    };
+    double threshold = chi2_bound;
     if (options.loss != RobustLoss::kNone) {
       solve(true, false);
+      threshold = outlier_threshold();
       for (int c = 0; c < m; ++c) excluded[c] = normalized2(c) > threshold;
       // Never drop so many cases that fewer equations than unknowns remain.
       const int kept = static_cast<int>(std::count(excluded.begin(), excluded.end(), false));
@@ -349,6 +363,8 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     }
     // Outlier flags at the solution; with a robust loss they are the cases
     // the robust pass excluded.
+    if (options.loss == RobustLoss::kNone) threshold = outlier_threshold();
+    res.outlier_threshold = std::sqrt(threshold);
     for (int c = 0; c < m; ++c) {
       const bool flag = options.loss != RobustLoss::kNone ? excluded[c] : normalized2(c) > threshold;
       if (flag) res.outliers.push_back(c);

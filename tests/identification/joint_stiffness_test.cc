@@ -179,6 +179,16 @@ TEST(IdentifyJointStiffness, RobustFitNamesOutliersAndRecoversValues) {
   }
   EXPECT_TRUE(named);
 
+  // A tracker noise understated 3× does not turn good cases into outliers:
+  // the threshold follows the noise the residuals show.
+  IdentificationOptions low = ro;
+  low.tracker_noise = ro.tracker_noise / 3.0;
+  const JointStiffnessResult rl = IdentifyJointStiffness(*model, dirty, low);
+  EXPECT_EQ(rl.outliers, bad);
+  // The sample median of 72 χ²₃ values has sd ≈ 1/(2 f(med) √72) = 0.31 with
+  // f(2.366) = 0.188 the χ²₃ density at its median: 13 % of the median,
+  // 6.6 % on its square root, ±0.2 here. 0.6 is 3 sd.
+  EXPECT_NEAR(rl.robust_noise_ratio, 3.0, 0.6);
   // The Huber loss, too.
   ro.loss = RobustLoss::kHuber;
   EXPECT_EQ(IdentifyJointStiffness(*model, dirty, ro).outliers, bad);

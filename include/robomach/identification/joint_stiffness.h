@@ -28,7 +28,8 @@ struct IdentificationOptions {
   double loss_scale{3.0};
   /// Family-wise false-alarm probability for outlier flags: a case is an
   /// outlier if its squared normalised residual exceeds the χ²(3) quantile
-  /// at 1 − outlier_false_alarm / num_cases (Bonferroni).
+  /// at 1 − outlier_false_alarm / num_cases (Bonferroni), scaled up by the
+  /// robust noise estimate when the residuals are larger than the noise.
   double outlier_false_alarm{0.01};
   /// Relative standard deviations (σ_k / k) above which a joint is "weakly
   /// determined" and "not determined".
@@ -82,6 +83,12 @@ struct JointStiffnessResult {
   double reduced_chi2{NAN};             // χ² / (3 m − p) of the inliers
   bool covariance_inflated{false};      // std_dev scaled by √reduced_chi2 (residuals > noise)
   double condition_number{NAN};         // of the column-scaled weighted Jacobian at the solution
+  /// Noise level the residuals show, relative to the stated one: √(median
+  /// of |r|²/σ_D² / median of χ²₃); robust to a few outliers.
+  double robust_noise_ratio{NAN};
+  /// A case is an outlier if |r|/σ_D exceeds this (the χ²₃ bound, scaled
+  /// up by robust_noise_ratio when that is above 1).
+  double outlier_threshold{NAN};
   Eigen::VectorXd linear_start;         // exact linear least-squares stiffness [N·m/rad]
   int iterations{0};
   /// Largest |moment about joint i's axis| over the cases [N·m], and the
