@@ -309,6 +309,11 @@ int Run(int argc, char** argv) {
     if (merge && out_path.empty()) throw std::invalid_argument("--merge needs --out for the merged config");
     RequireReadableFile(tracker_path, "tracker file");
     const auto model = cfg.Build();
+    if (!model->effects().empty()) {
+      Warn(kTool, robot_path + " enables effects with their own compliance; the load-test model "
+                  "D = J_T Kq^-1 J_L^T W has joint compliance only, so the identified stiffness absorbs "
+                  "theirs");
+    }
     const io::TrackerFile tf = io::ReadTrackerFile(tracker_path, model->num_joints());
     if (verbose && !tf.unknown_columns.empty()) {
       std::string cols;
