@@ -1,0 +1,199 @@
+// tracker-synth: simulates a laser-tracker load-test campaign from a robot
+// config and writes it in the tracker format (formats.md §2), to rehearse a
+// campaign or to test kq-identify.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <sstream>
+
+#include "cli_support.h"
+#include "robomach/common/errors.h"
+#include "robomach/common/units.h"
+#include "robomach/identification/campaign_synth.h"
+#include "robomach/io/csv_table.h"
+#include "robomach/io/number_format.h"
+#include "robomach/io/posture_file.h"
+#include "robomach/io/robot_config.h"
+#include "robomach/io/tracker_file.h"
+
+namespace robomach::apps {
+namespace {
+
+constexpr char kTool[] = "tracker-synth";
+
+std::vector<double> ParseNumbers(const std::string& option, const std::string& text) {
+  std::stringstream ss(text);
+  std::string item;
+  std::vector<double> v;
+  while (std::getline(ss, item, ',')) {
+    double x = 0.0;
+    if (!io::ParseFiniteNumber(item, &x)) {
+      throw std::invalid_argument(option + ": expected numbers separated by commas, got \"" + text + "\"");
+    }
+    v.push_back(x);
+  }
+  return v;
+}
+
+std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std::string& text) {
+  if (text == "tcp") return std::nullopt;
+  const auto v = ParseNumbers(option, text);
+  if (v.size() != 3) throw std::invalid_argument(option + ": expected x,y,z in mm or 'tcp', got \"" + text + "\"");
+  return Eigen::Vector3d(MmToM(v[0]), MmToM(v[1]), MmToM(v[2]));
+}
+
+int Run(int argc, char** argv) {
+  CLI::App app{
+      "tracker-synth: simulate a laser-tracker load-test campaign (formats.md §2).\n"
+      "For every posture, pulley and mass: the static deflection of the target under the rope\n"
+      "force (large-displacement equilibrium with the config's joint stiffness), tracker readings\n"
+      "with Gaussian noise, optional gross outliers. Seeded: the same options give the same file."};
+  app.footer(ExitCodeHelp());
+  std::string robot_path, out_path, postures_path, plan_path, masses = "10,20,30", load_point = "150,0,100",
+                                                   target = "0,120,50", form = "rope";
+  std::vector<std::string> pulleys{"1600,-1200,0", "1600,1200,0"}, sets;
+  int num_postures = 12, outliers = 0;
+  double noise_mm = 0.01, outlier_mm = 1.0, min_reach_mm = 1500.0;
+  unsigned seed = 1;
+  app.add_option("--robot", robot_path, "robot config YAML; its joint stiffness is the truth")->required();
+  app.add_option("--out", out_path, "tracker CSV to write (stdout if omitted)");
+  app.add_option("--postures", postures_path, "posture file CSV (formats.md §1); default: random postures");
+  app.add_option("--plan-file", plan_path,
+                 "a plan from kq-identify --plan: its postures and pulleys (and load point and target "
+                 "unless given here)");
+  app.add_option("--num-postures", num_postures, "number of random postures (without --postures)")
+      ->capture_default_str();
+  app.add_option("--min-reach-mm", min_reach_mm,
+                 "random postures: least horizontal distance of the load point from the base axis [mm]")
+      ->capture_default_str();
+  app.add_option("--masses-kg", masses, "masses hung at every posture and pulley [kg]")->capture_default_str();
+  app.add_option("--pulley-mm", pulleys, "pulley position x,y,z in the base frame [mm], one per rope direction")
+      ->capture_default_str();
+  app.add_option("--load-point-mm", load_point, "load point x,y,z in the tip frame [mm], or tcp")
+      ->capture_default_str();
+  app.add_option("--target-mm", target, "tracker target x,y,z in the tip frame [mm], or tcp")->capture_default_str();
+  app.add_option("--noise-mm", noise_mm, "tracker noise, 1 sigma per coordinate [mm]")->capture_default_str();
+  app.add_option("--outliers", outliers, "number of cases with a gross error")->capture_default_str();
+  app.add_option("--outlier-mm", outlier_mm, "size of that error [mm]")->capture_default_str();
+  app.add_option("--form", form, "load columns: rope (mass_kg + rope points) or force (fx_N..fz_N)")
+      ->check(CLI::IsMember({"rope", "force"}))
+      ->capture_default_str();
+  app.add_option("--seed", seed, "random seed (postures, noise, outliers)")->capture_default_str();
+  app.add_option("--set", sets, "override a model parameter of the truth, NAME=VALUE (e.g. kq3_Nm_per_rad=4e6)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+
+  return RunGuarded(kTool, [&]() -> int {
+    if (!(noise_mm >= 0.0)) throw std::invalid_argument("--noise-mm: expected a noise >= 0 mm");
+    if (outliers < 0) throw std::invalid_argument("--outliers: expected a count >= 0");
+    if (num_postures < 1) throw std::invalid_argument("--num-postures: expected at least 1");
+    RequireReadableFile(robot_path, "robot config");
+    if (!postures_path.empty()) RequireReadableFile(postures_path, "posture file");
+    if (!plan_path.empty()) RequireReadableFile(plan_path, "plan file");
+    if (!plan_path.empty() && !postures_path.empty()) {
+      throw std::invalid_argument("--plan-file and --postures exclude each other");
+    }
+    io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
+    for (const std::string& s : sets) {
+      const auto [name, value] = ParseAssignment("--set", s);
+      cfg.parameters.Set(name, value);
+    }
+    const auto model = cfg.Build();
+
+    identification::CampaignOptions o;
+    o.masses_kg = ParseNumbers("--masses-kg", masses);
+    for (double m : o.masses_kg) {
+      if (!(m > 0.0)) throw std::invalid_argument("--masses-kg: expected masses > 0 kg");
+    }
+    o.pulleys.clear();
+    for (const auto& p : pulleys) {
+      const auto v = ParsePointMm("--pulley-mm", p);
+      if (!v) throw std::invalid_argument("--pulley-mm: expected x,y,z in mm");
+      o.pulleys.push_back(*v);
+    }
+    o.p_load_tip = ParsePointMm("--load-point-mm", load_point);
+    o.p_target_tip = ParsePointMm("--target-mm", target);
+    o.tracker_noise = MmToM(noise_mm);
+    o.seed = seed;
+    o.num_outliers = outliers;
+    o.outlier_size = MmToM(outlier_mm);
+    o.force_form = form == "force";
+    o.min_reach = MmToM(min_reach_mm);
+
+    std::vector<std::string> ids;
+    std::vector<Eigen::VectorXd> qs;
+    std::vector<std::vector<Eigen::Vector3d>> plan_pulleys;
+    if (!plan_path.empty()) {
+      // The plan CSV of kq-identify --plan: one row per posture and rope
+      // direction, rows of one posture together.
+      const io::CsvTable t = io::CsvTable::ReadFile(plan_path);
+      t.RequireColumn("pose_id");
+      for (int r = 0; r < t.num_rows(); ++r) {
+        const std::string id = t.Text(r, "pose_id");
+        if (ids.empty() || ids.back() != id) {
+          for (const auto& seen : ids) {
+            if (seen == id) throw t.ErrorAt(r, "pose_id", "rows of posture " + id + " must be adjacent");
+          }
+          Eigen::VectorXd q(model->num_joints());
+          for (int j = 0; j < q.size(); ++j) q(j) = DegToRad(t.Number(r, "q" + std::to_string(j + 1) + "_deg"));
+          ids.push_back(id);
+          qs.push_back(q);
+          plan_pulleys.emplace_back();
+        }
+        plan_pulleys.back().emplace_back(MmToM(t.Number(r, "pulley_x_mm")), MmToM(t.Number(r, "pulley_y_mm")),
+                                         MmToM(t.Number(r, "pulley_z_mm")));
+      }
+      if (ids.empty()) throw InputError({plan_path, 0, 0}, "no postures in the plan");
+      const auto& meta = t.metadata();
+      if (app.count("--load-point-mm") == 0 && meta.count("load_point_mm")) {
+        o.p_load_tip = ParsePointMm(plan_path + ": load_point_mm", meta.at("load_point_mm"));
+      }
+      if (app.count("--target-mm") == 0 && meta.count("target_mm")) {
+        o.p_target_tip = ParsePointMm(plan_path + ": target_mm", meta.at("target_mm"));
+      }
+    } else if (!postures_path.empty()) {
+      for (const auto& p : io::ReadPostureFile(postures_path, model->num_joints())) {
+        ids.push_back(p.id);
+        qs.push_back(p.q);
+      }
+    } else {
+      qs = identification::CampaignPostures(*model, num_postures, o, seed);
+      for (size_t p = 0; p < qs.size(); ++p) ids.push_back("P" + std::to_string(p + 1));
+    }
+    std::vector<int> bad;
+    const auto ms = plan_pulleys.empty()
+                        ? identification::SimulateCampaign(*model, ids, qs, model->joint_stiffness(), o, &bad)
+                        : identification::SimulateCampaign(*model, ids, qs, plan_pulleys,
+                                                           model->joint_stiffness(), o, &bad);
+
+    std::vector<std::pair<std::string, std::string>> meta{
+        {"generator", "tracker-synth (robomach)"},
+        {"robot", robot_path},
+        {"seed", std::to_string(seed)},
+        {"tracker_noise_mm", io::FormatDouble(noise_mm)}};
+    for (int j = 0; j < model->num_joints(); ++j) {
+      meta.emplace_back("truth_kq" + std::to_string(j + 1) + "_Nm_per_rad",
+                        io::FormatDouble(model->joint_stiffness()(j)));
+    }
+    std::string bad_ids;
+    for (int c : bad) bad_ids += (bad_ids.empty() ? "" : " ") + ms[c].case_id;
+    if (!bad.empty()) meta.emplace_back("outlier_cases", bad_ids);
+    if (out_path.empty()) {
+      io::WriteTrackerFile(std::cout, ms, meta);
+    } else {
+      io::WriteTrackerFile(out_path, ms, meta);
+    }
+    std::cerr << kTool << ": " << ms.size() << " load cases (" << ids.size() << " postures x "
+              << (plan_pulleys.empty() ? o.pulleys.size() : plan_pulleys[0].size()) << " rope directions x " << o.masses_kg.size() << " masses)"
+              << (bad.empty() ? "" : "; outliers: " + bad_ids) << "\n";
+    return kExitOk;
+  });
+}
+
+}  // namespace
+}  // namespace robomach::apps
+
+int main(int argc, char** argv) { return robomach::apps::Run(argc, argv); }

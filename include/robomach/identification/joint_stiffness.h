@@ -1,0 +1,137 @@
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/common/progress.h"
+#include "robomach/dynamics/robot_model.h"
+#include "robomach/identification/load_case.h"
+
+namespace robomach::identification {
+
+enum class RobustLoss { kNone, kHuber, kCauchy };
+
+/// Options of IdentifyJointStiffness. Defaults in the header (style §2.2).
+struct IdentificationOptions {
+  /// Tracker noise, 1 sigma per measured coordinate [m]. A displacement is
+  /// the difference of two measurements, so its noise is √2 times this.
+  double tracker_noise{1e-5};
+  /// Robust loss on the normalised residual of each case (3 components).
+  /// With a loss, cases flagged as outliers are dropped and the fit is
+  /// repeated with the plain least-squares cost, so that the covariance is
+  /// that of the inliers.
+  RobustLoss loss{RobustLoss::kNone};
+  /// Scale of the robust loss in units of the displacement noise sigma.
+  double loss_scale{3.0};
+  /// Family-wise false-alarm probability for outlier flags: a case is an
+  /// outlier if its squared normalised residual exceeds the χ²(3) quantile
+  /// at 1 − outlier_false_alarm / num_cases (Bonferroni), scaled up by the
+  /// robust noise estimate when the residuals are larger than the noise.
+  double outlier_false_alarm{0.01};
+  /// Relative standard deviations (σ_k / k) above which a joint is "weakly
+  /// determined" and "not determined".
+  double weak_relative_std{0.1};
+  double undetermined_relative_std{0.5};
+  int max_iterations{100};
+};
+
+/// @throws std::invalid_argument naming the field and the violated bound.
+void CheckValid(const IdentificationOptions& options);
+
+/// Outcome of the solver (style §2.9).
+enum class FitStatus { kConverged, kNotConverged, kFailed };
+/// How well the data determine one joint's stiffness.
+enum class Determination { kDetermined, kWeak, kNotDetermined };
+
+const char* ToString(FitStatus s);
+const char* ToString(Determination d);
+
+/// The residual of one load case at the solution.
+struct CaseResidual {
+  std::string case_id;
+  Eigen::Vector3d measured{Eigen::Vector3d::Zero()};   // D measured [m, in B]
+  Eigen::Vector3d predicted{Eigen::Vector3d::Zero()};  // D of the model [m, in B]
+  Eigen::Vector3d residual{Eigen::Vector3d::Zero()};   // measured − predicted [m]
+  double norm{NAN};          // |residual| [m]
+  double normalized{NAN};    // |residual| / σ_D [-]
+  bool outlier{false};
+};
+
+struct JointStiffnessResult {
+  FitStatus status{FitStatus::kFailed};
+  std::string solver_message;           // ceres::Summary message, verbatim, plus our notes
+  int num_cases{0};
+  int num_joints{0};
+  Eigen::VectorXd joint_stiffness;      // [N·m/rad]; a not-determined joint keeps the prior
+  Eigen::VectorXd std_dev;              // 1 sigma [N·m/rad]; +inf for a joint held at the prior
+  Eigen::VectorXd lower_95, upper_95;   // 95 % interval [N·m/rad] (log-normal, from log k)
+  Eigen::VectorXd relative_std;         // σ(log k) ≈ σ_k / k [-]
+  Eigen::MatrixXd correlation;          // of the stiffnesses (NaN rows for undetermined joints)
+  std::vector<Determination> determination;
+  std::vector<int> weakly_identified;   // 0-based joint indices
+  std::vector<int> not_determined;      // 0-based joint indices
+  /// Sentences a test engineer can act on, one per problem found.
+  std::vector<std::string> advice;
+  std::vector<CaseResidual> residuals;  // every case, in input order
+  std::vector<int> outliers;            // indices into residuals
+  double rms_residual{NAN};             // RMS of |residual| over inliers [m]
+  double rms_residual_all{NAN};         // RMS of |residual| over all cases [m]
+  double noise_sigma_displacement{NAN}; // σ_D per coordinate [m]
+  double reduced_chi2{NAN};             // χ² / (3 m − p) of the inliers
+  bool covariance_inflated{false};      // std_dev scaled by √reduced_chi2 (residuals > noise)
+  double condition_number{NAN};         // of the column-scaled weighted Jacobian at the solution
+  /// Noise level the residuals show, relative to the stated one: √(median
+  /// of |r|²/σ_D² / median of χ²₃); robust to a few outliers.
+  double robust_noise_ratio{NAN};
+  /// A case is an outlier if |r|/σ_D exceeds this (the χ²₃ bound, scaled
+  /// up by robust_noise_ratio when that is above 1).
+  double outlier_threshold{NAN};
+  Eigen::VectorXd linear_start;         // exact linear least-squares stiffness [N·m/rad]
+  int iterations{0};
+  /// Largest |moment about joint i's axis| over the cases [N·m], and the
+  /// largest lever of the target about it [m] (what the advice is built on).
+  Eigen::VectorXd max_joint_torque;
+  Eigen::VectorXd max_target_lever;
+  bool flagged() const {
+    return status != FitStatus::kConverged || !not_determined.empty() || !weakly_identified.empty();
+  }
+};
+
+/// Identifies the diagonal joint stiffness K_q from load cases.
+///
+/// Steps: (i) joints the data cannot see are found at the prior (the
+/// model's stiffness): a joint whose relative standard deviation would exceed
+/// `undetermined_relative_std` even with all others known ("barely loaded" or
+/// "target barely moves"), or whose marginal one does (only a combination
+/// with other joints is determined), is held at the prior; (ii) the exact
+/// linear least-squares start in the compliances c_i = 1/k_i of model (1) of
+/// compliance_model.h, weighted by σ_D = √2·tracker_noise; (iii) Ceres solves
+/// the weighted problem in θ_i = log(k_i/k0_i) (positivity), first with the
+/// optional robust loss; (iv) outliers are flagged against the χ²(3) bound,
+/// and with a robust loss the plain fit is repeated without them; a joint
+/// driven more than 1000× away from the prior is held and the fit repeated;
+/// (v) ceres::Covariance gives the covariance of θ, scaled by χ²/dof when the
+/// residuals are clearly larger than the stated noise. Joints are then
+/// classified by σ(θ_i) against `weak_relative_std` and
+/// `undetermined_relative_std`, and `advice` says what to add to the tests.
+///
+/// Numerical trouble is reported in the result's status, never thrown.
+/// @param model  robot model; its joint stiffness is the prior and scale.
+/// @param cases  load cases; absent load points and targets are the TCP.
+/// @param progress  called with (cases evaluated, total) while the per-case
+///   kinematics are evaluated.
+/// @throws std::invalid_argument for invalid options, no cases, or a case
+///   whose q has the wrong size or a non-finite value.
+JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
+                                            const std::vector<LoadCase>& cases,
+                                            const IdentificationOptions& options = {},
+                                            const ProgressCallback& progress = {});
+
+/// Upper quantile of the χ² distribution with 3 degrees of freedom:
+/// x with P(χ²₃ > x) = p, for 0 < p < 1.
+double ChiSquare3UpperQuantile(double p);
+
+}  // namespace robomach::identification

@@ -1,0 +1,74 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/dynamics/robot_model.h"
+#include "robomach/identification/load_case.h"
+
+namespace robomach::identification {
+
+/// Fisher information of log-stiffness, θ_i = log k_i, for load cases with
+/// displacement noise σ_D per coordinate [m], at stiffness `kq`
+/// [N·m/rad]: I = Σ_cases Gᵀ G / σ_D², G = ∂D/∂θ = −A diag(c). Its inverse
+/// is the covariance of θ, whose diagonal is (σ_k / k)².
+Eigen::MatrixXd LogStiffnessInformation(const dynamics::RobotModel& model,
+                                        const std::vector<LoadCase>& cases,
+                                        const Eigen::VectorXd& kq, double sigma_displacement);
+
+/// Options of PlanLoadTests (defaults for the seed's rope set-up).
+struct PlanOptions {
+  int num_postures{12};
+  std::vector<double> masses_kg{10.0, 20.0, 30.0};   // each planned direction gets every mass
+  int directions_per_posture{2};                      // rope directions (pulley positions) per posture
+  double tracker_noise{1e-5};                         // 1 sigma per coordinate [m]
+  double floor_z{0.0};                                // floor height in B [m]
+  double min_load_height{0.3};                        // load point above the floor [m]
+  double max_rope_angle{0.7853981633974483};          // rope from vertical [rad] (45°)
+  double joint_limit_margin{0.08726646259971647};     // keep this far inside the limits [rad] (5°)
+  int num_candidate_postures{400};
+  int num_azimuths{8};                                // candidate rope azimuths per tilt
+  unsigned seed{1};
+  std::optional<Eigen::Vector3d> p_load_tip;          // [m] in the tip frame; nullopt = TCP
+  std::optional<Eigen::Vector3d> p_target_tip;        // [m] in the tip frame; nullopt = TCP
+};
+
+/// @throws std::invalid_argument naming the field and the violated bound.
+void CheckValid(const PlanOptions& options);
+
+/// One planned rope direction at one posture.
+struct PlannedLoad {
+  std::string pose_id;
+  Eigen::VectorXd q;                   // [rad]
+  Eigen::Vector3d rope_direction;      // unit vector in B, from the load point to the pulley
+  Eigen::Vector3d p_load;              // load point in B [m]
+  Eigen::Vector3d p_pulley;            // where the rope meets the floor, in B [m]
+};
+
+struct TestPlan {
+  std::vector<PlannedLoad> loads;        // num_postures × directions_per_posture
+  std::vector<LoadCase> cases;           // the loads with every mass (no displacement)
+  double log_det_information{NAN};       // D-optimality index, log det I (θ = log k)
+  Eigen::VectorXd expected_relative_std; // √diag(I⁻¹) [-]; +inf where I is singular
+  Eigen::VectorXd expected_std_dev;      // [N·m/rad] at the model's stiffness
+  int num_candidates{0};                 // feasible candidate postures found
+};
+
+/// Chooses postures (within the joint limits with a margin) and rope
+/// directions (downward, within max_rope_angle of vertical, reaching the
+/// floor from a load point at least min_load_height above it) that maximise
+/// log det of the Fisher information of log-stiffness at the model's
+/// stiffness (D-optimal design [Atkinson & Donev 1992]): greedy selection
+/// followed by Fedorov-style exchange passes over the random candidate set.
+/// Each chosen posture gets `directions_per_posture` directions and every
+/// mass. Deterministic for a given seed.
+/// @throws std::invalid_argument for invalid options.
+///
+/// - [Atkinson & Donev 1992] A. C. Atkinson, A. N. Donev, Optimum
+///   Experimental Designs, Oxford University Press, 1992.
+TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& options);
+
+}  // namespace robomach::identification

@@ -1,0 +1,535 @@
+#include "robomach/identification/joint_stiffness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+#include <ceres/ceres.h>
+#include <Eigen/Dense>
+
+#include "identification/internal/tracker_residual.h"
+#include "robomach/identification/compliance_model.h"
+
+namespace robomach::identification {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// 1.959964 is the two-sided 95 % quantile of the standard normal.
+constexpr double kZ95 = 1.959963984540054;
+
+std::string JointList(const std::vector<int>& joints) {
+  std::ostringstream s;
+  for (size_t i = 0; i < joints.size(); ++i) {
+    if (i > 0) s << (i + 1 == joints.size() ? " and " : ", ");
+    s << joints[i] + 1;
+  }
+  return s.str();
+}
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+// What a load case must add so that joint j (0-based, of n) is loaded.
+std::string MomentAdvice(int j, int n) {
+  if (j == n - 1) {
+    return "add load cases with a moment about the tool axis (a load point off the tool axis, "
+           "lx_mm/ly_mm, with the rope not parallel to the axis)";
+  }
+  if (j == 0) {
+    return "add load cases with a moment about the vertical base axis (pull the rope sideways, "
+           "with the flange far from the base axis)";
+  }
+  return "add load cases with a moment about joint " + std::to_string(j + 1) +
+         "'s axis (other postures or rope directions, so that the force passes farther from "
+         "that axis)";
+}
+
+// Information matrix of the scaled compliances x (x_i = c_i k0_i), restricted
+// to `free`; returns the marginal relative standard deviations (x ≈ 1), +inf
+// along numerically null directions.
+Eigen::VectorXd MarginalRelativeStd(const Eigen::MatrixXd& info) {
+  const int p = static_cast<int>(info.rows());
+  Eigen::VectorXd out = Eigen::VectorXd::Constant(p, kInf);
+  if (p == 0) return out;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(info);
+  const Eigen::VectorXd& lam = es.eigenvalues();
+  const double lmax = std::max(lam.maxCoeff(), 0.0);
+  // Eigenvalues below 1e-12 λ_max are rounding noise of a zero (eps·cond
+  // budget of a 6×6 symmetric eigensolver is ~1e-14 relative).
+  const double floor = 1e-12 * lmax;
+  for (int i = 0; i < p; ++i) {
+    double var = 0.0;
+    for (int k = 0; k < p; ++k) {
+      const double v2 = es.eigenvectors()(i, k) * es.eigenvectors()(i, k);
+      if (lam(k) <= floor || lam(k) <= 0.0) {
+        if (v2 > 1e-12) var = kInf;
+      } else {
+        var += v2 / lam(k);
+      }
+    }
+    out(i) = std::sqrt(var);
+  }
+  return out;
+}
+
+}  // namespace
+
+const char* ToString(FitStatus s) {
+  switch (s) {
+    case FitStatus::kConverged: return "converged";
+    case FitStatus::kNotConverged: return "not converged";
+    case FitStatus::kFailed: return "failed";
+  }
+  return "?";
+}
+
+const char* ToString(Determination d) {
+  switch (d) {
+    case Determination::kDetermined: return "determined";
+    case Determination::kWeak: return "weakly determined";
+    case Determination::kNotDetermined: return "not determined";
+  }
+  return "?";
+}
+
+void CheckValid(const IdentificationOptions& o) {
+  auto fail = [](const std::string& field, double v, const std::string& bound) {
+    std::ostringstream s;
+    s << "IdentificationOptions::" << field << ": expected " << bound << ", got " << v;
+    throw std::invalid_argument(s.str());
+  };
+  if (!(o.tracker_noise > 0.0) || !std::isfinite(o.tracker_noise)) {
+    fail("tracker_noise", o.tracker_noise, "a finite value > 0 m");
+  }
+  if (!(o.loss_scale > 0.0)) fail("loss_scale", o.loss_scale, "a value > 0");
+  if (!(o.outlier_false_alarm > 0.0 && o.outlier_false_alarm < 1.0)) {
+    fail("outlier_false_alarm", o.outlier_false_alarm, "a probability in (0, 1)");
+  }
+  if (!(o.weak_relative_std > 0.0)) fail("weak_relative_std", o.weak_relative_std, "a value > 0");
+  if (!(o.undetermined_relative_std > o.weak_relative_std)) {
+    fail("undetermined_relative_std", o.undetermined_relative_std, "a value > weak_relative_std");
+  }
+  if (o.max_iterations < 1) fail("max_iterations", o.max_iterations, "at least 1");
+}
+
+double ChiSquare3UpperQuantile(double p) {
+  if (!(p > 0.0 && p < 1.0)) throw std::invalid_argument("ChiSquare3UpperQuantile: p outside (0, 1)");
+  // Survival function of χ²₃: erfc(√(x/2)) + √(2x/π) e^(−x/2)
+  // (the odd-ν closed form of [Abramowitz & Stegun 1964, ch. 26] with ν = 3,
+  // M. Abramowitz, I. A. Stegun, Handbook of Mathematical Functions, NBS).
+  // It decreases strictly, so
+  // bisection on [0, 2000] (sf(2000) < 1e-400) converges to machine precision.
+  auto sf = [](double x) {
+    return std::erfc(std::sqrt(0.5 * x)) + std::sqrt(2.0 * x / 3.14159265358979323846) * std::exp(-0.5 * x);
+  };
+  double lo = 0.0, hi = 2000.0;
+  for (int it = 0; it < 200; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (sf(mid) > p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
+                                            const std::vector<LoadCase>& cases,
+                                            const IdentificationOptions& options,
+                                            const ProgressCallback& progress) {
+  CheckValid(options);
+  if (cases.empty()) throw std::invalid_argument("IdentifyJointStiffness: no load cases");
+  const int n = model.num_joints();
+  const int m = static_cast<int>(cases.size());
+  const Eigen::VectorXd k0 = model.joint_stiffness();
+
+  JointStiffnessResult res;
+  res.num_cases = m;
+  res.num_joints = n;
+  res.noise_sigma_displacement = std::sqrt(2.0) * options.tracker_noise;
+  const double sigma = res.noise_sigma_displacement;
+
+  // Per case: y = D/σ and B = A diag(1/k0)/σ of (3) in tracker_residual.h.
+  std::vector<Matrix3Xd> B(m);
+  std::vector<Eigen::Vector3d> y(m);
+  res.max_joint_torque = Eigen::VectorXd::Zero(n);
+  res.max_target_lever = Eigen::VectorXd::Zero(n);
+  const Eigen::Vector3d tcp = TcpInTip(model);
+  for (int c = 0; c < m; ++c) {
+    LoadCase lc = cases[c];
+    if (!lc.p_load_tip) lc.p_load_tip = tcp;
+    if (!lc.p_target_tip) lc.p_target_tip = tcp;
+    if (!lc.force.allFinite() || !lc.displacement.allFinite()) {
+      throw std::invalid_argument("load case " + lc.case_id + ": non-finite force or displacement");
+    }
+    const CaseKinematics k = EvaluateCaseKinematics(model, lc);
+    const Matrix3Xd A = DisplacementPerCompliance(k, lc.force);
+    B[c] = A * k0.cwiseInverse().asDiagonal() / sigma;
+    y[c] = lc.displacement / sigma;
+    const Eigen::VectorXd tau = k.Jv_L.transpose() * lc.force;
+    for (int j = 0; j < n; ++j) {
+      res.max_joint_torque(j) = std::max(res.max_joint_torque(j), std::abs(tau(j)));
+      res.max_target_lever(j) = std::max(res.max_target_lever(j), k.Jv_T.col(j).norm());
+    }
+    if (progress && (c + 1 == m || (c + 1) % 100 == 0)) progress(c + 1, m);
+  }
+
+  // (ii) Which joints the data can see at all, judged at the prior.
+  Eigen::MatrixXd info = Eigen::MatrixXd::Zero(n, n);
+  for (int c = 0; c < m; ++c) info.noalias() += B[c].transpose() * B[c];
+  res.determination.assign(n, Determination::kDetermined);
+  std::vector<int> barely, confounded, free, diverged, vague;
+  const double u = options.undetermined_relative_std;
+  for (int j = 0; j < n; ++j) {
+    // Even with every other joint known, σ(x_j) = 1/√I_jj.
+    if (!(info(j, j) > 1.0 / (u * u))) barely.push_back(j);
+  }
+  {
+    std::vector<int> rest;
+    for (int j = 0; j < n; ++j) {
+      if (std::find(barely.begin(), barely.end(), j) == barely.end()) rest.push_back(j);
+    }
+    Eigen::MatrixXd sub(rest.size(), rest.size());
+    for (size_t a = 0; a < rest.size(); ++a)
+      for (size_t b = 0; b < rest.size(); ++b) sub(a, b) = info(rest[a], rest[b]);
+    const Eigen::VectorXd rel = MarginalRelativeStd(sub);
+    for (size_t a = 0; a < rest.size(); ++a) {
+      (rel(a) > u ? confounded : free).push_back(rest[a]);
+    }
+  }
+
+  // (i) Exact linear least squares in x for the free joints, the others at
+  // the prior (x = 1).
+  int p = static_cast<int>(free.size());
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(n);  // θ = log(k/k0); 0 = prior
+  res.linear_start = Eigen::VectorXd::Constant(n, kNaN);
+  if (p > 0) {
+    Eigen::MatrixXd Bf(3 * m, p);
+    Eigen::VectorXd rhs(3 * m);
+    for (int c = 0; c < m; ++c) {
+      Eigen::Vector3d yc = y[c];
+      for (int j = 0; j < n; ++j) {
+        if (std::find(free.begin(), free.end(), j) == free.end()) yc -= B[c].col(j);
+      }
+      rhs.segment<3>(3 * c) = yc;
+      for (int a = 0; a < p; ++a) Bf.block<3, 1>(3 * c, a) = B[c].col(free[a]);
+    }
+    const Eigen::VectorXd x = Bf.colPivHouseholderQr().solve(rhs);
+    for (int a = 0; a < p; ++a) {
+      const int j = free[a];
+      if (x(a) > 0.0 && std::isfinite(x(a))) {
+        res.linear_start(j) = k0(j) / x(a);
+        theta(j) = -std::log(x(a));
+      }
+      // A compliance <= 0 from the linear fit means the data barely see the
+      // joint; Ceres starts it at the prior and the covariance says so.
+    }
+  }
+
+  // (iii) Ceres in θ. Cases in `excluded` are left out (robust second pass).
+  std::vector<bool> excluded(m, false);
+  ceres::Solver::Summary summary;
+  // Covariance of θ from ceres::Covariance (zero rows for held joints).
+  Eigen::MatrixXd cov_theta = Eigen::MatrixXd::Constant(n, n, kNaN);
+  auto solve = [&](bool robust, bool covariance) -> bool {
+    ceres::Problem::Options po;
+    po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+    auto problem = std::make_unique<ceres::Problem>(po);
+    for (int c = 0; c < m; ++c) {
+      if (excluded[c]) continue;
+      ceres::LossFunction* loss = nullptr;
+      if (robust && options.loss == RobustLoss::kHuber) loss = new ceres::HuberLoss(options.loss_scale);
+      if (robust && options.loss == RobustLoss::kCauchy) loss = new ceres::CauchyLoss(options.loss_scale);
+      problem->AddResidualBlock(new internal::TrackerResidual(y[c], B[c]), loss, theta.data());
+    }
+    if (p < n) {
+      std::vector<int> fixed;
+      for (int j = 0; j < n; ++j) {
+        if (std::find(free.begin(), free.end(), j) == free.end()) fixed.push_back(j);
+      }
+      problem->SetManifold(theta.data(), new ceres::SubsetManifold(n, fixed));
+    }
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::DENSE_QR;
+    so.max_num_iterations = options.max_iterations;
+    so.num_threads = 1;
+    so.logging_type = ceres::SILENT;
+    // Relative tolerances well below the noise-limited precision of θ
+    // (~1e-3 and worse), so the answer is converged for statistics.
+    so.function_tolerance = 1e-12;
+    so.parameter_tolerance = 1e-12;
+    so.gradient_tolerance = 1e-14;
+    ceres::Solve(so, problem.get(), &summary);
+    res.iterations += static_cast<int>(summary.iterations.size());
+    if (!covariance) return true;
+    // (v) covariance of θ on the final problem.
+    ceres::Covariance::Options co;
+    co.algorithm_type = ceres::DENSE_SVD;
+    {
+      int rows = 0;
+      for (int c = 0; c < m; ++c) rows += excluded[c] ? 0 : 3;
+      Eigen::MatrixXd J(rows, p);
+      int r0 = 0;
+      for (int c = 0; c < m; ++c) {
+        if (excluded[c]) continue;
+        for (int a = 0; a < p; ++a) J.block<3, 1>(r0, a) = B[c].col(free[a]) * std::exp(-theta(free[a]));
+        r0 += 3;
+      }
+      const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(J).singularValues();
+      // Ceres' own bound (min_reciprocal_condition_number) with margin.
+      if (!(sv.size() > 0 && sv(sv.size() - 1) > 1e-12 * sv(0))) return false;
+    }
+    ceres::Covariance cov(co);
+    std::vector<std::pair<const double*, const double*>> blocks{{theta.data(), theta.data()}};
+    if (!cov.Compute(blocks, problem.get())) return false;
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Cr(n, n);
+    cov.GetCovarianceBlock(theta.data(), theta.data(), Cr.data());
+    cov_theta = Cr;
+    return true;
+  };
+
+  if (p == 0) {
+    res.status = FitStatus::kFailed;
+    res.solver_message = "no joint stiffness can be determined from these load cases";
+  } else {
+    bool cov_ok = true;
+    const double chi2_bound = ChiSquare3UpperQuantile(options.outlier_false_alarm / m);
+    auto normalized2 = [&](int c) {
+      Eigen::Vector3d r = y[c];
+      for (int j = 0; j < n; ++j) r -= B[c].col(j) * std::exp(-theta(j));
+      return r.squaredNorm();
+    };
+    // Outliers are judged against the stated noise, or against the noise the
+    // residuals show if that is larger: a robust scale from the median of
+    // the squared normalised residuals (the median of χ²₃ is 2.365974), which
+    // a few gross outliers do not move. Otherwise an understated noise would
+    // make every case an "outlier".
+    auto outlier_threshold = [&]() {
+      std::vector<double> v(m);
+      for (int c = 0; c < m; ++c) v[c] = normalized2(c);
+      std::nth_element(v.begin(), v.begin() + m / 2, v.end());
+      res.robust_noise_ratio = std::sqrt(v[m / 2] / 2.365974);
+      return chi2_bound * std::max(1.0, res.robust_noise_ratio * res.robust_noise_ratio);
+    };
+    double threshold = chi2_bound;
+    if (options.loss != RobustLoss::kNone) {
+      solve(true, false);
+      threshold = outlier_threshold();
+      for (int c = 0; c < m; ++c) excluded[c] = normalized2(c) > threshold;
+      // Never drop so many cases that fewer equations than unknowns remain.
+      const int kept = static_cast<int>(std::count(excluded.begin(), excluded.end(), false));
+      if (3 * kept <= p) std::fill(excluded.begin(), excluded.end(), false);
+    }
+    // A joint whose stiffness runs away from the prior by more than 1000×
+    // (its compliance heads for 0 because the data ask for a negative one)
+    // is not determined by these cases: hold it at the prior and solve again.
+    // A prior off by 1000× is not a plausible robot config.
+    const double kMaxLogRatio = std::log(1e3);
+    for (;;) {
+      solve(false, false);
+      std::vector<int> runaway;
+      for (int j : free) {
+        if (!(std::abs(theta(j)) <= kMaxLogRatio)) runaway.push_back(j);
+      }
+      if (runaway.empty() || static_cast<int>(runaway.size()) == p) break;
+      for (int j : runaway) {
+        theta(j) = 0.0;
+        free.erase(std::find(free.begin(), free.end(), j));
+        diverged.push_back(j);
+      }
+      p = static_cast<int>(free.size());
+    }
+    // Ceres logs through glog when the covariance is rank-deficient; a
+    // rank check first keeps such noise off the user's terminal.
+    cov_ok = solve(false, true);
+    switch (summary.termination_type) {
+      case ceres::CONVERGENCE: res.status = FitStatus::kConverged; break;
+      case ceres::NO_CONVERGENCE: res.status = FitStatus::kNotConverged; break;
+      default: res.status = FitStatus::kFailed; break;
+    }
+    res.solver_message = summary.message;
+    if (!cov_ok) {
+      res.solver_message += "; the covariance could not be computed (rank-deficient Jacobian)";
+      cov_theta.setConstant(kNaN);
+    }
+    // Outlier flags at the solution; with a robust loss they are the cases
+    // the robust pass excluded.
+    if (options.loss == RobustLoss::kNone) threshold = outlier_threshold();
+    res.outlier_threshold = std::sqrt(threshold);
+    for (int c = 0; c < m; ++c) {
+      const bool flag = options.loss != RobustLoss::kNone ? excluded[c] : normalized2(c) > threshold;
+      if (flag) res.outliers.push_back(c);
+    }
+  }
+
+  // Residuals, χ² and the covariance inflation.
+  const Eigen::VectorXd k_hat = (k0.array() * theta.array().exp()).matrix();
+  double sum2_in = 0.0, sum2_all = 0.0, chi2 = 0.0;
+  int m_in = 0;
+  for (int c = 0; c < m; ++c) {
+    CaseResidual r;
+    r.case_id = cases[c].case_id;
+    r.measured = cases[c].displacement;
+    Eigen::Vector3d pred = Eigen::Vector3d::Zero();
+    for (int j = 0; j < n; ++j) pred += B[c].col(j) * std::exp(-theta(j));
+    r.predicted = pred * sigma;
+    r.residual = r.measured - r.predicted;
+    r.norm = r.residual.norm();
+    r.normalized = r.norm / sigma;
+    r.outlier = std::find(res.outliers.begin(), res.outliers.end(), c) != res.outliers.end();
+    sum2_all += r.norm * r.norm;
+    if (!r.outlier || options.loss == RobustLoss::kNone) {
+      sum2_in += r.norm * r.norm;
+      chi2 += r.normalized * r.normalized;
+      ++m_in;
+    }
+    res.residuals.push_back(std::move(r));
+  }
+  res.rms_residual = std::sqrt(sum2_in / std::max(m_in, 1));
+  res.rms_residual_all = std::sqrt(sum2_all / m);
+  const int dof = 3 * m_in - p;
+  res.reduced_chi2 = dof > 0 ? chi2 / dof : kNaN;
+  // χ²/dof has mean 1 and standard deviation √(2/dof) when the noise is as
+  // stated; three of those above 1 is not chance.
+  double inflate = 1.0;
+  if (dof > 0 && res.reduced_chi2 > 1.0 + 3.0 * std::sqrt(2.0 / dof)) {
+    inflate = std::sqrt(res.reduced_chi2);
+    res.covariance_inflated = true;
+  }
+
+  // Per-joint uncertainty and determination.
+  res.joint_stiffness = k_hat;
+  res.std_dev = Eigen::VectorXd::Constant(n, kInf);
+  res.relative_std = Eigen::VectorXd::Constant(n, kInf);
+  res.lower_95 = Eigen::VectorXd::Zero(n);
+  res.upper_95 = Eigen::VectorXd::Constant(n, kInf);
+  cov_theta *= inflate * inflate;
+  res.correlation = Eigen::MatrixXd::Constant(n, n, kNaN);
+  for (int j : barely) res.determination[j] = Determination::kNotDetermined;
+  for (int j : confounded) res.determination[j] = Determination::kNotDetermined;
+  for (int j : diverged) res.determination[j] = Determination::kNotDetermined;
+  for (int j : free) {
+    const double s = std::sqrt(std::max(cov_theta(j, j), 0.0));
+    if (!std::isfinite(s)) {
+      res.determination[j] = Determination::kNotDetermined;
+      confounded.push_back(j);
+      continue;
+    }
+    res.relative_std(j) = s;
+    // Delta method for σ_k; the interval is exact for log-normal θ.
+    res.std_dev(j) = k_hat(j) * s;
+    res.lower_95(j) = k_hat(j) * std::exp(-kZ95 * s);
+    res.upper_95(j) = k_hat(j) * std::exp(kZ95 * s);
+    if (s > options.undetermined_relative_std) {
+      res.determination[j] = Determination::kNotDetermined;
+      vague.push_back(j);
+    } else if (s > options.weak_relative_std) {
+      res.determination[j] = Determination::kWeak;
+    }
+  }
+  for (int a : free) {
+    for (int b : free) {
+      const double d = std::sqrt(cov_theta(a, a) * cov_theta(b, b));
+      if (d > 0.0) res.correlation(a, b) = cov_theta(a, b) / d;
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    if (res.determination[j] == Determination::kWeak) res.weakly_identified.push_back(j);
+    if (res.determination[j] == Determination::kNotDetermined) res.not_determined.push_back(j);
+  }
+
+  // Condition number of the column-scaled weighted Jacobian ∂r/∂θ (all joints).
+  {
+    Eigen::MatrixXd J(3 * m, n);
+    for (int c = 0; c < m; ++c) {
+      for (int j = 0; j < n; ++j) J.block<3, 1>(3 * c, j) = B[c].col(j) * std::exp(-theta(j));
+    }
+    for (int j = 0; j < n; ++j) {
+      const double cn = J.col(j).norm();
+      if (cn > 0.0) J.col(j) /= cn;
+    }
+    const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(J).singularValues();
+    res.condition_number = sv(sv.size() - 1) > 0.0 ? sv(0) / sv(sv.size() - 1) : kInf;
+  }
+
+  // Advice in words a test engineer can act on.
+  const double tmax = res.max_joint_torque.maxCoeff();
+  const double lmax = res.max_target_lever.maxCoeff();
+  std::sort(confounded.begin(), confounded.end());
+  for (int j : barely) {
+    std::ostringstream s;
+    const bool unloaded = res.max_joint_torque(j) < 0.1 * tmax;
+    const bool unseen = res.max_target_lever(j) < 0.1 * lmax;
+    s << "joint " << j + 1 << " is not determined: ";
+    if (tmax == 0.0) {
+      s << "no load case loads the robot (every force is zero)";
+    } else if (unloaded || !unseen) {
+      s << "it is barely loaded (largest moment about its axis " << Fixed(res.max_joint_torque(j), 1)
+        << " N·m, against " << Fixed(tmax, 1) << " N·m on the most loaded joint): "
+        << MomentAdvice(j, n);
+    }
+    if (unseen && tmax > 0.0) {
+      s << (unloaded || !unseen ? "; and the" : "the") << " tracker target barely moves when it turns "
+        << "(largest lever " << Fixed(1e3 * res.max_target_lever(j), 1)
+        << " mm): place the target farther from joint " << j + 1 << "'s axis"
+        << (j == n - 1 ? " (off the tool axis, tx_mm/ty_mm)" : "");
+    }
+    res.advice.push_back(s.str());
+  }
+  for (int j : diverged) {
+    res.advice.push_back(
+        "joint " + std::to_string(j + 1) +
+        " is not determined: the fit drives its stiffness to infinity (the cases ask for a negative "
+        "compliance), so its effect is lost in the noise or in inconsistent cases; check the outliers, "
+        "then " + MomentAdvice(j, n));
+  }
+  if (!confounded.empty()) {
+    res.advice.push_back(
+        "joint" + std::string(confounded.size() > 1 ? "s " : " ") + JointList(confounded) +
+        (confounded.size() > 1 ? " are" : " is") +
+        " not determined: this data set fixes only combinations of " +
+        (confounded.size() > 1 ? "their" : "its") +
+        " compliance with other joints'. Add postures with different joint angles (arm reach, "
+        "elbow and wrist angles) and load cases with other rope directions");
+  }
+  for (int j : vague) {
+    res.advice.push_back("joint " + std::to_string(j + 1) + " is not determined (±" +
+                         Fixed(100.0 * res.relative_std(j), 0) + " % at 1 sigma): " +
+                         MomentAdvice(j, n) + ", and check for outliers");
+  }
+  for (int j : res.weakly_identified) {
+    res.advice.push_back("joint " + std::to_string(j + 1) + " is weakly determined (±" +
+                         Fixed(100.0 * res.relative_std(j), 1) + " % at 1 sigma): " +
+                         MomentAdvice(j, n) + ", or repeat the cases to average the tracker noise");
+  }
+  if (!res.outliers.empty()) {
+    std::string ids;
+    for (size_t i = 0; i < res.outliers.size(); ++i) {
+      ids += (i ? ", " : "") + res.residuals[res.outliers[i]].case_id;
+    }
+    res.advice.push_back(
+        "case" + std::string(res.outliers.size() > 1 ? "s " : " ") + ids +
+        (options.loss == RobustLoss::kNone
+             ? " disagree with the model far beyond the tracker noise: check them (target moved, "
+               "rope slipped, wrong mass) or rerun with a robust loss"
+             : " disagree with the model far beyond the tracker noise and were left out of the fit: "
+               "check them (target moved, rope slipped, wrong mass)"));
+  }
+  if (res.covariance_inflated) {
+    res.advice.push_back("the residuals are " + Fixed(std::sqrt(res.reduced_chi2), 1) +
+                         " times the stated tracker noise: the standard deviations were scaled up "
+                         "by that factor; check the noise value and the set-up");
+  }
+  return res;
+}
+
+}  // namespace robomach::identification

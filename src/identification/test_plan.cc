@@ -1,0 +1,268 @@
+#include "robomach/identification/test_plan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+#include "robomach/common/units.h"
+#include "robomach/identification/compliance_model.h"
+
+namespace robomach::identification {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double LogDet(const Eigen::MatrixXd& I) {
+  Eigen::LLT<Eigen::MatrixXd> llt(I);
+  if (llt.info() != Eigen::Success) return -kInf;
+  return 2.0 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
+}
+
+// √diag(I⁻¹), +inf along numerically null directions (as in joint_stiffness.cc).
+Eigen::VectorXd RelativeStd(const Eigen::MatrixXd& info) {
+  const int n = static_cast<int>(info.rows());
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(info);
+  const Eigen::VectorXd& lam = es.eigenvalues();
+  const double floor = 1e-12 * std::max(lam.maxCoeff(), 0.0);
+  Eigen::VectorXd out(n);
+  for (int i = 0; i < n; ++i) {
+    double var = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const double v2 = es.eigenvectors()(i, k) * es.eigenvectors()(i, k);
+      if (lam(k) <= floor || lam(k) <= 0.0) {
+        if (v2 > 1e-12) var = kInf;
+      } else {
+        var += v2 / lam(k);
+      }
+    }
+    out(i) = std::sqrt(var);
+  }
+  return out;
+}
+
+struct Candidate {
+  Eigen::VectorXd q;
+  Eigen::Vector3d p_load;
+  std::vector<Eigen::Vector3d> directions;
+  std::vector<Eigen::MatrixXd> info;  // per direction, all masses included
+};
+
+// Best `count` directions of a candidate given the current information
+// (greedy within the posture); returns the log det reached.
+double ChooseDirections(const Candidate& c, const Eigen::MatrixXd& I, int count,
+                        std::vector<int>* chosen) {
+  Eigen::MatrixXd acc = I;
+  chosen->clear();
+  double best_total = -kInf;
+  for (int s = 0; s < count; ++s) {
+    int best = -1;
+    double best_ld = -kInf;
+    for (size_t d = 0; d < c.directions.size(); ++d) {
+      if (std::find(chosen->begin(), chosen->end(), static_cast<int>(d)) != chosen->end()) continue;
+      const double ld = LogDet(acc + c.info[d]);
+      if (ld > best_ld) {
+        best_ld = ld;
+        best = static_cast<int>(d);
+      }
+    }
+    if (best < 0) break;
+    chosen->push_back(best);
+    acc += c.info[best];
+    best_total = best_ld;
+  }
+  return best_total;
+}
+
+}  // namespace
+
+Eigen::MatrixXd LogStiffnessInformation(const dynamics::RobotModel& model,
+                                        const std::vector<LoadCase>& cases,
+                                        const Eigen::VectorXd& kq, double sigma_displacement) {
+  const int n = model.num_joints();
+  Eigen::MatrixXd I = Eigen::MatrixXd::Zero(n, n);
+  for (const LoadCase& c : cases) {
+    const Matrix3Xd G = DisplacementPerCompliance(EvaluateCaseKinematics(model, c), c.force) *
+                        kq.cwiseInverse().asDiagonal();
+    I.noalias() += G.transpose() * G;
+  }
+  return I / (sigma_displacement * sigma_displacement);
+}
+
+void CheckValid(const PlanOptions& o) {
+  auto fail = [](const std::string& field, double v, const std::string& bound) {
+    std::ostringstream s;
+    s << "PlanOptions::" << field << ": expected " << bound << ", got " << v;
+    throw std::invalid_argument(s.str());
+  };
+  if (o.num_postures < 1) fail("num_postures", o.num_postures, "at least 1");
+  if (o.directions_per_posture < 1) fail("directions_per_posture", o.directions_per_posture, "at least 1");
+  if (o.masses_kg.empty()) throw std::invalid_argument("PlanOptions::masses_kg: expected at least one mass");
+  for (double mkg : o.masses_kg) {
+    if (!(mkg > 0.0)) fail("masses_kg", mkg, "masses > 0 kg");
+  }
+  if (!(o.tracker_noise > 0.0)) fail("tracker_noise", o.tracker_noise, "a value > 0 m");
+  if (!(o.max_rope_angle >= 0.0 && o.max_rope_angle < 0.5 * kPi)) {
+    fail("max_rope_angle", o.max_rope_angle, "an angle in [0, pi/2) rad");
+  }
+  if (o.num_candidate_postures < o.num_postures) {
+    fail("num_candidate_postures", o.num_candidate_postures, "at least num_postures");
+  }
+  if (o.num_azimuths < 1) fail("num_azimuths", o.num_azimuths, "at least 1");
+  if (!(o.joint_limit_margin >= 0.0)) fail("joint_limit_margin", o.joint_limit_margin, "a value >= 0 rad");
+}
+
+TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) {
+  CheckValid(o);
+  const int n = model.num_joints();
+  const Eigen::VectorXd kq = model.joint_stiffness();
+  const double sigma = std::sqrt(2.0) * o.tracker_noise;
+  double sum_m2 = 0.0;
+  for (double mkg : o.masses_kg) sum_m2 += mkg * mkg;
+  // The displacement is linear in the force, so the masses of one direction
+  // add (m g)² times the unit-force information.
+  const double scale = kStandardGravity * kStandardGravity * sum_m2 / (sigma * sigma);
+  const Eigen::Vector3d tcp = TcpInTip(model);
+
+  // Candidate rope directions: vertical, and rings at half and full tilt.
+  std::vector<Eigen::Vector3d> dirs{Eigen::Vector3d(0, 0, -1)};
+  for (double tilt : {0.5 * o.max_rope_angle, o.max_rope_angle}) {
+    if (tilt <= 0.0) continue;
+    for (int a = 0; a < o.num_azimuths; ++a) {
+      const double phi = 2.0 * kPi * a / o.num_azimuths;
+      dirs.emplace_back(std::sin(tilt) * std::cos(phi), std::sin(tilt) * std::sin(phi), -std::cos(tilt));
+    }
+  }
+
+  std::mt19937 rng(o.seed);
+  std::vector<Candidate> cands;
+  const auto& limits = model.chain().limits();
+  const int max_tries = 50 * o.num_candidate_postures;
+  for (int tries = 0; tries < max_tries && static_cast<int>(cands.size()) < o.num_candidate_postures; ++tries) {
+    Candidate c;
+    c.q.resize(n);
+    for (int j = 0; j < n; ++j) {
+      double lo = -kPi, hi = kPi;
+      if (limits[j].bounded) {
+        lo = limits[j].lower + o.joint_limit_margin;
+        hi = limits[j].upper - o.joint_limit_margin;
+      }
+      if (hi < lo) lo = hi = 0.5 * (limits[j].lower + limits[j].upper);
+      c.q(j) = std::uniform_real_distribution<double>(lo, hi)(rng);
+    }
+    LoadCase lc;
+    lc.q = c.q;
+    lc.p_load_tip = o.p_load_tip.value_or(tcp);
+    lc.p_target_tip = o.p_target_tip.value_or(tcp);
+    const CaseKinematics k = EvaluateCaseKinematics(model, lc);
+    c.p_load = k.p_BL;
+    const double height = c.p_load.z() - o.floor_z;
+    if (height < o.min_load_height) continue;
+    for (const Eigen::Vector3d& d : dirs) {
+      const Eigen::Vector3d pulley = c.p_load + d * (height / -d.z());
+      // The pulley must stand clear of the robot's foot (0.6 m from the base
+      // axis covers the KR210's base plate and a person-sized margin).
+      if (pulley.head<2>().norm() < 0.6) continue;
+      const Matrix3Xd G = DisplacementPerCompliance(k, d) * kq.cwiseInverse().asDiagonal();
+      c.directions.push_back(d);
+      c.info.push_back(scale * G.transpose() * G);
+    }
+    if (static_cast<int>(c.directions.size()) < o.directions_per_posture) continue;
+    cands.push_back(std::move(c));
+  }
+  TestPlan plan;
+  plan.num_candidates = static_cast<int>(cands.size());
+  if (static_cast<int>(cands.size()) < o.num_postures) {
+    throw std::invalid_argument("PlanLoadTests: only " + std::to_string(cands.size()) +
+                                " feasible postures found for " + std::to_string(o.num_postures) +
+                                " requested: lower min_load_height or widen max_rope_angle");
+  }
+
+  // A ridge of 1e-6 (a prior σ(θ) of 1000, i.e. no knowledge) keeps log det
+  // finite while joints are still unseen; one load case adds ~1e3.
+  const Eigen::MatrixXd ridge = 1e-6 * Eigen::MatrixXd::Identity(n, n);
+  std::vector<int> sel;
+  std::vector<std::vector<int>> sel_dirs;
+  Eigen::MatrixXd I = ridge;
+  auto contribution = [&](int ci, const std::vector<int>& ds) {
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
+    for (int d : ds) M += cands[ci].info[d];
+    return M;
+  };
+  std::vector<int> chosen;
+  for (int s = 0; s < o.num_postures; ++s) {
+    int best = -1;
+    double best_ld = -kInf;
+    std::vector<int> best_dirs;
+    for (int ci = 0; ci < static_cast<int>(cands.size()); ++ci) {
+      if (std::find(sel.begin(), sel.end(), ci) != sel.end()) continue;
+      const double ld = ChooseDirections(cands[ci], I, o.directions_per_posture, &chosen);
+      if (ld > best_ld) {
+        best_ld = ld;
+        best = ci;
+        best_dirs = chosen;
+      }
+    }
+    sel.push_back(best);
+    sel_dirs.push_back(best_dirs);
+    I += contribution(best, best_dirs);
+  }
+  // Exchange passes (Fedorov-style): replace a chosen posture by a better one.
+  for (int pass = 0; pass < 3; ++pass) {
+    bool improved = false;
+    for (int s = 0; s < o.num_postures; ++s) {
+      const Eigen::MatrixXd I_minus = I - contribution(sel[s], sel_dirs[s]);
+      double cur = LogDet(I);
+      for (int ci = 0; ci < static_cast<int>(cands.size()); ++ci) {
+        if (std::find(sel.begin(), sel.end(), ci) != sel.end()) continue;
+        const double ld = ChooseDirections(cands[ci], I_minus, o.directions_per_posture, &chosen);
+        if (ld > cur + 1e-9) {
+          sel[s] = ci;
+          sel_dirs[s] = chosen;
+          I = I_minus + contribution(ci, chosen);
+          cur = ld;
+          improved = true;
+        }
+      }
+    }
+    if (!improved) break;
+  }
+
+  const Eigen::MatrixXd info = I - ridge;
+  plan.log_det_information = LogDet(info);
+  plan.expected_relative_std = RelativeStd(info);
+  plan.expected_std_dev = kq.cwiseProduct(plan.expected_relative_std);
+  for (int s = 0; s < o.num_postures; ++s) {
+    const Candidate& c = cands[sel[s]];
+    const std::string pose_id = "P" + std::to_string(s + 1);
+    for (size_t k = 0; k < sel_dirs[s].size(); ++k) {
+      const Eigen::Vector3d d = c.directions[sel_dirs[s][k]];
+      PlannedLoad pl;
+      pl.pose_id = pose_id;
+      pl.q = c.q;
+      pl.rope_direction = d;
+      pl.p_load = c.p_load;
+      pl.p_pulley = c.p_load + d * ((c.p_load.z() - o.floor_z) / -d.z());
+      plan.loads.push_back(pl);
+      for (double mkg : o.masses_kg) {
+        LoadCase lc;
+        std::ostringstream id;
+        id << pose_id << "-" << static_cast<char>('a' + k) << "-" << mkg << "kg";
+        lc.case_id = id.str();
+        lc.pose_id = pose_id;
+        lc.q = c.q;
+        lc.force = mkg * kStandardGravity * d;
+        lc.p_load_tip = o.p_load_tip;
+        lc.p_target_tip = o.p_target_tip;
+        plan.cases.push_back(lc);
+      }
+    }
+  }
+  return plan;
+}
+
+}  // namespace robomach::identification
