@@ -28,23 +28,6 @@ namespace {
 
 constexpr char kTool[] = "kq-identify";
 
-// "x,y,z" in mm -> metres; "tcp" -> nullopt.
-std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std::string& text) {
-  if (text.empty() || text == "tcp") return std::nullopt;
-  std::stringstream ss(text);
-  std::string item;
-  std::vector<double> v;
-  while (std::getline(ss, item, ',')) {
-    double x = 0.0;
-    if (!io::ParseFiniteNumber(item, &x)) {
-      throw std::invalid_argument(option + ": expected x,y,z in mm or 'tcp', got \"" + text + "\"");
-    }
-    v.push_back(x);
-  }
-  if (v.size() != 3) throw std::invalid_argument(option + ": expected three numbers x,y,z in mm, got \"" + text + "\"");
-  return Eigen::Vector3d(MmToM(v[0]), MmToM(v[1]), MmToM(v[2]));
-}
-
 std::string Sci(double v, int digits = 3) {
   if (!std::isfinite(v)) return "inf";
   std::ostringstream s;
@@ -226,18 +209,13 @@ int RunPlan(const io::RobotConfig& cfg, int num_postures, double noise_mm, unsig
   return flagged ? kExitFlagged : kExitOk;
 }
 
-std::vector<double> ParseList(const std::string& option, const std::string& text) {
-  std::stringstream ss(text);
-  std::string item;
-  std::vector<double> v;
-  while (std::getline(ss, item, ',')) {
-    double x = 0.0;
-    if (!io::ParseFiniteNumber(item, &x) || !(x > 0.0)) {
+std::vector<double> ParsePositiveList(const std::string& option, const std::string& text) {
+  const std::vector<double> v = ParseNumberList(option, text);
+  for (double x : v) {
+    if (!(x > 0.0)) {
       throw std::invalid_argument(option + ": expected positive numbers separated by commas, got \"" + text + "\"");
     }
-    v.push_back(x);
   }
-  if (v.empty()) throw std::invalid_argument(option + ": expected at least one value");
   return v;
 }
 
@@ -302,7 +280,7 @@ int Run(int argc, char** argv) {
       if (plan_n < 1) throw std::invalid_argument("--plan: expected a number of postures >= 1");
       if (merge) throw std::invalid_argument("--merge cannot be combined with --plan");
       return RunPlan(cfg, plan_n, noise_mm, seed, ParsePointMm("--load-point-mm", load_point),
-                     ParsePointMm("--target-mm", target), ParseList("--masses-kg", masses), rope_angle_deg,
+                     ParsePointMm("--target-mm", target), ParsePositiveList("--masses-kg", masses), rope_angle_deg,
                      out_path);
     }
     if (tracker_path.empty()) throw std::invalid_argument("--tracker is required (or --plan N)");

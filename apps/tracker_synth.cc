@@ -21,27 +21,6 @@ namespace {
 
 constexpr char kTool[] = "tracker-synth";
 
-std::vector<double> ParseNumbers(const std::string& option, const std::string& text) {
-  std::stringstream ss(text);
-  std::string item;
-  std::vector<double> v;
-  while (std::getline(ss, item, ',')) {
-    double x = 0.0;
-    if (!io::ParseFiniteNumber(item, &x)) {
-      throw std::invalid_argument(option + ": expected numbers separated by commas, got \"" + text + "\"");
-    }
-    v.push_back(x);
-  }
-  return v;
-}
-
-std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std::string& text) {
-  if (text == "tcp") return std::nullopt;
-  const auto v = ParseNumbers(option, text);
-  if (v.size() != 3) throw std::invalid_argument(option + ": expected x,y,z in mm or 'tcp', got \"" + text + "\"");
-  return Eigen::Vector3d(MmToM(v[0]), MmToM(v[1]), MmToM(v[2]));
-}
-
 int Run(int argc, char** argv) {
   CLI::App app{
       "tracker-synth: simulate a laser-tracker load-test campaign (formats.md §2).\n"
@@ -104,7 +83,7 @@ int Run(int argc, char** argv) {
     const auto model = cfg.Build();
 
     identification::CampaignOptions o;
-    o.masses_kg = ParseNumbers("--masses-kg", masses);
+    o.masses_kg = ParseNumberList("--masses-kg", masses);
     for (double m : o.masses_kg) {
       if (!(m > 0.0)) throw std::invalid_argument("--masses-kg: expected masses > 0 kg");
     }

@@ -86,4 +86,34 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
   return {text.substr(0, eq), v};
 }
 
+std::vector<double> ParseNumberList(const std::string& option, const std::string& text) {
+  std::vector<double> v;
+  size_t pos = 0;
+  while (pos <= text.size()) {
+    size_t comma = text.find(',', pos);
+    if (comma == std::string::npos) comma = text.size();
+    double x = 0.0;
+    if (!io::ParseFiniteNumber(text.substr(pos, comma - pos), &x)) {
+      throw std::invalid_argument(option + ": expected numbers separated by commas, got \"" + text + "\"");
+    }
+    v.push_back(x);
+    pos = comma + 1;
+  }
+  return v;
+}
+
+std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std::string& text) {
+  if (text.empty() || text == "tcp") return std::nullopt;
+  std::vector<double> v;
+  try {
+    v = ParseNumberList(option, text);
+  } catch (const std::invalid_argument&) {
+    v.clear();
+  }
+  if (v.size() != 3) {
+    throw std::invalid_argument(option + ": expected x,y,z in mm or 'tcp', got \"" + text + "\"");
+  }
+  return Eigen::Vector3d(v[0] * 1e-3, v[1] * 1e-3, v[2] * 1e-3);
+}
+
 }  // namespace robomach::apps

@@ -6,6 +6,9 @@
 
 #include <chrono>
 #include <functional>
+#include <optional>
+
+#include <Eigen/Core>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -60,5 +63,10 @@ void Warn(const std::string& tool, const std::string& message);
 
 /// Splits "NAME=VALUE"; @throws std::invalid_argument naming the option.
 std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text);
+
+/// "1,2.5,3" -> numbers; @throws std::invalid_argument naming the option.
+std::vector<double> ParseNumberList(const std::string& option, const std::string& text);
+/// "x,y,z" in millimetres -> metres, or nullopt for "tcp" (or empty).
+std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std::string& text);
 
 }  // namespace robomach::apps

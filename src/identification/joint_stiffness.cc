@@ -11,6 +11,7 @@
 #include <ceres/ceres.h>
 #include <Eigen/Dense>
 
+#include "identification/internal/information.h"
 #include "identification/internal/tracker_residual.h"
 #include "robomach/identification/compliance_model.h"
 
@@ -55,33 +56,6 @@ std::string MomentAdvice(int j, int n) {
          "that axis)";
 }
 
-// Information matrix of the scaled compliances x (x_i = c_i k0_i), restricted
-// to `free`; returns the marginal relative standard deviations (x ≈ 1), +inf
-// along numerically null directions.
-Eigen::VectorXd MarginalRelativeStd(const Eigen::MatrixXd& info) {
-  const int p = static_cast<int>(info.rows());
-  Eigen::VectorXd out = Eigen::VectorXd::Constant(p, kInf);
-  if (p == 0) return out;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(info);
-  const Eigen::VectorXd& lam = es.eigenvalues();
-  const double lmax = std::max(lam.maxCoeff(), 0.0);
-  // Eigenvalues below 1e-12 λ_max are rounding noise of a zero (eps·cond
-  // budget of a 6×6 symmetric eigensolver is ~1e-14 relative).
-  const double floor = 1e-12 * lmax;
-  for (int i = 0; i < p; ++i) {
-    double var = 0.0;
-    for (int k = 0; k < p; ++k) {
-      const double v2 = es.eigenvectors()(i, k) * es.eigenvectors()(i, k);
-      if (lam(k) <= floor || lam(k) <= 0.0) {
-        if (v2 > 1e-12) var = kInf;
-      } else {
-        var += v2 / lam(k);
-      }
-    }
-    out(i) = std::sqrt(var);
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -200,7 +174,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     Eigen::MatrixXd sub(rest.size(), rest.size());
     for (size_t a = 0; a < rest.size(); ++a)
       for (size_t b = 0; b < rest.size(); ++b) sub(a, b) = info(rest[a], rest[b]);
-    const Eigen::VectorXd rel = MarginalRelativeStd(sub);
+    const Eigen::VectorXd rel = internal::MarginalStdFromInformation(sub);
     for (size_t a = 0; a < rest.size(); ++a) {
       (rel(a) > u ? confounded : free).push_back(rest[a]);
     }

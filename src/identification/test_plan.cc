@@ -1,3 +1,4 @@
+#include "identification/internal/information.h"
 #include "robomach/identification/test_plan.h"
 
 #include <algorithm>
@@ -23,27 +24,6 @@ double LogDet(const Eigen::MatrixXd& I) {
   return 2.0 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
 }
 
-// √diag(I⁻¹), +inf along numerically null directions (as in joint_stiffness.cc).
-Eigen::VectorXd RelativeStd(const Eigen::MatrixXd& info) {
-  const int n = static_cast<int>(info.rows());
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(info);
-  const Eigen::VectorXd& lam = es.eigenvalues();
-  const double floor = 1e-12 * std::max(lam.maxCoeff(), 0.0);
-  Eigen::VectorXd out(n);
-  for (int i = 0; i < n; ++i) {
-    double var = 0.0;
-    for (int k = 0; k < n; ++k) {
-      const double v2 = es.eigenvectors()(i, k) * es.eigenvectors()(i, k);
-      if (lam(k) <= floor || lam(k) <= 0.0) {
-        if (v2 > 1e-12) var = kInf;
-      } else {
-        var += v2 / lam(k);
-      }
-    }
-    out(i) = std::sqrt(var);
-  }
-  return out;
-}
 
 struct Candidate {
   Eigen::VectorXd q;
@@ -234,7 +214,7 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
 
   const Eigen::MatrixXd info = I - ridge;
   plan.log_det_information = LogDet(info);
-  plan.expected_relative_std = RelativeStd(info);
+  plan.expected_relative_std = internal::MarginalStdFromInformation(info);
   plan.expected_std_dev = kq.cwiseProduct(plan.expected_relative_std);
   for (int s = 0; s < o.num_postures; ++s) {
     const Candidate& c = cands[sel[s]];
