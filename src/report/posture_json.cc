@@ -30,6 +30,16 @@ nlohmann::json Vector(const Eigen::VectorXd& v) {
 nlohmann::json PostureToJson(const std::string& pose_id, const dynamics::PostureDynamics& d) {
   nlohmann::json j;
   j["pose_id"] = pose_id;
+  // The matrices mix units by row and column; say which, once per posture.
+  j["units"] = {
+      {"M_q", "kg·m² (revolute joints: N·m·s²/rad)"},
+      {"K_q", "N·m/rad"},
+      {"C_q", "N·m·s/rad"},
+      {"J_BT", "rows 1-3 m/rad, rows 4-6 rad/rad"},
+      {"M_X", "blocks [kg, kg·m; kg·m, kg·m²] for [x y z; rx ry rz]"},
+      {"K_X", "blocks [N/m, N/rad; N, N·m/rad]"},
+      {"C_X", "blocks [N·s/m, N·s/rad; N·s, N·m·s/rad]"},
+      {"static_compliance_m_per_N", "m/N"}};
   j["q_rad"] = Vector(d.q);
   j["tcp_position_m"] = Vector(d.X_BT.translation());
   j["tcp_rotation"] = Matrix(d.X_BT.linear());
