@@ -18,14 +18,20 @@
 
 namespace robomach::dynamics {
 
+// KDL::Joint::pose() caches its last result in mutable members, so two
+// threads must never evaluate the same KDL::Chain object. Each workspace owns
+// a private copy of the chain (a few hundred bytes) and binds its solvers to
+// it; that is what makes a shared RobotModel safe across threads.
 struct PostureEvaluator::Workspace {
-  explicit Workspace(const KDL::Chain& chain)
-      : fk(chain),
+  explicit Workspace(const KDL::Chain& shared_chain)
+      : chain(shared_chain),
+        fk(chain),
         jac(chain),
         dyn(chain, KDL::Vector::Zero()),  // gravity does not enter M_q
-        q(chain.getNrOfJoints()),
-        J(chain.getNrOfJoints()),
-        H(chain.getNrOfJoints()) {}
+        q(shared_chain.getNrOfJoints()),
+        J(shared_chain.getNrOfJoints()),
+        H(shared_chain.getNrOfJoints()) {}
+  const KDL::Chain chain;  // declared first: the solvers below keep a reference to it
   KDL::ChainFkSolverPos_recursive fk;
   KDL::ChainJntToJacSolver jac;
   KDL::ChainDynParam dyn;

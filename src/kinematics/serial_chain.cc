@@ -176,9 +176,13 @@ KDL::JntArray ToJnt(const Eigen::VectorXd& q) {
 }
 }  // namespace
 
+// The one-off solvers below work on a private copy of the KDL chain:
+// KDL::Joint::pose() writes a cache in mutable members, so evaluating a
+// shared chain from two threads would race.
 Eigen::Isometry3d SegmentPose(const SerialChain& chain, const Eigen::VectorXd& q, int segment) {
   CheckJointVector(chain, q);
-  KDL::ChainFkSolverPos_recursive fk(chain.kdl());
+  const KDL::Chain own = chain.kdl();
+  KDL::ChainFkSolverPos_recursive fk(own);
   KDL::Frame f;
   internal::ThrowIfKdlFailed(fk.JntToCart(ToJnt(q), f, segment + 1), fk, "forward kinematics");
   return ToEigen(f);
@@ -190,7 +194,8 @@ Eigen::Isometry3d ForwardKinematics(const SerialChain& chain, const Eigen::Vecto
 
 Matrix6Xd Jacobian(const SerialChain& chain, const Eigen::VectorXd& q) {
   CheckJointVector(chain, q);
-  KDL::ChainJntToJacSolver solver(chain.kdl());
+  const KDL::Chain own = chain.kdl();
+  KDL::ChainJntToJacSolver solver(own);
   KDL::Jacobian J(chain.num_joints());
   internal::ThrowIfKdlFailed(solver.JntToJac(ToJnt(q), J), solver, "Jacobian");
   return J.data;

@@ -41,8 +41,10 @@ struct JointLimits {
 };
 
 /// A serial chain of rigid links joined by revolute joints, built on
-/// KDL::Chain. Immutable; copies share the KDL chain (KDL solvers keep a
-/// reference to it, so it must never move: it lives on the heap).
+/// KDL::Chain. Immutable; copies share the KDL chain. KDL::Joint caches its
+/// last pose in mutable members, so never run a KDL solver on kdl() from two
+/// threads: bind solvers to a private copy (as the functions below and
+/// dynamics::PostureEvaluator do).
 ///
 /// Conventions: the chain starts at the base frame B and ends at the tip
 /// frame of its last segment. Jacobians refer to the tip of the last segment,
