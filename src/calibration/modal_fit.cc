@@ -21,6 +21,16 @@ double CrossingFreq(const Eigen::VectorXd& f, const Eigen::VectorXd& p2, int i, 
   return f(i) + t * (f(j) - f(i));
 }
 
+// |H| of the data at the line nearest to f.
+double LocalLevel(const dynamics::Frf& frf, double f_hz) {
+  const Eigen::VectorXd& f = frf.freq_hz();
+  const auto it = std::lower_bound(f.data(), f.data() + f.size(), f_hz);
+  int i = static_cast<int>(it - f.data());
+  if (i >= f.size()) i = static_cast<int>(f.size()) - 1;
+  if (i > 0 && std::abs(f(i - 1) - f_hz) < std::abs(f(i) - f_hz)) --i;
+  return std::abs(frf.receptance()(i));
+}
+
 }  // namespace
 
 std::vector<PeakEstimate> PickPeaks(const dynamics::Frf& frf, const PeakPickOptions& options) {
@@ -416,78 +426,142 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
       result.stabilisation.push_back({n, f_hz, zeta, stable});
     }
   }
-  // The stable poles of the order, among the five highest, with the most of
-  // them (the highest such order on a tie): a pair of close modes may lose
-  // its stability at one order where the noise poles crowd it.
-  std::vector<cd> poles;
-  std::vector<int> chains;
-  int best_count = -1;
-  for (int n = nmax; n >= std::max(o.min_order, nmax - 4); --n) {
-    int count = 0;
-    for (const OrderPole& p : by_order[n]) count += p.chain >= o.min_stable_orders;
-    if (count > best_count) {
-      best_count = count;
-      poles.clear();
-      chains.clear();
-      for (const OrderPole& p : by_order[n]) {
-        if (p.chain >= o.min_stable_orders) {
-          poles.push_back(p.lambda);
-          chains.push_back(p.chain);
-        }
+  // Candidate pole sets: the stable poles of each of the five highest
+  // orders. Each is fitted (LSFD, pruning, refinement) and the one with the
+  // smallest refined error wins: a close pair may lose its stability at one
+  // order where noise poles crowd it, and refinement from a poor start can
+  // end in a local minimum.
+  const int N2 = 2 * N;
+  auto lower_for = [&](const std::vector<cd>& poles) {
+    double lowest = 1e300;
+    for (const cd& p : poles) lowest = std::min(lowest, RadPerSecToHz(std::abs(p)));
+    return result.fmin_hz > 0.2 * lowest;
+  };
+  auto prune = [&](ModalFitResult* r) {
+    std::vector<cd> keep;
+    std::vector<int> chain;
+    for (const FittedMode& m : r->modes) {
+      if (m.damping_ratio > 0.0 && m.damping_ratio < o.max_damping_ratio && std::isfinite(m.freq_hz) &&
+          m.freq_hz >= result.fmin_hz && m.freq_hz <= result.fmax_hz &&
+          m.peak_contribution >= o.min_relative_contribution * LocalLevel(frf, m.freq_hz)) {
+        keep.push_back(m.pole);
+        chain.push_back(m.stable_orders);
       }
-      result.order_used = n;
+    }
+    return std::pair{keep, chain};
+  };
+  // LSFD, prune, refine, prune again; returns the squared weighted error.
+  auto fit_with = [&](std::vector<cd> poles, std::vector<int> chains, ModalFitResult* r) {
+    for (int pass = 0; pass < 3 && !poles.empty(); ++pass) {
+      FitResidues(frf, poles, lower_for(poles), r);
+      for (size_t i = 0; i < r->modes.size(); ++i) r->modes[i].stable_orders = chains[i];
+      if (pass > 0 || true) {
+        const double before = r->modes.size();
+        if (pass == 1 || pass == 2) {
+          RefineAll(frf, lower_for(poles), r);
+        }
+        auto [keep, chain] = prune(r);
+        if (keep.size() == before && pass >= 1) break;
+        poles = keep;
+        chains = chain;
+      }
+    }
+    if (poles.empty()) {
+      r->modes.clear();
+      return 1e300;
+    }
+    double cost = 0.0;
+    for (int k = 0; k < N; ++k) {
+      const double a = std::abs(frf.receptance()(k));
+      if (a > 0.0) cost += std::norm((r->Evaluate(frf.freq_hz()(k)) - frf.receptance()(k)) / a);
+    }
+    return cost;
+  };
+  ModalFitResult best = result;
+  double best_cost = 1e300;
+  for (int n = nmax; n >= std::max(o.min_order, nmax - 4); --n) {
+    std::vector<cd> poles;
+    std::vector<int> chains;
+    for (const OrderPole& p : by_order[n]) {
+      if (p.chain >= o.min_stable_orders) {
+        poles.push_back(p.lambda);
+        chains.push_back(p.chain);
+      }
+    }
+    if (poles.empty()) continue;
+    ModalFitResult r = result;
+    const double cost = fit_with(poles, chains, &r);
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = r;
+      best.order_used = n;
     }
   }
-  if (poles.empty()) {
+  if (best_cost >= 1e300) {
     result.status = ModalFitStatus::kNoStableModes;
     result.message = "no pole was stable over " + std::to_string(o.min_stable_orders) +
-                     " consecutive orders up to " + std::to_string(nmax);
+                     " consecutive orders up to " + std::to_string(nmax) + " with a significant residue";
     return result;
   }
-  const double hmax = frf.receptance().cwiseAbs().maxCoeff();
-  // LSFD; then drop computational modes with a negligible contribution and refit.
-  for (int pass = 0; pass < 2; ++pass) {
-    double lowest = 1e300;
-    for (const cd& p : poles) lowest = std::min(lowest, RadPerSecToHz(std::abs(p)));
-    const bool lower = result.fmin_hz > 0.2 * lowest;
-    FitResidues(frf, poles, lower, &result);
-    std::vector<cd> keep;
-    std::vector<int> keep_chain;
-    for (size_t i = 0; i < result.modes.size(); ++i) {
-      if (result.modes[i].peak_contribution >= o.min_relative_contribution * hmax) {
-        keep.push_back(poles[i]);
-        keep_chain.push_back(chains[i]);
-      }
+  // Residual-driven additions: where the weighted residual is structured
+  // (its local mean square over ±W lines exceeds 4 times the median, i.e. it
+  // is not noise), a mode is missing; add a pole there, refit, and keep it
+  // if the Bayesian information criterion 2N ln(F) + p ln(2N) falls (p the
+  // number of real parameters, 4 per mode).
+  int added = 0;
+  for (int attempt = 0; attempt < o.max_added_modes; ++attempt) {
+    Eigen::VectorXd e2(N);
+    for (int k = 0; k < N; ++k) {
+      const double a = std::abs(frf.receptance()(k));
+      e2(k) = a > 0.0 ? std::norm((best.Evaluate(frf.freq_hz()(k)) - frf.receptance()(k)) / a) : 0.0;
     }
-    if (keep.size() == poles.size()) break;
-    poles = keep;
-    chains = keep_chain;
-    if (poles.empty()) {
-      result.status = ModalFitStatus::kNoStableModes;
-      result.message = "the stable poles all have negligible residues";
-      result.modes.clear();
-      return result;
+    const int W = std::max(3, N / 200);
+    Eigen::VectorXd local(N);
+    Eigen::VectorXd csum(N + 1);
+    csum(0) = 0.0;
+    for (int k = 0; k < N; ++k) csum(k + 1) = csum(k) + e2(k);
+    for (int k = 0; k < N; ++k) {
+      const int a = std::max(0, k - W), b = std::min(N, k + W + 1);
+      local(k) = (csum(b) - csum(a)) / (b - a);
+    }
+    std::vector<double> sorted(local.data(), local.data() + N);
+    std::nth_element(sorted.begin(), sorted.begin() + N / 2, sorted.end());
+    const double median = sorted[N / 2];
+    int kmax = 0;
+    local.maxCoeff(&kmax);
+    if (!(local(kmax) > 4.0 * median)) break;
+    const double wn = HzToRadPerSec(frf.freq_hz()(kmax));
+    const double z0 = 0.03;
+    std::vector<cd> poles;
+    std::vector<int> chains;
+    for (const FittedMode& m : best.modes) {
+      poles.push_back(m.pole);
+      chains.push_back(m.stable_orders);
+    }
+    poles.push_back(cd(-z0 * wn, wn * std::sqrt(1 - z0 * z0)));
+    chains.push_back(0);
+    ModalFitResult r = result;
+    const double cost = fit_with(poles, chains, &r);
+    auto bic = [&](double c, size_t modes) {
+      return N2 * std::log(std::max(c, 1e-300)) + (4.0 * modes + 2.0) * std::log(static_cast<double>(N2));
+    };
+    if (cost < 1e300 && bic(cost, r.modes.size()) < bic(best_cost, best.modes.size()) &&
+        r.modes.size() > best.modes.size()) {
+      r.order_used = best.order_used;
+      best = r;
+      best_cost = cost;
+      ++added;
+    } else {
+      break;
     }
   }
-  for (size_t i = 0; i < result.modes.size(); ++i) result.modes[i].stable_orders = chains[i];
-  {
-    double lowest = 1e300;
-    for (const cd& p : poles) lowest = std::min(lowest, RadPerSecToHz(std::abs(p)));
-    RefineAll(frf, result.fmin_hz > 0.2 * lowest, &result);
-  }
-  for (const FittedMode& m : result.modes) {
-    if (!(m.damping_ratio > 0.0 && m.damping_ratio < o.max_damping_ratio) || !std::isfinite(m.freq_hz)) {
-      result.status = ModalFitStatus::kFailed;
-      result.message = "the nonlinear refinement moved a pole out of the physical range";
-      return result;
-    }
-  }
+  result = best;
   std::sort(result.modes.begin(), result.modes.end(),
             [](const FittedMode& a, const FittedMode& b) { return a.freq_hz < b.freq_hz; });
-  // Restore the chain counts after sorting (the sort moved whole modes).
   result.status = ModalFitStatus::kOk;
-  result.message = std::to_string(result.modes.size()) + " stable modes at order " +
-                   std::to_string(result.order_used) + ", refined";
+  result.message = std::to_string(result.modes.size()) + " modes: stable poles of order " +
+                   std::to_string(result.order_used) + ", refined" +
+                   (added > 0 ? ", " + std::to_string(added) + " added from the residual" : "");
   return result;
 }
 

@@ -62,9 +62,14 @@ struct ModalFitOptions {
   /// Physical poles: 0 < ζ < max_damping_ratio.
   double max_damping_ratio{0.3};
   /// A selected mode's peak contribution |A| / (2 ζ ω_n²) must reach this
-  /// fraction of the largest |H| in the band; smaller ones are discarded as
-  /// computational (they model noise, not structure).
-  double min_relative_contribution{0.02};
+  /// fraction of the measured |H| at its natural frequency; smaller ones are
+  /// discarded as computational (they model noise, not structure). The
+  /// comparison is local, not with the largest peak: with relative weights a
+  /// weak high-frequency mode shapes the FRF where it lies and must be kept.
+  double min_relative_contribution{0.1};
+  /// At most this many modes are added where the refined fit's residual is
+  /// structured rather than noise (see FitModes).
+  int max_added_modes{4};
 };
 
 /// One identified mode of a single FRF H_re, with the pole λ and residue R
@@ -130,8 +135,11 @@ struct ModalFitResult {
 /// with weights 1/|H|. Finally poles, residues and residuals are refined
 /// together by Levenberg–Marquardt on the same weighted error (the
 /// maximum-likelihood fit for noise proportional to |H|), which removes the
-/// bias of the linearised LSCF estimate. Numerical trouble is a status, not
-/// an exception.
+/// bias of the linearised LSCF estimate. This is done for the stable pole
+/// sets of the five highest orders and the best fit is kept. Where its
+/// weighted residual is still structured (local mean square above four times
+/// the median), a pole is added there and kept if the Bayesian information
+/// criterion improves. Numerical trouble is a status, not an exception.
 ///
 /// - [Guillaume et al. 2003] P. Guillaume, P. Verboven, S. Vanlanduit,
 ///   H. Van der Auweraer, B. Peeters, A poly-reference implementation of the
