@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include <Eigen/Dense>
@@ -440,30 +441,51 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
   auto prune = [&](ModalFitResult* r) {
     std::vector<cd> keep;
     std::vector<int> chain;
-    for (const FittedMode& m : r->modes) {
-      if (m.damping_ratio > 0.0 && m.damping_ratio < o.max_damping_ratio && std::isfinite(m.freq_hz) &&
-          m.freq_hz >= result.fmin_hz && m.freq_hz <= result.fmax_hz &&
-          m.peak_contribution >= o.min_relative_contribution * LocalLevel(frf, m.freq_hz)) {
-        keep.push_back(m.pole);
-        chain.push_back(m.stable_orders);
+    std::vector<const FittedMode*> kept;
+    // Strongest first, so that of two unresolvable poles the weaker goes.
+    std::vector<const FittedMode*> order;
+    for (const FittedMode& m : r->modes) order.push_back(&m);
+    std::sort(order.begin(), order.end(), [](const FittedMode* a, const FittedMode* b) {
+      return a->peak_contribution > b->peak_contribution;
+    });
+    for (const FittedMode* mp : order) {
+      const FittedMode& m = *mp;
+      if (!(m.damping_ratio > 0.0 && m.damping_ratio < o.max_damping_ratio && std::isfinite(m.freq_hz) &&
+            m.freq_hz >= result.fmin_hz && m.freq_hz <= result.fmax_hz &&
+            m.peak_contribution >= o.min_relative_contribution * LocalLevel(frf, m.freq_hz))) {
+        continue;
       }
+      // Two poles closer than a fifth of the half-power bandwidth are one
+      // mode split in two (a degenerate fit), not two resolvable modes.
+      bool duplicate = false;
+      for (const FittedMode* k : kept) {
+        const double zbar = 0.5 * (k->damping_ratio + m.damping_ratio);
+        if (std::abs(k->freq_hz - m.freq_hz) < 0.2 * zbar * m.freq_hz) duplicate = true;
+      }
+      if (duplicate) continue;
+      kept.push_back(mp);
+      keep.push_back(m.pole);
+      chain.push_back(m.stable_orders);
     }
     return std::pair{keep, chain};
   };
   // LSFD, prune, refine, prune again; returns the squared weighted error.
-  auto fit_with = [&](std::vector<cd> poles, std::vector<int> chains, ModalFitResult* r) {
-    for (int pass = 0; pass < 3 && !poles.empty(); ++pass) {
+  // `refine_first`: refine before the first pruning (for a pole added by
+  // guess, whose linear residue alone may look negligible).
+  auto fit_with = [&](std::vector<cd> poles, std::vector<int> chains, ModalFitResult* r,
+                      bool refine_first = false) {
+    for (int pass = 0; pass < 4 && !poles.empty(); ++pass) {
       FitResidues(frf, poles, lower_for(poles), r);
       for (size_t i = 0; i < r->modes.size(); ++i) r->modes[i].stable_orders = chains[i];
-      if (pass > 0 || true) {
-        const double before = r->modes.size();
-        if (pass == 1 || pass == 2) {
-          RefineAll(frf, lower_for(poles), r);
-        }
-        auto [keep, chain] = prune(r);
-        if (keep.size() == before && pass >= 1) break;
-        poles = keep;
-        chains = chain;
+      if (pass > 0 || refine_first) RefineAll(frf, lower_for(poles), r);
+      auto [keep, chain] = prune(r);
+      if (keep.size() == r->modes.size() && (pass > 0 || refine_first)) break;
+      poles = keep;
+      chains = chain;
+      if (pass == 3 && !poles.empty()) {
+        FitResidues(frf, poles, lower_for(poles), r);
+        for (size_t i = 0; i < r->modes.size(); ++i) r->modes[i].stable_orders = chains[i];
+        RefineAll(frf, lower_for(poles), r);
       }
     }
     if (poles.empty()) {
@@ -508,6 +530,9 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
   // is not noise), a mode is missing; add a pole there, refit, and keep it
   // if the Bayesian information criterion 2N ln(F) + p ln(2N) falls (p the
   // number of real parameters, 4 per mode).
+  auto bic = [&](double c, size_t modes) {
+    return N2 * std::log(std::max(c, 1e-300)) + (4.0 * modes + 2.0) * std::log(static_cast<double>(N2));
+  };
   int added = 0;
   for (int attempt = 0; attempt < o.max_added_modes; ++attempt) {
     Eigen::VectorXd e2(N);
@@ -530,27 +555,66 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
     int kmax = 0;
     local.maxCoeff(&kmax);
     if (!(local(kmax) > 4.0 * median)) break;
-    const double wn = HzToRadPerSec(frf.freq_hz()(kmax));
-    const double z0 = 0.03;
-    std::vector<cd> poles;
-    std::vector<int> chains;
+    // The missing pole may hide under an existing one (a close pair fitted as
+    // one mode), so try it at the residual's peak and at ±2ζ and ±4ζ of it,
+    // ζ from the nearest fitted mode; keep the best fit.
+    const double f_peak = frf.freq_hz()(kmax);
+    double z0 = 0.03, nearest = 1e300;
     for (const FittedMode& m : best.modes) {
-      poles.push_back(m.pole);
-      chains.push_back(m.stable_orders);
+      if (std::abs(m.freq_hz - f_peak) < nearest) {
+        nearest = std::abs(m.freq_hz - f_peak);
+        z0 = m.damping_ratio;
+      }
     }
-    poles.push_back(cd(-z0 * wn, wn * std::sqrt(1 - z0 * z0)));
-    chains.push_back(0);
-    ModalFitResult r = result;
-    const double cost = fit_with(poles, chains, &r);
-    auto bic = [&](double c, size_t modes) {
-      return N2 * std::log(std::max(c, 1e-300)) + (4.0 * modes + 2.0) * std::log(static_cast<double>(N2));
-    };
+    ModalFitResult r;
+    double cost = 1e300;
+    for (double shift : {0.0, -2.0, 2.0, -4.0, 4.0}) {
+      const double wn = HzToRadPerSec(f_peak * (1.0 + shift * z0));
+      if (!(wn > 0.0)) continue;
+      std::vector<cd> poles;
+      std::vector<int> chains;
+      for (const FittedMode& m : best.modes) {
+        poles.push_back(m.pole);
+        chains.push_back(m.stable_orders);
+      }
+      poles.push_back(cd(-z0 * wn, wn * std::sqrt(1 - z0 * z0)));
+      chains.push_back(0);
+      ModalFitResult trial = result;
+      const double c = fit_with(poles, chains, &trial, true);
+      if (trial.modes.size() > best.modes.size() && c < cost) {
+        cost = c;
+        r = trial;
+      }
+    }
     if (cost < 1e300 && bic(cost, r.modes.size()) < bic(best_cost, best.modes.size()) &&
         r.modes.size() > best.modes.size()) {
       r.order_used = best.order_used;
       best = r;
       best_cost = cost;
       ++added;
+    } else {
+      break;
+    }
+  }
+  // Backward elimination: drop the weakest mode while that lowers the BIC
+  // (a pole that only fits noise does not pay for its four parameters).
+  for (int attempt = 0; attempt < 8 && best.modes.size() > 1; ++attempt) {
+    auto weakest = std::min_element(best.modes.begin(), best.modes.end(), [&](const FittedMode& a, const FittedMode& b) {
+      return a.peak_contribution / LocalLevel(frf, a.freq_hz) < b.peak_contribution / LocalLevel(frf, b.freq_hz);
+    });
+    std::vector<cd> poles;
+    std::vector<int> chains;
+    for (auto it = best.modes.begin(); it != best.modes.end(); ++it) {
+      if (it == weakest) continue;
+      poles.push_back(it->pole);
+      chains.push_back(it->stable_orders);
+    }
+    ModalFitResult r = result;
+    const double cost = fit_with(poles, chains, &r);
+    if (cost < 1e300 && bic(cost, r.modes.size()) < bic(best_cost, best.modes.size())) {
+      r.order_used = best.order_used;
+      best = r;
+      best_cost = cost;
     } else {
       break;
     }

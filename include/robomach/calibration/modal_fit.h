@@ -66,7 +66,7 @@ struct ModalFitOptions {
   /// discarded as computational (they model noise, not structure). The
   /// comparison is local, not with the largest peak: with relative weights a
   /// weak high-frequency mode shapes the FRF where it lies and must be kept.
-  double min_relative_contribution{0.1};
+  double min_relative_contribution{0.005};
   /// At most this many modes are added where the refined fit's residual is
   /// structured rather than noise (see FitModes).
   int max_added_modes{4};
@@ -139,7 +139,10 @@ struct ModalFitResult {
 /// sets of the five highest orders and the best fit is kept. Where its
 /// weighted residual is still structured (local mean square above four times
 /// the median), a pole is added there and kept if the Bayesian information
-/// criterion improves. Numerical trouble is a status, not an exception.
+/// criterion 2N ln F + p ln 2N improves (F the weighted squared error, p the
+/// number of real parameters); then the weakest modes are dropped while that
+/// lowers the criterion, and poles closer than a fifth of their half-power
+/// bandwidth are merged. Numerical trouble is a status, not an exception.
 ///
 /// - [Guillaume et al. 2003] P. Guillaume, P. Verboven, S. Vanlanduit,
 ///   H. Van der Auweraer, B. Peeters, A poly-reference implementation of the
