@@ -290,7 +290,7 @@ void RefineAll(const dynamics::Frf& frf, bool lower, ModalFitResult* res) {
         cost = c2;
         mu = std::max(mu / 10.0, 1e-12);
         improved = true;
-        if (rel < 1e-12) it = 1000;
+        if (rel < 1e-10) it = 1000;
         break;
       }
       mu *= 10.0;

@@ -56,9 +56,10 @@ TEST(PeakPicking, HalfPowerDampingOfSingleMode) {
 // Noise-free data from three modes, two of them 3 % apart with overlapping
 // half-power bands (2ζ = 4-5 % > 3 %). The final nonlinear refinement fits
 // the exact model class (poles and residues), so on noise-free data it
-// converges to the truth up to its stopping rule (relative cost decrease
-// < 1e-12, i.e. relative residual ~1e-6 at most, giving pole errors of that
-// order times ζ). Tolerances: 1e-6 relative fit residual, 1e-5 frequency,
+// converges to the truth up to its stopping rule (it stops when a step
+// lowers the cost by less than 1e-10 relative; from a start within the
+// linear regime Levenberg–Marquardt converges quadratically, so the relative
+// residual is then far below 1e-6, and pole errors are of that order times ζ). Tolerances: 1e-6 relative fit residual, 1e-5 frequency,
 // 1e-4 damping and modal constant (the damping is the real part of the pole,
 // ζ ≈ 0.02 times its modulus, so its relative error is up to 1/ζ = 50 times
 // the frequency's; the modal constant shares that error).
