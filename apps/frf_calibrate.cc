@@ -237,14 +237,22 @@ int Run(int argc, char** argv) {
     }
 
     // Outputs: each complete or absent (formats.md §4).
-    io::WriteFileAtomically(
-        out_path, CalibratedConfigText(robot_path, out_path,
-                                       io::ParametersYaml(result.parameters,
-                                                          dynamics::DefaultParameters(cfg.description))));
+    std::string config_text = CalibratedConfigText(
+        robot_path, out_path, io::ParametersYaml(result.parameters, dynamics::DefaultParameters(cfg.description)));
     if (!adds.empty()) {
-      Warn(kTool, "effects switched on with --add are not written into " + out_path +
-                      "; add them to its `effects:` list by hand");
+      // Effects switched on with --add go into an `effects:` list, so that the
+      // calibrated parameters (which may include theirs) load; an existing
+      // list is not edited (its layout is the user's).
+      if (config_text.find("\neffects:") == std::string::npos && config_text.rfind("effects:", 0) != 0) {
+        std::string block = "effects:\n";
+        for (const std::string& a : adds) block += "  - name: " + a + "\n";
+        config_text += block;
+      } else {
+        Warn(kTool, "the config already has an `effects:` list; add the effects given with --add to " +
+                        out_path + " by hand");
+      }
     }
+    io::WriteFileAtomically(out_path, config_text);
     io::EnsureDirectory(report_dir);
     const fs::path dir(report_dir);
     report::WriteTable3Csv((dir / "table3.csv").string(), sets_out);
