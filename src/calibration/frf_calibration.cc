@@ -100,6 +100,7 @@ MeasuredFeatures ExtractFeatures(const dynamics::FrfSet& measured, const ModalFi
       }
     }
     out.fits.emplace(key, std::move(fit));
+    out.peaks.emplace(key, PickPeaks(frf.Band(options.fmin_hz, options.fmax_hz)));
   }
   return out;
 }

@@ -203,7 +203,16 @@ nlohmann::json CalibrationSummaryJson(const calibration::CalibrationResult& resu
                            {"modal_constant", {m.modal_constant.real(), m.modal_constant.imag()}},
                            {"stable_orders", m.stable_orders}});
         }
+        json peaks = json::array();
+        if (auto it = s.features->peaks.find(key); it != s.features->peaks.end()) {
+          for (const auto& p : it->second) {
+            peaks.push_back({{"peak_freq_hz", p.peak_freq_hz},
+                             {"peak_magnitude_m_per_N", p.peak_magnitude},
+                             {"half_power_damping_ratio", p.damping_ratio}});
+          }
+        }
         fits.push_back({{"pose_id", key.pose_id},
+                        {"peak_picking", peaks},
                         {"direction", Dir(key)},
                         {"status", fit.status == calibration::ModalFitStatus::kOk ? "ok"
                                    : fit.status == calibration::ModalFitStatus::kNoStableModes ? "no_stable_modes"

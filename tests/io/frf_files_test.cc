@@ -292,3 +292,40 @@ TEST(FrfUff58, RejectsUnsupportedRecordsAndMissingPose) {
 
 }  // namespace
 }  // namespace robomach::io
+
+namespace robomach::io {
+namespace {
+
+// A negative direction code means the transducer points along −axis: the
+// value is negated once per negative code (response −1 and reference 2 give
+// −H_xy; both negative give +H).
+TEST(FrfUff58, NegativeDirectionCodesFlipTheSign) {
+  const std::string dir = robomach::testing::TempDir("frf_uff_sign");
+  dynamics::FrfSet s;
+  Eigen::VectorXd f(3);
+  f << 1.0, 2.0, 3.0;
+  Eigen::VectorXcd h(3);
+  h << std::complex<double>(1e-6, -2e-7), 2e-6, 3e-6;
+  s.Insert({"P1", Axis::kX, Axis::kY}, dynamics::Frf::FromSamples(f, h));
+  WriteUff58(dir + "/a.uff", s);
+  std::ifstream in(dir + "/a.uff");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::string rec6 = "    4         0    0         0        tip         1   1        tip         1   2";
+  ASSERT_NE(text.find(rec6), std::string::npos);
+  std::string one = text, both = text;
+  one.replace(one.find(rec6), rec6.size(), "    4         0    0         0        tip         1  -1        tip         1   2");
+  both.replace(both.find(rec6), rec6.size(), "    4         0    0         0        tip         1  -1        tip         1  -2");
+  robomach::testing::WriteText(dir + "/one.uff", one);
+  robomach::testing::WriteText(dir + "/both.uff", both);
+  const dynamics::FrfKey key{"P1", Axis::kX, Axis::kY};
+  // E20.12 keeps 13 digits: 5e-13 relative.
+  const Eigen::VectorXcd h1 = ReadUff58(dir + "/one.uff").frfs.at(key).receptance();
+  const Eigen::VectorXcd h2 = ReadUff58(dir + "/both.uff").frfs.at(key).receptance();
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LE(std::abs(h1(i) + h(i)), 5e-13 * std::abs(h(i)));
+    EXPECT_LE(std::abs(h2(i) - h(i)), 5e-13 * std::abs(h(i)));
+  }
+}
+
+}  // namespace
+}  // namespace robomach::io

@@ -39,6 +39,9 @@ struct MeasuredMode {
 
 struct MeasuredFeatures {
   std::map<dynamics::FrfKey, ModalFitResult> fits;
+  /// The quick estimate of peak picking with half-power damping, per FRF,
+  /// reported next to the fit for comparison.
+  std::map<dynamics::FrfKey, std::vector<PeakEstimate>> peaks;
   std::vector<MeasuredMode> modes;
 };
 
