@@ -1,5 +1,6 @@
 #include "robomach/report/calibration_report.h"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -153,10 +154,24 @@ nlohmann::json CalibrationSummaryJson(const calibration::CalibrationResult& resu
   }
   for (const TableSet& s : sets) {
     json set;
-    set["max_abs_freq_error"] = {{"before", s.before.max_abs_freq_error}, {"after", s.after.max_abs_freq_error}};
-    set["max_abs_peak_error"] = {{"before", s.before.max_abs_peak_error}, {"after", s.after.max_abs_peak_error}};
-    set["rms_freq_error"] = {{"before", s.before.rms_freq_error}, {"after", s.after.rms_freq_error}};
-    set["rms_peak_error"] = {{"before", s.before.rms_peak_error}, {"after", s.after.rms_peak_error}};
+    // From the matches themselves, the one source of the table's numbers.
+    auto stats = [](const calibration::Comparison& c) {
+      double mf = 0, mp = 0, sf = 0, sp = 0;
+      for (const ModeMatch& m : c.matches) {
+        mf = std::max(mf, std::abs(m.freq_error()));
+        mp = std::max(mp, std::abs(m.peak_error()));
+        sf += m.freq_error() * m.freq_error();
+        sp += m.peak_error() * m.peak_error();
+      }
+      const double n = std::max<size_t>(1, c.matches.size());
+      return std::array<double, 4>{mf, mp, std::sqrt(sf / n), std::sqrt(sp / n)};
+    };
+    const auto b = stats(s.before), a = stats(s.after);
+    set["max_abs_freq_error"] = {{"before", b[0]}, {"after", a[0]}};
+    set["max_abs_peak_error"] = {{"before", b[1]}, {"after", a[1]}};
+    set["rms_freq_error"] = {{"before", b[2]}, {"after", a[2]}};
+    set["rms_peak_error"] = {{"before", b[3]}, {"after", a[3]}};
+    set["num_matches"] = {{"before", s.before.matches.size()}, {"after", s.after.matches.size()}};
     json postures = json::object();
     for (const auto& [key, err] : s.after.whole_curve_error) {
       json& p = postures[key.pose_id];
