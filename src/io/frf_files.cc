@@ -227,7 +227,8 @@ FrfReadResult ReadFrfCsv(const std::string& path) {
             r, "mixed frequency grids: the lines of FRF " + key.ToString() + " resume here after "
                    "another FRF (its first block is lines " + std::to_string(it->second.first) +
                    "-" + std::to_string(it->second.second) +
-                   "); the lines of one FRF must be contiguous, on one strictly increasing grid");
+                   "); a duplicate FRF, or one FRF split into blocks: the lines of one FRF must be contiguous, "
+                   "on one strictly increasing grid");
       }
       cur = Block{};
       cur.key = key;
