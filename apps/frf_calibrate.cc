@@ -117,7 +117,8 @@ int Run(int argc, char** argv) {
       "or UFF58 ASCII; mobility and accelerance are converted to receptance). Writes the calibrated\n"
       "config (the input plus a `parameters:` block) and a report folder: table3.csv/.md (natural\n"
       "frequency and peak amplitude per posture, model vs measurement, relative error), one\n"
-      "<pose>.png overlay per posture (measured, model before, model after), summary.json."};
+      "<pose>.png overlay per posture (measured, model before, model after), stabilisation_<pose>.png\n"
+      "(the modal fits' stabilisation diagrams), summary.json."};
   app.footer(ExitCodeHelp() + " Exit 3 also when the fit did not converge or a parameter is weakly identified.");
   std::string robot_path, postures_path, out_path, report_dir, objective = "modal-two-stage";
   std::vector<std::string> measured_files, pose_files, validate_files, validate_pose_files, frees, sets, adds;
@@ -274,6 +275,14 @@ int Run(int argc, char** argv) {
       report::WriteOverlayPng((dir / (pose + ".png")).string(), Overlay(pose, all, db, da),
                               "frf-calibrate: posture " + pose + (held ? " (held out)" : "") +
                                   ", measured vs model before and after calibration");
+    }
+    for (const std::string& pose : measured.pose_ids()) {
+      report::WriteStabilisationPng((dir / ("stabilisation_" + pose + ".png")).string(), pose, features);
+    }
+    for (const std::string& pose : holdout.pose_ids()) {
+      if (measured.ForPose(pose).empty()) {
+        report::WriteStabilisationPng((dir / ("stabilisation_" + pose + ".png")).string(), pose, holdout_features);
+      }
     }
     // Matching and errors on stderr, briefly.
     for (const auto& s : sets_out) {

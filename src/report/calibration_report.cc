@@ -119,6 +119,42 @@ void WriteOverlayPng(const std::string& path, const PostureOverlay& o, const std
   fig.SavePng(path);
 }
 
+void WriteStabilisationPng(const std::string& path, const std::string& pose_id,
+                           const calibration::MeasuredFeatures& features) {
+  std::vector<const std::pair<const dynamics::FrfKey, calibration::ModalFitResult>*> fits;
+  for (const auto& kv : features.fits) {
+    if (kv.first.pose_id == pose_id) fits.push_back(&kv);
+  }
+  Figure fig(std::max<int>(1, static_cast<int>(fits.size())), 1, 900, 320);
+  fig.title = "stabilisation diagrams, posture " + pose_id;
+  for (size_t r = 0; r < fits.size(); ++r) {
+    const auto& [key, fit] = *fits[r];
+    Axes& ax = fig.at(static_cast<int>(r), 0);
+    ax.title = "H" + Dir(key) + ": " + std::to_string(fit.modes.size()) + " modes, LSCF order " +
+               std::to_string(fit.order_used) + ", relative rms misfit " + Fixed(fit.relative_rms_error, 4);
+    ax.x_label = "frequency [Hz]";
+    ax.y_label = "model order";
+    ax.log_x = fit.fmin_hz > 0.0 && fit.fmax_hz / fit.fmin_hz > 100.0;
+    ax.x_min = ax.log_x ? fit.fmin_hz : 0.0;
+    ax.x_max = fit.fmax_hz;
+    Series unstable, stable;
+    unstable.markers = stable.markers = true;
+    unstable.label = "pole";
+    stable.label = "stable pole";
+    unstable.color = {180, 180, 180};
+    stable.color = PaletteColor(2);
+    for (const auto& p : fit.stabilisation) {
+      Series& s = p.stable ? stable : unstable;
+      s.x.push_back(p.freq_hz);
+      s.y.push_back(p.order);
+    }
+    ax.series.push_back(std::move(unstable));
+    ax.series.push_back(std::move(stable));
+    for (const auto& m : fit.modes) ax.markers.push_back({m.freq_hz, Fixed(m.freq_hz, 1) + " Hz"});
+  }
+  fig.SavePng(path);
+}
+
 nlohmann::json CalibrationSummaryJson(const calibration::CalibrationResult& result,
                                       const calibration::CalibrationOptions& options,
                                       const std::vector<TableSet>& sets) {

@@ -48,6 +48,12 @@ struct PostureOverlay {
 /// One PNG: a magnitude and a phase panel per direction pair.
 void WriteOverlayPng(const std::string& path, const PostureOverlay& overlay, const std::string& title);
 
+/// The stabilisation diagrams of the modal fits of one posture's FRFs: one
+/// panel per FRF, poles per model order against frequency (stable ones in
+/// a second colour), the selected modes as vertical lines.
+void WriteStabilisationPng(const std::string& path, const std::string& pose_id,
+                           const calibration::MeasuredFeatures& features);
+
 /// The JSON summary: objective, status and solver message, stages,
 /// parameters (initial, value, 1-sigma, flags), per-posture errors before
 /// and after (fit and holdout sets), the matching, and the modal fits.
