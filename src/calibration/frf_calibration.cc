@@ -110,7 +110,7 @@ MeasuredFeatures ExtractFeatures(const dynamics::FrfSet& measured, const ModalFi
 std::pair<double, double> ModelPeak(const PostureDynamics& d, const FrfKey& key, int model_mode) {
   const dynamics::Mode& m = d.modes.at(model_mode);
   const double z = m.damping_ratio;
-  const double lo = m.freq_hz * (1.0 - 3.0 * z), hi = m.freq_hz * (1.0 + 3.0 * z);
+  const double lo = m.freq_hz * std::max(0.05, 1.0 - 3.0 * z), hi = m.freq_hz * (1.0 + 3.0 * z);
   // One vectorised call for the grid, then golden-section calls.
   constexpr int kGrid = 60;
   Eigen::VectorXd f = Eigen::VectorXd::LinSpaced(kGrid + 1, lo, hi);
