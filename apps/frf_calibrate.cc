@@ -1,0 +1,316 @@
+// frf-calibrate: calibrates named model parameters (default m6, d6, alpha,
+// beta) against measured tool-tip FRFs (CSV or UFF58) and writes the
+// calibrated robot config and a report folder.
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "cli_support.h"
+#include "robomach/common/errors.h"
+#include "robomach/calibration/frf_calibration.h"
+#include "robomach/dynamics/tool_tip_frf.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/frf_files.h"
+#include "robomach/io/posture_file.h"
+#include "robomach/io/robot_config.h"
+#include "robomach/report/calibration_report.h"
+#include "robomach/report/posture_json.h"
+
+namespace robomach::apps {
+namespace {
+
+constexpr char kTool[] = "frf-calibrate";
+namespace fs = std::filesystem;
+
+// Reads --measured files and --pose ID=file.uff assignments into one set.
+dynamics::FrfSet ReadMeasured(const std::vector<std::string>& files, const std::vector<std::string>& pose_files,
+                              const std::string& what) {
+  dynamics::FrfSet all;
+  auto add = [&](const std::string& path, const std::string& pose) {
+    RequireReadableFile(path, what);
+    const io::FrfReadResult r = io::ReadFrfFile(path, pose);
+    for (const std::string& w : r.warnings) Warn(kTool, w);
+    for (const auto& [key, frf] : r.frfs) {
+      if (all.contains(key)) {
+        throw InputError({path, 0, 0}, "FRF " + key.ToString() + " was already read from another file");
+      }
+      all.Insert(key, frf);
+    }
+  };
+  for (const std::string& f : files) add(f, "");
+  for (const std::string& a : pose_files) {
+    const auto eq = a.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == a.size()) {
+      throw std::invalid_argument("--pose '" + a + "': expected ID=file.uff, e.g. --pose P1=p1.uff");
+    }
+    add(a.substr(eq + 1), a.substr(0, eq));
+  }
+  return all;
+}
+
+// The input config text with a new `parameters:` block (an old one is
+// replaced) and the URDF path made valid from the output's folder.
+std::string CalibratedConfigText(const std::string& input_path, const std::string& output_path,
+                                 const std::string& parameters_yaml) {
+  std::ifstream in(input_path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::istringstream lines(ss.str());
+  std::ostringstream out;
+  std::string line;
+  bool skipping = false;
+  const fs::path in_dir = fs::absolute(input_path).parent_path();
+  const fs::path out_dir = fs::absolute(output_path).parent_path();
+  const std::regex urdf_re(R"(^(\s+urdf:\s*)([^#\s]+)(.*)$)");
+  while (std::getline(lines, line)) {
+    if (skipping) {
+      if (line.empty() || line[0] == ' ' || line[0] == '\t' || line[0] == '#') continue;
+      skipping = false;
+    }
+    if (line.rfind("parameters:", 0) == 0) {
+      skipping = true;
+      continue;
+    }
+    std::smatch m;
+    if (std::regex_match(line, m, urdf_re) && in_dir != out_dir) {
+      fs::path p = m[2].str();
+      if (p.is_relative()) {
+        p = fs::relative(fs::weakly_canonical(in_dir / p), out_dir);
+        line = m[1].str() + p.string() + m[3].str();
+      }
+    }
+    out << line << '\n';
+  }
+  out << "\n# Calibrated by robomach frf-calibrate against measured FRFs.\n" << parameters_yaml;
+  return out.str();
+}
+
+report::PostureOverlay Overlay(const std::string& pose, const dynamics::FrfSet& measured,
+                               const dynamics::PostureDynamics& before, const dynamics::PostureDynamics& after) {
+  report::PostureOverlay o;
+  o.pose_id = pose;
+  for (const auto& [key, frf] : measured.ForPose(pose)) {
+    o.keys.push_back(key);
+    o.freq_hz.push_back(frf.freq_hz());
+    o.measured.push_back(frf.receptance());
+    const auto hb = dynamics::Receptance(before, frf.freq_hz());
+    const auto ha = dynamics::Receptance(after, frf.freq_hz());
+    Eigen::VectorXcd b(frf.size()), a(frf.size());
+    for (int i = 0; i < frf.size(); ++i) {
+      b(i) = hb[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
+      a(i) = ha[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
+    }
+    o.before.push_back(b);
+    o.after.push_back(a);
+  }
+  for (const auto& m : after.modes) o.mode_freq_hz.push_back(m.freq_hz);
+  return o;
+}
+
+int Run(int argc, char** argv) {
+  CLI::App app{
+      "frf-calibrate: tune named model parameters to measured tool-tip FRFs (hammer tests).\n"
+      "Reads a robot config, a posture file (formats.md §1) and measured FRFs (CSV of formats.md §3\n"
+      "or UFF58 ASCII; mobility and accelerance are converted to receptance). Writes the calibrated\n"
+      "config (the input plus a `parameters:` block) and a report folder: table3.csv/.md (natural\n"
+      "frequency and peak amplitude per posture, model vs measurement, relative error), one\n"
+      "<pose>.png overlay per posture (measured, model before, model after), stabilisation_<pose>.png\n"
+      "(the modal fits' stabilisation diagrams), summary.json."};
+  app.footer(ExitCodeHelp() + " Exit 3 also when the fit did not converge or a parameter is weakly identified.");
+  std::string robot_path, postures_path, out_path, report_dir, objective = "modal-two-stage";
+  std::vector<std::string> measured_files, pose_files, validate_files, validate_pose_files, frees, sets, adds;
+  bool only_free = false;
+  calibration::CalibrationOptions opt;
+  app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
+  app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
+  app.add_option("--measured", measured_files, "measured FRFs, CSV or UFF58 (.uff/.unv); repeatable");
+  app.add_option("--pose", pose_files, "a UFF58 file of one posture whose records lack pose=ID: ID=file.uff; repeatable");
+  app.add_option("--out", out_path, "calibrated robot config YAML")->required();
+  app.add_option("--report", report_dir, "report folder (created)")->required();
+  app.add_option("--validate", validate_files, "held-out measured FRFs scored with the calibrated model; repeatable");
+  app.add_option("--validate-pose", validate_pose_files, "held-out UFF58 file of one posture: ID=file.uff; repeatable");
+  app.add_option("--free", frees, "also fit this parameter (any name of the model, e.g. kq2_Nm_per_rad); repeatable");
+  app.add_flag("--only-free", only_free, "fit only the --free parameters, not the default m6_kg, d6_m, alpha_s, beta_per_s");
+  app.add_option("--objective", objective, "modal-two-stage (frequencies, then peak amplitudes), modal-joint, whole-curve")
+      ->check(CLI::IsMember({"modal-two-stage", "modal-joint", "whole-curve"}))->capture_default_str();
+  app.add_option("--fmin-hz", opt.fmin_hz, "lowest frequency used (modal fit and whole curve) [Hz]")->capture_default_str();
+  app.add_option("--fmax-hz", opt.fmax_hz, "highest frequency used [Hz]; default: all lines");
+  app.add_option("--set", sets, "start value of a parameter, NAME=VALUE in its unit");
+  app.add_option("--add", adds, "switch on an effect by name (its parameters may then be --free)");
+  app.add_option("--max-iterations", opt.max_iterations, "solver iterations per stage")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  return RunGuarded(kTool, [&]() -> int {
+    RequireReadableFile(robot_path, "robot config");
+    RequireReadableFile(postures_path, "posture file");
+    if (measured_files.empty() && pose_files.empty()) {
+      throw std::invalid_argument("no measured FRFs: give --measured FILE or --pose ID=file.uff");
+    }
+    opt.objective = calibration::ParseObjective(objective);
+    if (only_free) opt.free_parameters.clear();
+    for (const std::string& f : frees) {
+      if (std::find(opt.free_parameters.begin(), opt.free_parameters.end(), f) == opt.free_parameters.end()) {
+        opt.free_parameters.push_back(f);
+      }
+    }
+    if (opt.free_parameters.empty()) throw std::invalid_argument("no free parameters (--only-free without --free)");
+    opt.modal_fit.fmin_hz = opt.fmin_hz;
+    opt.modal_fit.fmax_hz = opt.fmax_hz;
+
+    io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
+    for (const std::string& name : adds) cfg.description.effects.push_back({name, {}});
+    if (!adds.empty()) {
+      const dynamics::ParameterSet old = cfg.parameters;
+      cfg.parameters = dynamics::DefaultParameters(cfg.description);
+      for (const auto& s : old.specs()) cfg.parameters.Set(s.name, old.Get(s.name));
+    }
+    for (const std::string& s : sets) {
+      const auto [name, value] = ParseAssignment("--set", s);
+      cfg.parameters.Set(name, value);
+    }
+    for (const std::string& name : opt.free_parameters) {
+      if (!cfg.parameters.Has(name)) {
+        throw std::invalid_argument("--free " + name + ": unknown parameter; known: " + cfg.parameters.NameList());
+      }
+    }
+    const auto model_before = cfg.Build();
+    calibration::PostureMap postures;
+    std::map<std::string, int> posture_line;
+    for (const io::Posture& p : io::ReadPostureFile(postures_path, model_before->num_joints())) {
+      postures[p.id] = p.q;
+      posture_line[p.id] = p.line;
+    }
+    const dynamics::FrfSet measured = ReadMeasured(measured_files, pose_files, "measured FRF file");
+    const dynamics::FrfSet holdout = ReadMeasured(validate_files, validate_pose_files, "validation FRF file");
+    for (const auto* set : {&measured, &holdout}) {
+      for (const std::string& id : set->pose_ids()) {
+        if (!postures.count(id)) {
+          std::string known;
+          for (const auto& [k, q] : postures) known += (known.empty() ? "" : ", ") + k;
+          throw InputError({postures_path, 0, 0}, "posture " + id + " of the " +
+                                                      (set == &measured ? "measured" : "validation") +
+                                                      " FRFs is not in this posture file (it has " + known + ")");
+        }
+      }
+    }
+    if (measured.empty()) throw std::invalid_argument("no measured FRFs were read");
+
+    std::cerr << kTool << ": modal fit of " << measured.size() << " measured FRFs\n";
+    const calibration::MeasuredFeatures features = calibration::ExtractFeatures(measured, opt.modal_fit);
+    for (const auto& [key, fit] : features.fits) {
+      if (fit.status != calibration::ModalFitStatus::kOk) {
+        Warn(kTool, "modal fit of " + key.ToString() + ": " + fit.message);
+      }
+    }
+    std::cerr << kTool << ": calibrating (" << calibration::ObjectiveName(opt.objective) << ") ";
+    for (const auto& n : opt.free_parameters) std::cerr << n << ' ';
+    std::cerr << '\n';
+    const calibration::CalibrationResult result =
+        calibration::Calibrate(cfg.description, cfg.parameters, postures, measured, features, opt);
+    const auto model_after = dynamics::RobotModel::Build(cfg.description, result.parameters);
+
+    std::vector<report::TableSet> sets_out;
+    report::TableSet fit_set;
+    fit_set.label = "fit";
+    fit_set.features = &features;
+    fit_set.before = calibration::CompareWithMeasurement(model_before, postures, measured, features, opt.matching,
+                                                         opt.fmin_hz, opt.fmax_hz);
+    fit_set.after = calibration::CompareWithMeasurement(model_after, postures, measured, features, opt.matching,
+                                                        opt.fmin_hz, opt.fmax_hz);
+    sets_out.push_back(fit_set);
+    calibration::MeasuredFeatures holdout_features;
+    if (!holdout.empty()) {
+      holdout_features = calibration::ExtractFeatures(holdout, opt.modal_fit);
+      report::TableSet h;
+      h.label = "holdout";
+      h.features = &holdout_features;
+      h.before = calibration::CompareWithMeasurement(model_before, postures, holdout, holdout_features,
+                                                     opt.matching, opt.fmin_hz, opt.fmax_hz);
+      h.after = calibration::CompareWithMeasurement(model_after, postures, holdout, holdout_features, opt.matching,
+                                                    opt.fmin_hz, opt.fmax_hz);
+      sets_out.push_back(h);
+    }
+
+    // Outputs: each complete or absent (formats.md §4).
+    std::string config_text = CalibratedConfigText(
+        robot_path, out_path, io::ParametersYaml(result.parameters, dynamics::DefaultParameters(cfg.description)));
+    if (!adds.empty()) {
+      // Effects switched on with --add go into an `effects:` list, so that the
+      // calibrated parameters (which may include theirs) load; an existing
+      // list is not edited (its layout is the user's).
+      if (config_text.find("\neffects:") == std::string::npos && config_text.rfind("effects:", 0) != 0) {
+        std::string block = "effects:\n";
+        for (const std::string& a : adds) block += "  - name: " + a + "\n";
+        config_text += block;
+      } else {
+        Warn(kTool, "the config already has an `effects:` list; add the effects given with --add to " +
+                        out_path + " by hand");
+      }
+    }
+    io::WriteFileAtomically(out_path, config_text);
+    io::EnsureDirectory(report_dir);
+    const fs::path dir(report_dir);
+    report::WriteTable3Csv((dir / "table3.csv").string(), sets_out);
+    report::WriteTable3Markdown((dir / "table3.md").string(), sets_out,
+                                "frf-calibrate: " + robot_path + " against the measured FRFs");
+    nlohmann::json summary = report::CalibrationSummaryJson(result, opt, sets_out);
+    summary["robot"] = robot_path;
+    summary["calibrated_config"] = out_path;
+    io::WriteFileAtomically((dir / "summary.json").string(), report::DumpJson(summary));
+    dynamics::PostureEvaluator eb(model_before), ea(model_after);
+    dynamics::FrfSet all = measured;
+    for (const auto& [k, f] : holdout) {
+      if (!all.contains(k)) all.Insert(k, f);
+    }
+    for (const std::string& pose : all.pose_ids()) {
+      const auto db = eb.Evaluate(postures.at(pose));
+      const auto da = ea.Evaluate(postures.at(pose));
+      const bool held = !measured.ForPose(pose).size();
+      report::WriteOverlayPng((dir / (pose + ".png")).string(), Overlay(pose, all, db, da),
+                              "frf-calibrate: posture " + pose + (held ? " (held out)" : "") +
+                                  ", measured vs model before and after calibration");
+    }
+    for (const std::string& pose : measured.pose_ids()) {
+      report::WriteStabilisationPng((dir / ("stabilisation_" + pose + ".png")).string(), pose, features);
+    }
+    for (const std::string& pose : holdout.pose_ids()) {
+      if (measured.ForPose(pose).empty()) {
+        report::WriteStabilisationPng((dir / ("stabilisation_" + pose + ".png")).string(), pose, holdout_features);
+      }
+    }
+    // Matching and errors on stderr, briefly.
+    for (const auto& s : sets_out) {
+      std::ostringstream m;
+      m.precision(3);
+      m << kTool << ": " << s.label << ": " << s.after.matches.size()
+        << " matched modes; largest error after calibration: frequency " << 100 * s.after.max_abs_freq_error
+        << " %, peak amplitude " << 100 * s.after.max_abs_peak_error << " % (before: "
+        << 100 * s.before.max_abs_freq_error << " %, " << 100 * s.before.max_abs_peak_error << " %)\n";
+      std::cerr << m.str();
+    }
+    for (const auto& e : result.estimates) {
+      std::ostringstream m;
+      m.precision(6);
+      m << kTool << ": " << e.name << " = " << e.value << " ± " << e.std_dev << " " << e.unit << " (start "
+        << e.initial << ")" << (e.weakly_identified ? " WEAKLY IDENTIFIED" : "") << (e.at_bound ? " AT BOUND" : "")
+        << '\n';
+      std::cerr << m.str();
+    }
+    if (result.status != calibration::FitStatus::kConverged || !result.weakly_identified.empty()) {
+      Warn(kTool, result.message);
+      return kExitFlagged;
+    }
+    return kExitOk;
+  });
+}
+
+}  // namespace
+}  // namespace robomach::apps
+
+int main(int argc, char** argv) { return robomach::apps::Run(argc, argv); }

@@ -1,0 +1,213 @@
+#pragma once
+
+// Calibration of named model parameters against measured tool-tip FRFs
+// (issue #4): modal features (natural frequencies, then peak amplitudes, as
+// the seed's two-stage procedure, or jointly) or the whole curve
+// (log-magnitude and phase over a band). Any parameter of the model's
+// ParameterSet may be free; any measured direction pair may be used.
+
+#include <complex>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/calibration/modal_fit.h"
+#include "robomach/calibration/virtual_hammer_test.h"
+#include "robomach/dynamics/measured_frf.h"
+#include "robomach/dynamics/parameters.h"
+#include "robomach/dynamics/posture_dynamics.h"
+#include "robomach/dynamics/robot_model.h"
+
+namespace robomach::calibration {
+
+// ------------------------------------------------------ measured features --
+
+/// One mode identified in one measured FRF.
+struct MeasuredMode {
+  dynamics::FrfKey key;
+  FittedMode fit;
+  /// The maximum of |H_fit| within f_n (1 ± 3ζ): the peak amplitude of the
+  /// seed's Table 3, taken from the fitted curve so that noise on single
+  /// lines does not bias it upwards [m/N], and where it occurs [Hz].
+  double peak_freq_hz{0.0};
+  double peak_magnitude{0.0};
+};
+
+struct MeasuredFeatures {
+  std::map<dynamics::FrfKey, ModalFitResult> fits;
+  /// The quick estimate of peak picking with half-power damping, per FRF,
+  /// reported next to the fit for comparison.
+  std::map<dynamics::FrfKey, std::vector<PeakEstimate>> peaks;
+  std::vector<MeasuredMode> modes;
+};
+
+/// Fits every FRF of `measured` with FitModes and collects its modes.
+/// FRFs whose fit has no stable mode contribute none (their status is in
+/// `fits`).
+MeasuredFeatures ExtractFeatures(const dynamics::FrfSet& measured, const ModalFitOptions& options = {});
+
+// ------------------------------------------------------------- matching --
+
+struct MatchOptions {
+  /// A model mode is a candidate in an FRF H_re if its own peak contribution
+  /// |p_r p_e| / (2ζω²) reaches this fraction of the largest one in that
+  /// FRF; the same fraction applies to the measured modes (their fitted
+  /// contributions). Weaker modes cannot be told from their neighbours.
+  double min_relative_visibility{0.1};
+  /// Largest |ln(f_model / f_measured)| of a match (0.4 ≈ ±40 %).
+  double max_log_freq_ratio{0.4};
+  /// Weight of |ln(visibility ratio)| (the tool-tip direction term) against
+  /// |ln(frequency ratio)| in the matching cost.
+  double direction_weight{0.25};
+};
+
+/// A measured mode paired with a model mode of the same posture.
+struct ModeMatch {
+  dynamics::FrfKey key;
+  int measured{-1};      // index in MeasuredFeatures::modes
+  int model_mode{-1};    // 0-based index in PostureDynamics::modes (ascending frequency)
+  double measured_freq_hz{0.0};
+  double model_freq_hz{0.0};
+  double measured_peak{0.0};  // [m/N]
+  double model_peak{0.0};     // [m/N]
+  double measured_damping{0.0};
+  double model_damping{0.0};
+  Eigen::Vector3d model_shape_T{Eigen::Vector3d::Zero()};
+  double freq_error() const { return model_freq_hz / measured_freq_hz - 1.0; }  // relative
+  double peak_error() const { return model_peak / measured_peak - 1.0; }       // relative
+};
+
+/// The postures, by id, that a calibration or comparison uses.
+using PostureMap = std::map<std::string, Eigen::VectorXd>;  // q [rad]
+
+/// Peak of |H_model| for the FRF `key` near a model mode, on the same
+/// definition as MeasuredMode::peak_magnitude (window f_n (1 ± 3ζ)).
+std::pair<double, double> ModelPeak(const dynamics::PostureDynamics& d, const dynamics::FrfKey& key,
+                                    int model_mode);
+
+/// Matches measured modes to model modes by frequency and tool-tip direction
+/// (greedy on the cost |ln f ratio| + w |ln visibility ratio|, one-to-one
+/// per FRF), and fills in the model's features.
+std::vector<ModeMatch> MatchModes(const std::map<std::string, dynamics::PostureDynamics>& model,
+                                  const MeasuredFeatures& features, const MatchOptions& options = {});
+
+/// Whole-curve error of the model against one measured FRF over a band:
+/// rms of log(H_model / H_measured) (real part: log-magnitude; imaginary:
+/// phase [rad]) over the lines, as a complex-magnitude rms.
+double WholeCurveError(const dynamics::PostureDynamics& d, const dynamics::FrfKey& key,
+                       const dynamics::Frf& measured, double fmin_hz, double fmax_hz);
+
+/// How well a model fits measurements: matches per posture and summary errors.
+struct Comparison {
+  std::vector<ModeMatch> matches;
+  std::vector<int> unmatched_measured;                  // indices in features.modes
+  std::map<dynamics::FrfKey, double> whole_curve_error; // see WholeCurveError
+  double max_abs_freq_error{0.0};                       // relative
+  double max_abs_peak_error{0.0};                       // relative
+  double rms_freq_error{0.0};
+  double rms_peak_error{0.0};
+};
+
+/// Evaluates `model` at the postures and compares it with `measured`.
+/// @throws std::invalid_argument if a measured posture is not in `postures`.
+Comparison CompareWithMeasurement(const std::shared_ptr<const dynamics::RobotModel>& model,
+                                  const PostureMap& postures, const dynamics::FrfSet& measured,
+                                  const MeasuredFeatures& features, const MatchOptions& options = {},
+                                  double fmin_hz = 0.0,
+                                  double fmax_hz = std::numeric_limits<double>::infinity());
+
+// ---------------------------------------------------------- calibration --
+
+enum class Objective {
+  kModalTwoStage,  // stage 1 natural frequencies, stage 2 peak amplitudes (the seed's procedure)
+  kModalJoint,     // both feature kinds in one problem
+  kWholeCurve,     // log-magnitude and phase residuals per line over a band
+};
+std::string ObjectiveName(Objective o);
+/// "modal-two-stage", "modal-joint", "whole-curve"; @throws std::invalid_argument.
+Objective ParseObjective(const std::string& name);
+
+struct CalibrationOptions {
+  Objective objective{Objective::kModalTwoStage};
+  /// Names of the free parameters (any in the model's ParameterSet).
+  std::vector<std::string> free_parameters{"m6_kg", "d6_m", "alpha_s", "beta_per_s"};
+  MatchOptions matching;
+  ModalFitOptions modal_fit;
+  /// Expected scatter of the features, used as residual weights in the
+  /// joint objective: relative natural frequency and relative peak amplitude.
+  double freq_sigma{0.001};
+  double peak_sigma{0.01};
+  /// Band of the whole-curve objective [Hz].
+  double fmin_hz{0.0};
+  double fmax_hz{std::numeric_limits<double>::infinity()};
+  int max_iterations{100};
+  /// Rounds of (match, solve) while the matching changes.
+  int max_match_rounds{3};
+  /// A parameter is weakly identified if its standard deviation exceeds this
+  /// fraction of its value.
+  double weak_relative_std{0.1};
+};
+
+enum class FitStatus { kConverged, kNotConverged, kFailed };
+std::string FitStatusName(FitStatus s);
+
+struct ParameterEstimate {
+  std::string name;
+  std::string unit;
+  double initial{0.0};
+  double value{0.0};
+  double std_dev{NAN};         // 1 sigma from the covariance, scaled by the residual variance
+  bool weakly_identified{false};
+  bool at_bound{false};
+  std::string stage;           // which stage fitted it
+};
+
+struct StageSummary {
+  std::string name;                        // "frequencies", "peak amplitudes", "joint", "whole curve"
+  std::vector<std::string> parameters;
+  std::string termination;                 // Ceres termination type
+  std::string message;                     // ceres::Solver::Summary::message, verbatim
+  int iterations{0};
+  int num_residuals{0};
+  double initial_cost{0.0};
+  double final_cost{0.0};
+  bool covariance_ok{false};
+};
+
+struct CalibrationResult {
+  FitStatus status{FitStatus::kFailed};
+  std::string message;
+  dynamics::ParameterSet parameters;       // the full set with calibrated values
+  std::vector<ParameterEstimate> estimates;
+  std::vector<StageSummary> stages;
+  std::vector<std::string> weakly_identified;
+  std::vector<ModeMatch> matches_before;   // matching at the initial values
+  std::vector<ModeMatch> matches_after;
+};
+
+/// Calibrates `options.free_parameters` of `description` starting from
+/// `initial` against `measured` (with its modal `features`) at `postures`.
+/// Ceres Levenberg–Marquardt with central numeric derivatives (the model is
+/// double-only through KDL); parameters are scaled by their initial values
+/// and kept within their ParameterSpec bounds. Uncertainty: ceres::Covariance
+/// of each stage scaled by the residual variance 2 F / (m − n).
+///
+/// Two-stage: the free parameters that move the natural frequencies are
+/// fitted to them first (Rayleigh damping does not move undamped frequencies,
+/// so alpha_s and beta_per_s fall into the second stage automatically), then
+/// the rest to the peak amplitudes with the first ones fixed.
+///
+/// Not converged, a failed stage or an unidentifiable parameter are a status
+/// and flags in the result, not exceptions.
+/// @throws std::invalid_argument for an unknown or non-fittable parameter name,
+///   or a measured posture missing from `postures`.
+CalibrationResult Calibrate(const dynamics::RobotDescription& description,
+                            const dynamics::ParameterSet& initial, const PostureMap& postures,
+                            const dynamics::FrfSet& measured, const MeasuredFeatures& features,
+                            const CalibrationOptions& options = {});
+
+}  // namespace robomach::calibration

@@ -1,0 +1,93 @@
+#pragma once
+
+// Measured tool-tip FRFs as validated value types (style.md §2.5).
+//
+// Why in `dynamics`: a measured FRF is the measured counterpart of the
+// tool-tip receptance that dynamics::Receptance computes (same quantity, same
+// frame B, same unit). `dynamics` is the lowest module that knows that
+// quantity, and every module that needs measured FRFs may include it:
+// `io` (readers and writers), `calibration`, `audit` and `stability`
+// (style.md §2.1). `common` would also be reachable but holds only units,
+// frames and errors.
+
+#include <compare>
+#include <complex>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/common/frames.h"
+
+namespace robomach::dynamics {
+
+/// One tool-tip FRF: receptance H(f) [m/N] on a strictly increasing grid,
+/// expressed in the robot base frame B. Immutable after construction.
+class Frf {
+ public:
+  /// @param freq_hz     frequency lines [Hz], finite, >= 0, strictly increasing.
+  ///                    (0 Hz is allowed, unlike style.md §2.5's example: the
+  ///                    static compliance is a valid receptance line.)
+  /// @param receptance  H [m/N], finite, same size as freq_hz.
+  /// @param coherence   optional, in [0, 1], same size.
+  /// @throws std::invalid_argument naming the first offending line (0-based
+  ///   index and frequency) and the violated rule.
+  static Frf FromSamples(Eigen::VectorXd freq_hz, Eigen::VectorXcd receptance,
+                         std::optional<Eigen::VectorXd> coherence = std::nullopt);
+
+  const Eigen::VectorXd& freq_hz() const { return freq_hz_; }
+  const Eigen::VectorXcd& receptance() const { return receptance_; }  // [m/N]
+  const std::optional<Eigen::VectorXd>& coherence() const { return coherence_; }
+  int size() const { return static_cast<int>(freq_hz_.size()); }
+  /// True if the lines are evenly spaced within 1e-9 of the largest frequency.
+  bool evenly_spaced() const;
+  /// The lines with f in [fmin_hz, fmax_hz] (may be empty).
+  Frf Band(double fmin_hz, double fmax_hz) const;
+
+ private:
+  Frf() = default;
+  Eigen::VectorXd freq_hz_;
+  Eigen::VectorXcd receptance_;
+  std::optional<Eigen::VectorXd> coherence_;
+};
+
+/// Which FRF of a test campaign: posture, response and excitation direction
+/// at the tool tip (in B). (pose, x, x) is the direct FRF Hxx.
+struct FrfKey {
+  std::string pose_id;
+  Axis response{Axis::kX};
+  Axis excitation{Axis::kX};
+  auto operator<=>(const FrfKey&) const = default;
+  /// "pose P1, response x, excitation y".
+  std::string ToString() const;
+};
+
+/// All FRFs of one test campaign, keyed by posture and direction pair,
+/// iterated in key order (posture id, then response, then excitation).
+class FrfSet {
+ public:
+  /// @throws std::invalid_argument on a duplicate key, naming it.
+  void Insert(FrfKey key, Frf frf);
+  /// @throws std::out_of_range "no FRF for pose P3, response y, excitation x".
+  const Frf& at(const FrfKey& key) const;
+  bool contains(const FrfKey& key) const { return frfs_.count(key) > 0; }
+  int size() const { return static_cast<int>(frfs_.size()); }
+  bool empty() const { return frfs_.empty(); }
+  /// Distinct posture ids in key order.
+  std::vector<std::string> pose_ids() const;
+  std::vector<FrfKey> keys() const;
+  /// The FRFs of one posture.
+  FrfSet ForPose(const std::string& pose_id) const;
+  /// Adds all FRFs of `other`; @throws std::invalid_argument on a duplicate.
+  void Merge(const FrfSet& other);
+
+  auto begin() const { return frfs_.begin(); }
+  auto end() const { return frfs_.end(); }
+
+ private:
+  std::map<FrfKey, Frf> frfs_;
+};
+
+}  // namespace robomach::dynamics

@@ -1,0 +1,64 @@
+#pragma once
+
+// The report of frf-calibrate: the seed's Table 3 (natural frequency and
+// peak amplitude per posture, model against measurement, relative error) as
+// CSV and Markdown, one overlay PNG per posture, and a JSON summary.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "robomach/calibration/frf_calibration.h"
+#include "robomach/dynamics/measured_frf.h"
+
+namespace robomach::report {
+
+/// One row set of Table 3: the comparison after calibration, with the same
+/// measured mode's comparison before calibration where it was matched then.
+struct TableSet {
+  std::string label;  // "fit" or "holdout"
+  const calibration::MeasuredFeatures* features{nullptr};
+  calibration::Comparison before;
+  calibration::Comparison after;
+};
+
+/// Table 3 as CSV: pose_id, response, excitation, set, model_mode (1-based),
+/// measured and model natural frequency [Hz] before and after with relative
+/// errors [%], the same for the peak amplitude [m/N], damping ratios, and
+/// the model mode's unit tool-tip shape ux, uy, uz (the matching shown).
+/// Atomic.
+void WriteTable3Csv(const std::string& path, const std::vector<TableSet>& sets);
+/// The same as a Markdown table (frequency and amplitude, after calibration,
+/// with the error before calibration), plus the unmatched measured modes.
+void WriteTable3Markdown(const std::string& path, const std::vector<TableSet>& sets,
+                         const std::string& title);
+
+/// Measured FRFs and the model's before and after calibration for one posture.
+struct PostureOverlay {
+  std::string pose_id;
+  std::vector<dynamics::FrfKey> keys;
+  std::vector<Eigen::VectorXd> freq_hz;
+  std::vector<Eigen::VectorXcd> measured, before, after;  // [m/N]
+  std::vector<double> mode_freq_hz;                       // model after calibration
+};
+
+/// One PNG: a magnitude and a phase panel per direction pair.
+void WriteOverlayPng(const std::string& path, const PostureOverlay& overlay, const std::string& title);
+
+/// The stabilisation diagrams of the modal fits of one posture's FRFs: one
+/// panel per FRF, poles per model order against frequency (stable ones in
+/// a second colour), the selected modes as vertical lines.
+void WriteStabilisationPng(const std::string& path, const std::string& pose_id,
+                           const calibration::MeasuredFeatures& features);
+
+/// The JSON summary: objective, status and solver message, stages,
+/// parameters (initial, value, 1-sigma, flags), per-posture errors before
+/// and after (fit and holdout sets), the matching, and the modal fits.
+nlohmann::json CalibrationSummaryJson(const calibration::CalibrationResult& result,
+                                      const calibration::CalibrationOptions& options,
+                                      const std::vector<TableSet>& sets);
+
+}  // namespace robomach::report

@@ -1,0 +1,588 @@
+#include "robomach/calibration/frf_calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <ceres/ceres.h>
+
+#include "robomach/common/units.h"
+#include "robomach/dynamics/tool_tip_frf.h"
+
+namespace robomach::calibration {
+namespace {
+
+using dynamics::FrfKey;
+using dynamics::PostureDynamics;
+using cd = std::complex<double>;
+
+// |H_re| of a posture at one frequency.
+double ModelMagnitude(const PostureDynamics& d, const FrfKey& key, double f_hz) {
+  Eigen::VectorXd f(1);
+  f(0) = f_hz;
+  return std::abs(dynamics::Receptance(d, f)[0](static_cast<int>(key.response),
+                                                static_cast<int>(key.excitation)));
+}
+
+// Maximum of a smooth positive function on [lo, hi]: grid, then golden section.
+template <typename F>
+std::pair<double, double> MaximiseOnInterval(const F& fun, double lo, double hi, int grid) {
+  double best_x = lo, best = -1.0;
+  for (int i = 0; i <= grid; ++i) {
+    const double x = lo + (hi - lo) * i / grid;
+    const double v = fun(x);
+    if (v > best) {
+      best = v;
+      best_x = x;
+    }
+  }
+  const double step = (hi - lo) / grid;
+  double a = std::max(lo, best_x - step), b = std::min(hi, best_x + step);
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double c = b - g * (b - a), d = a + g * (b - a);
+  double fc = fun(c), fd = fun(d);
+  for (int it = 0; it < 80 && (b - a) > 1e-13 * std::max(1.0, b); ++it) {
+    if (fc > fd) {
+      b = d; d = c; fd = fc; c = b - g * (b - a); fc = fun(c);
+    } else {
+      a = c; c = d; fc = fd; d = a + g * (b - a); fd = fun(d);
+    }
+  }
+  const double xm = 0.5 * (a + b), vm = fun(xm);
+  return vm >= best ? std::pair{xm, vm} : std::pair{best_x, best};
+}
+
+double Visibility(const dynamics::Mode& m, const FrfKey& key) {
+  const double w = HzToRadPerSec(m.freq_hz);
+  const double pr = m.p_T(static_cast<int>(key.response)), pe = m.p_T(static_cast<int>(key.excitation));
+  return std::abs(pr * pe) / (2.0 * std::max(m.damping_ratio, 1e-6) * w * w);
+}
+
+std::map<std::string, PostureDynamics> EvaluatePostures(const std::shared_ptr<const dynamics::RobotModel>& model,
+                                                        const PostureMap& postures,
+                                                        const std::vector<std::string>& ids) {
+  dynamics::PostureEvaluator ev(model);
+  std::map<std::string, PostureDynamics> out;
+  for (const std::string& id : ids) {
+    auto it = postures.find(id);
+    if (it == postures.end()) {
+      std::string known;
+      for (const auto& [k, q] : postures) known += (known.empty() ? "" : ", ") + k;
+      throw std::invalid_argument("posture " + id + " of the measured FRFs is not in the posture file (known: " +
+                                  known + ")");
+    }
+    out.emplace(id, ev.Evaluate(it->second));
+  }
+  return out;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------- features --
+
+MeasuredFeatures ExtractFeatures(const dynamics::FrfSet& measured, const ModalFitOptions& options) {
+  MeasuredFeatures out;
+  for (const auto& [key, frf] : measured) {
+    ModalFitResult fit = FitModes(frf, options);
+    if (fit.status == ModalFitStatus::kOk) {
+      for (const FittedMode& m : fit.modes) {
+        MeasuredMode mm;
+        mm.key = key;
+        mm.fit = m;
+        const double lo = std::max(fit.fmin_hz, m.freq_hz * (1.0 - 3.0 * m.damping_ratio));
+        const double hi = std::min(fit.fmax_hz, m.freq_hz * (1.0 + 3.0 * m.damping_ratio));
+        const auto [fp, ap] = fit.PeakIn(lo, hi);
+        mm.peak_freq_hz = fp;
+        mm.peak_magnitude = ap;
+        out.modes.push_back(mm);
+      }
+    }
+    out.fits.emplace(key, std::move(fit));
+    out.peaks.emplace(key, PickPeaks(frf.Band(options.fmin_hz, options.fmax_hz)));
+  }
+  return out;
+}
+
+// ------------------------------------------------------------- matching --
+
+std::pair<double, double> ModelPeak(const PostureDynamics& d, const FrfKey& key, int model_mode) {
+  const dynamics::Mode& m = d.modes.at(model_mode);
+  const double z = m.damping_ratio;
+  const double lo = m.freq_hz * std::max(0.05, 1.0 - 3.0 * z), hi = m.freq_hz * (1.0 + 3.0 * z);
+  // One vectorised call for the grid, then golden-section calls.
+  constexpr int kGrid = 60;
+  Eigen::VectorXd f = Eigen::VectorXd::LinSpaced(kGrid + 1, lo, hi);
+  const auto H = dynamics::Receptance(d, f);
+  int best = 0;
+  for (int i = 0; i <= kGrid; ++i) {
+    if (std::abs(H[i](static_cast<int>(key.response), static_cast<int>(key.excitation))) >
+        std::abs(H[best](static_cast<int>(key.response), static_cast<int>(key.excitation)))) {
+      best = i;
+    }
+  }
+  const double step = (hi - lo) / kGrid;
+  return MaximiseOnInterval([&](double x) { return ModelMagnitude(d, key, x); },
+                            std::max(lo, f(best) - step), std::min(hi, f(best) + step), 2);
+}
+
+std::vector<ModeMatch> MatchModes(const std::map<std::string, PostureDynamics>& model,
+                                  const MeasuredFeatures& features, const MatchOptions& o) {
+  std::vector<ModeMatch> out;
+  for (const auto& [key, fit] : features.fits) {
+    auto pit = model.find(key.pose_id);
+    if (pit == model.end()) continue;
+    const PostureDynamics& d = pit->second;
+    std::vector<int> meas;
+    double meas_max = 0.0;
+    for (size_t i = 0; i < features.modes.size(); ++i) {
+      if (features.modes[i].key == key) {
+        meas.push_back(static_cast<int>(i));
+        meas_max = std::max(meas_max, features.modes[i].fit.peak_contribution);
+      }
+    }
+    if (meas.empty()) continue;
+    std::vector<double> vis(d.modes.size());
+    double vis_max = 0.0;
+    for (size_t k = 0; k < d.modes.size(); ++k) {
+      vis[k] = Visibility(d.modes[k], key);
+      vis_max = std::max(vis_max, vis[k]);
+    }
+    struct Cand {
+      double cost;
+      int i, k;
+    };
+    std::vector<Cand> cands;
+    for (int i : meas) {
+      const FittedMode& fm = features.modes[i].fit;
+      if (fm.peak_contribution < o.min_relative_visibility * meas_max) continue;
+      for (size_t k = 0; k < d.modes.size(); ++k) {
+        if (vis[k] < o.min_relative_visibility * vis_max) continue;
+        const double lf = std::abs(std::log(d.modes[k].freq_hz / fm.freq_hz));
+        if (lf > o.max_log_freq_ratio) continue;
+        const double lv = std::abs(std::log(vis[k] / fm.peak_contribution));
+        cands.push_back({lf + o.direction_weight * lv, i, static_cast<int>(k)});
+      }
+    }
+    std::sort(cands.begin(), cands.end(), [](const Cand& a, const Cand& b) { return a.cost < b.cost; });
+    std::set<int> used_i, used_k;
+    for (const Cand& c : cands) {
+      if (used_i.count(c.i) || used_k.count(c.k)) continue;
+      used_i.insert(c.i);
+      used_k.insert(c.k);
+      ModeMatch m;
+      m.key = key;
+      m.measured = c.i;
+      m.model_mode = c.k;
+      const MeasuredMode& mm = features.modes[c.i];
+      m.measured_freq_hz = mm.fit.freq_hz;
+      m.measured_damping = mm.fit.damping_ratio;
+      m.measured_peak = mm.peak_magnitude;
+      m.model_freq_hz = d.modes[c.k].freq_hz;
+      m.model_damping = d.modes[c.k].damping_ratio;
+      m.model_shape_T = d.modes[c.k].shape_T;
+      m.model_peak = ModelPeak(d, key, c.k).second;
+      out.push_back(m);
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const ModeMatch& a, const ModeMatch& b) {
+    return std::tie(a.key, a.measured_freq_hz) < std::tie(b.key, b.measured_freq_hz);
+  });
+  return out;
+}
+
+double WholeCurveError(const PostureDynamics& d, const FrfKey& key, const dynamics::Frf& measured,
+                       double fmin_hz, double fmax_hz) {
+  const dynamics::Frf band = measured.Band(fmin_hz, fmax_hz);
+  if (band.size() == 0) return NAN;
+  const auto H = dynamics::Receptance(d, band.freq_hz());
+  double s = 0.0;
+  int n = 0;
+  for (int i = 0; i < band.size(); ++i) {
+    const cd hm = H[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
+    const cd h = band.receptance()(i);
+    if (std::abs(h) == 0.0 || std::abs(hm) == 0.0) continue;
+    s += std::norm(std::log(hm / h));
+    ++n;
+  }
+  return n > 0 ? std::sqrt(s / n) : NAN;
+}
+
+Comparison CompareWithMeasurement(const std::shared_ptr<const dynamics::RobotModel>& model,
+                                  const PostureMap& postures, const dynamics::FrfSet& measured,
+                                  const MeasuredFeatures& features, const MatchOptions& options,
+                                  double fmin_hz, double fmax_hz) {
+  const auto dyn = EvaluatePostures(model, postures, measured.pose_ids());
+  Comparison c;
+  c.matches = MatchModes(dyn, features, options);
+  std::set<int> matched;
+  for (const ModeMatch& m : c.matches) matched.insert(m.measured);
+  for (size_t i = 0; i < features.modes.size(); ++i) {
+    if (!matched.count(static_cast<int>(i))) c.unmatched_measured.push_back(static_cast<int>(i));
+  }
+  for (const auto& [key, frf] : measured) {
+    c.whole_curve_error[key] = WholeCurveError(dyn.at(key.pose_id), key, frf, fmin_hz, fmax_hz);
+  }
+  double sf = 0, sp = 0;
+  for (const ModeMatch& m : c.matches) {
+    c.max_abs_freq_error = std::max(c.max_abs_freq_error, std::abs(m.freq_error()));
+    c.max_abs_peak_error = std::max(c.max_abs_peak_error, std::abs(m.peak_error()));
+    sf += m.freq_error() * m.freq_error();
+    sp += m.peak_error() * m.peak_error();
+  }
+  if (!c.matches.empty()) {
+    c.rms_freq_error = std::sqrt(sf / c.matches.size());
+    c.rms_peak_error = std::sqrt(sp / c.matches.size());
+  }
+  return c;
+}
+
+// ---------------------------------------------------------- calibration --
+
+std::string ObjectiveName(Objective o) {
+  switch (o) {
+    case Objective::kModalTwoStage: return "modal-two-stage";
+    case Objective::kModalJoint: return "modal-joint";
+    case Objective::kWholeCurve: return "whole-curve";
+  }
+  return "?";
+}
+
+Objective ParseObjective(const std::string& name) {
+  if (name == "modal-two-stage") return Objective::kModalTwoStage;
+  if (name == "modal-joint") return Objective::kModalJoint;
+  if (name == "whole-curve") return Objective::kWholeCurve;
+  throw std::invalid_argument("objective '" + name + "': expected modal-two-stage, modal-joint or whole-curve");
+}
+
+std::string FitStatusName(FitStatus s) {
+  switch (s) {
+    case FitStatus::kConverged: return "converged";
+    case FitStatus::kNotConverged: return "not_converged";
+    case FitStatus::kFailed: return "failed";
+  }
+  return "?";
+}
+
+namespace {
+
+enum class ResidualKind { kFrequency, kPeak, kJoint, kWholeCurve };
+
+// Everything a residual evaluation needs; the free parameters are scaled,
+// x_i = value_i / scale_i.
+struct ModelResidual {
+  const dynamics::RobotDescription* description;
+  dynamics::ParameterSet base;
+  std::vector<std::string> names;
+  std::vector<double> scale;
+  const PostureMap* postures;
+  std::vector<std::string> pose_ids;
+  ResidualKind kind;
+  std::vector<ModeMatch> matches;                     // modal kinds
+  std::vector<std::pair<FrfKey, dynamics::Frf>> curves;  // whole curve, band-limited
+  double freq_sigma{1.0}, peak_sigma{1.0};
+  int num_residuals{0};
+
+  int CountResiduals() const {
+    switch (kind) {
+      case ResidualKind::kFrequency:
+      case ResidualKind::kPeak: return static_cast<int>(matches.size());
+      case ResidualKind::kJoint: return 2 * static_cast<int>(matches.size());
+      case ResidualKind::kWholeCurve: {
+        int n = 0;
+        for (const auto& [k, f] : curves) n += 2 * f.size();
+        return n;
+      }
+    }
+    return 0;
+  }
+
+  dynamics::ParameterSet Values(const double* x) const {
+    dynamics::ParameterSet p = base;
+    for (size_t i = 0; i < names.size(); ++i) p.Set(names[i], x[i] * scale[i]);
+    return p;
+  }
+
+  bool operator()(double const* const* parameters, double* residuals) const {
+    try {
+      const auto model = dynamics::RobotModel::Build(*description, Values(parameters[0]));
+      const auto dyn = EvaluatePostures(model, *postures, pose_ids);
+      int r = 0;
+      if (kind == ResidualKind::kWholeCurve) {
+        for (const auto& [key, frf] : curves) {
+          const auto H = dynamics::Receptance(dyn.at(key.pose_id), frf.freq_hz());
+          for (int i = 0; i < frf.size(); ++i) {
+            const cd hm = H[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
+            const cd e = std::log(hm / frf.receptance()(i));
+            residuals[r++] = e.real();
+            residuals[r++] = std::remainder(e.imag(), 2.0 * kPi);
+          }
+        }
+        return true;
+      }
+      for (const ModeMatch& m : matches) {
+        const PostureDynamics& d = dyn.at(m.key.pose_id);
+        if (m.model_mode >= static_cast<int>(d.modes.size())) return false;
+        if (kind == ResidualKind::kFrequency || kind == ResidualKind::kJoint) {
+          residuals[r++] = (d.modes[m.model_mode].freq_hz / m.measured_freq_hz - 1.0) / freq_sigma;
+        }
+        if (kind == ResidualKind::kPeak || kind == ResidualKind::kJoint) {
+          const double peak = ModelPeak(d, m.key, m.model_mode).second;
+          residuals[r++] = std::log(peak / m.measured_peak) / peak_sigma;
+        }
+      }
+      return true;
+    } catch (const std::exception&) {
+      return false;  // e.g. a trial point the model rejects: Ceres shortens the step
+    }
+  }
+};
+
+struct StageOutcome {
+  StageSummary summary;
+  std::vector<double> values;   // in parameter units
+  std::vector<double> std_dev;  // in parameter units, NaN if unknown
+  ceres::TerminationType termination{ceres::FAILURE};
+};
+
+StageOutcome SolveStage(const std::string& stage_name, ModelResidual residual, const CalibrationOptions& o) {
+  StageOutcome out;
+  out.summary.name = stage_name;
+  out.summary.parameters = residual.names;
+  const int n = static_cast<int>(residual.names.size());
+  residual.num_residuals = residual.CountResiduals();
+  out.summary.num_residuals = residual.num_residuals;
+  std::vector<double> x(n);
+  for (int i = 0; i < n; ++i) x[i] = residual.base.Get(residual.names[i]) / residual.scale[i];
+  if (residual.num_residuals < n) {
+    out.summary.termination = "FAILURE";
+    out.summary.message = "fewer residuals (" + std::to_string(residual.num_residuals) + ") than free parameters (" +
+                          std::to_string(n) + "): too few matched modes";
+    for (int i = 0; i < n; ++i) {
+      out.values.push_back(x[i] * residual.scale[i]);
+      out.std_dev.push_back(NAN);
+    }
+    return out;
+  }
+  const std::vector<std::string> names = residual.names;
+  const std::vector<double> scale = residual.scale;
+  const dynamics::ParameterSet base = residual.base;
+  const int m = residual.num_residuals;
+  ceres::NumericDiffOptions nd;
+  nd.relative_step_size = 1e-6;
+  auto* cost = new ceres::DynamicNumericDiffCostFunction<ModelResidual, ceres::CENTRAL>(
+      new ModelResidual(std::move(residual)), ceres::TAKE_OWNERSHIP, nd);
+  cost->AddParameterBlock(n);
+  cost->SetNumResiduals(m);
+  ceres::Problem problem;
+  problem.AddResidualBlock(cost, nullptr, x.data());
+  for (int i = 0; i < n; ++i) {
+    const auto& spec = base.spec(names[i]);
+    if (spec.lower > -1e299) problem.SetParameterLowerBound(x.data(), i, spec.lower / scale[i]);
+    if (spec.upper < 1e299) problem.SetParameterUpperBound(x.data(), i, spec.upper / scale[i]);
+  }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = o.max_iterations;
+  so.function_tolerance = 1e-12;
+  so.parameter_tolerance = 1e-10;
+  so.gradient_tolerance = 1e-14;
+  so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
+  so.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  out.termination = summary.termination_type;
+  out.summary.termination = ceres::TerminationTypeToString(summary.termination_type);
+  out.summary.message = summary.message;
+  out.summary.iterations = static_cast<int>(summary.iterations.size());
+  out.summary.initial_cost = summary.initial_cost;
+  out.summary.final_cost = summary.final_cost;
+  for (int i = 0; i < n; ++i) out.values.push_back(x[i] * scale[i]);
+  out.std_dev.assign(n, NAN);
+  // Covariance of the scaled parameters, from Jᵀ J at the solution, scaled by
+  // the residual variance estimate 2 F / (m − n) (the residual weights are
+  // nominal, so the data's own scatter sets the uncertainty).
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  co.null_space_rank = 0;
+  co.min_reciprocal_condition_number = 1e-14;
+  ceres::Covariance cov(co);
+  std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
+  if (cov.Compute(blocks, &problem)) {
+    std::vector<double> c(n * n);
+    cov.GetCovarianceBlock(x.data(), x.data(), c.data());
+    const double dof = std::max(1, m - n);
+    const double s2 = 2.0 * summary.final_cost / dof;
+    for (int i = 0; i < n; ++i) out.std_dev[i] = std::sqrt(std::max(0.0, c[i * n + i] * s2)) * std::abs(scale[i]);
+    out.summary.covariance_ok = true;
+  }
+  return out;
+}
+
+bool SameMatching(const std::vector<ModeMatch>& a, const std::vector<ModeMatch>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (!(a[i].key == b[i].key) || a[i].measured != b[i].measured || a[i].model_mode != b[i].model_mode) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+CalibrationResult Calibrate(const dynamics::RobotDescription& description, const dynamics::ParameterSet& initial,
+                            const PostureMap& postures, const dynamics::FrfSet& measured,
+                            const MeasuredFeatures& features, const CalibrationOptions& o) {
+  for (const std::string& name : o.free_parameters) {
+    if (!initial.Has(name)) throw std::invalid_argument("unknown parameter '" + name + "'; known: " + initial.NameList());
+    if (!initial.spec(name).fittable) throw std::invalid_argument("parameter '" + name + "' is not fittable");
+  }
+  {
+    std::set<std::string> seen;
+    for (const std::string& name : o.free_parameters) {
+      if (!seen.insert(name).second) throw std::invalid_argument("parameter '" + name + "' is free twice");
+    }
+  }
+  const std::vector<std::string> pose_ids = measured.pose_ids();
+  // Fails early, with the message, if a measured posture is unknown.
+  CalibrationResult result;
+  result.parameters = initial;
+  auto evaluate = [&](const dynamics::ParameterSet& p) {
+    return EvaluatePostures(dynamics::RobotModel::Build(description, p), postures, pose_ids);
+  };
+  result.matches_before = MatchModes(evaluate(initial), features, o.matching);
+
+  ModelResidual proto;
+  proto.description = &description;
+  proto.postures = &postures;
+  proto.pose_ids = pose_ids;
+  proto.freq_sigma = o.freq_sigma;
+  proto.peak_sigma = o.peak_sigma;
+  auto scales = [&](const std::vector<std::string>& names) {
+    std::vector<double> s;
+    for (const std::string& nm : names) {
+      const double v = std::abs(initial.Get(nm));
+      s.push_back(v > 0.0 ? v : 1.0);
+    }
+    return s;
+  };
+
+  // Which free parameters move the undamped natural frequencies: a relative
+  // change of 1e-3 must move some frequency by more than 1e-9 relative
+  // (round-off of the eigen-solution is ~1e-13).
+  std::vector<std::string> stage1, stage2;
+  if (o.objective == Objective::kModalTwoStage) {
+    const auto d0 = evaluate(initial);
+    for (const std::string& nm : o.free_parameters) {
+      dynamics::ParameterSet p = initial;
+      const double v = initial.Get(nm);
+      const double dv = v != 0.0 ? 1e-3 * v : 1e-6;
+      const auto& spec = initial.spec(nm);
+      p.Set(nm, v + dv <= spec.upper ? v + dv : v - dv);
+      const auto d1 = evaluate(p);
+      double change = 0.0;
+      for (const auto& [id, d] : d0) {
+        for (size_t k = 0; k < d.modes.size() && k < d1.at(id).modes.size(); ++k) {
+          change = std::max(change, std::abs(d1.at(id).modes[k].freq_hz / d.modes[k].freq_hz - 1.0));
+        }
+      }
+      (change > 1e-9 ? stage1 : stage2).push_back(nm);
+    }
+  }
+
+  dynamics::ParameterSet current = initial;
+  std::vector<ModeMatch> matches = result.matches_before;
+  std::map<std::string, std::pair<double, std::string>> std_devs;  // name -> (std, stage)
+  std::vector<StageSummary> stages;
+  bool ok = true, converged = true;
+  for (int round = 0; round < std::max(1, o.max_match_rounds); ++round) {
+    stages.clear();
+    std_devs.clear();
+    ok = true;
+    converged = true;
+    auto run = [&](const std::string& name, ResidualKind kind, const std::vector<std::string>& free) {
+      if (free.empty()) return;
+      ModelResidual r = proto;
+      r.base = current;
+      r.names = free;
+      r.scale = scales(free);
+      r.kind = kind;
+      r.matches = matches;
+      if (kind == ResidualKind::kWholeCurve) {
+        for (const auto& [key, frf] : measured) {
+          dynamics::Frf band = frf.Band(std::max(o.fmin_hz, 1e-12), o.fmax_hz);
+          if (band.size() > 0) r.curves.emplace_back(key, std::move(band));
+        }
+      }
+      StageOutcome s = SolveStage(name, std::move(r), o);
+      for (size_t i = 0; i < free.size(); ++i) {
+        current.Set(free[i], s.values[i]);
+        std_devs[free[i]] = {s.std_dev[i], name};
+      }
+      if (s.termination == ceres::FAILURE || s.termination == ceres::USER_FAILURE) ok = false;
+      if (s.termination != ceres::CONVERGENCE) converged = false;
+      stages.push_back(s.summary);
+    };
+    switch (o.objective) {
+      case Objective::kModalTwoStage:
+        run("frequencies", ResidualKind::kFrequency, stage1);
+        run("peak amplitudes", ResidualKind::kPeak, stage2);
+        break;
+      case Objective::kModalJoint:
+        run("joint", ResidualKind::kJoint, o.free_parameters);
+        break;
+      case Objective::kWholeCurve:
+        run("whole curve", ResidualKind::kWholeCurve, o.free_parameters);
+        break;
+    }
+    const auto rematched = MatchModes(evaluate(current), features, o.matching);
+    const bool same = SameMatching(rematched, matches);
+    matches = rematched;
+    if (same || o.objective == Objective::kWholeCurve) break;
+  }
+  result.parameters = current;
+  result.stages = stages;
+  result.matches_after = matches;
+  for (const std::string& nm : o.free_parameters) {
+    ParameterEstimate e;
+    e.name = nm;
+    e.unit = initial.spec(nm).unit;
+    e.initial = initial.Get(nm);
+    e.value = current.Get(nm);
+    auto it = std_devs.find(nm);
+    if (it != std_devs.end()) {
+      e.std_dev = it->second.first;
+      e.stage = it->second.second;
+    }
+    e.weakly_identified = !(e.std_dev <= o.weak_relative_std * std::abs(e.value));
+    const auto& spec = initial.spec(nm);
+    const double tol = 1e-9 * std::max(1.0, std::abs(e.value));
+    e.at_bound = std::abs(e.value - spec.lower) < tol || std::abs(e.value - spec.upper) < tol;
+    if (e.weakly_identified) result.weakly_identified.push_back(nm);
+    result.estimates.push_back(e);
+  }
+  std::ostringstream msg;
+  if (!ok) {
+    result.status = FitStatus::kFailed;
+    msg << "a stage failed:";
+    for (const auto& s : stages) msg << " [" << s.name << ": " << s.termination << ", " << s.message << "]";
+  } else if (!converged) {
+    result.status = FitStatus::kNotConverged;
+    msg << "not converged:";
+    for (const auto& s : stages) msg << " [" << s.name << ": " << s.termination << ", " << s.message << "]";
+  } else {
+    result.status = FitStatus::kConverged;
+    msg << "converged";
+  }
+  if (!result.weakly_identified.empty()) {
+    msg << "; weakly identified (std > " << o.weak_relative_std * 100 << " % of the value, or no covariance):";
+    for (const auto& n : result.weakly_identified) msg << ' ' << n;
+  }
+  result.message = msg.str();
+  return result;
+}
+
+}  // namespace robomach::calibration

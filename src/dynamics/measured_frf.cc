@@ -1,0 +1,116 @@
+#include "robomach/dynamics/measured_frf.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace robomach::dynamics {
+
+Frf Frf::FromSamples(Eigen::VectorXd freq_hz, Eigen::VectorXcd receptance,
+                     std::optional<Eigen::VectorXd> coherence) {
+  if (freq_hz.size() != receptance.size()) {
+    std::ostringstream m;
+    m << "Frf: " << freq_hz.size() << " frequency lines but " << receptance.size()
+      << " receptance values";
+    throw std::invalid_argument(m.str());
+  }
+  if (freq_hz.size() == 0) throw std::invalid_argument("Frf: no frequency lines");
+  if (coherence && coherence->size() != freq_hz.size()) {
+    std::ostringstream m;
+    m << "Frf: " << freq_hz.size() << " frequency lines but " << coherence->size()
+      << " coherence values";
+    throw std::invalid_argument(m.str());
+  }
+  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
+    auto fail = [&](const std::string& what) {
+      std::ostringstream m;
+      m.precision(12);
+      m << "Frf: line " << i << " (f = " << freq_hz(i) << " Hz): " << what;
+      throw std::invalid_argument(m.str());
+    };
+    if (!std::isfinite(freq_hz(i)) || freq_hz(i) < 0.0) fail("expected a finite frequency >= 0");
+    if (i > 0 && !(freq_hz(i) > freq_hz(i - 1))) {
+      std::ostringstream m;
+      m.precision(12);
+      m << "frequencies must be strictly increasing (previous line " << freq_hz(i - 1) << " Hz)";
+      fail(m.str());
+    }
+    if (!std::isfinite(receptance(i).real()) || !std::isfinite(receptance(i).imag())) {
+      fail("receptance is not finite");
+    }
+    if (coherence && !((*coherence)(i) >= 0.0 && (*coherence)(i) <= 1.0)) {
+      fail("coherence must be in [0, 1]");
+    }
+  }
+  Frf f;
+  f.freq_hz_ = std::move(freq_hz);
+  f.receptance_ = std::move(receptance);
+  f.coherence_ = std::move(coherence);
+  return f;
+}
+
+bool Frf::evenly_spaced() const {
+  if (size() < 3) return true;
+  const double df = (freq_hz_(size() - 1) - freq_hz_(0)) / (size() - 1);
+  const double tol = 1e-9 * freq_hz_(size() - 1);
+  for (int i = 0; i < size(); ++i) {
+    if (std::abs(freq_hz_(i) - (freq_hz_(0) + i * df)) > tol) return false;
+  }
+  return true;
+}
+
+Frf Frf::Band(double fmin_hz, double fmax_hz) const {
+  int first = 0;
+  while (first < size() && freq_hz_(first) < fmin_hz) ++first;
+  int last = first;
+  while (last < size() && freq_hz_(last) <= fmax_hz) ++last;
+  Frf f;
+  f.freq_hz_ = freq_hz_.segment(first, last - first);
+  f.receptance_ = receptance_.segment(first, last - first);
+  if (coherence_) f.coherence_ = coherence_->segment(first, last - first);
+  return f;
+}
+
+std::string FrfKey::ToString() const {
+  return "pose " + pose_id + ", response " + AxisName(response) + ", excitation " +
+         AxisName(excitation);
+}
+
+void FrfSet::Insert(FrfKey key, Frf frf) {
+  if (frfs_.count(key)) throw std::invalid_argument("duplicate FRF for " + key.ToString());
+  frfs_.emplace(std::move(key), std::move(frf));
+}
+
+const Frf& FrfSet::at(const FrfKey& key) const {
+  auto it = frfs_.find(key);
+  if (it == frfs_.end()) throw std::out_of_range("no FRF for " + key.ToString());
+  return it->second;
+}
+
+std::vector<std::string> FrfSet::pose_ids() const {
+  std::vector<std::string> ids;
+  for (const auto& [k, f] : frfs_) {
+    if (ids.empty() || ids.back() != k.pose_id) ids.push_back(k.pose_id);
+  }
+  return ids;
+}
+
+std::vector<FrfKey> FrfSet::keys() const {
+  std::vector<FrfKey> k;
+  for (const auto& [key, f] : frfs_) k.push_back(key);
+  return k;
+}
+
+FrfSet FrfSet::ForPose(const std::string& pose_id) const {
+  FrfSet s;
+  for (const auto& [k, f] : frfs_) {
+    if (k.pose_id == pose_id) s.frfs_.emplace(k, f);
+  }
+  return s;
+}
+
+void FrfSet::Merge(const FrfSet& other) {
+  for (const auto& [k, f] : other.frfs_) Insert(k, f);
+}
+
+}  // namespace robomach::dynamics

@@ -1,0 +1,282 @@
+#include "robomach/report/calibration_report.h"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/number_format.h"
+#include "robomach/report/frf_plot.h"
+#include "robomach/report/plot.h"
+
+namespace robomach::report {
+namespace {
+
+using calibration::ModeMatch;
+
+const ModeMatch* FindBefore(const calibration::Comparison& before, const ModeMatch& after) {
+  for (const ModeMatch& m : before.matches) {
+    if (m.key == after.key && m.measured == after.measured) return &m;
+  }
+  return nullptr;
+}
+
+std::string Num(double v) { return std::isfinite(v) ? io::FormatDouble(v) : ""; }
+
+std::string Fixed(double v, int digits) {
+  if (!std::isfinite(v)) return "–";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
+  return buf;
+}
+
+std::string Sci(double v) {
+  if (!std::isfinite(v)) return "–";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.3e", v);
+  return buf;
+}
+
+std::string Dir(const dynamics::FrfKey& k) { return std::string(1, AxisName(k.response)) + AxisName(k.excitation); }
+
+}  // namespace
+
+void WriteTable3Csv(const std::string& path, const std::vector<TableSet>& sets) {
+  io::WriteFileAtomically(path, [&](std::ostream& os) {
+    os << "pose_id,response,excitation,set,model_mode,measured_freq_hz,model_freq_hz_before,"
+          "freq_error_before_pct,model_freq_hz,freq_error_pct,measured_peak_m_per_N,"
+          "model_peak_m_per_N_before,peak_error_before_pct,model_peak_m_per_N,peak_error_pct,"
+          "measured_damping_ratio,model_damping_ratio,ux,uy,uz\n";
+    for (const TableSet& s : sets) {
+      for (const ModeMatch& m : s.after.matches) {
+        const ModeMatch* b = FindBefore(s.before, m);
+        os << m.key.pose_id << ',' << AxisName(m.key.response) << ',' << AxisName(m.key.excitation) << ','
+           << s.label << ',' << m.model_mode + 1 << ',' << Num(m.measured_freq_hz) << ','
+           << (b ? Num(b->model_freq_hz) : "") << ',' << (b ? Num(100 * b->freq_error()) : "") << ','
+           << Num(m.model_freq_hz) << ',' << Num(100 * m.freq_error()) << ',' << Num(m.measured_peak) << ','
+           << (b ? Num(b->model_peak) : "") << ',' << (b ? Num(100 * b->peak_error()) : "") << ','
+           << Num(m.model_peak) << ',' << Num(100 * m.peak_error()) << ',' << Num(m.measured_damping) << ','
+           << Num(m.model_damping) << ',' << Num(m.model_shape_T(0)) << ',' << Num(m.model_shape_T(1)) << ','
+           << Num(m.model_shape_T(2)) << '\n';
+      }
+    }
+  });
+}
+
+void WriteTable3Markdown(const std::string& path, const std::vector<TableSet>& sets, const std::string& title) {
+  io::WriteFileAtomically(path, [&](std::ostream& os) {
+    os << "# " << title << "\n\n";
+    os << "Natural frequency and peak amplitude per posture and direction, model against measurement "
+          "(modal fit of the measured FRF), relative error = model / measured − 1. "
+          "'before' is the model with the initial parameters. Mode = model mode number (ascending "
+          "frequency) matched by frequency and tool-tip direction; u = its unit tool-tip shape.\n\n";
+    for (const TableSet& s : sets) {
+      os << "## " << (s.label == "fit" ? "Postures used in the fit" : "Held-out postures (validation)") << "\n\n";
+      os << "| pose | dir | mode | f meas [Hz] | f model [Hz] | err [%] | err before [%] | peak meas [m/N] | "
+            "peak model [m/N] | err [%] | err before [%] | u (x, y, z) |\n";
+      os << "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+      for (const ModeMatch& m : s.after.matches) {
+        const ModeMatch* b = FindBefore(s.before, m);
+        os << "| " << m.key.pose_id << " | " << Dir(m.key) << " | " << m.model_mode + 1 << " | "
+           << Fixed(m.measured_freq_hz, 3) << " | " << Fixed(m.model_freq_hz, 3) << " | "
+           << Fixed(100 * m.freq_error(), 2) << " | " << (b ? Fixed(100 * b->freq_error(), 2) : "–") << " | "
+           << Sci(m.measured_peak) << " | " << Sci(m.model_peak) << " | " << Fixed(100 * m.peak_error(), 2)
+           << " | " << (b ? Fixed(100 * b->peak_error(), 2) : "–") << " | (" << Fixed(m.model_shape_T(0), 2)
+           << ", " << Fixed(m.model_shape_T(1), 2) << ", " << Fixed(m.model_shape_T(2), 2) << ") |\n";
+      }
+      os << "\nLargest |error| after calibration: natural frequency " << Fixed(100 * s.after.max_abs_freq_error, 3)
+         << " %, peak amplitude " << Fixed(100 * s.after.max_abs_peak_error, 3) << " % (before: "
+         << Fixed(100 * s.before.max_abs_freq_error, 3) << " %, " << Fixed(100 * s.before.max_abs_peak_error, 3)
+         << " %).\n\n";
+      if (!s.after.unmatched_measured.empty() && s.features) {
+        os << "Measured modes without a model counterpart (too weak in this direction, or no model mode "
+              "nearby):\n\n";
+        for (int i : s.after.unmatched_measured) {
+          const auto& mm = s.features->modes[i];
+          os << "- " << mm.key.pose_id << " " << Dir(mm.key) << ": " << Fixed(mm.fit.freq_hz, 3) << " Hz, ζ = "
+             << Fixed(mm.fit.damping_ratio, 4) << ", peak " << Sci(mm.peak_magnitude) << " m/N\n";
+        }
+        os << "\n";
+      }
+    }
+  });
+}
+
+void WriteOverlayPng(const std::string& path, const PostureOverlay& o, const std::string& title) {
+  const int rows = static_cast<int>(o.keys.size());
+  Figure fig(std::max(1, rows), 2, 760, 340);
+  fig.title = title;
+  for (int r = 0; r < rows; ++r) {
+    std::vector<FrfCurve> curves(3);
+    curves[0] = {o.freq_hz[r], o.measured[r], "measured H" + Dir(o.keys[r]), PaletteColor(0), false};
+    curves[1] = {o.freq_hz[r], o.before[r], "model before", PaletteColor(1), true};
+    curves[2] = {o.freq_hz[r], o.after[r], "model after", PaletteColor(2), false};
+    FillFrfPanels(curves, o.mode_freq_hz, "posture " + o.pose_id + ": H" + Dir(o.keys[r]), &fig.at(r, 0),
+                  &fig.at(r, 1));
+    fig.at(r, 1).title = "phase";
+  }
+  fig.SavePng(path);
+}
+
+void WriteStabilisationPng(const std::string& path, const std::string& pose_id,
+                           const calibration::MeasuredFeatures& features) {
+  std::vector<const std::pair<const dynamics::FrfKey, calibration::ModalFitResult>*> fits;
+  for (const auto& kv : features.fits) {
+    if (kv.first.pose_id == pose_id) fits.push_back(&kv);
+  }
+  Figure fig(std::max<int>(1, static_cast<int>(fits.size())), 1, 900, 320);
+  fig.title = "stabilisation diagrams, posture " + pose_id;
+  for (size_t r = 0; r < fits.size(); ++r) {
+    const auto& [key, fit] = *fits[r];
+    Axes& ax = fig.at(static_cast<int>(r), 0);
+    ax.title = "H" + Dir(key) + ": " + std::to_string(fit.modes.size()) + " modes, LSCF order " +
+               std::to_string(fit.order_used) + ", relative rms misfit " + Fixed(fit.relative_rms_error, 4);
+    ax.x_label = "frequency [Hz]";
+    ax.y_label = "model order";
+    ax.log_x = fit.fmin_hz > 0.0 && fit.fmax_hz / fit.fmin_hz > 100.0;
+    ax.x_min = ax.log_x ? fit.fmin_hz : 0.0;
+    ax.x_max = fit.fmax_hz;
+    Series unstable, stable;
+    unstable.markers = stable.markers = true;
+    unstable.label = "pole";
+    stable.label = "stable pole";
+    unstable.color = {180, 180, 180};
+    stable.color = PaletteColor(2);
+    for (const auto& p : fit.stabilisation) {
+      Series& s = p.stable ? stable : unstable;
+      s.x.push_back(p.freq_hz);
+      s.y.push_back(p.order);
+    }
+    ax.series.push_back(std::move(unstable));
+    ax.series.push_back(std::move(stable));
+    for (const auto& m : fit.modes) ax.markers.push_back({m.freq_hz, Fixed(m.freq_hz, 1) + " Hz"});
+  }
+  fig.SavePng(path);
+}
+
+nlohmann::json CalibrationSummaryJson(const calibration::CalibrationResult& result,
+                                      const calibration::CalibrationOptions& options,
+                                      const std::vector<TableSet>& sets) {
+  using nlohmann::json;
+  json j;
+  j["objective"] = calibration::ObjectiveName(options.objective);
+  j["status"] = calibration::FitStatusName(result.status);
+  j["message"] = result.message;
+  j["weakly_identified"] = result.weakly_identified;
+  j["parameters"] = json::array();
+  for (const auto& e : result.estimates) {
+    j["parameters"].push_back({{"name", e.name},
+                               {"unit", e.unit},
+                               {"initial", e.initial},
+                               {"value", e.value},
+                               {"std_dev", e.std_dev},
+                               {"relative_std", e.std_dev / std::abs(e.value)},
+                               {"weakly_identified", e.weakly_identified},
+                               {"at_bound", e.at_bound},
+                               {"stage", e.stage}});
+  }
+  j["stages"] = json::array();
+  for (const auto& s : result.stages) {
+    j["stages"].push_back({{"name", s.name},
+                           {"parameters", s.parameters},
+                           {"termination", s.termination},
+                           {"message", s.message},
+                           {"iterations", s.iterations},
+                           {"num_residuals", s.num_residuals},
+                           {"initial_cost", s.initial_cost},
+                           {"final_cost", s.final_cost},
+                           {"covariance_ok", s.covariance_ok}});
+  }
+  for (const TableSet& s : sets) {
+    json set;
+    // From the matches themselves, the one source of the table's numbers.
+    auto stats = [](const calibration::Comparison& c) {
+      double mf = 0, mp = 0, sf = 0, sp = 0;
+      for (const ModeMatch& m : c.matches) {
+        mf = std::max(mf, std::abs(m.freq_error()));
+        mp = std::max(mp, std::abs(m.peak_error()));
+        sf += m.freq_error() * m.freq_error();
+        sp += m.peak_error() * m.peak_error();
+      }
+      const double n = std::max<size_t>(1, c.matches.size());
+      return std::array<double, 4>{mf, mp, std::sqrt(sf / n), std::sqrt(sp / n)};
+    };
+    const auto b = stats(s.before), a = stats(s.after);
+    set["max_abs_freq_error"] = {{"before", b[0]}, {"after", a[0]}};
+    set["max_abs_peak_error"] = {{"before", b[1]}, {"after", a[1]}};
+    set["rms_freq_error"] = {{"before", b[2]}, {"after", a[2]}};
+    set["rms_peak_error"] = {{"before", b[3]}, {"after", a[3]}};
+    set["num_matches"] = {{"before", s.before.matches.size()}, {"after", s.after.matches.size()}};
+    json postures = json::object();
+    for (const auto& [key, err] : s.after.whole_curve_error) {
+      json& p = postures[key.pose_id];
+      p["whole_curve_error"][Dir(key)] = {{"before", s.before.whole_curve_error.count(key)
+                                                         ? s.before.whole_curve_error.at(key)
+                                                         : NAN},
+                                          {"after", err}};
+    }
+    for (const auto& [label, cmp] : {std::pair<std::string, const calibration::Comparison*>{"before", &s.before},
+                                     {"after", &s.after}}) {
+      std::map<std::string, std::pair<double, double>> worst;
+      for (const ModeMatch& m : cmp->matches) {
+        auto& w = worst[m.key.pose_id];
+        w.first = std::max(w.first, std::abs(m.freq_error()));
+        w.second = std::max(w.second, std::abs(m.peak_error()));
+      }
+      for (const auto& [pose, w] : worst) {
+        postures[pose]["max_abs_freq_error"][label] = w.first;
+        postures[pose]["max_abs_peak_error"][label] = w.second;
+      }
+    }
+    set["postures"] = postures;
+    json matches = json::array();
+    for (const ModeMatch& m : s.after.matches) {
+      matches.push_back({{"pose_id", m.key.pose_id},
+                         {"direction", Dir(m.key)},
+                         {"model_mode", m.model_mode + 1},
+                         {"measured_freq_hz", m.measured_freq_hz},
+                         {"model_freq_hz", m.model_freq_hz},
+                         {"freq_error", m.freq_error()},
+                         {"measured_peak_m_per_N", m.measured_peak},
+                         {"model_peak_m_per_N", m.model_peak},
+                         {"peak_error", m.peak_error()},
+                         {"model_shape_T", {m.model_shape_T(0), m.model_shape_T(1), m.model_shape_T(2)}}});
+    }
+    set["matches"] = matches;
+    if (s.features) {
+      json fits = json::array();
+      for (const auto& [key, fit] : s.features->fits) {
+        json modes = json::array();
+        for (const auto& m : fit.modes) {
+          modes.push_back({{"freq_hz", m.freq_hz},
+                           {"damping_ratio", m.damping_ratio},
+                           {"modal_constant", {m.modal_constant.real(), m.modal_constant.imag()}},
+                           {"stable_orders", m.stable_orders}});
+        }
+        json peaks = json::array();
+        if (auto it = s.features->peaks.find(key); it != s.features->peaks.end()) {
+          for (const auto& p : it->second) {
+            peaks.push_back({{"peak_freq_hz", p.peak_freq_hz},
+                             {"peak_magnitude_m_per_N", p.peak_magnitude},
+                             {"half_power_damping_ratio", p.damping_ratio}});
+          }
+        }
+        fits.push_back({{"pose_id", key.pose_id},
+                        {"peak_picking", peaks},
+                        {"direction", Dir(key)},
+                        {"status", fit.status == calibration::ModalFitStatus::kOk ? "ok"
+                                   : fit.status == calibration::ModalFitStatus::kNoStableModes ? "no_stable_modes"
+                                                                                                 : "failed"},
+                        {"message", fit.message},
+                        {"relative_rms_error", fit.relative_rms_error},
+                        {"modes", modes}});
+      }
+      set["modal_fits"] = fits;
+    }
+    j["sets"][s.label] = set;
+  }
+  return j;
+}
+
+}  // namespace robomach::report

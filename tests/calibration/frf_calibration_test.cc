@@ -1,0 +1,224 @@
+// Calibration against virtual hammer tests with known truth (issue #4
+// acceptance), the matching of measured to model modes, and fit problems
+// reported as a status.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <set>
+
+#include "robomach/calibration/frf_calibration.h"
+#include "robomach/calibration/virtual_hammer_test.h"
+#include "robomach/common/units.h"
+#include "robomach/io/frf_files.h"
+#include "robomach/io/posture_file.h"
+#include "robomach/io/robot_config.h"
+#include "test_support.h"
+
+namespace robomach::calibration {
+namespace {
+
+using robomach::testing::SourcePath;
+using robomach::testing::TempDir;
+
+struct TestCampaign {
+  io::RobotConfig cfg;
+  dynamics::ParameterSet truth;
+  std::vector<NamedPosture> fit_postures, holdout_postures;
+  PostureMap postures;
+};
+
+// Truth: m6, d6, alpha, beta off the defaults by +20 %, −15 %, +30 %, −25 %
+// ("up to 30 %", issue #4). Held-out postures: three more inside the joint
+// limits, away from the wrist singularity (q5 far from 0).
+TestCampaign MakeSetup() {
+  TestCampaign s{io::LoadRobotConfig(SourcePath("config/kr210.yaml")), {}, {}, {}, {}};
+  s.truth = s.cfg.parameters;
+  s.truth.Set("m6_kg", 1.20 * s.cfg.parameters.Get("m6_kg"));
+  s.truth.Set("d6_m", 0.85 * s.cfg.parameters.Get("d6_m"));
+  s.truth.Set("alpha_s", 1.30 * s.cfg.parameters.Get("alpha_s"));
+  s.truth.Set("beta_per_s", 0.75 * s.cfg.parameters.Get("beta_per_s"));
+  for (const io::Posture& p : io::ReadPostureFile(SourcePath("config/postures_demo.csv"), 6)) {
+    s.fit_postures.push_back({p.id, p.q});
+    s.postures[p.id] = p.q;
+  }
+  const std::vector<std::pair<std::string, std::vector<double>>> held = {
+      {"H1", {15, -70, 95, 20, 50, -30}}, {"H2", {-30, -85, 110, -20, 35, 45}}, {"H3", {45, -50, 70, 0, -55, 0}}};
+  for (const auto& [id, deg] : held) {
+    Eigen::VectorXd q(6);
+    for (int j = 0; j < 6; ++j) q(j) = DegToRad(deg[j]);
+    s.holdout_postures.push_back({id, q});
+    s.postures[id] = q;
+  }
+  return s;
+}
+
+VirtualHammerOptions NoisyTest(unsigned seed) {
+  VirtualHammerOptions o;  // 0.25..500 Hz, 2000 lines, xx and yy
+  o.relative_noise = 0.02;
+  o.seed = seed;
+  return o;
+}
+
+void ExpectAcceptance(const TestCampaign& s, const CalibrationResult& r, const dynamics::FrfSet& holdout,
+                      const std::string& what) {
+  // Issue #4 acceptance targets, stated there: m6 and d6 within 1 %, alpha
+  // and beta within 5 %, after calibration natural-frequency errors below
+  // 0.5 % and peak-amplitude errors below 3 % at all postures, held-out ones
+  // included.
+  EXPECT_EQ(r.status, FitStatus::kConverged) << what << ": " << r.message;
+  for (const auto& [name, tol] : std::vector<std::pair<std::string, double>>{
+           {"m6_kg", 0.01}, {"d6_m", 0.01}, {"alpha_s", 0.05}, {"beta_per_s", 0.05}}) {
+    EXPECT_NEAR(r.parameters.Get(name) / s.truth.Get(name), 1.0, tol) << what << ": " << name;
+  }
+  const auto model = dynamics::RobotModel::Build(s.cfg.description, r.parameters);
+  std::vector<std::string> poses_with_matches;
+  for (const auto& [label, set] : {std::pair<std::string, const dynamics::FrfSet*>{"fit", nullptr},
+                                   {"holdout", &holdout}}) {
+    const std::vector<ModeMatch>& matches =
+        set ? CompareWithMeasurement(model, s.postures, *set, ExtractFeatures(*set)).matches : r.matches_after;
+    std::set<std::string> poses;
+    for (const ModeMatch& m : matches) {
+      poses.insert(m.key.pose_id);
+      EXPECT_LT(std::abs(m.freq_error()), 0.005)
+          << what << " " << label << " " << m.key.ToString() << " at " << m.measured_freq_hz << " Hz";
+      EXPECT_LT(std::abs(m.peak_error()), 0.03)
+          << what << " " << label << " " << m.key.ToString() << " at " << m.measured_freq_hz << " Hz";
+    }
+    // Every posture contributes matched modes (the table covers all of them).
+    EXPECT_EQ(poses.size(), set ? 3u : 5u) << what << " " << label;
+  }
+}
+
+TEST(FrfCalibration, AcceptanceTwoStageRecoversTruthFromNoisyHammerTests) {
+  const TestCampaign s = MakeSetup();
+  const auto truth_model = dynamics::RobotModel::Build(s.cfg.description, s.truth);
+  const dynamics::FrfSet measured = SynthesizeHammerTest(truth_model, s.fit_postures, NoisyTest(11));
+  const dynamics::FrfSet holdout = SynthesizeHammerTest(truth_model, s.holdout_postures, NoisyTest(12));
+  const MeasuredFeatures features = ExtractFeatures(measured);
+  const CalibrationResult r = Calibrate(s.cfg.description, s.cfg.parameters, s.postures, measured, features);
+  ExpectAcceptance(s, r, holdout, "two-stage");
+  ASSERT_EQ(r.stages.size(), 2u);
+  // The frequency stage holds exactly the parameters that move undamped
+  // frequencies; Rayleigh damping does not.
+  EXPECT_EQ(r.stages[0].parameters, (std::vector<std::string>{"m6_kg", "d6_m"}));
+  EXPECT_EQ(r.stages[1].parameters, (std::vector<std::string>{"alpha_s", "beta_per_s"}));
+  // The reported 1-sigma uncertainties are consistent with the actual error:
+  // |error| < 5 sigma for every parameter.
+  for (const ParameterEstimate& e : r.estimates) {
+    EXPECT_LT(std::abs(e.value - s.truth.Get(e.name)), 5.0 * e.std_dev) << e.name;
+    EXPECT_FALSE(e.weakly_identified) << e.name;
+  }
+}
+
+TEST(FrfCalibration, AcceptanceJointAndWholeCurveObjectives) {
+  const TestCampaign s = MakeSetup();
+  const auto truth_model = dynamics::RobotModel::Build(s.cfg.description, s.truth);
+  const dynamics::FrfSet measured = SynthesizeHammerTest(truth_model, s.fit_postures, NoisyTest(21));
+  const dynamics::FrfSet holdout = SynthesizeHammerTest(truth_model, s.holdout_postures, NoisyTest(22));
+  const MeasuredFeatures features = ExtractFeatures(measured);
+  for (Objective obj : {Objective::kModalJoint, Objective::kWholeCurve}) {
+    CalibrationOptions o;
+    o.objective = obj;
+    const CalibrationResult r = Calibrate(s.cfg.description, s.cfg.parameters, s.postures, measured, features, o);
+    ExpectAcceptance(s, r, holdout, ObjectiveName(obj));
+  }
+}
+
+// The same data as CSV and as a UFF58 copy: frf-synth rounds to UFF58's 13
+// digits, so both files hold identical numbers, and the calibration (a
+// deterministic computation) must give bit-identical results.
+TEST(FrfCalibration, UffCopyGivesIdenticalResults) {
+  const TestCampaign s = MakeSetup();
+  const auto truth_model = dynamics::RobotModel::Build(s.cfg.description, s.truth);
+  const dynamics::FrfSet synth = SynthesizeHammerTest(truth_model, s.fit_postures, NoisyTest(31));
+  const std::string dir = TempDir("calibration_uff_copy");
+  io::WriteFrfCsv(dir + "/hammer.csv", synth);
+  io::WriteUff58(dir + "/hammer.uff", synth);
+  const dynamics::FrfSet from_csv = io::ReadFrfFile(dir + "/hammer.csv").frfs;
+  const dynamics::FrfSet from_uff = io::ReadFrfFile(dir + "/hammer.uff").frfs;
+  ASSERT_EQ(from_csv.keys(), from_uff.keys());
+  for (const auto& [k, f] : from_csv) {
+    ASSERT_EQ(f.freq_hz(), from_uff.at(k).freq_hz());
+    ASSERT_EQ(f.receptance(), from_uff.at(k).receptance());
+  }
+  const CalibrationResult a = Calibrate(s.cfg.description, s.cfg.parameters, s.postures, from_csv,
+                                        ExtractFeatures(from_csv));
+  const CalibrationResult b = Calibrate(s.cfg.description, s.cfg.parameters, s.postures, from_uff,
+                                        ExtractFeatures(from_uff));
+  ASSERT_EQ(a.estimates.size(), b.estimates.size());
+  for (size_t i = 0; i < a.estimates.size(); ++i) {
+    EXPECT_EQ(a.estimates[i].value, b.estimates[i].value) << a.estimates[i].name;
+    EXPECT_EQ(a.estimates[i].std_dev, b.estimates[i].std_dev) << a.estimates[i].name;
+  }
+  EXPECT_EQ(a.status, b.status);
+}
+
+// Second method: on noise-free data of the default model, the modal fit of
+// the "measured" FRFs and the model's own eigen-solution must agree for every
+// matched mode. The fitter keeps a mode only if its own peak reaches
+// ModalFitOptions::min_relative_contribution (0.5 %) of the local |H|, so a
+// very weak mode may be left out; it leaves a misfit of at most ~0.5 % over
+// its half-power band (N_hp ≤ 40 of the 2000 lines), i.e. a relative rms over
+// the band ≤ 0.5 % · √(40/2000) ≈ 7e-4 per omitted mode: fit residual < 1e-3.
+// The matched (strong) modes are fitted with the data's full precision, so
+// their natural frequencies agree to ≲ ζ · 1e-3 ≈ 3e-5 and the curve peaks,
+// which the omitted modes barely touch (< 0.5 % of |H| spread over their own
+// bands, not at these peaks), to a few 1e-4: tolerances 1e-4 and 5e-4.
+TEST(FrfCalibration, MatchedModesAgreeWithModelEigenSolutionOnCleanData) {
+  const TestCampaign s = MakeSetup();
+  const auto model = s.cfg.Build();
+  VirtualHammerOptions o;
+  o.round_to_uff_precision = false;
+  const dynamics::FrfSet clean = SynthesizeHammerTest(model, s.fit_postures, o);
+  const MeasuredFeatures features = ExtractFeatures(clean);
+  for (const auto& [k, fit] : features.fits) EXPECT_LT(fit.relative_rms_error, 1e-3) << k.ToString();
+  const Comparison c = CompareWithMeasurement(model, s.postures, clean, features);
+  EXPECT_GE(c.matches.size(), 15u);
+  for (const ModeMatch& m : c.matches) {
+    EXPECT_LT(std::abs(m.freq_error()), 1e-4) << m.key.ToString() << " " << m.measured_freq_hz;
+    EXPECT_LT(std::abs(m.peak_error()), 5e-4) << m.key.ToString() << " " << m.measured_freq_hz;
+    // Matched by direction too: the model mode moves the tip along the
+    // measured direction (|u| component above 0.1).
+    EXPECT_GT(std::abs(m.model_shape_T(static_cast<int>(m.key.response))), 0.1) << m.key.ToString();
+  }
+  for (const auto& [k, e] : c.whole_curve_error) EXPECT_LT(e, 1e-9) << k.ToString();
+}
+
+// One FRF in a band with one mode cannot determine both alpha and beta (one
+// peak residual, two parameters): a status in the result, not an exception.
+TEST(FrfCalibration, UnidentifiableDampingIsAStatusNotAnException) {
+  const TestCampaign s = MakeSetup();
+  const auto model = s.cfg.Build();
+  VirtualHammerOptions o;
+  o.directions = {{Axis::kY, Axis::kY}};
+  o.fmin_hz = 12.0;
+  o.fmax_hz = 30.0;  // P1: only the 19 Hz mode in y
+  const dynamics::FrfSet one = SynthesizeHammerTest(model, {s.fit_postures[0]}, o);
+  CalibrationOptions co;
+  co.free_parameters = {"alpha_s", "beta_per_s"};
+  CalibrationResult r;
+  ASSERT_NO_THROW(r = Calibrate(s.cfg.description, s.cfg.parameters, s.postures, one, ExtractFeatures(one), co));
+  EXPECT_NE(r.status, FitStatus::kConverged);
+  EXPECT_FALSE(r.weakly_identified.empty());
+  EXPECT_NE(r.message.find("fewer residuals"), std::string::npos) << r.message;
+}
+
+TEST(FrfCalibration, RejectsUnknownParameterAndPosture) {
+  const TestCampaign s = MakeSetup();
+  const auto model = s.cfg.Build();
+  VirtualHammerOptions o;
+  const dynamics::FrfSet d = SynthesizeHammerTest(model, {{"P9", s.postures.at("P1")}}, o);
+  CalibrationOptions co;
+  co.free_parameters = {"m7_kg"};
+  EXPECT_THROW(Calibrate(s.cfg.description, s.cfg.parameters, s.postures, d, {}, co), std::invalid_argument);
+  try {
+    Calibrate(s.cfg.description, s.cfg.parameters, s.postures, d, ExtractFeatures(d));
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("posture P9 of the measured FRFs is not in the posture file"),
+              std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace robomach::calibration
