@@ -1,0 +1,147 @@
+#include "robomach/stability/zoa_lobes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "robomach/common/units.h"
+
+namespace robomach::stability {
+
+const char* ToString(LobeStatus s) {
+  switch (s) {
+    case LobeStatus::kOk: return "ok";
+    case LobeStatus::kNotCovered: return "not_covered";
+    case LobeStatus::kStableUpToMax: return "stable_up_to_max";
+    case LobeStatus::kUnstableAtZero: return "unstable_at_zero";
+  }
+  return "?";
+}
+
+namespace {
+
+using cd = std::complex<double>;
+
+// Eigenvalues of a 2×2 complex matrix from its trace and determinant.
+std::pair<cd, cd> Eigenvalues2(const Eigen::Matrix2cd& A) {
+  const cd half_tr = 0.5 * (A(0, 0) + A(1, 1));
+  const cd det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+  const cd disc = std::sqrt(half_tr * half_tr - det);
+  cd l1 = half_tr + disc, l2 = half_tr - disc;
+  // Avoid cancellation in the smaller root: l1 l2 = det.
+  if (std::abs(l2) > std::abs(l1)) std::swap(l1, l2);
+  if (std::abs(l1) > 0.0) l2 = det / l1;
+  return {l1, l2};
+}
+
+}  // namespace
+
+ZoaLobes ComputeZoaLobes(const Eigen::VectorXd& freq_hz, const std::vector<Eigen::Matrix2cd>& Phi_C,
+                         const MillingProcess& process, const ZoaOptions& options) {
+  process.Validate();
+  if (static_cast<size_t>(freq_hz.size()) != Phi_C.size() || freq_hz.size() < 2) {
+    throw std::invalid_argument("ZOA lobes: need at least 2 frequency lines and one FRF per line");
+  }
+  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
+    if (!(freq_hz(i) > 0.0) || (i > 0 && !(freq_hz(i) > freq_hz(i - 1)))) {
+      throw std::invalid_argument("ZOA lobes: frequencies must be > 0 and strictly increasing");
+    }
+  }
+  const Eigen::Matrix2cd H0 = AverageDirectionalMatrix(process).topRows<2>().cast<cd>();
+  int K = std::max(0, options.max_lobe_index);
+  if (options.min_spindle_speed_rad_s > 0.0) {
+    const double f_tooth_min = process.teeth * options.min_spindle_speed_rad_s / (2.0 * kPi);
+    K = std::min(K, static_cast<int>(std::ceil(freq_hz(freq_hz.size() - 1) / f_tooth_min)));
+  }
+  const int N = process.teeth;
+
+  ZoaLobes out;
+  out.curves_.resize(2 * (K + 1));
+  for (int b = 0; b < 2; ++b) {
+    for (int k = 0; k <= K; ++k) {
+      LobeCurve& c = out.curves_[b * (K + 1) + k];
+      c.lobe_index = k;
+      c.branch = b;
+      c.chatter_freq_hz.reserve(freq_hz.size());
+      c.spindle_speed_rad_s.reserve(freq_hz.size());
+      c.critical_depth.reserve(freq_hz.size());
+    }
+  }
+  cd prev1, prev2;
+  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
+    auto [l1, l2] = Eigenvalues2(Phi_C[i] * H0);
+    // Follow each branch by continuity with the previous line.
+    if (i > 0 && std::abs(l1 - prev2) + std::abs(l2 - prev1) <
+                     std::abs(l1 - prev1) + std::abs(l2 - prev2)) {
+      std::swap(l1, l2);
+    }
+    prev1 = l1;
+    prev2 = l2;
+    const double w = HzToRadPerSec(freq_hz(i));
+    const cd lam[2] = {l1, l2};
+    for (int b = 0; b < 2; ++b) {
+      double depth = NAN, theta = NAN;
+      if (std::abs(lam[b]) > 0.0) {
+        const cd L = -1.0 / lam[b];
+        if (L.real() > 0.0) {
+          depth = std::norm(L) / (2.0 * L.real());
+          theta = std::atan2(L.real(), L.imag());  // in (0, π)
+        }
+      }
+      for (int k = 0; k <= K; ++k) {
+        LobeCurve& c = out.curves_[b * (K + 1) + k];
+        c.chatter_freq_hz.push_back(freq_hz(i));
+        c.critical_depth.push_back(depth);
+        const double tau = (2.0 * theta + 2.0 * kPi * k) / w;
+        c.spindle_speed_rad_s.push_back(std::isfinite(depth) ? 2.0 * kPi / (N * tau) : NAN);
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<LobePoint> ZoaLobes::At(const Eigen::VectorXd& speeds) const {
+  const Eigen::Index n = speeds.size();
+  std::vector<LobePoint> out(n);
+  for (Eigen::Index j = 0; j < n; ++j) out[j].spindle_speed_rad_s = speeds(j);
+  std::vector<Eigen::Index> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](auto a, auto b) { return speeds(a) < speeds(b); });
+  std::vector<double> sorted(n);
+  for (Eigen::Index j = 0; j < n; ++j) sorted[j] = speeds(order[j]);
+  if (n == 0) return out;
+  const double s_lo = sorted.front(), s_hi = sorted.back();
+
+  for (const LobeCurve& c : curves_) {
+    const size_t m = c.spindle_speed_rad_s.size();
+    for (size_t i = 0; i + 1 < m; ++i) {
+      const double sa = c.spindle_speed_rad_s[i], sb = c.spindle_speed_rad_s[i + 1];
+      if (!std::isfinite(sa) || !std::isfinite(sb)) continue;
+      const double lo = std::min(sa, sb), hi = std::max(sa, sb);
+      if (hi < s_lo || lo > s_hi) continue;
+      auto it = std::lower_bound(sorted.begin(), sorted.end(), lo);
+      for (; it != sorted.end() && *it <= hi; ++it) {
+        const double s = *it;
+        const double t = hi > lo ? (s - sa) / (sb - sa) : 0.0;
+        const double depth = c.critical_depth[i] + t * (c.critical_depth[i + 1] - c.critical_depth[i]);
+        LobePoint& p = out[order[it - sorted.begin()]];
+        if (p.status != LobeStatus::kOk || depth < p.critical_depth) {
+          p.critical_depth = depth;
+          p.chatter_freq_hz = c.chatter_freq_hz[i] + t * (c.chatter_freq_hz[i + 1] - c.chatter_freq_hz[i]);
+          p.lobe_index = c.lobe_index;
+          p.status = LobeStatus::kOk;
+        }
+      }
+    }
+  }
+  return out;
+}
+
+LobePoint ZoaLobes::At(double spindle_speed_rad_s) const {
+  Eigen::VectorXd s(1);
+  s(0) = spindle_speed_rad_s;
+  return At(s)[0];
+}
+
+}  // namespace robomach::stability
