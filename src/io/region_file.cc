@@ -63,7 +63,12 @@ RegionSpec ReadRegionFile(const std::string& path, int num_joints) {
   if (!doc.IsMap()) throw doc.Error("expected a map (see config/region_demo.yaml)");
   RegionSpec r;
   r.path = path;
-  r.origin_B = Vec3(doc["origin_mm"]) * 1e-3;
+  {
+    const YamlDoc o = doc["origin_mm"];
+    r.origin_B = Vec3(o) * 1e-3;
+    r.origin_line = o.location().line;
+    r.origin_column = o.location().column;
+  }
   r.u_B = Direction(doc["u_axis"]);
   {
     const YamlDoc vn = doc["v_axis"];

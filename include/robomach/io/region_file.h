@@ -24,6 +24,7 @@ struct RegionSpec {
   double rotation_min{0.0}, rotation_max{0.0};    // [rad] when free
   Eigen::VectorXd seed_q;                         // preferred arm configuration [rad]
   std::string path;
+  int origin_line{0}, origin_column{0};  // where origin_mm is, for messages
 
   int num_u() const;  // grid points along u (size/step + 1)
   int num_v() const;
