@@ -38,7 +38,7 @@ int Run(int argc, char** argv) {
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
   app.add_option("--cut", cut_path, "cut file YAML (config/cut_demo.yaml)")->required();
   app.add_option("--region", region_path, "region file YAML (config/region_demo.yaml)");
-  app.add_option("--path", path_path, "tool-path CSV: x_mm,y_mm,z_mm,tool_i,tool_j,tool_k[,feed_i,feed_j,feed_k][,rotation_deg][,point_id]; the tool axis points from the tip to the spindle; needs --seed-from-region or uses the region's seed");
+  app.add_option("--path", path_path, "tool-path CSV: x_mm,y_mm,z_mm,tool_i,tool_j,tool_k[,feed_i,feed_j,feed_k][,rotation_deg][,point_id]; the tool axis points from the tip to the spindle; rotation_deg is added to the region's rotation about the tool axis; the region file gives the seed posture");
   app.add_option("--out", out_path, "per-point CSV; stdout if omitted");
   app.add_option("--plot", plot_path, "heat map PNG of the critical depth [mm] (grid only)");
   app.add_option("--threads", threads, "worker threads, 0 = all cores")->capture_default_str();
@@ -81,6 +81,7 @@ int Run(int argc, char** argv) {
 
     std::vector<stability::ToolPoseTarget> targets;
     std::vector<std::string> ids;
+    std::vector<double> path_rotation;  // per-point rotation added to the region's
     int rows = 0, cols = 0;
     const bool grid = path_path.empty();
     if (grid) {
@@ -94,6 +95,7 @@ int Run(int argc, char** argv) {
         t.x_ref = Eigen::AngleAxisd(p.rotation, t.z_T.normalized()) * t.x_ref;
         targets.push_back(t);
         ids.push_back(p.id);
+        path_rotation.push_back(p.rotation);
       }
       rows = 1;
       cols = static_cast<int>(targets.size());
@@ -142,7 +144,8 @@ int Run(int argc, char** argv) {
           os << ids[i] << ',';
         }
         os << Num(targets[i].p_BT.x(), 1e3) << ',' << Num(targets[i].p_BT.y(), 1e3) << ','
-           << Num(targets[i].p_BT.z(), 1e3) << ',' << Num(RadToDeg(p.rotation));
+           << Num(targets[i].p_BT.z(), 1e3) << ','
+           << Num(RadToDeg(p.rotation + (grid ? 0.0 : path_rotation[i])));
         for (int j = 0; j < n; ++j) os << ',' << (p.q.size() == n ? Num(RadToDeg(p.q(j))) : "");
         const bool mc = analysed && s.mode_coupling.status == stability::ModeCouplingStatus::kFound;
         const bool rg = analysed && s.regenerative.status == stability::LobeStatus::kOk;
