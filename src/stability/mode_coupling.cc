@@ -1,5 +1,6 @@
 #include "robomach/stability/mode_coupling.h"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <stdexcept>
@@ -37,6 +38,86 @@ std::complex<double> RightmostEigenvalue(const Eigen::MatrixXd& M, const Eigen::
   return ev(imax);
 }
 
+namespace {
+
+// Smallest depth in (0, max_depth] where the rightmost eigenvalue crosses
+// into the right half-plane: a geometric scan brackets it, then a
+// safeguarded regula falsi (Illinois, each step kept at least 5 % of the
+// bracket from its ends) narrows the bracket to the tolerance.
+template <class Rightmost>
+ModeCouplingResult SearchCriticalDepth(const Rightmost& rightmost, const ModeCouplingOptions& options) {
+  if (!(options.max_depth > 0.0) || options.scan_points < 1 || !(options.depth_tolerance > 0.0)) {
+    throw std::invalid_argument("mode coupling: need max_depth > 0, scan_points >= 1, tolerance > 0");
+  }
+  ModeCouplingResult out;
+  // An undamped stable system has Re λ = 0 up to rounding, ~eps·|λ|;
+  // 1e-9 |λ| is far above that and, since Re λ grows like √(a − a_c)
+  // past a flutter point, moves the crossing by only ~1e-18 relative.
+  auto growth = [&](double a, std::complex<double>* lambda) {
+    ++out.evaluations;
+    *lambda = rightmost(a);
+    return lambda->real() - 1e-9 * std::abs(*lambda);
+  };
+  std::complex<double> lam;
+  double lo = 0.0, hi = NAN, g_lo = growth(0.0, &lam), g_hi = 0.0;
+  if (g_lo > 0.0) {
+    out.status = ModeCouplingStatus::kUnstableAtZero;
+    return out;
+  }
+  std::complex<double> lam_hi;
+  for (int j = 1; j <= options.scan_points; ++j) {
+    const double a = options.max_depth * std::ldexp(1.0, j - options.scan_points);
+    const double g = growth(a, &lam);
+    if (g > 0.0) {
+      hi = a;
+      g_hi = g;
+      lam_hi = lam;
+      break;
+    }
+    lo = a;
+    g_lo = g;
+  }
+  if (!std::isfinite(hi)) {
+    out.status = ModeCouplingStatus::kStableUpToMax;
+    out.critical_depth = options.max_depth;
+    return out;
+  }
+  int side = 0;  // which end was kept last time (Illinois)
+  while (hi - lo > options.depth_tolerance * hi) {
+    const double w = hi - lo;
+    double x = (g_hi - g_lo) != 0.0 ? lo - g_lo * w / (g_hi - g_lo) : 0.5 * (lo + hi);
+    x = std::clamp(x, lo + 0.05 * w, hi - 0.05 * w);
+    const double g = growth(x, &lam);
+    if (g > 0.0) {
+      hi = x;
+      g_hi = g;
+      lam_hi = lam;
+      if (side == -1) g_lo *= 0.5;
+      side = -1;
+    } else {
+      lo = x;
+      g_lo = g;
+      if (side == 1) g_hi *= 0.5;
+      side = 1;
+    }
+  }
+  out.critical_depth = 0.5 * (lo + hi);
+  out.chatter_freq_hz = std::abs(lam_hi.imag()) / (2.0 * kPi);
+  out.flutter = std::abs(lam_hi.imag()) > 1e-6 * std::abs(lam_hi);
+  out.status = ModeCouplingStatus::kFound;
+  return out;
+}
+
+std::complex<double> RightmostOf(const Eigen::MatrixXd& A) {
+  Eigen::EigenSolver<Eigen::MatrixXd> es(A, false);
+  const Eigen::VectorXcd ev = es.eigenvalues();
+  Eigen::Index imax = 0;
+  ev.real().maxCoeff(&imax);
+  return ev(imax);
+}
+
+}  // namespace
+
 ModeCouplingResult CriticalDepthModeCoupling(const Eigen::MatrixXd& M, const Eigen::MatrixXd& C,
                                              const Eigen::MatrixXd& K, const Matrix3Xd& B,
                                              const Eigen::Matrix3d& Kc_B,
@@ -46,54 +127,36 @@ ModeCouplingResult CriticalDepthModeCoupling(const Eigen::MatrixXd& M, const Eig
       B.cols() != n) {
     throw std::invalid_argument("mode coupling: M, C, K must be n×n and B 3×n");
   }
-  if (!(options.max_depth > 0.0) || options.scan_points < 1 || !(options.depth_tolerance > 0.0)) {
-    throw std::invalid_argument("mode coupling: need max_depth > 0, scan_points >= 1, tolerance > 0");
-  }
   const Eigen::MatrixXd Kc_z = B.transpose() * Kc_B * B;
-  ModeCouplingResult out;
-  auto unstable = [&](double a, std::complex<double>* lambda) {
-    ++out.evaluations;
-    *lambda = RightmostEigenvalue(M, C, K, Kc_z, a);
-    // An undamped stable system has Re λ = 0 up to rounding, ~eps·|λ|;
-    // 1e-9 |λ| is far above that and, since Re λ grows like √(a − a_c)
-    // past a flutter point, moves the crossing by only ~1e-18 relative.
-    return lambda->real() > 1e-9 * std::abs(*lambda);
-  };
-  std::complex<double> lam;
-  if (unstable(0.0, &lam)) {
-    out.status = ModeCouplingStatus::kUnstableAtZero;
-    return out;
-  }
-  double lo = 0.0, hi = NAN;
-  std::complex<double> lam_hi;
-  for (int j = 1; j <= options.scan_points; ++j) {
-    const double a = options.max_depth * std::ldexp(1.0, j - options.scan_points);
-    if (unstable(a, &lam)) {
-      hi = a;
-      lam_hi = lam;
-      break;
-    }
-    lo = a;
-  }
-  if (!std::isfinite(hi)) {
-    out.status = ModeCouplingStatus::kStableUpToMax;
-    out.critical_depth = options.max_depth;
-    return out;
-  }
-  while (hi - lo > options.depth_tolerance * hi) {
-    const double mid = 0.5 * (lo + hi);
-    if (unstable(mid, &lam)) {
-      hi = mid;
-      lam_hi = lam;
-    } else {
-      lo = mid;
-    }
-  }
-  out.critical_depth = 0.5 * (lo + hi);
-  out.chatter_freq_hz = std::abs(lam_hi.imag()) / (2.0 * kPi);
-  out.flutter = std::abs(lam_hi.imag()) > 1e-6 * std::abs(lam_hi);
-  out.status = ModeCouplingStatus::kFound;
-  return out;
+  const Eigen::LLT<Eigen::MatrixXd> llt(M);
+  const Eigen::MatrixXd MiK = llt.solve(K), MiKc = llt.solve(Kc_z), MiC = llt.solve(C);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomRightCorner(n, n) = -MiC;
+  return SearchCriticalDepth(
+      [&](double a) {
+        A.bottomLeftCorner(n, n) = -(MiK + a * MiKc);
+        return RightmostOf(A);
+      },
+      options);
+}
+
+ModeCouplingResult CriticalDepthModeCouplingModal(const TipModalModel& modes, const Eigen::Matrix3d& Kc,
+                                                  const ModeCouplingOptions& options) {
+  modes.Validate();
+  const int n = modes.num_modes();
+  const Eigen::MatrixXd Kc_q = modes.p.transpose() * Kc * modes.p;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomRightCorner(n, n).diagonal() = -2.0 * modes.zeta.cwiseProduct(modes.omega_rad_s);
+  const Eigen::VectorXd w2 = modes.omega_rad_s.array().square();
+  return SearchCriticalDepth(
+      [&](double a) {
+        A.bottomLeftCorner(n, n) = -a * Kc_q;
+        A.bottomLeftCorner(n, n).diagonal() -= w2;
+        return RightmostOf(A);
+      },
+      options);
 }
 
 double FlutterDepthClosedForm(const Eigen::Matrix2d& S, const Eigen::Matrix2d& Kc) {

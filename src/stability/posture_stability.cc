@@ -26,15 +26,21 @@ PostureStability AnalysePosture(const dynamics::PostureDynamics& d, const Eigen:
   PostureStability out;
   const Eigen::Matrix3d Kc_C = CuttingStiffnessPerDepth(process);
   const Eigen::Matrix3d Kc_B = R_BC * Kc_C * R_BC.transpose();
-  out.mode_coupling = CriticalDepthModeCoupling(d.system.M, d.system.C, d.system.K, d.system.B, Kc_B,
-                                                options.mode_coupling);
+  out.mode_coupling = d.proportional_damping && !d.modes.empty()
+                          ? CriticalDepthModeCouplingModal(ModalModelFromPosture(d), Kc_B, options.mode_coupling)
+                          : CriticalDepthModeCoupling(d.system.M, d.system.C, d.system.K, d.system.B, Kc_B,
+                                                      options.mode_coupling);
   out.closed_form = ModeCouplingClosedForm(R_BC.transpose() * d.static_compliance * R_BC,
                                            Kc_C.topLeftCorner<2, 2>());
 
   const TipModalModel modes = ModalModelFromPosture(d);
   const Eigen::VectorXd f = LobeFrequencyGrid(modes, process.teeth,
                                               options.spindle_speed_rad_s.maxCoeff(), options.freq_lines);
-  const auto Phi = OrientInCuttingPlane(dynamics::Receptance(d, f), R_BC);
+  // With proportional damping the real modes are exact (tool_tip_frf.h
+  // (2)) and only the in-plane 2×2 block is needed; otherwise the
+  // complex-mode receptance of the dynamics module.
+  const auto Phi = d.proportional_damping ? InPlaneModalReceptance(modes.Rotated(R_BC), f)
+                                          : OrientInCuttingPlane(dynamics::Receptance(d, f), R_BC);
   ZoaOptions zo = options.zoa;
   zo.min_spindle_speed_rad_s = options.spindle_speed_rad_s.minCoeff();
   const ZoaLobes lobes = ComputeZoaLobes(f, Phi, process, zo);

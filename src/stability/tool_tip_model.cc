@@ -89,6 +89,27 @@ std::vector<Eigen::Matrix3cd> ModalReceptance(const TipModalModel& m, const Eige
   return H;
 }
 
+std::vector<Eigen::Matrix2cd> InPlaneModalReceptance(const TipModalModel& m,
+                                                     const Eigen::VectorXd& freq_hz) {
+  std::vector<Eigen::Matrix2cd> H(freq_hz.size(), Eigen::Matrix2cd::Zero());
+  const int n = m.num_modes();
+  std::vector<Eigen::Matrix2d> pp(n);
+  for (int k = 0; k < n; ++k) pp[k] = m.p.col(k).head<2>() * m.p.col(k).head<2>().transpose();
+  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
+    const double w = HzToRadPerSec(freq_hz(i));
+    Eigen::Matrix2d re = Eigen::Matrix2d::Zero(), im = Eigen::Matrix2d::Zero();
+    for (int k = 0; k < n; ++k) {
+      const double wk = m.omega_rad_s(k);
+      const double a = wk * wk - w * w, b = 2.0 * m.zeta(k) * wk * w, inv = 1.0 / (a * a + b * b);
+      re += (a * inv) * pp[k];   // 1/(a + ib) = (a − ib)/(a² + b²)
+      im -= (b * inv) * pp[k];
+    }
+    H[i].real() = re;
+    H[i].imag() = im;
+  }
+  return H;
+}
+
 std::vector<Eigen::Matrix2cd> OrientInCuttingPlane(const std::vector<Eigen::Matrix3cd>& H_B,
                                                    const Eigen::Matrix3d& R_BC) {
   std::vector<Eigen::Matrix2cd> out(H_B.size());

@@ -30,8 +30,8 @@ std::pair<cd, cd> Eigenvalues2(const Eigen::Matrix2cd& A) {
   const cd disc = std::sqrt(half_tr * half_tr - det);
   cd l1 = half_tr + disc, l2 = half_tr - disc;
   // Avoid cancellation in the smaller root: l1 l2 = det.
-  if (std::abs(l2) > std::abs(l1)) std::swap(l1, l2);
-  if (std::abs(l1) > 0.0) l2 = det / l1;
+  if (std::norm(l2) > std::norm(l1)) std::swap(l1, l2);
+  if (std::norm(l1) > 0.0) l2 = det * std::conj(l1) / std::norm(l1);
   return {l1, l2};
 }
 
@@ -72,8 +72,8 @@ ZoaLobes ComputeZoaLobes(const Eigen::VectorXd& freq_hz, const std::vector<Eigen
   for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
     auto [l1, l2] = Eigenvalues2(Phi_C[i] * H0);
     // Follow each branch by continuity with the previous line.
-    if (i > 0 && std::abs(l1 - prev2) + std::abs(l2 - prev1) <
-                     std::abs(l1 - prev1) + std::abs(l2 - prev2)) {
+    if (i > 0 && std::norm(l1 - prev2) + std::norm(l2 - prev1) <
+                     std::norm(l1 - prev1) + std::norm(l2 - prev2)) {
       std::swap(l1, l2);
     }
     prev1 = l1;
@@ -82,19 +82,21 @@ ZoaLobes ComputeZoaLobes(const Eigen::VectorXd& freq_hz, const std::vector<Eigen
     const cd lam[2] = {l1, l2};
     for (int b = 0; b < 2; ++b) {
       double depth = NAN, theta = NAN;
-      if (std::abs(lam[b]) > 0.0) {
-        const cd L = -1.0 / lam[b];
+      const double n2 = std::norm(lam[b]);
+      if (n2 > 0.0) {
+        const cd L = -std::conj(lam[b]) / n2;  // −1/λ without a library complex division
         if (L.real() > 0.0) {
           depth = std::norm(L) / (2.0 * L.real());
           theta = std::atan2(L.real(), L.imag());  // in (0, π)
         }
       }
+      // Ω = 2π/(N τ) with τ = (2θ + 2πk)/ω.
+      const double num = 2.0 * kPi * w / N;
       for (int k = 0; k <= K; ++k) {
         LobeCurve& c = out.curves_[b * (K + 1) + k];
         c.chatter_freq_hz.push_back(freq_hz(i));
         c.critical_depth.push_back(depth);
-        const double tau = (2.0 * theta + 2.0 * kPi * k) / w;
-        c.spindle_speed_rad_s.push_back(std::isfinite(depth) ? 2.0 * kPi / (N * tau) : NAN);
+        c.spindle_speed_rad_s.push_back(std::isfinite(depth) ? num / (2.0 * theta + 2.0 * kPi * k) : NAN);
       }
     }
   }

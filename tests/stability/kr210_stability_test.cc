@@ -96,3 +96,30 @@ TEST(Kr210Stability, JointAndCartesianModeCouplingAgree) {
 
 }  // namespace
 }  // namespace robomach::stability
+
+namespace robomach::stability {
+namespace {
+
+// Third form: modal coordinates of the proportionally damped KR210 with all
+// modes kept is again an exact change of coordinates (z = Φ η, ΦᵀMΦ = I),
+// so it must give the joint-space depth too. The modes come from a
+// symmetric eigensolver (~1e-13 relative in ΦᵀKΦ); bracket 1e-8.
+TEST(Kr210Stability, ModalAndJointSpaceModeCouplingAgree) {
+  const Kr210 k;
+  for (const auto& p : k.postures) {
+    const dynamics::PostureDynamics d = dynamics::EvaluatePosture(k.model, p.q);
+    ASSERT_TRUE(d.proportional_damping);
+    const Eigen::Matrix3d R = CuttingFrameAtPosture(d.X_BT, Eigen::Vector3d::UnitX());
+    const Eigen::Matrix3d Kc_B = R * CuttingStiffnessPerDepth(k.cut.process) * R.transpose();
+    ModeCouplingOptions opt;
+    opt.depth_tolerance = 1e-8;
+    const auto joint = CriticalDepthModeCoupling(d.system.M, d.system.C, d.system.K, d.system.B, Kc_B, opt);
+    const auto modal = CriticalDepthModeCouplingModal(ModalModelFromPosture(d), Kc_B, opt);
+    ASSERT_EQ(joint.status, ModeCouplingStatus::kFound);
+    EXPECT_NEAR(modal.critical_depth, joint.critical_depth, 1e-7 * joint.critical_depth) << p.id;
+    EXPECT_NEAR(modal.chatter_freq_hz, joint.chatter_freq_hz, 1e-3 * joint.chatter_freq_hz) << p.id;
+  }
+}
+
+}  // namespace
+}  // namespace robomach::stability

@@ -4,6 +4,7 @@
 
 #include "robomach/common/eigen_types.h"
 #include "robomach/stability/milling.h"
+#include "robomach/stability/tool_tip_model.h"
 
 namespace robomach::stability {
 
@@ -52,6 +53,13 @@ ModeCouplingResult CriticalDepthModeCoupling(const Eigen::MatrixXd& M, const Eig
                                              const Eigen::MatrixXd& K, const Matrix3Xd& B,
                                              const Eigen::Matrix3d& Kc_B,
                                              const ModeCouplingOptions& options = {});
+
+/// The same criterion in the modal coordinates of a proportionally damped
+/// structure (all its modes kept, so the result is identical to the
+/// joint-space form): M = I, C = diag(2ζω), K = diag(ω²), and the cutting
+/// term Pᵀ K_c P with P the tool-tip shapes p_k (in the frame of K_c).
+ModeCouplingResult CriticalDepthModeCouplingModal(const TipModalModel& modes, const Eigen::Matrix3d& Kc,
+                                                  const ModeCouplingOptions& options = {});
 
 /// The simplified closed-form criterion (our reading of the seed method;
 /// the seed's text is not in this repository). The in-plane static

@@ -47,6 +47,11 @@ TipModalModel ModalModelFromPosture(const dynamics::PostureDynamics& d);
 /// (1) on a frequency grid [Hz]; one 3×3 receptance per line [m/N].
 std::vector<Eigen::Matrix3cd> ModalReceptance(const TipModalModel& m, const Eigen::VectorXd& freq_hz);
 
+/// (1) restricted to the in-plane 2×2 block (rows x, y of p), for a model
+/// already expressed in the cutting frame C.
+std::vector<Eigen::Matrix2cd> InPlaneModalReceptance(const TipModalModel& modes_C,
+                                                     const Eigen::VectorXd& freq_hz);
+
 /// The 2×2 in-plane block Φ_C = [R_BCᵀ H_B R_BC]_{xy} of each line.
 std::vector<Eigen::Matrix2cd> OrientInCuttingPlane(const std::vector<Eigen::Matrix3cd>& H_B,
                                                    const Eigen::Matrix3d& R_BC);
