@@ -30,6 +30,10 @@
 namespace robomach::apps {
 namespace {
 
+// Speeds went rpm -> rad/s -> rpm; 1e-9 rpm is far below any meaningful
+// speed and hides the last-bit residue (6000.000000000001).
+double RoundRpm(double rpm) { return std::round(rpm * 1e9) / 1e9; }
+
 constexpr char kTool[] = "stability-lobes";
 
 // The tool-tip dynamics of one source, oriented into the cutting frame.
@@ -258,7 +262,7 @@ int Run(int argc, char** argv) {
       os << "pose_id,spindle_speed_rpm,critical_depth_mm,chatter_freq_hz,lobe_index,method,status\n";
       for (const LobeRow& r : rows) {
         const auto& p = r.point;
-        os << r.id << ',' << io::FormatDouble(RadPerSecToRpm(p.spindle_speed_rad_s)) << ','
+        os << r.id << ',' << io::FormatDouble(RoundRpm(RadPerSecToRpm(p.spindle_speed_rad_s))) << ','
            << (std::isfinite(p.critical_depth) ? io::FormatDouble(MToMm(p.critical_depth)) : "") << ','
            << (std::isfinite(p.chatter_freq_hz) ? io::FormatDouble(p.chatter_freq_hz) : "") << ','
            << (p.lobe_index >= 0 ? std::to_string(p.lobe_index) : "") << ',' << r.method << ','

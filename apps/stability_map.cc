@@ -20,6 +20,10 @@
 namespace robomach::apps {
 namespace {
 
+// Speeds went rpm -> rad/s -> rpm; 1e-9 rpm is far below any meaningful
+// speed and hides the last-bit residue (6000.000000000001).
+double RoundRpm(double rpm) { return std::round(rpm * 1e9) / 1e9; }
+
 constexpr char kTool[] = "stability-map";
 
 std::string Num(double v, double scale = 1.0) { return std::isfinite(v) ? io::FormatDouble(v * scale) : ""; }
@@ -153,7 +157,7 @@ int Run(int argc, char** argv) {
            << (analysed ? Num(s.closed_form.critical_depth, 1e3) : "") << ','
            << (analysed ? Num(s.closed_form.deformation_ratio) : "") << ','
            << (rg ? Num(s.regenerative.critical_depth, 1e3) : "") << ','
-           << (rg ? Num(RadPerSecToRpm(s.regenerative.spindle_speed_rad_s)) : "") << ','
+           << (rg ? Num(RoundRpm(RadPerSecToRpm(s.regenerative.spindle_speed_rad_s))) : "") << ','
            << (analysed ? Num(s.critical_depth, 1e3) : "") << ','
            << (analysed ? stability::ToString(s.limiting) : "") << ','
            << (analysed ? Num(s.chatter_freq_hz) : "") << ',' << Num(p.jacobian_condition) << ','

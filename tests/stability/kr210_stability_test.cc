@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "robomach/common/units.h"
+#include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/io/cut_file.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/robot_config.h"
@@ -119,6 +120,41 @@ TEST(Kr210Stability, ModalAndJointSpaceModeCouplingAgree) {
     EXPECT_NEAR(modal.critical_depth, joint.critical_depth, 1e-7 * joint.critical_depth) << p.id;
     EXPECT_NEAR(modal.chatter_freq_hz, joint.chatter_freq_hz, 1e-3 * joint.chatter_freq_hz) << p.id;
   }
+}
+
+}  // namespace
+}  // namespace robomach::stability
+
+namespace robomach::stability {
+namespace {
+
+// The oriented in-plane FRF from the real modes (what the lobes use) against
+// the direct solve of the assembled system (dynamics::ReceptanceDirect,
+// a different algorithm) rotated into C. Rayleigh damping makes the modal
+// form exact; both differ by rounding in the solve (~cond · eps, cond of
+// K − ω²M + iωC ≤ 1e8 near resonance) and in the eigenvectors (~1e-13):
+// 1e-7 relative to the largest entry of the line is the bound.
+TEST(Kr210Stability, InPlaneModalFrfMatchesDirectSolve) {
+  const Kr210 k;
+  const dynamics::PostureDynamics d = dynamics::EvaluatePosture(k.model, k.postures[4].q);
+  const Eigen::Matrix3d R = CuttingFrameAtPosture(d.X_BT, Eigen::Vector3d::UnitX());
+  const Eigen::VectorXd f = LogFrequencyGrid(2.0, 400.0, 300);
+  const auto modal = InPlaneModalReceptance(ModalModelFromPosture(d).Rotated(R), f);
+  const auto direct = OrientInCuttingPlane(dynamics::ReceptanceDirect(d.system, f), R);
+  for (Eigen::Index i = 0; i < f.size(); ++i) {
+    EXPECT_LE((modal[i] - direct[i]).cwiseAbs().maxCoeff(), 1e-7 * direct[i].cwiseAbs().maxCoeff()) << f(i);
+  }
+}
+
+TEST(CuttingFrame, IsRightHandedWithFeedProjectedAndRejectsParallelFeed) {
+  const Eigen::Vector3d axis(0.0, 0.0, 2.0), feed(1.0, 1.0, 5.0);
+  const Eigen::Matrix3d R = CuttingFrame(axis, feed);
+  // Orthonormal to rounding (a few eps).
+  EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_NEAR(R.determinant(), 1.0, 1e-15);
+  EXPECT_LT((R.col(0) - Eigen::Vector3d(1, 1, 0).normalized()).norm(), 1e-15);
+  EXPECT_LT((R.col(2) - Eigen::Vector3d::UnitZ()).norm(), 1e-15);
+  EXPECT_THROW(CuttingFrame(axis, Eigen::Vector3d(0, 0, -1)), std::invalid_argument);
 }
 
 }  // namespace
