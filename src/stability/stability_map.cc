@@ -7,7 +7,6 @@
 #include <stdexcept>
 #include <thread>
 
-#include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainiksolverpos_lma.hpp>
 #include <nlopt.hpp>
 
@@ -52,7 +51,7 @@ constexpr double kIkRotationTolerance = 1e-4;  // [rad]
 class IkSolver {
  public:
   explicit IkSolver(const kinematics::SerialChain& chain)
-      : chain_(chain), lma_(chain.kdl(), 1e-6, 500, 1e-15), fk_(chain.kdl()) {}
+      : chain_(chain), lma_(chain.kdl(), 1e-6, 500, 1e-15) {}
 
   // Solves from `seed`; the result is wrapped to the 2π branch nearest the
   // seed. Returns false if the pose was not reached.
@@ -76,7 +75,6 @@ class IkSolver {
  private:
   const kinematics::SerialChain& chain_;
   KDL::ChainIkSolverPos_LMA lma_;
-  KDL::ChainFkSolverPos_recursive fk_;
 };
 
 // Runs f(i) for i in [0, n) on `threads` threads; progress from the caller.
@@ -100,7 +98,7 @@ void ParallelFor(long n, int threads, const ProgressCallback& progress, long pro
   for (int t = 0; t < threads; ++t) pool.emplace_back(worker, t);
   while (done < n && !failed) {
     if (progress) progress(progress_offset + done, progress_total);
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);
