@@ -161,7 +161,7 @@ int Run(int argc, char** argv) {
         try {
           R = stability::CuttingFrameAtPosture(d.X_BT, cut.feed_direction_B);
         } catch (const std::invalid_argument& e) {
-          throw InputError({cut_path, 0, 0}, std::string("feed_direction: ") + e.what() + " at posture " + p->id);
+          throw InputError({cut_path, cut.feed_line, cut.feed_column}, std::string("feed_direction: ") + e.what() + " at posture " + p->id);
         }
         const stability::TipModalModel modes = stability::ModalModelFromPosture(d);
         t.freq_hz = stability::LobeFrequencyGrid(modes, cut.process.teeth, cut.spindle_speed_max_rad_s, kLines);
@@ -175,7 +175,7 @@ int Run(int argc, char** argv) {
       try {
         R = stability::CuttingFrame(axis, cut.feed_direction_B);
       } catch (const std::invalid_argument& e) {
-        throw InputError({cut_path, 0, 0}, std::string("feed_direction: ") + e.what() + " (--tool-axis " + tool_axis_text + ")");
+        throw InputError({cut_path, cut.feed_line, cut.feed_column}, std::string("feed_direction: ") + e.what() + " (--tool-axis " + tool_axis_text + ")");
       }
       if (!frf_path.empty()) {
         for (io::FrfSetOfPose& s : ReadFrfFile(frf_path)) {

@@ -107,7 +107,7 @@ int Run(int argc, char** argv) {
     for (const auto& t : targets) {
       const Eigen::Vector3d f = t.feed_B - t.feed_B.dot(t.z_T.normalized()) * t.z_T.normalized();
       if (f.norm() < 1e-6) {
-        throw InputError({cut_path, 0, 0}, "feed_direction is parallel to the tool axis of the " +
+        throw InputError({cut_path, cut.feed_line, cut.feed_column}, "feed_direction is parallel to the tool axis of the " +
                                                std::string(grid ? "region" : "path") + "; choose a feed in the work plane");
       }
     }

@@ -56,7 +56,12 @@ CutSpec ReadCutFile(const std::string& path) {
       throw m.Error("expected up or down, got \"" + s + "\"");
     }
   }
-  c.feed_direction_B = UnitVector(doc["feed_direction"]);
+  {
+    const YamlDoc f = doc["feed_direction"];
+    c.feed_direction_B = UnitVector(f);
+    c.feed_line = f.location().line;
+    c.feed_column = f.location().column;
+  }
   c.feed_per_tooth = MmToM(doc["feed_per_tooth_mm"].PositiveNumber());
   {
     const YamlDoc k = doc["cutting_coefficients"];

@@ -21,6 +21,7 @@ struct CutSpec {
   int spindle_speed_count{200};            // speeds scanned in [min, max]
   std::optional<double> spindle_speed_rad_s;  // the operating speed, if fixed
   std::string path;
+  int feed_line{0}, feed_column{0};        // where feed_direction is, for messages
 
   /// `spindle_speed_count` speeds evenly spaced in [min, max] (or the fixed one).
   Eigen::VectorXd SpeedGrid() const;
