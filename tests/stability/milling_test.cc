@@ -21,8 +21,7 @@ MillingProcess Process(int teeth, double immersion, MillingDirection dir) {
 }
 
 // Slotting (φst = 0, φex = π) has the textbook average
-// H0 = (N/4) [[Kr, Kt], [−Kt, Kr]] [Altintas 2000, §3.3, α_xx = α_yy =
-// −K_r·π/2... in his sign convention; here with F = −a H0 Δx]. The closed
+// H0 = (N/4) [[Kr, Kt], [−Kt, Kr]] [Altintas 2000; here in the sign convention F = −a H0 Δx]. The closed
 // form (3) evaluates sin/cos at 0 and π, so only rounding remains:
 // ~1e-15 relative; 1e-12 leaves margin.
 TEST(Milling, SlotAverageMatchesTextbookClosedForm) {

@@ -14,7 +14,7 @@ namespace {
 // - frequency: the peak line is within half a log step r/2 of the true
 //   resonance, r = ln(f_hi/f_lo)/(lines−1) = ln(10)/19999 ≈ 1.2e-4;
 // - damping: the half-power formula is exact to O(ζ²) for a single mode
-//   [Ewins 2000, §4.3] and the other mode adds a fraction
+//   [Ewins 2000] and the other mode adds a fraction
 //   q ≈ |H_other(ω_k)|/|H_k(ω_k)| ≈ 2ζ_k ω_k²/|ω_j² − ω_k²| of the peak,
 //   here ≈ 0.02·1/1.8 ≈ 1.1e-2, which shifts the half-power points by ~q;
 // - shape |p|: scales with √(ζ · peak), so errors of ~q/2 + ζ².

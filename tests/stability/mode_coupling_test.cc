@@ -9,7 +9,7 @@
 namespace robomach::stability {
 namespace {
 
-// Classic 2-DOF mode coupling [Tlusty 2000, §9.6]: equal masses m,
+// Classic 2-DOF mode coupling [Tlusty 2000]: equal masses m,
 // stiffnesses k1 ≠ k2 along x and y, no damping, and the slot cutting
 // stiffness K_c = (N/4)[[Kr, Kt], [−Kt, Kr]] (milling.h (3)). The stiffness
 // K + a K_c = [[k1 + a c r, a c], [−a c, k2 + a c r]] with c = N Kt/4 has

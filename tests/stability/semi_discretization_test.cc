@@ -72,7 +72,7 @@ TEST(SemiDiscretization, ZeroDepthSpectralRadiusIsFreeDecay) {
 // Convergence with the number of steps per period, in the low-immersion
 // case (a/D = 0.05) where the ZOA is not valid, at a flip-lobe speed and a
 // Hopf-lobe speed. The first-order method's error in the boundary falls
-// like Δt² [Insperger, Stepan & Turi 2008, Fig. 2]: successive
+// like Δt² [Insperger, Stepan & Turi 2008]: successive
 // differences |a_k − a_2k| must shrink by about 4 each time k doubles; we
 // require at least 2.5 (order > 1.3), which a first-order-accurate (or
 // non-convergent) scheme would fail.
@@ -109,7 +109,7 @@ namespace robomach::stability {
 namespace {
 
 // Exact stability boundary of turning, x'' + 2ζω_n x' + ω_n² x =
-// −(K_f a/m)(x − x(t−τ)), at delay τ [Tlusty 2000, §9.3]: on lobe k,
+// −(K_f a/m)(x − x(t−τ)), at delay τ [Tlusty 2000]: on lobe k,
 // ωτ = ε(ω) + 2πk with ε = 3π + 2 arg G(ω), a = −1/(2 K_f Re G(ω));
 // the boundary is the lowest lobe. Solved here by bisection in ω.
 double ExactTurningBoundary(double m, double wn, double zeta, double Kf, double tau) {

@@ -16,7 +16,7 @@ using cd = std::complex<double>;
 // A 1-DOF structure flexible only along the feed x: Φ_C = diag(G, 0). Then
 // Φ_C H0 = [[G h_xx, G h_xy], [0, 0]] has the eigenvalues G h_xx and 0, so
 // (1) reduces to the orthogonal-cutting (turning) problem with the force
-// coefficient K_f = h_xx [Tlusty 2000, §9.3]:
+// coefficient K_f = h_xx [Tlusty 2000]:
 //   a_lim = −1 / (2 K_f Re G),  ω_c T = ε + 2πk,  ε = 3π + 2ψ,  ψ = arg G,
 // whose absolute minimum is a_min = 2 k ζ (1 + ζ) / K_f at ω = ω_n √(1+2ζ).
 struct TurningCase {

@@ -6,13 +6,13 @@ namespace robomach::stability {
 
 /// Which side of the tool the material is on. Angles φ of a tooth are
 /// measured clockwise from the cutting-frame y axis (the feed normal), the
-/// tool turning clockwise seen from the spindle (Altintas 2000 §3.3,
+/// tool turning clockwise seen from the spindle (Altintas 2000,
 /// Insperger & Stepan 2004): up-milling enters at φ = 0, down-milling leaves
 /// at φ = π.
 enum class MillingDirection { kUp, kDown };
 
 /// Linear edge-force-free cutting law per unit depth of cut a and chip
-/// thickness h [Altintas 2000, eq. (2.x) mechanistic model without edge terms]:
+/// thickness h [Altintas 2000, mechanistic model without edge terms]:
 /// <pre>
 ///   F_t = K_t a h,   F_r = K_r a h,   F_a = K_a a h                     (1)
 /// </pre>
@@ -69,7 +69,7 @@ Eigen::Matrix<double, 3, 2> DirectionalMatrixAt(const MillingProcess& p, double 
 /// <pre>
 ///   H0 = (N / 2π) ∫_{φst}^{φex} h(φ) dφ                                   (3)
 /// </pre>
-/// [Altintas & Budak 1995, eq. (7)] (their α_xx.. times K_t, with K_r
+/// [Altintas & Budak 1995] (their α_xx.. times K_t, with K_r
 /// absolute).
 Eigen::Matrix<double, 3, 2> MeanDirectionalMatrix(const MillingProcess& p, double psi0,
                                                   double psi1);

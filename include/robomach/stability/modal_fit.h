@@ -9,7 +9,7 @@
 namespace robomach::stability {
 
 /// Modes fitted to a measured or predicted in-plane FRF by peak picking
-/// [Ewins 2000, §4.3]: each local maximum of |Im Φ_xx| + |Im Φ_yy| above
+/// [Ewins 2000, peak picking]: each local maximum of |Im Φ_xx| + |Im Φ_yy| above
 /// 5 % of the largest is a mode at that line; its damping ratio is the
 /// half-power bandwidth of the larger direct FRF, ζ = (f₂ − f₁)/(2 f_k);
 /// its shape follows from the residue at resonance, where a single mode

@@ -42,7 +42,7 @@ std::complex<double> RightmostEigenvalue(const Eigen::MatrixXd& M, const Eigen::
 /// displacement, F = −a K_c x (K_c = CuttingStiffnessPerDepth rotated into
 /// the frame of B), makes the stiffness of (1) non-symmetric; the critical
 /// depth is the smallest a where an eigenvalue of (1) reaches Re λ = 0
-/// [Tlusty 2000, §9.6 mode coupling; Pan et al. 2006]. Found by a geometric
+/// [Tlusty 2000, mode coupling; Pan et al. 2006]. Found by a geometric
 /// scan and bisection; Re λ > 1e-9 |λ| counts as unstable, so an undamped
 /// model is judged by the sign of the growth and not by rounding.
 ///

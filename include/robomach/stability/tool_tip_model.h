@@ -26,7 +26,7 @@ Eigen::Matrix3d CuttingFrameAtPosture(const Eigen::Isometry3d& X_BT, const Eigen
 /// <pre>
 ///   H(ω) = Σ_k p_k p_kᵀ / (ω_k² − ω² + 2i ζ_k ω_k ω)                     (1)
 /// </pre>
-/// [Ewins 2000, §2.3]; p_k is the tool-tip part of the mass-normalised mode
+/// [Ewins 2000]; p_k is the tool-tip part of the mass-normalised mode
 /// shape [1/√kg] (a unit shape u with modal mass m gives p = u/√m).
 struct TipModalModel {
   Eigen::VectorXd omega_rad_s;  // undamped natural frequencies [rad/s]

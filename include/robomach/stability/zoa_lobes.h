@@ -53,12 +53,12 @@ struct ZoaOptions {
 /// <pre>
 ///   det(I + a (1 − e^{−iωτ}) Φ_C(ω) H0) = 0                              (1)
 /// </pre>
-/// [Altintas & Budak 1995, eqs. (9)-(12)]. For each eigenvalue λ of Φ_C H0,
+/// [Altintas & Budak 1995]. For each eigenvalue λ of Φ_C H0,
 /// Λ = −1/λ = a (1 − e^{−iωτ}) must be real-positive-scaled, which gives
 /// <pre>
 ///   a_lim = |Λ|² / (2 Re Λ),   ωτ = 2θ + 2πk,  θ = atan2(Re Λ, Im Λ)     (2)
 /// </pre>
-/// for Re Λ > 0 (eq. (2) is Altintas-Budak's a_lim = −2π Λ_R (1+κ²)/(N K_t)
+/// for Re Λ > 0 ((2) is Altintas-Budak's a_lim = −2π Λ_R (1+κ²)/(N K_t)
 /// with their Λ scaled by N K_t / 4π), and the spindle speed Ω = 2π/(N τ).
 class ZoaLobes {
  public:
