@@ -292,3 +292,38 @@ TEST(SemiDiscretization, BoundaryAgreesWithTimeDomainSimulation) {
 
 }  // namespace
 }  // namespace robomach::stability
+
+namespace robomach::stability {
+namespace {
+
+// Low immersion (a/D = 0.05) has period-doubling (flip) lobes where the
+// tooth-passing frequency f_T is near or below 2 f_n/(2j+1) [Insperger &
+// Stepan 2004]: with j = 1, f_T ≤ 615 Hz, i.e. up to 18440 rpm for 2 teeth;
+// we take 17000 rpm (f_T = 567 Hz), inside that lobe. There the
+// critical multiplier is real and negative (μ < −1 just past the
+// boundary), and the chatter frequency f_c satisfies f_c τ = j + 1/2.
+// Eigenvalues of a real matrix that are real come out with Im exactly 0
+// (Eigen's real Schur form gives 1×1 blocks), so the check on Im μ is at
+// rounding level; f_c τ − 1/2 is an integer up to the same rounding.
+TEST(SemiDiscretization, LowImmersionFlipLobe) {
+  const TipModalModel m = BenchmarkModes();
+  const MillingProcess p = BenchmarkProcess(0.05);
+  const double speed = RpmToRadPerSec(17000.0);
+  SdOptions opt;
+  opt.steps_per_period = 60;
+  opt.max_depth = 0.01;
+  opt.depth_scan_points = 100;
+  opt.depth_tolerance = 1e-6;
+  const LobePoint pt = SdCriticalDepth(m, p, speed, opt);
+  ASSERT_EQ(pt.status, LobeStatus::kOk);
+  const SdMonodromy past = MillingMonodromy(m, p, speed, pt.critical_depth * 1.001, opt.steps_per_period);
+  EXPECT_GT(past.spectral_radius, 1.0);
+  EXPECT_LT(past.critical_multiplier.real(), -1.0);
+  EXPECT_LE(std::abs(past.critical_multiplier.imag()), 1e-12);
+  const double tau = 2.0 * kPi / (p.teeth * speed);
+  const double ft = pt.chatter_freq_hz * tau;
+  EXPECT_NEAR(ft - std::floor(ft), 0.5, 1e-9);
+}
+
+}  // namespace
+}  // namespace robomach::stability
