@@ -2,6 +2,7 @@
 // rectangle of the workspace or along a tool path, with IK per point.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <sstream>
@@ -129,6 +130,26 @@ int Run(int argc, char** argv) {
                             : "no pose of the path is reachable by the robot from the region's seed_posture_deg");
     }
 
+    {
+      // How far the seed's simplified closed form agrees with the eigenvalue
+      // criterion (issue #6 asks to report it).
+      std::vector<double> ratio;
+      for (const auto& p : pts) {
+        const auto& s = p.stability;
+        if (s.mode_coupling.status == stability::ModeCouplingStatus::kFound &&
+            std::isfinite(s.closed_form.critical_depth) && s.closed_form.critical_depth > 0.0) {
+          ratio.push_back(s.closed_form.critical_depth / s.mode_coupling.critical_depth);
+        }
+      }
+      if (!ratio.empty()) {
+        std::sort(ratio.begin(), ratio.end());
+        std::ostringstream msg;
+        msg << kTool << ": mode coupling, closed form / eigenvalue criterion over " << ratio.size()
+            << " points: median " << ratio[ratio.size() / 2] << ", range [" << ratio.front() << ", "
+            << ratio.back() << "]\n";
+        std::cerr << msg.str();
+      }
+    }
     const int n = model->num_joints();
     auto write = [&](std::ostream& os) {
       os << (grid ? "row,col,x_mm,y_mm," : "point_id,") << "px_mm,py_mm,pz_mm,rotation_deg";
