@@ -57,16 +57,12 @@ ZoaLobes ComputeZoaLobes(const Eigen::VectorXd& freq_hz, const std::vector<Eigen
   const int N = process.teeth;
 
   ZoaLobes out;
-  out.curves_.resize(2 * (K + 1));
-  for (int b = 0; b < 2; ++b) {
-    for (int k = 0; k <= K; ++k) {
-      LobeCurve& c = out.curves_[b * (K + 1) + k];
-      c.lobe_index = k;
-      c.branch = b;
-      c.chatter_freq_hz.reserve(freq_hz.size());
-      c.spindle_speed_rad_s.reserve(freq_hz.size());
-      c.critical_depth.reserve(freq_hz.size());
-    }
+  out.freq_hz_ = freq_hz;
+  out.max_lobe_index_ = K;
+  for (auto& br : out.branch_) {
+    br.depth.resize(freq_hz.size());
+    br.theta.resize(freq_hz.size());
+    br.speed_numerator.resize(freq_hz.size());
   }
   cd prev1, prev2;
   for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
@@ -90,14 +86,30 @@ ZoaLobes ComputeZoaLobes(const Eigen::VectorXd& freq_hz, const std::vector<Eigen
           theta = std::atan2(L.real(), L.imag());  // in (0, π)
         }
       }
-      // Ω = 2π/(N τ) with τ = (2θ + 2πk)/ω.
-      const double num = 2.0 * kPi * w / N;
-      for (int k = 0; k <= K; ++k) {
-        LobeCurve& c = out.curves_[b * (K + 1) + k];
-        c.chatter_freq_hz.push_back(freq_hz(i));
-        c.critical_depth.push_back(depth);
-        c.spindle_speed_rad_s.push_back(std::isfinite(depth) ? num / (2.0 * theta + 2.0 * kPi * k) : NAN);
+      out.branch_[b].depth[i] = depth;
+      out.branch_[b].theta[i] = theta;
+      out.branch_[b].speed_numerator[i] = 2.0 * kPi * w / N;  // Ω = this / (2θ + 2πk)
+    }
+  }
+  return out;
+}
+
+std::vector<LobeCurve> ZoaLobes::curves() const {
+  std::vector<LobeCurve> out;
+  for (int b = 0; b < 2; ++b) {
+    const Branch& br = branch_[b];
+    for (int k = 0; k <= max_lobe_index_; ++k) {
+      LobeCurve c;
+      c.lobe_index = k;
+      c.branch = b;
+      for (Eigen::Index i = 0; i < freq_hz_.size(); ++i) {
+        c.chatter_freq_hz.push_back(freq_hz_(i));
+        c.critical_depth.push_back(br.depth[i]);
+        c.spindle_speed_rad_s.push_back(std::isfinite(br.depth[i])
+                                            ? br.speed_numerator[i] / (2.0 * br.theta[i] + 2.0 * kPi * k)
+                                            : NAN);
       }
+      out.push_back(std::move(c));
     }
   }
   return out;
@@ -115,24 +127,29 @@ std::vector<LobePoint> ZoaLobes::At(const Eigen::VectorXd& speeds) const {
   if (n == 0) return out;
   const double s_lo = sorted.front(), s_hi = sorted.back();
 
-  for (const LobeCurve& c : curves_) {
-    const size_t m = c.spindle_speed_rad_s.size();
-    for (size_t i = 0; i + 1 < m; ++i) {
-      const double sa = c.spindle_speed_rad_s[i], sb = c.spindle_speed_rad_s[i + 1];
-      if (!std::isfinite(sa) || !std::isfinite(sb)) continue;
-      const double lo = std::min(sa, sb), hi = std::max(sa, sb);
-      if (hi < s_lo || lo > s_hi) continue;
-      auto it = std::lower_bound(sorted.begin(), sorted.end(), lo);
-      for (; it != sorted.end() && *it <= hi; ++it) {
-        const double s = *it;
-        const double t = hi > lo ? (s - sa) / (sb - sa) : 0.0;
-        const double depth = c.critical_depth[i] + t * (c.critical_depth[i + 1] - c.critical_depth[i]);
-        LobePoint& p = out[order[it - sorted.begin()]];
-        if (p.status != LobeStatus::kOk || depth < p.critical_depth) {
-          p.critical_depth = depth;
-          p.chatter_freq_hz = c.chatter_freq_hz[i] + t * (c.chatter_freq_hz[i + 1] - c.chatter_freq_hz[i]);
-          p.lobe_index = c.lobe_index;
-          p.status = LobeStatus::kOk;
+  for (const Branch& br : branch_) {
+    const size_t m = br.depth.size();
+    for (int k = 0; k <= max_lobe_index_; ++k) {
+      const double two_pi_k = 2.0 * kPi * k;
+      double sb = NAN;
+      for (size_t i = 0; i + 1 < m; ++i) {
+        const double sa = i == 0 || !std::isfinite(sb) ? br.speed_numerator[i] / (2.0 * br.theta[i] + two_pi_k) : sb;
+        sb = br.speed_numerator[i + 1] / (2.0 * br.theta[i + 1] + two_pi_k);  // NaN where no boundary
+        if (!std::isfinite(sa) || !std::isfinite(sb)) continue;
+        const double lo = std::min(sa, sb), hi = std::max(sa, sb);
+        if (hi < s_lo || lo > s_hi) continue;
+        auto it = std::lower_bound(sorted.begin(), sorted.end(), lo);
+        for (; it != sorted.end() && *it <= hi; ++it) {
+          const double s = *it;
+          const double t = hi > lo ? (s - sa) / (sb - sa) : 0.0;
+          const double depth = br.depth[i] + t * (br.depth[i + 1] - br.depth[i]);
+          LobePoint& p = out[order[it - sorted.begin()]];
+          if (p.status != LobeStatus::kOk || depth < p.critical_depth) {
+            p.critical_depth = depth;
+            p.chatter_freq_hz = freq_hz_(i) + t * (freq_hz_(i + 1) - freq_hz_(i));
+            p.lobe_index = k;
+            p.status = LobeStatus::kOk;
+          }
         }
       }
     }

@@ -103,7 +103,7 @@ TEST(ZoaLobes, EnvelopeAtCurveSpeedsReturnsTheLowestCurve) {
   ZoaOptions opt;
   opt.max_lobe_index = 3;
   const ZoaLobes lobes = ComputeZoaLobes(f, tc.Phi(f), tc.process, opt);
-  const LobeCurve& c = lobes.curves()[1];  // branch 0, lobe 1
+  const LobeCurve c = lobes.curves()[1];  // branch 0, lobe 1
   int n = 0;
   for (size_t i = 0; i < c.spindle_speed_rad_s.size(); i += 97) {
     if (!std::isfinite(c.critical_depth[i])) continue;

@@ -62,7 +62,8 @@ struct ZoaOptions {
 /// with their Λ scaled by N K_t / 4π), and the spindle speed Ω = 2π/(N τ).
 class ZoaLobes {
  public:
-  const std::vector<LobeCurve>& curves() const { return curves_; }
+  /// Every lobe k = 0..max of both branches (built on request).
+  std::vector<LobeCurve> curves() const;
   /// The lowest boundary over all curves at each speed [rad/s] (linear
   /// interpolation between grid lines); kNotCovered where no curve reaches.
   std::vector<LobePoint> At(const Eigen::VectorXd& spindle_speed_rad_s) const;
@@ -72,7 +73,14 @@ class ZoaLobes {
  private:
   friend ZoaLobes ComputeZoaLobes(const Eigen::VectorXd&, const std::vector<Eigen::Matrix2cd>&,
                                   const MillingProcess&, const ZoaOptions&);
-  std::vector<LobeCurve> curves_;
+  // Per eigenvalue branch and frequency line: a_lim [m] (NaN where
+  // Re Λ <= 0), θ, and 2πω/N, so that lobe k has Ω = (2πω/N)/(2θ + 2πk).
+  struct Branch {
+    std::vector<double> depth, theta, speed_numerator;
+  };
+  Eigen::VectorXd freq_hz_;
+  Branch branch_[2];
+  int max_lobe_index_{0};
 };
 
 /// Traces (2) on the grid `freq_hz` (strictly increasing, > 0) of the
