@@ -104,9 +104,19 @@ void ParallelFor(long n, int threads, const ProgressCallback& progress, long pro
   if (error) std::rethrow_exception(error);
 }
 
+// KDL::Joint caches its last pose in mutable members (kdl/joint.hpp,
+// `mutable Frame joint_pose; mutable double q_previous;`), so two threads
+// evaluating the same KDL::Chain race and can get each other's joint
+// frames. Every thread therefore works on its own copy of the model,
+// rebuilt from the same description and parameters (identical numbers,
+// separate KDL chains).
+std::shared_ptr<const dynamics::RobotModel> PrivateCopy(const dynamics::RobotModel& model) {
+  return dynamics::RobotModel::Build(model.description(), model.parameters());
+}
+
 struct Worker {
-  explicit Worker(const std::shared_ptr<const dynamics::RobotModel>& model)
-      : model(model), ik(model->chain()), evaluator(model) {}
+  explicit Worker(const dynamics::RobotModel& shared)
+      : model(PrivateCopy(shared)), ik(model->chain()), evaluator(model) {}
   std::shared_ptr<const dynamics::RobotModel> model;
   IkSolver ik;
   dynamics::PostureEvaluator evaluator;
@@ -173,7 +183,11 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
   {
     std::vector<std::unique_ptr<IkSolver>> solvers;
     const int t_ik = std::min(threads, rows);
-    for (int t = 0; t < t_ik; ++t) solvers.push_back(std::make_unique<IkSolver>(chain));
+    std::vector<std::shared_ptr<const dynamics::RobotModel>> copies;
+    for (int t = 0; t < t_ik; ++t) {
+      copies.push_back(PrivateCopy(*model));
+      solvers.push_back(std::make_unique<IkSolver>(copies.back()->chain()));
+    }
     std::atomic<int> next_row{0};
     std::vector<std::thread> pool;
     for (int t = 0; t < t_ik; ++t) {
@@ -194,7 +208,7 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
 
   // 2. Stability per point, one evaluator per thread.
   std::vector<std::unique_ptr<Worker>> workers;
-  for (int t = 0; t < threads; ++t) workers.push_back(std::make_unique<Worker>(model));
+  for (int t = 0; t < threads; ++t) workers.push_back(std::make_unique<Worker>(*model));
 
   auto analyse = [&](Worker& w, long i) {
     MapPoint& p = out[i];

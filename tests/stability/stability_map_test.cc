@@ -101,3 +101,33 @@ TEST(StabilityMap, FreeRotationIsAtLeastAsGoodAsTheBounds) {
 
 }  // namespace
 }  // namespace robomach::stability
+
+namespace robomach::stability {
+namespace {
+
+// Each point's computation does not depend on the schedule, so 1 and 2
+// threads must give bit-identical results. (This caught a data race: KDL
+// joints cache their last pose in mutable members, so threads sharing one
+// KDL chain corrupted each other's IK; every thread now has its own model.)
+TEST(StabilityMap, ThreadCountDoesNotChangeResults) {
+  Fixture f;
+  f.region.size_u = f.region.size_v = 0.4;
+  f.region.grid_step = 0.05;
+  const auto targets = f.region.Targets(f.cut.feed_direction_B);
+  MapOptions one = f.Options(), two = f.Options();
+  one.threads = 1;
+  two.threads = 2;
+  const auto a = EvaluateStabilityMap(f.model, targets, f.region.num_v(), f.region.num_u(), f.cut.process, one);
+  for (int rep = 0; rep < 3; ++rep) {
+    const auto b = EvaluateStabilityMap(f.model, targets, f.region.num_v(), f.region.num_u(), f.cut.process, two);
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+      ASSERT_EQ(a[i].status, b[i].status) << i;
+      ASSERT_EQ(a[i].q, b[i].q) << i;
+      ASSERT_EQ(a[i].stability.critical_depth, b[i].stability.critical_depth) << i;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace robomach::stability
