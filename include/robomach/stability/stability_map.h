@@ -59,7 +59,9 @@ struct MapPoint {
 /// path. IK (KDL ChainIkSolverPos_LMA) is seeded from the neighbour so
 /// the arm stays on one configuration: the first column from the point
 /// above (the first point from seed_q), then each row along its columns.
-/// Points are then analysed in parallel, one PostureEvaluator per thread.
+/// Points are then analysed in parallel, one PostureEvaluator per thread,
+/// each on its own copy of the model (KDL joints cache their last pose in
+/// mutable members, so threads must not share a KDL chain).
 /// With optimise_rotation, each point maximises its critical depth over
 /// the rotation about the tool axis with NLopt (LN_COBYLA after a coarse
 /// scan), re-solving the IK from the point's solution each time.
