@@ -1,0 +1,224 @@
+// stability-map: chatter limits (mode coupling and regenerative) over a
+// rectangle of the workspace or along a tool path, with IK per point.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <sstream>
+
+#include "cli_support.h"
+#include "robomach/common/errors.h"
+#include "robomach/common/units.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/cut_file.h"
+#include "robomach/io/number_format.h"
+#include "robomach/io/region_file.h"
+#include "robomach/io/robot_config.h"
+#include "robomach/report/heat_map.h"
+#include "robomach/stability/stability_map.h"
+
+namespace robomach::apps {
+namespace {
+
+// Speeds went rpm -> rad/s -> rpm; 1e-9 rpm is far below any meaningful
+// speed and hides the last-bit residue (6000.000000000001).
+double RoundRpm(double rpm) { return std::round(rpm * 1e9) / 1e9; }
+
+constexpr char kTool[] = "stability-map";
+
+std::string Num(double v, double scale = 1.0) { return std::isfinite(v) ? io::FormatDouble(v * scale) : ""; }
+
+int Run(int argc, char** argv) {
+  CLI::App app{
+      "stability-map: critical axial depth of cut over a work region (grid of tool poses from a\n"
+      "region file) or along a tool path: inverse kinematics per point seeded from the neighbour,\n"
+      "mode-coupling chatter (eigenvalues of the posture's 3-D tool-tip dynamics under the\n"
+      "cutting stiffness) and regenerative chatter (ZOA lobes at the cut's speed or the best\n"
+      "speed of its range); optionally the rotation about the tool axis that maximises the depth."};
+  app.footer(ExitCodeHelp());
+  std::string robot_path, cut_path, region_path, path_path, out_path, plot_path;
+  int threads = 0, speeds = 0, rotation_evals = 20;
+  double max_depth_mm = 50.0;
+  app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
+  app.add_option("--cut", cut_path, "cut file YAML (config/cut_demo.yaml)")->required();
+  app.add_option("--region", region_path, "region file YAML (config/region_demo.yaml)");
+  app.add_option("--path", path_path, "tool-path CSV: x_mm,y_mm,z_mm,tool_i,tool_j,tool_k[,feed_i,feed_j,feed_k][,rotation_deg][,point_id]; the tool axis points from the tip to the spindle; rotation_deg is added to the region's rotation about the tool axis; the region file gives the seed posture");
+  app.add_option("--out", out_path, "per-point CSV; stdout if omitted");
+  app.add_option("--plot", plot_path, "heat map PNG of the critical depth [mm] (grid only)");
+  app.add_option("--threads", threads, "worker threads, 0 = all cores")->capture_default_str();
+  app.add_option("--speeds", speeds, "speeds scanned for the best one (default: the cut file's spindle_speed_count)");
+  app.add_option("--max-depth-mm", max_depth_mm, "largest depth searched for mode coupling [mm]")->capture_default_str();
+  app.add_option("--rotation-evals", rotation_evals, "evaluations per point when the rotation is free")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  return RunGuarded(kTool, [&]() -> int {
+    if (region_path.empty()) {
+      throw std::invalid_argument("--region is required (with --path it gives the seed posture and rotation)");
+    }
+    if (!(max_depth_mm > 0.0) || speeds < 0 || rotation_evals < 8) {
+      throw std::invalid_argument("expected --max-depth-mm > 0, --speeds >= 0, --rotation-evals >= 8");
+    }
+    RequireReadableFile(robot_path, "robot config");
+    RequireReadableFile(cut_path, "cut file");
+    RequireReadableFile(region_path, "region file");
+    if (!path_path.empty()) RequireReadableFile(path_path, "tool-path file");
+    const auto model = io::LoadRobotConfig(robot_path).Build();
+    const io::CutSpec cut = io::ReadCutFile(cut_path);
+    const io::RegionSpec region = io::ReadRegionFile(region_path, model->num_joints());
+
+    stability::MapOptions opt;
+    opt.seed_q = region.seed_q;
+    opt.rotation = region.rotation_fixed;
+    opt.optimise_rotation = region.rotation_free;
+    opt.rotation_min = region.rotation_min;
+    opt.rotation_max = region.rotation_max;
+    opt.rotation_evaluations = rotation_evals;
+    opt.threads = threads;
+    opt.analysis.spindle_speed_rad_s =
+        cut.spindle_speed_rad_s ? cut.SpeedGrid()
+                                : Eigen::VectorXd::LinSpaced(speeds > 0 ? speeds : cut.spindle_speed_count,
+                                                             cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
+    opt.analysis.mode_coupling.max_depth = MmToM(max_depth_mm);
+
+    std::vector<stability::ToolPoseTarget> targets;
+    std::vector<std::string> ids;
+    std::vector<double> path_rotation;  // per-point rotation added to the region's
+    int rows = 0, cols = 0;
+    const bool grid = path_path.empty();
+    if (grid) {
+      targets = region.Targets(cut.feed_direction_B);
+      rows = region.num_v();
+      cols = region.num_u();
+    } else {
+      for (const io::PathPoint& p : io::ReadToolPathFile(path_path, cut.feed_direction_B)) {
+        stability::ToolPoseTarget t = p.target;
+        // A per-point rotation turns the reference x about the tool axis.
+        t.x_ref = Eigen::AngleAxisd(p.rotation, t.z_T.normalized()) * t.x_ref;
+        targets.push_back(t);
+        ids.push_back(p.id);
+        path_rotation.push_back(p.rotation);
+      }
+      rows = 1;
+      cols = static_cast<int>(targets.size());
+    }
+    for (const auto& t : targets) {
+      const Eigen::Vector3d f = t.feed_B - t.feed_B.dot(t.z_T.normalized()) * t.z_T.normalized();
+      if (f.norm() < 1e-6) {
+        throw InputError({cut_path, cut.feed_line, cut.feed_column}, "feed_direction is parallel to the tool axis of the " +
+                                               std::string(grid ? "region" : "path") + "; choose a feed in the work plane");
+      }
+    }
+    ProgressLine progress(kTool, "points", static_cast<long>(targets.size()));
+    opt.progress = [&](long done, long) { progress.Update(done); };
+    const std::vector<stability::MapPoint> pts =
+        stability::EvaluateStabilityMap(model, targets, rows, cols, cut.process, opt);
+    progress.Finish();
+
+    long reached = 0, flagged = 0;
+    for (const auto& p : pts) {
+      reached += p.status != stability::PointStatus::kUnreachable && p.status != stability::PointStatus::kJointLimits;
+      flagged += p.status != stability::PointStatus::kOk;
+    }
+    if (reached == 0) {
+      throw InputError({grid ? region_path : path_path, grid ? region.origin_line : 0, grid ? region.origin_column : 0},
+                       grid ? "no point of the region is reachable by the robot from seed_posture_deg within its joint limits "
+                              "(origin, axes and size place it out of reach)"
+                            : "no pose of the path is reachable by the robot from the region's seed_posture_deg");
+    }
+
+    {
+      // How far the seed's simplified closed form agrees with the eigenvalue
+      // criterion (issue #6 asks to report it).
+      std::vector<double> ratio;
+      for (const auto& p : pts) {
+        const auto& s = p.stability;
+        if (s.mode_coupling.status == stability::ModeCouplingStatus::kFound &&
+            std::isfinite(s.closed_form.critical_depth) && s.closed_form.critical_depth > 0.0) {
+          ratio.push_back(s.closed_form.critical_depth / s.mode_coupling.critical_depth);
+        }
+      }
+      if (!ratio.empty()) {
+        std::sort(ratio.begin(), ratio.end());
+        std::ostringstream msg;
+        msg << kTool << ": mode coupling, closed form / eigenvalue criterion over " << ratio.size()
+            << " points: median " << ratio[ratio.size() / 2] << ", range [" << ratio.front() << ", "
+            << ratio.back() << "]\n";
+        std::cerr << msg.str();
+      }
+    }
+    const int n = model->num_joints();
+    auto write = [&](std::ostream& os) {
+      os << (grid ? "row,col,x_mm,y_mm," : "point_id,") << "px_mm,py_mm,pz_mm,rotation_deg";
+      for (int j = 0; j < n; ++j) os << ",q" << j + 1 << "_deg";
+      os << ",depth_mode_coupling_mm,depth_closed_form_mm,deformation_ratio,depth_regenerative_mm,"
+            "spindle_speed_rpm,critical_depth_mm,limiting_mechanism,chatter_freq_hz,jacobian_condition,status\n";
+      for (size_t i = 0; i < pts.size(); ++i) {
+        const auto& p = pts[i];
+        const auto& s = p.stability;
+        const bool analysed = std::isfinite(s.critical_depth) || s.limiting != stability::Mechanism::kNone ||
+                              s.mode_coupling.evaluations > 0;
+        if (grid) {
+          const int r = static_cast<int>(i) / cols, c = static_cast<int>(i) % cols;
+          const Eigen::Vector2d uv = region.PlaneCoordinates(r, c);
+          os << r << ',' << c << ',' << Num(uv(0), 1e3) << ',' << Num(uv(1), 1e3) << ',';
+        } else {
+          os << ids[i] << ',';
+        }
+        os << Num(targets[i].p_BT.x(), 1e3) << ',' << Num(targets[i].p_BT.y(), 1e3) << ','
+           << Num(targets[i].p_BT.z(), 1e3) << ','
+           << Num(RadToDeg(p.rotation + (grid ? 0.0 : path_rotation[i])));
+        for (int j = 0; j < n; ++j) os << ',' << (p.q.size() == n ? Num(RadToDeg(p.q(j))) : "");
+        const bool mc = analysed && s.mode_coupling.status == stability::ModeCouplingStatus::kFound;
+        const bool rg = analysed && s.regenerative.status == stability::LobeStatus::kOk;
+        os << ',' << (mc ? Num(s.mode_coupling.critical_depth, 1e3) : "") << ','
+           << (analysed ? Num(s.closed_form.critical_depth, 1e3) : "") << ','
+           << (analysed ? Num(s.closed_form.deformation_ratio) : "") << ','
+           << (rg ? Num(s.regenerative.critical_depth, 1e3) : "") << ','
+           << (rg ? Num(RoundRpm(RadPerSecToRpm(s.regenerative.spindle_speed_rad_s))) : "") << ','
+           << (analysed ? Num(s.critical_depth, 1e3) : "") << ','
+           << (analysed ? stability::ToString(s.limiting) : "") << ','
+           << (analysed ? Num(s.chatter_freq_hz) : "") << ',' << Num(p.jacobian_condition) << ','
+           << stability::ToString(p.status) << '\n';
+      }
+    };
+    if (!plot_path.empty() && !grid) Warn(kTool, "--plot draws grids only; ignored with --path");
+    if (out_path.empty()) {
+      write(std::cout);
+    } else {
+      io::WriteFileAtomically(out_path, write);
+    }
+    if (!plot_path.empty() && grid) {
+      report::HeatMap hm;
+      hm.title = "robomach stability-map: critical axial depth (" + cut_path + ")";
+      hm.x_label = "u [mm] from the region origin";
+      hm.y_label = "v [mm] from the region origin";
+      hm.colorbar_label = "depth [mm]";
+      hm.dx = hm.dy = MToMm(region.grid_step);
+      hm.nx = cols;
+      hm.ny = rows;
+      hm.mark_label = "unreachable / joint limits";
+      hm.nan_label = "no limit found";
+      for (const auto& p : pts) {
+        const bool out = p.status == stability::PointStatus::kUnreachable || p.status == stability::PointStatus::kJointLimits;
+        hm.values.push_back(out ? NAN : MToMm(p.stability.critical_depth));
+        hm.marks.push_back(out ? 1 : 0);
+      }
+      report::SaveHeatMapPng(hm, plot_path);
+    }
+    if (flagged > 0) {
+      Warn(kTool, std::to_string(flagged) + " of " + std::to_string(pts.size()) +
+                      " points are flagged (status column: unreachable, joint_limits, near_singular, other_configuration)");
+      return kExitFlagged;
+    }
+    return kExitOk;
+  });
+}
+
+}  // namespace
+}  // namespace robomach::apps
+
+int main(int argc, char** argv) { return robomach::apps::Run(argc, argv); }

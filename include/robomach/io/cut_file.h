@@ -1,0 +1,40 @@
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "robomach/stability/milling.h"
+
+namespace robomach::io {
+
+/// A milling cut as `cut_*.yaml` describes it (see config/cut_demo.yaml for
+/// the documented schema). Values in SI and radians.
+struct CutSpec {
+  stability::MillingProcess process;
+  double tool_diameter{0.0};               // [m]
+  double feed_per_tooth{0.0};              // [m]
+  Eigen::Vector3d feed_direction_B{Eigen::Vector3d::UnitX()};  // unit, base frame
+  double spindle_speed_min_rad_s{0.0};
+  double spindle_speed_max_rad_s{0.0};
+  int spindle_speed_count{200};            // speeds scanned in [min, max]
+  std::optional<double> spindle_speed_rad_s;  // the operating speed, if fixed
+  std::string path;
+  int feed_line{0}, feed_column{0};        // where feed_direction is, for messages
+
+  /// `spindle_speed_count` speeds evenly spaced in [min, max] (or the fixed one).
+  Eigen::VectorXd SpeedGrid() const;
+};
+
+/// Reads a cut file. Keys: `diameter_mm`, `teeth` (>= 1), `radial_immersion`
+/// (a_e/D in (0, 1]), `milling` (up | down), `feed_direction` ([x, y, z] in
+/// the base frame), `feed_per_tooth_mm`, `cutting_coefficients` with either
+/// `ktc_N_per_mm2`, `krc_N_per_mm2` (and optional `kac_N_per_mm2`) or
+/// `Ks_N_per_mm2` with `beta_deg`; `spindle_speed_min_rpm`,
+/// `spindle_speed_max_rpm`, optional `spindle_speed_count` and
+/// `spindle_speed_rpm`. Unknown keys are rejected.
+/// @throws InputError with file:line:col naming the key and what was expected.
+CutSpec ReadCutFile(const std::string& path);
+
+}  // namespace robomach::io

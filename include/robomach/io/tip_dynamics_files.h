@@ -1,0 +1,45 @@
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/stability/tool_tip_model.h"
+
+namespace robomach::io {
+
+/// The tool-tip FRFs of one posture from a file, as receptance [m/N] in B.
+/// Directions that the file does not give are zero and flagged absent.
+struct FrfSetOfPose {
+  std::string pose_id;
+  Eigen::VectorXd freq_hz;            // one grid shared by all pairs of the pose
+  std::vector<Eigen::Matrix3cd> H;    // per line [m/N]
+  std::array<std::array<bool, 3>, 3> present{};  // [response][excitation]
+  std::string source;                 // file, for messages
+};
+
+/// Reads measured or predicted tool-tip FRFs (formats.md §3: the long CSV,
+/// or UFF58 by extension; io/frf_files.h validates them and converts
+/// mobility and accelerance to receptance) and groups them per posture. All
+/// FRFs of one posture must share one frequency grid. `default_pose_id`
+/// names the posture of a UFF file whose records do not. Reader warnings are
+/// appended to `warnings` if given.
+/// @throws InputError naming file, line and column.
+std::vector<FrfSetOfPose> ReadTipFrfs(const std::string& path, const std::string& default_pose_id = "",
+                                      std::vector<std::string>* warnings = nullptr);
+
+/// One posture of a modal table.
+struct ModalTableEntry {
+  std::string pose_id;
+  stability::TipModalModel modes;  // p in B [1/√kg]
+};
+
+/// Reads a modal table (formats.md §4): `pose_id,mode,freq_hz,damping_ratio,`
+/// then `modal_mass_kg` or `modal_stiffness_N_per_m` (k = m ω_n²), and the
+/// tool-tip shape `ux,uy,uz` (normalised on reading). p = u/√m.
+/// @throws InputError naming file, line and column.
+std::vector<ModalTableEntry> ReadModalTable(const std::string& path);
+
+}  // namespace robomach::io

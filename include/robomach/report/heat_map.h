@@ -1,0 +1,29 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace robomach::report {
+
+/// A scalar field on a regular grid drawn as coloured cells with axes, a
+/// colour bar and a legend entry for cells without a value. Units belong in
+/// the labels ("x [mm]", "critical depth [mm]").
+struct HeatMap {
+  std::string title;
+  std::string x_label, y_label, colorbar_label;
+  double x0{0.0}, y0{0.0};   // centre of cell (0, 0)
+  double dx{1.0}, dy{1.0};   // cell pitch
+  int nx{0}, ny{0};
+  std::vector<double> values;        // row-major, ny rows of nx; NaN = no value
+  std::vector<int> marks;            // same size or empty; 0 = none, 1 = hatched
+  std::string mark_label;            // legend text of hatched cells, e.g. "unreachable"
+  std::string nan_label{"no value"}; // legend text of grey cells
+};
+
+/// Renders to PNG bytes (viridis colours, colour bar with ticks).
+std::vector<unsigned char> EncodeHeatMapPng(const HeatMap& map);
+/// Renders and writes atomically (formats.md §4).
+/// @throws OutputError if the file cannot be written.
+void SaveHeatMapPng(const HeatMap& map, const std::string& path);
+
+}  // namespace robomach::report

@@ -1,0 +1,90 @@
+#pragma once
+
+#include <complex>
+#include <functional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/common/progress.h"
+#include "robomach/stability/milling.h"
+#include "robomach/stability/tool_tip_model.h"
+#include "robomach/stability/zoa_lobes.h"
+
+namespace robomach::stability {
+
+/// The piecewise-constant coefficients of step i of a periodic delay
+/// differential equation
+/// <pre>
+///   y'(t) = A(t) y(t) + B(t) u(t − τ),   u = first n_u entries of y,     (1)
+///   A(t + T) = A(t),  B(t + T) = B(t)
+/// </pre>
+/// on [t_i, t_{i+1}] (usually their means there). A is d×d, B is d×n_u.
+using SdStepCoefficients =
+    std::function<void(int step, double t0, double t1, Eigen::MatrixXd* A, Eigen::MatrixXd* B)>;
+
+/// Result of one monodromy evaluation.
+struct SdMonodromy {
+  double spectral_radius{NAN};
+  std::complex<double> critical_multiplier;  // the eigenvalue of largest modulus
+  int dimension{0};                          // d + m n_u
+};
+
+/// First-order semi-discretization [Insperger, Stepan & Turi 2008]: the
+/// period T is split into k steps Δt = T/k, the delay into m =
+/// round(τ/Δt) steps; on step i the coefficients are frozen and the delayed
+/// term is the linear interpolation
+/// <pre>
+///   u(t − τ) ≈ u_{i−m} + (t − t_i)/Δt · (u_{i−m+1} − u_{i−m}),           (2)
+/// </pre>
+/// so that the step is solved exactly:
+/// <pre>
+///   y_{i+1} = e^{A_i Δt} y_i + (Γ0 − Γ1/Δt) B_i u_{i−m} + (Γ1/Δt) B_i u_{i−m+1},
+///   Γ0 = ∫₀^Δt e^{A_i(Δt−s)} ds,  Γ1 = ∫₀^Δt e^{A_i(Δt−s)} s ds          (3)
+/// </pre>
+/// (Γ0, Γ1 and e^{A_i Δt} from one exponential of a 3d×3d block matrix
+/// [Van Loan 1978]). The monodromy matrix is the product of the k step
+/// matrices on z_i = [y_i; u_{i−1}; …; u_{i−m}]; (1) is asymptotically stable
+/// iff its spectral radius is < 1.
+/// @throws std::invalid_argument if k < 1, m < 1 or sizes are inconsistent.
+SdMonodromy FirstOrderSdMonodromy(int d, int n_u, double period, double delay, int steps,
+                                  const SdStepCoefficients& coefficients);
+
+/// Milling on a modal model in the cutting plane (modes.p rows x, y of C):
+/// <pre>
+///   η'' + 2ZΩ η' + Ω² η = −a Pᵀ H(t) P (η − η(t − τ)),   τ = 2π/(N Ω_s)
+/// </pre>
+/// with H(t) the 2×2 in-plane block of milling.h (2), averaged exactly over
+/// each step. Returns the monodromy over one tooth period.
+SdMonodromy MillingMonodromy(const TipModalModel& modes_C, const MillingProcess& process,
+                             double spindle_speed_rad_s, double depth, int steps);
+
+struct SdOptions {
+  int steps_per_period{40};   // k
+  double max_depth{0.02};     // [m] search range of the depth
+  int depth_scan_points{20};  // coarse scan of [0, max_depth] before bisection
+  double depth_tolerance{1e-3};  // relative width of the final bracket
+};
+
+/// The smallest depth with spectral radius 1 at one spindle speed: a
+/// coarse scan of [0, max_depth] for the first unstable depth, then
+/// bisection. Unstable islands narrower than max_depth/depth_scan_points can
+/// be missed. The chatter frequency is the member of the family
+/// (±arg μ + 2πj)/τ closest to a natural frequency of the model.
+LobePoint SdCriticalDepth(const TipModalModel& modes_C, const MillingProcess& process,
+                          double spindle_speed_rad_s, const SdOptions& options = {});
+
+/// SdCriticalDepth for each speed, in parallel on `threads` threads (0 = all
+/// cores); `progress` (may be empty) is called from the calling thread only.
+std::vector<LobePoint> SdLobes(const TipModalModel& modes_C, const MillingProcess& process,
+                               const Eigen::VectorXd& spindle_speed_rad_s, const SdOptions& options,
+                               int threads = 0, const ProgressCallback& progress = {});
+
+/// - [Insperger, Stepan & Turi 2008] T. Insperger, G. Stepan, J. Turi, On the
+///   higher-order semi-discretizations for periodic delayed systems, J. Sound
+///   Vib. 313:334-341, 2008.
+/// - [Insperger & Stepan 2004] see milling.h.
+/// - [Van Loan 1978] C. F. Van Loan, Computing integrals involving the matrix
+///   exponential, IEEE Trans. Automatic Control 23(3):395-404, 1978.
+
+}  // namespace robomach::stability

@@ -1,0 +1,75 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "robomach/common/progress.h"
+#include "robomach/common/units.h"
+#include "robomach/dynamics/robot_model.h"
+#include "robomach/stability/posture_stability.h"
+
+namespace robomach::stability {
+
+/// A tool pose to evaluate: the TCP at p_BT with its z axis (spindle to tool
+/// tip, into the work) along z_T, its x axis at `rotation` about z_T from
+/// x_ref, and the feed direction (all in B).
+struct ToolPoseTarget {
+  Eigen::Vector3d p_BT{Eigen::Vector3d::Zero()};  // [m]
+  Eigen::Vector3d z_T{Eigen::Vector3d::UnitZ()};  // unit
+  Eigen::Vector3d x_ref{Eigen::Vector3d::UnitX()};  // unit, normal to z_T
+  Eigen::Vector3d feed_B{Eigen::Vector3d::UnitX()};
+  /// X_BT for a rotation [rad] about the tool axis.
+  Eigen::Isometry3d Pose(double rotation) const;
+};
+
+enum class PointStatus {
+  kOk,
+  kUnreachable,        // IK did not reach the pose (1e-5 m, 1e-4 rad)
+  kJointLimits,        // IK reached it only outside the joint limits
+  kNearSingular,       // reached, but cond(J) > kNearSingularCondition
+  kOtherConfiguration, // reached on another arm configuration than the seed's (wrist flip)
+};
+const char* ToString(PointStatus s);
+
+struct MapOptions {
+  Eigen::VectorXd seed_q;            // preferred arm configuration [rad]
+  double rotation{0.0};              // fixed rotation about the tool axis [rad]
+  bool optimise_rotation{false};     // choose it per point in [rotation_min, rotation_max]
+  double rotation_min{-0.5 * kPi}, rotation_max{0.5 * kPi};  // [rad]
+  int rotation_evaluations{20};      // budget of the NLopt search per point
+  PostureStabilityOptions analysis;
+  int threads{0};                    // 0 = all cores
+  ProgressCallback progress;         // called from the calling thread
+};
+
+struct MapPoint {
+  PointStatus status{PointStatus::kUnreachable};
+  Eigen::VectorXd q;           // [rad]; IK result even when flagged (empty if none)
+  double rotation{0.0};        // [rad] the rotation used
+  double jacobian_condition{NAN};
+  PostureStability stability;  // evaluated for kOk and kNearSingular points
+  std::string optimiser_status;  // NLopt outcome when the rotation is optimised
+};
+
+/// Evaluates a grid of rows × cols targets (row-major) or, with rows = 1, a
+/// path. IK (KDL ChainIkSolverPos_LMA) is seeded from the neighbour so
+/// the arm stays on one configuration: the first column from the point
+/// above (the first point from seed_q), then each row along its columns.
+/// Points are then analysed in parallel, one PostureEvaluator per thread,
+/// each on its own copy of the model (KDL joints cache their last pose in
+/// mutable members, so threads must not share a KDL chain).
+/// With optimise_rotation, each point maximises its critical depth over
+/// the rotation about the tool axis with NLopt (LN_COBYLA after a coarse
+/// scan), re-solving the IK from the point's solution each time.
+/// @throws std::invalid_argument if rows·cols != targets.size() or the seed
+///   has the wrong size.
+std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::RobotModel> model,
+                                           const std::vector<ToolPoseTarget>& targets, int rows,
+                                           int cols, const MillingProcess& process,
+                                           const MapOptions& options);
+
+}  // namespace robomach::stability

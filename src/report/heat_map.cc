@@ -1,0 +1,144 @@
+#include "robomach/report/heat_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string_view>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "robomach/common/errors.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/report/plot.h"
+
+namespace robomach::report {
+namespace {
+
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+const cv::Scalar kBlack(0, 0, 0);
+
+std::string Label(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", std::abs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
+
+void Text(cv::Mat& img, const std::string& s, cv::Point p, double scale = 0.45, int align = 0) {
+  int base = 0;
+  const cv::Size sz = cv::getTextSize(s, kFont, scale, 1, &base);
+  if (align == 1) p.x -= sz.width / 2;
+  if (align == 2) p.x -= sz.width;
+  cv::putText(img, s, p, kFont, scale, kBlack, 1, cv::LINE_AA);
+}
+
+// Viridis through OpenCV's colour map (BGR).
+cv::Vec3b Colour(double t) {
+  cv::Mat one(1, 1, CV_8UC1, cv::Scalar(std::clamp(static_cast<int>(std::lround(255 * t)), 0, 255)));
+  cv::Mat out;
+  cv::applyColorMap(one, out, cv::COLORMAP_VIRIDIS);
+  return out.at<cv::Vec3b>(0, 0);
+}
+
+}  // namespace
+
+std::vector<unsigned char> EncodeHeatMapPng(const HeatMap& m) {
+  const int W = 1000, H = 720, left = 90, right = 180, top = 60, bottom = 90;
+  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+  const int pw = W - left - right, ph = H - top - bottom;
+  Text(img, m.title, {W / 2, 30}, 0.6, 1);
+  double vmin = INFINITY, vmax = -INFINITY;
+  for (double v : m.values) {
+    if (std::isfinite(v)) {
+      vmin = std::min(vmin, v);
+      vmax = std::max(vmax, v);
+    }
+  }
+  if (!std::isfinite(vmin)) vmin = 0.0, vmax = 1.0;
+  if (!(vmax > vmin)) vmax = vmin + (vmin == 0.0 ? 1.0 : std::abs(vmin) * 0.1);
+  // Data extent: cell edges.
+  const double xa = m.x0 - 0.5 * m.dx, xb = m.x0 + (m.nx - 0.5) * m.dx;
+  const double ya = m.y0 - 0.5 * m.dy, yb = m.y0 + (m.ny - 0.5) * m.dy;
+  auto px = [&](double x) { return left + static_cast<int>(std::lround((x - xa) / (xb - xa) * pw)); };
+  auto py = [&](double y) { return top + ph - static_cast<int>(std::lround((y - ya) / (yb - ya) * ph)); };
+  for (int r = 0; r < m.ny; ++r) {
+    for (int c = 0; c < m.nx; ++c) {
+      const size_t i = static_cast<size_t>(r) * m.nx + c;
+      const double v = i < m.values.size() ? m.values[i] : NAN;
+      const cv::Point a(px(m.x0 + (c - 0.5) * m.dx), py(m.y0 + (r + 0.5) * m.dy));
+      const cv::Point b(px(m.x0 + (c + 0.5) * m.dx), py(m.y0 + (r - 0.5) * m.dy));
+      const cv::Rect cell(a, b);
+      if (std::isfinite(v)) {
+        const cv::Vec3b col = Colour((v - vmin) / (vmax - vmin));
+        cv::rectangle(img, cell, cv::Scalar(col[0], col[1], col[2]), cv::FILLED);
+      } else {
+        cv::rectangle(img, cell, cv::Scalar(200, 200, 200), cv::FILLED);
+      }
+      if (i < m.marks.size() && m.marks[i] == 1) {
+        cv::rectangle(img, cell, cv::Scalar(235, 235, 235), cv::FILLED);
+        cv::line(img, cell.tl(), cell.br(), cv::Scalar(40, 40, 200), 1, cv::LINE_AA);
+        cv::line(img, {cell.x, cell.y + cell.height}, {cell.x + cell.width, cell.y}, cv::Scalar(40, 40, 200), 1,
+                 cv::LINE_AA);
+      }
+    }
+  }
+  cv::rectangle(img, cv::Rect(left, top, pw, ph), kBlack, 1);
+  for (double t : LinearTicks(xa, xb, 7)) {
+    if (t < xa || t > xb) continue;
+    cv::line(img, {px(t), top + ph}, {px(t), top + ph + 5}, kBlack);
+    Text(img, Label(t), {px(t), top + ph + 20}, 0.42, 1);
+  }
+  for (double t : LinearTicks(ya, yb, 7)) {
+    if (t < ya || t > yb) continue;
+    cv::line(img, {left - 5, py(t)}, {left, py(t)}, kBlack);
+    Text(img, Label(t), {left - 8, py(t) + 5}, 0.42, 2);
+  }
+  Text(img, m.x_label, {left + pw / 2, top + ph + 45}, 0.5, 1);
+  {
+    // Rotated y label.
+    int base = 0;
+    const cv::Size sz = cv::getTextSize(m.y_label, kFont, 0.5, 1, &base);
+    cv::Mat t(sz.height + base + 4, sz.width + 4, CV_8UC3, cv::Scalar(255, 255, 255));
+    cv::putText(t, m.y_label, {2, sz.height + 1}, kFont, 0.5, kBlack, 1, cv::LINE_AA);
+    cv::Mat r;
+    cv::rotate(t, r, cv::ROTATE_90_COUNTERCLOCKWISE);
+    const int x = 12, y = std::max(0, top + ph / 2 - r.rows / 2);
+    if (y + r.rows <= H && x + r.cols <= W) r.copyTo(img(cv::Rect(x, y, r.cols, r.rows)));
+  }
+  // Colour bar.
+  const int bx = left + pw + 40, bw = 22;
+  for (int y = 0; y < ph; ++y) {
+    const cv::Vec3b col = Colour(1.0 - static_cast<double>(y) / (ph - 1));
+    cv::line(img, {bx, top + y}, {bx + bw, top + y}, cv::Scalar(col[0], col[1], col[2]));
+  }
+  cv::rectangle(img, cv::Rect(bx, top, bw, ph), kBlack, 1);
+  for (double t : LinearTicks(vmin, vmax, 6)) {
+    if (t < vmin || t > vmax) continue;
+    const int y = top + ph - static_cast<int>(std::lround((t - vmin) / (vmax - vmin) * ph));
+    cv::line(img, {bx + bw, y}, {bx + bw + 5, y}, kBlack);
+    Text(img, Label(t), {bx + bw + 8, y + 5}, 0.42);
+  }
+  Text(img, m.colorbar_label, {bx - 10, top - 10}, 0.45);
+  // Legend for cells without colour.
+  const int ly = top + ph + 70;
+  cv::rectangle(img, cv::Rect(left, ly - 12, 16, 16), cv::Scalar(200, 200, 200), cv::FILLED);
+  Text(img, m.nan_label, {left + 22, ly + 1}, 0.45);
+  if (!m.mark_label.empty()) {
+    const cv::Rect cell(left + 260, ly - 12, 16, 16);
+    cv::rectangle(img, cell, cv::Scalar(235, 235, 235), cv::FILLED);
+    cv::line(img, cell.tl(), cell.br(), cv::Scalar(40, 40, 200), 1, cv::LINE_AA);
+    cv::line(img, {cell.x, cell.y + cell.height}, {cell.x + cell.width, cell.y}, cv::Scalar(40, 40, 200), 1, cv::LINE_AA);
+    Text(img, m.mark_label, {left + 282, ly + 1}, 0.45);
+  }
+  std::vector<unsigned char> png;
+  if (!cv::imencode(".png", img, png)) throw OutputError("PNG encoding failed");
+  return png;
+}
+
+void SaveHeatMapPng(const HeatMap& map, const std::string& path) {
+  const std::vector<unsigned char> png = EncodeHeatMapPng(map);
+  io::WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+}
+
+}  // namespace robomach::report

@@ -1,0 +1,202 @@
+#include "robomach/stability/mode_coupling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include "robomach/common/units.h"
+
+namespace robomach::stability {
+
+const char* ToString(ModeCouplingStatus s) {
+  switch (s) {
+    case ModeCouplingStatus::kFound: return "ok";
+    case ModeCouplingStatus::kStableUpToMax: return "stable_up_to_max";
+    case ModeCouplingStatus::kUnstableAtZero: return "unstable_at_zero";
+  }
+  return "?";
+}
+
+std::complex<double> RightmostEigenvalue(const Eigen::MatrixXd& M, const Eigen::MatrixXd& C,
+                                         const Eigen::MatrixXd& K, const Eigen::MatrixXd& Kc_z,
+                                         double depth) {
+  const Eigen::Index n = M.rows();
+  const Eigen::LLT<Eigen::MatrixXd> llt(M);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomLeftCorner(n, n) = -llt.solve(K + depth * Kc_z);
+  A.bottomRightCorner(n, n) = -llt.solve(C);
+  Eigen::EigenSolver<Eigen::MatrixXd> es(A, false);
+  const Eigen::VectorXcd ev = es.eigenvalues();
+  Eigen::Index imax = 0;
+  ev.real().maxCoeff(&imax);
+  return ev(imax);
+}
+
+namespace {
+
+// Smallest depth in (0, max_depth] where the rightmost eigenvalue crosses
+// into the right half-plane: a geometric scan brackets it, then a
+// safeguarded regula falsi (Illinois, each step kept at least 5 % of the
+// bracket from its ends) narrows the bracket to the tolerance.
+template <class Rightmost>
+ModeCouplingResult SearchCriticalDepth(const Rightmost& rightmost, const ModeCouplingOptions& options) {
+  if (!(options.max_depth > 0.0) || options.scan_points < 1 || !(options.depth_tolerance > 0.0)) {
+    throw std::invalid_argument("mode coupling: need max_depth > 0, scan_points >= 1, tolerance > 0");
+  }
+  ModeCouplingResult out;
+  // An undamped stable system has Re λ = 0 up to rounding, ~eps·|λ|;
+  // 1e-9 |λ| is far above that and, since Re λ grows like √(a − a_c)
+  // past a flutter point, moves the crossing by only ~1e-18 relative.
+  auto growth = [&](double a, std::complex<double>* lambda) {
+    ++out.evaluations;
+    *lambda = rightmost(a);
+    return lambda->real() - 1e-9 * std::abs(*lambda);
+  };
+  std::complex<double> lam;
+  double lo = 0.0, hi = NAN, g_lo = growth(0.0, &lam), g_hi = 0.0;
+  if (g_lo > 0.0) {
+    out.status = ModeCouplingStatus::kUnstableAtZero;
+    return out;
+  }
+  std::complex<double> lam_hi;
+  for (int j = 1; j <= options.scan_points; ++j) {
+    const double a = options.max_depth * std::ldexp(1.0, j - options.scan_points);
+    const double g = growth(a, &lam);
+    if (g > 0.0) {
+      hi = a;
+      g_hi = g;
+      lam_hi = lam;
+      break;
+    }
+    lo = a;
+    g_lo = g;
+  }
+  if (!std::isfinite(hi)) {
+    out.status = ModeCouplingStatus::kStableUpToMax;
+    out.critical_depth = options.max_depth;
+    return out;
+  }
+  int side = 0;  // which end was kept last time (Illinois)
+  while (hi - lo > options.depth_tolerance * hi) {
+    const double w = hi - lo;
+    double x = (g_hi - g_lo) != 0.0 ? lo - g_lo * w / (g_hi - g_lo) : 0.5 * (lo + hi);
+    x = std::clamp(x, lo + 0.05 * w, hi - 0.05 * w);
+    const double g = growth(x, &lam);
+    if (g > 0.0) {
+      hi = x;
+      g_hi = g;
+      lam_hi = lam;
+      if (side == -1) g_lo *= 0.5;
+      side = -1;
+    } else {
+      lo = x;
+      g_lo = g;
+      if (side == 1) g_hi *= 0.5;
+      side = 1;
+    }
+  }
+  out.critical_depth = 0.5 * (lo + hi);
+  out.chatter_freq_hz = std::abs(lam_hi.imag()) / (2.0 * kPi);
+  out.flutter = std::abs(lam_hi.imag()) > 1e-6 * std::abs(lam_hi);
+  out.status = ModeCouplingStatus::kFound;
+  return out;
+}
+
+std::complex<double> RightmostOf(const Eigen::MatrixXd& A) {
+  Eigen::EigenSolver<Eigen::MatrixXd> es(A, false);
+  const Eigen::VectorXcd ev = es.eigenvalues();
+  Eigen::Index imax = 0;
+  ev.real().maxCoeff(&imax);
+  return ev(imax);
+}
+
+}  // namespace
+
+ModeCouplingResult CriticalDepthModeCoupling(const Eigen::MatrixXd& M, const Eigen::MatrixXd& C,
+                                             const Eigen::MatrixXd& K, const Matrix3Xd& B,
+                                             const Eigen::Matrix3d& Kc_B,
+                                             const ModeCouplingOptions& options) {
+  const Eigen::Index n = M.rows();
+  if (M.cols() != n || C.rows() != n || C.cols() != n || K.rows() != n || K.cols() != n ||
+      B.cols() != n) {
+    throw std::invalid_argument("mode coupling: M, C, K must be n×n and B 3×n");
+  }
+  const Eigen::MatrixXd Kc_z = B.transpose() * Kc_B * B;
+  const Eigen::LLT<Eigen::MatrixXd> llt(M);
+  const Eigen::MatrixXd MiK = llt.solve(K), MiKc = llt.solve(Kc_z), MiC = llt.solve(C);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomRightCorner(n, n) = -MiC;
+  return SearchCriticalDepth(
+      [&](double a) {
+        A.bottomLeftCorner(n, n) = -(MiK + a * MiKc);
+        return RightmostOf(A);
+      },
+      options);
+}
+
+ModeCouplingResult CriticalDepthModeCouplingModal(const TipModalModel& modes, const Eigen::Matrix3d& Kc,
+                                                  const ModeCouplingOptions& options) {
+  modes.Validate();
+  const int n = modes.num_modes();
+  const Eigen::MatrixXd Kc_q = modes.p.transpose() * Kc * modes.p;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomRightCorner(n, n).diagonal() = -2.0 * modes.zeta.cwiseProduct(modes.omega_rad_s);
+  const Eigen::VectorXd w2 = modes.omega_rad_s.array().square();
+  return SearchCriticalDepth(
+      [&](double a) {
+        A.bottomLeftCorner(n, n) = -a * Kc_q;
+        A.bottomLeftCorner(n, n).diagonal() -= w2;
+        return RightmostOf(A);
+      },
+      options);
+}
+
+double FlutterDepthClosedForm(const Eigen::Matrix2d& S, const Eigen::Matrix2d& Kc) {
+  const double ds = S(0, 0) - S(1, 1), dc = Kc(0, 0) - Kc(1, 1);
+  // D(a) = q2 a² + q1 a + q0
+  const double q2 = dc * dc + 4.0 * Kc(0, 1) * Kc(1, 0);
+  const double q1 = 2.0 * ds * dc + 4.0 * (S(0, 1) * Kc(1, 0) + Kc(0, 1) * S(1, 0));
+  const double q0 = ds * ds + 4.0 * S(0, 1) * S(1, 0);
+  if (q0 < 0.0) return 0.0;  // already complex without cutting
+  // Smallest a > 0 where D changes sign from >= 0 to < 0.
+  if (q2 == 0.0) {
+    if (q1 < 0.0) return -q0 / q1;
+    return INFINITY;
+  }
+  const double disc = q1 * q1 - 4.0 * q2 * q0;
+  if (disc < 0.0) return INFINITY;  // D keeps the sign of q2 > 0 (q0 >= 0)
+  const double sq = std::sqrt(disc);
+  // Stable root formulas (no cancellation).
+  const double qq = -0.5 * (q1 + std::copysign(sq, q1));
+  double r1 = qq / q2, r2 = qq != 0.0 ? q0 / qq : -q1 / q2;
+  if (r1 > r2) std::swap(r1, r2);
+  // With q2 > 0, D < 0 between the roots; with q2 < 0, beyond the larger.
+  if (q2 > 0.0) {
+    if (r2 <= 0.0) return INFINITY;
+    return r1 > 0.0 ? r1 : (q0 > 0.0 ? INFINITY : 0.0);
+  }
+  return r2 > 0.0 ? r2 : 0.0;
+}
+
+ClosedFormModeCoupling ModeCouplingClosedForm(const Eigen::Matrix3d& compliance_C,
+                                              const Eigen::Matrix2d& Kc_C) {
+  ClosedFormModeCoupling out;
+  const Eigen::Matrix2d G = compliance_C.topLeftCorner<2, 2>();
+  const Eigen::Matrix2d S = G.inverse();
+  out.deformation_ratio = G(1, 0) / G(0, 0);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(0.5 * (S + S.transpose()));
+  out.k_min = es.eigenvalues()(0);
+  out.k_max = es.eigenvalues()(1);
+  out.critical_depth = FlutterDepthClosedForm(S, Kc_C);
+  return out;
+}
+
+}  // namespace robomach::stability

@@ -1,0 +1,213 @@
+#include "robomach/stability/semi_discretization.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+#include <Eigen/Eigenvalues>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include "robomach/common/units.h"
+
+namespace robomach::stability {
+
+SdMonodromy FirstOrderSdMonodromy(int d, int n_u, double period, double delay, int steps,
+                                  const SdStepCoefficients& coefficients) {
+  if (steps < 1 || d < 1 || n_u < 1 || n_u > d || !(period > 0.0) || !(delay > 0.0)) {
+    throw std::invalid_argument("semi-discretization: need steps >= 1, 1 <= n_u <= d, T > 0, tau > 0");
+  }
+  const double dt = period / steps;
+  const int m = static_cast<int>(std::lround(delay / dt));
+  if (m < 1) throw std::invalid_argument("semi-discretization: the delay is shorter than half a step");
+  const int D = d + m * n_u;
+
+  // Z holds the product of the step matrices applied so far, as rows of
+  // z = [y (d); u_{i-1}; ...; u_{i-m}] (block l at row d + (l-1) n_u).
+  Eigen::MatrixXd Z = Eigen::MatrixXd::Identity(D, D);
+  Eigen::MatrixXd A(d, d), B(d, n_u), E(3 * d, 3 * d), top(d, D);
+  for (int i = 0; i < steps; ++i) {
+    A.setZero();
+    B.setZero();
+    coefficients(i, i * dt, (i + 1) * dt, &A, &B);
+    // Van Loan: exp([[A, I, 0], [0, 0, I], [0, 0, 0]] Δt) has blocks
+    // (1,1) = e^{AΔt}, (1,2) = Γ0, (1,3) = Γ1.
+    E.setZero();
+    E.block(0, 0, d, d) = A * dt;
+    E.block(0, d, d, d) = Eigen::MatrixXd::Identity(d, d) * dt;
+    E.block(d, 2 * d, d, d) = Eigen::MatrixXd::Identity(d, d) * dt;
+    const Eigen::MatrixXd X = E.exp();
+    // With u' = v, v' = 0 appended to y' = A y + u, the flow over Δt from
+    // (0, I, 0) is Γ0 and from (0, 0, I) is Γ1 (u grows as s).
+    const Eigen::MatrixXd P = X.block(0, 0, d, d);
+    const Eigen::MatrixXd G0 = X.block(0, d, d, d);
+    const Eigen::MatrixXd G1 = X.block(0, 2 * d, d, d);
+    const Eigen::MatrixXd R1 = (G1 / dt) * B;        // weight of u_{i-m+1}
+    const Eigen::MatrixXd R0 = (G0 - G1 / dt) * B;   // weight of u_{i-m}
+    auto u_rows = [&](int l) {  // rows of u_{i-l} in Z, l = 0..m
+      return l == 0 ? Z.middleRows(0, n_u) : Z.middleRows(d + (l - 1) * n_u, n_u);
+    };
+    top.noalias() = P * Z.topRows(d);
+    top.noalias() += R1 * u_rows(m - 1);
+    top.noalias() += R0 * u_rows(m);
+    // Shift the delay line down by one block, then insert u_i and y_{i+1}.
+    for (int l = m; l >= 2; --l) Z.middleRows(d + (l - 1) * n_u, n_u) = Z.middleRows(d + (l - 2) * n_u, n_u);
+    Z.middleRows(d, n_u) = Z.topRows(n_u);
+    Z.topRows(d) = top;
+  }
+  SdMonodromy out;
+  out.dimension = D;
+  Eigen::EigenSolver<Eigen::MatrixXd> es(Z, false);
+  const Eigen::VectorXcd ev = es.eigenvalues();
+  Eigen::Index imax = 0;
+  ev.cwiseAbs().maxCoeff(&imax);
+  out.critical_multiplier = ev(imax);
+  out.spectral_radius = std::abs(ev(imax));
+  return out;
+}
+
+SdMonodromy MillingMonodromy(const TipModalModel& modes_C, const MillingProcess& process,
+                             double spindle_speed_rad_s, double depth, int steps) {
+  const int n = modes_C.num_modes();
+  const double tau = 2.0 * kPi / (process.teeth * spindle_speed_rad_s);
+  const Eigen::MatrixXd P = modes_C.p.topRows(2);  // 2 × n, in-plane shapes
+  const Eigen::VectorXd w2 = modes_C.omega_rad_s.array().square();
+  const Eigen::VectorXd c = 2.0 * modes_C.zeta.array() * modes_C.omega_rad_s.array();
+  auto coeff = [&](int, double t0, double t1, Eigen::MatrixXd* A, Eigen::MatrixXd* B) {
+    const Eigen::Matrix2d Hbar =
+        MeanDirectionalMatrix(process, spindle_speed_rad_s * t0, spindle_speed_rad_s * t1)
+            .topRows<2>();
+    const Eigen::MatrixXd W = depth * P.transpose() * Hbar * P;
+    A->topRightCorner(n, n).setIdentity();
+    A->bottomLeftCorner(n, n) = -W;
+    A->bottomLeftCorner(n, n).diagonal() -= w2;
+    A->bottomRightCorner(n, n).diagonal() = -c;
+    B->bottomRows(n) = W;
+  };
+  return FirstOrderSdMonodromy(2 * n, n, tau, tau, steps, coeff);
+}
+
+namespace {
+
+double ChatterFrequencyHz(const TipModalModel& m, std::complex<double> mu, double tau) {
+  const double arg = std::abs(std::arg(mu));  // in [0, π]
+  const double f_max = 3.0 * RadPerSecToHz(m.omega_rad_s.maxCoeff()) + 2.0 / tau;
+  double best = NAN, best_dist = INFINITY;
+  for (int j = 0;; ++j) {
+    bool any = false;
+    for (double sgn : {1.0, -1.0}) {
+      const double f = (sgn * arg + 2.0 * kPi * j) / (2.0 * kPi * tau);
+      if (f <= 0.0 || f > f_max) continue;
+      any = true;
+      for (int k = 0; k < m.num_modes(); ++k) {
+        const double dist = std::abs(f - RadPerSecToHz(m.omega_rad_s(k)));
+        if (dist < best_dist) {
+          best_dist = dist;
+          best = f;
+        }
+      }
+    }
+    if (!any && j > 0) break;
+  }
+  return best;
+}
+
+}  // namespace
+
+LobePoint SdCriticalDepth(const TipModalModel& modes_C, const MillingProcess& process,
+                          double spindle_speed_rad_s, const SdOptions& options) {
+  process.Validate();
+  modes_C.Validate();
+  if (!(spindle_speed_rad_s > 0.0) || !(options.max_depth > 0.0) || options.depth_scan_points < 1) {
+    throw std::invalid_argument("SD critical depth: need a speed > 0, max_depth > 0, scan points >= 1");
+  }
+  LobePoint out;
+  out.spindle_speed_rad_s = spindle_speed_rad_s;
+  const double tau = 2.0 * kPi / (process.teeth * spindle_speed_rad_s);
+  auto rho = [&](double a) {
+    return MillingMonodromy(modes_C, process, spindle_speed_rad_s, a, options.steps_per_period);
+  };
+  const SdMonodromy zero = rho(0.0);
+  if (zero.spectral_radius >= 1.0) {
+    out.status = LobeStatus::kUnstableAtZero;
+    return out;
+  }
+  double lo = 0.0, hi = NAN;
+  SdMonodromy at_hi;
+  for (int j = 1; j <= options.depth_scan_points; ++j) {
+    const double a = options.max_depth * j / options.depth_scan_points;
+    const SdMonodromy r = rho(a);
+    if (r.spectral_radius >= 1.0) {
+      hi = a;
+      at_hi = r;
+      break;
+    }
+    lo = a;
+  }
+  if (!std::isfinite(hi)) {
+    out.status = LobeStatus::kStableUpToMax;
+    out.critical_depth = options.max_depth;
+    return out;
+  }
+  while (hi - lo > options.depth_tolerance * hi) {
+    const double mid = 0.5 * (lo + hi);
+    const SdMonodromy r = rho(mid);
+    if (r.spectral_radius >= 1.0) {
+      hi = mid;
+      at_hi = r;
+    } else {
+      lo = mid;
+    }
+  }
+  out.critical_depth = 0.5 * (lo + hi);
+  out.chatter_freq_hz = ChatterFrequencyHz(modes_C, at_hi.critical_multiplier, tau);
+  // The lobe index of the chatter frequency: f τ = k + fraction.
+  out.lobe_index = static_cast<int>(std::floor(out.chatter_freq_hz * tau));
+  out.status = LobeStatus::kOk;
+  return out;
+}
+
+std::vector<LobePoint> SdLobes(const TipModalModel& modes_C, const MillingProcess& process,
+                               const Eigen::VectorXd& speeds, const SdOptions& options, int threads,
+                               const ProgressCallback& progress) {
+  process.Validate();
+  modes_C.Validate();
+  const long n = speeds.size();
+  std::vector<LobePoint> out(n);
+  if (threads <= 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  threads = static_cast<int>(std::min<long>(threads, std::max(1L, n)));
+  std::atomic<long> next{0}, done{0};
+  std::exception_ptr error;
+  std::atomic<bool> failed{false};
+  auto worker = [&]() {
+    for (long i = next++; i < n && !failed; i = next++) {
+      try {
+        out[i] = SdCriticalDepth(modes_C, process, speeds(i), options);
+      } catch (...) {
+        if (!failed.exchange(true)) error = std::current_exception();
+      }
+      ++done;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  if (threads == 1 || !progress) {
+    worker();
+  } else {
+    // The calling thread reports progress while the pool works.
+    std::thread last(worker);
+    while (done < n && !failed) {
+      progress(done, n);
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
+    last.join();
+  }
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+  if (progress) progress(n, n);
+  return out;
+}
+
+}  // namespace robomach::stability

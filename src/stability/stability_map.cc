@@ -1,0 +1,293 @@
+#include "robomach/stability/stability_map.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+#include <kdl/chainiksolverpos_lma.hpp>
+#include <nlopt.hpp>
+
+#include "robomach/dynamics/posture_dynamics.h"
+#include "robomach/kinematics/serial_chain.h"
+#include "robomach/stability/tool_tip_model.h"
+
+namespace robomach::stability {
+
+const char* ToString(PointStatus s) {
+  switch (s) {
+    case PointStatus::kOk: return "ok";
+    case PointStatus::kUnreachable: return "unreachable";
+    case PointStatus::kJointLimits: return "joint_limits";
+    case PointStatus::kNearSingular: return "near_singular";
+    case PointStatus::kOtherConfiguration: return "other_configuration";
+  }
+  return "?";
+}
+
+Eigen::Isometry3d ToolPoseTarget::Pose(double rotation) const {
+  const Eigen::Vector3d z = z_T.normalized();
+  const Eigen::Vector3d x0 = (x_ref - x_ref.dot(z) * z).normalized();
+  const Eigen::Vector3d x = std::cos(rotation) * x0 + std::sin(rotation) * z.cross(x0);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear().col(0) = x;
+  X.linear().col(1) = z.cross(x);
+  X.linear().col(2) = z;
+  X.translation() = p_BT;
+  return X;
+}
+
+namespace {
+
+// Tolerances of an accepted IK solution. 1e-5 m and 1e-4 rad are well
+// below what matters for the dynamics (the stiffness changes on the scale
+// of centimetres and degrees) and well above LMA's convergence (eps 1e-5
+// on a weighted error norm, about 1e-6 m here).
+constexpr double kIkPositionTolerance = 1e-5;  // [m]
+constexpr double kIkRotationTolerance = 1e-4;  // [rad]
+
+class IkSolver {
+ public:
+  explicit IkSolver(const kinematics::SerialChain& chain)
+      : chain_(chain), lma_(chain.kdl(), 1e-6, 500, 1e-15) {}
+
+  // Solves from `seed`; the result is wrapped to the 2π branch nearest the
+  // seed. Returns false if the pose was not reached.
+  bool Solve(const Eigen::Isometry3d& X, const Eigen::VectorXd& seed, Eigen::VectorXd* q) {
+    const int n = chain_.num_joints();
+    KDL::JntArray q0(n), q1(n);
+    for (int j = 0; j < n; ++j) q0(j) = seed(j);
+    lma_.CartToJnt(q0, kinematics::ToKdl(X), q1);
+    q->resize(n);
+    for (int j = 0; j < n; ++j) {
+      double v = q1(j);
+      v -= 2.0 * kPi * std::round((v - seed(j)) / (2.0 * kPi));
+      (*q)(j) = v;
+    }
+    const Eigen::Isometry3d X_got = kinematics::ForwardKinematics(chain_, *q);
+    const double dp = (X_got.translation() - X.translation()).norm();
+    const double dr = Eigen::AngleAxisd(X_got.linear().transpose() * X.linear()).angle();
+    return q->allFinite() && dp < kIkPositionTolerance && dr < kIkRotationTolerance;
+  }
+
+ private:
+  const kinematics::SerialChain& chain_;
+  KDL::ChainIkSolverPos_LMA lma_;
+};
+
+// Runs f(i) for i in [0, n) on `threads` threads; progress from the caller.
+template <class F>
+void ParallelFor(long n, int threads, const ProgressCallback& progress, long progress_offset,
+                 long progress_total, F f) {
+  std::atomic<long> next{0}, done{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr error;
+  auto worker = [&](int t) {
+    for (long i = next++; i < n && !failed; i = next++) {
+      try {
+        f(t, i);
+      } catch (...) {
+        if (!failed.exchange(true)) error = std::current_exception();
+      }
+      ++done;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) pool.emplace_back(worker, t);
+  while (done < n && !failed) {
+    if (progress) progress(progress_offset + done, progress_total);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+// KDL::Joint caches its last pose in mutable members (kdl/joint.hpp,
+// `mutable Frame joint_pose; mutable double q_previous;`), so two threads
+// evaluating the same KDL::Chain race and can get each other's joint
+// frames. Every thread therefore works on its own copy of the model,
+// rebuilt from the same description and parameters (identical numbers,
+// separate KDL chains).
+std::shared_ptr<const dynamics::RobotModel> PrivateCopy(const dynamics::RobotModel& model) {
+  return dynamics::RobotModel::Build(model.description(), model.parameters());
+}
+
+struct Worker {
+  explicit Worker(const dynamics::RobotModel& shared)
+      : model(PrivateCopy(shared)), ik(model->chain()), evaluator(model) {}
+  std::shared_ptr<const dynamics::RobotModel> model;
+  IkSolver ik;
+  dynamics::PostureEvaluator evaluator;
+};
+
+}  // namespace
+
+std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::RobotModel> model,
+                                           const std::vector<ToolPoseTarget>& targets, int rows,
+                                           int cols, const MillingProcess& process,
+                                           const MapOptions& options) {
+  process.Validate();
+  const int n = model->num_joints();
+  if (rows < 1 || cols < 1 || static_cast<size_t>(rows) * cols != targets.size()) {
+    throw std::invalid_argument("stability map: rows x cols must equal the number of targets");
+  }
+  if (options.seed_q.size() != n) {
+    throw std::invalid_argument("stability map: the seed posture has " +
+                                std::to_string(options.seed_q.size()) + " joints, the robot " +
+                                std::to_string(n));
+  }
+  if (options.optimise_rotation && !(options.rotation_max > options.rotation_min)) {
+    throw std::invalid_argument("stability map: rotation_max must exceed rotation_min");
+  }
+  int threads = options.threads > 0 ? options.threads
+                                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const long total = static_cast<long>(targets.size());
+  std::vector<MapPoint> out(total);
+  const double rot0 = options.optimise_rotation
+                          ? std::clamp(options.rotation, options.rotation_min, options.rotation_max)
+                          : options.rotation;
+  const auto& chain = model->chain();
+
+  auto ik_point = [&](IkSolver& ik, long i, const Eigen::VectorXd& seed) {
+    MapPoint& p = out[i];
+    p.rotation = rot0;
+    Eigen::VectorXd q;
+    const bool reached = ik.Solve(targets[i].Pose(rot0), seed, &q);
+    p.q = q;
+    if (!reached) {
+      p.status = PointStatus::kUnreachable;
+    } else if (!chain.JointsOutsideLimits(q).empty()) {
+      p.status = PointStatus::kJointLimits;
+    } else if (n >= 5 && q(4) * options.seed_q(4) < 0.0) {
+      // The sign of the wrist bend q5 tells the wrist configuration.
+      p.status = PointStatus::kOtherConfiguration;
+    } else {
+      p.status = PointStatus::kOk;
+    }
+    return p.status != PointStatus::kUnreachable;
+  };
+
+  // 1. IK: the first column top-down, then every row from its first point.
+  {
+    IkSolver ik(chain);
+    Eigen::VectorXd seed = options.seed_q;
+    for (int r = 0; r < rows; ++r) {
+      if (ik_point(ik, static_cast<long>(r) * cols, seed) &&
+          out[static_cast<long>(r) * cols].status == PointStatus::kOk) {
+        seed = out[static_cast<long>(r) * cols].q;
+      }
+    }
+  }
+  {
+    std::vector<std::unique_ptr<IkSolver>> solvers;
+    const int t_ik = std::min(threads, rows);
+    std::vector<std::shared_ptr<const dynamics::RobotModel>> copies;
+    for (int t = 0; t < t_ik; ++t) {
+      copies.push_back(PrivateCopy(*model));
+      solvers.push_back(std::make_unique<IkSolver>(copies.back()->chain()));
+    }
+    std::atomic<int> next_row{0};
+    std::vector<std::thread> pool;
+    for (int t = 0; t < t_ik; ++t) {
+      pool.emplace_back([&, t]() {
+        for (int r = next_row++; r < rows; r = next_row++) {
+          const long first = static_cast<long>(r) * cols;
+          Eigen::VectorXd seed = out[first].status == PointStatus::kOk ? out[first].q : options.seed_q;
+          for (int c = 1; c < cols; ++c) {
+            if (ik_point(*solvers[t], first + c, seed) && out[first + c].status == PointStatus::kOk) {
+              seed = out[first + c].q;
+            }
+          }
+        }
+      });
+    }
+    for (auto& th : pool) th.join();
+  }
+
+  // 2. Stability per point, one evaluator per thread.
+  std::vector<std::unique_ptr<Worker>> workers;
+  for (int t = 0; t < threads; ++t) workers.push_back(std::make_unique<Worker>(*model));
+
+  auto analyse = [&](Worker& w, long i) {
+    MapPoint& p = out[i];
+    if (p.status != PointStatus::kOk && p.status != PointStatus::kOtherConfiguration) return;
+    auto evaluate = [&](const Eigen::VectorXd& q, double rotation, PostureStability* s,
+                        double* cond) -> bool {
+      const dynamics::PostureDynamics d = w.evaluator.Evaluate(q, dynamics::PostureOptions{false, true});
+      *cond = d.jacobian_condition;
+      *s = AnalysePosture(d, CuttingFrameAtPosture(targets[i].Pose(rotation), targets[i].feed_B),
+                          process, options.analysis);
+      return d.near_singular;
+    };
+    bool singular = evaluate(p.q, p.rotation, &p.stability, &p.jacobian_condition);
+    if (options.optimise_rotation) {
+      const Eigen::VectorXd q_start = p.q;
+      auto depth_at = [&](double rot, Eigen::VectorXd* q_out, PostureStability* s, double* cond,
+                          bool* sing) -> double {
+        Eigen::VectorXd q;
+        if (!w.ik.Solve(targets[i].Pose(rot), q_start, &q)) return 0.0;
+        if (!chain.JointsOutsideLimits(q).empty()) return 0.0;
+        *sing = evaluate(q, rot, s, cond);
+        *q_out = q;
+        return std::isfinite(s->critical_depth) ? s->critical_depth : 0.0;
+      };
+      double best = std::isfinite(p.stability.critical_depth) ? p.stability.critical_depth : 0.0;
+      double best_rot = p.rotation;
+      auto consider = [&](double rot) {
+        Eigen::VectorXd q;
+        PostureStability s;
+        double cond = NAN;
+        bool sing = false;
+        const double v = depth_at(rot, &q, &s, &cond, &sing);
+        if (v > best) {
+          best = v;
+          best_rot = rot;
+          p.q = q;
+          p.stability = s;
+          p.jacobian_condition = cond;
+          singular = sing;
+        }
+        return v;
+      };
+      // Coarse scan: the depth is not unimodal in the rotation.
+      constexpr int kScan = 7;
+      for (int j = 0; j < kScan; ++j) {
+        consider(options.rotation_min + (options.rotation_max - options.rotation_min) * j / (kScan - 1));
+      }
+      // Local refinement with NLopt around the best scan point.
+      nlopt::opt opt(nlopt::LN_COBYLA, 1);
+      const double h = (options.rotation_max - options.rotation_min) / (kScan - 1);
+      opt.set_lower_bounds(std::max(options.rotation_min, best_rot - h));
+      opt.set_upper_bounds(std::min(options.rotation_max, best_rot + h));
+      opt.set_maxeval(std::max(1, options.rotation_evaluations - kScan));
+      opt.set_xtol_abs(1e-3);
+      opt.set_initial_step(0.25 * h);
+      opt.set_max_objective(
+          [](unsigned, const double* x, double*, void* data) {
+            return (*static_cast<decltype(consider)*>(data))(x[0]);
+          },
+          &consider);
+      std::vector<double> x{best_rot};
+      double fx = 0.0;
+      try {
+        const nlopt::result r = opt.optimize(x, fx);
+        p.optimiser_status = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : "converged";
+      } catch (const nlopt::roundoff_limited&) {
+        p.optimiser_status = "roundoff_limited";
+      } catch (const std::runtime_error& e) {
+        p.optimiser_status = std::string("failed: ") + e.what();
+      }
+      p.rotation = best_rot;
+    }
+    if (singular) p.status = PointStatus::kNearSingular;
+  };
+
+  ParallelFor(total, threads, options.progress, 0, total,
+              [&](int t, long i) { analyse(*workers[t], i); });
+  if (options.progress) options.progress(total, total);
+  return out;
+}
+
+}  // namespace robomach::stability

@@ -1,0 +1,138 @@
+#include "robomach/stability/tool_tip_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "robomach/common/units.h"
+
+namespace robomach::stability {
+
+Eigen::Matrix3d CuttingFrame(const Eigen::Vector3d& tool_axis_B, const Eigen::Vector3d& feed_B) {
+  if (!tool_axis_B.allFinite() || !feed_B.allFinite() || tool_axis_B.norm() == 0.0 ||
+      feed_B.norm() == 0.0) {
+    throw std::invalid_argument("tool axis and feed direction must be finite, non-zero vectors");
+  }
+  const Eigen::Vector3d z = tool_axis_B.normalized();
+  const Eigen::Vector3d f = feed_B.normalized();
+  const Eigen::Vector3d x_raw = f - f.dot(z) * z;
+  // |x_raw| = sin(angle between feed and axis); below 1e-6 the in-plane
+  // direction is lost in rounding of a 1e-16 relative product.
+  if (x_raw.norm() < 1e-6) {
+    throw std::invalid_argument("the feed direction is parallel to the tool axis");
+  }
+  Eigen::Matrix3d R;
+  R.col(0) = x_raw.normalized();
+  R.col(2) = z;
+  R.col(1) = z.cross(R.col(0));
+  return R;
+}
+
+Eigen::Matrix3d CuttingFrameAtPosture(const Eigen::Isometry3d& X_BT, const Eigen::Vector3d& feed_B) {
+  return CuttingFrame(-X_BT.linear().col(2), feed_B);
+}
+
+TipModalModel TipModalModel::Rotated(const Eigen::Matrix3d& R_BC) const {
+  TipModalModel out = *this;
+  out.p = R_BC.transpose() * p;
+  return out;
+}
+
+void TipModalModel::Validate() const {
+  const auto n = omega_rad_s.size();
+  if (zeta.size() != n || p.cols() != n) {
+    throw std::invalid_argument("modal model: frequencies, damping ratios and shapes differ in count");
+  }
+  if (n == 0) throw std::invalid_argument("modal model: no modes");
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (!(std::isfinite(omega_rad_s(k)) && omega_rad_s(k) > 0.0)) {
+      throw std::invalid_argument("modal model: mode " + std::to_string(k + 1) +
+                                  ": natural frequency must be > 0");
+    }
+    if (!(zeta(k) >= 0.0 && zeta(k) < 1.0)) {
+      throw std::invalid_argument("modal model: mode " + std::to_string(k + 1) +
+                                  ": damping ratio must be in [0, 1)");
+    }
+    if (!p.col(k).allFinite()) {
+      throw std::invalid_argument("modal model: mode " + std::to_string(k + 1) + ": shape not finite");
+    }
+  }
+}
+
+TipModalModel ModalModelFromPosture(const dynamics::PostureDynamics& d) {
+  TipModalModel m;
+  const int n = static_cast<int>(d.modes.size());
+  m.omega_rad_s.resize(n);
+  m.zeta.resize(n);
+  m.p.resize(3, n);
+  for (int k = 0; k < n; ++k) {
+    m.omega_rad_s(k) = HzToRadPerSec(d.modes[k].freq_hz);
+    m.zeta(k) = d.modes[k].damping_ratio;
+    m.p.col(k) = d.modes[k].p_T;
+  }
+  return m;
+}
+
+std::vector<Eigen::Matrix3cd> ModalReceptance(const TipModalModel& m, const Eigen::VectorXd& freq_hz) {
+  std::vector<Eigen::Matrix3cd> H(freq_hz.size(), Eigen::Matrix3cd::Zero());
+  std::vector<Eigen::Matrix3d> pp(m.num_modes());
+  for (int k = 0; k < m.num_modes(); ++k) pp[k] = m.p.col(k) * m.p.col(k).transpose();
+  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
+    const double w = HzToRadPerSec(freq_hz(i));
+    for (int k = 0; k < m.num_modes(); ++k) {
+      const double wk = m.omega_rad_s(k);
+      const std::complex<double> g = 1.0 / std::complex<double>(wk * wk - w * w, 2.0 * m.zeta(k) * wk * w);
+      H[i] += g * pp[k].cast<std::complex<double>>();
+    }
+  }
+  return H;
+}
+
+std::vector<Eigen::Matrix2cd> InPlaneModalReceptance(const TipModalModel& m,
+                                                     const Eigen::VectorXd& freq_hz) {
+  std::vector<Eigen::Matrix2cd> H(freq_hz.size(), Eigen::Matrix2cd::Zero());
+  const int n = m.num_modes();
+  std::vector<Eigen::Matrix2d> pp(n);
+  for (int k = 0; k < n; ++k) pp[k] = m.p.col(k).head<2>() * m.p.col(k).head<2>().transpose();
+  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
+    const double w = HzToRadPerSec(freq_hz(i));
+    Eigen::Matrix2d re = Eigen::Matrix2d::Zero(), im = Eigen::Matrix2d::Zero();
+    for (int k = 0; k < n; ++k) {
+      const double wk = m.omega_rad_s(k);
+      const double a = wk * wk - w * w, b = 2.0 * m.zeta(k) * wk * w, inv = 1.0 / (a * a + b * b);
+      re += (a * inv) * pp[k];   // 1/(a + ib) = (a − ib)/(a² + b²)
+      im -= (b * inv) * pp[k];
+    }
+    H[i].real() = re;
+    H[i].imag() = im;
+  }
+  return H;
+}
+
+std::vector<Eigen::Matrix2cd> OrientInCuttingPlane(const std::vector<Eigen::Matrix3cd>& H_B,
+                                                   const Eigen::Matrix3d& R_BC) {
+  std::vector<Eigen::Matrix2cd> out(H_B.size());
+  const Eigen::Matrix<std::complex<double>, 3, 2> R = R_BC.leftCols<2>().cast<std::complex<double>>();
+  for (size_t i = 0; i < H_B.size(); ++i) out[i] = R.transpose() * H_B[i] * R;
+  return out;
+}
+
+Eigen::VectorXd LogFrequencyGrid(double f_lo_hz, double f_hi_hz, int lines) {
+  if (!(f_lo_hz > 0.0 && f_hi_hz > f_lo_hz) || lines < 2) {
+    throw std::invalid_argument("frequency grid: expected 0 < f_lo < f_hi and at least 2 lines");
+  }
+  Eigen::VectorXd f = Eigen::VectorXd::LinSpaced(lines, std::log(f_lo_hz), std::log(f_hi_hz));
+  return f.array().exp();
+}
+
+Eigen::VectorXd LobeFrequencyGrid(const TipModalModel& m, int teeth, double max_speed_rad_s,
+                                  int lines) {
+  m.Validate();
+  const double f_lo = 0.5 * RadPerSecToHz(m.omega_rad_s.minCoeff());
+  const double f_hi = std::max(1.5 * RadPerSecToHz(m.omega_rad_s.maxCoeff()),
+                               1.05 * teeth * max_speed_rad_s / (2.0 * kPi));
+  return LogFrequencyGrid(f_lo, std::max(f_hi, 2.0 * f_lo), lines);
+}
+
+}  // namespace robomach::stability
