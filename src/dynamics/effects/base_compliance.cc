@@ -57,6 +57,9 @@ class BaseComplianceEffect final : public Effect {
          "mass moving with the base besides the chain's links (base casting, plate)"},
         {"foundation_inertia_kgm2", "kg·m²", 40.0, 0.0, 1e5, false,
          "rotational inertia of that mass about the base origin (isotropic)"},
+        // Anchored bases on concrete: ≈ 5 % (grout and floor losses).
+        {"damping_ratio", "1", 0.05, 0.001, 0.3, true,
+         "damping ratio of the robot's rigid-body modes on the foundation (replaces alpha K there)"},
     };
   }
   EffectStage stage() const override { return EffectStage::kBase; }
@@ -79,6 +82,12 @@ class BaseComplianceEffect final : public Effect {
     Vector6d k;
     k << v[0], v[0], v[1], v[2], v[2], v[3];
     sys->K.block<6, 6>(b, b) += k.asDiagonal();
+    // Damping of the foundation's own modes, as for a mounted body
+    // (dynamics/internal/body_on_springs.h): the robot held rigid on its
+    // springs has six modes of ratio ζ, instead of α K's α ω/2.
+    const Matrix6d K_bb = k.asDiagonal();
+    sys->C_extra.block<6, 6>(b, b) +=
+        internal::ModalDampingMatrix(M_bb, K_bb, v[6]) - ctx.model.alpha() * K_bb;
     // The tool-carrying body moves with the base: its twist at T per base DOF.
     sys->V_T.middleCols<6>(b) = internal::ShiftTwist(ctx.X_BT.translation());
     sys->B = sys->V_T.topRows<3>();

@@ -45,6 +45,9 @@ class FlangeComplianceEffect final : public Effect {
          "flange joint stiffness about the axes across the spindle axis"},
         {"torsional_stiffness_Nm_per_rad", "N·m/rad", 2e6, 1e3, 1e10, true,
          "flange joint stiffness about the spindle axis"},
+        // Bolted joints dissipate by micro-slip: 2–5 % is the usual range.
+        {"damping_ratio", "1", 0.03, 0.001, 0.3, true,
+         "damping ratio of the end effector's modes on the flange (replaces alpha K there)"},
     };
   }
   EffectStage stage() const override { return EffectStage::kFlange; }
@@ -65,7 +68,8 @@ class FlangeComplianceEffect final : public Effect {
                     .asDiagonal();
     mount.body_B = kinematics::TransformInertial(ee, X_B_tip);
     mount.carries_tool_tip = true;
-    internal::MountBodyOnSprings(mount, ctx.X_BT.translation(), first, sys);
+    mount.damping_ratio = v[4];
+    internal::MountBodyOnSprings(mount, ctx.X_BT.translation(), model.alpha(), first, sys);
   }
 };
 

@@ -1,6 +1,11 @@
 #include "dynamics/internal/body_on_springs.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+
 
 namespace robomach::dynamics::internal {
 namespace {
@@ -26,6 +31,18 @@ Matrix6d SpatialInertiaAtCom(const kinematics::Inertial& b) {
   return L;
 }
 
+Eigen::MatrixXd ModalDampingMatrix(const Eigen::MatrixXd& M, const Eigen::MatrixXd& K,
+                                   double zeta) {
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ges(K, M, Eigen::ComputeEigenvectors |
+                                                                          Eigen::Ax_lBx);
+  if (ges.info() != Eigen::Success) {
+    throw std::runtime_error("modal damping: the mounted body's mass matrix is not positive definite");
+  }
+  const Eigen::VectorXd omega = ges.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  const Eigen::MatrixXd MPhi = M * ges.eigenvectors();
+  return MPhi * (2.0 * zeta * omega).asDiagonal() * MPhi.transpose();
+}
+
 Matrix6Xd MountColumns(const SpringMount& mount) {
   const int k = static_cast<int>(mount.components.size());
   Matrix6Xd E = Matrix6Xd::Zero(6, k);
@@ -38,8 +55,8 @@ Matrix6Xd MountColumns(const SpringMount& mount) {
   return E;
 }
 
-void MountBodyOnSprings(const SpringMount& mount, const Eigen::Vector3d& p_BT, int first_dof,
-                        AssembledSystem* sys) {
+void MountBodyOnSprings(const SpringMount& mount, const Eigen::Vector3d& p_BT, double alpha,
+                        int first_dof, AssembledSystem* sys) {
   const int k = static_cast<int>(mount.components.size());
   const int N = static_cast<int>(sys->M.rows());
   if (mount.K_S.rows() != k || mount.K_S.cols() != k || first_dof + k > N) {
@@ -57,6 +74,9 @@ void MountBodyOnSprings(const SpringMount& mount, const Eigen::Vector3d& p_BT, i
   sys->M.middleCols(first_dof, k) += MA.middleCols(first_dof, k);
   sys->M.block(first_dof, first_dof, k, k) -= MA.block(first_dof, first_dof, k, k);  // added twice
   sys->K.block(first_dof, first_dof, k, k) += mount.K_S;
+  const Eigen::MatrixXd M_rr = MA.block(first_dof, first_dof, k, k);
+  sys->C_extra.block(first_dof, first_dof, k, k) +=
+      ModalDampingMatrix(M_rr, mount.K_S, mount.damping_ratio) - alpha * mount.K_S;
   if (mount.carries_tool_tip) {
     sys->V_T.middleCols(first_dof, k) = ShiftTwist(p_BT - mount.p_BP) * E;
     sys->B = sys->V_T.topRows<3>();
