@@ -136,5 +136,21 @@ TEST(SpindleInterface, AddsHolderModesAndReadsTheConfigSection) {
   EXPECT_THROW(EvaluatePosture(bad, q), std::invalid_argument);
 }
 
+// A tip mass listed before the interface in the config still sits on the
+// holder: effects apply base-to-tool (EffectStage), so tip_mass sees B with
+// the interface columns and adds m BᵀB over all ten coordinates (closed
+// form of tip_mass; exact up to rounding, 1e-12 of max|M|).
+TEST(SpindleInterface, TipMassRidesOnTheHolder) {
+  const auto holder = Kr210With({{"spindle_interface", {}}});
+  const auto both = Kr210With({{"tip_mass", {{"mass_kg", 0.05}}}, {"spindle_interface", {}}});
+  EXPECT_EQ(both->effects().back().effect->name(), "tip_mass");
+  const Eigen::VectorXd q = (Eigen::VectorXd(6) << 0.1, -1.1, 1.3, 0.2, 0.7, 0.1).finished();
+  const PostureDynamics p0 = EvaluatePosture(holder, q);
+  const PostureDynamics p1 = EvaluatePosture(both, q);
+  const Eigen::MatrixXd expected = p0.system.M + 0.05 * p0.system.B.transpose() * p0.system.B;
+  EXPECT_LE((p1.system.M - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
+  EXPECT_GT((0.05 * p0.system.B.rightCols(4).transpose() * p0.system.B.rightCols(4)).norm(), 0.0);
+}
+
 }  // namespace
 }  // namespace robomach::dynamics
