@@ -5,12 +5,14 @@
 // complex [Ewins 2000, §2.4]; the FRF is exact by the direct solve or the
 // state-space modes (tool_tip_frf.h).
 //
-// Defaults: c_j = 2 ζ k_j / ω_j with ζ = 2 % at ω_j = 2π·20 Hz, the band of
-// the first robot modes, i.e. c_j = k_j · 3.2e-4 s. With the seed's joint
-// stiffness that is about 1e3 N·m·s/rad for the main axes and 1e2 for the
-// wrist, the order reported for joint damping of heavy industrial robots
-// (identified values of 1e2–1e4 N·m·s/rad). They add to the Rayleigh
-// damping of the base model; fit them with alpha and beta held.
+// Defaults: c_j = 2 ζ √(k_j I_j) with ζ = 3 %, k_j the seed's joint
+// stiffness and I_j = M_q(j, j) of the default robot at the demo posture P1
+// (0, −90°, 90°, 0, 45°, 0): each joint alone, the others held, would
+// have 3 % damping. That gives 1.3–2.8e3 N·m·s/rad for the main axes and
+// 7–80 for the wrist (c_j/k_j from 5e-4 s down to 4e-5 s, so clearly not
+// proportional to K_q), the order reported for joint damping of heavy
+// industrial robots. They add to the Rayleigh damping of the base model;
+// fit them with alpha and beta held.
 //
 // - [Ewins 2000] D. J. Ewins, Modal Testing: Theory, Practice and
 //   Application, 2nd ed., Research Studies Press, 2000.
@@ -33,12 +35,12 @@ class JointDampingEffect final : public Effect {
     return "viscous damping at each joint, not proportional to M or K (Ewins 2000, §2.4)";
   }
   std::vector<ParameterSpec> parameters() const override {
-    // 3.2e-4 s × the seed's K_q (see the header comment).
-    const double k[kMaxJoints] = {3.3479e6, 3.1318e6, 4.2895e6, 2.4787e5, 6.4292e5, 1.8847e5};
+    // 2 · 0.03 · √(k_j M_q(j, j)) at P1, rounded (see the header comment).
+    const double c[kMaxJoints] = {1700.0, 2800.0, 1300.0, 40.0, 80.0, 7.0};
     std::vector<ParameterSpec> p;
     for (int j = 0; j < kMaxJoints; ++j) {
       const std::string i = std::to_string(j + 1);
-      p.push_back({"c" + i + "_Nms_per_rad", "N·m·s/rad", 3.2e-4 * k[j], 0.0, 1e6, true,
+      p.push_back({"c" + i + "_Nms_per_rad", "N·m·s/rad", c[j], 0.0, 1e6, true,
                    "viscous damping of joint " + i});
     }
     return p;
