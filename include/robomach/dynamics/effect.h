@@ -35,8 +35,9 @@ struct AssembledSystem {
   /// Twist [v; ω] at T of the body that carries the tool tip, per
   /// generalised coordinate, in B (6×N; J_BT in the joint columns). B is its
   /// top three rows. An effect that puts the tool-carrying part on springs
-  /// (flange, spindle interface) reads it to find how its attachment point
-  /// moves and updates it (and B) for its own DOFs; see EffectStage.
+  /// (base, flange, spindle interface, tool) reads it to find how its
+  /// attachment point moves and sets its own DOFs' columns (and B's); see
+  /// EffectStage. Effects that only read B (tip_mass) leave it alone.
   Matrix6Xd V_T;
   int num_joints{0};
 };

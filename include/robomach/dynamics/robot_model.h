@@ -112,6 +112,8 @@ class RobotModel {
   const Eigen::VectorXd& joint_stiffness() const { return joint_stiffness_; }  // [N·m/rad]
   double alpha() const { return alpha_; }  // [s]
   double beta() const { return beta_; }    // [1/s]
+  /// In the order they are applied: by EffectStage, then as in the config
+  /// (so not necessarily description().effects' order).
   const std::vector<BoundEffect>& effects() const { return effects_; }
   /// Position of the spindle nose (gauge line) in the TCP frame [m].
   const Eigen::Vector3d& p_TN() const { return p_TN_; }
