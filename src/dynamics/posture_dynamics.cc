@@ -120,9 +120,11 @@ PostureDynamics PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const Postu
   sys.K.setZero(N, N);
   sys.C_extra.setZero(N, N);
   sys.B.setZero(3, N);
+  sys.V_T.setZero(6, N);
   sys.M.topLeftCorner(n, n) = w.H.data;
   sys.K.topLeftCorner(n, n).diagonal() = model.joint_stiffness();
   sys.B.leftCols(n) = out.J_BT.topRows<3>();
+  sys.V_T.leftCols(n) = out.J_BT;
   const EffectContext ctx{model, q, out.X_BT, out.J_BT};
   for (const BoundEffect& be : model.effects()) {
     be.effect->Contribute(ctx, be.values, be.first_extra_dof, &sys);

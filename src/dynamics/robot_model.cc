@@ -1,5 +1,6 @@
 #include "robomach/dynamics/robot_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -140,6 +141,7 @@ std::shared_ptr<const RobotModel> RobotModel::Build(const RobotDescription& d,
     b.inertia_com *= scale;
     if (h_tcp > 0.0) b.com += delta_d6 * (b.com.dot(g.axis) / h_tcp) * g.axis;
     ee = CombineInertials(ee, b);
+    m->end_effector_bodies_.push_back({body.name, b});
   }
   chain = chain.WithFixedSegment("end_effector", Eigen::Isometry3d::Identity(), ee);
   Eigen::Isometry3d X_tip_tcp = Eigen::Isometry3d::Identity();
@@ -147,17 +149,26 @@ std::shared_ptr<const RobotModel> RobotModel::Build(const RobotDescription& d,
   chain = chain.WithFixedSegment("tcp", X_tip_tcp, Inertial{});
   m->chain_ = chain;
   m->p_TN_ = d.end_effector.p_spindle_nose - p_tcp;
+  m->p_tcp_ = p_tcp;
 
-  int next_dof = n;
   for (const EffectConfig& ec : d.effects) {
     BoundEffect be;
     be.effect = EffectRegistry::Instance().Create(ec.name);
     for (const auto& spec : be.effect->parameters()) {
       be.values.push_back(checked.Get(ec.name + "." + spec.name));
     }
+    m->effects_.push_back(std::move(be));
+  }
+  // Apply (and number the extra DOFs of) effects from the floor to the tool
+  // tip, whatever their order in the config (EffectStage).
+  std::stable_sort(m->effects_.begin(), m->effects_.end(),
+                   [](const BoundEffect& a, const BoundEffect& b) {
+                     return a.effect->stage() < b.effect->stage();
+                   });
+  int next_dof = n;
+  for (BoundEffect& be : m->effects_) {
     be.first_extra_dof = next_dof;
     next_dof += be.effect->num_extra_dofs(be.values);
-    m->effects_.push_back(std::move(be));
   }
   m->num_dofs_ = next_dof;
   return m;

@@ -32,6 +32,13 @@ struct AssembledSystem {
   Eigen::MatrixXd C_extra;  // non-proportional damping added by effects
   Eigen::MatrixXd C;        // total damping, set after all effects
   Matrix3Xd B;              // tool-tip translation per generalised coordinate
+  /// Twist [v; ω] at T of the body that carries the tool tip, per
+  /// generalised coordinate, in B (6×N; J_BT in the joint columns). B is its
+  /// top three rows. An effect that puts the tool-carrying part on springs
+  /// (base, flange, spindle interface, tool) reads it to find how its
+  /// attachment point moves and sets its own DOFs' columns (and B's); see
+  /// EffectStage. Effects that only read B (tip_mass) leave it alone.
+  Matrix6Xd V_T;
   int num_joints{0};
 };
 
@@ -41,6 +48,21 @@ struct EffectContext {
   const Eigen::VectorXd& q;         // [rad]
   const Eigen::Isometry3d& X_BT;    // TCP pose
   const Matrix6Xd& J_BT;            // TCP Jacobian, rows [v; ω]
+};
+
+/// Where along the path from the floor to the tool tip an effect acts.
+/// RobotModel applies effects in ascending stage (stable within a stage), so
+/// that an effect that mounts a body on springs at some point of the robot
+/// sees, in AssembledSystem::V_T, every flexibility between the floor and that
+/// point (base before flange before spindle interface before tool), and a
+/// load at the tool tip (tip_mass) sees all of them.
+enum class EffectStage {
+  kJointSpace = 0,  // terms on the joint coordinates only (damping, gravity)
+  kBase = 1,        // the robot's base on a foundation
+  kFlange = 2,      // the end effector on the flange
+  kSpindle = 3,     // the tool holder in the spindle
+  kTool = 4,        // the tool in the holder
+  kToolTip = 5,     // loads at the tool tip
 };
 
 /// A physical effect added to the base robot model: joint-space terms and/or
@@ -58,6 +80,8 @@ class Effect {
   /// Parameters with unprefixed names ("mass_kg"); the model exposes them
   /// as "<effect>.<name>".
   virtual std::vector<ParameterSpec> parameters() const = 0;
+  /// Where the effect acts; see EffectStage.
+  virtual EffectStage stage() const { return EffectStage::kJointSpace; }
   /// Extra generalised coordinates this effect adds (0 for joint-space terms).
   virtual int num_extra_dofs(std::span<const double> /*values*/) const { return 0; }
   /// Adds the effect's terms to `system`. Extra DOFs occupy indices

@@ -112,9 +112,16 @@ class RobotModel {
   const Eigen::VectorXd& joint_stiffness() const { return joint_stiffness_; }  // [N·m/rad]
   double alpha() const { return alpha_; }  // [s]
   double beta() const { return beta_; }    // [1/s]
+  /// In the order they are applied: by EffectStage, then as in the config
+  /// (so not necessarily description().effects' order).
   const std::vector<BoundEffect>& effects() const { return effects_; }
   /// Position of the spindle nose (gauge line) in the TCP frame [m].
   const Eigen::Vector3d& p_TN() const { return p_TN_; }
+  /// The end-effector bodies as built (m6/d6 rule applied), in the arm's tip
+  /// frame; the chain's "end_effector" segment is their sum.
+  const std::vector<EndEffectorBody>& end_effector_bodies() const { return end_effector_bodies_; }
+  /// Position of the TCP in the arm's tip frame as built (d6 applied) [m].
+  const Eigen::Vector3d& p_tcp() const { return p_tcp_; }
 
  private:
   RobotModel() = default;
@@ -127,6 +134,8 @@ class RobotModel {
   std::vector<BoundEffect> effects_;
   int num_dofs_{0};
   Eigen::Vector3d p_TN_{Eigen::Vector3d::Zero()};
+  std::vector<EndEffectorBody> end_effector_bodies_;
+  Eigen::Vector3d p_tcp_{Eigen::Vector3d::Zero()};
 };
 
 }  // namespace robomach::dynamics

@@ -18,6 +18,9 @@ class TipMassEffect final : public Effect {
   std::vector<ParameterSpec> parameters() const override {
     return {{"mass_kg", "kg", 0.01, 0.0, 5.0, true, "mass at the tool tip"}};
   }
+  // After every flexibility between the floor and the tool tip, so that the
+  // mass moves with all of them (B includes their columns then).
+  EffectStage stage() const override { return EffectStage::kToolTip; }
   void Contribute(const EffectContext&, std::span<const double> values, int,
                   AssembledSystem* sys) const override {
     sys->M += values[0] * sys->B.transpose() * sys->B;
