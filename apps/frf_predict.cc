@@ -208,6 +208,8 @@ int Run(int argc, char** argv) {
       for (size_t p = 0; p < postures.size(); ++p) j["postures"].push_back(report::PostureToJson(ids[p], dyns[p]));
       io::WriteFileAtomically(details_path, report::DumpJson(j));
     }
+    std::string title = "robomach frf-predict: " + robot_path;
+    for (const auto& e : model->effects()) title += " + " + e.effect->name();
     if (!plot_path.empty()) {
       constexpr size_t kMaxSheet = 12;
       std::vector<const io::PosturePrediction*> pp;
@@ -220,12 +222,12 @@ int Run(int argc, char** argv) {
         Warn(kTool, "the sheet shows the first 12 of " + std::to_string(preds.size()) +
                         " postures; use --plot-dir for one picture per posture");
       }
-      PostureFigure(pp, dd, "robomach frf-predict: " + robot_path).SavePng(plot_path);
+      PostureFigure(pp, dd, title).SavePng(plot_path);
     }
     if (!plot_dir.empty()) {
       io::EnsureDirectory(plot_dir);
       for (size_t p = 0; p < preds.size(); ++p) {
-        PostureFigure({&preds[p]}, {&dyns[p]}, "robomach frf-predict: " + robot_path)
+        PostureFigure({&preds[p]}, {&dyns[p]}, title)
             .SavePng((std::filesystem::path(plot_dir) / (preds[p].pose_id + ".png")).string());
       }
     }
