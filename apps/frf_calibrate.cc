@@ -164,16 +164,7 @@ int Run(int argc, char** argv) {
     opt.modal_fit.fmax_hz = opt.fmax_hz;
 
     io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
-    for (const std::string& name : adds) cfg.description.effects.push_back({name, {}});
-    if (!adds.empty()) {
-      const dynamics::ParameterSet old = cfg.parameters;
-      cfg.parameters = dynamics::DefaultParameters(cfg.description);
-      for (const auto& s : old.specs()) cfg.parameters.Set(s.name, old.Get(s.name));
-    }
-    for (const std::string& s : sets) {
-      const auto [name, value] = ParseAssignment("--set", s);
-      cfg.parameters.Set(name, value);
-    }
+    ApplyAddsAndSets(adds, sets, &cfg);
     for (const std::string& name : opt.free_parameters) {
       if (!cfg.parameters.Has(name)) {
         throw std::invalid_argument("--free " + name + ": unknown parameter; known: " + cfg.parameters.NameList());

@@ -121,18 +121,7 @@ int Run(int argc, char** argv) {
     }
 
     io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
-    for (const std::string& name : adds) {
-      cfg.description.effects.push_back({name, {}});
-    }
-    if (!adds.empty()) {
-      const dynamics::ParameterSet old = cfg.parameters;
-      cfg.parameters = dynamics::DefaultParameters(cfg.description);
-      for (const auto& s : old.specs()) cfg.parameters.Set(s.name, old.Get(s.name));
-    }
-    for (const std::string& s : sets) {
-      const auto [name, value] = ParseAssignment("--set", s);
-      cfg.parameters.Set(name, value);
-    }
+    ApplyAddsAndSets(adds, sets, &cfg);
     if (verbose) {
       for (const auto& s : cfg.parameters.specs()) {
         std::cerr << kTool << ": parameter " << s.name << " = " << cfg.parameters.Get(s.name) << " "

@@ -60,16 +60,7 @@ int Run(int argc, char** argv) {
       o.directions.emplace_back(static_cast<Axis>(r), static_cast<Axis>(e));
     }
     io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
-    for (const std::string& name : adds) cfg.description.effects.push_back({name, {}});
-    if (!adds.empty()) {
-      const dynamics::ParameterSet old = cfg.parameters;
-      cfg.parameters = dynamics::DefaultParameters(cfg.description);
-      for (const auto& s : old.specs()) cfg.parameters.Set(s.name, old.Get(s.name));
-    }
-    for (const std::string& s : sets) {
-      const auto [name, value] = ParseAssignment("--set", s);
-      cfg.parameters.Set(name, value);
-    }
+    ApplyAddsAndSets(adds, sets, &cfg);
     if (std::isfinite(fs_hz)) {
       o.sample_rate_hz = fs_hz;
     } else if (auto it = cfg.description.extra_values.find("hammer_test.sample_rate_hz");

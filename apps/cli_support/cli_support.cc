@@ -116,4 +116,18 @@ std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std
   return Eigen::Vector3d(v[0] * 1e-3, v[1] * 1e-3, v[2] * 1e-3);
 }
 
+void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<std::string>& sets,
+                      io::RobotConfig* cfg) {
+  for (const std::string& name : adds) cfg->description.effects.push_back({name, {}});
+  if (!adds.empty()) {
+    const dynamics::ParameterSet old = cfg->parameters;
+    cfg->parameters = dynamics::DefaultParameters(cfg->description);
+    for (const auto& s : old.specs()) cfg->parameters.Set(s.name, old.Get(s.name));
+  }
+  for (const std::string& s : sets) {
+    const auto [name, value] = ParseAssignment("--set", s);
+    cfg->parameters.Set(name, value);
+  }
+}
+
 }  // namespace robomach::apps

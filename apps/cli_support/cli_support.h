@@ -9,6 +9,8 @@
 #include <optional>
 
 #include <Eigen/Core>
+
+#include "robomach/io/robot_config.h"
 #include <iostream>
 #include <string>
 #include <vector>
@@ -68,5 +70,12 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
 std::vector<double> ParseNumberList(const std::string& option, const std::string& text);
 /// "x,y,z" in millimetres -> metres, or nullopt for "tcp" (or empty).
 std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std::string& text);
+
+/// Applies `--add EFFECT` (with its default parameters; values already set
+/// are kept) and then `--set NAME=VALUE` to a loaded robot config.
+/// @throws std::invalid_argument for an unknown effect or parameter, or a
+///   value outside its bounds.
+void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<std::string>& sets,
+                      io::RobotConfig* config);
 
 }  // namespace robomach::apps
