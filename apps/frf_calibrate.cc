@@ -149,6 +149,14 @@ int Run(int argc, char** argv) {
   return RunGuarded(kTool, [&]() -> int {
     RequireReadableFile(robot_path, "robot config");
     RequireReadableFile(postures_path, "posture file");
+    CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
+    {
+      std::vector<std::pair<std::string, std::string>> inputs = {{"--robot", robot_path},
+                                                                 {"--postures", postures_path}};
+      for (const auto& f : measured_files) inputs.emplace_back("--measured", f);
+      for (const auto& f : validate_files) inputs.emplace_back("--validate", f);
+      CheckDistinctPaths(inputs, {{"--out", out_path}});
+    }
     if (measured_files.empty() && pose_files.empty()) {
       throw std::invalid_argument("no measured FRFs: give --measured FILE or --pose ID=file.uff");
     }

@@ -53,8 +53,10 @@ int Run(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   return RunGuarded(kTool, [&]() -> int {
+    CheckOptionRange("--block-samples", static_cast<double>(o.block_samples), 2, 1 << 22);
     RequireReadableFile(robot_path, "robot config");
     RequireReadableFile(postures_path, "posture file");
+    CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}}, {{"--out", out_path}});
     o.directions.clear();
     for (const auto& [r, e] : io::ParseDirectionPairs(directions)) {
       o.directions.emplace_back(static_cast<Axis>(r), static_cast<Axis>(e));

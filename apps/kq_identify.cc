@@ -273,8 +273,14 @@ int Run(int argc, char** argv) {
   if (app.count("--robust") > 0 && robust.empty()) robust = "cauchy";
 
   return RunGuarded(kTool, [&]() -> int {
-    if (!(noise_mm > 0.0)) throw std::invalid_argument("--noise-mm: expected a noise > 0 mm");
+    if (!(noise_mm > 0.0) || !std::isfinite(noise_mm)) {
+      throw std::invalid_argument("--noise-mm: expected a finite noise > 0 mm");
+    }
+    CheckOptionRange("--plan", plan_n, 0, 500);  // 500 postures: ~15 s of planning
     RequireReadableFile(robot_path, "robot config");
+    CheckDistinctPaths({{"--robot", robot_path}, {"--tracker", tracker_path}},
+                       {{"--out", out_path}, {"--residuals", residuals_path}, {"--plot", plot_path},
+                        {"--json", json_path}});
     const io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
     if (plan_n != 0) {
       if (plan_n < 1) throw std::invalid_argument("--plan: expected a number of postures >= 1");

@@ -117,7 +117,18 @@ int Run(int argc, char** argv) {
     if (sd_steps < 2 || sd_speeds < 1 || sd_modes < 1 || !(sd_max_depth_mm > 0.0) || speeds < 0 || max_lobe < 0) {
       throw std::invalid_argument("expected --sd-steps >= 2, --sd-speeds >= 1, --sd-modes >= 1, --sd-max-depth-mm > 0");
     }
+    // Bounds that keep a typo from hours of work or an allocation failure.
+    CheckOptionRange("--speeds", speeds, 0, 100000);
+    CheckOptionRange("--sd-speeds", sd_speeds, 1, 10000);
+    CheckOptionRange("--sd-steps", sd_steps, 2, 1000);
+    CheckOptionRange("--sd-modes", sd_modes, 1, 200);
+    CheckOptionRange("--sd-max-depth-mm", sd_max_depth_mm, 1e-6, 1e4);
+    CheckOptionRange("--threads", threads, 0, 256);
+    CheckOptionRange("--max-lobe", max_lobe, 0, 1000);
     RequireReadableFile(cut_path, "cut file");
+    CheckDistinctPaths({{"--cut", cut_path}, {"--robot", robot_path}, {"--postures", postures_path},
+                        {"--frf", frf_path}, {"--modal-table", modal_path}},
+                       {{"--out", out_path}, {"--plot", plot_path}});
     for (const auto& [p, what] : {std::pair{robot_path, "robot config"}, {postures_path, "posture file"},
                                   {frf_path, "FRF file"}, {modal_path, "modal table"}}) {
       if (!p.empty()) RequireReadableFile(p, what);

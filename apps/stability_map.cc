@@ -62,9 +62,14 @@ int Run(int argc, char** argv) {
     if (!(max_depth_mm > 0.0) || speeds < 0 || rotation_evals < 8) {
       throw std::invalid_argument("expected --max-depth-mm > 0, --speeds >= 0, --rotation-evals >= 8");
     }
+    // Bounds that keep a typo from spawning 1e5 threads or hours of work.
+    CheckOptionRange("--threads", threads, 0, 256);
+    CheckOptionRange("--speeds", speeds, 0, 100000);
     RequireReadableFile(robot_path, "robot config");
     RequireReadableFile(cut_path, "cut file");
     RequireReadableFile(region_path, "region file");
+    CheckDistinctPaths({{"--robot", robot_path}, {"--cut", cut_path}, {"--region", region_path}, {"--path", path_path}},
+                       {{"--out", out_path}, {"--plot", plot_path}});
     if (!path_path.empty()) RequireReadableFile(path_path, "tool-path file");
     const auto model = io::LoadRobotConfig(robot_path).Build();
     const io::CutSpec cut = io::ReadCutFile(cut_path);

@@ -69,8 +69,12 @@ int Run(int argc, char** argv) {
     if (!(noise_mm >= 0.0)) throw std::invalid_argument("--noise-mm: expected a noise >= 0 mm");
     if (outliers < 0) throw std::invalid_argument("--outliers: expected a count >= 0");
     if (num_postures < 1) throw std::invalid_argument("--num-postures: expected at least 1");
+    CheckOptionRange("--noise-mm", noise_mm, 0.0, 1e3);
+    CheckOptionRange("--outlier-mm", outlier_mm, 0.0, 1e4);
     RequireReadableFile(robot_path, "robot config");
     if (!postures_path.empty()) RequireReadableFile(postures_path, "posture file");
+    CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}, {"--plan-file", plan_path}},
+                       {{"--out", out_path}});
     if (!plan_path.empty()) RequireReadableFile(plan_path, "plan file");
     if (!plan_path.empty() && !postures_path.empty()) {
       throw std::invalid_argument("--plan-file and --postures exclude each other");
@@ -84,6 +88,9 @@ int Run(int argc, char** argv) {
 
     identification::CampaignOptions o;
     o.masses_kg = ParseNumberList("--masses-kg", masses);
+    // Load tests hang tens of kilograms; beyond a tonne the linear model and
+    // the static equilibrium of the simulation are meaningless.
+    for (double m : o.masses_kg) CheckOptionRange("--masses-kg", m, 1e-3, 1e3);
     for (double m : o.masses_kg) {
       if (!(m > 0.0)) throw std::invalid_argument("--masses-kg: expected masses > 0 kg");
     }
@@ -95,6 +102,9 @@ int Run(int argc, char** argv) {
     }
     o.p_load_tip = ParsePointMm("--load-point-mm", load_point);
     o.p_target_tip = ParsePointMm("--target-mm", target);
+    for (const auto& [opt, p] : {std::pair{"--load-point-mm", o.p_load_tip}, {"--target-mm", o.p_target_tip}}) {
+      if (p && p->norm() > 2.0) throw std::invalid_argument(std::string(opt) + ": expected a point within 2000 mm of the flange");
+    }
     o.tracker_noise = MmToM(noise_mm);
     o.seed = seed;
     o.num_outliers = outliers;

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "robomach/common/errors.h"
@@ -19,7 +20,15 @@ std::string ExitCodeHelp() {
 
 int RunGuarded(const std::string& tool, const std::function<int()>& body) {
   try {
-    return body();
+    const int rc = body();
+    // Results on stdout count as output: a full disk or closed pipe is an
+    // error, not a silent success.
+    std::cout.flush();
+    if (!std::cout) {
+      std::cerr << tool << ": cannot write the results to standard output\n";
+      return kExitCantCreate;
+    }
+    return rc;
   } catch (const NoInputError& e) {
     std::cerr << tool << ": " << e.what() << '\n';
     return kExitNoInput;
@@ -84,6 +93,39 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
     throw std::invalid_argument(option + " " + text + ": expected NAME=VALUE with a number, e.g. m6_kg=30");
   }
   return {text.substr(0, eq), v};
+}
+
+void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& inputs,
+                        const std::vector<std::pair<std::string, std::string>>& outputs) {
+  namespace fs = std::filesystem;
+  auto key = [](const std::string& p) {
+    std::error_code ec;
+    const fs::path c = fs::weakly_canonical(fs::path(p), ec);
+    return ec ? fs::absolute(p).lexically_normal().string() : c.string();
+  };
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const auto& [opt, path] = outputs[i];
+    if (path.empty() || path == "-") continue;
+    for (const auto& [in_opt, in_path] : inputs) {
+      if (!in_path.empty() && key(in_path) == key(path)) {
+        throw std::invalid_argument(opt + " " + path + " is also the input of " + in_opt +
+                                    "; writing it would destroy the input");
+      }
+    }
+    for (size_t j = 0; j < i; ++j) {
+      if (!outputs[j].second.empty() && key(outputs[j].second) == key(path)) {
+        throw std::invalid_argument(opt + " and " + outputs[j].first + " name the same file " + path);
+      }
+    }
+  }
+}
+
+void CheckOptionRange(const std::string& option, double value, double lo, double hi) {
+  if (!(value >= lo && value <= hi)) {
+    std::ostringstream s;
+    s << option << ": expected a value in [" << lo << ", " << hi << "], got " << value;
+    throw std::invalid_argument(s.str());
+  }
 }
 
 std::vector<double> ParseNumberList(const std::string& option, const std::string& text) {

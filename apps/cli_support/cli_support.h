@@ -66,6 +66,15 @@ void Warn(const std::string& tool, const std::string& message);
 /// Splits "NAME=VALUE"; @throws std::invalid_argument naming the option.
 std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text);
 
+/// Refuses an output path that is also an input or another output (a user
+/// typo that would silently destroy data). Empty paths are ignored; "-"
+/// means stdout. @throws std::invalid_argument naming both options.
+void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& inputs,
+                        const std::vector<std::pair<std::string, std::string>>& outputs);
+
+/// @throws std::invalid_argument unless lo <= value <= hi (and finite).
+void CheckOptionRange(const std::string& option, double value, double lo, double hi);
+
 /// "1,2.5,3" -> numbers; @throws std::invalid_argument naming the option.
 std::vector<double> ParseNumberList(const std::string& option, const std::string& text);
 /// "x,y,z" in millimetres -> metres, or nullopt for "tcp" (or empty).

@@ -50,6 +50,11 @@ std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints) {
   for (int r = 0; r < t.num_rows(); ++r) {
     Posture p;
     p.id = t.Text(r, "pose_id");
+    // formats.md §1: any non-empty text without commas (it is written back
+    // unquoted in FRF and modal tables); 256 characters is plenty for a name.
+    if (p.id.find(',') != std::string::npos || p.id.size() > 256) {
+      throw t.ErrorAt(r, "pose_id", "expected a name without commas of at most 256 characters");
+    }
     p.line = t.line(r);
     auto [it, fresh] = seen.emplace(p.id, p.line);
     if (!fresh) {

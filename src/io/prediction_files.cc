@@ -1,5 +1,6 @@
 #include "robomach/io/prediction_files.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "robomach/io/atomic_file.h"
@@ -34,7 +35,11 @@ DirectionPairs ParseDirectionPairs(const std::string& text) {
       throw std::invalid_argument("direction pair '" + item +
                                   "': expected two of x, y, z such as xx or xy");
     }
-    out.emplace_back(axis(item[0]), axis(item[1]));
+    const std::pair<int, int> pair(axis(item[0]), axis(item[1]));
+    if (std::find(out.begin(), out.end(), pair) != out.end()) {
+      throw std::invalid_argument("direction pair '" + item + "' is given twice");
+    }
+    out.push_back(pair);
     pos = comma + 1;
   }
   return out;

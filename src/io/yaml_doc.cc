@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "robomach/io/csv_table.h"
 
@@ -22,9 +23,37 @@ YamlDoc YamlDoc::LoadFile(const std::string& path) {
   return LoadString(text, path);
 }
 
+namespace {
+
+// yaml-cpp keeps the first of two equal keys in a map and drops the other
+// without a word; a config edited by hand must not change meaning that way.
+void RejectDuplicateKeys(const YAML::Node& node, const std::string& path) {
+  if (node.IsMap()) {
+    std::map<std::string, YAML::Mark> seen;
+    for (const auto& kv : node) {
+      if (kv.first.IsScalar()) {
+        const std::string key = kv.first.Scalar();
+        const auto [it, fresh] = seen.emplace(key, kv.first.Mark());
+        if (!fresh) {
+          const YAML::Mark m = kv.first.Mark();
+          throw InputError({path, m.line + 1, m.column + 1},
+                           "key '" + key + "' appears twice (first on line " +
+                               std::to_string(it->second.line + 1) + ")");
+        }
+      }
+      RejectDuplicateKeys(kv.second, path);
+    }
+  } else if (node.IsSequence()) {
+    for (const auto& item : node) RejectDuplicateKeys(item, path);
+  }
+}
+
+}  // namespace
+
 YamlDoc YamlDoc::LoadString(const std::string& text, const std::string& path) {
   try {
     YAML::Node root = YAML::Load(text);
+    RejectDuplicateKeys(root, path);
     return YamlDoc(root, std::make_shared<const std::string>(path), "");
   } catch (const YAML::Exception& e) {
     throw InputError({path, e.mark.line + 1, e.mark.column + 1},

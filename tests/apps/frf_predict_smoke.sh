@@ -56,4 +56,19 @@ expect_in "$work/stderr" "posture L: joint 2 at 0 deg is outside its limits [-14
 expect_file "$work/flag_out.csv"
 if grep -qiE "nan|inf" "$work/flag_out.csv"; then echo "FAIL: non-finite FRF"; fails=$((fails+1)); fi
 expect_in "$work/flag.json" "\"cartesian\": null"
+
+# An output on an input's path is refused, and the input survives.
+cp config/postures_demo.csv "$work/same.csv"
+expect_exit 64 "$tool" --robot config/kr210.yaml --postures "$work/same.csv" --out "$work/same.csv"
+expect_in "$work/stderr" "is also the input of --postures"
+cmp -s config/postures_demo.csv "$work/same.csv" || { echo "FAIL: input changed"; fails=$((fails+1)); }
+expect_exit 64 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --out "$work/o.csv" --modes "$work/o.csv"
+# A full disk on stdout is an error (exit 73), not a silent success.
+if [ -w /dev/full ]; then
+  "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --directions xx > /dev/full 2>"$work/stderr"
+  rc=$?; [ "$rc" -eq 73 ] || { echo "FAIL: /dev/full gave exit $rc"; fails=$((fails+1)); }
+fi
+# Duplicated direction pairs and absurd grids are usage errors.
+expect_exit 64 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --directions xx,xx
+expect_exit 64 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --df-hz 1e-17
 finish

@@ -50,3 +50,16 @@ TEST(PostureFile, BadInputGetsLocatedMessages) {
 
 }  // namespace
 }  // namespace robomach::io
+
+namespace robomach::io {
+namespace {
+
+TEST(PostureFile, PoseIdsWithCommasAreRejected) {
+  const std::string dir = robomach::testing::TempDir("posture_comma");
+  const std::string path = robomach::testing::WriteText(dir + "/p.csv", "pose_id,q1_deg\n\"P,1\",0\n");
+  EXPECT_THAT(robomach::testing::CaptureError([&] { ReadPostureFile(path, 1); }),
+              ::testing::HasSubstr("p.csv:2: column pose_id: expected a name without commas"));
+}
+
+}  // namespace
+}  // namespace robomach::io

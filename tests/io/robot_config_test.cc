@@ -88,3 +88,16 @@ TEST(RobotConfig, ParametersAndEffectsRoundTripThroughYaml) {
 
 }  // namespace
 }  // namespace robomach::io
+
+namespace robomach::io {
+namespace {
+
+// yaml-cpp silently keeps the first of two equal keys; we refuse the file.
+TEST(RobotConfig, DuplicateKeysAreRejectedWithBothLines) {
+  const std::string p = Variant("dupkey", "damping:\n", "damping:\n  alpha_s: 2.0e-4\n");
+  EXPECT_THAT(CaptureError([&] { LoadRobotConfig(p); }),
+              HasSubstr("robot.yaml:31:3: key 'alpha_s' appears twice (first on line 30)"));
+}
+
+}  // namespace
+}  // namespace robomach::io
