@@ -3,6 +3,8 @@
 // file, on a hammer-test grid, with seeded noise, as CSV or UFF58.
 #include <CLI/CLI.hpp>
 
+#include <cctype>
+
 #include <cmath>
 #include <sstream>
 
@@ -78,6 +80,7 @@ int Run(int argc, char** argv) {
     const dynamics::FrfSet frfs = calibration::SynthesizeHammerTest(model, postures, o);
     const io::FrfQuantity q = io::ParseQuantity(quantity);
     std::string ext = out_path.substr(out_path.find_last_of('.') + 1);
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (ext == "uff" || ext == "unv" || ext == "uf") {
       io::WriteUff58(out_path, frfs, q);
     } else {

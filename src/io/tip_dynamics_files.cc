@@ -54,8 +54,18 @@ std::vector<ModalTableEntry> ReadModalTable(const std::string& path) {
   }
   std::map<std::string, std::vector<int>> rows;
   std::vector<std::string> order;
+  std::map<std::pair<std::string, std::string>, int> seen;  // (pose, mode) -> line
   for (int r = 0; r < t.num_rows(); ++r) {
     const std::string pose = t.Text(r, "pose_id");
+    if (t.HasColumn("mode")) {
+      // The same mode twice would be superposed twice: a silent error.
+      const std::string mode = t.Text(r, "mode");
+      const auto [it, fresh] = seen.emplace(std::pair{pose, mode}, t.line(r));
+      if (!fresh) {
+        throw t.ErrorAt(r, "mode", "mode " + mode + " of posture " + pose +
+                                       " appears twice (first on line " + std::to_string(it->second) + ")");
+      }
+    }
     if (!rows.count(pose)) order.push_back(pose);
     rows[pose].push_back(r);
   }
