@@ -4,6 +4,7 @@
 // a hidden effect raise no alarm.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 
 #include "robomach/audit/model_audit.h"
@@ -59,6 +60,10 @@ dynamics::FrfSet Synthesize(const Campaign& c, const dynamics::RobotDescription&
   return calibration::SynthesizeHammerTest(dynamics::RobotModel::Build(d, p), c.poses, o);
 }
 
+double Seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 // The noise floor and the error of the true model against the independent
 // reference: the noise the synthesis put in. H(1 + σ n), n complex standard
 // normal, gives ln|H| an error Re(σ n) + O(σ²) of standard deviation σ/√2
@@ -82,6 +87,53 @@ TEST(ModelAudit, NoiseFloorAndTrueModelErrorMatchTheSynthesisNoise) {
   }
   // BIC by hand: n ln(RSS/n) + k ln n.
   EXPECT_DOUBLE_EQ(Bic(2.0, 4, 1), 4 * std::log(0.5) + std::log(4.0));
+}
+
+void ExpectHiddenEffectFound(const std::string& hidden, const std::map<std::string, double>& values, unsigned seed) {
+  const Campaign c = MakeCampaign();
+  const auto [d, p] = Truth(c, hidden, values);
+  const dynamics::FrfSet measured = Synthesize(c, d, p, seed);
+  const auto t0 = std::chrono::steady_clock::now();
+  // Run time: the full library (7 candidates) takes ~4 min on 2 cores, far
+  // beyond the test budget: spindle_interface, tool_flexibility,
+  // base_compliance and joint_damping take 0.5-2 min each (many extra DOFs,
+  // complex modes). This test ranks the hidden effect against the cheap
+  // one-parameter effects only; the full ranking is still to be tested
+  // (README, model-audit status). Fit stride 2 (the default): stride 4 was
+  // tried and leaves the flange fit at twice the true model's error, since
+  // 1 Hz lines undersample the 10.5 Hz mode's 0.84 Hz half-power band.
+  AuditOptions o;
+  o.candidates = {"flange_compliance", "gravity_stiffness", "tip_mass"};
+  o.progress = [](const std::string& m) { std::cout << m << std::endl; };
+  const AuditResult r = RunAudit(c.cfg.description, c.cfg.parameters, c.postures, measured, o);
+  const double seconds = Seconds(t0);
+  const double true_error =
+      ComputeErrors(dynamics::RobotModel::Build(d, p), c.postures, measured, 0.0, 1e9, 8).total_rms_log_mag;
+  // (i) significant failure: beyond 1.3 × noise floor (see AuditOptions).
+  EXPECT_TRUE(r.significant_failure) << hidden << ": error " << r.errors_before.total_rms_log_mag << ", floor "
+                                     << r.noise_floor;
+  // (ii) ranked first, with a lower BIC than the current model.
+  ASSERT_FALSE(r.candidates.empty());
+  EXPECT_EQ(r.candidates[0].name(), hidden);
+  EXPECT_LT(r.candidates[0].bic_change, 0.0);
+  EXPECT_EQ(r.missing_effects, std::vector<std::string>{hidden}) << r.verdict;
+  EXPECT_TRUE(r.explained) << r.verdict;
+  // (iii) the error after adding it is within 1.5 × that of the true model
+  // on the same noisy data (issue #5's bound).
+  EXPECT_LT(r.candidates[0].errors.total_rms_log_mag, 1.5 * true_error);
+  std::cout << hidden << ": error before " << r.errors_before.total_rms_log_mag << ", after "
+            << r.candidates[0].errors.total_rms_log_mag << ", true model " << true_error << ", floor "
+            << r.noise_floor << "; " << r.candidates.size() << " candidates in " << seconds << " s\n";
+  for (const CandidateResult& cand : r.candidates) {
+    std::cout << "  " << cand.name() << " dBIC " << cand.bic_change << " error " << cand.errors.total_rms_log_mag
+              << (cand.plausible ? "" : " implausible: " + cand.note) << "\n";
+  }
+}
+
+TEST(ModelAudit, HiddenFlangeComplianceIsFlaggedRankedFirstAndExplainsTheError) {
+  // Bending stiffness at half the library default (2e6 → 1e6 N·m/rad): a
+  // soft quick-change flange; it lowers the end-effector modes visibly.
+  ExpectHiddenEffectFound("flange_compliance", {{"flange_compliance.bending_stiffness_Nm_per_rad", 1e6}}, 41);
 }
 
 TEST(ModelAudit, NoHiddenEffectRaisesNoFalseAlarm) {
