@@ -90,7 +90,7 @@ int Run(int argc, char** argv) {
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
   app.add_option("--measured", measured_files, "measured FRFs, CSV or UFF58; repeatable")->required();
   app.add_option("--report", report_dir, "report folder (created)")->required();
-  app.add_option("--add", adds, "switch on an effect before the audit (e.g. the winner of a previous one); repeatable");
+  app.add_option("--add", adds, "switch on an effect before the audit (e.g. the winner of a previous one); its fittable parameters are calibrated too; repeatable");
   app.add_option("--compare", compare_dir, "a previous audit's report folder: its errors are shown next to these");
   app.add_option("--candidates", candidates_list, "comma-separated effects to try; default: every library effect not in the model");
   app.add_option("--fmin-hz", opt.fmin_hz, "lowest frequency used [Hz]")->capture_default_str();
@@ -115,6 +115,11 @@ int Run(int argc, char** argv) {
     io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
     for (const std::string& name : adds) {
       std::tie(cfg.description, cfg.parameters) = audit::WithEffect(cfg.description, cfg.parameters, name);
+      // An effect switched on here starts at its defaults, so its fittable
+      // parameters are calibrated with the others.
+      for (const auto& spec : cfg.parameters.specs()) {
+        if (spec.fittable && spec.name.rfind(name + ".", 0) == 0) opt.calibration_parameters.push_back(spec.name);
+      }
     }
     calibration::PostureMap postures;
     for (const io::Posture& p : io::ReadPostureFile(postures_path, cfg.description.arm.num_joints())) {

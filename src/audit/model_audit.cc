@@ -258,7 +258,22 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   say("modal fit of " + std::to_string(measured.size()) + " measured FRFs");
   const calibration::MeasuredFeatures features = calibration::ExtractFeatures(measured, base_opt.modal_fit);
   say("calibrating the current model (whole curve)");
-  r.baseline_fit = calibration::Calibrate(description, parameters, postures, measured, features, base_opt);
+  // Effect parameters among the calibration parameters (an effect switched
+  // on with defaults) are fitted in a second step from the calibrated core,
+  // as the candidates are: in one step from the defaults the whole-curve fit
+  // was seen to stop at twice the noise floor (iteration limit), which a
+  // candidate effect then "explained".
+  std::vector<std::string> core;
+  for (const auto& n : o.calibration_parameters) {
+    if (n.find('.') == std::string::npos) core.push_back(n);
+  }
+  if (!core.empty() && core.size() < o.calibration_parameters.size()) {
+    const calibration::CalibrationResult first =
+        calibration::Calibrate(description, parameters, postures, measured, features, FitOptions(o, core));
+    r.baseline_fit = calibration::Calibrate(description, first.parameters, postures, measured, features, base_opt);
+  } else {
+    r.baseline_fit = calibration::Calibrate(description, parameters, postures, measured, features, base_opt);
+  }
   const auto base_model = dynamics::RobotModel::Build(description, r.baseline_fit.parameters);
   r.errors_before = ComputeErrors(base_model, postures, measured, o.fmin_hz, o.fmax_hz, o.num_bands);
   r.modes_before = calibration::CompareWithMeasurement(base_model, postures, measured, features, base_opt.matching,
