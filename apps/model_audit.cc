@@ -1,0 +1,315 @@
+// model-audit: compares a calibrated model with measured tool-tip FRFs,
+// shows where it fails, ranks the library effects that could explain the
+// failure and writes the YAML lines that add the best one (issue #5).
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cli_support.h"
+#include "robomach/audit/model_audit.h"
+#include "robomach/common/errors.h"
+#include "robomach/dynamics/tool_tip_frf.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/frf_files.h"
+#include "robomach/io/posture_file.h"
+#include "robomach/io/robot_config.h"
+#include "robomach/report/calibration_report.h"
+#include "robomach/report/posture_json.h"
+
+namespace robomach::apps {
+namespace {
+
+constexpr char kTool[] = "model-audit";
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string KeyLabel(const dynamics::FrfKey& k) {
+  return k.pose_id + " " + AxisName(k.response) + AxisName(k.excitation);
+}
+
+// rms log-magnitude error per posture, over all lines of its FRFs.
+std::map<std::string, double> PerPosture(const audit::ModelErrors& e) {
+  std::map<std::string, std::pair<double, int>> acc;
+  for (const auto& c : e.curves) {
+    acc[c.key.pose_id].first += c.rms_log_mag * c.rms_log_mag * c.lines;
+    acc[c.key.pose_id].second += c.lines;
+  }
+  std::map<std::string, double> out;
+  for (const auto& [id, a] : acc) out[id] = a.second > 0 ? std::sqrt(a.first / a.second) : NAN;
+  return out;
+}
+
+std::string Html(const std::string& s) {
+  std::string o;
+  for (char ch : s) {
+    if (ch == '<') o += "&lt;";
+    else if (ch == '>') o += "&gt;";
+    else if (ch == '&') o += "&amp;";
+    else o += ch;
+  }
+  return o;
+}
+
+std::string Num(double v, int precision = 4) {
+  std::ostringstream s;
+  s.precision(precision);
+  s << v;
+  return s.str();
+}
+
+json ReadPreviousSummary(const std::string& dir) {
+  const std::string path = (fs::path(dir) / "summary.json").string();
+  RequireReadableFile(path, "--compare summary");
+  std::ifstream in(path);
+  try {
+    json j = json::parse(in);
+    if (!j.contains("error_before") || !j.contains("postures")) {
+      throw InputError({path, 1, 0}, "not a model-audit summary (no error_before/postures keys)");
+    }
+    return j;
+  } catch (const json::parse_error& e) {
+    throw InputError({path, 0, 0}, std::string("invalid JSON: ") + e.what());
+  }
+}
+
+int Run(int argc, char** argv) {
+  CLI::App app{
+      "model-audit: where a robot model fails against measured tool-tip FRFs, and which physical effect\n"
+      "of the library is missing. Calibrates the model (whole curve), reports the rms log-magnitude error\n"
+      "per posture and direction with its worst bands, the per-mode errors and a noise-floor estimate; if\n"
+      "the failure is significant, adds each library effect not in the model, fits it with the calibration\n"
+      "parameters and ranks the candidates by BIC (greedily a second one). Writes REPORT/summary.json,\n"
+      "index.html, errors.csv, candidates.csv, effects.yaml and overlay_<pose>.png."};
+  app.footer(ExitCodeHelp() + " Exit 3 when the failure is significant and no candidate explains it.");
+  std::string robot_path, postures_path, report_dir, compare_dir, candidates_list;
+  std::vector<std::string> measured_files, adds;
+  audit::AuditOptions opt;
+  app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
+  app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
+  app.add_option("--measured", measured_files, "measured FRFs, CSV or UFF58; repeatable")->required();
+  app.add_option("--report", report_dir, "report folder (created)")->required();
+  app.add_option("--add", adds, "switch on an effect before the audit (e.g. the winner of a previous one); its fittable parameters are calibrated too; repeatable");
+  app.add_option("--compare", compare_dir, "a previous audit's report folder: its errors are shown next to these");
+  app.add_option("--candidates", candidates_list, "comma-separated effects to try; default: every library effect not in the model");
+  app.add_option("--fmin-hz", opt.fmin_hz, "lowest frequency used [Hz]")->capture_default_str();
+  app.add_option("--fmax-hz", opt.fmax_hz, "highest frequency used [Hz]; default: all lines");
+  app.add_option("--max-iterations", opt.max_iterations, "solver iterations per fit")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  return RunGuarded(kTool, [&]() -> int {
+    RequireReadableFile(robot_path, "robot config");
+    RequireReadableFile(postures_path, "posture file");
+    std::stringstream cl(candidates_list);
+    for (std::string n; std::getline(cl, n, ',');) {
+      if (!n.empty()) opt.candidates.push_back(n);
+    }
+    opt.progress = [](const std::string& s) { std::cerr << kTool << ": " << s << '\n'; };
+    json previous;
+    if (!compare_dir.empty()) previous = ReadPreviousSummary(compare_dir);
+
+    io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
+    for (const std::string& name : adds) {
+      std::tie(cfg.description, cfg.parameters) = audit::WithEffect(cfg.description, cfg.parameters, name);
+      // An effect switched on here starts at its defaults, so its fittable
+      // parameters are calibrated with the others.
+      for (const auto& spec : cfg.parameters.specs()) {
+        if (spec.fittable && spec.name.rfind(name + ".", 0) == 0) opt.calibration_parameters.push_back(spec.name);
+      }
+    }
+    calibration::PostureMap postures;
+    for (const io::Posture& p : io::ReadPostureFile(postures_path, cfg.description.arm.num_joints())) {
+      postures[p.id] = p.q;
+    }
+    dynamics::FrfSet measured;
+    for (const std::string& f : measured_files) {
+      RequireReadableFile(f, "measured FRF file");
+      const io::FrfReadResult r = io::ReadFrfFile(f, "");
+      for (const std::string& w : r.warnings) Warn(kTool, w);
+      for (const auto& [key, frf] : r.frfs) {
+        if (measured.contains(key)) throw InputError({f, 0, 0}, "FRF " + key.ToString() + " was already read");
+        if (!postures.count(key.pose_id)) {
+          throw InputError({postures_path, 0, 0}, "posture " + key.pose_id + " of " + f + " is not in this posture file");
+        }
+        measured.Insert(key, frf);
+      }
+    }
+    if (measured.empty()) throw std::invalid_argument("no measured FRFs were read");
+
+    const audit::AuditResult r = audit::RunAudit(cfg.description, cfg.parameters, postures, measured, opt);
+    const audit::CandidateResult* best = r.best >= 0 ? &r.candidates[r.best] : nullptr;
+    const audit::ModelErrors& after = best ? best->errors : r.errors_before;
+
+    // ---- summary.json (stable keys; see README)
+    json j;
+    j["robot"] = robot_path;
+    j["effects_in_model"] = json::array();
+    for (const auto& e : cfg.description.effects) j["effects_in_model"].push_back(e.name);
+    j["error_before"] = r.errors_before.total_rms_log_mag;
+    j["error_after"] = after.total_rms_log_mag;
+    j["noise_floor"] = r.noise_floor;
+    j["significant_failure"] = r.significant_failure;
+    j["baseline_calibration"] = {{"status", calibration::FitStatusName(r.baseline_fit.status)},
+                                 {"message", r.baseline_fit.message}};
+    const auto pb = PerPosture(r.errors_before), pa = PerPosture(after);
+    for (const auto& [id, e] : pb) j["postures"][id] = {{"error_before", e}, {"error_after", pa.at(id)}};
+    j["candidates"] = json::array();
+    for (const auto& c : r.candidates) {
+      json cj{{"name", c.name()}, {"bic_change", c.bic_change}, {"error_after", c.errors.total_rms_log_mag},
+              {"plausible", c.plausible}, {"note", c.note}, {"parameters", json::object()}};
+      for (const auto& e : c.fit.estimates) cj["parameters"][e.name] = {{"value", e.value}, {"std", e.std_dev}};
+      j["candidates"].push_back(cj);
+    }
+    j["verdict"] = {{"missing_effects", r.missing_effects}, {"explained", r.explained}, {"text", r.verdict}};
+    const std::string yaml = best ? audit::EffectYaml(*best) : "";
+    j["yaml"] = yaml;
+
+    // ---- errors.csv, candidates.csv
+    std::ostringstream ecsv;
+    ecsv << "pose_id,response,excitation,lines,error_before,error_after,worst_band_fmin_hz,worst_band_fmax_hz,"
+            "worst_band_error\n";
+    for (size_t i = 0; i < r.errors_before.curves.size(); ++i) {
+      const auto& c = r.errors_before.curves[i];
+      ecsv << c.key.pose_id << ',' << AxisName(c.key.response) << ',' << AxisName(c.key.excitation) << ','
+           << c.lines << ',' << Num(c.rms_log_mag, 6) << ',' << Num(after.curves[i].rms_log_mag, 6);
+      if (!c.bands.empty()) {
+        ecsv << ',' << Num(c.bands[0].fmin_hz, 6) << ',' << Num(c.bands[0].fmax_hz, 6) << ','
+             << Num(c.bands[0].rms_log_mag, 6);
+      } else {
+        ecsv << ",,,";
+      }
+      ecsv << '\n';
+    }
+    std::ostringstream ccsv;
+    ccsv << "rank,candidate,bic_change,error_after,plausible,note\n";
+    for (size_t i = 0; i < r.candidates.size(); ++i) {
+      const auto& c = r.candidates[i];
+      std::string note = c.note;
+      std::replace(note.begin(), note.end(), ',', ';');
+      std::replace(note.begin(), note.end(), '\n', ' ');
+      ccsv << i + 1 << ',' << c.name() << ',' << Num(c.bic_change, 8) << ',' << Num(c.errors.total_rms_log_mag, 6)
+           << ',' << (c.plausible ? "yes" : "no") << ',' << note << '\n';
+    }
+
+    // ---- index.html (self-contained; PNGs by relative path)
+    std::ostringstream h;
+    h << "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>model-audit</title><style>"
+         "body{font-family:sans-serif;max-width:70em;margin:auto}table{border-collapse:collapse}"
+         "td,th{border:1px solid #999;padding:2px 6px;text-align:right}pre{background:#eee;padding:6px}"
+         "</style></head><body><h1>model-audit: " << Html(robot_path) << "</h1>\n";
+    h << "<p><b>Verdict:</b> " << Html(r.verdict) << "</p>\n<p>Whole-curve error (rms of ln|H<sub>model</sub>| − "
+      << "ln|H<sub>measured</sub>|): before " << Num(r.errors_before.total_rms_log_mag) << ", after "
+      << Num(after.total_rms_log_mag) << "; noise floor " << Num(r.noise_floor) << " ("
+      << (r.significant_failure ? "significant failure" : "consistent with the noise") << ").</p>\n";
+    h << "<h2>Error per posture</h2><table><tr><th>posture</th><th>before</th><th>after</th>";
+    if (!previous.is_null()) h << "<th>previous before</th><th>previous after</th>";
+    h << "</tr>\n";
+    for (const auto& [id, e] : pb) {
+      h << "<tr><td>" << Html(id) << "</td><td>" << Num(e) << "</td><td>" << Num(pa.at(id)) << "</td>";
+      if (!previous.is_null()) {
+        const bool has = previous["postures"].contains(id);
+        h << "<td>" << (has ? Num(previous["postures"][id]["error_before"].get<double>()) : "–") << "</td><td>"
+          << (has ? Num(previous["postures"][id]["error_after"].get<double>()) : "–") << "</td>";
+      }
+      h << "</tr>\n";
+    }
+    h << "<tr><th>total</th><th>" << Num(r.errors_before.total_rms_log_mag) << "</th><th>"
+      << Num(after.total_rms_log_mag) << "</th>";
+    if (!previous.is_null()) {
+      h << "<th>" << Num(previous["error_before"].get<double>()) << "</th><th>"
+        << Num(previous["error_after"].get<double>()) << "</th>";
+    }
+    h << "</tr></table>\n<h2>Error per posture and direction, worst band</h2><table><tr><th>FRF</th><th>before</th>"
+         "<th>after</th><th>worst band [Hz]</th><th>its error</th></tr>\n";
+    for (size_t i = 0; i < r.errors_before.curves.size(); ++i) {
+      const auto& c = r.errors_before.curves[i];
+      h << "<tr><td>" << Html(KeyLabel(c.key)) << "</td><td>" << Num(c.rms_log_mag) << "</td><td>"
+        << Num(after.curves[i].rms_log_mag) << "</td>";
+      if (!c.bands.empty()) {
+        h << "<td>" << Num(c.bands[0].fmin_hz, 3) << "–" << Num(c.bands[0].fmax_hz, 3) << "</td><td>"
+          << Num(c.bands[0].rms_log_mag) << "</td>";
+      } else {
+        h << "<td></td><td></td>";
+      }
+      h << "</tr>\n";
+    }
+    h << "</table>\n<h2>Modes (current model, calibrated)</h2><table><tr><th>FRF</th><th>measured [Hz]</th>"
+         "<th>frequency error</th><th>damping meas.</th><th>damping model</th><th>peak error</th></tr>\n";
+    for (const auto& m : r.modes_before.matches) {
+      h << "<tr><td>" << Html(KeyLabel(m.key)) << "</td><td>" << Num(m.measured_freq_hz) << "</td><td>"
+        << Num(100 * m.freq_error(), 3) << " %</td><td>" << Num(m.measured_damping, 3) << "</td><td>"
+        << Num(m.model_damping, 3) << "</td><td>" << Num(100 * m.peak_error(), 3) << " %</td></tr>\n";
+    }
+    h << "</table><p>Measured modes without a model counterpart: " << r.modes_before.unmatched_measured.size()
+      << ".</p>\n<h2>Candidate effects (best first)</h2>";
+    if (r.candidates.empty()) h << "<p>None tried.</p>";
+    h << "<table><tr><th>rank</th><th>candidate</th><th>ΔBIC</th><th>error after</th><th>plausible</th>"
+         "<th>fitted parameters (±1σ)</th></tr>\n";
+    for (size_t i = 0; i < r.candidates.size(); ++i) {
+      const auto& c = r.candidates[i];
+      h << "<tr><td>" << i + 1 << "</td><td>" << Html(c.name()) << "</td><td>" << Num(c.bic_change, 6)
+        << "</td><td>" << Num(c.errors.total_rms_log_mag) << "</td><td>" << (c.plausible ? "yes" : "no: " + Html(c.note))
+        << "</td><td style=\"text-align:left\">";
+      for (const auto& e : c.fit.estimates) {
+        if (e.name.find('.') != std::string::npos) h << Html(e.name) << " = " << Num(e.value) << " ± " << Num(e.std_dev, 2) << "<br>";
+      }
+      h << "</td></tr>\n";
+    }
+    h << "</table>\n";
+    if (best) {
+      h << "<h2>Add the effect</h2><p>Append to the robot config:</p><pre>" << Html(yaml) << "</pre>\n";
+      h << "<h2>Overlays (measured, model before, with " << Html(best->name()) << ")</h2>\n";
+      for (const auto& id : measured.pose_ids()) h << "<p><img src=\"overlay_" << Html(id) << ".png\"></p>\n";
+    }
+    h << "</body></html>\n";
+
+    // ---- write (each file complete or absent)
+    io::EnsureDirectory(report_dir);
+    const fs::path dir(report_dir);
+    if (best) {
+      dynamics::RobotDescription desc = cfg.description;
+      for (const auto& e : best->effects) desc.effects.push_back({e, {}});
+      dynamics::PostureEvaluator eb(dynamics::RobotModel::Build(cfg.description, r.baseline_fit.parameters));
+      dynamics::PostureEvaluator ea(dynamics::RobotModel::Build(desc, best->fit.parameters));
+      for (const std::string& pose : measured.pose_ids()) {
+        const auto db = eb.Evaluate(postures.at(pose)), da = ea.Evaluate(postures.at(pose));
+        report::PostureOverlay o;
+        o.pose_id = pose;
+        for (const auto& [key, frf] : measured.ForPose(pose)) {
+          o.keys.push_back(key);
+          o.freq_hz.push_back(frf.freq_hz());
+          o.measured.push_back(frf.receptance());
+          const auto hb = dynamics::Receptance(db, frf.freq_hz()), ha = dynamics::Receptance(da, frf.freq_hz());
+          Eigen::VectorXcd b(frf.size()), a(frf.size());
+          for (int i = 0; i < frf.size(); ++i) {
+            b(i) = hb[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
+            a(i) = ha[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
+          }
+          o.before.push_back(b);
+          o.after.push_back(a);
+        }
+        for (const auto& m : da.modes) o.mode_freq_hz.push_back(m.freq_hz);
+        report::WriteOverlayPng((dir / ("overlay_" + pose + ".png")).string(), o,
+                                "model-audit: posture " + pose + ", measured vs model before and with " + best->name());
+      }
+      io::WriteFileAtomically((dir / "effects.yaml").string(), "# model-audit: add to the robot config\n" + yaml);
+    }
+    io::WriteFileAtomically((dir / "errors.csv").string(), ecsv.str());
+    io::WriteFileAtomically((dir / "candidates.csv").string(), ccsv.str());
+    io::WriteFileAtomically((dir / "index.html").string(), h.str());
+    io::WriteFileAtomically((dir / "summary.json").string(), report::DumpJson(j));
+
+    std::cerr << kTool << ": " << r.verdict << '\n';
+    if (best) std::cout << yaml;
+    return r.significant_failure && !r.explained ? kExitFlagged : kExitOk;
+  });
+}
+
+}  // namespace
+}  // namespace robomach::apps
+
+int main(int argc, char** argv) { return robomach::apps::Run(argc, argv); }
