@@ -88,28 +88,6 @@ std::string CalibratedConfigText(const std::string& input_path, const std::strin
   return out.str();
 }
 
-report::PostureOverlay Overlay(const std::string& pose, const dynamics::FrfSet& measured,
-                               const dynamics::PostureDynamics& before, const dynamics::PostureDynamics& after) {
-  report::PostureOverlay o;
-  o.pose_id = pose;
-  for (const auto& [key, frf] : measured.ForPose(pose)) {
-    o.keys.push_back(key);
-    o.freq_hz.push_back(frf.freq_hz());
-    o.measured.push_back(frf.receptance());
-    const auto hb = dynamics::Receptance(before, frf.freq_hz());
-    const auto ha = dynamics::Receptance(after, frf.freq_hz());
-    Eigen::VectorXcd b(frf.size()), a(frf.size());
-    for (int i = 0; i < frf.size(); ++i) {
-      b(i) = hb[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
-      a(i) = ha[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
-    }
-    o.before.push_back(b);
-    o.after.push_back(a);
-  }
-  for (const auto& m : after.modes) o.mode_freq_hz.push_back(m.freq_hz);
-  return o;
-}
-
 int Run(int argc, char** argv) {
   CLI::App app{
       "frf-calibrate: tune named model parameters to measured tool-tip FRFs (hammer tests).\n"
@@ -271,7 +249,7 @@ int Run(int argc, char** argv) {
       const auto db = eb.Evaluate(postures.at(pose));
       const auto da = ea.Evaluate(postures.at(pose));
       const bool held = !measured.ForPose(pose).size();
-      report::WriteOverlayPng((dir / (pose + ".png")).string(), Overlay(pose, all, db, da),
+      report::WriteOverlayPng((dir / (pose + ".png")).string(), report::MakePostureOverlay(pose, all, db, da),
                               "frf-calibrate: posture " + pose + (held ? " (held out)" : "") +
                                   ", measured vs model before and after calibration");
     }

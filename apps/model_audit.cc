@@ -277,22 +277,7 @@ int Run(int argc, char** argv) {
       dynamics::PostureEvaluator ea(dynamics::RobotModel::Build(desc, best->fit.parameters));
       for (const std::string& pose : measured.pose_ids()) {
         const auto db = eb.Evaluate(postures.at(pose)), da = ea.Evaluate(postures.at(pose));
-        report::PostureOverlay o;
-        o.pose_id = pose;
-        for (const auto& [key, frf] : measured.ForPose(pose)) {
-          o.keys.push_back(key);
-          o.freq_hz.push_back(frf.freq_hz());
-          o.measured.push_back(frf.receptance());
-          const auto hb = dynamics::Receptance(db, frf.freq_hz()), ha = dynamics::Receptance(da, frf.freq_hz());
-          Eigen::VectorXcd b(frf.size()), a(frf.size());
-          for (int i = 0; i < frf.size(); ++i) {
-            b(i) = hb[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
-            a(i) = ha[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
-          }
-          o.before.push_back(b);
-          o.after.push_back(a);
-        }
-        for (const auto& m : da.modes) o.mode_freq_hz.push_back(m.freq_hz);
+        const report::PostureOverlay o = report::MakePostureOverlay(pose, measured, db, da);
         report::WriteOverlayPng((dir / ("overlay_" + pose + ".png")).string(), o,
                                 "model-audit: posture " + pose + ", measured vs model before and with " + best->name());
       }

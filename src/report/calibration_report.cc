@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/frf_plot.h"
@@ -101,6 +102,30 @@ void WriteTable3Markdown(const std::string& path, const std::vector<TableSet>& s
       }
     }
   });
+}
+
+PostureOverlay MakePostureOverlay(const std::string& pose, const dynamics::FrfSet& measured,
+                                  const dynamics::PostureDynamics& before,
+                                  const dynamics::PostureDynamics& after) {
+  PostureOverlay o;
+  o.pose_id = pose;
+  for (const auto& [key, frf] : measured.ForPose(pose)) {
+    o.keys.push_back(key);
+    o.freq_hz.push_back(frf.freq_hz());
+    o.measured.push_back(frf.receptance());
+    const auto hb = dynamics::Receptance(before, frf.freq_hz());
+    const auto ha = dynamics::Receptance(after, frf.freq_hz());
+    const int r = static_cast<int>(key.response), e = static_cast<int>(key.excitation);
+    Eigen::VectorXcd b(frf.size()), a(frf.size());
+    for (int i = 0; i < frf.size(); ++i) {
+      b(i) = hb[i](r, e);
+      a(i) = ha[i](r, e);
+    }
+    o.before.push_back(b);
+    o.after.push_back(a);
+  }
+  for (const auto& m : after.modes) o.mode_freq_hz.push_back(m.freq_hz);
+  return o;
 }
 
 void WriteOverlayPng(const std::string& path, const PostureOverlay& o, const std::string& title) {

@@ -13,6 +13,7 @@
 
 #include "robomach/calibration/frf_calibration.h"
 #include "robomach/dynamics/measured_frf.h"
+#include "robomach/dynamics/posture_dynamics.h"
 
 namespace robomach::report {
 
@@ -44,6 +45,12 @@ struct PostureOverlay {
   std::vector<Eigen::VectorXcd> measured, before, after;  // [m/N]
   std::vector<double> mode_freq_hz;                       // model after calibration
 };
+
+/// The overlay of one posture: every measured FRF of `pose` with the model
+/// `before` and `after` (e.g. calibration, or an added effect) on its grid.
+PostureOverlay MakePostureOverlay(const std::string& pose, const dynamics::FrfSet& measured,
+                                  const dynamics::PostureDynamics& before,
+                                  const dynamics::PostureDynamics& after);
 
 /// One PNG: a magnitude and a phase panel per direction pair.
 void WriteOverlayPng(const std::string& path, const PostureOverlay& overlay, const std::string& title);
