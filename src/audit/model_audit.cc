@@ -43,7 +43,7 @@ ModelErrors ComputeErrors(const std::shared_ptr<const dynamics::RobotModel>& mod
   for (const std::string& pose : measured.pose_ids()) {
     const auto q = postures.find(pose);
     if (q == postures.end()) throw std::invalid_argument("measured posture " + pose + " is not in the posture set");
-    const dynamics::PostureDynamics d = eval.Evaluate(q->second);
+    const dynamics::ReceptanceEvaluator H(eval.Evaluate(q->second));
     for (const auto& [key, full] : measured.ForPose(pose)) {
       const dynamics::Frf frf = full.Band(fmin_hz, fmax_hz);
       CurveError c;
@@ -52,12 +52,10 @@ ModelErrors ComputeErrors(const std::shared_ptr<const dynamics::RobotModel>& mod
         out.curves.push_back(c);
         continue;
       }
-      const auto H = dynamics::Receptance(d, frf.freq_hz());
+      const Eigen::VectorXcd hm =
+          H.Entry(frf.freq_hz(), static_cast<int>(key.response), static_cast<int>(key.excitation));
       Eigen::VectorXd r(frf.size());
-      for (int i = 0; i < frf.size(); ++i) {
-        const std::complex<double> hm = H[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
-        r(i) = std::log(std::abs(hm)) - std::log(std::abs(frf.receptance()(i)));
-      }
+      for (int i = 0; i < frf.size(); ++i) r(i) = std::log(std::abs(hm(i))) - std::log(std::abs(frf.receptance()(i)));
       c.lines = frf.size();
       c.rms_log_mag = std::sqrt(r.squaredNorm() / c.lines);
       out.rss += r.squaredNorm();
@@ -157,6 +155,115 @@ calibration::CalibrationOptions FitOptions(const AuditOptions& o, std::vector<st
   return c;
 }
 
+// Sum of squared whole-curve residuals |ln(H_model / H_measured)|² (log
+// magnitude and phase, as the calibration's whole-curve objective) over all
+// lines of `data`; +inf if the model cannot be built or evaluated there.
+double WholeCurveCost(const dynamics::RobotDescription& desc, const dynamics::ParameterSet& params,
+                      const calibration::PostureMap& postures, const dynamics::FrfSet& data, double fmin_hz,
+                      double fmax_hz) {
+  try {
+    const auto model = dynamics::RobotModel::Build(desc, params);
+    dynamics::PostureEvaluator eval(model);
+    double cost = 0.0;
+    for (const std::string& pose : data.pose_ids()) {
+      const dynamics::PostureDynamics d = eval.Evaluate(postures.at(pose));
+      for (const auto& [key, frf] : data.ForPose(pose)) {
+        const int n = frf.Band(fmin_hz, fmax_hz).size();
+        if (n > 0) cost += n * std::pow(calibration::WholeCurveError(d, key, frf, fmin_hz, fmax_hz), 2);
+      }
+    }
+    return std::isfinite(cost) ? cost : std::numeric_limits<double>::infinity();
+  } catch (const std::exception&) {
+    return std::numeric_limits<double>::infinity();
+  }
+}
+
+// Trial values of one effect parameter for the start-value scan: a
+// log-spaced grid over its bounds (factor ≈ 2 between points, at most
+// kScanPoints), or for a parameter that may be zero, zero and a log grid
+// over 1e-3..1e3 times its default.
+std::vector<double> ScanGrid(const dynamics::ParameterSpec& s, double current) {
+  constexpr int kScanPoints = 25;
+  double lo = s.lower, hi = s.upper;
+  std::vector<double> grid;
+  if (!(lo > 0.0)) {
+    grid.push_back(std::max(lo, 0.0));
+    const double ref = current > 0.0 ? current : s.default_value;
+    if (!(ref > 0.0)) return grid;
+    lo = std::max(ref * 1e-3, lo);
+    hi = std::min(ref * 1e3, hi);
+  }
+  if (!(hi > lo) || !std::isfinite(hi)) return grid;
+  const int n = std::clamp(static_cast<int>(std::ceil(std::log2(hi / lo))) + 1, 3, kScanPoints);
+  for (int i = 0; i < n; ++i) grid.push_back(lo * std::pow(hi / lo, static_cast<double>(i) / (n - 1)));
+  return grid;
+}
+
+// Start values for an added effect's parameters. Fitting an FRF is
+// multimodal: from the library defaults a local fit can explain a peak with
+// the wrong mode (a flange's torsion or lateral spring instead of its
+// bending) and stop there; so can a coordinate-wise scan that takes the
+// parameters in a fixed order. Best-first instead: scan every added
+// parameter over its grid from the current point, apply only the single
+// move that lowers the whole-curve cost most, and repeat (a few rounds);
+// the joint fit then refines from the right basin.
+dynamics::ParameterSet ScanStart(const dynamics::RobotDescription& desc, dynamics::ParameterSet params,
+                                 const std::vector<std::string>& added, const calibration::PostureMap& postures,
+                                 const dynamics::FrfSet& data, const AuditOptions& o) {
+  constexpr int kRounds = 3;
+  double best = WholeCurveCost(desc, params, postures, data, o.fmin_hz, o.fmax_hz);
+  for (int round = 0; round < kRounds; ++round) {
+    std::string best_name;
+    double best_value = 0.0;
+    for (const std::string& name : added) {
+      const double start = params.Get(name);
+      for (double v : ScanGrid(params.spec(name), start)) {
+        if (v == start) continue;
+        dynamics::ParameterSet trial = params;
+        trial.Set(name, v);
+        const double c = WholeCurveCost(desc, trial, postures, data, o.fmin_hz, o.fmax_hz);
+        if (c < best) {
+          best = c;
+          best_name = name;
+          best_value = v;
+        }
+      }
+    }
+    if (best_name.empty()) break;
+    // Refine the move between its grid neighbours (golden section in the
+    // logarithm, or linearly for a grid that starts at zero).
+    {
+      const std::vector<double> grid = ScanGrid(params.spec(best_name), params.Get(best_name));
+      const auto it = std::find(grid.begin(), grid.end(), best_value);
+      const size_t k = static_cast<size_t>(it - grid.begin());
+      const double lo = k > 0 ? grid[k - 1] : best_value, hi = k + 1 < grid.size() ? grid[k + 1] : best_value;
+      const bool log_axis = lo > 0.0;
+      const auto cost_at = [&](double u) {
+        dynamics::ParameterSet trial = params;
+        trial.Set(best_name, log_axis ? std::exp(u) : u);
+        return WholeCurveCost(desc, trial, postures, data, o.fmin_hz, o.fmax_hz);
+      };
+      double a = log_axis ? std::log(lo) : lo, b = log_axis ? std::log(hi) : hi;
+      const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+      double c = b - g * (b - a), d = a + g * (b - a), fc = cost_at(c), fd = cost_at(d);
+      for (int it2 = 0; it2 < 12; ++it2) {
+        if (fc < fd) {
+          b = d; d = c; fd = fc; c = b - g * (b - a); fc = cost_at(c);
+        } else {
+          a = c; c = d; fc = fd; d = a + g * (b - a); fd = cost_at(d);
+        }
+      }
+      const double u = fc < fd ? c : d, fu = std::min(fc, fd);
+      if (fu < best) {
+        best = fu;
+        best_value = std::clamp(log_axis ? std::exp(u) : u, params.spec(best_name).lower, params.spec(best_name).upper);
+      }
+    }
+    params.Set(best_name, best_value);
+  }
+  return params;
+}
+
 CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const dynamics::ParameterSet& start,
                              const std::vector<std::string>& base_effects_added, const std::string& effect,
                              const std::vector<std::string>& base_free, const calibration::PostureMap& postures,
@@ -172,6 +279,7 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
   free.insert(free.end(), added.begin(), added.end());
   c.added_parameters = static_cast<int>(free.size() - o.calibration_parameters.size());
   try {
+    params = ScanStart(desc, params, added, postures, fit_data, o);
     c.fit = calibration::Calibrate(desc, params, postures, fit_data, features, FitOptions(o, free));
     c.errors = ComputeErrors(dynamics::RobotModel::Build(desc, c.fit.parameters), postures, measured, o.fmin_hz,
                              o.fmax_hz, o.num_bands);

@@ -18,14 +18,6 @@ using dynamics::FrfKey;
 using dynamics::PostureDynamics;
 using cd = std::complex<double>;
 
-// |H_re| of a posture at one frequency.
-double ModelMagnitude(const PostureDynamics& d, const FrfKey& key, double f_hz) {
-  Eigen::VectorXd f(1);
-  f(0) = f_hz;
-  return std::abs(dynamics::Receptance(d, f)[0](static_cast<int>(key.response),
-                                                static_cast<int>(key.excitation)));
-}
-
 // Maximum of a smooth positive function on [lo, hi]: grid, then golden section.
 template <typename F>
 std::pair<double, double> MaximiseOnInterval(const F& fun, double lo, double hi, int grid) {
@@ -111,20 +103,17 @@ std::pair<double, double> ModelPeak(const PostureDynamics& d, const FrfKey& key,
   const dynamics::Mode& m = d.modes.at(model_mode);
   const double z = m.damping_ratio;
   const double lo = m.freq_hz * std::max(0.05, 1.0 - 3.0 * z), hi = m.freq_hz * (1.0 + 3.0 * z);
-  // One vectorised call for the grid, then golden-section calls.
+  const dynamics::ReceptanceEvaluator H(d);
+  const int r = static_cast<int>(key.response), e = static_cast<int>(key.excitation);
+  // A grid for the neighbourhood of the maximum, then golden section.
   constexpr int kGrid = 60;
-  Eigen::VectorXd f = Eigen::VectorXd::LinSpaced(kGrid + 1, lo, hi);
-  const auto H = dynamics::Receptance(d, f);
-  int best = 0;
-  for (int i = 0; i <= kGrid; ++i) {
-    if (std::abs(H[i](static_cast<int>(key.response), static_cast<int>(key.excitation))) >
-        std::abs(H[best](static_cast<int>(key.response), static_cast<int>(key.excitation)))) {
-      best = i;
-    }
-  }
+  const Eigen::VectorXd f = Eigen::VectorXd::LinSpaced(kGrid + 1, lo, hi);
+  const Eigen::VectorXd mag = H.Entry(f, r, e).cwiseAbs();
+  Eigen::Index best = 0;
+  mag.maxCoeff(&best);
   const double step = (hi - lo) / kGrid;
-  return MaximiseOnInterval([&](double x) { return ModelMagnitude(d, key, x); },
-                            std::max(lo, f(best) - step), std::min(hi, f(best) + step), 2);
+  return MaximiseOnInterval([&](double x) { return std::abs(H.Entry(x, r, e)); }, std::max(lo, f(best) - step),
+                            std::min(hi, f(best) + step), 2);
 }
 
 std::vector<ModeMatch> MatchModes(const std::map<std::string, PostureDynamics>& model,
@@ -196,14 +185,16 @@ double WholeCurveError(const PostureDynamics& d, const FrfKey& key, const dynami
                        double fmin_hz, double fmax_hz) {
   const dynamics::Frf band = measured.Band(fmin_hz, fmax_hz);
   if (band.size() == 0) return NAN;
-  const auto H = dynamics::Receptance(d, band.freq_hz());
+  const Eigen::VectorXcd H = dynamics::ReceptanceEvaluator(d).Entry(band.freq_hz(), static_cast<int>(key.response),
+                                                                     static_cast<int>(key.excitation));
   double s = 0.0;
   int n = 0;
   for (int i = 0; i < band.size(); ++i) {
-    const cd hm = H[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
+    const cd hm = H(i);
     const cd h = band.receptance()(i);
     if (std::abs(h) == 0.0 || std::abs(hm) == 0.0) continue;
-    s += std::norm(std::log(hm / h));
+    const auto r = WholeCurveResiduals(hm, h);
+    s += r[0] * r[0] + r[1] * r[1];
     ++n;
   }
   return n > 0 ? std::sqrt(s / n) : NAN;
@@ -269,13 +260,20 @@ namespace {
 
 enum class ResidualKind { kFrequency, kPeak, kJoint, kWholeCurve };
 
-// Everything a residual evaluation needs; the free parameters are scaled,
-// x_i = value_i / scale_i.
+// Everything a residual evaluation needs. The free parameters are scaled
+// by their initial values: x_i = value_i / scale_i, or, for a parameter
+// bounded away from zero (a stiffness, a damping ratio, a scale factor),
+// x_i = ln(value_i / scale_i). In the logarithm a fit moves such a
+// parameter by factors, as its physics does, and a step cannot carry it to
+// its lower bound by overshooting a linear extrapolation (seen with
+// flange stiffnesses: linear steps parked the torsional stiffness at its
+// lower bound, 1e3 of a true 2e6 N·m/rad).
 struct ModelResidual {
   const dynamics::RobotDescription* description;
   dynamics::ParameterSet base;
   std::vector<std::string> names;
   std::vector<double> scale;
+  std::vector<char> log_scale;
   const PostureMap* postures;
   std::vector<std::string> pose_ids;
   ResidualKind kind;
@@ -298,9 +296,30 @@ struct ModelResidual {
     return 0;
   }
 
+  // Ceres keeps the iterates inside the bounds, but its numeric derivative
+  // steps across a bound when a parameter sits on it, and x · scale may round
+  // past it: such values are clamped to the bound (the derivative there is
+  // then one-sided), not rejected, which would fail the whole evaluation.
+  // The logarithm is offset by kLogOffset so that x stays well away from 0,
+  // where Ceres' relative numeric-derivative step |x| · 1e-6 would shrink to
+  // its floor √eps; parameters whose bounds reach below e^-(kLogOffset-1)
+  // times their start stay linear (see the caller).
+  static constexpr double kLogOffset = 12.0;
+  double ToValue(double x, size_t i) const {
+    return log_scale[i] ? scale[i] * std::exp(x - kLogOffset) : x * scale[i];
+  }
+  double ToX(double value, size_t i) const {
+    return log_scale[i] ? std::log(value / scale[i]) + kLogOffset : value / scale[i];
+  }
+  /// d value / d x, for the uncertainty (delta method).
+  double Slope(double x, size_t i) const { return log_scale[i] ? ToValue(x, i) : scale[i]; }
+
   dynamics::ParameterSet Values(const double* x) const {
     dynamics::ParameterSet p = base;
-    for (size_t i = 0; i < names.size(); ++i) p.Set(names[i], x[i] * scale[i]);
+    for (size_t i = 0; i < names.size(); ++i) {
+      const auto& spec = base.spec(names[i]);
+      p.Set(names[i], std::clamp(ToValue(x[i], i), spec.lower, spec.upper));
+    }
     return p;
   }
 
@@ -310,13 +329,15 @@ struct ModelResidual {
       const auto dyn = EvaluatePostures(model, *postures, pose_ids);
       int r = 0;
       if (kind == ResidualKind::kWholeCurve) {
+        std::map<std::string, dynamics::ReceptanceEvaluator> evaluators;
+        for (const auto& [id, d] : dyn) evaluators.emplace(id, dynamics::ReceptanceEvaluator(d));
         for (const auto& [key, frf] : curves) {
-          const auto H = dynamics::Receptance(dyn.at(key.pose_id), frf.freq_hz());
+          const Eigen::VectorXcd H = evaluators.at(key.pose_id).Entry(
+              frf.freq_hz(), static_cast<int>(key.response), static_cast<int>(key.excitation));
           for (int i = 0; i < frf.size(); ++i) {
-            const cd hm = H[i](static_cast<int>(key.response), static_cast<int>(key.excitation));
-            const cd e = std::log(hm / frf.receptance()(i));
-            residuals[r++] = e.real();
-            residuals[r++] = std::remainder(e.imag(), 2.0 * kPi);
+            const auto e = WholeCurveResiduals(H(i), frf.receptance()(i));
+            residuals[r++] = e[0];
+            residuals[r++] = e[1];
           }
         }
         return true;
@@ -354,20 +375,20 @@ StageOutcome SolveStage(const std::string& stage_name, ModelResidual residual, c
   residual.num_residuals = residual.CountResiduals();
   out.summary.num_residuals = residual.num_residuals;
   std::vector<double> x(n);
-  for (int i = 0; i < n; ++i) x[i] = residual.base.Get(residual.names[i]) / residual.scale[i];
+  for (int i = 0; i < n; ++i) x[i] = residual.ToX(residual.base.Get(residual.names[i]), i);
   if (residual.num_residuals < n) {
     out.summary.termination = "FAILURE";
     out.summary.message = "fewer residuals (" + std::to_string(residual.num_residuals) + ") than free parameters (" +
                           std::to_string(n) + "): too few matched modes";
     for (int i = 0; i < n; ++i) {
-      out.values.push_back(x[i] * residual.scale[i]);
+      out.values.push_back(residual.ToValue(x[i], i));
       out.std_dev.push_back(NAN);
     }
     return out;
   }
   const std::vector<std::string> names = residual.names;
-  const std::vector<double> scale = residual.scale;
-  const dynamics::ParameterSet base = residual.base;
+  const ModelResidual map = residual;  // for the parameter mapping after the solve
+  const dynamics::ParameterSet& base = map.base;
   const int m = residual.num_residuals;
   ceres::NumericDiffOptions nd;
   nd.relative_step_size = 1e-6;
@@ -379,8 +400,8 @@ StageOutcome SolveStage(const std::string& stage_name, ModelResidual residual, c
   problem.AddResidualBlock(cost, nullptr, x.data());
   for (int i = 0; i < n; ++i) {
     const auto& spec = base.spec(names[i]);
-    if (spec.lower > -1e299) problem.SetParameterLowerBound(x.data(), i, spec.lower / scale[i]);
-    if (spec.upper < 1e299) problem.SetParameterUpperBound(x.data(), i, spec.upper / scale[i]);
+    if (spec.lower > -1e299) problem.SetParameterLowerBound(x.data(), i, map.ToX(spec.lower, i));
+    if (spec.upper < 1e299) problem.SetParameterUpperBound(x.data(), i, map.ToX(spec.upper, i));
   }
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
@@ -399,7 +420,8 @@ StageOutcome SolveStage(const std::string& stage_name, ModelResidual residual, c
   out.summary.iterations = static_cast<int>(summary.iterations.size());
   out.summary.initial_cost = summary.initial_cost;
   out.summary.final_cost = summary.final_cost;
-  for (int i = 0; i < n; ++i) out.values.push_back(x[i] * scale[i]);
+  for (int i = 0; i < n; ++i) out.values.push_back(std::clamp(map.ToValue(x[i], i), base.spec(names[i]).lower,
+                                                               base.spec(names[i]).upper));
   out.std_dev.assign(n, NAN);
   // Covariance of the scaled parameters, from Jᵀ J at the solution, scaled by
   // the residual variance estimate 2 F / (m − n) (the residual weights are
@@ -415,7 +437,9 @@ StageOutcome SolveStage(const std::string& stage_name, ModelResidual residual, c
     cov.GetCovarianceBlock(x.data(), x.data(), c.data());
     const double dof = std::max(1, m - n);
     const double s2 = 2.0 * summary.final_cost / dof;
-    for (int i = 0; i < n; ++i) out.std_dev[i] = std::sqrt(std::max(0.0, c[i * n + i] * s2)) * std::abs(scale[i]);
+    for (int i = 0; i < n; ++i) {
+      out.std_dev[i] = std::sqrt(std::max(0.0, c[i * n + i] * s2)) * std::abs(map.Slope(x[i], i));
+    }
     out.summary.covariance_ok = true;
   }
   return out;
@@ -509,6 +533,11 @@ CalibrationResult Calibrate(const dynamics::RobotDescription& description, const
       r.base = current;
       r.names = free;
       r.scale = scales(free);
+      for (const std::string& nm : free) {
+        const double lower = initial.spec(nm).lower, v = initial.Get(nm);
+        r.log_scale.push_back(lower > 0.0 && v > 0.0 &&
+                              std::log(lower / std::abs(v)) > 1.0 - ModelResidual::kLogOffset);
+      }
       r.kind = kind;
       r.matches = matches;
       if (kind == ResidualKind::kWholeCurve) {

@@ -183,7 +183,8 @@ PostureDynamics PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const Postu
     if (!out.proportional_damping) {
       // Non-proportional damping: the damping ratio of each mode is that of
       // the complex pole nearest to its undamped frequency.
-      const ComplexModalModel cm = ComputeComplexModes(sys);
+      out.complex_modes = ComputeComplexModes(sys);
+      const ComplexModalModel& cm = out.complex_modes;
       for (Mode& m : out.modes) {
         double best = INFINITY;
         for (int k = 0; k < cm.poles.size(); ++k) {

@@ -6,6 +6,7 @@
 // (log-magnitude and phase over a band). Any parameter of the model's
 // ParameterSet may be free; any measured direction pair may be used.
 
+#include <array>
 #include <complex>
 #include <limits>
 #include <map>
@@ -95,9 +96,20 @@ std::pair<double, double> ModelPeak(const dynamics::PostureDynamics& d, const dy
 std::vector<ModeMatch> MatchModes(const std::map<std::string, dynamics::PostureDynamics>& model,
                                   const MeasuredFeatures& features, const MatchOptions& options = {});
 
+/// The two residuals of the whole-curve objective at one line, from the
+/// model's and the measured receptance: the log-magnitude error ln|Hm/H|
+/// and the chord 2 sin(Δφ/2) of the phase error Δφ = arg(Hm/H). The chord
+/// equals Δφ to O(Δφ³) but, unlike Δφ wrapped to (−π, π], is smooth where
+/// the phase error passes ±π; wrapped phases gave numeric derivatives of
+/// 2π/h there and stalled whole-curve fits for dozens of iterations.
+inline std::array<double, 2> WholeCurveResiduals(std::complex<double> h_model, std::complex<double> h_measured) {
+  const std::complex<double> ratio = h_model / h_measured;
+  return {std::log(std::abs(ratio)), 2.0 * std::sin(0.5 * std::arg(ratio))};
+}
+
 /// Whole-curve error of the model against one measured FRF over a band:
-/// rms of log(H_model / H_measured) (real part: log-magnitude; imaginary:
-/// phase [rad]) over the lines, as a complex-magnitude rms.
+/// the rms over the lines of the residual pair of WholeCurveResiduals (as a
+/// complex-magnitude rms: √(mean(r_mag² + r_phase²))).
 double WholeCurveError(const dynamics::PostureDynamics& d, const dynamics::FrfKey& key,
                        const dynamics::Frf& measured, double fmin_hz, double fmax_hz);
 

@@ -57,6 +57,10 @@ struct PostureDynamics {
   Matrix6d M_X, K_X, C_X;
   Eigen::Matrix3d static_compliance;   // H_T(0) = B K⁻¹ Bᵀ [m/N]
   std::vector<Mode> modes;             // ascending frequency
+  /// Poles and residues of the damped system when the damping is not
+  /// proportional and modes were asked for (empty otherwise); computed once
+  /// here because the damping ratios of `modes` need them anyway.
+  ComplexModalModel complex_modes;
 
   /// Joint-space blocks of the assembled system (n × n).
   Eigen::MatrixXd M_q() const { return system.M.topLeftCorner(system.num_joints, system.num_joints); }

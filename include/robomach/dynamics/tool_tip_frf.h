@@ -44,4 +44,28 @@ std::vector<Eigen::Matrix3cd> ReceptanceComplexModal(const ComplexModalModel& mo
 std::vector<Eigen::Matrix3cd> Receptance(const PostureDynamics& dynamics,
                                          const Eigen::VectorXd& freq_hz);
 
+/// Single entries H_re of the tool-tip receptance at one posture, for fits
+/// and error measures that need one direction pair on many lines: the modal
+/// data (real modes for proportional damping, complex modes otherwise) are
+/// prepared once, and each line costs one scalar term per mode instead of a
+/// 3×3 matrix. Same values as Receptance(dynamics, f)(r, e).
+class ReceptanceEvaluator {
+ public:
+  /// @throws std::runtime_error if the complex modal analysis fails.
+  explicit ReceptanceEvaluator(const PostureDynamics& dynamics);
+  /// H_re [m/N] at every line of `freq_hz` [Hz]; response r, excitation e in 0..2.
+  Eigen::VectorXcd Entry(const Eigen::VectorXd& freq_hz, int response, int excitation) const;
+  /// H_re at one frequency.
+  std::complex<double> Entry(double freq_hz, int response, int excitation) const;
+
+ private:
+  bool real_modes_{false};
+  // Real modes: ω_k², 2 ζ_k ω_k and p_T per mode (columns).
+  Eigen::VectorXd w2_, c_;
+  Eigen::Matrix3Xd p_;
+  // Complex modes: poles λ_k and residue matrices.
+  Eigen::VectorXcd poles_;
+  std::vector<Eigen::Matrix3cd> residues_;
+};
+
 }  // namespace robomach::dynamics
