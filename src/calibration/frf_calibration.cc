@@ -431,13 +431,27 @@ StageOutcome SolveStage(const std::string& stage_name, ModelResidual residual, c
   co.null_space_rank = 0;
   co.min_reciprocal_condition_number = 1e-14;
   ceres::Covariance cov(co);
+  // Parameters that ended on a bound are held in the covariance (their
+  // one-sided derivative does not describe an interval, and a bound-pinned
+  // damping made the whole matrix singular): the others' uncertainty is
+  // conditional on them; theirs is reported as unknown.
+  std::vector<int> pinned;
+  for (int i = 0; i < n; ++i) {
+    const auto& spec = base.spec(names[i]);
+    const double v = map.ToValue(x[i], i), tol = 1e-9 * std::max(1.0, std::abs(v));
+    if (std::abs(v - spec.lower) < tol || std::abs(v - spec.upper) < tol) pinned.push_back(i);
+  }
+  if (!pinned.empty() && static_cast<int>(pinned.size()) < n) {
+    problem.SetManifold(x.data(), new ceres::SubsetManifold(n, pinned));
+  }
   std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
-  if (cov.Compute(blocks, &problem)) {
+  if (static_cast<int>(pinned.size()) < n && cov.Compute(blocks, &problem)) {
     std::vector<double> c(n * n);
     cov.GetCovarianceBlock(x.data(), x.data(), c.data());
     const double dof = std::max(1, m - n);
     const double s2 = 2.0 * summary.final_cost / dof;
     for (int i = 0; i < n; ++i) {
+      if (std::find(pinned.begin(), pinned.end(), i) != pinned.end()) continue;
       out.std_dev[i] = std::sqrt(std::max(0.0, c[i * n + i] * s2)) * std::abs(map.Slope(x[i], i));
     }
     out.summary.covariance_ok = true;

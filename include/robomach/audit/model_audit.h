@@ -50,6 +50,10 @@ struct AuditOptions {
   /// of 2 keeps ≥ 1.7 lines in the half-power band of the most lightly
   /// damped mode (2ζf = 0.84 Hz at 10.5 Hz) and halves the cost of every fit.
   int fit_line_stride{2};
+  /// Identifiability screen of a candidate's parameters: a factor of two
+  /// on a parameter must change the χ² (residuals over the noise floor) by
+  /// at least this much for it to be fitted (4: a 2σ change).
+  double identifiable_chi2{4.0};
   /// Candidates fitted at the same time (each fit is single-threaded).
   int threads{2};
   /// Called with one line per step (for progress on stderr); may be empty.
@@ -106,7 +110,20 @@ struct CandidateResult {
   ModelErrors errors;
   double bic{0.0};
   double bic_change{0.0};   // against the calibrated current model (negative: better)
-  int added_parameters{0};
+  int added_parameters{0};  // fitted effect parameters (counted in the BIC)
+  /// Fittable effect parameters that these data cannot determine: halving
+  /// or doubling one (the others held) changes the fit's χ² by less than
+  /// AuditOptions::identifiable_chi2 noise variances, so its 95 % interval
+  /// spans more than a factor of two each way. They are held at their start
+  /// values (library defaults), not fitted, and listed here.
+  std::vector<std::string> not_identifiable;
+  /// Calibration parameters held at their calibrated values because the
+  /// effect's parameters can replace them exactly (see `note`).
+  std::vector<std::string> held_calibration;
+  /// Which start the reported fit came from: "scan" (best-first grid scan
+  /// from the calibrated model) or "defaults" (library defaults with the
+  /// model's own start values; tried when the first did not explain the data).
+  std::string start;
   /// Every fitted effect parameter converged, inside its bounds and not pinned at one.
   bool plausible{false};
   std::string note;         // why not plausible, or the fit's message
@@ -127,6 +144,9 @@ struct AuditResult {
   std::vector<std::string> missing_effects;
   bool explained{false};
   std::string verdict;  // one sentence for people
+  /// When not explained: where the remaining error lies (see DescribePattern),
+  /// also appended to the verdict; empty otherwise.
+  std::string pattern;
 };
 
 /// BIC of a Gaussian least-squares fit: n ln(RSS/n) + k ln n.
@@ -144,6 +164,12 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
 /// values kept, the new effect's at their defaults.
 std::pair<dynamics::RobotDescription, dynamics::ParameterSet> WithEffect(
     const dynamics::RobotDescription& description, const dynamics::ParameterSet& base, const std::string& effect);
+
+/// Words for the pattern of a model's errors: how many FRFs fail
+/// significantly, the band that is worst in most FRFs and whether it is the
+/// same at every posture and direction (then the cause does not follow the
+/// posture), and the range of the per-posture error.
+std::string DescribePattern(const ModelErrors& errors, double noise_floor, double significance_factor);
 
 /// The YAML lines that add the candidate's effects with their fitted
 /// parameters to a robot config's `effects:` list.

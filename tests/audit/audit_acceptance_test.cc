@@ -1,0 +1,235 @@
+// Issue #5 acceptance on virtual hammer tests with known truth: for each
+// library effect in turn, data from the default robot with the effect
+// switched on (a realistic value), calibration parameters perturbed, 2 %
+// noise, five postures; the full audit (every library effect a candidate)
+// must (i) flag a significant failure, (ii) rank the effect first, (iii)
+// bring the whole-curve error within 1.5 × that of the true model on the
+// same data, with the effect's fitted parameters within 10 % of the truth
+// or within their reported 95 % interval. Also: two hidden effects are both
+// found; an effect outside the library is reported as unexplained.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <iostream>
+#include <set>
+
+#include "audit_test_support.h"
+#include "robomach/common/units.h"
+
+namespace robomach::audit {
+namespace {
+
+using testing::Campaign;
+using testing::Hidden;
+using testing::MakeCampaign;
+using testing::Synthesize;
+using testing::Truth;
+
+struct Case {
+  std::string name;
+  std::vector<Hidden> hidden;
+  unsigned seed;
+};
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }  // test names without byte dumps
+
+// Realistic values, each a physical situation rather than a library default:
+// - tip_mass 0.5 kg: an instrumentation block at the tool tip. Below about
+//   0.4 kg a tip mass is absorbed by the calibration of m6 and d6 within 2 %
+//   noise (measured: 0.5 kg gives 1.39 × the noise floor before the fix).
+// - flange_compliance: a soft quick-change flange, bending stiffness
+//   1e6 N·m/rad (half the default).
+// - joint_damping: 1.5 × the library's joint damping.
+// - base_compliance: a soft foundation, lateral 3e8 N/m, rocking 2e7 N·m/rad.
+// - tool_flexibility: a long-reach tool, 12 mm × 60 mm stick-out.
+// - spindle_interface: an HSK face contact, tilting 10 × and translational
+//   1.5 × the taper-only contact.
+const std::vector<Case>& Cases() {
+  static const std::vector<Case> cases = {
+      {"tip_mass", {{"tip_mass", {{"tip_mass.mass_kg", 0.5}}}}, 101},
+      {"flange_compliance", {{"flange_compliance", {{"flange_compliance.bending_stiffness_Nm_per_rad", 1e6}}}}, 102},
+      {"joint_damping",
+       {{"joint_damping",
+         {{"joint_damping.c1_Nms_per_rad", 2550.0}, {"joint_damping.c2_Nms_per_rad", 4200.0},
+          {"joint_damping.c3_Nms_per_rad", 1950.0}, {"joint_damping.c4_Nms_per_rad", 60.0},
+          {"joint_damping.c5_Nms_per_rad", 120.0}, {"joint_damping.c6_Nms_per_rad", 10.5}}}},
+       103},
+      {"base_compliance",
+       {{"base_compliance",
+         {{"base_compliance.lateral_stiffness_N_per_m", 3e8}, {"base_compliance.rocking_stiffness_Nm_per_rad", 2e7}}}},
+       104},
+      {"tool_flexibility",
+       {{"tool_flexibility", {{"tool_flexibility.diameter_m", 0.012}, {"tool_flexibility.stick_out_m", 0.06}}}},
+       105},
+      {"spindle_interface",
+       {{"spindle_interface",
+         {{"spindle_interface.translational_scale", 1.5}, {"spindle_interface.tilting_scale", 10.0}}}},
+       106},
+  };
+  return cases;
+}
+
+double Seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+struct Outcome {
+  AuditResult result;
+  double true_error{0.0};
+  dynamics::ParameterSet truth;
+};
+
+Outcome Audit(const Campaign& c, const std::vector<Hidden>& hidden, unsigned seed,
+              const std::function<void(dynamics::FrfSet*)>& alter = {}) {
+  const auto [d, p] = Truth(c, hidden);
+  dynamics::FrfSet measured = Synthesize(c, d, p, seed);
+  if (alter) alter(&measured);
+  AuditOptions o;  // every library effect is a candidate
+  o.progress = [](const std::string& m) { std::cout << "  " << m << std::endl; };
+  const auto t0 = std::chrono::steady_clock::now();
+  Outcome out{RunAudit(c.cfg.description, c.cfg.parameters, c.postures, measured, o), 0.0, p};
+  std::cout << "audit in " << Seconds(t0) << " s: " << out.result.verdict << "\n";
+  for (const CandidateResult& cand : out.result.candidates) {
+    std::cout << "  " << cand.name() << ": dBIC " << cand.bic_change << ", error " << cand.errors.total_rms_log_mag
+              << (cand.plausible ? ", plausible" : ", implausible") << " (" << cand.start << ") " << cand.note << "\n";
+  }
+  out.true_error =
+      ComputeErrors(dynamics::RobotModel::Build(d, p), c.postures, measured, 0.0, 1e9, 8).total_rms_log_mag;
+  return out;
+}
+
+// The value a fitted parameter is compared with. Joint damping and the
+// stiffness-proportional Rayleigh term are the same matrix (alpha K_q is
+// the diagonal joint damping alpha k_qi), so the audit holds alpha_s at 0
+// and c_i takes it over: its truth is then c_i + alpha k_qi.
+double Expected(const Outcome& o, const CandidateResult& cand, const std::string& name) {
+  double v = o.truth.Get(name);
+  const std::string prefix = "joint_damping.c";
+  if (name.rfind(prefix, 0) == 0 && cand.fit.parameters.Get("alpha_s") == 0.0) {
+    const std::string joint = name.substr(prefix.size(), 1);
+    v += o.truth.Get("alpha_s") * o.truth.Get("kq" + joint + "_Nm_per_rad");
+  }
+  return v;
+}
+
+class HiddenEffect : public ::testing::TestWithParam<Case> {};
+
+TEST_P(HiddenEffect, IsFlaggedRankedFirstAndExplainsTheError) {
+  const Case& k = GetParam();
+  const Campaign c = MakeCampaign();
+  const Outcome o = Audit(c, k.hidden, k.seed);
+  const AuditResult& r = o.result;
+  // (i) A significant failure: beyond 1.3 × the noise floor (AuditOptions).
+  EXPECT_TRUE(r.significant_failure) << r.errors_before.total_rms_log_mag << " vs floor " << r.noise_floor;
+  ASSERT_FALSE(r.candidates.empty());
+  // (ii) Ranked first, lowering the BIC, and named as the missing effect.
+  const CandidateResult& top = r.candidates.front();
+  EXPECT_EQ(top.name(), k.name);
+  EXPECT_LT(top.bic_change, 0.0);
+  EXPECT_TRUE(top.plausible) << top.note;
+  EXPECT_EQ(r.missing_effects, std::vector<std::string>{k.name}) << r.verdict;
+  EXPECT_TRUE(r.explained) << r.verdict;
+  // (iii) Error within 1.5 × the true model's on the same noisy data.
+  EXPECT_LT(top.errors.total_rms_log_mag, 1.5 * o.true_error);
+  std::cout << k.name << ": error before " << r.errors_before.total_rms_log_mag << ", after "
+            << top.errors.total_rms_log_mag << ", true model " << o.true_error << ", floor " << r.noise_floor << "\n";
+  // Fitted values within 10 % of the truth or within their 95 % interval.
+  int checked = 0;
+  for (const auto& e : top.fit.estimates) {
+    if (e.name.rfind(k.name + ".", 0) != 0) continue;
+    const double truth = Expected(o, top, e.name);
+    const bool within_10 = std::abs(e.value / truth - 1.0) <= 0.10;
+    const bool within_ci = std::abs(e.value - truth) <= 1.96 * e.std_dev;
+    EXPECT_TRUE(within_10 || within_ci) << e.name << " = " << e.value << " ± " << e.std_dev << ", truth " << truth;
+    std::cout << "  " << e.name << " = " << e.value << " ± " << e.std_dev << " (truth " << truth << ")\n";
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+  // Parameters the screen held must be ones the data cannot see: the
+  // candidate's error is already at the true model's.
+  for (const auto& n : top.not_identifiable) std::cout << "  not identifiable: " << n << "\n";
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryLibraryEffect, HiddenEffect, ::testing::ValuesIn(Cases()),
+                         [](const ::testing::TestParamInfo<Case>& i) { return i.param.name; });
+
+// gravity_stiffness switched on at its physical value (scale 1) moves the
+// KR210's modes by less than 0.1 %: below what 2 % noise lets anyone see.
+// The independent check is the true-model error itself: the model without
+// the effect, calibrated, is within the noise, so the audit must not claim
+// a failure (and cannot rank what it cannot see).
+TEST(HiddenEffectBelowDetection, GravityStiffnessIsWithinTheNoiseAndRaisesNoAlarm) {
+  const Campaign c = MakeCampaign();
+  const Outcome o = Audit(c, {{"gravity_stiffness", {}}}, 107);
+  EXPECT_FALSE(o.result.significant_failure) << o.result.errors_before.total_rms_log_mag;
+  EXPECT_LT(o.result.errors_before.total_rms_log_mag, 1.05 * o.true_error);
+  EXPECT_TRUE(o.result.missing_effects.empty());
+}
+
+// A soft quick-change flange on a soft foundation: flexibilities at both
+// ends of the robot. (A soft flange with the long-reach tool was tried too:
+// the greedy pair ends at 1.1 × the true model's error with a 3 × 9 mm tool
+// whose damping sits on its bound. With its first bending mode near 3 kHz,
+// far above the 500 Hz band, the tool shows mainly as a static compliance
+// ∝ L³/d⁴, and diameter and stick-out trade off; noted in the README.)
+TEST(TwoHiddenEffects, AreBothFound) {
+  const Campaign c = MakeCampaign();
+  const Outcome o = Audit(c,
+                          {{"flange_compliance", {{"flange_compliance.bending_stiffness_Nm_per_rad", 1e6}}},
+                           {"base_compliance",
+                            {{"base_compliance.lateral_stiffness_N_per_m", 3e8},
+                             {"base_compliance.rocking_stiffness_Nm_per_rad", 2e7}}}},
+                          108);
+  const AuditResult& r = o.result;
+  EXPECT_TRUE(r.significant_failure);
+  ASSERT_GE(r.best, 0) << r.verdict;
+  std::vector<std::string> found = r.missing_effects;
+  std::sort(found.begin(), found.end());
+  EXPECT_EQ(found, (std::vector<std::string>{"base_compliance", "flange_compliance"})) << r.verdict;
+  EXPECT_TRUE(r.explained) << r.verdict;
+  EXPECT_LT(r.candidates[r.best].errors.total_rms_log_mag, 1.5 * o.true_error);
+}
+
+// Outside the library: a resonance of the measurement chain (an
+// accelerometer's mounting, 320 Hz, 4 % damping) multiplies every measured
+// FRF by 1 / (1 − r² + 2iζr), r = f / 320 Hz, at every posture alike. No
+// effect of the robot model makes a posture-independent resonance in every
+// FRF, so the audit must not attribute it with confidence: the verdict is
+// "unexplained" and describes the pattern (the failing band is the same at
+// every posture).
+TEST(EffectOutsideTheLibrary, IsReportedAsUnexplainedWithItsPattern) {
+  const Campaign c = MakeCampaign();
+  const auto mounting = [](dynamics::FrfSet* m) {
+    dynamics::FrfSet out;
+    for (const auto& [key, frf] : *m) {
+      Eigen::VectorXcd h = frf.receptance();
+      for (int i = 0; i < frf.size(); ++i) {
+        const double r = frf.freq_hz()(i) / 320.0;
+        h(i) /= std::complex<double>(1.0 - r * r, 2.0 * 0.04 * r);
+      }
+      out.Insert(key, dynamics::Frf::FromSamples(frf.freq_hz(), h));
+    }
+    *m = out;
+  };
+  const Outcome o = Audit(c, {}, 109, mounting);
+  const AuditResult& r = o.result;
+  EXPECT_TRUE(r.significant_failure);
+  EXPECT_FALSE(r.explained) << r.verdict;
+  EXPECT_TRUE(r.missing_effects.empty()) << r.verdict;
+  EXPECT_NE(r.verdict.find("unexplained"), std::string::npos) << r.verdict;
+  // The pattern: the band with 320 Hz is the worst at every posture (in at
+  // least one direction; the calibration may bend a robot mode elsewhere in
+  // the other), and the verdict says so.
+  EXPECT_NE(r.pattern.find("at every posture"), std::string::npos) << r.pattern;
+  EXPECT_NE(r.verdict.find(r.pattern), std::string::npos) << r.verdict;
+  std::set<std::string> poses;
+  for (const CurveError& ce : r.errors_before.curves) {
+    ASSERT_FALSE(ce.bands.empty());
+    if (ce.bands[0].fmin_hz <= 320.0 && ce.bands[0].fmax_hz >= 320.0) poses.insert(ce.key.pose_id);
+  }
+  EXPECT_EQ(poses.size(), c.postures.size());
+}
+
+}  // namespace
+}  // namespace robomach::audit
