@@ -1,5 +1,7 @@
 #include "cli_support.h"
 
+#include <glog/logging.h>
+
 #include <unistd.h>
 
 #include <filesystem>
@@ -19,6 +21,11 @@ std::string ExitCodeHelp() {
 }
 
 int RunGuarded(const std::string& tool, const std::function<int()>& body) {
+  // Ceres logs through glog ("E... covariance_impl.cc: Covariance matrix is
+  // near rank deficient", "Terminating: ..."). The library reports the same
+  // trouble as fit statuses and flags, which the tools print in their own
+  // words, so glog's lines below FATAL are silenced.
+  FLAGS_minloglevel = google::GLOG_FATAL;
   try {
     const int rc = body();
     // Results on stdout count as output: a full disk or closed pipe is an
