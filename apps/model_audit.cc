@@ -293,8 +293,8 @@ int Run(int argc, char** argv) {
     const std::string before_label = "current model (calibrated)";
     const std::string after_label = shown ? "with " + shown->name() + (best ? "" : " (not accepted)") : "";
     if (best) h << "<h2>Add the effect</h2><p>Append to the robot config:</p><pre>" << Html(yaml) << "</pre>\n";
-    h << "<h2>Overlays per posture</h2><p>Measured FRFs (wide band), the " << Html(before_label)
-      << " (dashed)" << (shown ? " and the model " + Html(after_label) + " (thin line)" : std::string())
+    h << "<h2>Overlays per posture</h2><p>Measured FRFs (wide band), the calibrated current model (dashed)"
+      << (shown ? " and the model " + Html(after_label) + " (thin line)" : std::string())
       << "; vertical lines: the natural frequencies of the " << (shown ? "latter" : "model") << ".</p>\n";
     for (const auto& id : measured.pose_ids()) {
       h << "<p><img src=\"overlay_" << Html(id) << ".png\" alt=\"overlay " << Html(id) << "\"></p>\n";
