@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "cli_support.h"
+#include "robomach/audit/error_patterns.h"
 #include "robomach/audit/model_audit.h"
 #include "robomach/common/errors.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -15,6 +16,7 @@
 #include "robomach/io/frf_files.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/report/audit_patterns_report.h"
 #include "robomach/report/calibration_report.h"
 #include "robomach/report/posture_json.h"
 
@@ -80,8 +82,11 @@ int Run(int argc, char** argv) {
       "of the library is missing. Calibrates the model (whole curve), reports the rms log-magnitude error\n"
       "per posture and direction with its worst bands, the per-mode errors and a noise-floor estimate; if\n"
       "the failure is significant, adds each library effect not in the model, fits it with the calibration\n"
-      "parameters and ranks the candidates by BIC (greedily a second one). Writes REPORT/summary.json,\n"
-      "index.html, errors.csv, candidates.csv, effects.yaml and overlay_<pose>.png."};
+      "parameters and ranks the candidates by BIC (greedily a second one). Also reports the trends of the\n"
+      "error against posture descriptors, an error map of postures against modes, and modes without a\n"
+      "counterpart either way. Writes REPORT/summary.json, index.html, errors.csv, candidates.csv,\n"
+      "trends.csv, posture_descriptors.csv, mode_errors.csv, unmatched_modes.csv, trends.png,\n"
+      "mode_error_map.png, overlay_<pose>.png and (with an accepted candidate) effects.yaml."};
   app.footer(ExitCodeHelp() + " Exit 3 when the failure is significant and no candidate explains it.");
   std::string robot_path, postures_path, report_dir, compare_dir, candidates_list;
   std::vector<std::string> measured_files, adds;
@@ -144,6 +149,20 @@ int Run(int argc, char** argv) {
     const audit::CandidateResult* best = r.best >= 0 ? &r.candidates[r.best] : nullptr;
     const audit::ModelErrors& after = best ? best->errors : r.errors_before;
 
+    // ---- where it fails: trends, error map, modes without a counterpart.
+    // RunAudit does not return its measured modes; the modal fit is
+    // deterministic, so fitting again with the audit's options gives the
+    // features its comparison indexes (AnalyzeErrorPatterns checks that).
+    opt.progress("error patterns: trends against posture descriptors, mode error map, unmatched modes");
+    const auto base_model = dynamics::RobotModel::Build(cfg.description, r.baseline_fit.parameters);
+    const calibration::MeasuredFeatures features =
+        calibration::ExtractFeatures(measured, audit::AuditModalFitOptions(opt));
+    audit::ErrorPatternOptions popt;
+    popt.fmin_hz = opt.fmin_hz;
+    popt.fmax_hz = opt.fmax_hz;
+    const audit::ErrorPatterns patterns = audit::AnalyzeErrorPatterns(r, base_model, postures, measured, features, popt);
+    const report::AuditPatternsReport pr = report::MakeAuditPatternsReport(patterns, r.noise_floor, "model-audit");
+
     // ---- summary.json (stable keys; see README)
     json j;
     j["robot"] = robot_path;
@@ -156,7 +175,14 @@ int Run(int argc, char** argv) {
     j["baseline_calibration"] = {{"status", calibration::FitStatusName(r.baseline_fit.status)},
                                  {"message", r.baseline_fit.message}};
     const auto pb = PerPosture(r.errors_before), pa = PerPosture(after);
-    for (const auto& [id, e] : pb) j["postures"][id] = {{"error_before", e}, {"error_after", pa.at(id)}};
+    for (const auto& [id, e] : pb) {
+      j["postures"][id] = {{"error_before", e}, {"error_after", pa.at(id)}};
+      if (pr.posture_descriptors.contains(id)) j["postures"][id]["descriptors"] = pr.posture_descriptors[id];
+    }
+    j["trends"] = pr.trends;
+    j["mode_error_map"] = pr.mode_error_map;
+    j["unmatched_model_modes"] = pr.unmatched_model_modes;
+    j["unmatched_measured_modes"] = pr.unmatched_measured_modes;
     j["candidates"] = json::array();
     for (const auto& c : r.candidates) {
       json cj{{"name", c.name()}, {"bic_change", c.bic_change}, {"error_after", c.errors.total_rms_log_mag},
@@ -244,8 +270,7 @@ int Run(int argc, char** argv) {
         << Num(100 * m.freq_error(), 3) << " %</td><td>" << Num(m.measured_damping, 3) << "</td><td>"
         << Num(m.model_damping, 3) << "</td><td>" << Num(100 * m.peak_error(), 3) << " %</td></tr>\n";
     }
-    h << "</table><p>Measured modes without a model counterpart: " << r.modes_before.unmatched_measured.size()
-      << ".</p>\n<h2>Candidate effects (best first)</h2>";
+    h << "</table>\n" << pr.html << "<h2>Candidate effects (best first)</h2>";
     if (r.candidates.empty()) h << "<p>None tried.</p>";
     h << "<table><tr><th>rank</th><th>candidate</th><th>ΔBIC</th><th>error after</th><th>plausible</th>"
          "<th>fitted parameters (±1σ)</th></tr>\n";
@@ -260,31 +285,59 @@ int Run(int argc, char** argv) {
       h << "</td></tr>\n";
     }
     h << "</table>\n";
-    if (best) {
-      h << "<h2>Add the effect</h2><p>Append to the robot config:</p><pre>" << Html(yaml) << "</pre>\n";
-      h << "<h2>Overlays (measured, model before, with " << Html(best->name()) << ")</h2>\n";
-      for (const auto& id : measured.pose_ids()) h << "<p><img src=\"overlay_" << Html(id) << ".png\"></p>\n";
+    // Overlays: the calibrated current model against the accepted candidate;
+    // without one, against the best-ranked candidate, labelled as not
+    // accepted, so that the unexplained pattern can be seen; with no
+    // candidate fitted, the current model alone.
+    const audit::CandidateResult* shown = best ? best : (r.candidates.empty() ? nullptr : &r.candidates[0]);
+    const std::string before_label = "current model (calibrated)";
+    const std::string after_label = shown ? "with " + shown->name() + (best ? "" : " (not accepted)") : "";
+    if (best) h << "<h2>Add the effect</h2><p>Append to the robot config:</p><pre>" << Html(yaml) << "</pre>\n";
+    h << "<h2>Overlays per posture</h2><p>Measured FRFs (wide band), the calibrated current model (dashed)"
+      << (shown ? " and the model " + Html(after_label) + " (thin line)" : std::string())
+      << "; vertical lines: the natural frequencies of the " << (shown ? "latter" : "model") << ".</p>\n";
+    for (const auto& id : measured.pose_ids()) {
+      h << "<p><img src=\"overlay_" << Html(id) << ".png\" alt=\"overlay " << Html(id) << "\"></p>\n";
     }
     h << "</body></html>\n";
 
     // ---- write (each file complete or absent)
     io::EnsureDirectory(report_dir);
     const fs::path dir(report_dir);
-    if (best) {
-      dynamics::RobotDescription desc = cfg.description;
-      for (const auto& e : best->effects) desc.effects.push_back({e, {}});
-      dynamics::PostureEvaluator eb(dynamics::RobotModel::Build(cfg.description, r.baseline_fit.parameters));
-      dynamics::PostureEvaluator ea(dynamics::RobotModel::Build(desc, best->fit.parameters));
-      for (const std::string& pose : measured.pose_ids()) {
-        const auto db = eb.Evaluate(postures.at(pose)), da = ea.Evaluate(postures.at(pose));
-        const report::PostureOverlay o = report::MakePostureOverlay(pose, measured, db, da);
-        report::WriteOverlayPng((dir / ("overlay_" + pose + ".png")).string(), o,
-                                "model-audit: posture " + pose + ", measured vs model before and with " + best->name());
+    {
+      dynamics::PostureEvaluator eb(base_model);
+      std::unique_ptr<dynamics::PostureEvaluator> ea;
+      if (shown) {
+        dynamics::RobotDescription desc = cfg.description;
+        for (const auto& e : shown->effects) desc.effects.push_back({e, {}});
+        ea = std::make_unique<dynamics::PostureEvaluator>(dynamics::RobotModel::Build(desc, shown->fit.parameters));
       }
+      for (const std::string& pose : measured.pose_ids()) {
+        const auto db = eb.Evaluate(postures.at(pose));
+        const report::PostureOverlay o = ea ? report::MakePostureOverlay(pose, measured, db, ea->Evaluate(postures.at(pose)))
+                                            : report::MakePostureOverlay(pose, measured, db);
+        report::WriteOverlayPng((dir / ("overlay_" + pose + ".png")).string(), o,
+                                "model-audit: posture " + pose + ", measured vs " + before_label +
+                                    (shown ? " and " + after_label : std::string()),
+                                before_label, after_label);
+      }
+    }
+    if (best) {
       io::WriteFileAtomically((dir / "effects.yaml").string(), "# model-audit: add to the robot config\n" + yaml);
     }
     io::WriteFileAtomically((dir / "errors.csv").string(), ecsv.str());
     io::WriteFileAtomically((dir / "candidates.csv").string(), ccsv.str());
+    const report::AuditPatternFiles names;
+    io::WriteFileAtomically((dir / names.trends_csv).string(), pr.trends_csv);
+    io::WriteFileAtomically((dir / names.posture_descriptors_csv).string(), pr.posture_descriptors_csv);
+    io::WriteFileAtomically((dir / names.mode_errors_csv).string(), pr.mode_errors_csv);
+    io::WriteFileAtomically((dir / names.unmatched_modes_csv).string(), pr.unmatched_modes_csv);
+    auto write_png = [&](const std::string& name, const std::vector<unsigned char>& png) {
+      io::WriteFileAtomically((dir / name).string(),
+                              std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+    };
+    write_png(names.trends_png, pr.trends_png);
+    if (!pr.mode_error_map_png.empty()) write_png(names.mode_error_map_png, pr.mode_error_map_png);
     io::WriteFileAtomically((dir / "index.html").string(), h.str());
     io::WriteFileAtomically((dir / "summary.json").string(), report::DumpJson(j));
 

@@ -104,39 +104,58 @@ void WriteTable3Markdown(const std::string& path, const std::vector<TableSet>& s
   });
 }
 
+namespace {
+
+Eigen::VectorXcd ModelEntry(const dynamics::PostureDynamics& d, const dynamics::FrfKey& key,
+                            const Eigen::VectorXd& freq_hz) {
+  const auto H = dynamics::Receptance(d, freq_hz);
+  const int r = static_cast<int>(key.response), e = static_cast<int>(key.excitation);
+  Eigen::VectorXcd h(freq_hz.size());
+  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) h(i) = H[i](r, e);
+  return h;
+}
+
+}  // namespace
+
 PostureOverlay MakePostureOverlay(const std::string& pose, const dynamics::FrfSet& measured,
                                   const dynamics::PostureDynamics& before,
                                   const dynamics::PostureDynamics& after) {
+  PostureOverlay o = MakePostureOverlay(pose, measured, before);
+  for (size_t k = 0; k < o.keys.size(); ++k) o.after.push_back(ModelEntry(after, o.keys[k], o.freq_hz[k]));
+  o.mode_freq_hz.clear();
+  for (const auto& m : after.modes) o.mode_freq_hz.push_back(m.freq_hz);
+  return o;
+}
+
+PostureOverlay MakePostureOverlay(const std::string& pose, const dynamics::FrfSet& measured,
+                                  const dynamics::PostureDynamics& model) {
   PostureOverlay o;
   o.pose_id = pose;
   for (const auto& [key, frf] : measured.ForPose(pose)) {
     o.keys.push_back(key);
     o.freq_hz.push_back(frf.freq_hz());
     o.measured.push_back(frf.receptance());
-    const auto hb = dynamics::Receptance(before, frf.freq_hz());
-    const auto ha = dynamics::Receptance(after, frf.freq_hz());
-    const int r = static_cast<int>(key.response), e = static_cast<int>(key.excitation);
-    Eigen::VectorXcd b(frf.size()), a(frf.size());
-    for (int i = 0; i < frf.size(); ++i) {
-      b(i) = hb[i](r, e);
-      a(i) = ha[i](r, e);
-    }
-    o.before.push_back(b);
-    o.after.push_back(a);
+    o.before.push_back(ModelEntry(model, key, frf.freq_hz()));
   }
-  for (const auto& m : after.modes) o.mode_freq_hz.push_back(m.freq_hz);
+  for (const auto& m : model.modes) o.mode_freq_hz.push_back(m.freq_hz);
   return o;
 }
 
-void WriteOverlayPng(const std::string& path, const PostureOverlay& o, const std::string& title) {
+void WriteOverlayPng(const std::string& path, const PostureOverlay& o, const std::string& title,
+                     const std::string& before_label, const std::string& after_label) {
   const int rows = static_cast<int>(o.keys.size());
   Figure fig(std::max(1, rows), 2, 760, 340);
   fig.title = title;
   for (int r = 0; r < rows; ++r) {
-    std::vector<FrfCurve> curves(3);
-    curves[0] = {o.freq_hz[r], o.measured[r], "measured H" + Dir(o.keys[r]), PaletteColor(0), false};
-    curves[1] = {o.freq_hz[r], o.before[r], "model before", PaletteColor(1), true};
-    curves[2] = {o.freq_hz[r], o.after[r], "model after", PaletteColor(2), false};
+    // Measured wide and first, the models thin on top: a model that fits
+    // the measurement runs inside the measured band instead of hiding it.
+    std::vector<FrfCurve> curves;
+    // Light (sky blue) under dark (black): the contrast keeps both visible.
+    curves.push_back({o.freq_hz[r], o.measured[r], "measured H" + Dir(o.keys[r]), PaletteColor(5), false, 6});
+    curves.push_back({o.freq_hz[r], o.before[r], before_label, PaletteColor(1), true, 2});
+    if (static_cast<size_t>(r) < o.after.size()) {
+      curves.push_back({o.freq_hz[r], o.after[r], after_label, PaletteColor(6), false, 1});
+    }
     FillFrfPanels(curves, o.mode_freq_hz, "posture " + o.pose_id + ": H" + Dir(o.keys[r]), &fig.at(r, 0),
                   &fig.at(r, 1));
     fig.at(r, 1).title = "phase";

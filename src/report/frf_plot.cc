@@ -36,6 +36,7 @@ void FillFrfPanels(const std::vector<FrfCurve>& curves, const std::vector<double
     m.label = c.label;
     m.color = p.color = c.color;
     m.dashed = p.dashed = c.dashed;
+    m.thickness = p.thickness = c.thickness;
     for (Eigen::Index i = 0; i < c.freq_hz.size(); ++i) {
       m.x.push_back(c.freq_hz(i));
       p.x.push_back(c.freq_hz(i));

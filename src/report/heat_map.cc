@@ -41,10 +41,14 @@ cv::Vec3b Colour(double t) {
   return out.at<cv::Vec3b>(0, 0);
 }
 
-}  // namespace
-
-std::vector<unsigned char> EncodeHeatMapPng(const HeatMap& m) {
-  const int W = 1000, H = 720, left = 90, right = 180, top = 60, bottom = 90;
+cv::Mat Render(const HeatMap& m) {
+  const int W = m.width_px, H = m.height_px, right = 180, top = 60, bottom = 90;
+  // Categorical row labels (posture ids) may be wider than numeric ticks.
+  int left = 90;
+  for (const std::string& l : m.y_tick_labels) {
+    int base = 0;
+    left = std::max(left, 50 + cv::getTextSize(l, kFont, 0.42, 1, &base).width);
+  }
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   const int pw = W - left - right, ph = H - top - bottom;
   Text(img, m.title, {W / 2, 30}, 0.6, 1);
@@ -61,14 +65,23 @@ std::vector<unsigned char> EncodeHeatMapPng(const HeatMap& m) {
   const double xa = m.x0 - 0.5 * m.dx, xb = m.x0 + (m.nx - 0.5) * m.dx;
   const double ya = m.y0 - 0.5 * m.dy, yb = m.y0 + (m.ny - 0.5) * m.dy;
   auto px = [&](double x) { return left + static_cast<int>(std::lround((x - xa) / (xb - xa) * pw)); };
-  auto py = [&](double y) { return top + ph - static_cast<int>(std::lround((y - ya) / (yb - ya) * ph)); };
+  auto py = [&](double y) {
+    const int from_bottom = static_cast<int>(std::lround((y - ya) / (yb - ya) * ph));
+    return m.first_row_at_top ? top + from_bottom : top + ph - from_bottom;
+  };
+  if (m.symmetric_range) {
+    const double a = std::max(std::abs(vmin), std::abs(vmax));
+    vmin = -a;
+    vmax = a;
+  }
   for (int r = 0; r < m.ny; ++r) {
     for (int c = 0; c < m.nx; ++c) {
       const size_t i = static_cast<size_t>(r) * m.nx + c;
       const double v = i < m.values.size() ? m.values[i] : NAN;
       const cv::Point a(px(m.x0 + (c - 0.5) * m.dx), py(m.y0 + (r + 0.5) * m.dy));
       const cv::Point b(px(m.x0 + (c + 0.5) * m.dx), py(m.y0 + (r - 0.5) * m.dy));
-      const cv::Rect cell(a, b);
+      const cv::Rect cell(cv::Point(std::min(a.x, b.x), std::min(a.y, b.y)),
+                          cv::Point(std::max(a.x, b.x), std::max(a.y, b.y)));
       if (std::isfinite(v)) {
         const cv::Vec3b col = Colour((v - vmin) / (vmax - vmin));
         cv::rectangle(img, cell, cv::Scalar(col[0], col[1], col[2]), cv::FILLED);
@@ -81,18 +94,44 @@ std::vector<unsigned char> EncodeHeatMapPng(const HeatMap& m) {
         cv::line(img, {cell.x, cell.y + cell.height}, {cell.x + cell.width, cell.y}, cv::Scalar(40, 40, 200), 1,
                  cv::LINE_AA);
       }
+      if (m.annotate && std::isfinite(v)) {
+        char buf[32];
+        std::snprintf(buf, sizeof(buf), "%.3g", v);
+        // Dark text on the light (yellow) end of viridis, light text on the dark end.
+        const bool light = (v - vmin) / (vmax - vmin) > 0.6;
+        int base = 0;
+        const cv::Size sz = cv::getTextSize(buf, kFont, 0.45, 1, &base);
+        cv::putText(img, buf, {cell.x + (cell.width - sz.width) / 2, cell.y + (cell.height + sz.height) / 2}, kFont,
+                    0.45, light ? kBlack : cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+      }
     }
   }
   cv::rectangle(img, cv::Rect(left, top, pw, ph), kBlack, 1);
-  for (double t : LinearTicks(xa, xb, 7)) {
-    if (t < xa || t > xb) continue;
-    cv::line(img, {px(t), top + ph}, {px(t), top + ph + 5}, kBlack);
-    Text(img, Label(t), {px(t), top + ph + 20}, 0.42, 1);
+  if (!m.x_tick_labels.empty()) {
+    for (int c = 0; c < m.nx && c < static_cast<int>(m.x_tick_labels.size()); ++c) {
+      const int x = px(m.x0 + c * m.dx);
+      cv::line(img, {x, top + ph}, {x, top + ph + 5}, kBlack);
+      Text(img, m.x_tick_labels[c], {x, top + ph + 20}, 0.42, 1);
+    }
+  } else {
+    for (double t : LinearTicks(xa, xb, 7)) {
+      if (t < xa || t > xb) continue;
+      cv::line(img, {px(t), top + ph}, {px(t), top + ph + 5}, kBlack);
+      Text(img, Label(t), {px(t), top + ph + 20}, 0.42, 1);
+    }
   }
-  for (double t : LinearTicks(ya, yb, 7)) {
-    if (t < ya || t > yb) continue;
-    cv::line(img, {left - 5, py(t)}, {left, py(t)}, kBlack);
-    Text(img, Label(t), {left - 8, py(t) + 5}, 0.42, 2);
+  if (!m.y_tick_labels.empty()) {
+    for (int r = 0; r < m.ny && r < static_cast<int>(m.y_tick_labels.size()); ++r) {
+      const int y = py(m.y0 + r * m.dy);
+      cv::line(img, {left - 5, y}, {left, y}, kBlack);
+      Text(img, m.y_tick_labels[r], {left - 8, y + 5}, 0.42, 2);
+    }
+  } else {
+    for (double t : LinearTicks(ya, yb, 7)) {
+      if (t < ya || t > yb) continue;
+      cv::line(img, {left - 5, py(t)}, {left, py(t)}, kBlack);
+      Text(img, Label(t), {left - 8, py(t) + 5}, 0.42, 2);
+    }
   }
   Text(img, m.x_label, {left + pw / 2, top + ph + 45}, 0.5, 1);
   {
@@ -131,13 +170,42 @@ std::vector<unsigned char> EncodeHeatMapPng(const HeatMap& m) {
     cv::line(img, {cell.x, cell.y + cell.height}, {cell.x + cell.width, cell.y}, cv::Scalar(40, 40, 200), 1, cv::LINE_AA);
     Text(img, m.mark_label, {left + 282, ly + 1}, 0.45);
   }
+  return img;
+}
+
+std::vector<unsigned char> Encode(const cv::Mat& img) {
   std::vector<unsigned char> png;
   if (!cv::imencode(".png", img, png)) throw OutputError("PNG encoding failed");
   return png;
 }
 
+}  // namespace
+
+std::vector<unsigned char> EncodeHeatMapPng(const HeatMap& map) { return Encode(Render(map)); }
+
 void SaveHeatMapPng(const HeatMap& map, const std::string& path) {
   const std::vector<unsigned char> png = EncodeHeatMapPng(map);
+  io::WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+}
+
+std::vector<unsigned char> EncodeHeatMapsPng(const std::vector<HeatMap>& maps) {
+  std::vector<cv::Mat> images;
+  int width = 1;
+  for (const HeatMap& m : maps) {
+    images.push_back(Render(m));
+    width = std::max(width, images.back().cols);
+  }
+  if (images.empty()) images.emplace_back(1, 1, CV_8UC3, cv::Scalar(255, 255, 255));
+  for (cv::Mat& im : images) {
+    if (im.cols < width) cv::copyMakeBorder(im, im, 0, 0, 0, width - im.cols, cv::BORDER_CONSTANT, cv::Scalar(255, 255, 255));
+  }
+  cv::Mat all;
+  cv::vconcat(images, all);
+  return Encode(all);
+}
+
+void SaveHeatMapsPng(const std::vector<HeatMap>& maps, const std::string& path) {
+  const std::vector<unsigned char> png = EncodeHeatMapsPng(maps);
   io::WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
 }
 

@@ -1,6 +1,8 @@
 # Runs one app and checks its exit code, stderr and output files.
 #   cmake -DCMD="exe;arg;..." -DEXPECT_RC=0 [-DSTDERR_REGEX=...] [-DFILES="a;b"]
-#         [-DNO_FILES="c;d"] [-DCLEAN="c;d"] -P check_app.cmake
+#         [-DNO_FILES="c;d"] [-DCLEAN="c;d"]
+#         [-DJSON=out.json -DJSON_KEYS="key;key.sub;..."] -P check_app.cmake
+# JSON_KEYS are paths of object keys, dots between levels; each must exist.
 foreach(f ${CLEAN})
   file(REMOVE_RECURSE ${f})
 endforeach()
@@ -24,3 +26,13 @@ foreach(f ${NO_FILES})
     message(FATAL_ERROR "${f} exists although the run failed (partial output)")
   endif()
 endforeach()
+if(DEFINED JSON)
+  file(READ ${JSON} json_text)
+  foreach(path ${JSON_KEYS})
+    string(REPLACE "." ";" parts "${path}")
+    string(JSON type ERROR_VARIABLE json_error TYPE "${json_text}" ${parts})
+    if(json_error)
+      message(FATAL_ERROR "${JSON}: no key '${path}' (${json_error})")
+    endif()
+  endforeach()
+endif()

@@ -42,8 +42,8 @@ struct PostureOverlay {
   std::string pose_id;
   std::vector<dynamics::FrfKey> keys;
   std::vector<Eigen::VectorXd> freq_hz;
-  std::vector<Eigen::VectorXcd> measured, before, after;  // [m/N]
-  std::vector<double> mode_freq_hz;                       // model after calibration
+  std::vector<Eigen::VectorXcd> measured, before, after;  // [m/N]; `after` may be empty
+  std::vector<double> mode_freq_hz;                       // model after calibration (else before)
 };
 
 /// The overlay of one posture: every measured FRF of `pose` with the model
@@ -51,9 +51,17 @@ struct PostureOverlay {
 PostureOverlay MakePostureOverlay(const std::string& pose, const dynamics::FrfSet& measured,
                                   const dynamics::PostureDynamics& before,
                                   const dynamics::PostureDynamics& after);
+/// The same with one model only (`after` empty): measured against `model`.
+PostureOverlay MakePostureOverlay(const std::string& pose, const dynamics::FrfSet& measured,
+                                  const dynamics::PostureDynamics& model);
 
-/// One PNG: a magnitude and a phase panel per direction pair.
-void WriteOverlayPng(const std::string& path, const PostureOverlay& overlay, const std::string& title);
+/// One PNG: a magnitude and a phase panel per direction pair. The measured
+/// curve is drawn wide underneath the models, so that a model that fits it
+/// does not hide it. `before_label` and `after_label` name the two models
+/// in the legend.
+void WriteOverlayPng(const std::string& path, const PostureOverlay& overlay, const std::string& title,
+                     const std::string& before_label = "model before",
+                     const std::string& after_label = "model after");
 
 /// The stabilisation diagrams of the modal fits of one posture's FRFs: one
 /// panel per FRF, poles per model order against frequency (stable ones in

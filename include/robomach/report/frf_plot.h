@@ -17,6 +17,7 @@ struct FrfCurve {
   std::string label;            // e.g. "Hxx"
   Rgb color;
   bool dashed{false};
+  int thickness{2};             // [px]
 };
 
 /// Fills a magnitude panel (log |H| in m/N) and a phase panel (degrees, -180..180)

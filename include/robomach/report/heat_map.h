@@ -18,6 +18,14 @@ struct HeatMap {
   std::vector<int> marks;            // same size or empty; 0 = none, 1 = hatched
   std::string mark_label;            // legend text of hatched cells, e.g. "unreachable"
   std::string nan_label{"no value"}; // legend text of grey cells
+  /// Categorical axes: one label per column / row at the cell centres
+  /// instead of numeric ticks (e.g. mode numbers, posture ids); ASCII only.
+  std::vector<std::string> x_tick_labels;
+  std::vector<std::string> y_tick_labels;
+  bool first_row_at_top{false};      // row 0 drawn at the top (tables), not the bottom (plots)
+  bool annotate{false};              // print each cell's value (3 significant digits) in it
+  bool symmetric_range{false};       // colour range −max|v| … +max|v|: 0 in the middle
+  int width_px{1000}, height_px{720};
 };
 
 /// Renders to PNG bytes (viridis colours, colour bar with ticks).
@@ -25,5 +33,8 @@ std::vector<unsigned char> EncodeHeatMapPng(const HeatMap& map);
 /// Renders and writes atomically (formats.md §4).
 /// @throws OutputError if the file cannot be written.
 void SaveHeatMapPng(const HeatMap& map, const std::string& path);
+/// Several maps stacked top to bottom in one PNG (the widest sets the width).
+std::vector<unsigned char> EncodeHeatMapsPng(const std::vector<HeatMap>& maps);
+void SaveHeatMapsPng(const std::vector<HeatMap>& maps, const std::string& path);
 
 }  // namespace robomach::report

@@ -1,0 +1,334 @@
+#include "robomach/report/audit_patterns_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "robomach/common/units.h"
+#include "robomach/io/number_format.h"
+#include "robomach/report/heat_map.h"
+#include "robomach/report/plot.h"
+
+namespace robomach::report {
+namespace {
+
+using nlohmann::json;
+
+std::string Num(double v) { return std::isfinite(v) ? io::FormatDouble(v) : ""; }
+
+std::string Fixed(double v, int digits) {
+  if (!std::isfinite(v)) return "–";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
+  return buf;
+}
+
+json JsonNumber(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+std::string Dir(const dynamics::FrfKey& k) { return std::string(1, AxisName(k.response)) + AxisName(k.excitation); }
+
+std::string Html(const std::string& s) {
+  std::string o;
+  for (char ch : s) {
+    if (ch == '<') o += "&lt;";
+    else if (ch == '>') o += "&gt;";
+    else if (ch == '&') o += "&amp;";
+    else o += ch;
+  }
+  return o;
+}
+
+// A descriptor as shown: joint angles in degrees, the rest in SI.
+struct Shown {
+  std::string name;
+  std::string unit;
+  double scale{1.0};
+  std::string key() const { return name + "_" + unit; }
+};
+
+Shown Display(const std::string& name, const std::string& unit) {
+  if (unit == "rad") return {name, "deg", RadToDeg(1.0)};
+  return {name, unit, 1.0};
+}
+
+std::vector<unsigned char> TrendsPng(const audit::ErrorPatterns& p, double noise_floor, const std::string& title) {
+  const audit::ErrorTrends& t = p.trends;
+  const int n = static_cast<int>(t.trends.size());
+  const int cols = 2, rows = std::max(1, (n + cols - 1) / cols);
+  Figure fig(rows, cols, 620, 300);
+  fig.title = title;
+  for (int i = 0; i < n; ++i) {
+    const audit::Trend& tr = t.trends[i];
+    const Shown s = Display(tr.descriptor, tr.unit);
+    Axes& ax = fig.at(i / cols, i % cols);
+    std::string head = tr.descriptor + ": r = " + Fixed(tr.correlation_before, 2);
+    if (t.error_after.size() > 0) head += " before, " + Fixed(tr.correlation_after, 2) + " after";
+    head += " (n = " + std::to_string(t.n) + (tr.significant_before ? ", significant)" : ")");
+    ax.title = head;
+    ax.x_label = s.name + " [" + s.unit + "]";
+    ax.y_label = "rms log-mag error [-]";
+    ax.y_min = 0.0;
+    ax.legend = Axes::LegendPosition::kTopRight;
+    Series before, after, floor;
+    before.markers = after.markers = true;
+    before.label = "before";
+    before.color = PaletteColor(1);
+    after.label = "after best candidate";
+    after.color = PaletteColor(2);
+    double xlo = INFINITY, xhi = -INFINITY;
+    for (int k = 0; k < t.n; ++k) {
+      const double x = s.scale * tr.values(k);
+      xlo = std::min(xlo, x);
+      xhi = std::max(xhi, x);
+      before.x.push_back(x);
+      before.y.push_back(t.error_before(k));
+      if (t.error_after.size() > 0) {
+        after.x.push_back(x);
+        after.y.push_back(t.error_after(k));
+      }
+    }
+    ax.series.push_back(std::move(before));
+    if (!after.x.empty()) ax.series.push_back(std::move(after));
+    if (std::isfinite(noise_floor) && std::isfinite(xlo)) {
+      const double pad = xhi > xlo ? 0.05 * (xhi - xlo) : 1.0;
+      floor.x = {xlo - pad, xhi + pad};
+      floor.y = {noise_floor, noise_floor};
+      floor.label = "noise floor";
+      floor.color = {120, 120, 120};
+      floor.dashed = true;
+      floor.thickness = 1;
+      ax.series.push_back(std::move(floor));
+    }
+    // Headroom for the legend above the highest point.
+    double ymax = std::isfinite(noise_floor) ? noise_floor : 0.0;
+    for (const Series& se : ax.series) {
+      for (double y : se.y) {
+        if (std::isfinite(y)) ymax = std::max(ymax, y);
+      }
+    }
+    ax.y_max = ymax > 0.0 ? 1.6 * ymax : 1.0;
+  }
+  return fig.EncodePng();
+}
+
+std::vector<unsigned char> ModeMapPng(const audit::ModeErrorMap& m, const std::string& title) {
+  if (m.modes.empty() || m.pose_ids.empty()) return {};
+  auto make = [&](const Eigen::MatrixXd& values, const std::string& what) {
+    HeatMap h;
+    h.title = title + ": " + what;
+    h.x_label = "model mode (ascending frequency)";
+    h.y_label = "posture";
+    h.colorbar_label = "error [%]";
+    h.nan_label = "no match (mode not seen or not matched)";
+    h.nx = static_cast<int>(m.modes.size());
+    h.ny = static_cast<int>(m.pose_ids.size());
+    for (int r = 0; r < h.ny; ++r) {
+      for (int c = 0; c < h.nx; ++c) h.values.push_back(100.0 * values(r, c));
+    }
+    for (int mode : m.modes) h.x_tick_labels.push_back(std::to_string(mode));
+    h.y_tick_labels = m.pose_ids;
+    h.first_row_at_top = h.annotate = h.symmetric_range = true;
+    h.width_px = std::clamp(300 + 90 * h.nx, 760, 1100);
+    h.height_px = 150 + std::clamp(40 * h.ny, 160, 600);
+    return h;
+  };
+  return EncodeHeatMapsPng({make(m.freq_error, "natural frequency, 100 (f_model / f_measured - 1)"),
+                            make(m.peak_error, "peak amplitude, 100 (|H|_model / |H|_measured - 1)")});
+}
+
+}  // namespace
+
+AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, double noise_floor,
+                                            const std::string& title, const AuditPatternFiles& files) {
+  AuditPatternsReport out;
+  const audit::ErrorTrends& t = p.trends;
+  const bool has_after = t.error_after.size() > 0;
+
+  // ---- trends
+  out.trends = json::array();
+  std::ostringstream tcsv;
+  tcsv << "descriptor,unit,n,critical_correlation,correlation_before,significant_before,correlation_after,"
+          "significant_after\n";
+  for (const audit::Trend& tr : t.trends) {
+    const Shown s = Display(tr.descriptor, tr.unit);
+    out.trends.push_back({{"descriptor", tr.descriptor},
+                          {"unit", s.unit},
+                          {"correlation", JsonNumber(tr.correlation_before)},
+                          {"significant", tr.significant_before},
+                          {"n", t.n},
+                          {"critical_correlation", JsonNumber(t.critical_correlation)},
+                          {"correlation_after", JsonNumber(tr.correlation_after)},
+                          {"significant_after", has_after ? json(tr.significant_after) : json(nullptr)}});
+    tcsv << tr.descriptor << ',' << s.unit << ',' << t.n << ',' << Num(t.critical_correlation) << ','
+         << Num(tr.correlation_before) << ',' << (tr.significant_before ? "yes" : "no") << ','
+         << Num(tr.correlation_after) << ',' << (has_after ? (tr.significant_after ? "yes" : "no") : "") << '\n';
+  }
+  out.trends_csv = tcsv.str();
+
+  // ---- per-posture descriptors and errors
+  std::ostringstream dcsv;
+  dcsv << "pose_id,error_before,error_after";
+  for (const audit::Trend& tr : t.trends) dcsv << ',' << Display(tr.descriptor, tr.unit).key();
+  dcsv << '\n';
+  out.posture_descriptors = json::object();
+  for (int k = 0; k < t.n; ++k) {
+    const std::string& id = t.pose_ids[k];
+    dcsv << id << ',' << Num(t.error_before(k)) << ',' << (has_after ? Num(t.error_after(k)) : "");
+    json d = json::object();
+    for (const audit::Trend& tr : t.trends) {
+      const Shown s = Display(tr.descriptor, tr.unit);
+      dcsv << ',' << Num(s.scale * tr.values(k));
+      d[s.key()] = JsonNumber(s.scale * tr.values(k));
+    }
+    dcsv << '\n';
+    out.posture_descriptors[id] = d;
+  }
+  out.posture_descriptors_csv = dcsv.str();
+
+  // ---- mode error map
+  const audit::ModeErrorMap& m = p.mode_map;
+  json fe = json::array(), pe = json::array();
+  std::ostringstream mcsv;
+  mcsv << "pose_id,model_mode,response,excitation,model_freq_hz,measured_freq_hz,freq_error,model_peak_m_per_N,"
+          "measured_peak_m_per_N,peak_error\n";
+  for (size_t r = 0; r < m.pose_ids.size(); ++r) {
+    json fr = json::array(), pr = json::array();
+    for (size_t c = 0; c < m.modes.size(); ++c) {
+      const auto ri = static_cast<Eigen::Index>(r), ci = static_cast<Eigen::Index>(c);
+      fr.push_back(JsonNumber(m.freq_error(ri, ci)));
+      pr.push_back(JsonNumber(m.peak_error(ri, ci)));
+      mcsv << m.pose_ids[r] << ',' << m.modes[c] << ',';
+      const int k = m.match(ri, ci);
+      if (k < 0 || k >= static_cast<int>(m.matches.size())) {
+        mcsv << ",,,,,,,\n";
+        continue;
+      }
+      const calibration::ModeMatch& mm = m.matches[k];
+      mcsv << AxisName(mm.key.response) << ',' << AxisName(mm.key.excitation) << ',' << Num(mm.model_freq_hz) << ','
+           << Num(mm.measured_freq_hz) << ',' << Num(mm.freq_error()) << ',' << Num(mm.model_peak) << ','
+           << Num(mm.measured_peak) << ',' << Num(mm.peak_error()) << '\n';
+    }
+    fe.push_back(fr);
+    pe.push_back(pr);
+  }
+  out.mode_error_map = {{"poses", m.pose_ids}, {"modes", m.modes}, {"freq_error", fe}, {"peak_error", pe}};
+  out.mode_errors_csv = mcsv.str();
+
+  // ---- unmatched modes
+  out.unmatched_model_modes = json::array();
+  out.unmatched_measured_modes = json::array();
+  std::ostringstream ucsv;
+  ucsv << "side,pose_id,response,excitation,model_mode,freq_hz,damping_ratio,relative_visibility\n";
+  for (const audit::UnmatchedMode& u : p.unmatched_model) {
+    out.unmatched_model_modes.push_back({{"pose", u.key.pose_id},
+                                         {"direction", Dir(u.key)},
+                                         {"frequency_hz", u.freq_hz},
+                                         {"model_mode", u.model_mode + 1},
+                                         {"damping_ratio", u.damping_ratio},
+                                         {"relative_visibility", JsonNumber(u.relative_visibility)}});
+    ucsv << "model," << u.key.pose_id << ',' << AxisName(u.key.response) << ',' << AxisName(u.key.excitation) << ','
+         << u.model_mode + 1 << ',' << Num(u.freq_hz) << ',' << Num(u.damping_ratio) << ','
+         << Num(u.relative_visibility) << '\n';
+  }
+  for (const audit::UnmatchedMode& u : p.unmatched_measured) {
+    out.unmatched_measured_modes.push_back({{"pose", u.key.pose_id},
+                                            {"direction", Dir(u.key)},
+                                            {"frequency_hz", u.freq_hz},
+                                            {"damping_ratio", u.damping_ratio},
+                                            {"relative_visibility", JsonNumber(u.relative_visibility)}});
+    ucsv << "measured," << u.key.pose_id << ',' << AxisName(u.key.response) << ',' << AxisName(u.key.excitation)
+         << ",," << Num(u.freq_hz) << ',' << Num(u.damping_ratio) << ',' << Num(u.relative_visibility) << '\n';
+  }
+  out.unmatched_modes_csv = ucsv.str();
+
+  // ---- pictures
+  std::string figure_title = title + ": error per posture against posture descriptors (n = " + std::to_string(t.n);
+  if (std::isfinite(t.critical_correlation)) {
+    figure_title += "; |r| > " + Fixed(t.critical_correlation, 2) + " is significant at " +
+                    Fixed(100 * t.significance_level, 0) + " %)";
+  } else {
+    figure_title += "; too few postures for a test)";
+  }
+  out.trends_png = TrendsPng(p, noise_floor, figure_title);
+  out.mode_error_map_png = ModeMapPng(m, title);
+
+  // ---- HTML
+  std::ostringstream h;
+  h << "<h2>Error against posture descriptors</h2>\n<p>Pearson correlation r of the rms log-magnitude error per "
+       "posture with each posture descriptor over n = "
+    << t.n << " postures. ";
+  if (std::isfinite(t.critical_correlation)) {
+    h << "|r| must exceed " << Fixed(t.critical_correlation, 3) << " to be significant at "
+      << Fixed(100 * t.significance_level, 0)
+      << " % (two-sided t-test, n − 2 degrees of freedom). With few postures a trend is only indicative: one "
+         "posture can make or break it.";
+  } else {
+    h << "At least 3 postures are needed for a significance test; these correlations mean nothing.";
+  }
+  if (!t.failing_before) {
+    h << " The errors are consistent with the noise floor at every posture: there is no failure whose pattern "
+         "could be flagged.";
+  }
+  if (has_after && !t.failing_after) {
+    h << " After the best candidate the errors are at the noise floor everywhere: the correlations after it "
+         "describe noise and are never flagged.";
+  }
+  h << " Data: <a href=\"" << Html(files.trends_csv) << "\">" << Html(files.trends_csv) << "</a>, <a href=\""
+    << Html(files.posture_descriptors_csv) << "\">" << Html(files.posture_descriptors_csv) << "</a>.</p>\n";
+  h << "<table><tr><th>descriptor</th><th>unit</th><th>r before</th>" << (has_after ? "<th>r after</th>" : "")
+    << "<th>significant</th></tr>\n";
+  for (const audit::Trend& tr : t.trends) {
+    h << "<tr><td>" << Html(tr.descriptor) << "</td><td>" << Html(Display(tr.descriptor, tr.unit).unit)
+      << "</td><td>" << Fixed(tr.correlation_before, 3) << "</td>";
+    if (has_after) h << "<td>" << Fixed(tr.correlation_after, 3) << "</td>";
+    h << "<td>" << (tr.significant_before ? "<b>yes</b>" : "no")
+      << (has_after ? std::string(" / ") + (tr.significant_after ? "<b>yes</b>" : "no") + " after" : "")
+      << "</td></tr>\n";
+  }
+  h << "</table>\n<p><img src=\"" << Html(files.trends_png) << "\" alt=\"error against posture descriptors\"></p>\n";
+
+  h << "<h2>Error map: postures against model modes</h2>\n";
+  if (out.mode_error_map_png.empty()) {
+    h << "<p>No measured mode was matched to a model mode: nothing to map.</p>\n";
+  } else {
+    h << "<p>Relative error of the calibrated current model per posture and model mode (numbered in ascending "
+         "frequency), where a measured mode matched it; where it matched in several FRFs, the one with the largest "
+         "measured peak. Table: <a href=\""
+      << Html(files.mode_errors_csv) << "\">" << Html(files.mode_errors_csv) << "</a>.</p>\n<p><img src=\""
+      << Html(files.mode_error_map_png) << "\" alt=\"error map postures x modes\"></p>\n";
+  }
+
+  h << "<h2>Modes without a counterpart</h2>\n<p>Per FRF: measured modes with no model mode near them (the model "
+       "lacks them), and model modes that should show in the FRF (peak contribution |p<sub>r</sub> p<sub>e</sub>|"
+       "/(2ζω²) at least 10 % of the largest model mode in the FRF's band) with no measured mode near them. "
+       "\"Near\" is the matching's rule (frequency within its window, cost |ln f ratio| + w |ln visibility "
+       "ratio|, one to one); modes too weak for the matching to try are paired by the same rule without the "
+       "visibility threshold ("
+    << p.weak_pairs << " such weak pairs, not listed). Table: <a href=\"" << Html(files.unmatched_modes_csv) << "\">"
+    << Html(files.unmatched_modes_csv) << "</a>.</p>\n";
+  auto table = [&](const std::vector<audit::UnmatchedMode>& list, const std::string& what, bool model) {
+    h << "<h3>" << what << ": " << list.size() << "</h3>\n";
+    if (list.empty()) return;
+    h << "<table><tr><th>posture</th><th>FRF</th>" << (model ? "<th>model mode</th>" : "")
+      << "<th>frequency [Hz]</th><th>damping ratio</th><th>relative visibility</th></tr>\n";
+    for (const audit::UnmatchedMode& u : list) {
+      h << "<tr><td>" << Html(u.key.pose_id) << "</td><td>H" << Dir(u.key) << "</td>";
+      if (model) h << "<td>" << u.model_mode + 1 << "</td>";
+      h << "<td>" << Fixed(u.freq_hz, 2) << "</td><td>" << Fixed(u.damping_ratio, 4) << "</td><td>"
+        << Fixed(u.relative_visibility, 2) << "</td></tr>\n";
+    }
+    h << "</table>\n";
+  };
+  table(p.unmatched_measured, "Measured modes without a model mode", false);
+  table(p.unmatched_model, "Model modes without a measured mode", true);
+  if (!p.frfs_without_modal_fit.empty()) {
+    h << "<p>The modal fit found no mode in";
+    for (const auto& k : p.frfs_without_modal_fit) h << ' ' << Html(k.pose_id) << " H" << Dir(k);
+    h << "; model modes are not checked there.</p>\n";
+  }
+  out.html = h.str();
+  return out;
+}
+
+}  // namespace robomach::report
