@@ -150,13 +150,9 @@ int Run(int argc, char** argv) {
     const audit::ModelErrors& after = best ? best->errors : r.errors_before;
 
     // ---- where it fails: trends, error map, modes without a counterpart.
-    // RunAudit does not return its measured modes; the modal fit is
-    // deterministic, so fitting again with the audit's options gives the
-    // features its comparison indexes (AnalyzeErrorPatterns checks that).
     opt.progress("error patterns: trends against posture descriptors, mode error map, unmatched modes");
     const auto base_model = dynamics::RobotModel::Build(cfg.description, r.baseline_fit.parameters);
-    const calibration::MeasuredFeatures features =
-        calibration::ExtractFeatures(measured, audit::AuditModalFitOptions(opt));
+    const calibration::MeasuredFeatures& features = r.features;
     audit::ErrorPatternOptions popt;
     popt.fmin_hz = opt.fmin_hz;
     popt.fmax_hz = opt.fmax_hz;
@@ -186,11 +182,16 @@ int Run(int argc, char** argv) {
     j["candidates"] = json::array();
     for (const auto& c : r.candidates) {
       json cj{{"name", c.name()}, {"bic_change", c.bic_change}, {"error_after", c.errors.total_rms_log_mag},
-              {"plausible", c.plausible}, {"note", c.note}, {"parameters", json::object()}};
+              {"plausible", c.plausible}, {"note", c.note}, {"parameters", json::object()},
+              {"not_identifiable", c.not_identifiable}, {"held_calibration", c.held_calibration},
+              {"start", c.start}};
       for (const auto& e : c.fit.estimates) cj["parameters"][e.name] = {{"value", e.value}, {"std", e.std_dev}};
       j["candidates"].push_back(cj);
     }
-    j["verdict"] = {{"missing_effects", r.missing_effects}, {"explained", r.explained}, {"text", r.verdict}};
+    j["verdict"] = {{"missing_effects", r.missing_effects},
+                    {"explained", r.explained},
+                    {"text", r.verdict},
+                    {"pattern", r.pattern}};
     const std::string yaml = best ? audit::EffectYaml(*best) : "";
     j["yaml"] = yaml;
 

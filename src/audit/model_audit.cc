@@ -616,7 +616,8 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   r.noise_floor = EstimateNoiseFloor(measured, o.fmin_hz, o.fmax_hz);
   const calibration::CalibrationOptions base_opt = FitOptions(o, o.calibration_parameters);
   say("modal fit of " + std::to_string(measured.size()) + " measured FRFs");
-  const calibration::MeasuredFeatures features = calibration::ExtractFeatures(measured, base_opt.modal_fit);
+  r.features = calibration::ExtractFeatures(measured, base_opt.modal_fit);
+  const calibration::MeasuredFeatures& features = r.features;
   say("calibrating the current model (whole curve)");
   // Effect parameters among the calibration parameters (an effect switched
   // on with defaults) are fitted in a second step from the calibrated core,

@@ -134,6 +134,7 @@ struct AuditResult {
   calibration::CalibrationResult baseline_fit;  // the current model calibrated
   ModelErrors errors_before;
   calibration::Comparison modes_before;         // per-mode errors (matching)
+  calibration::MeasuredFeatures features;       // the measured modes modes_before indexes
   double noise_floor{0.0};
   double baseline_bic{0.0};
   bool significant_failure{false};
