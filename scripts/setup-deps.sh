@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev liborocos-kdl-dev liburdfdom-dev
-  libnlopt-cxx-dev libceres-dev
+  libnlopt-cxx-dev libceres-dev libgoogle-glog-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
