@@ -674,6 +674,7 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
       if (c.fit.status == calibration::FitStatus::kFailed && !std::isfinite(c.bic)) {
         throw std::runtime_error("the fit of the added effect " + e + " failed: " + c.fit.message);
       }
+      if (!c.note.empty()) say(e + ": " + c.note);
       so_far = WithEffect(so_far, start, e).first;
       start = c.fit.parameters;
       effects_so_far.push_back(e);
@@ -690,7 +691,15 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
     for (const auto& spec : start.specs()) {
       if (polished_start.Has(spec.name)) polished_start.Set(spec.name, start.Get(spec.name));
     }
-    r.baseline_fit = calibration::Calibrate(description, polished_start, postures, measured, features, base_opt);
+    // The polish frees what the candidate fits left free: a calibration
+    // parameter held for an exact trade-off and an effect parameter the data
+    // cannot determine stay held (each candidate's note says which).
+    std::vector<std::string> polish_free;
+    for (const auto& n : o.calibration_parameters) {
+      if (std::find(free.begin(), free.end(), n) != free.end()) polish_free.push_back(n);
+    }
+    r.baseline_fit = calibration::Calibrate(description, polished_start, postures, measured, features,
+                                            FitOptions(o, polish_free));
   } else {
     r.baseline_fit = calibration::Calibrate(description, parameters, postures, measured, features, base_opt);
   }
