@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "cli_support.h"
@@ -109,6 +110,28 @@ int Run(int argc, char** argv) {
   return RunGuarded(kTool, [&]() -> int {
     RequireReadableFile(robot_path, "robot config");
     RequireReadableFile(postures_path, "posture file");
+    // Option values, with the options' names (before minutes of fitting).
+    CheckOptionRange("--fmin-hz", opt.fmin_hz, 0.0, 1e9);
+    if (!(opt.fmax_hz > opt.fmin_hz)) {
+      throw std::invalid_argument("--fmax-hz must be above --fmin-hz (" + Num(opt.fmin_hz) + " Hz), got " +
+                                  Num(opt.fmax_hz));
+    }
+    CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
+    {
+      std::set<std::string> seen;
+      for (const std::string& a : adds) {
+        if (!seen.insert(a).second) throw std::invalid_argument("--add " + a + " is given twice");
+      }
+    }
+    if (fs::exists(report_dir) && !fs::is_directory(report_dir)) {
+      throw std::invalid_argument("--report " + report_dir + " exists and is not a folder");
+    }
+    {
+      std::vector<std::pair<std::string, std::string>> inputs = {{"--robot", robot_path},
+                                                                  {"--postures", postures_path}};
+      for (const auto& f : measured_files) inputs.push_back({"--measured", f});
+      CheckDistinctPaths(inputs, {{"--report", report_dir}});
+    }
     std::stringstream cl(candidates_list);
     for (std::string n; std::getline(cl, n, ',');) {
       if (!n.empty()) opt.candidates.push_back(n);
@@ -144,6 +167,15 @@ int Run(int argc, char** argv) {
       }
     }
     if (measured.empty()) throw std::invalid_argument("no measured FRFs were read");
+    {
+      int lines = 0;
+      for (const auto& [key, frf] : measured) lines += frf.Band(opt.fmin_hz, opt.fmax_hz).size();
+      if (lines < 3) {
+        throw InputError({measured_files.front(), 0, 0},
+                         "the measured FRFs have " + std::to_string(lines) + " lines in the band " +
+                             Num(opt.fmin_hz) + ".." + Num(opt.fmax_hz) + " Hz (--fmin-hz, --fmax-hz); need at least 3");
+      }
+    }
 
     const audit::AuditResult r = audit::RunAudit(cfg.description, cfg.parameters, postures, measured, opt);
     const audit::CandidateResult* best = r.best >= 0 ? &r.candidates[r.best] : nullptr;
@@ -169,7 +201,15 @@ int Run(int argc, char** argv) {
     j["noise_floor"] = r.noise_floor;
     j["significant_failure"] = r.significant_failure;
     j["baseline_calibration"] = {{"status", calibration::FitStatusName(r.baseline_fit.status)},
-                                 {"message", r.baseline_fit.message}};
+                                 {"message", r.baseline_fit.message},
+                                 {"parameters", json::object()}};
+    for (const auto& e : r.baseline_fit.estimates) {
+      j["baseline_calibration"]["parameters"][e.name] = {{"value", e.value}, {"std", e.std_dev}};
+    }
+    if (r.baseline_fit.status != calibration::FitStatus::kConverged) {
+      Warn(kTool, "the calibration of the current model did not converge (" + r.baseline_fit.message +
+                      "); its errors are those of the last iterate");
+    }
     const auto pb = PerPosture(r.errors_before), pa = PerPosture(after);
     for (const auto& [id, e] : pb) {
       j["postures"][id] = {{"error_before", e}, {"error_after", pa.at(id)}};
@@ -192,7 +232,17 @@ int Run(int argc, char** argv) {
                     {"explained", r.explained},
                     {"text", r.verdict},
                     {"pattern", r.pattern}};
-    const std::string yaml = best ? audit::EffectYaml(*best) : "";
+    // The YAML to paste: the accepted candidate's effects, or else the
+    // effects switched on with --add, with their calibrated values.
+    std::string yaml;
+    if (best) {
+      yaml = audit::EffectYaml(*best);
+    } else if (!adds.empty()) {
+      audit::CandidateResult added;
+      added.effects = adds;
+      added.fit = r.baseline_fit;
+      yaml = audit::EffectYaml(added);
+    }
     j["yaml"] = yaml;
 
     // ---- errors.csv, candidates.csv
@@ -293,7 +343,11 @@ int Run(int argc, char** argv) {
     const audit::CandidateResult* shown = best ? best : (r.candidates.empty() ? nullptr : &r.candidates[0]);
     const std::string before_label = "current model (calibrated)";
     const std::string after_label = shown ? "with " + shown->name() + (best ? "" : " (not accepted)") : "";
-    if (best) h << "<h2>Add the effect</h2><p>Append to the robot config:</p><pre>" << Html(yaml) << "</pre>\n";
+    if (!yaml.empty()) {
+      h << "<h2>" << (best ? "Add the effect" : "The added effects, calibrated")
+        << "</h2><p>Append to the robot config (merge into its <code>effects:</code> list if it has one):</p><pre>"
+        << Html(yaml) << "</pre>\n";
+    }
     h << "<h2>Overlays per posture</h2><p>Measured FRFs (wide band), the calibrated current model (dashed)"
       << (shown ? " and the model " + Html(after_label) + " (thin line)" : std::string())
       << "; vertical lines: the natural frequencies of the " << (shown ? "latter" : "model") << ".</p>\n";
@@ -305,6 +359,7 @@ int Run(int argc, char** argv) {
     // ---- write (each file complete or absent)
     io::EnsureDirectory(report_dir);
     const fs::path dir(report_dir);
+    const report::AuditPatternFiles names;
     {
       dynamics::PostureEvaluator eb(base_model);
       std::unique_ptr<dynamics::PostureEvaluator> ea;
@@ -323,12 +378,28 @@ int Run(int argc, char** argv) {
                                 before_label, after_label);
       }
     }
-    if (best) {
+    // Files of an earlier run in this folder that this run does not
+    // rewrite would be taken for its results: remove them.
+    {
+      std::vector<fs::path> stale;
+      const std::vector<std::string> ids = measured.pose_ids();
+      const std::set<std::string> poses(ids.begin(), ids.end());
+      if (yaml.empty()) stale.push_back(dir / "effects.yaml");
+      if (pr.mode_error_map_png.empty()) stale.push_back(dir / names.mode_error_map_png);
+      for (const auto& entry : fs::directory_iterator(dir)) {
+        const std::string n = entry.path().filename().string();
+        if (n.rfind("overlay_", 0) == 0 && entry.path().extension() == ".png" &&
+            !poses.count(n.substr(8, n.size() - 12))) {
+          stale.push_back(entry.path());
+        }
+      }
+      for (const auto& f : stale) fs::remove(f);
+    }
+    if (!yaml.empty()) {
       io::WriteFileAtomically((dir / "effects.yaml").string(), "# model-audit: add to the robot config\n" + yaml);
     }
     io::WriteFileAtomically((dir / "errors.csv").string(), ecsv.str());
     io::WriteFileAtomically((dir / "candidates.csv").string(), ccsv.str());
-    const report::AuditPatternFiles names;
     io::WriteFileAtomically((dir / names.trends_csv).string(), pr.trends_csv);
     io::WriteFileAtomically((dir / names.posture_descriptors_csv).string(), pr.posture_descriptors_csv);
     io::WriteFileAtomically((dir / names.mode_errors_csv).string(), pr.mode_errors_csv);
@@ -343,7 +414,7 @@ int Run(int argc, char** argv) {
     io::WriteFileAtomically((dir / "summary.json").string(), report::DumpJson(j));
 
     std::cerr << kTool << ": " << r.verdict << '\n';
-    if (best) std::cout << yaml;
+    std::cout << yaml;
     return r.significant_failure && !r.explained ? kExitFlagged : kExitOk;
   });
 }
