@@ -215,6 +215,19 @@ int Run(int argc, char** argv) {
       j["postures"][id] = {{"error_before", e}, {"error_after", pa.at(id)}};
       if (pr.posture_descriptors.contains(id)) j["postures"][id]["descriptors"] = pr.posture_descriptors[id];
     }
+    if (!previous.is_null()) {
+      // The previous audit's errors next to these, per posture and in total.
+      j["compare"] = {{"report", compare_dir},
+                      {"error_before", previous["error_before"]},
+                      {"error_after", previous["error_after"]},
+                      {"postures", json::object()}};
+      for (const auto& [id, e] : pb) {
+        if (previous["postures"].contains(id)) {
+          j["compare"]["postures"][id] = {{"error_before", previous["postures"][id]["error_before"]},
+                                          {"error_after", previous["postures"][id]["error_after"]}};
+        }
+      }
+    }
     j["trends"] = pr.trends;
     j["mode_error_map"] = pr.mode_error_map;
     j["unmatched_model_modes"] = pr.unmatched_model_modes;
