@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "robomach/common/golden_section.h"
 #include "robomach/dynamics/effect.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -128,15 +129,24 @@ std::string EffectYaml(const CandidateResult& c) {
   out << "effects:\n";
   for (const std::string& e : c.effects) {
     out << "  - name: " << e << "\n";
+    // Every fittable parameter of the effect, fitted or held (a held value
+    // may come from the start-value scan), and any other that is not at its
+    // default: the lines rebuild the fitted model (to 6 significant digits).
     const std::string prefix = e + ".";
-    for (const auto& est : c.fit.estimates) {
-      if (est.name.rfind(prefix, 0) == 0) out << "    " << est.name.substr(prefix.size()) << ": " << est.value << "\n";
+    for (const auto& spec : c.fit.parameters.specs()) {
+      if (spec.name.rfind(prefix, 0) != 0) continue;
+      const double v = c.fit.parameters.Get(spec.name);
+      if (spec.fittable || v != spec.default_value) out << "    " << spec.name.substr(prefix.size()) << ": " << v << "\n";
     }
   }
   return out.str();
 }
 
 namespace {
+
+bool Contains(const std::vector<std::string>& v, const std::string& n) {
+  return std::find(v.begin(), v.end(), n) != v.end();
+}
 
 // Fittable parameters that `effect` adds, prefixed.
 std::vector<std::string> FittableOf(const std::string& effect) {
@@ -263,17 +273,10 @@ dynamics::ParameterSet ScanStart(const dynamics::RobotDescription& desc, dynamic
         trial.Set(best_name, log_axis ? std::exp(u) : u);
         return WholeCurveCost(desc, trial, postures, data, o.fmin_hz, o.fmax_hz);
       };
-      double a = log_axis ? std::log(lo) : lo, b = log_axis ? std::log(hi) : hi;
-      const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-      double c = b - g * (b - a), d = a + g * (b - a), fc = cost_at(c), fd = cost_at(d);
-      for (int it2 = 0; it2 < 12; ++it2) {
-        if (fc < fd) {
-          b = d; d = c; fd = fc; c = b - g * (b - a); fc = cost_at(c);
-        } else {
-          a = c; c = d; fc = fd; d = a + g * (b - a); fd = cost_at(d);
-        }
-      }
-      const double u = fc < fd ? c : d, fu = std::min(fc, fd);
+      const auto [u, neg_fu] = GoldenSectionMaximum([&](double v) { return -cost_at(v); },
+                                                    log_axis ? std::log(lo) : lo, log_axis ? std::log(hi) : hi, 12,
+                                                    0.0);
+      const double fu = -neg_fu;
       if (fu < best) {
         best = fu;
         best_value = std::clamp(log_axis ? std::exp(u) : u, params.spec(best_name).lower, params.spec(best_name).upper);
@@ -282,6 +285,21 @@ dynamics::ParameterSet ScanStart(const dynamics::RobotDescription& desc, dynamic
     params.Set(best_name, best_value);
   }
   return params;
+}
+
+// The free parameters once `effect` is in the model as fitted in `c`: the
+// previous ones without the calibration parameters c had to hold, plus the
+// effect's fittable parameters that c could identify.
+std::vector<std::string> FreeAfter(const std::vector<std::string>& previous, const std::string& effect,
+                                   const CandidateResult& c) {
+  std::vector<std::string> free;
+  for (const auto& n : previous) {
+    if (!Contains(c.held_calibration, n)) free.push_back(n);
+  }
+  for (const auto& n : FittableOf(effect)) {
+    if (!Contains(c.not_identifiable, n)) free.push_back(n);
+  }
+  return free;
 }
 
 // What every candidate fit shares.
@@ -296,6 +314,19 @@ struct FitContext {
   double baseline_error;  // total rms log-magnitude error of the calibrated model
   const dynamics::ParameterSet& user_start;  // the model's own start values
 };
+
+// How much setting `name` to `value` (the rest held) changes χ² =
+// |Δr|² / noise² of the whole-curve residuals `r_at` at `at`, scaled from
+// the fit's every stride-th line to all lines; +inf if the model breaks.
+double Chi2OfMove(const dynamics::RobotDescription& desc, const dynamics::ParameterSet& at,
+                  const Eigen::VectorXd& r_at, const std::string& name, double value, const FitContext& x) {
+  dynamics::ParameterSet moved = at;
+  moved.Set(name, value);
+  const Eigen::VectorXd r = WholeCurveResidualVector(desc, moved, x.postures, x.fit_data, x.options.fmin_hz,
+                                                     x.options.fmax_hz);
+  if (r.size() == 0 || r.size() != r_at.size()) return std::numeric_limits<double>::infinity();
+  return x.options.fit_line_stride * (r - r_at).squaredNorm() / (x.noise_floor * x.noise_floor);
+}
 
 // The identifiability screen of one candidate at a parameter point.
 struct Screen {
@@ -330,18 +361,11 @@ Screen ScreenParameters(const dynamics::RobotDescription& desc, const dynamics::
   for (const std::string& name : added) {
     const dynamics::ParameterSpec& spec = at.spec(name);
     const double v = at.Get(name);
-    double most = 0.0;
+    double most = 0.0;  // a move that breaks the model counts as seen (+inf)
     for (double f : {0.5, 2.0}) {
       const double trial_value = v > 0.0 ? std::clamp(v * f, spec.lower, spec.upper) : spec.default_value * f;
       if (trial_value == v || !(trial_value >= spec.lower && trial_value <= spec.upper)) continue;
-      dynamics::ParameterSet trial = at;
-      trial.Set(name, trial_value);
-      const Eigen::VectorXd r = residuals(trial);
-      if (r.size() != r0.size()) {
-        most = std::numeric_limits<double>::infinity();  // the model breaks: the data do see it
-        continue;
-      }
-      most = std::max(most, (weight * (r - r0)).squaredNorm());
+      most = std::max(most, Chi2OfMove(desc, at, r0, name, trial_value, x));
     }
     if (most < o.identifiable_chi2) out.not_identifiable.push_back(name);
   }
@@ -445,15 +469,12 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
     cand.start = label;
     cand.not_identifiable = screen.not_identifiable;
     cand.held_calibration = screen.held_calibration;
-    const auto listed = [](const std::vector<std::string>& v, const std::string& n) {
-      return std::find(v.begin(), v.end(), n) != v.end();
-    };
     std::vector<std::string> free;
     for (const std::string& n : base_free) {
-      if (!listed(screen.held_calibration, n) && !listed(screen.not_identifiable, n)) free.push_back(n);
+      if (!Contains(screen.held_calibration, n) && !Contains(screen.not_identifiable, n)) free.push_back(n);
     }
     for (const std::string& n : added) {
-      if (!listed(screen.not_identifiable, n)) free.push_back(n);
+      if (!Contains(screen.not_identifiable, n)) free.push_back(n);
     }
     cand.added_parameters = 0;
     for (const std::string& n : free) cand.added_parameters += n.find('.') != std::string::npos;
@@ -470,7 +491,9 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
     for (const std::string& n : base_free) {
       if (n.find('.') != std::string::npos) scanned.push_back(n);
     }
-    scanned.insert(scanned.end(), added.begin(), added.end());
+    for (const std::string& n : added) {
+      if (!Contains(screen.not_identifiable, n)) scanned.push_back(n);
+    }
     c = fit_from(ScanStart(desc, params, scanned, x.postures, x.fit_data, o), "scan");
     // A second start when the first fit is a near miss (it explains much of
     // the failure, error below half the calibrated model's, but not all)
@@ -483,7 +506,7 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
     // 0.13 and 3 instead of 1.5 and 10; a tool at 3 × 9 mm with damping 0.3
     // next to a soft flange, instead of 12 × 60 mm with 0.02). A candidate
     // that barely helps is not worth it.
-    const auto pinned = [](const CandidateResult& cand) {
+    const auto doubtful = [](const CandidateResult& cand) {  // a parameter on a bound, or not converged
       for (const auto& e : cand.fit.estimates) {
         if (e.at_bound && e.name.find('.') != std::string::npos) return true;
       }
@@ -491,7 +514,7 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
     };
     const bool near_miss = !(c.errors.total_rms_log_mag <= o.explained_factor * x.noise_floor) &&
                            c.errors.total_rms_log_mag < 0.5 * x.baseline_error;
-    if (near_miss || (pinned(c) && c.errors.total_rms_log_mag < 0.5 * x.baseline_error)) {
+    if (near_miss || (doubtful(c) && c.errors.total_rms_log_mag < 0.5 * x.baseline_error)) {
       dynamics::ParameterSet from = params;
       for (const auto& s : from.specs()) {
         if (s.name.find('.') != std::string::npos) {
@@ -501,7 +524,7 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
         }
       }
       CandidateResult second = fit_from(from, "defaults");
-      const bool better = pinned(c) != pinned(second) ? !pinned(second) : second.bic < c.bic;
+      const bool better = doubtful(c) != doubtful(second) ? !doubtful(second) : second.bic < c.bic;
       if (better) c = std::move(second);
     }
   } catch (const std::runtime_error& e) {
@@ -534,12 +557,7 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
       if (r_fit.size() == 0) {
         r_fit = WholeCurveResidualVector(desc, c.fit.parameters, x.postures, x.fit_data, o.fmin_hz, o.fmax_hz);
       }
-      dynamics::ParameterSet moved = c.fit.parameters;
-      moved.Set(e.name, inside);
-      const Eigen::VectorXd r = WholeCurveResidualVector(desc, moved, x.postures, x.fit_data, o.fmin_hz, o.fmax_hz);
-      if (r.size() == r_fit.size() && r.size() > 0) {
-        chi2 = o.fit_line_stride * (r - r_fit).squaredNorm() / (x.noise_floor * x.noise_floor);
-      }
+      chi2 = Chi2OfMove(desc, c.fit.parameters, r_fit, e.name, inside, x);
     }
     std::ostringstream m;
     m.precision(3);
@@ -619,11 +637,6 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   r.features = calibration::ExtractFeatures(measured, base_opt.modal_fit);
   const calibration::MeasuredFeatures& features = r.features;
   say("calibrating the current model (whole curve)");
-  // Effect parameters among the calibration parameters (an effect switched
-  // on with defaults) are fitted in a second step from the calibrated core,
-  // as the candidates are: in one step from the defaults the whole-curve fit
-  // was seen to stop at twice the noise floor (iteration limit), which a
-  // candidate effect then "explained".
   std::vector<std::string> core;
   for (const auto& n : o.calibration_parameters) {
     if (n.find('.') == std::string::npos) core.push_back(n);
@@ -678,14 +691,7 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
       so_far = WithEffect(so_far, start, e).first;
       start = c.fit.parameters;
       effects_so_far.push_back(e);
-      std::erase_if(free, [&](const std::string& n) {
-        return std::find(c.held_calibration.begin(), c.held_calibration.end(), n) != c.held_calibration.end();
-      });
-      for (const auto& n : FittableOf(e)) {
-        if (std::find(c.not_identifiable.begin(), c.not_identifiable.end(), n) == c.not_identifiable.end()) {
-          free.push_back(n);
-        }
-      }
+      free = FreeAfter(free, e, c);
     }
     dynamics::ParameterSet polished_start = parameters;
     for (const auto& spec : start.specs()) {
@@ -696,7 +702,7 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
     // cannot determine stay held (each candidate's note says which).
     std::vector<std::string> polish_free;
     for (const auto& n : o.calibration_parameters) {
-      if (std::find(free.begin(), free.end(), n) != free.end()) polish_free.push_back(n);
+      if (Contains(free, n)) polish_free.push_back(n);
     }
     r.baseline_fit = calibration::Calibrate(description, polished_start, postures, measured, features,
                                             FitOptions(o, polish_free));
@@ -766,9 +772,6 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   const CandidateResult& top = singles.front();
   const bool top_usable = top.bic_change < 0.0 && top.fit.status != calibration::FitStatus::kFailed;
   if ((r.best < 0 || !explains(singles[r.best])) && top_usable && o.greedy_second_round && singles.size() > 1) {
-    const auto listed = [](const std::vector<std::string>& v, const std::string& n) {
-      return std::find(v.begin(), v.end(), n) != v.end();
-    };
     auto [desc1, params1] = WithEffect(description, top.fit.parameters, top.effects[0]);
     // The first effect's parameters that its single fit pinned at a bound
     // were standing in for what is still missing: they restart from their
@@ -778,13 +781,7 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
     for (const auto& e : top.fit.estimates) {
       if (e.at_bound && e.name.find('.') != std::string::npos) start1.Set(e.name, start1.spec(e.name).default_value);
     }
-    std::vector<std::string> free1;
-    for (const auto& n : o.calibration_parameters) {
-      if (!listed(top.held_calibration, n)) free1.push_back(n);
-    }
-    for (const auto& n : FittableOf(top.effects[0])) {
-      if (!listed(top.not_identifiable, n)) free1.push_back(n);
-    }
+    const std::vector<std::string> free1 = FreeAfter(o.calibration_parameters, top.effects[0], top);
     std::vector<std::string> others;
     for (const std::string& n : candidates) {
       if (n != top.effects[0]) others.push_back(n);

@@ -8,6 +8,7 @@
 
 #include <ceres/ceres.h>
 
+#include "robomach/common/golden_section.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 
@@ -18,33 +19,6 @@ using dynamics::FrfKey;
 using dynamics::PostureDynamics;
 using cd = std::complex<double>;
 
-// Maximum of a smooth positive function on [lo, hi]: grid, then golden section.
-template <typename F>
-std::pair<double, double> MaximiseOnInterval(const F& fun, double lo, double hi, int grid) {
-  double best_x = lo, best = -1.0;
-  for (int i = 0; i <= grid; ++i) {
-    const double x = lo + (hi - lo) * i / grid;
-    const double v = fun(x);
-    if (v > best) {
-      best = v;
-      best_x = x;
-    }
-  }
-  const double step = (hi - lo) / grid;
-  double a = std::max(lo, best_x - step), b = std::min(hi, best_x + step);
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  double c = b - g * (b - a), d = a + g * (b - a);
-  double fc = fun(c), fd = fun(d);
-  for (int it = 0; it < 80 && (b - a) > 1e-13 * std::max(1.0, b); ++it) {
-    if (fc > fd) {
-      b = d; d = c; fd = fc; c = b - g * (b - a); fc = fun(c);
-    } else {
-      a = c; c = d; fc = fd; d = a + g * (b - a); fd = fun(d);
-    }
-  }
-  const double xm = 0.5 * (a + b), vm = fun(xm);
-  return vm >= best ? std::pair{xm, vm} : std::pair{best_x, best};
-}
 
 double Visibility(const dynamics::Mode& m, const FrfKey& key) {
   const double w = HzToRadPerSec(m.freq_hz);
@@ -112,8 +86,8 @@ std::pair<double, double> ModelPeak(const PostureDynamics& d, const FrfKey& key,
   Eigen::Index best = 0;
   mag.maxCoeff(&best);
   const double step = (hi - lo) / kGrid;
-  return MaximiseOnInterval([&](double x) { return std::abs(H.Entry(x, r, e)); }, std::max(lo, f(best) - step),
-                            std::min(hi, f(best) + step), 2);
+  return MaximiseOnGrid([&](double x) { return std::abs(H.Entry(x, r, e)); }, std::max(lo, f(best) - step),
+                        std::min(hi, f(best) + step), 2, 80, 1e-13);
 }
 
 std::vector<ModeMatch> MatchModes(const std::map<std::string, PostureDynamics>& model,

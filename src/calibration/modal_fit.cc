@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
 
+#include "robomach/common/golden_section.h"
 #include "robomach/common/units.h"
 
 namespace robomach::calibration {
@@ -102,32 +103,9 @@ std::complex<double> ModalFitResult::Evaluate(double freq_hz) const {
 }
 
 std::pair<double, double> ModalFitResult::PeakIn(double f_lo, double f_hi) const {
-  constexpr int kGrid = 200;
-  double best_f = f_lo, best = -1.0;
-  for (int i = 0; i <= kGrid; ++i) {
-    const double fi = f_lo + (f_hi - f_lo) * i / kGrid;
-    const double a = std::abs(Evaluate(fi));
-    if (a > best) {
-      best = a;
-      best_f = fi;
-    }
-  }
-  // Golden-section refinement within one grid cell on each side.
-  const double step = (f_hi - f_lo) / kGrid;
-  double a = std::max(f_lo, best_f - step), b = std::min(f_hi, best_f + step);
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  double c = b - g * (b - a), d = a + g * (b - a);
-  double fc = std::abs(Evaluate(c)), fd = std::abs(Evaluate(d));
-  for (int it = 0; it < 60 && (b - a) > 1e-12 * std::max(1.0, b); ++it) {
-    if (fc > fd) {
-      b = d; d = c; fd = fc; c = b - g * (b - a); fc = std::abs(Evaluate(c));
-    } else {
-      a = c; c = d; fc = fd; d = a + g * (b - a); fd = std::abs(Evaluate(d));
-    }
-  }
-  const double fm = 0.5 * (a + b);
-  const double am = std::abs(Evaluate(fm));
-  return am >= best ? std::pair{fm, am} : std::pair{best_f, best};
+  // A 200-point grid, then golden-section refinement within one grid cell
+  // on each side of its best point.
+  return MaximiseOnGrid([&](double f) { return std::abs(Evaluate(f)); }, f_lo, f_hi, 200, 60, 1e-12);
 }
 
 void FitResidues(const dynamics::Frf& frf, const std::vector<std::complex<double>>& poles,
