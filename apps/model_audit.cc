@@ -32,15 +32,11 @@ std::string KeyLabel(const dynamics::FrfKey& k) {
   return k.pose_id + " " + AxisName(k.response) + AxisName(k.excitation);
 }
 
-// rms log-magnitude error per posture, over all lines of its FRFs.
-std::map<std::string, double> PerPosture(const audit::ModelErrors& e) {
-  std::map<std::string, std::pair<double, int>> acc;
-  for (const auto& c : e.curves) {
-    acc[c.key.pose_id].first += c.rms_log_mag * c.rms_log_mag * c.lines;
-    acc[c.key.pose_id].second += c.lines;
-  }
+// rms log-magnitude error per posture (audit::ErrorPerPosture), by id.
+std::map<std::string, double> PerPosture(const audit::ModelErrors& e, const std::vector<std::string>& ids) {
+  const Eigen::VectorXd v = audit::ErrorPerPosture(e, ids);
   std::map<std::string, double> out;
-  for (const auto& [id, a] : acc) out[id] = a.second > 0 ? std::sqrt(a.first / a.second) : NAN;
+  for (size_t i = 0; i < ids.size(); ++i) out[ids[i]] = v(static_cast<Eigen::Index>(i));
   return out;
 }
 
@@ -210,7 +206,7 @@ int Run(int argc, char** argv) {
       Warn(kTool, "the calibration of the current model did not converge (" + r.baseline_fit.message +
                       "); its errors are those of the last iterate");
     }
-    const auto pb = PerPosture(r.errors_before), pa = PerPosture(after);
+    const auto pb = PerPosture(r.errors_before, measured.pose_ids()), pa = PerPosture(after, measured.pose_ids());
     for (const auto& [id, e] : pb) {
       j["postures"][id] = {{"error_before", e}, {"error_after", pa.at(id)}};
       if (pr.posture_descriptors.contains(id)) j["postures"][id]["descriptors"] = pr.posture_descriptors[id];

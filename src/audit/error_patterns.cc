@@ -28,15 +28,6 @@ const Eigen::VectorXd& PostureOf(const calibration::PostureMap& postures, const 
   return it->second;
 }
 
-// The peak contribution of a model mode in FRF H_re, as the matching
-// defines it (calibration::MatchOptions): |p_r p_e| / (2ζω²), with ζ floored
-// at 1e-6 so an undamped mode stays finite.
-double Visibility(const dynamics::Mode& m, const dynamics::FrfKey& key) {
-  const double w = HzToRadPerSec(m.freq_hz);
-  const double pr = m.p_T(static_cast<int>(key.response)), pe = m.p_T(static_cast<int>(key.excitation));
-  return std::abs(pr * pe) / (2.0 * std::max(m.damping_ratio, 1e-6) * w * w);
-}
-
 }  // namespace
 
 PostureDescriptors DescribePostures(const dynamics::RobotModel& model, const calibration::PostureMap& postures,
@@ -245,7 +236,7 @@ ErrorPatterns AnalyzeErrorPatterns(const AuditResult& result,
     double vis_max = 0.0;
     for (size_t k = 0; k < modes.size(); ++k) {
       if (modes[k].freq_hz < lo || modes[k].freq_hz > hi) continue;
-      vis[k] = Visibility(modes[k], key);
+      vis[k] = calibration::ModelModeVisibility(modes[k], key);
       vis_max = std::max(vis_max, vis[k]);
     }
     double meas_max = 0.0;

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "robomach/audit/error_patterns.h"
 #include "robomach/common/golden_section.h"
 #include "robomach/dynamics/effect.h"
 #include "robomach/dynamics/posture_dynamics.h"
@@ -826,15 +827,14 @@ std::string DescribePattern(const ModelErrors& e, double noise_floor, double sig
   m.precision(3);
   // Where: the worst band of each FRF, and whether it is the same everywhere.
   std::map<std::pair<long long, long long>, int> worst;  // band (mHz) -> FRFs
-  std::map<std::string, std::pair<double, int>> per_pose;
+  std::set<std::string> pose_ids;
   int significant = 0, curves = 0;
   for (const CurveError& c : e.curves) {
     if (c.lines == 0 || c.bands.empty()) continue;
     ++curves;
     significant += c.rms_log_mag > significance_factor * noise_floor;
     ++worst[{std::llround(c.bands[0].fmin_hz * 1e3), std::llround(c.bands[0].fmax_hz * 1e3)}];
-    per_pose[c.key.pose_id].first += c.rms_log_mag * c.rms_log_mag * c.lines;
-    per_pose[c.key.pose_id].second += c.lines;
+    pose_ids.insert(c.key.pose_id);
   }
   if (curves == 0) return "no measured lines in the band";
   const auto top = std::max_element(worst.begin(), worst.end(),
@@ -849,7 +849,7 @@ std::string DescribePattern(const ModelErrors& e, double noise_floor, double sig
     }
   }
   m << "in " << top->second << " of " << curves << " FRFs";
-  if (poses_with_top.size() == per_pose.size() && per_pose.size() > 1) {
+  if (poses_with_top.size() == pose_ids.size() && pose_ids.size() > 1) {
     m << ", at every posture: the failing band does not follow the robot's posture, which points at parts "
          "whose dynamics do not depend on it (tool, holder, spindle, end effector) or at the measurement chain "
          "(sensor mounting, hammer tip)";
@@ -857,14 +857,16 @@ std::string DescribePattern(const ModelErrors& e, double noise_floor, double sig
   // How it varies with posture.
   std::string lo_id, hi_id;
   double lo = INFINITY, hi = -INFINITY;
-  for (const auto& [id, acc] : per_pose) {
-    const double v = std::sqrt(acc.first / acc.second);
-    if (v < lo) lo = v, lo_id = id;
-    if (v > hi) hi = v, hi_id = id;
+  const std::vector<std::string> ids(pose_ids.begin(), pose_ids.end());
+  const Eigen::VectorXd per_pose = ErrorPerPosture(e, ids);
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const double v = per_pose(static_cast<Eigen::Index>(i));
+    if (v < lo) lo = v, lo_id = ids[i];
+    if (v > hi) hi = v, hi_id = ids[i];
   }
   m << "; the rms log-magnitude error ranges from " << lo << " (" << lo_id << ") to " << hi << " (" << hi_id
     << ") over the postures";
-  if (per_pose.size() > 1 && hi - lo < 0.1 * hi) m << ", nearly the same at every posture";
+  if (ids.size() > 1 && hi - lo < 0.1 * hi) m << ", nearly the same at every posture";
   m << " (noise floor " << noise_floor << ")";
   return m.str();
 }

@@ -20,11 +20,6 @@ using dynamics::PostureDynamics;
 using cd = std::complex<double>;
 
 
-double Visibility(const dynamics::Mode& m, const FrfKey& key) {
-  const double w = HzToRadPerSec(m.freq_hz);
-  const double pr = m.p_T(static_cast<int>(key.response)), pe = m.p_T(static_cast<int>(key.excitation));
-  return std::abs(pr * pe) / (2.0 * std::max(m.damping_ratio, 1e-6) * w * w);
-}
 
 std::map<std::string, PostureDynamics> EvaluatePostures(const std::shared_ptr<const dynamics::RobotModel>& model,
                                                         const PostureMap& postures,
@@ -73,6 +68,12 @@ MeasuredFeatures ExtractFeatures(const dynamics::FrfSet& measured, const ModalFi
 
 // ------------------------------------------------------------- matching --
 
+double ModelModeVisibility(const dynamics::Mode& m, const FrfKey& key) {
+  const double w = HzToRadPerSec(m.freq_hz);
+  const double pr = m.p_T(static_cast<int>(key.response)), pe = m.p_T(static_cast<int>(key.excitation));
+  return std::abs(pr * pe) / (2.0 * std::max(m.damping_ratio, 1e-6) * w * w);
+}
+
 std::pair<double, double> ModelPeak(const PostureDynamics& d, const FrfKey& key, int model_mode) {
   const dynamics::Mode& m = d.modes.at(model_mode);
   const double z = m.damping_ratio;
@@ -109,7 +110,7 @@ std::vector<ModeMatch> MatchModes(const std::map<std::string, PostureDynamics>& 
     std::vector<double> vis(d.modes.size());
     double vis_max = 0.0;
     for (size_t k = 0; k < d.modes.size(); ++k) {
-      vis[k] = Visibility(d.modes[k], key);
+      vis[k] = ModelModeVisibility(d.modes[k], key);
       vis_max = std::max(vis_max, vis[k]);
     }
     struct Cand {

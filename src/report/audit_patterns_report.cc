@@ -190,8 +190,8 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
   const audit::ModeErrorMap& m = p.mode_map;
   json fe = json::array(), pe = json::array();
   std::ostringstream mcsv;
-  mcsv << "pose_id,model_mode,response,excitation,model_freq_hz,measured_freq_hz,freq_error,model_peak_m_per_N,"
-          "measured_peak_m_per_N,peak_error\n";
+  mcsv << "pose_id,model_mode,response,excitation,model_freq_hz,measured_freq_hz,freq_error_rel,model_peak_m_per_N,"
+          "measured_peak_m_per_N,peak_error_rel\n";
   for (size_t r = 0; r < m.pose_ids.size(); ++r) {
     json fr = json::array(), pr = json::array();
     for (size_t c = 0; c < m.modes.size(); ++c) {
@@ -212,7 +212,7 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
     fe.push_back(fr);
     pe.push_back(pr);
   }
-  out.mode_error_map = {{"poses", m.pose_ids}, {"modes", m.modes}, {"freq_error", fe}, {"peak_error", pe}};
+  out.mode_error_map = {{"poses", m.pose_ids}, {"modes", m.modes}, {"freq_error_rel", fe}, {"peak_error_rel", pe}};
   out.mode_errors_csv = mcsv.str();
 
   // ---- unmatched modes

@@ -108,11 +108,8 @@ namespace {
 
 Eigen::VectorXcd ModelEntry(const dynamics::PostureDynamics& d, const dynamics::FrfKey& key,
                             const Eigen::VectorXd& freq_hz) {
-  const auto H = dynamics::Receptance(d, freq_hz);
-  const int r = static_cast<int>(key.response), e = static_cast<int>(key.excitation);
-  Eigen::VectorXcd h(freq_hz.size());
-  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) h(i) = H[i](r, e);
-  return h;
+  return dynamics::ReceptanceEvaluator(d).Entry(freq_hz, static_cast<int>(key.response),
+                                                static_cast<int>(key.excitation));
 }
 
 }  // namespace

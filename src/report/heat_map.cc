@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <cstdio>
 #include <string_view>
 
@@ -41,6 +42,21 @@ cv::Vec3b Colour(double t) {
   return out.at<cv::Vec3b>(0, 0);
 }
 
+// @throws std::invalid_argument naming the field of a map that cannot be
+// drawn (it would divide by a zero extent or index outside `values`).
+void CheckDrawable(const HeatMap& m, int pw, int ph) {
+  const auto bad = [&](const std::string& what) {
+    throw std::invalid_argument("heat map '" + m.title + "': " + what);
+  };
+  if (m.nx < 1 || m.ny < 1) bad("nx and ny must be >= 1");
+  if (!std::isfinite(m.dx) || !std::isfinite(m.dy) || m.dx == 0.0 || m.dy == 0.0) {
+    bad("dx and dy must be finite and non-zero");
+  }
+  if (m.values.size() != static_cast<size_t>(m.nx) * static_cast<size_t>(m.ny)) bad("values must hold nx * ny cells");
+  if (!m.marks.empty() && m.marks.size() != m.values.size()) bad("marks must be empty or hold nx * ny cells");
+  if (pw < 2 || ph < 2) bad("width_px / height_px leave no room for the plot");
+}
+
 cv::Mat Render(const HeatMap& m) {
   const int W = m.width_px, H = m.height_px, right = 180, top = 60, bottom = 90;
   // Categorical row labels (posture ids) may be wider than numeric ticks.
@@ -49,8 +65,9 @@ cv::Mat Render(const HeatMap& m) {
     int base = 0;
     left = std::max(left, 50 + cv::getTextSize(l, kFont, 0.42, 1, &base).width);
   }
-  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   const int pw = W - left - right, ph = H - top - bottom;
+  CheckDrawable(m, pw, ph);
+  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   Text(img, m.title, {W / 2, 30}, 0.6, 1);
   double vmin = INFINITY, vmax = -INFINITY;
   for (double v : m.values) {

@@ -18,28 +18,9 @@ using robomach::testing::Kr210;
 using robomach::testing::Kr210With;
 using robomach::testing::RandomPosture;
 
-constexpr double kG = 9.80665;  // [m/s²]
+constexpr double kG = kStandardGravity;  // [m/s²]
 
-// One link on a horizontal joint: DH frame 0 is turned +90° about base x,
-// so the joint axis is −y_B and the COM at (l_c, 0, 0) of the link is at
-// (l_c cos q, 0, l_c sin q) in B (z up). V = m g l_c sin q, so
-// ∂²V/∂q² = −m g l_c sin q: +m g l_c hanging down (q = −π/2), −m g l_c upright.
-RobotDescription Pendulum(double m, double lc) {
-  kinematics::ModifiedDhRow r;
-  r.joint_name = "j1";
-  r.inertial.mass = m;
-  r.inertial.com = Eigen::Vector3d(lc, 0.0, 0.0);
-  r.inertial.inertia_com = Eigen::Vector3d(0.01, 0.02, 0.02).asDiagonal();
-  Eigen::Isometry3d X_B0 = Eigen::Isometry3d::Identity();
-  X_B0.linear() = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  Eigen::Isometry3d X_nT = Eigen::Isometry3d::Identity();
-  X_nT.translation() = Eigen::Vector3d(2 * lc, 0.0, 0.0);
-  RobotDescription d;
-  d.arm = kinematics::BuildModifiedDhChain({r}, X_B0, X_nT);
-  d.joint_stiffness = Eigen::VectorXd::Constant(1, 1e5);
-  d.end_effector.p_tcp = Eigen::Vector3d::Zero();
-  return d;
-}
+using robomach::testing::Pendulum;  // V = m g l_c sin q (test_models.h)
 
 // Closed form of the single pendulum; the products in (1) round at ~eps of
 // m g l_c, so 1e-12 relative.

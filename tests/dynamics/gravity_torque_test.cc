@@ -19,25 +19,7 @@ namespace {
 using robomach::testing::Kr210;
 using robomach::testing::RandomPosture;
 
-// One link on a horizontal joint (as in gravity_stiffness_test.cc): the COM
-// at (l_c, 0, 0) of the link is at (l_c cos q, 0, l_c sin q) in B, so
-// V = m g l_c sin q and G = ∂V/∂q = m g l_c cos q.
-RobotDescription Pendulum(double m, double lc) {
-  kinematics::ModifiedDhRow r;
-  r.joint_name = "j1";
-  r.inertial.mass = m;
-  r.inertial.com = Eigen::Vector3d(lc, 0.0, 0.0);
-  r.inertial.inertia_com = Eigen::Vector3d(0.01, 0.02, 0.02).asDiagonal();
-  Eigen::Isometry3d X_B0 = Eigen::Isometry3d::Identity();
-  X_B0.linear() = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  Eigen::Isometry3d X_nT = Eigen::Isometry3d::Identity();
-  X_nT.translation() = Eigen::Vector3d(2 * lc, 0.0, 0.0);
-  RobotDescription d;
-  d.arm = kinematics::BuildModifiedDhChain({r}, X_B0, X_nT);
-  d.joint_stiffness = Eigen::VectorXd::Constant(1, 1e5);
-  d.end_effector.p_tcp = Eigen::Vector3d::Zero();
-  return d;
-}
+using robomach::testing::Pendulum;  // V = m g l_c sin q (test_models.h)
 
 // The recursion rounds at ~eps · m g l_c ≈ 1e-13 N·m; 1e-10 N·m leaves margin.
 TEST(GravityTorque, PendulumMatchesClosedForm) {

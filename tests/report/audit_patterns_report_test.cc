@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "robomach/common/units.h"
+#include "robomach/io/number_format.h"
 #include "robomach/report/audit_patterns_report.h"
 
 namespace robomach::report {
@@ -79,9 +80,9 @@ TEST(AuditPatternsReport, JsonKeysUnitsAndNulls) {
   // The map: nulls where no match, the relative errors where matched.
   EXPECT_EQ(r.mode_error_map["modes"], nlohmann::json({1, 3}));
   EXPECT_EQ(r.mode_error_map["poses"], nlohmann::json({"P1", "P2", "P3"}));
-  EXPECT_TRUE(r.mode_error_map["freq_error"][0][0].is_null());
-  EXPECT_NEAR(r.mode_error_map["freq_error"][1][1].get<double>(), 0.1, 1e-15);   // 11/10 − 1
-  EXPECT_NEAR(r.mode_error_map["peak_error"][1][1].get<double>(), -0.5, 1e-15);  // 1/2 − 1
+  EXPECT_TRUE(r.mode_error_map["freq_error_rel"][0][0].is_null());
+  EXPECT_NEAR(r.mode_error_map["freq_error_rel"][1][1].get<double>(), 0.1, 1e-15);   // 11/10 − 1
+  EXPECT_NEAR(r.mode_error_map["peak_error_rel"][1][1].get<double>(), -0.5, 1e-15);  // 1/2 − 1
   // Unmatched: model modes numbered from 1, directions as "xx".
   ASSERT_EQ(r.unmatched_model_modes.size(), 1u);
   EXPECT_EQ(r.unmatched_model_modes[0]["model_mode"], 4);
@@ -100,7 +101,10 @@ TEST(AuditPatternsReport, CsvRowsAndPngs) {
   EXPECT_NE(r.trends_csv.find("\nreach,m,3,0.997,,no,,\n"), std::string::npos) << r.trends_csv;
   // One row per posture and mode; an empty cell keeps its pose and mode.
   EXPECT_NE(r.mode_errors_csv.find("\nP1,1,,,,,,,,\n"), std::string::npos) << r.mode_errors_csv;
-  EXPECT_NE(r.mode_errors_csv.find("\nP2,3,y,y,11,10,0.10000000000000009,1e-06,2e-06,-0.5\n"), std::string::npos)
+  // The relative error as the CSV writer prints any double (round-trip form
+  // of 11/10 − 1, which is not exactly 0.1).
+  EXPECT_NE(r.mode_errors_csv.find("\nP2,3,y,y,11,10," + io::FormatDouble(11.0 / 10.0 - 1.0) + ",1e-06,2e-06,-0.5\n"),
+            std::string::npos)
       << r.mode_errors_csv;
   EXPECT_NE(r.unmatched_modes_csv.find("\nmodel,P3,x,x,4,64.3,"), std::string::npos) << r.unmatched_modes_csv;
   EXPECT_NE(r.posture_descriptors_csv.find("pose_id,error_before,error_after,q2_deg,reach_m\n"), std::string::npos);

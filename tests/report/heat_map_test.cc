@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -30,6 +32,35 @@ HeatMap Table() {
 }
 
 cv::Mat Decode(const std::vector<unsigned char>& png) { return cv::imdecode(png, cv::IMREAD_COLOR); }
+
+// Maps that cannot be drawn are rejected with the field named, not drawn
+// with a division by a zero extent or cells read past `values`.
+TEST(HeatMap, RejectsMapsThatCannotBeDrawn) {
+  const auto rejects = [](HeatMap m, const std::string& field) {
+    try {
+      EncodeHeatMapPng(m);
+      ADD_FAILURE() << "accepted a map with bad " << field;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  HeatMap m = Table();
+  m.nx = 0;
+  rejects(m, "nx");
+  m = Table();
+  m.dy = 0.0;
+  rejects(m, "dy");
+  m = Table();
+  m.values.pop_back();
+  rejects(m, "values");
+  m = Table();
+  m.marks = {1};
+  rejects(m, "marks");
+  m = Table();
+  m.height_px = 151;
+  rejects(m, "height_px");
+  EXPECT_FALSE(EncodeHeatMapPng(Table()).empty());
+}
 
 // Categorical, annotated maps decode at the requested size; stacked maps
 // are one below the other at the widest width.

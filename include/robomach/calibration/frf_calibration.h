@@ -85,6 +85,11 @@ struct ModeMatch {
 /// The postures, by id, that a calibration or comparison uses.
 using PostureMap = std::map<std::string, Eigen::VectorXd>;  // q [rad]
 
+/// The peak contribution of a model mode in the FRF H_re, as the matching
+/// measures visibility (MatchOptions::min_relative_visibility):
+/// |p_r p_e| / (2ζω²), ζ floored at 1e-6 so an undamped mode stays finite.
+double ModelModeVisibility(const dynamics::Mode& mode, const dynamics::FrfKey& key);
+
 /// Peak of |H_model| for the FRF `key` near a model mode, on the same
 /// definition as MeasuredMode::peak_magnitude (window f_n (1 ± 3ζ)).
 std::pair<double, double> ModelPeak(const dynamics::PostureDynamics& d, const dynamics::FrfKey& key,

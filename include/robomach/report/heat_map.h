@@ -29,6 +29,9 @@ struct HeatMap {
 };
 
 /// Renders to PNG bytes (viridis colours, colour bar with ticks).
+/// @throws std::invalid_argument, naming the field, for a map that cannot be
+///   drawn: nx or ny < 1, dx or dy zero or not finite, values (or non-empty
+///   marks) not of nx · ny cells, or a size that leaves no room for the plot.
 std::vector<unsigned char> EncodeHeatMapPng(const HeatMap& map);
 /// Renders and writes atomically (formats.md §4).
 /// @throws OutputError if the file cannot be written.

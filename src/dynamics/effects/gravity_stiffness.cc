@@ -33,6 +33,7 @@
 
 #include <kdl/frames.hpp>
 
+#include "robomach/common/units.h"
 #include "robomach/dynamics/effect.h"
 #include "robomach/dynamics/robot_model.h"
 
@@ -40,7 +41,6 @@ namespace robomach::dynamics {
 
 class GravityStiffnessEffect final : public Effect {
  public:
-  static constexpr double kStandardGravity = 9.80665;  // [m/s²]
 
   std::string name() const override { return "gravity_stiffness"; }
   std::string description() const override {
