@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli_support.h"
+#include "measured_data.h"
 #include "robomach/common/errors.h"
 #include "robomach/calibration/frf_calibration.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -23,33 +24,11 @@ namespace robomach::apps {
 namespace {
 
 constexpr char kTool[] = "frf-calibrate";
+// A calibrated model is flagged when its rms whole-curve residual exceeds
+// 1.3 noise standard deviations (mean square 1.69): the audit's
+// significance factor (audit::AuditOptions::significance_factor).
+constexpr double kMisfitFlag = 1.3 * 1.3;
 namespace fs = std::filesystem;
-
-// Reads --measured files and --pose ID=file.uff assignments into one set.
-dynamics::FrfSet ReadMeasured(const std::vector<std::string>& files, const std::vector<std::string>& pose_files,
-                              const std::string& what) {
-  dynamics::FrfSet all;
-  auto add = [&](const std::string& path, const std::string& pose) {
-    RequireReadableFile(path, what);
-    const io::FrfReadResult r = io::ReadFrfFile(path, pose);
-    for (const std::string& w : r.warnings) Warn(kTool, w);
-    for (const auto& [key, frf] : r.frfs) {
-      if (all.contains(key)) {
-        throw InputError({path, 0, 0}, "FRF " + key.ToString() + " was already read from another file");
-      }
-      all.Insert(key, frf);
-    }
-  };
-  for (const std::string& f : files) add(f, "");
-  for (const std::string& a : pose_files) {
-    const auto eq = a.find('=');
-    if (eq == std::string::npos || eq == 0 || eq + 1 == a.size()) {
-      throw std::invalid_argument("--pose '" + a + "': expected ID=file.uff, e.g. --pose P1=p1.uff");
-    }
-    add(a.substr(eq + 1), a.substr(0, eq));
-  }
-  return all;
-}
 
 // The input config text with a new `parameters:` block (an old one is
 // replaced) and the URDF path made valid from the output's folder.
@@ -119,6 +98,8 @@ int Run(int argc, char** argv) {
   app.add_option("--set", sets, "start value of a parameter, NAME=VALUE in its unit");
   app.add_option("--add", adds, "switch on an effect by name (its parameters may then be --free)");
   app.add_option("--max-iterations", opt.max_iterations, "solver iterations per stage")->capture_default_str();
+  NoiseCliOptions noise_opt;
+  AddNoiseOptions(app, &noise_opt);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -163,20 +144,30 @@ int Run(int argc, char** argv) {
       postures[p.id] = p.q;
       posture_line[p.id] = p.line;
     }
-    const dynamics::FrfSet measured = ReadMeasured(measured_files, pose_files, "measured FRF file");
-    const dynamics::FrfSet holdout = ReadMeasured(validate_files, validate_pose_files, "validation FRF file");
-    for (const auto* set : {&measured, &holdout}) {
+    const MeasuredData measured_read = ReadMeasuredFiles(kTool, measured_files, pose_files, "measured FRF file");
+    const MeasuredData holdout_read =
+        ReadMeasuredFiles(kTool, validate_files, validate_pose_files, "validation FRF file");
+    for (const auto* set : {&measured_read.frfs, &holdout_read.frfs}) {
       for (const std::string& id : set->pose_ids()) {
         if (!postures.count(id)) {
           std::string known;
           for (const auto& [k, q] : postures) known += (known.empty() ? "" : ", ") + k;
           throw InputError({postures_path, 0, 0}, "posture " + id + " of the " +
-                                                      (set == &measured ? "measured" : "validation") +
+                                                      (set == &measured_read.frfs ? "measured" : "validation") +
                                                       " FRFs is not in this posture file (it has " + known + ")");
         }
       }
     }
-    if (measured.empty()) throw std::invalid_argument("no measured FRFs were read");
+    if (measured_read.frfs.empty()) throw std::invalid_argument("no measured FRFs were read");
+    // The noise of every FRF, and the lines every fit uses (issue #10).
+    const calibration::NoiseModels noise = EstimateNoiseModels(kTool, measured_read, noise_opt);
+    const dynamics::FrfSet measured = FitData(measured_read, noise);
+    calibration::NoiseModels holdout_noise;
+    dynamics::FrfSet holdout;
+    if (!holdout_read.frfs.empty()) {
+      holdout_noise = EstimateNoiseModels(kTool, holdout_read, noise_opt);
+      holdout = FitData(holdout_read, holdout_noise);
+    }
 
     std::cerr << kTool << ": modal fit of " << measured.size() << " measured FRFs\n";
     const calibration::MeasuredFeatures features = calibration::ExtractFeatures(measured, opt.modal_fit);
@@ -236,20 +227,62 @@ int Run(int argc, char** argv) {
     report::WriteTable3Csv((dir / "table3.csv").string(), sets_out);
     report::WriteTable3Markdown((dir / "table3.md").string(), sets_out,
                                 "frf-calibrate: " + robot_path + " against the measured FRFs");
+    bool flagged = false;
+    std::vector<std::string> flags;
+    double per_residual = NAN;
+    if (result.status == calibration::FitStatus::kNotImproved) {
+      Warn(kTool, "the calibration did not improve on the start values; " + out_path +
+                      " keeps them. " + result.message);
+      flagged = true;
+    } else if (result.status != calibration::FitStatus::kConverged || !result.weakly_identified.empty()) {
+      Warn(kTool, result.message);
+      flagged = true;
+    }
+    // Goodness of fit against the noise: with a noise model, a model that
+    // represents the data leaves a misfit of about one noise variance per
+    // residual (two residuals per line).
+    if (!noise.empty()) {
+      int lines = 0;
+      for (const auto& [k, f] : measured) lines += f.Band(opt.fmin_hz, opt.fmax_hz).size();
+      per_residual = result.misfit_final / std::max(1, 2 * lines);
+      if (per_residual > kMisfitFlag) {
+        std::ostringstream m;
+        m.precision(3);
+        m << "the calibrated model misses the data by " << std::sqrt(per_residual)
+          << " times the noise (rms over " << 2 * lines << " residuals): it cannot represent these data with "
+          << "the free parameters (another effect, another robot?); see the overlays and model-audit";
+        Warn(kTool, m.str());
+        flags.push_back(m.str());
+        flagged = true;
+      }
+    }
     nlohmann::json summary = report::CalibrationSummaryJson(result, opt, sets_out);
+    summary["misfit"] = {{"start", result.misfit_start},
+                         {"calibrated", result.misfit_final},
+                         {"rms_per_residual_in_noise_units", noise.empty() ? NAN : std::sqrt(per_residual)},
+                         {"starts_tried", result.starts_tried},
+                         {"start_used", result.start_used},
+                         {"flags", flags}};
+    summary["noise"] = report::NoiseSummaryJson(noise, noise_opt.model, noise_opt.min_snr);
+    if (!holdout_noise.empty()) summary["holdout_noise"] = report::NoiseSummaryJson(holdout_noise, noise_opt.model, noise_opt.min_snr);
     summary["robot"] = robot_path;
     summary["calibrated_config"] = out_path;
     io::WriteFileAtomically((dir / "summary.json").string(), report::DumpJson(summary));
     dynamics::PostureEvaluator eb(model_before), ea(model_after);
-    dynamics::FrfSet all = measured;
-    for (const auto& [k, f] : holdout) {
+    // Overlays show every measured line with the noise model, not only the usable ones.
+    dynamics::FrfSet all = measured_read.frfs;
+    calibration::NoiseModels all_noise = noise;
+    for (const auto& [k, f] : holdout_read.frfs) {
       if (!all.contains(k)) all.Insert(k, f);
     }
+    for (const auto& [k, n] : holdout_noise) all_noise.emplace(k, n);
     for (const std::string& pose : all.pose_ids()) {
       const auto db = eb.Evaluate(postures.at(pose));
       const auto da = ea.Evaluate(postures.at(pose));
-      const bool held = !measured.ForPose(pose).size();
-      report::WriteOverlayPng((dir / (pose + ".png")).string(), report::MakePostureOverlay(pose, all, db, da),
+      const bool held = !measured_read.frfs.ForPose(pose).size();
+      report::PostureOverlay overlay = report::MakePostureOverlay(pose, all, db, da);
+      report::AddNoise(all_noise, &overlay);
+      report::WriteOverlayPng((dir / (pose + ".png")).string(), overlay,
                               "frf-calibrate: posture " + pose + (held ? " (held out)" : "") +
                                   ", measured vs model before and after calibration");
     }
@@ -279,11 +312,17 @@ int Run(int argc, char** argv) {
         << '\n';
       std::cerr << m.str();
     }
-    if (result.status != calibration::FitStatus::kConverged || !result.weakly_identified.empty()) {
-      Warn(kTool, result.message);
-      return kExitFlagged;
+    {
+      std::ostringstream m;
+      m.precision(4);
+      m << kTool << ": whole-curve misfit (chi^2";
+      if (!noise.empty()) m << ", in units of the noise";
+      m << ") " << result.misfit_start << " at the start, " << result.misfit_final << " calibrated ("
+        << result.starts_tried << " start" << (result.starts_tried > 1 ? "s" : "") << ", result from: "
+        << result.start_used << ")\n";
+      std::cerr << m.str();
     }
-    return kExitOk;
+    return flagged ? kExitFlagged : kExitOk;
   });
 }
 

@@ -27,7 +27,12 @@ int Run(int argc, char** argv) {
       "(formats.md §1) on a hammer-test grid with seeded noise, as the CSV of formats.md §3\n"
       "or UFF58 (chosen by the extension of --out: .uff/.unv = UFF58). Grid: lines k*df with\n"
       "df = fs/N; defaults fs from the config's hammer_test.sample_rate_hz (else 5120 Hz) and\n"
-      "N = 20480 samples (a 4 s record, df = 0.25 Hz), band 0.25..500 Hz (2000 lines)."};
+      "N = 20480 samples (a 4 s record, df = 0.25 Hz), band 0.25..500 Hz (2000 lines).\n"
+      "Noise per line: H (1 + rel n1) + floor(f) n2 (n1, n2 complex standard normal), with\n"
+      "floor(f)^2 = [a_r^2 + (a_v/w)^2 + (a_a/w^2)^2] (1 + (f/fc)^4): sensor floors flat in receptance,\n"
+      "mobility or accelerance, raised where the hammer's force spectrum rolls off above fc.\n"
+      "--coherence writes the H1 coherence of that noise for --averages impacts:\n"
+      "gamma^2 = |H|^2 / (|H|^2 + (n-1) sigma^2), sigma^2 = (rel |H|)^2 + floor^2."};
   app.footer(ExitCodeHelp());
   std::string robot_path, postures_path, out_path, directions = "xx,yy", quantity = "receptance";
   std::vector<std::string> sets, adds;
@@ -44,7 +49,18 @@ int Run(int argc, char** argv) {
   app.add_option("--fmin-hz", o.fmin_hz, "lowest line kept [Hz], > 0")->capture_default_str();
   app.add_option("--fmax-hz", o.fmax_hz, "highest line kept [Hz]")->capture_default_str();
   app.add_option("--noise-rel", o.relative_noise, "relative noise, rms of complex Gaussian [-] (0.02 = 2 %)")->capture_default_str();
-  app.add_option("--noise-abs-m-per-N", o.absolute_noise_m_per_N, "absolute noise floor, rms [m/N]")->capture_default_str();
+  app.add_option("--noise-abs-m-per-N", o.absolute_noise_m_per_N,
+                 "additive noise floor flat in receptance, rms [m/N]")->capture_default_str();
+  app.add_option("--noise-abs-m-per-s-per-N", o.absolute_noise_m_per_s_per_N,
+                 "additive noise floor flat in mobility (a velocity sensor), rms [(m/s)/N]")->capture_default_str();
+  app.add_option("--noise-abs-m-per-s2-per-N", o.absolute_noise_m_per_s2_per_N,
+                 "additive noise floor flat in accelerance (an accelerometer), rms [(m/s^2)/N]")->capture_default_str();
+  app.add_option("--hammer-cutoff-hz", o.hammer_cutoff_hz,
+                 "the hammer tip's force spectrum falls as 1/sqrt(1+(f/fc)^4) above this frequency, which raises the "
+                 "floor by the inverse; 0: flat force spectrum [Hz]")->capture_default_str();
+  app.add_option("--averages", o.averages,
+                 "number of averaged impacts behind the noise levels; sets the coherence and is written as "
+                 "'# averages: N' (CSV)")->capture_default_str();
   app.add_option("--seed", o.seed, "random seed of the noise")->capture_default_str();
   app.add_flag("--coherence", o.coherence, "also write a coherence (expected for the noise level)");
   app.add_option("--quantity", quantity, "receptance, mobility or accelerance")
@@ -56,6 +72,7 @@ int Run(int argc, char** argv) {
   }
   return RunGuarded(kTool, [&]() -> int {
     CheckOptionRange("--block-samples", static_cast<double>(o.block_samples), 2, 1 << 22);
+    CheckOptionRange("--averages", o.averages, o.coherence ? 2 : 1, 100000);
     RequireReadableFile(robot_path, "robot config");
     RequireReadableFile(postures_path, "posture file");
     CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}}, {{"--out", out_path}});
@@ -82,9 +99,13 @@ int Run(int argc, char** argv) {
     std::string ext = out_path.substr(out_path.find_last_of('.') + 1);
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (ext == "uff" || ext == "unv" || ext == "uf") {
+      if (o.coherence && o.averages > 1) {
+        Warn(kTool, "UFF58 has no field for the number of averages: give --averages " +
+                        std::to_string(o.averages) + " to the tools that read " + out_path);
+      }
       io::WriteUff58(out_path, frfs, q);
     } else {
-      io::WriteFrfCsv(out_path, frfs, q);
+      io::WriteFrfCsv(out_path, frfs, q, o.coherence ? o.averages : 0);
     }
     std::ostringstream msg;
     msg << kTool << ": wrote " << frfs.size() << " FRFs of " << calibration::HammerTestGrid(o).size()

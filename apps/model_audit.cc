@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli_support.h"
+#include "measured_data.h"
 #include "robomach/audit/error_patterns.h"
 #include "robomach/audit/model_audit.h"
 #include "robomach/common/errors.h"
@@ -84,7 +85,9 @@ int Run(int argc, char** argv) {
       "counterpart either way. Writes REPORT/summary.json, index.html, errors.csv, candidates.csv,\n"
       "trends.csv, posture_descriptors.csv, mode_errors.csv, unmatched_modes.csv, trends.png,\n"
       "mode_error_map.png, overlay_<pose>.png and (with an accepted candidate) effects.yaml."};
-  app.footer(ExitCodeHelp() + " Exit 3 when the failure is significant and no candidate explains it.");
+  app.footer(ExitCodeHelp() +
+             " Exit 3 when the failure is significant and no candidate explains it, or a fit failed (the report is "
+             "complete; candidates.csv says which and why).");
   std::string robot_path, postures_path, report_dir, compare_dir, candidates_list;
   std::vector<std::string> measured_files, adds;
   audit::AuditOptions opt;
@@ -98,6 +101,8 @@ int Run(int argc, char** argv) {
   app.add_option("--fmin-hz", opt.fmin_hz, "lowest frequency used [Hz]")->capture_default_str();
   app.add_option("--fmax-hz", opt.fmax_hz, "highest frequency used [Hz]; default: all lines");
   app.add_option("--max-iterations", opt.max_iterations, "solver iterations per fit")->capture_default_str();
+  NoiseCliOptions noise_opt;
+  AddNoiseOptions(app, &noise_opt);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -149,19 +154,17 @@ int Run(int argc, char** argv) {
     for (const io::Posture& p : io::ReadPostureFile(postures_path, cfg.description.arm.num_joints())) {
       postures[p.id] = p.q;
     }
-    dynamics::FrfSet measured;
-    for (const std::string& f : measured_files) {
-      RequireReadableFile(f, "measured FRF file");
-      const io::FrfReadResult r = io::ReadFrfFile(f, "");
-      for (const std::string& w : r.warnings) Warn(kTool, w);
-      for (const auto& [key, frf] : r.frfs) {
-        if (measured.contains(key)) throw InputError({f, 0, 0}, "FRF " + key.ToString() + " was already read");
-        if (!postures.count(key.pose_id)) {
-          throw InputError({postures_path, 0, 0}, "posture " + key.pose_id + " of " + f + " is not in this posture file");
-        }
-        measured.Insert(key, frf);
+    const MeasuredData measured_read = ReadMeasuredFiles(kTool, measured_files, {}, "measured FRF file");
+    for (const auto& [key, frf] : measured_read.frfs) {
+      if (!postures.count(key.pose_id)) {
+        throw InputError({postures_path, 0, 0}, "posture " + key.pose_id + " of " + measured_read.file.at(key) +
+                                                    " is not in this posture file");
       }
     }
+    if (measured_read.frfs.empty()) throw std::invalid_argument("no measured FRFs were read");
+    // The noise of every FRF and the lines every fit and error uses (issue #10).
+    const calibration::NoiseModels noise = EstimateNoiseModels(kTool, measured_read, noise_opt);
+    const dynamics::FrfSet measured = FitData(measured_read, noise);
     if (measured.empty()) throw std::invalid_argument("no measured FRFs were read");
     {
       int lines = 0;
@@ -195,6 +198,11 @@ int Run(int argc, char** argv) {
     j["error_before"] = r.errors_before.total_rms_log_mag;
     j["error_after"] = after.total_rms_log_mag;
     j["noise_floor"] = r.noise_floor;
+    // With a noise model every error is in units of the noise (1: a model
+    // that is right); with --noise-model none, an rms of ln|H| differences.
+    j["error_units"] = noise.empty() ? "log_magnitude" : "noise_sigma";
+    j["noise"] = report::NoiseSummaryJson(noise, noise_opt.model, noise_opt.min_snr);
+    j["warnings"] = r.warnings;
     j["significant_failure"] = r.significant_failure;
     j["baseline_calibration"] = {{"status", calibration::FitStatusName(r.baseline_fit.status)},
                                  {"message", r.baseline_fit.message},
@@ -288,9 +296,19 @@ int Run(int argc, char** argv) {
          "td,th{border:1px solid #999;padding:2px 6px;text-align:right}pre{background:#eee;padding:6px}"
          "</style></head><body><h1>model-audit: " << Html(robot_path) << "</h1>\n";
     h << "<p><b>Verdict:</b> " << Html(r.verdict) << "</p>\n<p>Whole-curve error (rms of ln|H<sub>model</sub>| − "
-      << "ln|H<sub>measured</sub>|): before " << Num(r.errors_before.total_rms_log_mag) << ", after "
+      << "ln|H<sub>measured</sub>|" << (noise.empty() ? "" : ", each line in units of its noise: 1 is a model that is right")
+      << "): before " << Num(r.errors_before.total_rms_log_mag) << ", after "
       << Num(after.total_rms_log_mag) << "; noise floor " << Num(r.noise_floor) << " ("
       << (r.significant_failure ? "significant failure" : "consistent with the noise") << ").</p>\n";
+    if (!noise.empty()) {
+      h << "<h2>Noise model and usable band per FRF</h2><p>Lines used where |H| ≥ " << Num(noise_opt.min_snr)
+        << " × the additive noise floor (--min-snr).</p><table><tr><th>FRF</th><th>noise model</th></tr>\n";
+      for (const auto& [key, n] : noise) {
+        h << "<tr><td>" << Html(KeyLabel(key)) << "</td><td style=\"text-align:left\">" << Html(n.description)
+          << "</td></tr>\n";
+      }
+      h << "</table>\n";
+    }
     h << "<h2>Error per posture</h2><table><tr><th>posture</th><th>before</th><th>after</th>";
     if (!previous.is_null()) h << "<th>previous before</th><th>previous after</th>";
     h << "</tr>\n";
@@ -379,8 +397,11 @@ int Run(int argc, char** argv) {
       }
       for (const std::string& pose : measured.pose_ids()) {
         const auto db = eb.Evaluate(postures.at(pose));
-        const report::PostureOverlay o = ea ? report::MakePostureOverlay(pose, measured, db, ea->Evaluate(postures.at(pose)))
-                                            : report::MakePostureOverlay(pose, measured, db);
+        // Every measured line with its noise, not only the usable ones.
+        report::PostureOverlay o = ea ? report::MakePostureOverlay(pose, measured_read.frfs, db,
+                                                                   ea->Evaluate(postures.at(pose)))
+                                      : report::MakePostureOverlay(pose, measured_read.frfs, db);
+        report::AddNoise(noise, &o);
         report::WriteOverlayPng((dir / ("overlay_" + pose + ".png")).string(), o,
                                 "model-audit: posture " + pose + ", measured vs " + before_label +
                                     (shown ? " and " + after_label : std::string()),
@@ -423,8 +444,13 @@ int Run(int argc, char** argv) {
     io::WriteFileAtomically((dir / "summary.json").string(), report::DumpJson(j));
 
     std::cerr << kTool << ": " << r.verdict << '\n';
+    for (const auto& w : r.warnings) Warn(kTool, w);
+    bool failed_candidate = false;
+    for (const auto& c : r.candidates) failed_candidate |= c.fit.status == calibration::FitStatus::kFailed;
+    if (failed_candidate) Warn(kTool, "a candidate's fit failed; its row in candidates.csv says why");
     std::cout << yaml;
-    return r.significant_failure && !r.explained ? kExitFlagged : kExitOk;
+    return (r.significant_failure && !r.explained) || !r.warnings.empty() || failed_candidate ? kExitFlagged
+                                                                                              : kExitOk;
   });
 }
 

@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "robomach/audit/error_patterns.h"
+#include "robomach/calibration/frf_noise.h"
 #include "robomach/common/golden_section.h"
 #include "robomach/dynamics/effect.h"
 #include "robomach/dynamics/posture_dynamics.h"
@@ -33,7 +34,7 @@ void CheckValid(const AuditOptions& o) {
     throw std::invalid_argument("AuditOptions: significance_factor and explained_factor must be > 1");
   }
   if (o.max_iterations < 1) throw std::invalid_argument("AuditOptions::max_iterations must be >= 1");
-  if (o.fit_line_stride < 1) throw std::invalid_argument("AuditOptions::fit_line_stride must be >= 1");
+  if (o.fit_line_stride < 0) throw std::invalid_argument("AuditOptions::fit_line_stride must be >= 0 (0: automatic)");
   if (o.threads < 1) throw std::invalid_argument("AuditOptions::threads must be >= 1");
 }
 
@@ -60,8 +61,13 @@ ModelErrors ComputeErrors(const std::shared_ptr<const dynamics::RobotModel>& mod
       }
       const Eigen::VectorXcd hm =
           H.Entry(frf.freq_hz(), static_cast<int>(key.response), static_cast<int>(key.excitation));
+      // Log-magnitude residuals, in units of their noise when the data carry
+      // a noise model (LogResidualWeights; all ones otherwise).
+      const Eigen::VectorXd w = calibration::LogResidualWeights(frf);
       Eigen::VectorXd r(frf.size());
-      for (int i = 0; i < frf.size(); ++i) r(i) = std::log(std::abs(hm(i))) - std::log(std::abs(frf.receptance()(i)));
+      for (int i = 0; i < frf.size(); ++i) {
+        r(i) = w(i) * (std::log(std::abs(hm(i))) - std::log(std::abs(frf.receptance()(i))));
+      }
       c.lines = frf.size();
       c.rms_log_mag = std::sqrt(r.squaredNorm() / c.lines);
       out.rss += r.squaredNorm();
@@ -94,6 +100,10 @@ ModelErrors ComputeErrors(const std::shared_ptr<const dynamics::RobotModel>& mod
 }
 
 double EstimateNoiseFloor(const dynamics::FrfSet& measured, double fmin_hz, double fmax_hz) {
+  // With a noise model the errors are in units of the noise already.
+  bool all_noise = !measured.empty();
+  for (const auto& [key, frf] : measured) all_noise = all_noise && frf.noise_sigma().has_value();
+  if (all_noise) return 1.0;
   std::vector<double> d;
   for (const auto& [key, full] : measured) {
     const dynamics::Frf frf = full.Band(fmin_hz, fmax_hz);
@@ -167,6 +177,8 @@ calibration::CalibrationOptions FitOptions(const AuditOptions& o, std::vector<st
   c.modal_fit.fmin_hz = o.fmin_hz;
   c.modal_fit.fmax_hz = o.fmax_hz;
   c.max_iterations = o.max_iterations;
+  // The audit chooses its own starts (scan, defaults) per candidate.
+  c.extra_starts = false;
   return c;
 }
 
@@ -187,10 +199,11 @@ Eigen::VectorXd WholeCurveResidualVector(const dynamics::RobotDescription& desc,
         const dynamics::Frf frf = full.Band(fmin_hz, fmax_hz);
         const Eigen::VectorXcd hm =
             H.Entry(frf.freq_hz(), static_cast<int>(key.response), static_cast<int>(key.excitation));
+        const Eigen::VectorXd w = calibration::LogResidualWeights(frf);
         for (int i = 0; i < frf.size(); ++i) {
           const auto e = calibration::WholeCurveResiduals(hm(i), frf.receptance()(i));
-          r.push_back(e[0]);
-          r.push_back(e[1]);
+          r.push_back(w(i) * e[0]);
+          r.push_back(w(i) * e[1]);
         }
       }
     }
@@ -251,7 +264,7 @@ dynamics::ParameterSet ScanStart(const dynamics::RobotDescription& desc, dynamic
       for (double v : ScanGrid(params.spec(name), start)) {
         if (v == start) continue;
         dynamics::ParameterSet trial = params;
-        trial.Set(name, v);
+        trial.SetClamped(name, v);
         const double c = WholeCurveCost(desc, trial, postures, data, o.fmin_hz, o.fmax_hz);
         if (c < best) {
           best = c;
@@ -271,7 +284,7 @@ dynamics::ParameterSet ScanStart(const dynamics::RobotDescription& desc, dynamic
       const bool log_axis = lo > 0.0;
       const auto cost_at = [&](double u) {
         dynamics::ParameterSet trial = params;
-        trial.Set(best_name, log_axis ? std::exp(u) : u);
+        trial.SetClamped(best_name, log_axis ? std::exp(u) : u);
         return WholeCurveCost(desc, trial, postures, data, o.fmin_hz, o.fmax_hz);
       };
       const auto [u, neg_fu] = GoldenSectionMaximum([&](double v) { return -cost_at(v); },
@@ -283,7 +296,7 @@ dynamics::ParameterSet ScanStart(const dynamics::RobotDescription& desc, dynamic
         best_value = std::clamp(log_axis ? std::exp(u) : u, params.spec(best_name).lower, params.spec(best_name).upper);
       }
     }
-    params.Set(best_name, best_value);
+    params.SetClamped(best_name, best_value);
   }
   return params;
 }
@@ -322,7 +335,7 @@ struct FitContext {
 double Chi2OfMove(const dynamics::RobotDescription& desc, const dynamics::ParameterSet& at,
                   const Eigen::VectorXd& r_at, const std::string& name, double value, const FitContext& x) {
   dynamics::ParameterSet moved = at;
-  moved.Set(name, value);
+  moved.SetClamped(name, value);
   const Eigen::VectorXd r = WholeCurveResidualVector(desc, moved, x.postures, x.fit_data, x.options.fmin_hz,
                                                      x.options.fmax_hz);
   if (r.size() == 0 || r.size() != r_at.size()) return std::numeric_limits<double>::infinity();
@@ -528,9 +541,11 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
       const bool better = doubtful(c) != doubtful(second) ? !doubtful(second) : second.bic < c.bic;
       if (better) c = std::move(second);
     }
-  } catch (const std::runtime_error& e) {
-    // Numerical trouble in one candidate (e.g. an eigensolver failing at an
-    // extreme parameter value) is that candidate's status, not the audit's end.
+  } catch (const std::exception& e) {
+    // Any trouble in one candidate (an eigensolver failing at an extreme
+    // parameter value, a value the model rejects) is that candidate's
+    // status, reported in its row, not the audit's end: the other
+    // candidates and everything already computed are kept.
     c.fit.status = calibration::FitStatus::kFailed;
     c.fit.message = e.what();
     c.note = std::string("fit failed: ") + e.what();
@@ -584,16 +599,27 @@ dynamics::FrfSet Decimate(const dynamics::FrfSet& in, int stride) {
   if (stride == 1) return in;
   dynamics::FrfSet out;
   for (const auto& [key, frf] : in) {
-    const int n = (frf.size() + stride - 1) / stride;
-    Eigen::VectorXd f(n);
-    Eigen::VectorXcd h(n);
-    for (int i = 0; i < n; ++i) {
-      f(i) = frf.freq_hz()(i * stride);
-      h(i) = frf.receptance()(i * stride);
-    }
-    out.Insert(key, dynamics::Frf::FromSamples(f, h));
+    std::vector<int> lines;
+    for (int i = 0; i < frf.size(); i += stride) lines.push_back(i);
+    out.Insert(key, frf.Select(lines));  // keeps the per-line noise
   }
   return out;
+}
+
+// The largest stride that keeps at least 1.7 lines in the half-power band
+// 2ζf of the most lightly damped measured mode (at most 4).
+int AutoLineStride(const dynamics::FrfSet& measured, const calibration::MeasuredFeatures& features) {
+  std::vector<double> spacing;
+  for (const auto& [key, frf] : measured) {
+    for (int i = 1; i < frf.size(); ++i) spacing.push_back(frf.freq_hz()(i) - frf.freq_hz()(i - 1));
+  }
+  if (spacing.empty()) return 1;
+  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
+  const double df = spacing[spacing.size() / 2];
+  double band = std::numeric_limits<double>::infinity();
+  for (const auto& m : features.modes) band = std::min(band, 2.0 * m.fit.damping_ratio * m.fit.freq_hz);
+  if (!std::isfinite(band) || !(df > 0.0)) return 1;
+  return std::clamp(static_cast<int>(std::floor(band / (1.7 * df))), 1, 4);
 }
 
 // Runs fit(i) for i in [0, n) on up to `threads` threads; results in order.
@@ -611,8 +637,9 @@ std::vector<CandidateResult> RunAll(int n, int threads, const std::function<Cand
 
 AuditResult RunAudit(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
                      const calibration::PostureMap& postures, const dynamics::FrfSet& measured,
-                     const AuditOptions& o) {
-  CheckValid(o);
+                     const AuditOptions& options) {
+  CheckValid(options);
+  AuditOptions o = options;  // fit_line_stride 0 is resolved below
   const auto say = [&](const std::string& s) {
     if (o.progress) o.progress(s);
   };
@@ -633,10 +660,18 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
 
   AuditResult r;
   r.noise_floor = EstimateNoiseFloor(measured, o.fmin_hz, o.fmax_hz);
-  const calibration::CalibrationOptions base_opt = FitOptions(o, o.calibration_parameters);
+  calibration::CalibrationOptions base_opt = FitOptions(o, o.calibration_parameters);
+  // The baseline sets the error every candidate is judged against: it gets
+  // the calibration's further starts (a poor baseline fit is a false alarm).
+  base_opt.extra_starts = true;
   say("modal fit of " + std::to_string(measured.size()) + " measured FRFs");
   r.features = calibration::ExtractFeatures(measured, base_opt.modal_fit);
   const calibration::MeasuredFeatures& features = r.features;
+  if (o.fit_line_stride == 0) {
+    o.fit_line_stride = AutoLineStride(measured, features);
+    say("fits use every " + std::to_string(o.fit_line_stride) + (o.fit_line_stride == 1 ? "st" : "th") +
+        " line (half-power bands of the measured modes)");
+  }
   say("calibrating the current model (whole curve)");
   std::vector<std::string> core;
   for (const auto& n : o.calibration_parameters) {
@@ -686,7 +721,16 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
       say("fitting the added effect " + e + " (as a candidate)");
       const CandidateResult c = FitCandidate(so_far, start, effects_so_far, e, free, added_context);
       if (c.fit.status == calibration::FitStatus::kFailed && !std::isfinite(c.bic)) {
-        throw std::runtime_error("the fit of the added effect " + e + " failed: " + c.fit.message);
+        // Reported, not fatal: the effect stays at its start values and the
+        // audit goes on with the rest.
+        r.warnings.push_back("the fit of the added effect " + e + " failed (" + c.fit.message +
+                             "); it is kept at its start values");
+        say(r.warnings.back());
+        auto [with_desc, with_params] = WithEffect(so_far, start, e);
+        so_far = std::move(with_desc);
+        start = std::move(with_params);
+        effects_so_far.push_back(e);
+        continue;
       }
       if (!c.note.empty()) say(e + ": " + c.note);
       so_far = WithEffect(so_far, start, e).first;
@@ -705,8 +749,9 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
     for (const auto& n : o.calibration_parameters) {
       if (Contains(free, n)) polish_free.push_back(n);
     }
-    r.baseline_fit = calibration::Calibrate(description, polished_start, postures, measured, features,
-                                            FitOptions(o, polish_free));
+    calibration::CalibrationOptions polish_opt = FitOptions(o, polish_free);
+    polish_opt.extra_starts = true;
+    r.baseline_fit = calibration::Calibrate(description, polished_start, postures, measured, features, polish_opt);
   } else {
     r.baseline_fit = calibration::Calibrate(description, parameters, postures, measured, features, base_opt);
   }

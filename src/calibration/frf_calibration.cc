@@ -8,6 +8,7 @@
 
 #include <ceres/ceres.h>
 
+#include "robomach/calibration/frf_noise.h"
 #include "robomach/common/golden_section.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -162,6 +163,7 @@ double WholeCurveError(const PostureDynamics& d, const FrfKey& key, const dynami
   if (band.size() == 0) return NAN;
   const Eigen::VectorXcd H = dynamics::ReceptanceEvaluator(d).Entry(band.freq_hz(), static_cast<int>(key.response),
                                                                      static_cast<int>(key.excitation));
+  const Eigen::VectorXd w = LogResidualWeights(band);
   double s = 0.0;
   int n = 0;
   for (int i = 0; i < band.size(); ++i) {
@@ -169,7 +171,7 @@ double WholeCurveError(const PostureDynamics& d, const FrfKey& key, const dynami
     const cd h = band.receptance()(i);
     if (std::abs(h) == 0.0 || std::abs(hm) == 0.0) continue;
     const auto r = WholeCurveResiduals(hm, h);
-    s += r[0] * r[0] + r[1] * r[1];
+    s += w(i) * w(i) * (r[0] * r[0] + r[1] * r[1]);
     ++n;
   }
   return n > 0 ? std::sqrt(s / n) : NAN;
@@ -227,6 +229,7 @@ std::string FitStatusName(FitStatus s) {
     case FitStatus::kConverged: return "converged";
     case FitStatus::kNotConverged: return "not_converged";
     case FitStatus::kFailed: return "failed";
+    case FitStatus::kNotImproved: return "not_improved";
   }
   return "?";
 }
@@ -254,6 +257,7 @@ struct ModelResidual {
   ResidualKind kind;
   std::vector<ModeMatch> matches;                     // modal kinds
   std::vector<std::pair<FrfKey, dynamics::Frf>> curves;  // whole curve, band-limited
+  std::vector<Eigen::VectorXd> curve_weights;            // LogResidualWeights of each curve
   double freq_sigma{1.0}, peak_sigma{1.0};
   int num_residuals{0};
 
@@ -306,13 +310,15 @@ struct ModelResidual {
       if (kind == ResidualKind::kWholeCurve) {
         std::map<std::string, dynamics::ReceptanceEvaluator> evaluators;
         for (const auto& [id, d] : dyn) evaluators.emplace(id, dynamics::ReceptanceEvaluator(d));
-        for (const auto& [key, frf] : curves) {
+        for (size_t c = 0; c < curves.size(); ++c) {
+          const auto& [key, frf] = curves[c];
           const Eigen::VectorXcd H = evaluators.at(key.pose_id).Entry(
               frf.freq_hz(), static_cast<int>(key.response), static_cast<int>(key.excitation));
+          const Eigen::VectorXd& w = curve_weights[c];
           for (int i = 0; i < frf.size(); ++i) {
             const auto e = WholeCurveResiduals(H(i), frf.receptance()(i));
-            residuals[r++] = e[0];
-            residuals[r++] = e[1];
+            residuals[r++] = w(i) * e[0];
+            residuals[r++] = w(i) * e[1];
           }
         }
         return true;
@@ -444,11 +450,9 @@ bool SameMatching(const std::vector<ModeMatch>& a, const std::vector<ModeMatch>&
   return true;
 }
 
-}  // namespace
-
-CalibrationResult Calibrate(const dynamics::RobotDescription& description, const dynamics::ParameterSet& initial,
-                            const PostureMap& postures, const dynamics::FrfSet& measured,
-                            const MeasuredFeatures& features, const CalibrationOptions& o) {
+CalibrationResult CalibrateOnce(const dynamics::RobotDescription& description, const dynamics::ParameterSet& initial,
+                                const PostureMap& postures, const dynamics::FrfSet& measured,
+                                const MeasuredFeatures& features, const CalibrationOptions& o) {
   for (const std::string& name : o.free_parameters) {
     if (!initial.Has(name)) throw std::invalid_argument("unknown parameter '" + name + "'; known: " + initial.NameList());
     if (!initial.spec(name).fittable) throw std::invalid_argument("parameter '" + name + "' is not fittable");
@@ -532,7 +536,10 @@ CalibrationResult Calibrate(const dynamics::RobotDescription& description, const
       if (kind == ResidualKind::kWholeCurve) {
         for (const auto& [key, frf] : measured) {
           dynamics::Frf band = frf.Band(std::max(o.fmin_hz, 1e-12), o.fmax_hz);
-          if (band.size() > 0) r.curves.emplace_back(key, std::move(band));
+          if (band.size() > 0) {
+            r.curve_weights.push_back(LogResidualWeights(band));
+            r.curves.emplace_back(key, std::move(band));
+          }
         }
       }
       StageOutcome s = SolveStage(name, std::move(r), o);
@@ -601,6 +608,116 @@ CalibrationResult Calibrate(const dynamics::RobotDescription& description, const
   }
   result.message = msg.str();
   return result;
+}
+
+}  // namespace
+
+double WholeCurveMisfit(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
+                        const PostureMap& postures, const dynamics::FrfSet& measured, double fmin_hz,
+                        double fmax_hz) {
+  try {
+    const auto dyn = EvaluatePostures(dynamics::RobotModel::Build(description, parameters), postures,
+                                      measured.pose_ids());
+    double s = 0.0;
+    for (const auto& [key, frf] : measured) {
+      const dynamics::Frf band = frf.Band(fmin_hz, fmax_hz);
+      if (band.size() == 0) continue;
+      const Eigen::VectorXcd H = dynamics::ReceptanceEvaluator(dyn.at(key.pose_id))
+                                     .Entry(band.freq_hz(), static_cast<int>(key.response),
+                                            static_cast<int>(key.excitation));
+      const Eigen::VectorXd w = LogResidualWeights(band);
+      for (int i = 0; i < band.size(); ++i) {
+        if (std::abs(band.receptance()(i)) == 0.0) continue;
+        const auto r = WholeCurveResiduals(H(i), band.receptance()(i));
+        s += w(i) * w(i) * (r[0] * r[0] + r[1] * r[1]);
+      }
+    }
+    return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
+  } catch (const std::invalid_argument&) {
+    throw;  // a posture missing from the posture file is the caller's error
+  } catch (const std::exception&) {
+    return std::numeric_limits<double>::infinity();
+  }
+}
+
+CalibrationResult Calibrate(const dynamics::RobotDescription& description, const dynamics::ParameterSet& initial,
+                            const PostureMap& postures, const dynamics::FrfSet& measured,
+                            const MeasuredFeatures& features, const CalibrationOptions& o) {
+  const double misfit_start = WholeCurveMisfit(description, initial, postures, measured, o.fmin_hz, o.fmax_hz);
+  const auto misfit_of = [&](const CalibrationResult& r) {
+    return WholeCurveMisfit(description, r.parameters, postures, measured, o.fmin_hz, o.fmax_hz);
+  };
+  const auto doubtful = [](const CalibrationResult& r) {
+    if (r.status != FitStatus::kConverged) return true;
+    for (const ParameterEstimate& e : r.estimates) {
+      if (e.at_bound) return true;
+    }
+    return false;
+  };
+  CalibrationResult best = CalibrateOnce(description, initial, postures, measured, features, o);
+  best.start_used = "given";
+  double best_misfit = misfit_of(best);
+  int tried = 1;
+  const auto consider = [&](CalibrationResult r, const std::string& label) {
+    ++tried;
+    const double m = misfit_of(r);
+    // A converged fit off the bounds wins over a doubtful one; otherwise the misfit decides.
+    const bool better = doubtful(best) != doubtful(r) && m <= misfit_start ? !doubtful(r) : m < best_misfit;
+    if (better) {
+      best = std::move(r);
+      best.start_used = label;
+      best_misfit = m;
+    }
+  };
+  if (o.extra_starts && (!(best_misfit <= misfit_start) || doubtful(best))) {
+    dynamics::ParameterSet defaults = initial;
+    bool differs = false;
+    for (const std::string& n : o.free_parameters) {
+      const double d = initial.spec(n).default_value;
+      if (d != initial.Get(n)) {
+        defaults.Set(n, d);
+        differs = true;
+      }
+    }
+    if (differs) consider(CalibrateOnce(description, defaults, postures, measured, features, o), "defaults");
+    if (o.objective != Objective::kWholeCurve) {
+      CalibrationOptions wc = o;
+      wc.objective = Objective::kWholeCurve;
+      const dynamics::ParameterSet from = best_misfit <= misfit_start ? best.parameters : initial;
+      CalibrationResult polished = CalibrateOnce(description, from, postures, measured, features, wc);
+      polished.matches_before = best.matches_before;
+      consider(std::move(polished), "whole-curve polish");
+    }
+  }
+  best.starts_tried = tried;
+  best.misfit_start = misfit_start;
+  best.misfit_final = best_misfit;
+  // Round-off allowance: a fit that returns to an optimal start is not worse.
+  if (!(best_misfit <= misfit_start * (1.0 + 1e-9))) {
+    // No start did as well as where we began: keep the start values.
+    CalibrationResult kept = best;
+    kept.parameters = initial;
+    kept.matches_after = kept.matches_before;
+    for (ParameterEstimate& e : kept.estimates) {
+      e.value = e.initial;
+      e.std_dev = NAN;
+      e.at_bound = false;
+    }
+    kept.status = FitStatus::kNotImproved;
+    kept.start_used = "none (start kept)";
+    kept.misfit_final = misfit_start;
+    std::ostringstream m;
+    m.precision(4);
+    m << "no fit improved on the start values (whole-curve misfit " << misfit_start << " at the start, best of "
+      << tried << " starts " << best_misfit << "): the start values are kept; the model cannot represent these "
+      << "data with these free parameters, or the data are from another set-up";
+    kept.message = m.str();
+    return kept;
+  }
+  if (best.start_used != "given") {
+    best.message += "; result from the start '" + best.start_used + "' (" + std::to_string(tried) + " starts tried)";
+  }
+  return best;
 }
 
 }  // namespace robomach::calibration

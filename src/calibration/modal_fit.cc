@@ -35,6 +35,19 @@ double LocalLevel(const dynamics::Frf& frf, double f_hz) {
 
 }  // namespace
 
+Eigen::VectorXd ModalFitWeights(const dynamics::Frf& frf) {
+  Eigen::VectorXd w(frf.size());
+  for (int k = 0; k < frf.size(); ++k) {
+    if (frf.noise_sigma()) {
+      w(k) = 1.0 / (*frf.noise_sigma())(k);
+    } else {
+      const double a = std::abs(frf.receptance()(k));
+      w(k) = a > 0.0 ? 1.0 / a : 0.0;
+    }
+  }
+  return w;
+}
+
 std::vector<PeakEstimate> PickPeaks(const dynamics::Frf& frf, const PeakPickOptions& options) {
   const Eigen::VectorXd& f = frf.freq_hz();
   const Eigen::VectorXd mag = frf.receptance().cwiseAbs();
@@ -115,10 +128,11 @@ void FitResidues(const dynamics::Frf& frf, const std::vector<std::complex<double
   const int nc = 2 * nm + 2 + (lower_residual ? 2 : 0);
   Eigen::MatrixXd A(2 * n, nc);
   Eigen::VectorXd b(2 * n);
+  const Eigen::VectorXd weights = ModalFitWeights(frf);
   for (int k = 0; k < n; ++k) {
     const cd s(0.0, HzToRadPerSec(frf.freq_hz()(k)));
     const cd h = frf.receptance()(k);
-    const double w = std::abs(h) > 0.0 ? 1.0 / std::abs(h) : 1.0;
+    const double w = weights(k);
     auto put = [&](int col, cd v) {
       A(2 * k, col) = w * v.real();
       A(2 * k + 1, col) = w * v.imag();
@@ -194,12 +208,8 @@ void RefineAll(const dynamics::Frf& frf, bool lower, ModalFitResult* res) {
     th(4 * nm + 3) = res->lower_residual.imag();
   }
   std::vector<cd> sk(N);
-  Eigen::VectorXd wk(N);
-  for (int k = 0; k < N; ++k) {
-    sk[k] = cd(0.0, HzToRadPerSec(frf.freq_hz()(k)));
-    const double a = std::abs(frf.receptance()(k));
-    wk(k) = a > 0.0 ? 1.0 / a : 0.0;
-  }
+  const Eigen::VectorXd wk = ModalFitWeights(frf);
+  for (int k = 0; k < N; ++k) sk[k] = cd(0.0, HzToRadPerSec(frf.freq_hz()(k)));
   auto residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* e, Eigen::MatrixXd* J) {
     e->resize(2 * N);
     if (J) J->setZero(2 * N, np);
@@ -447,6 +457,7 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
     }
     return std::pair{keep, chain};
   };
+  const Eigen::VectorXd weights = ModalFitWeights(frf);
   // LSFD, prune, refine, prune again; returns the squared weighted error.
   // `refine_first`: refine before the first pruning (for a pole added by
   // guess, whose linear residue alone may look negligible).
@@ -471,10 +482,7 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
       return 1e300;
     }
     double cost = 0.0;
-    for (int k = 0; k < N; ++k) {
-      const double a = std::abs(frf.receptance()(k));
-      if (a > 0.0) cost += std::norm((r->Evaluate(frf.freq_hz()(k)) - frf.receptance()(k)) / a);
-    }
+    for (int k = 0; k < N; ++k) cost += std::norm((r->Evaluate(frf.freq_hz()(k)) - frf.receptance()(k)) * weights(k));
     return cost;
   };
   ModalFitResult best = result;
@@ -497,10 +505,36 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
       best.order_used = n;
     }
   }
+  bool from_peaks = false;
+  if (best_cost >= 1e300) {
+    // No pole was stable: start from the peaks of |H| instead (half-power
+    // damping, 2 % where a side does not reach half power), so that a clear
+    // resonance is never reported as "no mode"; the refinement and the
+    // pruning below still decide whether each is a mode.
+    std::vector<cd> poles;
+    std::vector<int> chains;
+    for (const PeakEstimate& p : PickPeaks(frf)) {
+      const double z = std::isfinite(p.damping_ratio) ? std::clamp(p.damping_ratio, 1e-3, 0.2) : 0.02;
+      const double wn = HzToRadPerSec(p.peak_freq_hz) / std::sqrt(std::max(1e-6, 1.0 - 2.0 * z * z));
+      poles.push_back(cd(-z * wn, wn * std::sqrt(1.0 - z * z)));
+      chains.push_back(0);
+    }
+    if (!poles.empty()) {
+      ModalFitResult r = result;
+      const double cost = fit_with(poles, chains, &r, true);
+      if (cost < 1e300) {
+        best = r;
+        best_cost = cost;
+        best.order_used = 0;
+        from_peaks = true;
+      }
+    }
+  }
   if (best_cost >= 1e300) {
     result.status = ModalFitStatus::kNoStableModes;
     result.message = "no pole was stable over " + std::to_string(o.min_stable_orders) +
-                     " consecutive orders up to " + std::to_string(nmax) + " with a significant residue";
+                     " consecutive orders up to " + std::to_string(nmax) +
+                     " with a significant residue, and no peak of |H| fitted as a mode";
     return result;
   }
   // Residual-driven additions: where the weighted residual is structured
@@ -514,10 +548,7 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
   int added = 0;
   for (int attempt = 0; attempt < o.max_added_modes; ++attempt) {
     Eigen::VectorXd e2(N);
-    for (int k = 0; k < N; ++k) {
-      const double a = std::abs(frf.receptance()(k));
-      e2(k) = a > 0.0 ? std::norm((best.Evaluate(frf.freq_hz()(k)) - frf.receptance()(k)) / a) : 0.0;
-    }
+    for (int k = 0; k < N; ++k) e2(k) = std::norm((best.Evaluate(frf.freq_hz()(k)) - frf.receptance()(k)) * weights(k));
     const int W = std::max(3, N / 200);
     Eigen::VectorXd local(N);
     Eigen::VectorXd csum(N + 1);
@@ -601,8 +632,11 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
   std::sort(result.modes.begin(), result.modes.end(),
             [](const FittedMode& a, const FittedMode& b) { return a.freq_hz < b.freq_hz; });
   result.status = ModalFitStatus::kOk;
-  result.message = std::to_string(result.modes.size()) + " modes: stable poles of order " +
-                   std::to_string(result.order_used) + ", refined" +
+  result.message = std::to_string(result.modes.size()) + " modes: " +
+                   (from_peaks ? std::string("no pole stable over ") + std::to_string(o.min_stable_orders) +
+                                     " orders, poles from the peaks of |H|"
+                               : "stable poles of order " + std::to_string(result.order_used)) +
+                   ", refined" +
                    (added > 0 ? ", " + std::to_string(added) + " added from the residual" : "");
   return result;
 }

@@ -6,6 +6,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "robomach/common/units.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 
@@ -28,8 +29,23 @@ void CheckValid(const VirtualHammerOptions& o) {
   if (!(o.fmin_hz > 0.0)) fail("fmin_hz must be > 0 (the 0 Hz line is not measured)");
   if (!(o.fmax_hz > o.fmin_hz)) fail("fmax_hz must be > fmin_hz");
   if (o.fmax_hz > 0.5 * o.sample_rate_hz) fail("fmax_hz must not exceed the Nyquist frequency sample_rate_hz/2");
-  if (!(o.relative_noise >= 0.0) || !(o.absolute_noise_m_per_N >= 0.0)) fail("noise levels must be >= 0");
+  if (!(o.relative_noise >= 0.0) || !(o.absolute_noise_m_per_N >= 0.0) ||
+      !(o.absolute_noise_m_per_s_per_N >= 0.0) || !(o.absolute_noise_m_per_s2_per_N >= 0.0)) {
+    fail("noise levels must be >= 0");
+  }
+  if (!(o.hammer_cutoff_hz >= 0.0) || !std::isfinite(o.hammer_cutoff_hz)) fail("hammer_cutoff_hz must be >= 0");
+  if (o.averages < 1) fail("averages must be >= 1");
+  if (o.coherence && o.averages < 2) fail("a coherence needs averages >= 2 (one impact's coherence is 1)");
   if (o.directions.empty()) fail("no direction pairs");
+}
+
+double SynthNoiseFloor(const VirtualHammerOptions& o, double freq_hz) {
+  const double w = HzToRadPerSec(freq_hz);
+  double a2 = o.absolute_noise_m_per_N * o.absolute_noise_m_per_N;
+  if (o.absolute_noise_m_per_s_per_N > 0.0) a2 += std::pow(o.absolute_noise_m_per_s_per_N / w, 2);
+  if (o.absolute_noise_m_per_s2_per_N > 0.0) a2 += std::pow(o.absolute_noise_m_per_s2_per_N / (w * w), 2);
+  if (o.hammer_cutoff_hz > 0.0) a2 *= 1.0 + std::pow(freq_hz / o.hammer_cutoff_hz, 4);
+  return std::sqrt(a2);
 }
 
 Eigen::VectorXd HammerTestGrid(const VirtualHammerOptions& o) {
@@ -61,13 +77,13 @@ dynamics::FrfSet SynthesizeHammerTest(const std::shared_ptr<const dynamics::Robo
       for (Eigen::Index i = 0; i < f.size(); ++i) {
         const std::complex<double> clean = H[i](static_cast<int>(r), static_cast<int>(e));
         const std::complex<double> n1(g(rng), g(rng)), n2(g(rng), g(rng));
-        std::complex<double> v = clean * (1.0 + o.relative_noise * n1) + o.absolute_noise_m_per_N * n2;
+        const double floor = SynthNoiseFloor(o, f(i));
+        std::complex<double> v = clean * (1.0 + o.relative_noise * n1) + floor * n2;
         if (o.round_to_uff_precision) v = {Round13(v.real()), Round13(v.imag())};
         h(i) = v;
         const double a2 = std::norm(clean);
-        const double s2 = o.relative_noise * o.relative_noise * a2 +
-                          o.absolute_noise_m_per_N * o.absolute_noise_m_per_N;
-        coh(i) = a2 + s2 > 0.0 ? a2 / (a2 + s2) : 0.0;
+        const double s2 = o.relative_noise * o.relative_noise * a2 + floor * floor;
+        coh(i) = a2 + (o.averages - 1) * s2 > 0.0 ? a2 / (a2 + (o.averages - 1) * s2) : 0.0;
         if (o.round_to_uff_precision) coh(i) = Round13(coh(i));
       }
       out.Insert({p.id, r, e}, dynamics::Frf::FromSamples(f, h, o.coherence ? std::optional(coh) : std::nullopt));

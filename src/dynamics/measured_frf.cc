@@ -68,6 +68,50 @@ Frf Frf::Band(double fmin_hz, double fmax_hz) const {
   f.freq_hz_ = freq_hz_.segment(first, last - first);
   f.receptance_ = receptance_.segment(first, last - first);
   if (coherence_) f.coherence_ = coherence_->segment(first, last - first);
+  if (noise_sigma_) f.noise_sigma_ = noise_sigma_->segment(first, last - first);
+  return f;
+}
+
+Frf Frf::WithNoise(Eigen::VectorXd sigma) const {
+  if (sigma.size() != size()) {
+    std::ostringstream m;
+    m << "Frf: " << size() << " frequency lines but " << sigma.size() << " noise values";
+    throw std::invalid_argument(m.str());
+  }
+  for (Eigen::Index i = 0; i < sigma.size(); ++i) {
+    if (!(std::isfinite(sigma(i)) && sigma(i) > 0.0)) {
+      std::ostringstream m;
+      m.precision(12);
+      m << "Frf: line " << i << " (f = " << freq_hz_(i) << " Hz): noise sigma must be finite and > 0, got "
+        << sigma(i);
+      throw std::invalid_argument(m.str());
+    }
+  }
+  Frf f = *this;
+  f.noise_sigma_ = std::move(sigma);
+  return f;
+}
+
+Frf Frf::Select(const std::vector<int>& lines) const {
+  const int n = static_cast<int>(lines.size());
+  for (int k = 0; k < n; ++k) {
+    if (lines[k] < 0 || lines[k] >= size() || (k > 0 && lines[k] <= lines[k - 1])) {
+      throw std::invalid_argument("Frf::Select: line indices must be strictly increasing in [0, " +
+                                  std::to_string(size()) + "), got " + std::to_string(lines[k]) + " at position " +
+                                  std::to_string(k));
+    }
+  }
+  Frf f;
+  f.freq_hz_.resize(n);
+  f.receptance_.resize(n);
+  if (coherence_) f.coherence_ = Eigen::VectorXd(n);
+  if (noise_sigma_) f.noise_sigma_ = Eigen::VectorXd(n);
+  for (int k = 0; k < n; ++k) {
+    f.freq_hz_(k) = freq_hz_(lines[k]);
+    f.receptance_(k) = receptance_(lines[k]);
+    if (coherence_) (*f.coherence_)(k) = (*coherence_)(lines[k]);
+    if (noise_sigma_) (*f.noise_sigma_)(k) = (*noise_sigma_)(lines[k]);
+  }
   return f;
 }
 

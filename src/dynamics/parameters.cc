@@ -63,4 +63,12 @@ void ParameterSet::Set(std::string_view name, double value) {
   values_(IndexOf(name)) = value;
 }
 
+void ParameterSet::SetClamped(std::string_view name, double value) {
+  const ParameterSpec& s = spec(name);
+  if (!std::isfinite(value)) {
+    throw std::invalid_argument("parameter '" + s.name + "': " + Num(value) + " is not a finite number");
+  }
+  values_(IndexOf(name)) = std::min(std::max(value, s.lower), s.upper);
+}
+
 }  // namespace robomach::dynamics

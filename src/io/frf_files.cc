@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -170,6 +171,14 @@ FrfReadResult ReadFrfCsv(const std::string& path) {
                                          "': expected receptance, mobility or accelerance");
     }
   }
+  if (auto it = t.metadata().find("averages"); it != t.metadata().end()) {
+    char* end = nullptr;
+    const long n = std::strtol(it->second.c_str(), &end, 10);
+    if (end == it->second.c_str() || *end != '\0' || n < 1 || n > 1000000) {
+      throw InputError({path, 0, 0}, "metadata '# averages: " + it->second + "': expected a whole number >= 1");
+    }
+    out.averages = static_cast<int>(n);
+  }
   for (const char* c : {"pose_id", "response", "excitation", "freq_hz", "re", "im"}) t.RequireColumn(c);
   const bool has_coherence = t.HasColumn("coherence");
   if (t.num_rows() == 0) throw InputError({path, t.header_line(), 0}, "no FRF lines after the header");
@@ -281,10 +290,11 @@ FrfReadResult ReadFrfCsv(const std::string& path) {
   return out;
 }
 
-void WriteFrfCsv(std::ostream& os, const FrfSet& frfs, FrfQuantity quantity) {
+void WriteFrfCsv(std::ostream& os, const FrfSet& frfs, FrfQuantity quantity, int averages) {
   bool coherence = !frfs.empty();
   for (const auto& [k, f] : frfs) coherence = coherence && f.coherence().has_value();
   os << "# quantity: " << QuantityName(quantity) << '\n';
+  if (averages > 0) os << "# averages: " << averages << '\n';
   os << "# written by robomach; tool-tip FRFs in the robot base frame B, SI units\n";
   os << "pose_id,response,excitation,freq_hz,re,im" << (coherence ? ",coherence" : "") << '\n';
   for (const auto& [k, frf] : frfs) {
@@ -300,8 +310,8 @@ void WriteFrfCsv(std::ostream& os, const FrfSet& frfs, FrfQuantity quantity) {
   }
 }
 
-void WriteFrfCsv(const std::string& path, const FrfSet& frfs, FrfQuantity quantity) {
-  WriteFileAtomically(path, [&](std::ostream& os) { WriteFrfCsv(os, frfs, quantity); });
+void WriteFrfCsv(const std::string& path, const FrfSet& frfs, FrfQuantity quantity, int averages) {
+  WriteFileAtomically(path, [&](std::ostream& os) { WriteFrfCsv(os, frfs, quantity, averages); });
 }
 
 // ---------------------------------------------------------------- UFF58 --

@@ -138,6 +138,43 @@ PostureOverlay MakePostureOverlay(const std::string& pose, const dynamics::FrfSe
   return o;
 }
 
+nlohmann::json NoiseSummaryJson(const calibration::NoiseModels& noise, const std::string& model, double min_snr) {
+  nlohmann::json j{{"model", model}, {"min_snr", min_snr}, {"frfs", nlohmann::json::array()}};
+  for (const auto& [key, n] : noise) {
+    nlohmann::json bands = nlohmann::json::array();
+    for (const auto& [lo, hi] : n.usable_bands) bands.push_back({lo, hi});
+    j["frfs"].push_back({{"pose_id", key.pose_id},
+                         {"response", std::string(1, AxisName(key.response))},
+                         {"excitation", std::string(1, AxisName(key.excitation))},
+                         {"source", calibration::NoiseSourceName(n.source)},
+                         {"averages", n.averages},
+                         {"relative", n.relative},
+                         {"floor_min_m_per_N", n.floor_m_per_N.minCoeff()},
+                         {"floor_max_m_per_N", n.floor_m_per_N.maxCoeff()},
+                         {"usable_bands_hz", bands},
+                         {"usable_lines", n.usable_lines},
+                         {"lines", static_cast<int>(n.usable.size())},
+                         {"converged", n.converged}});
+  }
+  return j;
+}
+
+void AddNoise(const calibration::NoiseModels& noise, PostureOverlay* o) {
+  o->noise_sigma.clear();
+  o->usable.clear();
+  for (size_t k = 0; k < o->keys.size(); ++k) {
+    auto it = noise.find(o->keys[k]);
+    if (it == noise.end() || it->second.sigma_m_per_N.size() != o->freq_hz[k].size()) {
+      o->noise_sigma.emplace_back();
+      o->usable.emplace_back();
+      continue;
+    }
+    o->noise_sigma.push_back(it->second.sigma_m_per_N);
+    const std::string u = calibration::DescribeUsable(it->second);
+    o->usable.push_back(u);
+  }
+}
+
 void WriteOverlayPng(const std::string& path, const PostureOverlay& o, const std::string& title,
                      const std::string& before_label, const std::string& after_label) {
   const int rows = static_cast<int>(o.keys.size());
@@ -153,8 +190,15 @@ void WriteOverlayPng(const std::string& path, const PostureOverlay& o, const std
     if (static_cast<size_t>(r) < o.after.size()) {
       curves.push_back({o.freq_hz[r], o.after[r], after_label, PaletteColor(6), false, 1});
     }
-    FillFrfPanels(curves, o.mode_freq_hz, "posture " + o.pose_id + ": H" + Dir(o.keys[r]), &fig.at(r, 0),
-                  &fig.at(r, 1));
+    std::string panel = "posture " + o.pose_id + ": H" + Dir(o.keys[r]);
+    if (static_cast<size_t>(r) < o.noise_sigma.size() && o.noise_sigma[r].size() == o.freq_hz[r].size()) {
+      FrfCurve noise{o.freq_hz[r], o.noise_sigma[r].cast<std::complex<double>>(), "noise (1 sigma)", {150, 150, 150},
+                     true, 1};
+      noise.magnitude_only = true;
+      curves.push_back(noise);
+      panel += ", " + o.usable[r];
+    }
+    FillFrfPanels(curves, o.mode_freq_hz, panel, &fig.at(r, 0), &fig.at(r, 1));
     fig.at(r, 1).title = "phase";
   }
   fig.SavePng(path);

@@ -48,7 +48,7 @@ void FillFrfPanels(const std::vector<FrfCurve>& curves, const std::vector<double
       if (std::abs(p.y[i] - p.y[i - 1]) > 180.0) p.y[i - 1] = NAN;
     }
     mag->series.push_back(std::move(m));
-    phase->series.push_back(std::move(p));
+    if (!c.magnitude_only) phase->series.push_back(std::move(p));
   }
   for (size_t k = 0; k < mode_freq_hz.size(); ++k) {
     if (!(mode_freq_hz[k] > 0.0) || (fmax > 0 && mode_freq_hz[k] > fmax)) continue;

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "robomach/calibration/frf_calibration.h"
+#include "robomach/calibration/frf_noise.h"
 #include "robomach/calibration/virtual_hammer_test.h"
 #include "robomach/common/units.h"
 #include "robomach/io/frf_files.h"
@@ -85,7 +86,7 @@ void ExpectAcceptance(const TestCampaign& s, const CalibrationResult& r, const d
           << what << " " << label << " " << m.key.ToString() << " at " << m.measured_freq_hz << " Hz";
     }
     // Every posture contributes matched modes (the table covers all of them).
-    EXPECT_EQ(poses.size(), set ? 3u : 5u) << what << " " << label;
+    EXPECT_EQ(poses.size(), set ? s.holdout_postures.size() : s.fit_postures.size()) << what << " " << label;
   }
 }
 
@@ -121,6 +122,136 @@ TEST(FrfCalibration, AcceptanceJointAndWholeCurveObjectives) {
     o.objective = obj;
     const CalibrationResult r = Calibrate(s.cfg.description, s.cfg.parameters, s.postures, measured, features, o);
     ExpectAcceptance(s, r, holdout, ObjectiveName(obj));
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Issue #10: hammer data as they really come. Accelerance files of a
+// 5120 Hz test (0.625..2560 Hz, 4096 lines) at 6 postures, 2 % relative
+// noise plus an additive floor: flat in acceleration (the accelerometer),
+// flat in receptance, and raised above the hammer's 1 kHz cutoff, so that
+// the signal-to-noise ratio falls below 1 above roughly 300 Hz and at the
+// lowest lines. The end effector is 3 kg heavier and 15 mm longer than the
+// config and the damping differs.
+
+TestCampaign MakeRealisticSetup() {
+  TestCampaign s{io::LoadRobotConfig(SourcePath("config/kr210.yaml")), {}, {}, {}, {}};
+  s.truth = s.cfg.parameters;
+  s.truth.Set("m6_kg", s.cfg.parameters.Get("m6_kg") + 3.0);
+  s.truth.Set("d6_m", s.cfg.parameters.Get("d6_m") + 0.015);
+  s.truth.Set("alpha_s", 1.4 * s.cfg.parameters.Get("alpha_s"));
+  s.truth.Set("beta_per_s", 0.8 * s.cfg.parameters.Get("beta_per_s"));
+  const std::vector<std::pair<std::string, std::vector<double>>> fit = {
+      {"P1", {0, -90, 90, 0, 45, 0}},       {"P2", {30, -60, 100, 10, -40, 20}}, {"P3", {0, -45, 60, 0, 60, 0}},
+      {"P4", {-20, -100, 120, 30, 30, 0}}, {"P5", {10, -80, 80, -45, 70, 90}},  {"P6", {-40, -65, 85, 15, -50, -20}}};
+  const std::vector<std::pair<std::string, std::vector<double>>> held = {
+      {"H1", {15, -70, 95, 20, 50, -30}}, {"H2", {-30, -85, 110, -20, 35, 45}}};
+  for (const auto& [list, out] : {std::pair{&fit, &s.fit_postures}, std::pair{&held, &s.holdout_postures}}) {
+    for (const auto& [id, deg] : *list) {
+      Eigen::VectorXd q(6);
+      for (int j = 0; j < 6; ++j) q(j) = DegToRad(deg[j]);
+      out->push_back({id, q});
+      s.postures[id] = q;
+    }
+  }
+  return s;
+}
+
+VirtualHammerOptions RealisticTest(unsigned seed, bool coherence) {
+  VirtualHammerOptions o;
+  o.sample_rate_hz = 5120.0;
+  o.block_samples = 8192;  // Δf = 0.625 Hz
+  o.fmin_hz = 0.625;
+  o.fmax_hz = 2560.0;
+  o.relative_noise = 0.02;
+  o.absolute_noise_m_per_s2_per_N = 1.5e-4;
+  o.absolute_noise_m_per_N = 4e-9;
+  o.hammer_cutoff_hz = 1000.0;
+  o.averages = 5;
+  o.coherence = coherence;
+  o.seed = seed;
+  return o;
+}
+
+// Through an accelerance CSV file and back, as a user's export would come.
+dynamics::FrfSet ViaAccelerance(const dynamics::FrfSet& frfs, const std::string& name, int averages) {
+  const std::string path = TempDir("frf_calibration_" + name) + "/" + name + ".csv";
+  io::WriteFrfCsv(path, frfs, io::FrfQuantity::kAccelerance, averages);
+  const io::FrfReadResult r = io::ReadFrfCsv(path);
+  EXPECT_EQ(r.file_quantity, io::FrfQuantity::kAccelerance);
+  EXPECT_EQ(r.averages, averages);
+  return r.frfs;
+}
+
+// The pipeline of frf-calibrate with its defaults: noise model per FRF,
+// usable lines with their σ, modal fit, calibration.
+dynamics::FrfSet Usable(const dynamics::FrfSet& read, int averages) {
+  NoiseOptions no;
+  no.averages = averages;
+  return UsableData(read, EstimateNoise(read, no));
+}
+
+TEST(FrfCalibration, AcceptanceRealisticHammerDataWithAndWithoutCoherence) {
+  const TestCampaign s = MakeRealisticSetup();
+  const auto truth_model = dynamics::RobotModel::Build(s.cfg.description, s.truth);
+  for (bool coherence : {false, true}) {
+    const std::string what = coherence ? "with coherence" : "without coherence";
+    const int averages = coherence ? 5 : 0;
+    const dynamics::FrfSet measured = Usable(
+        ViaAccelerance(SynthesizeHammerTest(truth_model, s.fit_postures, RealisticTest(31, coherence)),
+                       "realistic_fit_" + std::to_string(coherence), averages),
+        averages);
+    const dynamics::FrfSet holdout = Usable(
+        ViaAccelerance(SynthesizeHammerTest(truth_model, s.holdout_postures, RealisticTest(32, coherence)),
+                       "realistic_holdout_" + std::to_string(coherence), averages),
+        averages);
+    ASSERT_EQ(measured.size(), 12) << what;
+    const MeasuredFeatures features = ExtractFeatures(measured);
+    for (const auto& [key, fit] : features.fits) {
+      EXPECT_EQ(fit.status, ModalFitStatus::kOk) << what << " " << key.ToString() << ": " << fit.message;
+    }
+    const CalibrationResult r = Calibrate(s.cfg.description, s.cfg.parameters, s.postures, measured, features);
+    ExpectAcceptance(s, r, holdout, what);
+    EXPECT_LT(r.misfit_final, r.misfit_start) << what;
+    // A model that is right leaves about one noise variance per residual.
+    int lines = 0;
+    for (const auto& [k, f] : measured) lines += f.size();
+    EXPECT_LT(r.misfit_final / (2.0 * lines), 1.3 * 1.3) << what;
+  }
+}
+
+// A hopeless start, and data from another robot (all joints 2.5 times
+// softer): whatever the fit does, the result never fits worse than the start.
+TEST(FrfCalibration, NeverWorseThanTheStart) {
+  const TestCampaign s = MakeRealisticSetup();
+  dynamics::ParameterSet other = s.truth;
+  for (int j = 1; j <= 6; ++j) {
+    const std::string n = "kq" + std::to_string(j) + "_Nm_per_rad";
+    other.Set(n, other.Get(n) / 2.5);
+  }
+  const auto other_model = dynamics::RobotModel::Build(s.cfg.description, other);
+  const dynamics::FrfSet measured =
+      Usable(SynthesizeHammerTest(other_model, s.fit_postures, RealisticTest(41, false)), 0);
+  const MeasuredFeatures features = ExtractFeatures(measured);
+  dynamics::ParameterSet hopeless = s.cfg.parameters;
+  hopeless.Set("m6_kg", 120.0);
+  hopeless.Set("beta_per_s", 200.0);
+  for (const auto& [label, start] : {std::pair<std::string, const dynamics::ParameterSet*>{"config", &s.cfg.parameters},
+                                     {"hopeless", &hopeless}}) {
+    const CalibrationResult r = Calibrate(s.cfg.description, *start, s.postures, measured, features);
+    const double m0 = WholeCurveMisfit(s.cfg.description, *start, s.postures, measured);
+    const double m1 = WholeCurveMisfit(s.cfg.description, r.parameters, s.postures, measured);
+    EXPECT_DOUBLE_EQ(r.misfit_start, m0) << label;
+    EXPECT_DOUBLE_EQ(r.misfit_final, m1) << label;
+    EXPECT_LE(m1, m0) << label;
+    if (r.status == FitStatus::kNotImproved) {
+      EXPECT_EQ(r.parameters.values(), start->values()) << label;
+    }
+    // Another robot: the calibrated model still misses the data by far more
+    // than the noise, which the caller reports (frf-calibrate exits 3).
+    int lines = 0;
+    for (const auto& [k, f] : measured) lines += f.size();
+    EXPECT_GT(m1 / (2.0 * lines), 1.3 * 1.3) << label;
   }
 }
 
@@ -196,6 +327,7 @@ TEST(FrfCalibration, UnidentifiableDampingIsAStatusNotAnException) {
   const dynamics::FrfSet one = SynthesizeHammerTest(model, {s.fit_postures[0]}, o);
   CalibrationOptions co;
   co.free_parameters = {"alpha_s", "beta_per_s"};
+  co.extra_starts = false;  // the modal objective alone (a whole-curve start would see the curve's shape)
   CalibrationResult r;
   ASSERT_NO_THROW(r = Calibrate(s.cfg.description, s.cfg.parameters, s.postures, one, ExtractFeatures(one), co));
   EXPECT_NE(r.status, FitStatus::kConverged);

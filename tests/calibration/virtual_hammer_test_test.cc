@@ -60,8 +60,8 @@ TEST(VirtualHammerTest, NoiseHasTheRequestedRmsAndIsSeeded) {
       s2 += std::norm(d);
       mean += d;
       ++m;
-      // γ² = 1 / (1 + r²) for relative noise only.
-      EXPECT_NEAR((*frf.coherence())(i), 1.0 / (1.0 + 0.02 * 0.02), 1e-12);
+      // γ² = 1 / (1 + (n − 1) r²) for relative noise only, n = 5 averages.
+      EXPECT_NEAR((*frf.coherence())(i), 1.0 / (1.0 + 4 * 0.02 * 0.02), 1e-12);
     }
   }
   ASSERT_EQ(m, 4000);

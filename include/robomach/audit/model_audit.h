@@ -46,10 +46,12 @@ struct AuditOptions {
   bool rank_only_if_failing{true};
   int max_iterations{100};
   /// The fits use every fit_line_stride-th line of each FRF (errors are
-  /// always on all lines). At the default hammer grid (Δf = 0.25 Hz) a stride
-  /// of 2 keeps ≥ 1.7 lines in the half-power band of the most lightly
-  /// damped mode (2ζf = 0.84 Hz at 10.5 Hz) and halves the cost of every fit.
-  int fit_line_stride{2};
+  /// always on all lines). 0: automatic, the largest stride (at most 4) that
+  /// keeps 1.7 lines in the half-power band 2ζf of the most lightly damped
+  /// measured mode: 2 at the default hammer grid (Δf = 0.25 Hz, 2ζf = 0.84
+  /// Hz at 10.5 Hz), 1 at Δf = 0.625 Hz, where a stride of 2 left the 10 Hz
+  /// modes less than a line and candidate fits missed the truth.
+  int fit_line_stride{0};
   /// Identifiability screen of a candidate's parameters: a factor of two
   /// on a parameter must change the χ² (residuals over the noise floor) by
   /// at least this much for it to be fitted (4: a 2σ change).
@@ -87,7 +89,11 @@ struct ModelErrors {
   int lines{0};
 };
 
-/// Log-magnitude errors of `model` against `measured` in [fmin, fmax].
+/// Log-magnitude errors of `model` against `measured` in [fmin, fmax]. When
+/// the measured FRFs carry a noise model (calibration::UsableData), every
+/// residual is divided by its noise standard deviation
+/// (calibration::LogResidualWeights): the errors are then in units of the
+/// noise, 1 for a model that is right.
 /// @throws std::invalid_argument if a measured posture is not in `postures`.
 ModelErrors ComputeErrors(const std::shared_ptr<const dynamics::RobotModel>& model,
                           const calibration::PostureMap& postures, const dynamics::FrfSet& measured,
@@ -100,7 +106,8 @@ ModelErrors ComputeErrors(const std::shared_ptr<const dynamics::RobotModel>& mod
 /// Lines near sharp peaks break "locally straight"; the median of |d|
 /// (with 0.6745 σ for a normal variable) ignores them as long as they are
 /// fewer than half. Returns s, comparable with CurveError::rms_log_mag of a
-/// correct model; NaN if there are fewer than 3 lines in the band.
+/// correct model; NaN if there are fewer than 3 lines in the band. If every
+/// FRF carries a noise model the errors are already in its units: 1.
 double EstimateNoiseFloor(const dynamics::FrfSet& measured, double fmin_hz, double fmax_hz);
 
 /// One candidate effect (or pair, in the greedy round) fitted to the data.
@@ -148,6 +155,9 @@ struct AuditResult {
   /// When not explained: where the remaining error lies (see DescribePattern),
   /// also appended to the verdict; empty otherwise.
   std::string pattern;
+  /// Trouble that did not stop the audit (a failed fit of an effect given
+  /// with --add), for the caller to report.
+  std::vector<std::string> warnings;
 };
 
 /// BIC of a Gaussian least-squares fit: n ln(RSS/n) + k ln n.

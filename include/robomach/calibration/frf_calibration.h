@@ -114,7 +114,10 @@ inline std::array<double, 2> WholeCurveResiduals(std::complex<double> h_model, s
 
 /// Whole-curve error of the model against one measured FRF over a band:
 /// the rms over the lines of the residual pair of WholeCurveResiduals (as a
-/// complex-magnitude rms: √(mean(r_mag² + r_phase²))).
+/// complex-magnitude rms: √(mean(r_mag² + r_phase²))). When the FRF carries
+/// a noise model (Frf::noise_sigma) each residual is divided by its standard
+/// deviation (LogResidualWeights), so the error is in units of the noise:
+/// about √2 for a model that is right (both residuals of a line count).
 double WholeCurveError(const dynamics::PostureDynamics& d, const dynamics::FrfKey& key,
                        const dynamics::Frf& measured, double fmin_hz, double fmax_hz);
 
@@ -167,9 +170,17 @@ struct CalibrationOptions {
   /// A parameter is weakly identified if its standard deviation exceeds this
   /// fraction of its value.
   double weak_relative_std{0.1};
+  /// Further starts when the fit from the given values does not lower the
+  /// whole-curve misfit (WholeCurveMisfit), ends with a parameter on a
+  /// bound or does not converge: the free parameters at their library
+  /// defaults, and for a modal objective a whole-curve fit from the best
+  /// result so far. The best by misfit is kept.
+  bool extra_starts{true};
 };
 
-enum class FitStatus { kConverged, kNotConverged, kFailed };
+/// kNotImproved: no start lowered the whole-curve misfit below that of the
+/// start values, which the result keeps.
+enum class FitStatus { kConverged, kNotConverged, kFailed, kNotImproved };
 std::string FitStatusName(FitStatus s);
 
 struct ParameterEstimate {
@@ -204,7 +215,24 @@ struct CalibrationResult {
   std::vector<std::string> weakly_identified;
   std::vector<ModeMatch> matches_before;   // matching at the initial values
   std::vector<ModeMatch> matches_after;
+  /// WholeCurveMisfit of the start values and of the result: the result is
+  /// accepted only if it is lower.
+  double misfit_start{NAN};
+  double misfit_final{NAN};
+  /// Which start gave the result: "given", "defaults", "whole-curve polish",
+  /// or "none (start kept)".
+  std::string start_used;
+  int starts_tried{0};
 };
+
+/// The whole-curve misfit of a model against measured FRFs in a band: the
+/// sum over lines of the squared log-magnitude and phase residuals
+/// (WholeCurveResiduals), each in units of its noise when the FRF carries a
+/// noise model (LogResidualWeights) — the χ² of the data; +inf if the model
+/// cannot be built or evaluated.
+double WholeCurveMisfit(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
+                        const PostureMap& postures, const dynamics::FrfSet& measured,
+                        double fmin_hz = 0.0, double fmax_hz = std::numeric_limits<double>::infinity());
 
 /// Calibrates `options.free_parameters` of `description` starting from
 /// `initial` against `measured` (with its modal `features`) at `postures`.
@@ -217,6 +245,12 @@ struct CalibrationResult {
 /// fitted to them first (Rayleigh damping does not move undamped frequencies,
 /// so alpha_s and beta_per_s fall into the second stage automatically), then
 /// the rest to the peak amplitudes with the first ones fixed.
+///
+/// The result must fit better than the start: its WholeCurveMisfit must be
+/// lower than that of `initial`; otherwise further starts are tried
+/// (CalibrationOptions::extra_starts) and, if none does better, the start
+/// values are kept with status kNotImproved. "converged" is never the status
+/// of a model that fits worse than where it began.
 ///
 /// Not converged, a failed stage or an unidentifiable parameter are a status
 /// and flags in the result, not exceptions.

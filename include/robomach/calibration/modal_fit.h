@@ -142,7 +142,11 @@ struct ModalFitResult {
 /// criterion 2N ln F + p ln 2N improves (F the weighted squared error, p the
 /// number of real parameters); then the weakest modes are dropped while that
 /// lowers the criterion, and poles closer than a fifth of their half-power
-/// bandwidth are merged. Numerical trouble is a status, not an exception.
+/// bandwidth are merged. If no pole is stable over min_stable_orders, the
+/// peaks of |H| (PickPeaks, half-power damping) start the same refinement,
+/// so that a clear resonance in noisy data still gives its mode. All weights
+/// are those of ModalFitWeights (1/σ with a noise model, else 1/|H|).
+/// Numerical trouble is a status, not an exception.
 ///
 /// - [Guillaume et al. 2003] P. Guillaume, P. Verboven, S. Vanlanduit,
 ///   H. Van der Auweraer, B. Peeters, A poly-reference implementation of the
@@ -150,6 +154,11 @@ struct ModalFitResult {
 /// - [Ewins 2000] D. J. Ewins, Modal Testing: Theory, Practice and
 ///   Application, 2nd ed., Research Studies Press, 2000.
 ModalFitResult FitModes(const dynamics::Frf& frf, const ModalFitOptions& options = {});
+
+/// The weights of the modal fit's complex residuals: 1/σ per line when the
+/// FRF carries a noise model (Frf::noise_sigma, the maximum-likelihood
+/// weights for that noise), else 1/|H| (noise proportional to |H|).
+Eigen::VectorXd ModalFitWeights(const dynamics::Frf& frf);
 
 /// Residues (and residual terms) for given poles by weighted linear least
 /// squares; fills modes, residuals and the error of `result`. Exposed for

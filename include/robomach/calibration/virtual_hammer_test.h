@@ -36,15 +36,31 @@ struct VirtualHammerOptions {
   double fmax_hz{500.0};  // highest line kept [Hz]
   /// Response/excitation pairs, in the robot base frame.
   std::vector<std::pair<Axis, Axis>> directions{{Axis::kX, Axis::kX}, {Axis::kY, Axis::kY}};
-  /// Noise added to each line: H (1 + relative_noise · n₁) + absolute_noise · n₂,
-  /// n₁, n₂ complex standard normal (each part of variance 1/2), so these
-  /// are rms values: relative [-] and absolute [m/N].
+  /// Noise added to each line:
+  ///   H (1 + relative_noise · n₁) + floor(f) · n₂,
+  /// n₁, n₂ complex standard normal (each part of variance 1/2), so these are
+  /// rms values of the final (averaged) estimate. The additive floor is that
+  /// of the response sensor, flat in the quantity it measures, divided by the
+  /// normalised force spectrum of the hammer:
+  ///   floor(f)² = [a_r² + (a_v/ω)² + (a_a/ω²)²] / |F(f)/F(0)|²,
+  /// a_r, a_v, a_a the floors flat in receptance, mobility and accelerance.
   double relative_noise{0.0};
-  double absolute_noise_m_per_N{0.0};
+  double absolute_noise_m_per_N{0.0};             // a_r [m/N]
+  double absolute_noise_m_per_s_per_N{0.0};       // a_v [(m/s)/N]
+  double absolute_noise_m_per_s2_per_N{0.0};      // a_a [(m/s²)/N]
+  /// The hammer tip's force spectrum |F(f)/F(0)| = 1 / √(1 + (f/f_c)⁴):
+  /// flat below the cutoff f_c, −3 dB at it, falling as f⁻² above, the slope
+  /// of the envelope of a half-sine impact's spectrum (without its zeros,
+  /// which a real tip's pulse shape smears out). 0: a flat force spectrum.
+  double hammer_cutoff_hz{0.0};
+  /// Averages behind the estimate (for the coherence), >= 2 with coherence.
+  int averages{5};
   unsigned seed{1};
-  /// Also give a coherence: the value an H1 estimate has with output noise
-  /// of the variance above, γ² = |H|² / (|H|² + σ²) with
-  /// σ² = (relative_noise |H|)² + absolute_noise² (one average).
+  /// Also give a coherence, the value that an H1 estimate averaged over
+  /// n = `averages` impacts of equal force has for this noise: the impacts'
+  /// scatter about their mean is (n − 1) n σ² and |H|² (1 − γ²)/γ² is that
+  /// over n (see calibration/frf_noise.h), so
+  /// γ² = |H|² / (|H|² + (n − 1) σ²), σ² = (relative_noise |H|)² + floor(f)².
   bool coherence{false};
   /// Round values to 13 significant digits (UFF58's E20.12) so CSV and UFF58
   /// copies of the data hold identical numbers.
@@ -53,6 +69,9 @@ struct VirtualHammerOptions {
 
 /// @throws std::invalid_argument naming the field for a bad option.
 void CheckValid(const VirtualHammerOptions& options);
+
+/// The additive noise floor of the options at one line [m/N] (see above).
+double SynthNoiseFloor(const VirtualHammerOptions& options, double freq_hz);
 
 /// The frequency lines of the options' grid [Hz]: f_p = f_0 + p Δf with
 /// f_0 = ceil(fmin/Δf) Δf (the form a UFF58 reader reconstructs).

@@ -40,7 +40,17 @@ class Frf {
   const Eigen::VectorXd& freq_hz() const { return freq_hz_; }
   const Eigen::VectorXcd& receptance() const { return receptance_; }  // [m/N]
   const std::optional<Eigen::VectorXd>& coherence() const { return coherence_; }
+  /// Standard deviation σ of the complex measurement noise of each line
+  /// [m/N]: E|H_measured − H_true|² = σ² (see calibration/frf_noise.h).
+  /// Absent until a noise model is attached with WithNoise.
+  const std::optional<Eigen::VectorXd>& noise_sigma() const { return noise_sigma_; }
   int size() const { return static_cast<int>(freq_hz_.size()); }
+  /// A copy with the per-line noise σ [m/N] attached.
+  /// @throws std::invalid_argument if the size differs or a σ is not finite and > 0.
+  Frf WithNoise(Eigen::VectorXd sigma_m_per_N) const;
+  /// A copy of the given lines (0-based, strictly increasing), with their
+  /// coherence and noise. @throws std::invalid_argument for a bad index list.
+  Frf Select(const std::vector<int>& lines) const;
   /// True if the lines are evenly spaced within 1e-9 of the largest frequency.
   bool evenly_spaced() const;
   /// The lines with f in [fmin_hz, fmax_hz] (may be empty).
@@ -51,6 +61,7 @@ class Frf {
   Eigen::VectorXd freq_hz_;
   Eigen::VectorXcd receptance_;
   std::optional<Eigen::VectorXd> coherence_;
+  std::optional<Eigen::VectorXd> noise_sigma_;
 };
 
 /// Which FRF of a test campaign: posture, response and excitation direction

@@ -41,6 +41,12 @@ class ParameterSet {
   /// @throws std::invalid_argument for an unknown name, a non-finite value or
   ///   one outside [lower, upper] (the message names both).
   void Set(std::string_view name, double value);
+  /// Set for values an algorithm computed (a scan's grid point, a fitted
+  /// value, a step from a bound) that may pass a bound by round-off or by
+  /// design: the value is clamped to [lower, upper]. A value on a bound is
+  /// legal. @throws std::invalid_argument for an unknown name or a
+  ///   non-finite value.
+  void SetClamped(std::string_view name, double value);
   /// All names, comma separated, for messages.
   std::string NameList() const;
 

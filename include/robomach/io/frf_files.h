@@ -34,6 +34,8 @@ std::complex<double> FromReceptance(FrfQuantity quantity, double freq_hz, std::c
 struct FrfReadResult {
   dynamics::FrfSet frfs;                 // receptance [m/N]
   FrfQuantity file_quantity{FrfQuantity::kReceptance};
+  /// Number of averages behind the coherence (`# averages: N`); 0 if not given.
+  int averages{0};
   std::vector<std::string> warnings;     // "path:line: ..." each
 };
 
@@ -52,12 +54,13 @@ struct FrfReadResult {
 FrfReadResult ReadFrfCsv(const std::string& path);
 
 /// Writes `frfs` in the format of formats.md §3 as `quantity`, with a
-/// coherence column if every FRF has coherence. Numbers are written so that
-/// they read back exactly. Atomic (formats.md §4).
+/// coherence column if every FRF has coherence, and `# averages: N` if
+/// `averages` > 0. Numbers are written so that they read back exactly.
+/// Atomic (formats.md §4).
 void WriteFrfCsv(const std::string& path, const dynamics::FrfSet& frfs,
-                 FrfQuantity quantity = FrfQuantity::kReceptance);
+                 FrfQuantity quantity = FrfQuantity::kReceptance, int averages = 0);
 void WriteFrfCsv(std::ostream& os, const dynamics::FrfSet& frfs,
-                 FrfQuantity quantity = FrfQuantity::kReceptance);
+                 FrfQuantity quantity = FrfQuantity::kReceptance, int averages = 0);
 
 /// Reads a Universal File Format file of ASCII dataset 58 records (one
 /// function per record; [SDRC 1993], record layout below). Supported:

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "robomach/calibration/frf_calibration.h"
+#include "robomach/calibration/frf_noise.h"
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/dynamics/posture_dynamics.h"
 
@@ -43,6 +44,10 @@ struct PostureOverlay {
   std::vector<dynamics::FrfKey> keys;
   std::vector<Eigen::VectorXd> freq_hz;
   std::vector<Eigen::VectorXcd> measured, before, after;  // [m/N]; `after` may be empty
+  /// The noise σ per line of each measured FRF [m/N] and its usable band
+  /// (text); empty when no noise model is attached (AddNoise).
+  std::vector<Eigen::VectorXd> noise_sigma;
+  std::vector<std::string> usable;
   std::vector<double> mode_freq_hz;                       // model after calibration (else before)
 };
 
@@ -59,6 +64,13 @@ PostureOverlay MakePostureOverlay(const std::string& pose, const dynamics::FrfSe
 /// curve is drawn wide underneath the models, so that a model that fits it
 /// does not hide it. `before_label` and `after_label` name the two models
 /// in the legend.
+/// The noise models for summary.json: the model option, the SNR threshold,
+/// and per FRF its source, rel, floor range, usable bands and line counts.
+nlohmann::json NoiseSummaryJson(const calibration::NoiseModels& noise, const std::string& model, double min_snr);
+
+/// Attaches the noise models (σ per line, usable bands) of the overlay's FRFs.
+void AddNoise(const calibration::NoiseModels& noise, PostureOverlay* overlay);
+
 void WriteOverlayPng(const std::string& path, const PostureOverlay& overlay, const std::string& title,
                      const std::string& before_label = "model before",
                      const std::string& after_label = "model after");

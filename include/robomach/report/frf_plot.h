@@ -18,6 +18,8 @@ struct FrfCurve {
   Rgb color;
   bool dashed{false};
   int thickness{2};             // [px]
+  /// Drawn in the magnitude panel only (a noise floor has no phase).
+  bool magnitude_only{false};
 };
 
 /// Fills a magnitude panel (log |H| in m/N) and a phase panel (degrees, -180..180)
