@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <span>
+
+#include "robomach/dynamics/effect.h"
 
 #include "audit_test_support.h"
 
@@ -50,6 +54,58 @@ TEST(ModelAudit, NoHiddenEffectRaisesNoFalseAlarm) {
   EXPECT_FALSE(r.significant_failure) << r.errors_before.total_rms_log_mag << " vs floor " << r.noise_floor;
   EXPECT_TRUE(r.explained);
   EXPECT_TRUE(r.missing_effects.empty());
+}
+
+// Fault injection (issue #10 §5): a candidate whose model throws at every
+// evaluation (std::invalid_argument, which once escaped the audit as a "bad
+// command line"), next to one whose fit ends on its bound (a 5 kg tip mass,
+// the top of tip_mass.mass_kg's range). The audit completes, the failed
+// candidate is reported in its row with the reason, the other is fitted.
+// (Registered inside the test: ctest runs each test case in its own
+// process, so no other test sees this effect.)
+class ThrowingEffect final : public dynamics::Effect {
+ public:
+  std::string name() const override { return "injected_fault"; }
+  std::string description() const override { return "test effect that throws"; }
+  std::vector<dynamics::ParameterSpec> parameters() const override {
+    return {{"scale", "-", 1.0, 0.1, 10.0, true, "unused"}};
+  }
+  void Contribute(const dynamics::EffectContext&, std::span<const double>, int,
+                  dynamics::AssembledSystem*) const override {
+    throw std::invalid_argument("injected fault");
+  }
+};
+
+TEST(ModelAudit, AFailingCandidateAndOneOnItsBoundLeaveACompleteResult) {
+  dynamics::EffectRegistry::Instance().Register([] { return std::make_shared<const ThrowingEffect>(); });
+  const Campaign c = MakeCampaign();
+  const auto [d, p] = Truth(c, {{"tip_mass", {{"tip_mass.mass_kg", 5.0}}}});
+  const dynamics::FrfSet measured = Synthesize(c, d, p, 44);
+  AuditOptions o;
+  o.candidates = {"injected_fault", "tip_mass"};
+  AuditResult r;
+  ASSERT_NO_THROW(r = RunAudit(c.cfg.description, c.cfg.parameters, c.postures, measured, o));
+  EXPECT_TRUE(r.significant_failure);
+  ASSERT_GE(r.candidates.size(), 2u);
+  bool saw_failed = false, saw_tip = false;
+  for (const CandidateResult& cand : r.candidates) {
+    if (cand.name() == "injected_fault") {
+      saw_failed = true;
+      EXPECT_EQ(cand.fit.status, calibration::FitStatus::kFailed);
+      EXPECT_NE(cand.note.find("fit failed"), std::string::npos) << cand.note;
+      EXPECT_NE(cand.note.find("injected fault"), std::string::npos) << cand.note;
+      EXPECT_FALSE(cand.plausible);
+    }
+    if (cand.name() == "tip_mass") {
+      saw_tip = true;
+      EXPECT_NE(cand.fit.status, calibration::FitStatus::kFailed) << cand.note;
+      EXPECT_TRUE(std::isfinite(cand.errors.total_rms_log_mag));
+      EXPECT_NEAR(cand.fit.parameters.Get("tip_mass.mass_kg"), 5.0, 0.25);
+    }
+  }
+  EXPECT_TRUE(saw_failed);
+  EXPECT_TRUE(saw_tip);
+  EXPECT_FALSE(r.verdict.empty());
 }
 
 TEST(ModelAudit, RejectsBadOptionsAndUnknownCandidates) {
