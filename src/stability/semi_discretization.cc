@@ -116,6 +116,31 @@ double ChatterFrequencyHz(const TipModalModel& m, std::complex<double> mu, doubl
 
 }  // namespace
 
+int SdStepsPerPeriod(const TipModalModel& modes_C, const MillingProcess& process, double spindle_speed_rad_s,
+                     const SdOptions& options, bool* capped) {
+  if (capped) *capped = false;
+  if (options.steps_per_period > 0) return options.steps_per_period;
+  if (!(options.steps_per_mode_period > 0.0) || options.min_steps_per_period < 1 ||
+      options.max_monodromy_dimension < 1) {
+    throw std::invalid_argument(
+        "SD steps: need steps_per_mode_period > 0, min_steps_per_period >= 1 and max_monodromy_dimension >= 1");
+  }
+  if (!(spindle_speed_rad_s > 0.0) || process.teeth < 1) {
+    throw std::invalid_argument("SD steps: need a spindle speed > 0 and at least one tooth");
+  }
+  const double tau = 2.0 * kPi / (process.teeth * spindle_speed_rad_s);
+  const double f_max = modes_C.num_modes() > 0 ? RadPerSecToHz(modes_C.omega_rad_s.maxCoeff()) : 0.0;
+  const int n = std::max(1, modes_C.num_modes());
+  const int k_max = (options.max_monodromy_dimension - 2 * n) / n;
+  const double want = std::ceil(options.steps_per_mode_period * f_max * tau);
+  int k = want < 1e6 ? static_cast<int>(want) : 1000000;
+  if (k > k_max) {
+    k = k_max;
+    if (capped) *capped = true;
+  }
+  return std::max(options.min_steps_per_period, k);
+}
+
 LobePoint SdCriticalDepth(const TipModalModel& modes_C, const MillingProcess& process,
                           double spindle_speed_rad_s, const SdOptions& options) {
   process.Validate();
@@ -126,9 +151,9 @@ LobePoint SdCriticalDepth(const TipModalModel& modes_C, const MillingProcess& pr
   LobePoint out;
   out.spindle_speed_rad_s = spindle_speed_rad_s;
   const double tau = 2.0 * kPi / (process.teeth * spindle_speed_rad_s);
-  auto rho = [&](double a) {
-    return MillingMonodromy(modes_C, process, spindle_speed_rad_s, a, options.steps_per_period);
-  };
+  const int steps = SdStepsPerPeriod(modes_C, process, spindle_speed_rad_s, options);
+  out.sd_steps = steps;
+  auto rho = [&](double a) { return MillingMonodromy(modes_C, process, spindle_speed_rad_s, a, steps); };
   const SdMonodromy zero = rho(0.0);
   if (zero.spectral_radius >= 1.0) {
     out.status = LobeStatus::kUnstableAtZero;
