@@ -77,7 +77,7 @@ struct SdOptions {
   int min_steps_per_period{30};
   int max_monodromy_dimension{400};
   double max_depth{0.02};     // [m] search range of the depth
-  int depth_scan_points{20};  // coarse scan of [0, max_depth] before bisection
+  int depth_scan_points{20};  // coarse scan of [0, max_depth] before the bracketing search
   double depth_tolerance{1e-3};  // relative width of the final bracket
 };
 
@@ -94,8 +94,9 @@ int SdStepsPerPeriod(const TipModalModel& modes_C, const MillingProcess& process
                      const SdOptions& options, bool* capped = nullptr);
 
 /// The smallest depth with spectral radius 1 at one spindle speed: a
-/// coarse scan of [0, max_depth] for the first unstable depth, then
-/// bisection. Unstable islands narrower than max_depth/depth_scan_points can
+/// coarse scan of [0, max_depth] for the first unstable depth, then a
+/// bracketing search (Illinois regula falsi with bisection as a safeguard)
+/// down to depth_tolerance. Unstable islands narrower than max_depth/depth_scan_points can
 /// be missed. The steps per tooth period are SdStepsPerPeriod's, returned
 /// in LobePoint::sd_steps. The chatter frequency is the member of the family
 /// (±arg μ + 2πj)/τ closest to a natural frequency of the model.
