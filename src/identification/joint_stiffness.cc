@@ -446,6 +446,54 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
       }
     }
   }
+  // A joint the fit drove to infinite stiffness (its unconstrained linear
+  // estimate of the compliance is negative) is still informed by the data
+  // if that estimate is within noise of zero or above: the data are then
+  // consistent with a rigid joint, and only a lower bound of its stiffness
+  // is known. It is weakly determined with that one-sided 95 % interval
+  // (exact in the compliance, as above) and keeps the prior as its value.
+  // Only a compliance below zero beyond the noise (cases inconsistent with
+  // the model) leaves it not determined.
+  std::vector<int> rigid;
+  std::vector<double> rigid_x, rigid_sx;
+  if (!diverged.empty()) {
+    std::vector<int> S;
+    for (int j : free) {
+      if (std::find(cov_failed.begin(), cov_failed.end(), j) == cov_failed.end()) S.push_back(j);
+    }
+    S.insert(S.end(), diverged.begin(), diverged.end());
+    const int q = static_cast<int>(S.size());
+    int rows = 0;
+    for (int c = 0; c < m; ++c) rows += excluded[c] ? 0 : 3;
+    Eigen::MatrixXd Bs(rows, q);
+    Eigen::VectorXd rhs(rows);
+    int r0 = 0;
+    for (int c = 0; c < m; ++c) {
+      if (excluded[c]) continue;
+      Eigen::Vector3d yc = y[c];
+      for (int j = 0; j < n; ++j) {
+        if (std::find(S.begin(), S.end(), j) == S.end()) yc -= B[c].col(j) * std::exp(-theta(j));
+      }
+      rhs.segment<3>(r0) = yc;
+      for (int a = 0; a < q; ++a) Bs.block<3, 1>(r0, a) = B[c].col(S[a]);
+      r0 += 3;
+    }
+    const Eigen::MatrixXd F = Bs.transpose() * Bs;
+    const Eigen::VectorXd x = Bs.colPivHouseholderQr().solve(rhs);
+    const Eigen::MatrixXd C = F.ldlt().solve(Eigen::MatrixXd::Identity(q, q)) * (inflate * inflate);
+    for (int a = static_cast<int>(S.size() - diverged.size()); a < q; ++a) {
+      const int j = S[a];
+      const double sx = std::sqrt(std::max(C(a, a), 0.0));
+      if (!(std::isfinite(x(a)) && std::isfinite(sx) && x(a) + kZ95 * sx > 0.0)) continue;
+      rigid.push_back(j);
+      rigid_x.push_back(x(a));
+      rigid_sx.push_back(sx);
+      res.determination[j] = Determination::kWeak;
+      res.lower_95(j) = k0(j) / (x(a) + kZ95 * sx);
+      res.upper_95(j) = kInf;
+    }
+    for (int j : rigid) diverged.erase(std::find(diverged.begin(), diverged.end(), j));
+  }
   for (int j = 0; j < n; ++j) {
     if (res.determination[j] == Determination::kWeak) res.weakly_identified.push_back(j);
     if (res.determination[j] == Determination::kNotDetermined) res.not_determined.push_back(j);
@@ -529,7 +577,17 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
         "compliance), so its effect is lost in the noise or in inconsistent cases; check the outliers, "
         "then " + MomentAdvice(j, n));
   }
+  for (size_t i = 0; i < rigid.size(); ++i) {
+    const int j = rigid[i];
+    res.advice.push_back(
+        "joint " + std::to_string(j + 1) + " is weakly determined: the data are consistent with a rigid joint "
+        "(its compliance is estimated at " + Fixed(100.0 * rigid_x[i], 0) + " ± " + Fixed(100.0 * rigid_sx[i], 0) +
+        " % of the robot config's, 1 sigma), so only a lower bound is known: k > " +
+        Fixed(res.lower_95(j), 0) + " N·m/rad (95 %); the robot config's value is kept. Low sensitivity: " +
+        sensitivity(j) + "; or repeat the cases to average the tracker noise");
+  }
   for (int j : res.weakly_identified) {
+    if (std::find(rigid.begin(), rigid.end(), j) != rigid.end()) continue;
     std::ostringstream s;
     const double s_all = res.relative_std(j);
     const double vif = res.variance_inflation(j);

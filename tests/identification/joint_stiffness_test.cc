@@ -279,10 +279,11 @@ TEST(IdentifyJointStiffness, UnderstatedNoiseInflatesCovariance) {
 // postures are fixed; only the tracker noise changes with `seed`.
 constexpr double kWeakBracket = 0.05;  // [m]
 
-std::vector<LoadCase> WeakJoint6Campaign(unsigned seed, double tracker_noise = 1e-5) {
+std::vector<LoadCase> WeakJoint6Campaign(unsigned seed, double tracker_noise = 1e-5,
+                                         double bracket = kWeakBracket) {
   const auto model = Kr210();
   CampaignOptions o;
-  o.p_load_tip = Eigen::Vector3d(kWeakBracket, 0.0, 0.10);
+  o.p_load_tip = Eigen::Vector3d(bracket, 0.0, 0.10);
   o.tracker_noise = tracker_noise;
   o.seed = seed;
   const auto postures = CampaignPostures(*model, 16, o, 4242);
@@ -359,6 +360,34 @@ TEST(IdentifyJointStiffness, WeaklyInformedJointIsWeakWithCoveringInterval) {
   EXPECT_GE(covered, 9);
   RecordProperty("joint6_covered_of_10", covered);
   std::cerr << "joint 6: the 95 % interval covered the truth in " << covered << " of 10\n";
+}
+
+// Weaker still (bracket 20 mm: σ(log k6) ≈ 1.0 at the truth), the linear
+// estimate of the compliance is negative in ~16 % of repetitions and the fit
+// then drives k6 to infinity. That is still data, not a rank deficiency:
+// the joint is weakly determined with a one-sided interval (a lower bound),
+// never "not determined", and the intervals still cover the truth.
+TEST(IdentifyJointStiffness, JointConsistentWithRigidIsWeakWithLowerBound) {
+  const auto model = Kr210();
+  const double truth = model->joint_stiffness()(5);
+  int covered = 0, one_sided = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    const JointStiffnessResult r = IdentifyJointStiffness(*model, WeakJoint6Campaign(seed, 1e-5, 0.02));
+    ASSERT_EQ(r.status, FitStatus::kConverged) << r.solver_message;
+    EXPECT_EQ(r.determination[5], Determination::kWeak) << "seed " << seed;
+    EXPECT_TRUE(r.not_determined.empty()) << "seed " << seed;
+    if (truth >= r.lower_95(5) && truth <= r.upper_95(5)) ++covered;
+    if (!std::isfinite(r.relative_std(5))) {
+      ++one_sided;
+      EXPECT_EQ(r.joint_stiffness(5), truth);  // the prior (= the truth here) is kept
+      std::string all;
+      for (const auto& a : r.advice) all += a + "\n";
+      EXPECT_THAT(all, HasSubstr("joint 6 is weakly determined: the data are consistent with a rigid joint"));
+    }
+  }
+  EXPECT_GE(covered, 9);
+  EXPECT_GE(one_sided, 1) << "no repetition exercised the rigid case; pick another bracket";
+  std::cerr << "bracket 20 mm: covered " << covered << " of 10, " << one_sided << " one-sided\n";
 }
 
 // A near (not exact) trade-off: two load cases at one posture with rope

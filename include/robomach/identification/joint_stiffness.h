@@ -131,7 +131,10 @@ struct JointStiffnessResult {
 /// robust loss; (iv) outliers are flagged against the χ²(3) bound, and with
 /// a robust loss the plain fit is repeated without them; a joint driven more
 /// than 1000× away from the prior (the data ask for a negative compliance)
-/// is held and the fit repeated; (v) ceres::Covariance gives the covariance
+/// is held at the prior and the fit repeated: it is weakly determined with a
+/// one-sided interval (a lower bound of k) if its unconstrained compliance
+/// is within 1.96 σ of zero or above (the data are consistent with a rigid
+/// joint), not determined otherwise (cases inconsistent with the model); (v) ceres::Covariance gives the covariance
 /// of θ, scaled by χ²/dof when the residuals are clearly larger than the
 /// stated noise. A fitted joint is "weakly determined" if σ(θ_i) exceeds
 /// `weak_relative_std`, and `advice` names the cause: low sensitivity (its
