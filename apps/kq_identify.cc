@@ -147,7 +147,7 @@ int RunPlan(const io::RobotConfig& cfg, int num_postures, double noise_mm, unsig
   o.max_rope_angle = DegToRad(max_rope_angle_deg);
   o.num_candidate_postures = std::max(400, 4 * num_postures);
   const identification::TestPlan plan = identification::PlanLoadTests(*model, o);
-  const double undetermined = identification::IdentificationOptions{}.undetermined_relative_std;
+  const double weak = identification::IdentificationOptions{}.weak_relative_std;
   std::ostringstream csv;
   csv << "# kq-identify --plan " << num_postures << ": D-optimal load tests for " << cfg.path << "\n";
   csv << "# log_det_information: " << io::FormatDouble(plan.log_det_information) << "\n";
@@ -196,13 +196,22 @@ int RunPlan(const io::RobotConfig& cfg, int num_postures, double noise_mm, unsig
     }
     std::cerr << kTool << ":   joint " << j + 1 << ": k = " << Sci(model->joint_stiffness()(j)) << " N·m/rad, std dev "
               << Sci(plan.expected_std_dev(j), 2) << " N·m/rad (" << rel.str() << ")\n";
-    if (!(plan.expected_relative_std(j) <= undetermined)) {
+    // The identification's rule: not determined only where the plan's
+    // information is numerically rank-deficient (an infinite std); a finite
+    // std above the weak bound is a weakly determined joint.
+    if (!std::isfinite(plan.expected_relative_std(j))) {
       flagged = true;
       std::cerr << kTool << ": warning: joint " << j + 1
                 << " cannot be determined with this set-up"
                 << (j == model->num_joints() - 1
                         ? ": put the load point and the target off the tool axis (--load-point-mm, --target-mm)"
                         : ": allow more postures or rope directions")
+                << "\n";
+    } else if (plan.expected_relative_std(j) > weak) {
+      std::cerr << kTool << ": warning: joint " << j + 1 << " would be weakly determined (±"
+                << std::fixed << std::setprecision(0) << 100 * plan.expected_relative_std(j)
+                << " % at 1 sigma): plan more postures (--plan N)"
+                << (j == model->num_joints() - 1 ? " or put the load point and the target farther off the tool axis" : "")
                 << "\n";
     }
   }
@@ -357,6 +366,13 @@ int Run(int argc, char** argv) {
       std::vector<std::string> det;
       for (auto d : r.determination) det.push_back(identification::ToString(d));
       j["determination"] = det;
+      j["variance_inflation"] = vec(r.variance_inflation);
+      j["trade_off_with"] = nlohmann::json::array();
+      for (const auto& t : r.trade_off_with) {
+        std::vector<int> one_based;
+        for (int i : t) one_based.push_back(i + 1);
+        j["trade_off_with"].push_back(one_based);
+      }
       j["correlation"] = nlohmann::json::array();
       for (int a = 0; a < r.correlation.rows(); ++a) j["correlation"].push_back(vec(r.correlation.row(a).transpose()));
       j["rms_residual_mm"] = MToMm(r.rms_residual);

@@ -3,6 +3,7 @@
 // posture, by a measured or predicted FRF file, or by a modal table.
 #include <CLI/CLI.hpp>
 
+#include <climits>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -83,8 +84,10 @@ int Run(int argc, char** argv) {
   std::string robot_path, cut_path, postures_path, frf_path, modal_path, out_path, plot_path,
       method = "zoa", tool_axis_text = "0,0,1";
   std::vector<std::string> pose_ids;
-  int speeds = 0, sd_speeds = 60, sd_steps = 30, sd_modes = 3, threads = 0, max_lobe = 30;
+  int speeds = 0, sd_speeds = 60, sd_steps = 0, sd_modes = 3, threads = 0, max_lobe = 30;
   double sd_max_depth_mm = 20.0;
+  const stability::SdOptions sd_defaults;
+  double sd_steps_per_mode = sd_defaults.steps_per_mode_period;
   app.add_option("--cut", cut_path, "cut file YAML (config/cut_demo.yaml): tool, immersion, coefficients, speed range")->required();
   app.add_option("--robot", robot_path, "robot config YAML; with --postures and --posture");
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg");
@@ -98,7 +101,13 @@ int Run(int argc, char** argv) {
   app.add_option("--speeds", speeds, "ZOA: number of spindle speeds in the cut's range (default: the cut file's spindle_speed_count)");
   app.add_option("--max-lobe", max_lobe, "ZOA: highest lobe index traced")->capture_default_str();
   app.add_option("--sd-speeds", sd_speeds, "SD: number of spindle speeds in the cut's range")->capture_default_str();
-  app.add_option("--sd-steps", sd_steps, "SD: steps per tooth period")->capture_default_str();
+  app.add_option("--sd-steps", sd_steps,
+                 "SD: steps per tooth period at every speed; 0 = automatic (--sd-steps-per-mode-period steps per period of "
+                 "the highest retained mode, at least " + std::to_string(sd_defaults.min_steps_per_period) +
+                 " per tooth period, at most what keeps the monodromy matrix within " +
+                 std::to_string(sd_defaults.max_monodromy_dimension) + " rows)")->capture_default_str();
+  app.add_option("--sd-steps-per-mode-period", sd_steps_per_mode,
+                 "SD, automatic steps: steps per period of the highest retained mode")->capture_default_str();
   app.add_option("--sd-modes", sd_modes, "SD: number of modes kept (largest in-plane compliance)")->capture_default_str();
   app.add_option("--sd-max-depth-mm", sd_max_depth_mm, "SD: largest depth searched [mm]")->capture_default_str();
   app.add_option("--threads", threads, "SD: worker threads, 0 = all cores")->capture_default_str();
@@ -114,13 +123,16 @@ int Run(int argc, char** argv) {
       throw std::invalid_argument("give exactly one tool-tip source: --robot (with --postures), --frf or --modal-table");
     }
     if (!robot_path.empty() && postures_path.empty()) throw std::invalid_argument("--robot needs --postures");
-    if (sd_steps < 2 || sd_speeds < 1 || sd_modes < 1 || !(sd_max_depth_mm > 0.0) || speeds < 0 || max_lobe < 0) {
-      throw std::invalid_argument("expected --sd-steps >= 2, --sd-speeds >= 1, --sd-modes >= 1, --sd-max-depth-mm > 0");
+    if ((sd_steps != 0 && sd_steps < 2) || sd_speeds < 1 || sd_modes < 1 || !(sd_max_depth_mm > 0.0) || speeds < 0 ||
+        max_lobe < 0) {
+      throw std::invalid_argument(
+          "expected --sd-steps 0 (automatic) or >= 2, --sd-speeds >= 1, --sd-modes >= 1, --sd-max-depth-mm > 0");
     }
     // Bounds that keep a typo from hours of work or an allocation failure.
     CheckOptionRange("--speeds", speeds, 0, 100000);
     CheckOptionRange("--sd-speeds", sd_speeds, 1, 10000);
-    CheckOptionRange("--sd-steps", sd_steps, 2, 1000);
+    CheckOptionRange("--sd-steps", sd_steps, 0, 1000);
+    CheckOptionRange("--sd-steps-per-mode-period", sd_steps_per_mode, 4.0, 1000.0);
     CheckOptionRange("--sd-modes", sd_modes, 1, 200);
     CheckOptionRange("--sd-max-depth-mm", sd_max_depth_mm, 1e-6, 1e4);
     CheckOptionRange("--threads", threads, 0, 256);
@@ -253,8 +265,40 @@ int Run(int argc, char** argv) {
       if (do_sd) {
         stability::SdOptions so;
         so.steps_per_period = sd_steps;
+        so.steps_per_mode_period = sd_steps_per_mode;
         so.max_depth = MmToM(sd_max_depth_mm);
         const stability::TipModalModel m = stability::DominantModes(t.modes_C, sd_modes);
+        // Say what discretisation is used, before the (possibly long) work.
+        int k_lo = INT_MAX, k_hi = 0;
+        bool capped = false;
+        for (Eigen::Index i = 0; i < sd_speed_grid.size(); ++i) {
+          bool c = false;
+          const int k = stability::SdStepsPerPeriod(m, cut.process, sd_speed_grid(i), so, &c);
+          k_lo = std::min(k_lo, k);
+          k_hi = std::max(k_hi, k);
+          capped |= c;
+        }
+        {
+          std::ostringstream msg;
+          msg << kTool << ": SD of " << t.id << ": " << m.num_modes() << " mode" << (m.num_modes() > 1 ? "s" : "")
+              << " kept (highest " << io::FormatDouble(std::round(10.0 * RadPerSecToHz(m.omega_rad_s.maxCoeff())) / 10.0)
+              << " Hz); steps per tooth period " << k_lo;
+          if (k_hi != k_lo) msg << " to " << k_hi;
+          if (sd_steps > 0) {
+            msg << " (--sd-steps)";
+          } else {
+            msg << " (automatic: " << io::FormatDouble(sd_steps_per_mode) << " per period of the highest mode, at least "
+                << so.min_steps_per_period << ")";
+          }
+          std::cerr << msg.str() << "\n";
+        }
+        if (capped) {
+          Warn(kTool, "SD of " + t.id + ": at the lowest speeds the automatic steps per tooth period were capped "
+                          "at " + std::to_string(k_hi) + " (monodromy matrix of " +
+                          std::to_string(so.max_monodromy_dimension) + " rows), fewer than " +
+                          io::FormatDouble(sd_steps_per_mode) + " per period of the highest mode: the lobes there "
+                          "are less accurate (fewer modes, --sd-modes, or --sd-steps to force more steps)");
+        }
         ProgressLine progress(kTool, "SD speeds of " + t.id, sd_speed_grid.size() >= 20 ? 1000 : 0);
         const auto pts = stability::SdLobes(m, cut.process, sd_speed_grid, so, threads,
                                             [&](long done, long total) { progress.Update(done * 1000 / total); });
@@ -267,14 +311,14 @@ int Run(int argc, char** argv) {
     }
 
     auto write = [&](std::ostream& os) {
-      os << "pose_id,spindle_speed_rpm,critical_depth_mm,chatter_freq_hz,lobe_index,method,status\n";
+      os << "pose_id,spindle_speed_rpm,critical_depth_mm,chatter_freq_hz,lobe_index,method,status,sd_steps\n";
       for (const LobeRow& r : rows) {
         const auto& p = r.point;
         os << r.id << ',' << io::FormatDouble(RoundRpm(RadPerSecToRpm(p.spindle_speed_rad_s))) << ','
            << (std::isfinite(p.critical_depth) ? io::FormatDouble(MToMm(p.critical_depth)) : "") << ','
            << (std::isfinite(p.chatter_freq_hz) ? io::FormatDouble(p.chatter_freq_hz) : "") << ','
            << (p.lobe_index >= 0 ? std::to_string(p.lobe_index) : "") << ',' << r.method << ','
-           << stability::ToString(p.status) << '\n';
+           << stability::ToString(p.status) << ',' << (p.sd_steps > 0 ? std::to_string(p.sd_steps) : "") << '\n';
       }
     };
     if (out_path.empty()) {

@@ -11,8 +11,10 @@
 #include "robomach/io/posture_file.h"
 #include "robomach/io/region_file.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/stability/modal_fit.h"
 #include "robomach/stability/mode_coupling.h"
 #include "robomach/stability/posture_stability.h"
+#include "robomach/stability/semi_discretization.h"
 #include "robomach/stability/stability_map.h"
 #include "robomach/stability/tool_tip_model.h"
 #include "robomach/stability/zoa_lobes.h"
@@ -89,6 +91,60 @@ void BM_Map100x100(benchmark::State& state) {
   state.counters["threads"] = std::thread::hardware_concurrency();
 }
 BENCHMARK(BM_Map100x100)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+// Semi-discretization lobes on the Insperger-Stepan 2004 benchmark (1 DOF,
+// 922 Hz, 2 teeth) as `stability-lobes --method sd` runs them by default:
+// 60 speeds over 5000-25000 rpm, depth search up to 20 mm, one thread.
+// Arg(0): 0 = the automatic steps per tooth period (issue #10; 40 per
+// period of the mode, at least 40), 30 = the old fixed default; Arg(1):
+// radial immersion in percent.
+void BM_SdLobesInspergerStepan60Speeds(benchmark::State& state) {
+  stability::TipModalModel m;
+  m.omega_rad_s = Eigen::VectorXd::Constant(1, HzToRadPerSec(922.0));
+  m.zeta = Eigen::VectorXd::Constant(1, 0.011);
+  m.p = Matrix3Xd::Zero(3, 1);
+  m.p(0, 0) = 1.0 / std::sqrt(0.03993);
+  stability::MillingProcess p;
+  p.teeth = 2;
+  p.radial_immersion = state.range(1) / 100.0;
+  p.direction = stability::MillingDirection::kDown;
+  p.coefficients = {6e8, 2e8, 0.0};
+  stability::SdOptions o;
+  o.steps_per_period = static_cast<int>(state.range(0));
+  o.max_depth = 0.02;
+  const Eigen::VectorXd speeds = Eigen::VectorXd::LinSpaced(60, RpmToRadPerSec(5000.0), RpmToRadPerSec(25000.0));
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(stability::SdLobes(m, p, speeds, o, 1).data());
+  }
+}
+BENCHMARK(BM_SdLobesInspergerStepan60Speeds)
+    ->Args({30, 100})
+    ->Args({0, 100})
+    ->Args({30, 5})
+    ->Args({0, 5})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
+
+// The same for the demo posture P1 of the KR210 (3 dominant modes of the
+// robot model, config/cut_demo.yaml: 4 teeth, 6000-24000 rpm), as in
+// `stability-lobes --robot ... --method sd`: 60 speeds, one thread.
+void BM_SdLobesKr210Posture60Speeds(benchmark::State& state) {
+  const Setup s;
+  dynamics::PostureEvaluator ev(s.model);
+  const dynamics::PostureDynamics d = ev.Evaluate(s.postures[0].q);
+  const Eigen::Matrix3d R = stability::CuttingFrameAtPosture(d.X_BT, s.cut.feed_direction_B);
+  const auto modes = stability::DominantModes(stability::ModalModelFromPosture(d).Rotated(R), 3);
+  stability::SdOptions o;
+  o.steps_per_period = static_cast<int>(state.range(0));
+  const Eigen::VectorXd speeds =
+      Eigen::VectorXd::LinSpaced(60, s.cut.spindle_speed_min_rad_s, s.cut.spindle_speed_max_rad_s);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(stability::SdLobes(modes, s.cut.process, speeds, o, 1).data());
+  }
+  state.counters["steps_at_min_speed"] =
+      stability::SdStepsPerPeriod(modes, s.cut.process, s.cut.spindle_speed_min_rad_s, o);
+}
+BENCHMARK(BM_SdLobesKr210Posture60Speeds)->Arg(30)->Arg(0)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 

@@ -91,9 +91,6 @@ void CheckValid(const IdentificationOptions& o) {
     fail("outlier_false_alarm", o.outlier_false_alarm, "a probability in (0, 1)");
   }
   if (!(o.weak_relative_std > 0.0)) fail("weak_relative_std", o.weak_relative_std, "a value > 0");
-  if (!(o.undetermined_relative_std > o.weak_relative_std)) {
-    fail("undetermined_relative_std", o.undetermined_relative_std, "a value > weak_relative_std");
-  }
   if (o.max_iterations < 1) fail("max_iterations", o.max_iterations, "at least 1");
 }
 
@@ -156,28 +153,22 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     if (progress && (c + 1 == m || (c + 1) % 100 == 0)) progress(c + 1, m);
   }
 
-  // (ii) Which joints the data can see at all, judged at the prior.
+  // (ii) Which joints the data can determine at all. The model is linear in
+  // the relative compliances x_j = c_j/c0_j, so its information B^T B (the
+  // Fisher information of x) does not depend on where it is evaluated. A
+  // joint is not determined only where that information is numerically
+  // rank-deficient in it (internal::AnalyseIdentifiability): no sensitivity
+  // at all (`unseen`), or an exact trade-off with other joints (`traded`).
+  // A joint with little but finite information is fitted and reported with
+  // its (large) uncertainty.
   Eigen::MatrixXd info = Eigen::MatrixXd::Zero(n, n);
   for (int c = 0; c < m; ++c) info.noalias() += B[c].transpose() * B[c];
   res.determination.assign(n, Determination::kDetermined);
-  std::vector<int> barely, confounded, free, diverged, vague;
-  const double u = options.undetermined_relative_std;
+  std::vector<int> unseen, traded, free, diverged;
+  const internal::Identifiability prior_ident = internal::AnalyseIdentifiability(info);
   for (int j = 0; j < n; ++j) {
-    // Even with every other joint known, σ(x_j) = 1/√I_jj.
-    if (!(info(j, j) > 1.0 / (u * u))) barely.push_back(j);
-  }
-  {
-    std::vector<int> rest;
-    for (int j = 0; j < n; ++j) {
-      if (std::find(barely.begin(), barely.end(), j) == barely.end()) rest.push_back(j);
-    }
-    Eigen::MatrixXd sub(rest.size(), rest.size());
-    for (size_t a = 0; a < rest.size(); ++a)
-      for (size_t b = 0; b < rest.size(); ++b) sub(a, b) = info(rest[a], rest[b]);
-    const Eigen::VectorXd rel = internal::MarginalStdFromInformation(sub);
-    for (size_t a = 0; a < rest.size(); ++a) {
-      (rel(a) > u ? confounded : free).push_back(rest[a]);
-    }
+    if (!prior_ident.null[j]) free.push_back(j);
+    else (prior_ident.no_sensitivity[j] ? unseen : traded).push_back(j);
   }
 
   // (i) Exact linear least squares in x for the free joints, the others at
@@ -386,35 +377,122 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
   res.relative_std = Eigen::VectorXd::Constant(n, kInf);
   res.lower_95 = Eigen::VectorXd::Zero(n);
   res.upper_95 = Eigen::VectorXd::Constant(n, kInf);
+  res.variance_inflation = Eigen::VectorXd::Constant(n, kNaN);
+  res.trade_off_with.assign(n, {});
   cov_theta *= inflate * inflate;
   res.correlation = Eigen::MatrixXd::Constant(n, n, kNaN);
-  for (int j : barely) res.determination[j] = Determination::kNotDetermined;
-  for (int j : confounded) res.determination[j] = Determination::kNotDetermined;
+  for (int j : unseen) res.determination[j] = Determination::kNotDetermined;
+  for (int j : traded) res.determination[j] = Determination::kNotDetermined;
   for (int j : diverged) res.determination[j] = Determination::kNotDetermined;
+  std::vector<int> cov_failed;
   for (int j : free) {
     const double s = std::sqrt(std::max(cov_theta(j, j), 0.0));
     if (!std::isfinite(s)) {
       res.determination[j] = Determination::kNotDetermined;
-      confounded.push_back(j);
+      cov_failed.push_back(j);
       continue;
     }
     res.relative_std(j) = s;
-    // Delta method for σ_k; the interval is exact for log-normal θ.
+    // Delta method for σ_k.
     res.std_dev(j) = k_hat(j) * s;
-    res.lower_95(j) = k_hat(j) * std::exp(-kZ95 * s);
-    res.upper_95(j) = k_hat(j) * std::exp(kZ95 * s);
-    if (s > options.undetermined_relative_std) {
-      res.determination[j] = Determination::kNotDetermined;
-      vague.push_back(j);
-    } else if (s > options.weak_relative_std) {
-      res.determination[j] = Determination::kWeak;
-    }
+    // The 95 % interval is built in the relative compliance x = e^{-θ}, in
+    // which the model is linear (so x̂ is Gaussian with σ_x = x̂ σ_θ exactly,
+    // the Gauss-Newton covariance being that of a linear problem), and mapped
+    // to k = k0/x. It stays exact for weakly determined joints, where a
+    // symmetric interval in log k would not cover the truth 95 % of the
+    // time; its upper end is +inf when the compliance interval reaches 0
+    // (the data cannot exclude a rigid joint).
+    const double x = std::exp(-theta(j)), sx = x * s;
+    res.lower_95(j) = k0(j) / (x + kZ95 * sx);
+    res.upper_95(j) = x - kZ95 * sx > 0.0 ? k0(j) / (x - kZ95 * sx) : kInf;
+    if (s > options.weak_relative_std) res.determination[j] = Determination::kWeak;
   }
   for (int a : free) {
     for (int b : free) {
       const double d = std::sqrt(cov_theta(a, a) * cov_theta(b, b));
       if (d > 0.0) res.correlation(a, b) = cov_theta(a, b) / d;
     }
+  }
+  // Why a joint's uncertainty is what it is: the information of the final
+  // problem (fitted joints, inlier cases). Variance inflation and
+  // correlations are invariant to the scaling of the parameters, so the
+  // information in x serves for θ at the solution as well.
+  {
+    std::vector<int> fitted;
+    for (int j : free) {
+      if (std::find(cov_failed.begin(), cov_failed.end(), j) == cov_failed.end()) fitted.push_back(j);
+    }
+    const int f = static_cast<int>(fitted.size());
+    Eigen::MatrixXd sub = Eigen::MatrixXd::Zero(f, f);
+    for (int c = 0; c < m; ++c) {
+      if (std::find(res.outliers.begin(), res.outliers.end(), c) != res.outliers.end() &&
+          options.loss != RobustLoss::kNone) continue;
+      for (int a = 0; a < f; ++a)
+        for (int b = 0; b < f; ++b) sub(a, b) += B[c].col(fitted[a]).dot(B[c].col(fitted[b]));
+    }
+    const internal::Identifiability id = internal::AnalyseIdentifiability(sub);
+    for (int a = 0; a < f; ++a) {
+      const int j = fitted[a];
+      res.variance_inflation(j) = id.variance_inflation(a);
+      // Partners of a near trade-off: the joints correlated with j by at
+      // least 0.5 in magnitude, strongest first; at least the strongest one.
+      std::vector<std::pair<double, int>> corr;
+      for (int b = 0; b < f; ++b) {
+        if (b != a && std::isfinite(id.correlation(a, b))) corr.push_back({std::abs(id.correlation(a, b)), fitted[b]});
+      }
+      std::sort(corr.rbegin(), corr.rend());
+      for (size_t i = 0; i < corr.size(); ++i) {
+        if (i == 0 || corr[i].first >= 0.5) res.trade_off_with[j].push_back(corr[i].second);
+      }
+    }
+  }
+  // A joint the fit drove to infinite stiffness (its unconstrained linear
+  // estimate of the compliance is negative) is still informed by the data
+  // if that estimate is within noise of zero or above: the data are then
+  // consistent with a rigid joint, and only a lower bound of its stiffness
+  // is known. It is weakly determined with that one-sided 95 % interval
+  // (exact in the compliance, as above) and keeps the prior as its value.
+  // Only a compliance below zero beyond the noise (cases inconsistent with
+  // the model) leaves it not determined.
+  std::vector<int> rigid;
+  std::vector<double> rigid_x, rigid_sx;
+  if (!diverged.empty()) {
+    std::vector<int> S;
+    for (int j : free) {
+      if (std::find(cov_failed.begin(), cov_failed.end(), j) == cov_failed.end()) S.push_back(j);
+    }
+    S.insert(S.end(), diverged.begin(), diverged.end());
+    const int q = static_cast<int>(S.size());
+    int rows = 0;
+    for (int c = 0; c < m; ++c) rows += excluded[c] ? 0 : 3;
+    Eigen::MatrixXd Bs(rows, q);
+    Eigen::VectorXd rhs(rows);
+    int r0 = 0;
+    for (int c = 0; c < m; ++c) {
+      if (excluded[c]) continue;
+      Eigen::Vector3d yc = y[c];
+      for (int j = 0; j < n; ++j) {
+        if (std::find(S.begin(), S.end(), j) == S.end()) yc -= B[c].col(j) * std::exp(-theta(j));
+      }
+      rhs.segment<3>(r0) = yc;
+      for (int a = 0; a < q; ++a) Bs.block<3, 1>(r0, a) = B[c].col(S[a]);
+      r0 += 3;
+    }
+    const Eigen::MatrixXd F = Bs.transpose() * Bs;
+    const Eigen::VectorXd x = Bs.colPivHouseholderQr().solve(rhs);
+    const Eigen::MatrixXd C = F.ldlt().solve(Eigen::MatrixXd::Identity(q, q)) * (inflate * inflate);
+    for (int a = static_cast<int>(S.size() - diverged.size()); a < q; ++a) {
+      const int j = S[a];
+      const double sx = std::sqrt(std::max(C(a, a), 0.0));
+      if (!(std::isfinite(x(a)) && std::isfinite(sx) && x(a) + kZ95 * sx > 0.0)) continue;
+      rigid.push_back(j);
+      rigid_x.push_back(x(a));
+      rigid_sx.push_back(sx);
+      res.determination[j] = Determination::kWeak;
+      res.lower_95(j) = k0(j) / (x(a) + kZ95 * sx);
+      res.upper_95(j) = kInf;
+    }
+    for (int j : rigid) diverged.erase(std::find(diverged.begin(), diverged.end(), j));
   }
   for (int j = 0; j < n; ++j) {
     if (res.determination[j] == Determination::kWeak) res.weakly_identified.push_back(j);
@@ -438,26 +516,59 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
   // Advice in words a test engineer can act on.
   const double tmax = res.max_joint_torque.maxCoeff();
   const double lmax = res.max_target_lever.maxCoeff();
-  std::sort(confounded.begin(), confounded.end());
-  for (int j : barely) {
+  // The sensitivity of the target to joint j's compliance is the product of
+  // the moment about its axis and the target's lever about it; say which of
+  // the two is relatively smaller (both if both are under 1 % of the largest).
+  auto sensitivity = [&](int j) {
     std::ostringstream s;
-    const bool unloaded = res.max_joint_torque(j) < 0.1 * tmax;
-    const bool unseen = res.max_target_lever(j) < 0.1 * lmax;
-    s << "joint " << j + 1 << " is not determined: ";
-    if (tmax == 0.0) {
-      s << "no load case loads the robot (every force is zero)";
-    } else if (unloaded || !unseen) {
+    const double tr = tmax > 0.0 ? res.max_joint_torque(j) / tmax : 0.0;
+    const double lr = lmax > 0.0 ? res.max_target_lever(j) / lmax : 0.0;
+    const bool unloaded = tr <= lr || tr < 0.01;
+    const bool unwatched = lr < tr || lr < 0.01;
+    if (tmax == 0.0) return std::string("no load case loads the robot (every force is zero)");
+    if (unloaded) {
       s << "it is barely loaded (largest moment about its axis " << Fixed(res.max_joint_torque(j), 1)
-        << " N·m, against " << Fixed(tmax, 1) << " N·m on the most loaded joint): "
-        << MomentAdvice(j, n);
+        << " N·m, against " << Fixed(tmax, 1) << " N·m on the most loaded joint): " << MomentAdvice(j, n);
     }
-    if (unseen && tmax > 0.0) {
-      s << (unloaded || !unseen ? "; and the" : "the") << " tracker target barely moves when it turns "
-        << "(largest lever " << Fixed(1e3 * res.max_target_lever(j), 1)
-        << " mm): place the target farther from joint " << j + 1 << "'s axis"
+    if (unwatched) {
+      s << (unloaded ? "; and the" : "the") << " tracker target barely moves when it turns "
+        << "(largest lever " << Fixed(1e3 * res.max_target_lever(j), 1) << " mm, against "
+        << Fixed(1e3 * lmax, 1) << " mm): place the target farther from joint " << j + 1 << "'s axis"
         << (j == n - 1 ? " (off the tool axis, tx_mm/ty_mm)" : "");
     }
-    res.advice.push_back(s.str());
+    return s.str();
+  };
+  const std::string kMoreVariety =
+      "add postures with different joint angles (arm reach, elbow and wrist angles) and load cases with "
+      "other rope directions";
+  for (int j : unseen) {
+    res.advice.push_back("joint " + std::to_string(j + 1) +
+                         " is not determined (the data do not depend on its stiffness): " + sensitivity(j));
+  }
+  // Exact trade-offs, one sentence per group of joints sharing null directions.
+  std::sort(traded.begin(), traded.end());
+  std::vector<std::vector<int>> groups;
+  for (int j : traded) {
+    std::vector<int> g{j};
+    for (int i : prior_ident.null_partners[j]) g.push_back(i);
+    std::sort(g.begin(), g.end());
+    if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
+  }
+  for (const auto& g : groups) {
+    if (g.size() == 1) {
+      res.advice.push_back("joint " + std::to_string(g[0] + 1) +
+                           " is not determined: this data set fixes its compliance only in a combination "
+                           "with joints held at the prior. " + kMoreVariety);
+      continue;
+    }
+    res.advice.push_back("joints " + JointList(g) +
+                         " are not determined: this data set fixes only combinations of their compliances "
+                         "(an exact trade-off: changes of one are undone by the others). " + kMoreVariety);
+  }
+  if (!cov_failed.empty()) {
+    res.advice.push_back("joint" + std::string(cov_failed.size() > 1 ? "s " : " ") + JointList(cov_failed) +
+                         (cov_failed.size() > 1 ? " are" : " is") +
+                         " not determined: the covariance at the solution is rank-deficient. " + kMoreVariety);
   }
   for (int j : diverged) {
     res.advice.push_back(
@@ -466,24 +577,45 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
         "compliance), so its effect is lost in the noise or in inconsistent cases; check the outliers, "
         "then " + MomentAdvice(j, n));
   }
-  if (!confounded.empty()) {
+  for (size_t i = 0; i < rigid.size(); ++i) {
+    const int j = rigid[i];
     res.advice.push_back(
-        "joint" + std::string(confounded.size() > 1 ? "s " : " ") + JointList(confounded) +
-        (confounded.size() > 1 ? " are" : " is") +
-        " not determined: this data set fixes only combinations of " +
-        (confounded.size() > 1 ? "their" : "its") +
-        " compliance with other joints'. Add postures with different joint angles (arm reach, "
-        "elbow and wrist angles) and load cases with other rope directions");
-  }
-  for (int j : vague) {
-    res.advice.push_back("joint " + std::to_string(j + 1) + " is not determined (±" +
-                         Fixed(100.0 * res.relative_std(j), 0) + " % at 1 sigma): " +
-                         MomentAdvice(j, n) + ", and check for outliers");
+        "joint " + std::to_string(j + 1) + " is weakly determined: the data are consistent with a rigid joint "
+        "(its compliance is estimated at " + Fixed(100.0 * rigid_x[i], 0) + " ± " + Fixed(100.0 * rigid_sx[i], 0) +
+        " % of the robot config's, 1 sigma), so only a lower bound is known: k > " +
+        Fixed(res.lower_95(j), 0) + " N·m/rad (95 %); the robot config's value is kept. Low sensitivity: " +
+        sensitivity(j) + "; or repeat the cases to average the tracker noise");
   }
   for (int j : res.weakly_identified) {
-    res.advice.push_back("joint " + std::to_string(j + 1) + " is weakly determined (±" +
-                         Fixed(100.0 * res.relative_std(j), 1) + " % at 1 sigma): " +
-                         MomentAdvice(j, n) + ", or repeat the cases to average the tracker noise");
+    if (std::find(rigid.begin(), rigid.end(), j) != rigid.end()) continue;
+    std::ostringstream s;
+    const double s_all = res.relative_std(j);
+    const double vif = res.variance_inflation(j);
+    const double s_alone = std::isfinite(vif) && vif >= 1.0 ? s_all / std::sqrt(vif) : s_all;
+    s << "joint " << j + 1 << " is weakly determined (±" << Fixed(100.0 * s_all, s_all < 1.0 ? 1 : 0)
+      << " % at 1 sigma): ";
+    std::vector<std::string> causes;
+    // A near trade-off when more than half its variance comes from the
+    // correlation with other joints (variance inflation >= 2).
+    if (std::isfinite(vif) && vif >= 2.0 && !res.trade_off_with[j].empty()) {
+      std::ostringstream t;
+      t << "a near trade-off with joint" << (res.trade_off_with[j].size() > 1 ? "s " : " ")
+        << JointList(res.trade_off_with[j]) << " (correlation";
+      for (size_t i = 0; i < res.trade_off_with[j].size(); ++i) {
+        t << (i ? ", " : " ") << Fixed(res.correlation(j, res.trade_off_with[j][i]), 2);
+      }
+      t << ") makes it ±" << Fixed(100.0 * s_all, 0) << " % where it would be ±" << Fixed(100.0 * s_alone, 0)
+        << " % with those known: " << kMoreVariety;
+      causes.push_back(t.str());
+    }
+    // Low sensitivity when even with every other joint known it would be weak.
+    if (s_alone > options.weak_relative_std || causes.empty()) {
+      causes.push_back("low sensitivity (±" + Fixed(100.0 * s_alone, 0) +
+                       " % even with the other joints known): " + sensitivity(j));
+    }
+    for (size_t i = 0; i < causes.size(); ++i) s << (i ? "; and " : "") << causes[i];
+    s << "; or repeat the cases to average the tracker noise";
+    res.advice.push_back(s.str());
   }
   if (!res.outliers.empty()) {
     std::string ids;

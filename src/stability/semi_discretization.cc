@@ -116,6 +116,31 @@ double ChatterFrequencyHz(const TipModalModel& m, std::complex<double> mu, doubl
 
 }  // namespace
 
+int SdStepsPerPeriod(const TipModalModel& modes_C, const MillingProcess& process, double spindle_speed_rad_s,
+                     const SdOptions& options, bool* capped) {
+  if (capped) *capped = false;
+  if (options.steps_per_period > 0) return options.steps_per_period;
+  if (!(options.steps_per_mode_period > 0.0) || options.min_steps_per_period < 1 ||
+      options.max_monodromy_dimension < 1) {
+    throw std::invalid_argument(
+        "SD steps: need steps_per_mode_period > 0, min_steps_per_period >= 1 and max_monodromy_dimension >= 1");
+  }
+  if (!(spindle_speed_rad_s > 0.0) || process.teeth < 1) {
+    throw std::invalid_argument("SD steps: need a spindle speed > 0 and at least one tooth");
+  }
+  const double tau = 2.0 * kPi / (process.teeth * spindle_speed_rad_s);
+  const double f_max = modes_C.num_modes() > 0 ? RadPerSecToHz(modes_C.omega_rad_s.maxCoeff()) : 0.0;
+  const int n = std::max(1, modes_C.num_modes());
+  const int k_max = (options.max_monodromy_dimension - 2 * n) / n;
+  const double want = std::ceil(options.steps_per_mode_period * f_max * tau);
+  int k = want < 1e6 ? static_cast<int>(want) : 1000000;
+  if (k > k_max) {
+    k = k_max;
+    if (capped) *capped = true;
+  }
+  return std::max(options.min_steps_per_period, k);
+}
+
 LobePoint SdCriticalDepth(const TipModalModel& modes_C, const MillingProcess& process,
                           double spindle_speed_rad_s, const SdOptions& options) {
   process.Validate();
@@ -126,15 +151,15 @@ LobePoint SdCriticalDepth(const TipModalModel& modes_C, const MillingProcess& pr
   LobePoint out;
   out.spindle_speed_rad_s = spindle_speed_rad_s;
   const double tau = 2.0 * kPi / (process.teeth * spindle_speed_rad_s);
-  auto rho = [&](double a) {
-    return MillingMonodromy(modes_C, process, spindle_speed_rad_s, a, options.steps_per_period);
-  };
+  const int steps = SdStepsPerPeriod(modes_C, process, spindle_speed_rad_s, options);
+  out.sd_steps = steps;
+  auto rho = [&](double a) { return MillingMonodromy(modes_C, process, spindle_speed_rad_s, a, steps); };
   const SdMonodromy zero = rho(0.0);
   if (zero.spectral_radius >= 1.0) {
     out.status = LobeStatus::kUnstableAtZero;
     return out;
   }
-  double lo = 0.0, hi = NAN;
+  double lo = 0.0, hi = NAN, rho_lo = zero.spectral_radius;
   SdMonodromy at_hi;
   for (int j = 1; j <= options.depth_scan_points; ++j) {
     const double a = options.max_depth * j / options.depth_scan_points;
@@ -145,20 +170,50 @@ LobePoint SdCriticalDepth(const TipModalModel& modes_C, const MillingProcess& pr
       break;
     }
     lo = a;
+    rho_lo = r.spectral_radius;
   }
   if (!std::isfinite(hi)) {
     out.status = LobeStatus::kStableUpToMax;
     out.critical_depth = options.max_depth;
     return out;
   }
+  // Shrink the bracket [lo, hi] of ρ(a) = 1 by the Illinois variant of
+  // regula falsi on g(a) = ρ(a) − 1 (the retained end's g is halved when
+  // the same end is kept twice), which needs about half the monodromy
+  // evaluations of bisection for the same final width; the new point is
+  // kept a quarter of the tolerance inside the bracket, so that the bracket
+  // closes once the estimate has converged. ρ(a) is only piecewise smooth
+  // (the critical multiplier can switch): if three steps have not halved
+  // the bracket, the next step is a bisection. Either way the result is a
+  // bracket of relative width depth_tolerance with ρ(lo) < 1 <= ρ(hi).
+  double g_lo = rho_lo - 1.0, g_hi = at_hi.spectral_radius - 1.0;
+  int last_moved = 0;  // +1 hi, −1 lo
+  int steps_in_window = 0;
+  double window_width = hi - lo;
+  bool bisect = false;
   while (hi - lo > options.depth_tolerance * hi) {
-    const double mid = 0.5 * (lo + hi);
-    const SdMonodromy r = rho(mid);
-    if (r.spectral_radius >= 1.0) {
-      hi = mid;
+    const double w = hi - lo, eps = 0.25 * options.depth_tolerance * hi;
+    double x = 0.5 * (lo + hi);
+    if (!bisect) x = std::clamp(lo - g_lo * w / (g_hi - g_lo), lo + eps, hi - eps);
+    const SdMonodromy r = rho(x);
+    const double g = r.spectral_radius - 1.0;
+    if (g >= 0.0) {
+      hi = x;
+      g_hi = g;
       at_hi = r;
+      if (last_moved == +1) g_lo *= 0.5;
+      last_moved = +1;
     } else {
-      lo = mid;
+      lo = x;
+      g_lo = g;
+      if (last_moved == -1) g_hi *= 0.5;
+      last_moved = -1;
+    }
+    bisect = false;
+    if (++steps_in_window == 3) {
+      bisect = hi - lo > 0.5 * window_width;
+      steps_in_window = 0;
+      window_width = hi - lo;
     }
   }
   out.critical_depth = 0.5 * (lo + hi);

@@ -223,9 +223,17 @@ TEST(IdentifyJointStiffness, DegenerateCampaignFlagsJointsItCannotSee) {
   EXPECT_FALSE(std::isfinite(r.std_dev(0)));
   std::string all;
   for (const auto& a : r.advice) all += a + "\n";
-  EXPECT_THAT(all, HasSubstr("joint 1 is not determined: it is barely loaded"));
+  EXPECT_THAT(all, HasSubstr("joint 1 is not determined (the data do not depend on its stiffness): it is barely loaded"));
   EXPECT_THAT(all, HasSubstr("joint 6 is not determined"));
   EXPECT_THAT(all, HasSubstr("moment about the tool axis"));
+  // Joints 2-5: four unknowns against one 3-vector of equations; at least
+  // one exact trade-off among them, named as such, never "weakly".
+  EXPECT_THAT(all, HasSubstr("exact trade-off"));
+  for (int j = 1; j < 5; ++j) {
+    if (r.determination[j] == Determination::kNotDetermined) {
+      EXPECT_FALSE(std::isfinite(r.std_dev(j))) << "joint " << j + 1;
+    }
+  }
 }
 
 // Joint 6 loaded through a bracket but watched by a target on the tool axis:
@@ -261,6 +269,160 @@ TEST(IdentifyJointStiffness, UnderstatedNoiseInflatesCovariance) {
   EXPECT_NEAR(r.reduced_chi2, 25.0, 10.0);
   const JointStiffnessResult ref = IdentifyJointStiffness(*model, cases);
   for (int j = 0; j < 6; ++j) EXPECT_NEAR(r.relative_std(j) / ref.relative_std(j), 1.0, 0.3);
+}
+
+// Issue #10: a campaign whose joint 6 is weakly but genuinely informed.
+// 16 postures of the machining workspace, two rope directions, 10/20/30 kg,
+// tracker noise 0.01 mm, as the seed's campaign, but the load bracket only
+// kWeakBracket off the tool axis, so the moment about joint 6 (and with it
+// the information on k6, which grows as the moment squared) is small. The
+// postures are fixed; only the tracker noise changes with `seed`.
+constexpr double kWeakBracket = 0.05;  // [m]
+
+std::vector<LoadCase> WeakJoint6Campaign(unsigned seed, double tracker_noise = 1e-5,
+                                         double bracket = kWeakBracket) {
+  const auto model = Kr210();
+  CampaignOptions o;
+  o.p_load_tip = Eigen::Vector3d(bracket, 0.0, 0.10);
+  o.tracker_noise = tracker_noise;
+  o.seed = seed;
+  const auto postures = CampaignPostures(*model, 16, o, 4242);
+  std::vector<std::string> ids;
+  for (int p = 0; p < 16; ++p) ids.push_back("W" + std::to_string(p + 1));
+  return ToLoadCases(SimulateCampaign(*model, ids, postures, model->joint_stiffness(), o));
+}
+
+// The independent reference: the Fisher information JᵀWJ of the campaign
+// with J the central finite differences, in θ_j = log k_j, of the
+// large-displacement static equilibrium (SolveStaticDeflection, the second
+// method the synthesis uses, not the identification's linear model),
+// W = 1/σ_D², σ_D = √2·0.01 mm. On noise-free data the fit sits at the
+// truth, so its reported σ(θ_j) must equal √(F⁻¹)_jj. Agreement to 2 %:
+// the linear model differs from the equilibrium by O(|Δq|) ~ 1e-3 relative,
+// and the central differences (step 1e-3 in θ) by O(1e-6).
+TEST(IdentifyJointStiffness, ReportedUncertaintyMatchesIndependentFisherInformation) {
+  const auto model = Kr210();
+  const auto cases = WeakJoint6Campaign(1, 0.0);
+  const Eigen::VectorXd k0 = model->joint_stiffness();
+  const double sigma = std::sqrt(2.0) * 1e-5, h = 1e-3;
+  Eigen::MatrixXd F = Eigen::MatrixXd::Zero(6, 6);
+  for (const LoadCase& c : cases) {
+    Eigen::Matrix<double, 3, 6> J;
+    for (int j = 0; j < 6; ++j) {
+      Eigen::VectorXd kp = k0, km = k0;
+      kp(j) *= std::exp(h);
+      km(j) *= std::exp(-h);
+      J.col(j) = (SolveStaticDeflection(*model, c, kp) - SolveStaticDeflection(*model, c, km)) / (2.0 * h);
+    }
+    F += J.transpose() * J / (sigma * sigma);
+  }
+  const Eigen::MatrixXd C = F.inverse();
+  const JointStiffnessResult r = IdentifyJointStiffness(*model, cases);
+  ASSERT_EQ(r.status, FitStatus::kConverged) << r.solver_message;
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_NEAR(r.relative_std(j) / std::sqrt(C(j, j)), 1.0, 0.02) << "joint " << j + 1;
+  }
+  // The campaign is what the acceptance asks for: joint 6 at 30-60 %.
+  EXPECT_GT(std::sqrt(C(5, 5)), 0.3);
+  EXPECT_LT(std::sqrt(C(5, 5)), 0.6);
+  std::cerr << "weak campaign: reference sigma(log k6) = " << std::sqrt(C(5, 5)) << ", reported "
+            << r.relative_std(5) << "\n";
+}
+
+// Acceptance (issue #10): the weakly informed joint is reported "weakly
+// determined" with its uncertainty, the advice names low sensitivity (the
+// moment about its axis) and no trade-off, and the 95 % interval covers the
+// truth in at least 9 of 10 seeded repetitions (exact intervals pass with
+// probability 0.914, see SeedCampaignIntervalsCoverTruth; seeds 1..10 fixed
+// before the first run). Never "not determined": the information is finite.
+TEST(IdentifyJointStiffness, WeaklyInformedJointIsWeakWithCoveringInterval) {
+  const auto model = Kr210();
+  const double truth = model->joint_stiffness()(5);
+  int covered = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    const JointStiffnessResult r = IdentifyJointStiffness(*model, WeakJoint6Campaign(seed));
+    ASSERT_EQ(r.status, FitStatus::kConverged) << r.solver_message;
+    EXPECT_EQ(r.determination[5], Determination::kWeak) << "seed " << seed;
+    EXPECT_TRUE(r.not_determined.empty()) << "seed " << seed;
+    EXPECT_TRUE(std::isfinite(r.relative_std(5)));
+    if (truth >= r.lower_95(5) && truth <= r.upper_95(5)) ++covered;
+    std::string all;
+    for (const auto& a : r.advice) all += a + "\n";
+    EXPECT_THAT(all, HasSubstr("joint 6 is weakly determined (±")) << "seed " << seed;
+    EXPECT_THAT(all, HasSubstr("low sensitivity")) << all;
+    EXPECT_THAT(all, HasSubstr("moment about the tool axis")) << all;
+    EXPECT_THAT(all, ::testing::Not(HasSubstr("not determined"))) << all;
+    EXPECT_THAT(all, ::testing::Not(HasSubstr("trade-off"))) << all;
+    std::cerr << "seed " << seed << ": k6 = " << r.joint_stiffness(5) << " [" << r.lower_95(5) << ", "
+              << r.upper_95(5) << "], rel. std " << r.relative_std(5) << ", VIF " << r.variance_inflation(5)
+              << "\n";
+  }
+  EXPECT_GE(covered, 9);
+  RecordProperty("joint6_covered_of_10", covered);
+  std::cerr << "joint 6: the 95 % interval covered the truth in " << covered << " of 10\n";
+}
+
+// Weaker still (bracket 20 mm: σ(log k6) ≈ 1.0 at the truth), the linear
+// estimate of the compliance is negative in ~16 % of repetitions and the fit
+// then drives k6 to infinity. That is still data, not a rank deficiency:
+// the joint is weakly determined with a one-sided interval (a lower bound),
+// never "not determined", and the intervals still cover the truth.
+TEST(IdentifyJointStiffness, JointConsistentWithRigidIsWeakWithLowerBound) {
+  const auto model = Kr210();
+  const double truth = model->joint_stiffness()(5);
+  int covered = 0, one_sided = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    const JointStiffnessResult r = IdentifyJointStiffness(*model, WeakJoint6Campaign(seed, 1e-5, 0.02));
+    ASSERT_EQ(r.status, FitStatus::kConverged) << r.solver_message;
+    EXPECT_EQ(r.determination[5], Determination::kWeak) << "seed " << seed;
+    EXPECT_TRUE(r.not_determined.empty()) << "seed " << seed;
+    if (truth >= r.lower_95(5) && truth <= r.upper_95(5)) ++covered;
+    if (!std::isfinite(r.relative_std(5))) {
+      ++one_sided;
+      EXPECT_EQ(r.joint_stiffness(5), truth);  // the prior (= the truth here) is kept
+      std::string all;
+      for (const auto& a : r.advice) all += a + "\n";
+      EXPECT_THAT(all, HasSubstr("joint 6 is weakly determined: the data are consistent with a rigid joint"));
+    }
+  }
+  EXPECT_GE(covered, 9);
+  EXPECT_GE(one_sided, 1) << "no repetition exercised the rigid case; pick another bracket";
+  std::cerr << "bracket 20 mm: covered " << covered << " of 10, " << one_sided << " one-sided\n";
+}
+
+// A near (not exact) trade-off: two load cases at one posture with rope
+// directions close to each other give 6 equations whose joint columns are
+// nearly dependent; the weakly determined joints are reported with the
+// joints they trade off against, and the variance inflation says so.
+TEST(IdentifyJointStiffness, NearTradeOffNamesThePartners) {
+  const auto model = Kr210();
+  // Postures close to each other: the columns of joints 2 and 3 (shoulder
+  // and elbow, both horizontal axes) stay nearly proportional.
+  CampaignOptions o;
+  o.tracker_noise = 0.0;
+  const auto cases = ToLoadCases(SeedCampaign(5, 3, o));
+  const JointStiffnessResult r = IdentifyJointStiffness(*model, cases);
+  ASSERT_EQ(r.status, FitStatus::kConverged) << r.solver_message;
+  bool traded = false;
+  for (int j : r.weakly_identified) {
+    if (r.variance_inflation(j) >= 2.0) {
+      traded = true;
+      ASSERT_FALSE(r.trade_off_with[j].empty());
+      // The named partner is the one most correlated with j.
+      const int p = r.trade_off_with[j][0];
+      for (int i = 0; i < 6; ++i) {
+        if (i != j && i != p && std::isfinite(r.correlation(j, i))) {
+          EXPECT_GE(std::abs(r.correlation(j, p)), std::abs(r.correlation(j, i)) - 1e-12);
+        }
+      }
+      std::string all;
+      for (const auto& a : r.advice) all += a + "\n";
+      EXPECT_THAT(all, HasSubstr("joint " + std::to_string(j + 1) + " is weakly determined"));
+      EXPECT_THAT(all, HasSubstr("near trade-off with joint"));
+      std::cerr << all;
+    }
+  }
+  EXPECT_TRUE(traded) << "this campaign has no near trade-off; pick another";
 }
 
 TEST(IdentifyJointStiffness, InvalidOptionsNameTheField) {

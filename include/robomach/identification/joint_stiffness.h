@@ -31,10 +31,11 @@ struct IdentificationOptions {
   /// at 1 − outlier_false_alarm / num_cases (Bonferroni), scaled up by the
   /// robust noise estimate when the residuals are larger than the noise.
   double outlier_false_alarm{0.01};
-  /// Relative standard deviations (σ_k / k) above which a joint is "weakly
-  /// determined" and "not determined".
+  /// Relative standard deviation (σ_k / k) above which a joint is "weakly
+  /// determined". There is no such bound for "not determined": that is a
+  /// numerical rank-deficiency of the problem in the joint (see
+  /// IdentifyJointStiffness), never a large but finite uncertainty.
   double weak_relative_std{0.1};
-  double undetermined_relative_std{0.5};
   int max_iterations{100};
 };
 
@@ -67,10 +68,20 @@ struct JointStiffnessResult {
   int num_joints{0};
   Eigen::VectorXd joint_stiffness;      // [N·m/rad]; a not-determined joint keeps the prior
   Eigen::VectorXd std_dev;              // 1 sigma [N·m/rad]; +inf for a joint held at the prior
-  Eigen::VectorXd lower_95, upper_95;   // 95 % interval [N·m/rad] (log-normal, from log k)
+  /// 95 % interval [N·m/rad], exact in the compliance 1/k (in which the
+  /// model is linear) and mapped to k; upper end +inf when the compliance
+  /// interval reaches zero.
+  Eigen::VectorXd lower_95, upper_95;
   Eigen::VectorXd relative_std;         // σ(log k) ≈ σ_k / k [-]
   Eigen::MatrixXd correlation;          // of the stiffnesses (NaN rows for undetermined joints)
   std::vector<Determination> determination;
+  /// Per fitted joint: σ² over its σ² with every other joint known (>= 1;
+  /// NaN for a joint not fitted). 2 or more means over half its variance
+  /// comes from near trade-offs with the joints in trade_off_with.
+  Eigen::VectorXd variance_inflation;
+  /// Per fitted joint: the joints most correlated with it (|correlation|
+  /// >= 0.5, strongest first; at least the strongest one).
+  std::vector<std::vector<int>> trade_off_with;
   std::vector<int> weakly_identified;   // 0-based joint indices
   std::vector<int> not_determined;      // 0-based joint indices
   /// Sentences a test engineer can act on, one per problem found.
@@ -102,21 +113,34 @@ struct JointStiffnessResult {
 
 /// Identifies the diagonal joint stiffness K_q from load cases.
 ///
-/// Steps: (i) joints the data cannot see are found at the prior (the
-/// model's stiffness): a joint whose relative standard deviation would exceed
-/// `undetermined_relative_std` even with all others known ("barely loaded" or
-/// "target barely moves"), or whose marginal one does (only a combination
-/// with other joints is determined), is held at the prior; (ii) the exact
-/// linear least-squares start in the compliances c_i = 1/k_i of model (1) of
-/// compliance_model.h, weighted by σ_D = √2·tracker_noise; (iii) Ceres solves
-/// the weighted problem in θ_i = log(k_i/k0_i) (positivity), first with the
-/// optional robust loss; (iv) outliers are flagged against the χ²(3) bound,
-/// and with a robust loss the plain fit is repeated without them; a joint
-/// driven more than 1000× away from the prior is held and the fit repeated;
-/// (v) ceres::Covariance gives the covariance of θ, scaled by χ²/dof when the
-/// residuals are clearly larger than the stated noise. Joints are then
-/// classified by σ(θ_i) against `weak_relative_std` and
-/// `undetermined_relative_std`, and `advice` says what to add to the tests.
+/// Steps: (i) joints the data cannot determine are found and held at the
+/// prior (the model's stiffness). The model is linear in the relative
+/// compliances x_i = c_i/c0_i, so the Fisher information BᵀB of x (B the
+/// noise-weighted displacement per relative compliance) is the same
+/// wherever it is evaluated. A joint is *not determined* only where that
+/// information is numerically rank-deficient in it: an eigenvalue below
+/// 1e-12 of the largest (singular values of B below 1e-6 of the largest,
+/// rounding of an exact zero) whose eigenvector has a component above 1e-3
+/// on the joint. That is either no sensitivity at all (I_ii ≈ 0: the joint
+/// is not loaded, or the target does not move when it turns) or an exact
+/// trade-off with other joints (only a combination is fixed); see
+/// internal::AnalyseIdentifiability. Every other joint is fitted, however
+/// weak its information; (ii) the exact linear least-squares start in x,
+/// weighted by σ_D = √2·tracker_noise; (iii) Ceres solves the weighted
+/// problem in θ_i = log(k_i/k0_i) (positivity), first with the optional
+/// robust loss; (iv) outliers are flagged against the χ²(3) bound, and with
+/// a robust loss the plain fit is repeated without them; a joint driven more
+/// than 1000× away from the prior (the data ask for a negative compliance)
+/// is held at the prior and the fit repeated: it is weakly determined with a
+/// one-sided interval (a lower bound of k) if its unconstrained compliance
+/// is within 1.96 σ of zero or above (the data are consistent with a rigid
+/// joint), not determined otherwise (cases inconsistent with the model); (v) ceres::Covariance gives the covariance
+/// of θ, scaled by χ²/dof when the residuals are clearly larger than the
+/// stated noise. A fitted joint is "weakly determined" if σ(θ_i) exceeds
+/// `weak_relative_std`, and `advice` names the cause: low sensitivity (its
+/// σ with all other joints known is itself above that bound: which of load
+/// moment and target lever is small), and/or a near trade-off (variance
+/// inflation >= 2) with the joints it is most correlated with.
 ///
 /// Numerical trouble is reported in the result's status, never thrown.
 /// @param model  robot model; its joint stiffness is the prior and scale.

@@ -60,16 +60,45 @@ SdMonodromy MillingMonodromy(const TipModalModel& modes_C, const MillingProcess&
                              double spindle_speed_rad_s, double depth, int steps);
 
 struct SdOptions {
-  int steps_per_period{40};   // k
+  /// Steps per tooth period k. 0 (the default) chooses k per spindle speed
+  /// by SdStepsPerPeriod; a positive value overrides that choice.
+  int steps_per_period{0};
+  /// The automatic choice: this many steps per period of the highest
+  /// retained mode, at least min_steps_per_period (the fixed default before
+  /// issue #10) per tooth period, and at most what keeps the monodromy
+  /// matrix (dimension 2n + k n for n modes) within max_monodromy_dimension:
+  /// its eigenvalues cost O(dimension³) per depth tried, ~0.1-0.4 s at 400 on
+  /// this machine. The first-order method's error
+  /// in the critical depth falls like (ω Δt)² [Insperger, Stepan & Turi
+  /// 2008]; on the Insperger-Stepan benchmark 40 steps per mode period keep
+  /// it below ~0.3 % (README, stability-lobes), where a fixed 30 steps per
+  /// tooth period were 15 % off at 5000 rpm.
+  double steps_per_mode_period{40.0};
+  int min_steps_per_period{30};
+  int max_monodromy_dimension{400};
   double max_depth{0.02};     // [m] search range of the depth
-  int depth_scan_points{20};  // coarse scan of [0, max_depth] before bisection
+  int depth_scan_points{20};  // coarse scan of [0, max_depth] before the bracketing search
   double depth_tolerance{1e-3};  // relative width of the final bracket
 };
 
+/// The steps per tooth period SdCriticalDepth uses at one spindle speed:
+/// options.steps_per_period if positive, otherwise
+/// <pre>
+///   k = max(min_steps_per_period, min(ceil(steps_per_mode_period · f_max · τ), k_max)),
+///   k_max = (max_monodromy_dimension − 2n) / n
+/// </pre>
+/// with f_max the highest natural frequency of the n retained modes [Hz]
+/// and τ = 2π/(N Ω) the tooth period. `capped`, if not null, is set when
+/// k_max was hit (the result is then less accurate than intended).
+int SdStepsPerPeriod(const TipModalModel& modes_C, const MillingProcess& process, double spindle_speed_rad_s,
+                     const SdOptions& options, bool* capped = nullptr);
+
 /// The smallest depth with spectral radius 1 at one spindle speed: a
-/// coarse scan of [0, max_depth] for the first unstable depth, then
-/// bisection. Unstable islands narrower than max_depth/depth_scan_points can
-/// be missed. The chatter frequency is the member of the family
+/// coarse scan of [0, max_depth] for the first unstable depth, then a
+/// bracketing search (Illinois regula falsi with bisection as a safeguard)
+/// down to depth_tolerance. Unstable islands narrower than max_depth/depth_scan_points can
+/// be missed. The steps per tooth period are SdStepsPerPeriod's, returned
+/// in LobePoint::sd_steps. The chatter frequency is the member of the family
 /// (±arg μ + 2πj)/τ closest to a natural frequency of the model.
 LobePoint SdCriticalDepth(const TipModalModel& modes_C, const MillingProcess& process,
                           double spindle_speed_rad_s, const SdOptions& options = {});

@@ -25,6 +25,7 @@ struct LobePoint {
   double chatter_freq_hz{NAN};  // [Hz]
   int lobe_index{-1};           // full vibration waves between two teeth, k
   LobeStatus status{LobeStatus::kNotCovered};
+  int sd_steps{0};              // semi-discretization only: steps per tooth period used
 };
 
 /// One lobe (one eigenvalue branch and one lobe index k) traced over the
