@@ -10,6 +10,7 @@
 #include "robomach/common/units.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
+#include "robomach/io/format17.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/yaml_doc.h"
 
@@ -580,9 +581,12 @@ void AcquiredPathWriter::Row(double t_s, const machine::AcquiredSample& s, const
   char buf[40];
   buffer_.clear();
   auto put = [&](double v, bool full) {
-    const auto r = full ? std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 17)
-                        : std::to_chars(buf, buf + sizeof buf, v);
-    buffer_.append(buf, r.ptr);
+    if (full) {
+      AppendDouble17(v, &buffer_);  // "%.17g", fast
+    } else {
+      const auto r = std::to_chars(buf, buf + sizeof buf, v);
+      buffer_.append(buf, r.ptr);
+    }
   };
   put(t_s, false);  // copied from the counts: shortest exact text
   for (size_t a = 0; a < axes_.size(); ++a) {

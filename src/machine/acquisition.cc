@@ -87,18 +87,35 @@ ToolPose ProgrammedPath::At(double s) const {
 ContourTracker::ContourTracker(const ProgrammedPath& path, int window_segments)
     : path_(path), window_(std::max(1, window_segments)) {}
 
-ContourError ContourTracker::OnSegment(int i, const ToolPose& pose) const {
-  const Eigen::Vector3d& a = path_.tips()[i];
-  const Eigen::Vector3d& b = path_.tips()[i + 1];
+namespace {
+
+// Squared distance of p to segment [a, b] and the segment parameter of the
+// nearest point: the cheap part, evaluated for every candidate segment.
+inline double SegmentDistanceSq(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& p,
+                                double* f) {
   const Eigen::Vector3d ab = b - a;
   const double l2 = ab.squaredNorm();
-  const double f = l2 > 0.0 ? std::clamp((pose.p_W - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  *f = l2 > 0.0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (p - (a + *f * ab)).squaredNorm();
+}
+
+}  // namespace
+
+ContourError ContourTracker::OnSegment(int i, const ToolPose& pose) const {
+  double f = 0.0;
+  const Eigen::Vector3d& a = path_.tips()[i];
+  const Eigen::Vector3d& b = path_.tips()[i + 1];
   ContourError e;
-  e.distance = (pose.p_W - (a + f * ab)).norm();
-  e.s = path_.arc_length()[i] + f * std::sqrt(l2);
+  e.distance = std::sqrt(SegmentDistanceSq(a, b, pose.p_W, &f));
+  e.s = path_.arc_length()[i] + f * (path_.arc_length()[i + 1] - path_.arc_length()[i]);
   const Eigen::Vector3d k = (path_.axes()[i] + f * (path_.axes()[i + 1] - path_.axes()[i])).normalized();
   e.axis_angle = std::atan2(k.cross(pose.k_W).norm(), k.dot(pose.k_W));
   return e;
+}
+
+double ContourTracker::DistanceSq(int i, const ToolPose& pose) const {
+  double f = 0.0;
+  return SegmentDistanceSq(path_.tips()[i], path_.tips()[i + 1], pose.p_W, &f);
 }
 
 ContourError ContourTracker::Nearest(const ToolPose& pose) const {
@@ -113,37 +130,34 @@ ContourError ContourTracker::Nearest(const ToolPose& pose) const {
 
 ContourError ContourTracker::Next(const ToolPose& pose) {
   const int segments = path_.num_points() - 1;
+  int best_i = 0;
+  double best = INFINITY;
   if (last_ < 0) {
     // First sample: exhaustive.
-    ContourError best;
-    best.distance = INFINITY;
     for (int i = 0; i < segments; ++i) {
-      const ContourError e = OnSegment(i, pose);
-      if (e.distance < best.distance) best = e, last_ = i;
+      const double d = DistanceSq(i, pose);
+      if (d < best) best = d, best_i = i;
     }
-    return best;
-  }
-  int lo = std::max(0, last_ - window_), hi = std::min(segments - 1, last_ + window_);
-  ContourError best;
-  best.distance = INFINITY;
-  int best_i = last_;
-  for (int i = lo; i <= hi; ++i) {
-    const ContourError e = OnSegment(i, pose);
-    if (e.distance < best.distance) best = e, best_i = i;
-  }
-  // Widen while the best sits on an edge of the window and the distance falls.
-  while (best_i == hi && hi < segments - 1) {
-    const ContourError e = OnSegment(++hi, pose);
-    if (!(e.distance < best.distance)) break;
-    best = e, best_i = hi;
-  }
-  while (best_i == lo && lo > 0) {
-    const ContourError e = OnSegment(--lo, pose);
-    if (!(e.distance < best.distance)) break;
-    best = e, best_i = lo;
+  } else {
+    int lo = std::max(0, last_ - window_), hi = std::min(segments - 1, last_ + window_);
+    for (int i = lo; i <= hi; ++i) {
+      const double d = DistanceSq(i, pose);
+      if (d < best) best = d, best_i = i;
+    }
+    // Widen while the best sits on an edge of the window and the distance falls.
+    while (best_i == hi && hi < segments - 1) {
+      const double d = DistanceSq(++hi, pose);
+      if (!(d < best)) break;
+      best = d, best_i = hi;
+    }
+    while (best_i == lo && lo > 0) {
+      const double d = DistanceSq(--lo, pose);
+      if (!(d < best)) break;
+      best = d, best_i = lo;
+    }
   }
   last_ = best_i;
-  return best;
+  return OnSegment(best_i, pose);
 }
 
 SeriesStats Stats(const std::vector<double>& v) {

@@ -87,6 +87,7 @@ class ContourTracker {
 
  private:
   ContourError OnSegment(int i, const ToolPose& pose) const;
+  double DistanceSq(int i, const ToolPose& pose) const;
   const ProgrammedPath& path_;
   int window_;
   int last_{-1};
