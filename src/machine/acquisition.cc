@@ -132,12 +132,28 @@ ContourError ContourTracker::Next(const ToolPose& pose) {
   const int segments = path_.num_points() - 1;
   int best_i = 0;
   double best = INFINITY;
-  if (last_ < 0) {
-    // First sample: exhaustive.
+  auto exhaustive = [&](bool prefer_first) {
+    best = INFINITY;
     for (int i = 0; i < segments; ++i) {
       const double d = DistanceSq(i, pose);
       if (d < best) best = d, best_i = i;
     }
+    if (prefer_first) {
+      // A closed path starts and ends at the same point: start at its start
+      // (the first segment within 10 µm of the nearest; measurement noise
+      // can make the end look nearer by a few micrometres).
+      const double tol = std::sqrt(best) + 1e-5;
+      for (int i = 0; i < best_i; ++i) {
+        const double d = DistanceSq(i, pose);
+        if (d <= tol * tol) {
+          best = d, best_i = i;
+          break;
+        }
+      }
+    }
+  };
+  if (last_ < 0) {
+    exhaustive(true);
   } else {
     int lo = std::max(0, last_ - window_), hi = std::min(segments - 1, last_ + window_);
     for (int i = lo; i <= hi; ++i) {
@@ -155,6 +171,9 @@ ContourError ContourTracker::Next(const ToolPose& pose) {
       if (!(d < best)) break;
       best = d, best_i = lo;
     }
+    // Far off the local stretch (a jump, or the machine somewhere else on the
+    // path): search everything again.
+    if (best > kRecoverDistance * kRecoverDistance) exhaustive(false);
   }
   last_ = best_i;
   return OnSegment(best_i, pose);

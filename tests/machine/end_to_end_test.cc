@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "robomach/common/units.h"
 #include "robomach/machine/acquisition.h"
@@ -172,6 +173,44 @@ TEST(EndToEnd, WithoutCompensationAndRotaryErrorsTheErrorIsWhatTheyPredict) {
   EXPECT_LT(worst_miss, 1.0e-6);
   std::cout << "error " << smallest_error * 1e6 << " .. " << largest_error * 1e6 << " um, prediction off by at most "
             << worst_miss * 1e6 << " um\n";
+}
+
+}  // namespace
+}  // namespace robomach::machine
+
+namespace robomach::machine {
+namespace {
+
+// The windowed search against the exhaustive one along a closed circle
+// traversed twice, with noise: same distances; and a closed path is
+// followed from its start.
+TEST(ContourTracker, FollowsAClosedPathLikeTheExhaustiveSearch) {
+  std::vector<Eigen::Vector3d> tips, axes;
+  for (int i = 0; i <= 360; ++i) {
+    const double a = DegToRad(i);
+    tips.emplace_back(0.045 * std::cos(a), 0.045 * std::sin(a), 0.02);
+    axes.emplace_back(0.2 * std::cos(a), 0.2 * std::sin(a), 1.0);
+  }
+  const ProgrammedPath path(tips, axes);
+  ContourTracker tracker(path);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 2e-6);
+  for (int k = 0; k <= 4000; ++k) {
+    const double s = path.length() * k / 4000.0;
+    ToolPose p = path.At(s);
+    p.p_W += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    const ContourError e = tracker.Next(p);
+    const ContourError full = tracker.Nearest(p);
+    // Followed in order, from the start to the end of the closed path.
+    ASSERT_NEAR(e.s, s, 1e-4) << "sample " << k;
+    if (k > 0 && k < 4000) {
+      ASSERT_NEAR(e.distance, full.distance, 1e-15) << "sample " << k;
+    } else {
+      // Start and end coincide: the tracker keeps to its end of the path,
+      // at most the 10 µm start preference farther than the global nearest.
+      ASSERT_LE(e.distance, full.distance + 1e-5) << "sample " << k;
+    }
+  }
 }
 
 }  // namespace

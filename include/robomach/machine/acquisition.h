@@ -77,9 +77,13 @@ struct ContourError {
 /// Nearest-point search that follows the machine along the path: the first
 /// sample searches every segment, later ones a window around the previous
 /// nearest segment, widened while the distance keeps falling at its edge.
-/// (A full search at every sample would cost n_samples x n_segments.)
+/// (A full search at every sample would cost n_samples x n_segments.) The
+/// first sample takes the earliest segment within 10 µm of the nearest, so a
+/// closed path is followed from its start; a sample farther than
+/// kRecoverDistance from the local stretch triggers a full search again.
 class ContourTracker {
  public:
+  static constexpr double kRecoverDistance = 1e-4;  // [m]
   explicit ContourTracker(const ProgrammedPath& path, int window_segments = 32);
   ContourError Next(const ToolPose& pose);
   /// Exhaustive search, for tests and for the first sample.
