@@ -64,6 +64,10 @@ void AppendDouble17(double v, std::string* out) {
   if (s <= 0 || s >= 127) return Fallback(v, out);
   // floor(log10(a)) to within one; the loop below corrects it.
   int exp10 = static_cast<int>(std::floor((biased - 1023) * 0.30102999566398120));
+  // Powers of ten up to 1e22 are exact doubles: settle exp10 >= 0 here.
+  static constexpr double kPow10d[17] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7, 1e8,
+                                         1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16};
+  if (exp10 >= 0 && exp10 < 16 && a >= kPow10d[exp10 + 1]) ++exp10;
   std::uint64_t digits = 0;
   for (int attempt = 0; attempt < 3; ++attempt) {
     const int k = 16 - exp10;

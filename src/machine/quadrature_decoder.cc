@@ -33,6 +33,19 @@ constexpr TransitionTable MakeTable() {
 
 constexpr TransitionTable kTable = MakeTable();
 
+// delta + error * 2^32 in one 64-bit addend, so the hot loop does one table
+// lookup and one add per axis; unpacked at the end of a run of fewer than
+// 2^31 samples (|sum of deltas| < 2^31 then).
+struct PackedTable {
+  std::int64_t v[16];
+};
+constexpr PackedTable MakePacked() {
+  PackedTable p{};
+  for (int i = 0; i < 16; ++i) p.v[i] = static_cast<std::int64_t>(kTable.delta[i]) + (static_cast<std::int64_t>(kTable.error[i]) << 32);
+  return p;
+}
+constexpr PackedTable kPacked = MakePacked();
+
 }  // namespace
 
 void CheckValid(const QuadratureOptions& options) {
@@ -94,29 +107,37 @@ std::uint32_t DecodeFixed(const std::uint16_t* words, std::size_t n, std::uint32
                           std::int64_t* counts, std::int64_t* errors) {
   constexpr std::uint32_t kMask = N == 8 ? 0xFFFFu : ((1u << (2 * N)) - 1u);
   constexpr std::uint64_t kMask4 = static_cast<std::uint64_t>(kMask) * 0x0001000100010001ull;
-  std::int64_t c[N], e[N];
-  for (int k = 0; k < N; ++k) c[k] = 0, e[k] = 0;
-  std::size_t i = 0;
-  while (i < n) {
-    const std::uint64_t rep = static_cast<std::uint64_t>(state) * 0x0001000100010001ull;
-    while (i + 4 <= n) {
-      std::uint64_t four;
-      std::memcpy(&four, words + i, 8);
-      if (((four ^ rep) & kMask4) != 0) break;
-      i += 4;
-    }
-    const std::size_t end = std::min(n, i + 4);
-    for (; i < end; ++i) {
-      const std::uint32_t w = words[i] & kMask;
-      for (int k = 0; k < N; ++k) {
-        const unsigned t = (((state >> (2 * k)) & 3u) << 2) | ((w >> (2 * k)) & 3u);
-        c[k] += kTable.delta[t];
-        e[k] += kTable.error[t];
+  constexpr std::size_t kRun = std::size_t{1} << 30;  // keeps the packed deltas below 2^31
+  for (std::size_t start = 0; start < n; start += kRun) {
+    const std::size_t end_all = std::min(n, start + kRun);
+    std::int64_t acc[N];
+    for (int k = 0; k < N; ++k) acc[k] = 0;
+    std::size_t i = start;
+    while (i < end_all) {
+      const std::uint64_t rep = static_cast<std::uint64_t>(state) * 0x0001000100010001ull;
+      while (i + 4 <= end_all) {
+        std::uint64_t four;
+        std::memcpy(&four, words + i, 8);
+        if (((four ^ rep) & kMask4) != 0) break;
+        i += 4;
       }
-      state = w;
+      const std::size_t end = std::min(end_all, i + 4);
+      for (; i < end; ++i) {
+        const std::uint32_t w = words[i] & kMask;
+        // Per axis: index (old code << 2) | new code, from the two words.
+        for (int k = 0; k < N; ++k) {
+          const unsigned t = (((state >> (2 * k)) & 3u) << 2) | ((w >> (2 * k)) & 3u);
+          acc[k] += kPacked.v[t];
+        }
+        state = w;
+      }
+    }
+    for (int k = 0; k < N; ++k) {
+      const std::int64_t e = (acc[k] + (std::int64_t{1} << 31)) >> 32;
+      errors[k] += e;
+      counts[k] += acc[k] - (e << 32);
     }
   }
-  for (int k = 0; k < N; ++k) counts[k] += c[k], errors[k] += e[k];
   return state;
 }
 

@@ -75,7 +75,7 @@ struct ContourError {
 };
 
 /// Nearest-point search that follows the machine along the path: the first
-/// sample searches every segment, later ones a window around the previous
+/// sample searches every segment, later ones a window (±8 segments) around the previous
 /// nearest segment, widened while the distance keeps falling at its edge.
 /// (A full search at every sample would cost n_samples x n_segments.) The
 /// first sample takes the earliest segment within 10 µm of the nearest, so a
@@ -84,7 +84,7 @@ struct ContourError {
 class ContourTracker {
  public:
   static constexpr double kRecoverDistance = 1e-4;  // [m]
-  explicit ContourTracker(const ProgrammedPath& path, int window_segments = 32);
+  explicit ContourTracker(const ProgrammedPath& path, int window_segments = 8);
   ContourError Next(const ToolPose& pose);
   /// Exhaustive search, for tests and for the first sample.
   ContourError Nearest(const ToolPose& pose) const;
