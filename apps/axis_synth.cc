@@ -120,7 +120,9 @@ int Run(int argc, char** argv) {
                                                           {"sample_rate_hz", io::FormatDouble(rate_hz)}};
     // Capture first (it can fail on too fast a move), then the counts.
     if (!capture_path.empty()) {
-      machine::CaptureSynthesizer cap(static_cast<int>(n), capture_every, settle, glitch_p, seed);
+      std::vector<std::string> names;
+      for (const auto& a : mf.machine.axes) names.push_back(a.name);
+      machine::CaptureSynthesizer cap(static_cast<int>(n), capture_every, settle, glitch_p, seed, names);
       io::WriteFileAtomically(capture_path, [&](std::ostream& out) {
         std::vector<std::uint16_t> words;
         auto flush = [&]() {
@@ -132,7 +134,12 @@ int Run(int argc, char** argv) {
         };
         cap.Start(rec.counts.data(), &words);
         for (long r = 1; r < rec.rows(); ++r) {
-          cap.Next(rec.counts.data() + r * n, &words);
+          try {
+            cap.Next(rec.counts.data() + r * n, &words);
+          } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(std::string("--capture-every ") + std::to_string(capture_every) + ": " + e.what() +
+                                        "; raise --capture-every or lower --feed-mm-min");
+          }
           if (words.size() > (1u << 16)) flush();
         }
         flush();

@@ -88,8 +88,10 @@ SynthesisResult SynthesizeCounts(const Machine& machine, const Compensation* com
 }
 
 CaptureSynthesizer::CaptureSynthesizer(int num_axes, int every, int settle, double glitch_probability,
-                                       unsigned seed)
+                                       unsigned seed, std::vector<std::string> axis_names)
     : num_axes_(num_axes), every_(every), settle_(settle), glitch_probability_(glitch_probability), rng_(seed) {
+  names_ = std::move(axis_names);
+  for (int k = static_cast<int>(names_.size()); k < num_axes; ++k) names_.push_back(std::to_string(k + 1));
   if (num_axes < 1 || num_axes > 8) throw std::invalid_argument("capture: 1..8 axes");
   if (every < 1 || settle < 0 || settle >= every) {
     throw std::invalid_argument("capture: expected every >= 1 and 0 <= settle < every");
@@ -124,10 +126,10 @@ void CaptureSynthesizer::Next(const std::int64_t* counts, std::vector<std::uint1
   for (int k = 0; k < num_axes_; ++k) {
     const std::int64_t d = counts[k] - current_[k];
     if (std::abs(d) > span) {
-      throw std::invalid_argument("capture: axis " + std::to_string(k + 1) + " moves " + std::to_string(d) +
+      throw std::invalid_argument("capture: axis " + names_[k] + " moves " + std::to_string(d) +
                                   " counts between rows " + std::to_string(rows_) + " and " +
                                   std::to_string(rows_ + 1) + ", more than the " + std::to_string(span) +
-                                  " capture samples between them allow (raise the capture rate)");
+                                  " capture samples between them (every - settle) allow");
     }
   }
   const size_t first = out->size();

@@ -58,7 +58,8 @@ std::vector<double> StartMeasured(const Machine& machine, const Compensation* co
 /// samples removes them all.
 class CaptureSynthesizer {
  public:
-  CaptureSynthesizer(int num_axes, int every, int settle, double glitch_probability, unsigned seed);
+  CaptureSynthesizer(int num_axes, int every, int settle, double glitch_probability, unsigned seed,
+                     std::vector<std::string> axis_names = {});
   /// Words for the first row (one sample).
   void Start(const std::int64_t* counts, std::vector<std::uint16_t>* out);
   /// Words for the `every` samples that lead from the previous row to `counts`.
@@ -70,6 +71,7 @@ class CaptureSynthesizer {
   std::uint16_t Word(const std::int64_t* c) const;
   int num_axes_, every_, settle_;
   std::vector<int> phase0_;
+  std::vector<std::string> names_;
   double glitch_probability_;
   std::mt19937 rng_;
   std::vector<std::int64_t> current_;
