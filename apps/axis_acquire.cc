@@ -11,6 +11,7 @@
 #include "robomach/common/units.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/machine_files.h"
+#include "robomach/io/parallel_rows.h"
 #include "robomach/machine/acquisition.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/posture_json.h"
@@ -96,19 +97,29 @@ int Run(int argc, char** argv) {
       angle.reserve(rec.rows());
       s_along.reserve(rec.rows());
     }
+    // Chunks of rows: computed in order (the contour tracker follows the
+    // path), then formatted on two threads (formatting 17-digit numbers is
+    // most of the work) and written in order. Constant memory per chunk.
     io::WriteFileAtomically(out_path, [&](std::ostream& out) {
-      io::AcquiredPathWriter w(out, mf.machine.axes, path.has_value());
-      for (long r = 0; r < rec.rows(); ++r) {
-        const machine::AcquiredSample& s = acq.Process(rec.t_s[r], rec.counts.data() + r * n);
-        if (tracker) {
-          const machine::ContourError e = tracker->Next(s.pose);
-          dist.push_back(e.distance);
-          angle.push_back(e.axis_angle);
-          s_along.push_back(e.s);
-          w.Row(rec.t_s[r], s, &e);
-        } else {
-          w.Row(rec.t_s[r], s, nullptr);
+      const io::AcquiredPathWriter w(out, mf.machine.axes, path.has_value());
+      constexpr long kChunk = 1 << 15;
+      std::vector<machine::AcquiredSample> samples(kChunk);
+      std::vector<machine::ContourError> contour(kChunk);
+      for (long first = 0; first < rec.rows(); first += kChunk) {
+        const long last = std::min(rec.rows(), first + kChunk);
+        for (long r = first; r < last; ++r) {
+          samples[r - first] = acq.Process(rec.t_s[r], rec.counts.data() + r * n);
+          if (tracker) {
+            const machine::ContourError e = tracker->Next(samples[r - first].pose);
+            contour[r - first] = e;
+            dist.push_back(e.distance);
+            angle.push_back(e.axis_angle);
+            s_along.push_back(e.s);
+          }
         }
+        io::WriteRowsInParallel(out, first, last, [&](long r, std::string* buf) {
+          w.AppendRow(buf, rec.t_s[r], samples[r - first], tracker ? &contour[r - first] : nullptr);
+        });
       }
     });
     nlohmann::json j;

@@ -578,33 +578,32 @@ AcquiredPathWriter::AcquiredPathWriter(std::ostream& out, const std::vector<Axis
 }
 
 void AcquiredPathWriter::Row(double t_s, const machine::AcquiredSample& s, const machine::ContourError* c) {
-  char buf[40];
   buffer_.clear();
-  auto put = [&](double v, bool full) {
-    if (full) {
-      AppendDouble17(v, &buffer_);  // "%.17g", fast
-    } else {
-      const auto r = std::to_chars(buf, buf + sizeof buf, v);
-      buffer_.append(buf, r.ptr);
-    }
-  };
-  put(t_s, false);  // copied from the counts: shortest exact text
-  for (size_t a = 0; a < axes_.size(); ++a) {
-    buffer_.push_back(',');
-    put(FromSi(axes_[a], s.real[a]), true);
-  }
-  for (int i = 0; i < 3; ++i) buffer_.push_back(','), put(MToMm(s.pose.p_W(i)), true);
-  for (int i = 0; i < 3; ++i) buffer_.push_back(','), put(s.pose.k_W(i), true);
-  if (c != nullptr) {
-    buffer_.push_back(',');
-    put(MToMm(c->distance), true);
-    buffer_.push_back(',');
-    put(RadToDeg(c->axis_angle), true);
-    buffer_.push_back(',');
-    put(MToMm(c->s), true);
-  }
-  buffer_.push_back('\n');
+  AppendRow(&buffer_, t_s, s, c);
   out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+}
+
+void AcquiredPathWriter::AppendRow(std::string* buffer, double t_s, const machine::AcquiredSample& s,
+                                   const machine::ContourError* c) const {
+  std::string& b = *buffer;
+  {
+    char buf[40];  // t_s copied from the counts: shortest exact text
+    const auto r = std::to_chars(buf, buf + sizeof buf, t_s);
+    b.append(buf, r.ptr);
+  }
+  auto put = [&](double v) {
+    b.push_back(',');
+    AppendDouble17(v, &b);  // "%.17g", fast
+  };
+  for (size_t a = 0; a < axes_.size(); ++a) put(FromSi(axes_[a], s.real[a]));
+  for (int i = 0; i < 3; ++i) put(MToMm(s.pose.p_W(i)));
+  for (int i = 0; i < 3; ++i) put(s.pose.k_W(i));
+  if (c != nullptr) {
+    put(MToMm(c->distance));
+    put(RadToDeg(c->axis_angle));
+    put(MToMm(c->s));
+  }
+  b.push_back('\n');
 }
 
 // -------------------------------------------------------------------- ISO runs

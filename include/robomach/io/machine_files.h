@@ -77,6 +77,10 @@ class AcquiredPathWriter {
   AcquiredPathWriter(std::ostream& out, const std::vector<machine::AxisScale>& axes,
                      bool contour_columns);
   void Row(double t_s, const machine::AcquiredSample& s, const machine::ContourError* contour);
+  /// The text of one row (with its newline) appended to `buffer`; safe to
+  /// call from several threads.
+  void AppendRow(std::string* buffer, double t_s, const machine::AcquiredSample& s,
+                 const machine::ContourError* contour) const;
 
  private:
   std::ostream& out_;
