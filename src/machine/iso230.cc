@@ -1,0 +1,105 @@
+#include "robomach/machine/iso230.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <tuple>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace robomach::machine {
+namespace {
+
+std::string Num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+
+void MeanAndS(const std::vector<double>& x, double* mean, double* s) {
+  double sum = 0.0;
+  for (double v : x) sum += v;
+  *mean = sum / static_cast<double>(x.size());
+  double ss = 0.0;
+  for (double v : x) ss += (v - *mean) * (v - *mean);
+  *s = std::sqrt(ss / static_cast<double>(x.size() - 1));
+}
+
+}  // namespace
+
+double WrapDeviationDeg(double d) {
+  double w = std::remainder(d, 360.0);  // [-180, 180]
+  if (w <= -180.0) w += 360.0;
+  return w;
+}
+
+Iso230Result EvaluateIso230(const std::vector<Iso230Approach>& approaches) {
+  if (approaches.empty()) throw std::invalid_argument("ISO 230-2: no approaches");
+  std::map<double, std::pair<std::vector<double>, std::vector<double>>> by_target;
+  std::set<std::tuple<double, int, bool>> seen;
+  for (const auto& a : approaches) {
+    if (!std::isfinite(a.target) || !std::isfinite(a.deviation)) {
+      throw std::invalid_argument("ISO 230-2: non-finite target or deviation");
+    }
+    if (!seen.insert({a.target, a.run, a.up}).second) {
+      throw std::invalid_argument("ISO 230-2: target " + Num(a.target) + ", run " + std::to_string(a.run) +
+                                  ", direction " + (a.up ? "+" : "-") + " is given twice");
+    }
+    auto& d = by_target[a.target];
+    (a.up ? d.first : d.second).push_back(a.deviation);
+  }
+  Iso230Result r;
+  for (const auto& [target, d] : by_target) {
+    if (d.first.size() < 2 || d.second.size() < 2) {
+      throw std::invalid_argument("ISO 230-2: target " + Num(target) + " has " + std::to_string(d.first.size()) +
+                                  " runs in + and " + std::to_string(d.second.size()) +
+                                  " in - direction; at least 2 each are needed (ISO asks for 5)");
+    }
+    Iso230Target t;
+    t.target = target;
+    t.runs_up = static_cast<int>(d.first.size());
+    t.runs_down = static_cast<int>(d.second.size());
+    MeanAndS(d.first, &t.mean_up, &t.s_up);
+    MeanAndS(d.second, &t.mean_down, &t.s_down);
+    t.mean = 0.5 * (t.mean_up + t.mean_down);
+    t.reversal = t.mean_up - t.mean_down;
+    t.R_up = 4.0 * t.s_up;
+    t.R_down = 4.0 * t.s_down;
+    t.R = std::max({2.0 * t.s_up + 2.0 * t.s_down + std::abs(t.reversal), t.R_up, t.R_down});
+    r.targets.push_back(t);
+  }
+  auto max_of = [&](auto f) {
+    double m = -INFINITY;
+    for (const auto& t : r.targets) m = std::max(m, f(t));
+    return m;
+  };
+  auto min_of = [&](auto f) {
+    double m = INFINITY;
+    for (const auto& t : r.targets) m = std::min(m, f(t));
+    return m;
+  };
+  r.E_up = max_of([](const Iso230Target& t) { return t.mean_up; }) - min_of([](const Iso230Target& t) { return t.mean_up; });
+  r.E_down = max_of([](const Iso230Target& t) { return t.mean_down; }) -
+             min_of([](const Iso230Target& t) { return t.mean_down; });
+  r.E = max_of([](const Iso230Target& t) { return std::max(t.mean_up, t.mean_down); }) -
+        min_of([](const Iso230Target& t) { return std::min(t.mean_up, t.mean_down); });
+  r.M = max_of([](const Iso230Target& t) { return t.mean; }) - min_of([](const Iso230Target& t) { return t.mean; });
+  r.R_up = max_of([](const Iso230Target& t) { return t.R_up; });
+  r.R_down = max_of([](const Iso230Target& t) { return t.R_down; });
+  r.R = max_of([](const Iso230Target& t) { return t.R; });
+  r.B = max_of([](const Iso230Target& t) { return std::abs(t.reversal); });
+  double sum_b = 0.0;
+  for (const auto& t : r.targets) sum_b += t.reversal;
+  r.B_mean = sum_b / static_cast<double>(r.targets.size());
+  r.A_up = max_of([](const Iso230Target& t) { return t.mean_up + 2.0 * t.s_up; }) -
+           min_of([](const Iso230Target& t) { return t.mean_up - 2.0 * t.s_up; });
+  r.A_down = max_of([](const Iso230Target& t) { return t.mean_down + 2.0 * t.s_down; }) -
+             min_of([](const Iso230Target& t) { return t.mean_down - 2.0 * t.s_down; });
+  r.A = max_of([](const Iso230Target& t) { return std::max(t.mean_up + 2.0 * t.s_up, t.mean_down + 2.0 * t.s_down); }) -
+        min_of([](const Iso230Target& t) { return std::min(t.mean_up - 2.0 * t.s_up, t.mean_down - 2.0 * t.s_down); });
+  return r;
+}
+
+}  // namespace robomach::machine
