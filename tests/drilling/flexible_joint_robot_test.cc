@@ -95,7 +95,7 @@ TEST(FlexibleJointRobot, StaticDeflectionWithMotorsHeldIsInverseStiffnessTimesJa
   const Eigen::VectorXd expected = tau_ext.cwiseQuotient(robot.stiffness());
   const int sub = SubstepsFor(robot.HighestFreeModeRadS(q0), 1e-3);
   Rk4Integrator rk4(3);
-  for (int k = 0; k < 1000; ++k) {
+  for (int k = 0; k < 300; ++k) {
     for (int i = 0; i < sub; ++i) {
       rk4.Step(robot, Eigen::VectorXd::Zero(3), tau_ext, 1e-3 / sub, &x);
       x.theta = theta_held;  // motors held (brakes on)
@@ -104,14 +104,15 @@ TEST(FlexibleJointRobot, StaticDeflectionWithMotorsHeldIsInverseStiffnessTimesJa
   }
   const Eigen::VectorXd dq = x.q - q0;
   // The deflection is ~1e-4 rad; J changes with it by a relative ~1e-4,
-  // so the linear prediction holds to ~1e-4 relative; the slowest mode has
-  // decayed by exp(-D t / 2 M) < 1e-20 after 1 s.
+  // so the linear prediction holds to ~1e-4 relative. The transient starts
+  // at the size of the deflection and decays at least as exp(-D t / (2 M))
+  // with M < 3 kg m^2 (the whole arm about joint 1): exp(-200 * 0.3 / 6)
+  // = 4.5e-5 after 0.3 s. 1e-3 of the largest component covers both.
   for (int j = 0; j < 3; ++j) {
     EXPECT_NEAR(dq(j), expected(j), 1e-3 * expected.cwiseAbs().maxCoeff()) << "joint " << j;
   }
-  // Rates: the slowest mode decays as exp(-D t / (2 M)); after 1 s the
-  // remaining motion is far below the deflection's scale per second.
-  EXPECT_LT(x.qd.norm(), 1e-6);
+  // Rates: what is left of the transient.
+  EXPECT_LT(x.qd.norm(), 1e-5);
 }
 
 TEST(FlexibleJointRobot, RejectsBadDrives) {
