@@ -13,6 +13,7 @@
 #include <kdl/chaindynparam.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
 
 #include "robomach/common/units.h"
 
@@ -22,6 +23,11 @@ struct FlexibleJointRobot::Kdl {
   KDL::Chain chain;
   KDL::ChainDynParam dyn;
   KDL::ChainIdSolver_RNE rne;   // C q' + G in one pass (q'' = 0)
+  KDL::ChainFkSolverPos_recursive fk;
+  KDL::ChainJntToJacSolver jac;
+  KDL::JntArray q_kin;          // for TipPose / TipJacobian
+  KDL::Frame X;
+  KDL::Jacobian J;
   KDL::JntArray q, qd, qdd, c, g, h;
   KDL::JntSpaceInertiaMatrix M;
   KDL::Wrenches no_wrench;
@@ -29,6 +35,10 @@ struct FlexibleJointRobot::Kdl {
       : chain(ch),
         dyn(chain, KDL::Vector(0.0, 0.0, -kStandardGravity)),
         rne(chain, KDL::Vector(0.0, 0.0, -kStandardGravity)),
+        fk(chain),
+        jac(chain),
+        q_kin(n),
+        J(n),
         q(n), qd(n), qdd(n), c(n), g(n), h(n), M(n),
         no_wrench(chain.getNrOfSegments(), KDL::Wrench::Zero()) {}
 };
@@ -182,12 +192,22 @@ double FlexibleJointRobot::HighestFreeModeRadS(const Eigen::VectorXd& q0) {
   return std::sqrt(std::max(w2, 0.0));
 }
 
+// KDL solvers bound to this robot's own chain copy (kinematics::
+// ForwardKinematics and Jacobian build new solvers per call; the simulation
+// calls these once per control period). Same conventions: tip of the last
+// segment, Jacobian rows [v; w] in the base frame, reference point at the tip.
 Eigen::Isometry3d FlexibleJointRobot::TipPose(const Eigen::VectorXd& q) const {
-  return kinematics::ForwardKinematics(chain_, q);
+  kinematics::CheckJointVector(chain_, q);
+  kdl_->q_kin.data = q;
+  if (kdl_->fk.JntToCart(kdl_->q_kin, kdl_->X) < 0) throw std::runtime_error("TipPose: KDL error");
+  return kinematics::ToEigen(kdl_->X);
 }
 
 Matrix6Xd FlexibleJointRobot::TipJacobian(const Eigen::VectorXd& q) const {
-  return kinematics::Jacobian(chain_, q);
+  kinematics::CheckJointVector(chain_, q);
+  kdl_->q_kin.data = q;
+  if (kdl_->jac.JntToJac(kdl_->q_kin, kdl_->J) < 0) throw std::runtime_error("TipJacobian: KDL error");
+  return kdl_->J.data;
 }
 
 namespace {

@@ -115,6 +115,16 @@ TEST(FlexibleJointRobot, StaticDeflectionWithMotorsHeldIsInverseStiffnessTimesJa
   EXPECT_LT(x.qd.norm(), 1e-5);
 }
 
+TEST(FlexibleJointRobot, TipPoseAndJacobianMatchKinematicsModule) {
+  // The robot keeps its own KDL solvers; the kinematics module builds new
+  // ones per call. Same chain, same arithmetic: equal to rounding.
+  FlexibleJointRobot robot(PlanarRodArm(true), SeedDrives(1.0));
+  const Eigen::VectorXd q = Eigen::Vector3d(-1.2, 1.4, 0.7);
+  EXPECT_LT((robot.TipPose(q).matrix() - kinematics::ForwardKinematics(robot.chain(), q).matrix())
+                .cwiseAbs().maxCoeff(), 1e-14);
+  EXPECT_LT((robot.TipJacobian(q) - kinematics::Jacobian(robot.chain(), q)).cwiseAbs().maxCoeff(), 1e-14);
+}
+
 TEST(FlexibleJointRobot, RejectsBadDrives) {
   auto drives = SeedDrives(1.0);
   drives[1].gear_ratio = 0.0;

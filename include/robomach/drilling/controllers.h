@@ -122,11 +122,15 @@ class PdTdcController final : public JointController {
   int steps_{0};
 };
 
-/// The TDE stability measure ||I - M^-1 Mbar||_2 [Youcef-Toumi & Ito 1990;
-/// Hsia & Gao 1990]; the estimate converges when it is < 1. M is the
-/// inertia the motor torques see: diag(n) ... here M = (n² J_m + M(q)) / n
-/// per joint row (rigid-gear approximation: theta = n q), i.e.
-/// M_eff = diag(1/n) (M(q) + diag(n² J_m)).
+/// The TDE stability measure ||I - M_eff^-1 Mbar||_2 [Youcef-Toumi & Ito
+/// 1990; Hsia & Gao 1990]; the estimate converges when it is < 1. M_eff is
+/// the inertia the motor torques see per link acceleration with rigid gears
+/// (theta = n q): M_eff = diag(1/n) (M(q) + diag(n² J_m))
+/// (DrillingScenario::effective_inertia()).
+///
+/// - [Hsia & Gao 1990] T. C. Hsia, L. S. Gao, Robot manipulator control using
+///   decentralized linear time-invariant time-delayed joint controllers,
+///   IEEE ICRA 1990, 2070-2075.
 double TdeStabilityMeasure(const Eigen::MatrixXd& M_eff, const Eigen::VectorXd& mbar);
 
 }  // namespace robomach::drilling

@@ -81,8 +81,8 @@ class DrillingScenario {
 
   int num_samples() const { return static_cast<int>(q_d_.cols()); }
   const Eigen::MatrixXd& desired() const { return q_d_; }
-  /// Inertia seen by the motor torques per link acceleration at q0 (rigid
-  /// gears): (M(q0) + diag(n² J_m)) diag(1/n) rows... see controllers.h.
+  /// Inertia seen by the motor torques per link acceleration at q0 with
+  /// rigid gears: M_eff = diag(1/n) (M(q0) + diag(n² J_m)) [N·m·s²/rad].
   const Eigen::MatrixXd& effective_inertia() const { return M_eff_; }
   const Eigen::VectorXd& holding_torque() const { return tau_hold_; }
   const Eigen::VectorXd& plant_modes_hz() const { return modes_hz_; }
