@@ -97,6 +97,7 @@ int RunDrillForceFit(int argc, char** argv) {
   app.footer(ExitCodeHelp());
   std::string table_path, drill_path, out_path, plot_path, predict_path, predictions_path;
   std::string chisel = "seed_scaling";
+  bool verbose = false;
   app.add_option("--table", table_path,
                  "measured force table CSV (formats.md 9.1): diameter_mm, feed_mm_per_rev, thrust_N, "
                  "torque_Nm[, speed_rpm]")->required();
@@ -108,6 +109,7 @@ int RunDrillForceFit(int argc, char** argv) {
   app.add_option("--predictions", predictions_path, "CSV written for --predict: diameter_mm, feed_mm_per_rev, thrust_N, torque_Nm[, speed_rpm]");
   app.add_option("--chisel", chisel, "chisel-edge model: seed_scaling (F_A = 2.5 F_L, T_A = 1.67 T), orthogonal, none")
       ->check(CLI::IsMember({"seed_scaling", "orthogonal", "none"}))->capture_default_str();
+  app.add_flag("--verbose", verbose, "list ignored (unknown) table columns on stderr");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -124,6 +126,9 @@ int RunDrillForceFit(int argc, char** argv) {
     if (!predict_path.empty()) RequireReadableFile(predict_path, "rows to predict");
     const io::ForceTableFile table = io::ReadForceTable(table_path);
     const io::DrillFile drill = io::ReadDrillFile(drill_path);
+    if (verbose) {
+      for (const auto& c : table.unknown_columns) Warn(kTool, table_path + ": ignored column '" + c + "'");
+    }
     std::optional<io::ForceTableFile> predict;
     if (!predict_path.empty()) predict = io::ReadForceTable(predict_path, false);
 

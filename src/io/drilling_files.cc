@@ -74,6 +74,8 @@ ForceTableFile ReadForceTable(const std::string& path, bool require_forces) {
   if (t.num_rows() == 0) {
     throw InputError({path, t.header_line(), 0}, "expected at least one data row after the header");
   }
+  out.unknown_columns =
+      t.UnknownColumns({"diameter_mm", "feed_mm_per_rev", "thrust_N", "torque_Nm", "speed_rpm"});
   for (int r = 0; r < t.num_rows(); ++r) {
     drilling::ForceTableRow row;
     row.diameter = MmToM(PositiveCell(t, r, "diameter_mm"));

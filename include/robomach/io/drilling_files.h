@@ -19,6 +19,7 @@ struct ForceTableFile {
   std::vector<drilling::ForceTableRow> rows;
   std::vector<std::optional<double>> speed_rpm;  // per row, when the column is given
   std::vector<int> lines;                   // 1-based file line of each row
+  std::vector<std::string> unknown_columns; // ignored (formats.md: listed with --verbose)
 };
 
 /// Reads a force table. With `require_forces` false (for --predict rows)
