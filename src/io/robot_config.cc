@@ -102,6 +102,30 @@ std::string FormatNumber(double v) { return FormatDouble(v); }
 
 }  // namespace
 
+kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& path) {
+  kinematics::SerialChain arm;
+  if (robot.Has("dh")) {
+    arm = ReadDh(robot["dh"]);
+  } else {
+    const YamlDoc urdf = robot["urdf"];
+    const std::string urdf_path = ResolveRelative(path, urdf.String());
+    const std::string base = robot["base_link"].String();
+    const std::string tip = robot["tip_frame"].String();
+    arm = LoadUrdfChain(urdf_path, base, tip);
+  }
+  if (robot.Has("joint_names")) {
+    const YamlDoc jn = robot["joint_names"];
+    if (jn.Strings() != arm.joint_names()) {
+      std::string have;
+      for (const auto& n : arm.joint_names()) have += (have.empty() ? "" : ", ") + n;
+      throw jn.Error("the chain's joints are [" + have + "]");
+    }
+  }
+  robot.MarkUsed("joint_names");
+  robot.RejectUnknownKeys();
+  return arm;
+}
+
 RobotConfig LoadRobotConfig(const std::string& path) {
   const YamlDoc doc = YamlDoc::LoadFile(path);
   if (!doc.IsMap()) throw doc.Error("expected a robot config (a YAML map)");
@@ -110,26 +134,7 @@ RobotConfig LoadRobotConfig(const std::string& path) {
   dynamics::RobotDescription& d = cfg.description;
   d.source = path;
 
-  const YamlDoc robot = doc["robot"];
-  if (robot.Has("dh")) {
-    d.arm = ReadDh(robot["dh"]);
-  } else {
-    const YamlDoc urdf = robot["urdf"];
-    const std::string urdf_path = ResolveRelative(path, urdf.String());
-    const std::string base = robot["base_link"].String();
-    const std::string tip = robot["tip_frame"].String();
-    d.arm = LoadUrdfChain(urdf_path, base, tip);
-  }
-  if (robot.Has("joint_names")) {
-    const YamlDoc jn = robot["joint_names"];
-    if (jn.Strings() != d.arm.joint_names()) {
-      std::string have;
-      for (const auto& n : d.arm.joint_names()) have += (have.empty() ? "" : ", ") + n;
-      throw jn.Error("the chain's joints are [" + have + "]");
-    }
-  }
-  robot.MarkUsed("joint_names");
-  robot.RejectUnknownKeys();
+  d.arm = ReadRobotChain(doc["robot"], path);
   const int n = d.arm.num_joints();
 
   const YamlDoc kq = doc["joint_stiffness_Nm_per_rad"];

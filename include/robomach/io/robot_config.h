@@ -5,6 +5,7 @@
 
 #include "robomach/dynamics/parameters.h"
 #include "robomach/dynamics/robot_model.h"
+#include "robomach/io/yaml_doc.h"
 
 namespace robomach::io {
 
@@ -29,6 +30,12 @@ struct RobotConfig {
 /// Unknown keys are rejected. Paths are relative to the config's folder.
 /// @throws InputError with `file:line:col` for any problem.
 RobotConfig LoadRobotConfig(const std::string& path);
+
+/// The kinematic chain of a config's `robot:` section (URDF or `dh:`, as
+/// LoadRobotConfig reads it); `path` is the config file, for relative paths.
+/// Used by readers of other robot files (drilling's flexible-joint robot).
+/// @throws InputError with `file:line:col` for any problem.
+kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& path);
 
 /// The `parameters:` block that reproduces `parameters` where they differ
 /// from the description's defaults (all of them if `all`), as YAML text.

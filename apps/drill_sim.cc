@@ -1,0 +1,324 @@
+// drill-sim: a flexible-joint robot drilling a hole (seed 003): the robot
+// holds a posture and feeds the drill along the hole axis; the drilling
+// thrust, torque and tilt imbalance deflect the joints; a controller
+// (PID, PD or PD with time-delay estimation) corrects. Writes the time series
+// and summary of formats.md §9.4 and a plot like the seed's Figs. 6-7.
+#include <CLI/CLI.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "cli_support.h"
+#include "robomach/common/errors.h"
+#include "robomach/common/units.h"
+#include "robomach/drilling/drilling_sim.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/drilling_files.h"
+#include "robomach/io/number_format.h"
+#include "robomach/report/plot.h"
+
+namespace robomach::apps {
+namespace {
+
+constexpr char kTool[] = "drill-sim";
+
+// "run.csv" + "pd-tdc" -> "run_pd-tdc.csv" (several controllers: one file each).
+std::string WithSuffix(const std::string& path, const std::string& name, bool several) {
+  if (!several || path.empty()) return path;
+  const std::filesystem::path p(path);
+  return (p.parent_path() / (p.stem().string() + "_" + name + p.extension().string())).string();
+}
+
+std::string SeriesCsv(const drilling::SimResult& r) {
+  const drilling::SimSeries& s = r.series;
+  const int n = static_cast<int>(s.q.rows());
+  std::ostringstream o;
+  o << "t_s";
+  for (int i = 1; i <= n; ++i) o << ",q" << i << "_deg";
+  for (int i = 1; i <= n; ++i) o << ",e" << i << "_deg";
+  for (int i = 1; i <= n; ++i) o << ",tau_m" << i << "_Nm";
+  o << ",thrust_N,torque_Nm,offset_deg\n";
+  for (size_t k = 0; k < s.t.size(); ++k) {
+    o << io::FormatDouble(s.t[k]);
+    for (int i = 0; i < n; ++i) o << "," << io::FormatDouble(RadToDeg(s.q(i, k)));
+    for (int i = 0; i < n; ++i) o << "," << io::FormatDouble(RadToDeg(s.e(i, k)));
+    for (int i = 0; i < n; ++i) o << "," << io::FormatDouble(s.tau_m(i, k));
+    o << "," << io::FormatDouble(s.thrust[k]) << "," << io::FormatDouble(s.torque[k]) << ","
+      << io::FormatDouble(RadToDeg(s.offset[k])) << "\n";
+  }
+  return o.str();
+}
+
+std::vector<double> Deg(const Eigen::VectorXd& v) {
+  std::vector<double> out;
+  for (int i = 0; i < v.size(); ++i) out.push_back(RadToDeg(v(i)));
+  return out;
+}
+
+struct Run {
+  drilling::ControllerParameters parameters;
+  bool tuned{false};
+  drilling::TuneResult tune;
+  drilling::SimResult result;
+  double tde_measure{NAN};
+};
+
+nlohmann::json Summary(const Run& run, const drilling::DrillingScenario& sc,
+                       const Eigen::VectorXd& limit) {
+  const drilling::SimResult& r = run.result;
+  nlohmann::json j;
+  j["controller"] = run.parameters.kind;
+  nlohmann::json gains;
+  for (const auto& [name, v] : r.gains) gains[name] = std::vector<double>(v.data(), v.data() + v.size());
+  j["gains"] = gains;
+  nlohmann::json par{{"omega_rad_s", run.parameters.omega}, {"zeta", run.parameters.zeta}};
+  if (run.parameters.kind == "pid") par["integral_ratio"] = run.parameters.third;
+  if (run.parameters.kind == "pd-tdc") par["mbar_ratio"] = run.parameters.third;
+  par["filter_time_constant_s"] = run.parameters.filter_time_constant;
+  j["gain_parameters"] = par;
+  j["gains_source"] = run.tuned ? "tuned" : "defaults";
+  if (run.tuned) {
+    j["tuning"] = {{"cost_rad_s2", run.tune.cost},
+                   {"evaluations", run.tune.evaluations},
+                   {"status", run.tune.message}};
+  }
+  j["band_deg"] = RadToDeg(sc.process().error_band);
+  j["settling_time_s"] = std::isnan(r.settling_time) ? nlohmann::json(nullptr) : nlohmann::json(r.settling_time);
+  j["max_abs_error_deg"] = Deg(r.max_abs_error);
+  j["max_abs_error_last_10pc_deg"] = Deg(r.max_abs_error_last_10pc);
+  if (r.thrust.available) {
+    j["thrust_N"] = {{"min", r.thrust.min}, {"max", r.thrust.max}, {"mean", r.thrust.mean},
+                     {"range", r.thrust.max - r.thrust.min}};
+  } else {
+    j["thrust_N"] = nullptr;
+  }
+  j["full_engagement_time_s"] = sc.full_engagement_time();
+  const Eigen::VectorXd& f = sc.plant_modes_hz();
+  j["plant_modes_hz"] = std::vector<double>(f.data(), f.data() + f.size());
+  j["motor_torque_limit_Nm"] = std::vector<double>(limit.data(), limit.data() + limit.size());
+  j["cost_rad_s2"] = r.cost;
+  j["diverged"] = r.diverged;
+  j["plant_substeps_per_period"] = r.substeps;
+  if (run.parameters.kind == "pd-tdc") j["tde_stability_measure"] = run.tde_measure;
+  return j;
+}
+
+void Plot(const std::string& path, const std::vector<Run>& runs, int n) {
+  const int panels = n + 3;
+  const int rows = (panels + 1) / 2;
+  report::Figure fig(rows, 2, 700, 300);
+  fig.title = "drill-sim: joint errors, drill offset, thrust and torque";
+  auto axes = [&](int k) -> report::Axes& { return fig.at(k / 2, k % 2); };
+  for (int i = 0; i < n; ++i) {
+    axes(i).title = "joint " + std::to_string(i + 1);
+    axes(i).y_label = "e" + std::to_string(i + 1) + " [deg]";
+  }
+  axes(n).title = "drill offset from the hole axis";
+  axes(n).y_label = "offset [deg]";
+  axes(n + 1).title = "thrust";
+  axes(n + 1).y_label = "thrust [N]";
+  axes(n + 2).title = "torque";
+  axes(n + 2).y_label = "torque [N m]";
+  for (int k = 0; k < panels; ++k) axes(k).x_label = "time [s]";
+  int c = 0;
+  for (const Run& run : runs) {
+    const drilling::SimSeries& s = run.result.series;
+    const report::Rgb color = report::PaletteColor(c++);
+    const std::string label = run.parameters.kind;
+    for (int i = 0; i < n; ++i) {
+      report::Series se{.x = s.t, .label = label, .color = color};
+      for (size_t k = 0; k < s.t.size(); ++k) se.y.push_back(RadToDeg(s.e(i, k)));
+      axes(i).series.push_back(se);
+    }
+    report::Series so{.x = s.t, .label = label, .color = color};
+    for (double v : s.offset) so.y.push_back(RadToDeg(v));
+    axes(n).series.push_back(so);
+    axes(n + 1).series.push_back({.x = s.t, .y = s.thrust, .label = label, .color = color});
+    axes(n + 2).series.push_back({.x = s.t, .y = s.torque, .label = label, .color = color});
+  }
+  fig.SavePng(path);
+}
+
+}  // namespace
+
+int RunDrillSim(int argc, char** argv) {
+  CLI::App app{"drill-sim: flexible-joint robot drilling a hole (seed 003): joint deflection, "
+               "drill tilt and forces under PID, PD or PD with time-delay estimation"};
+  app.footer("With several controllers each output gets the controller's name before its "
+             "extension (run.csv -> run_pid.csv, run_pd-tdc.csv); the plot overlays them.\n" +
+             ExitCodeHelp());
+  std::string robot_path, drill_path, material_path, out_path, summary_path, plot_path;
+  std::string controllers = "pd-tdc";
+  bool tune = false;
+  int tune_evaluations = 30;
+  double limit_Nm = 10.0;
+  app.add_option("--robot", robot_path, "flexible-joint robot YAML (formats.md 9.3)")->required();
+  app.add_option("--drill", drill_path, "drill and process YAML (formats.md 9.2) with process:")->required();
+  app.add_option("--material", material_path, "material YAML written by drill-force-fit")->required();
+  app.add_option("--controller", controllers, "comma-separated: pid, pd, pd-tdc")->capture_default_str();
+  app.add_flag("--tune", tune, "tune every controller's gains with NLopt against one cost "
+               "(time-weighted absolute joint error, motor torque limits); otherwise tuned defaults");
+  app.add_option("--tune-evaluations", tune_evaluations, "simulations per controller when tuning")
+      ->check(CLI::Range(5, 1000))->capture_default_str();
+  app.add_option("--motor-torque-limit-Nm", limit_Nm, "motor torque limit, every joint [N m]")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  std::vector<std::string> gain_texts;
+  app.add_option("--gains", gain_texts,
+                 "gain parameters KIND=OMEGA,ZETA[,THIRD[,FILTER_S]] (repeatable): OMEGA [rad/s] and ZETA set "
+                 "K_P, K_D per joint from the effective inertia; THIRD is r of K_I = K_P OMEGA / r "
+                 "(pid) or the Mbar ratio (pd-tdc); FILTER_S the low-pass time constant [s] on e' (pid, pd) "
+                 "or q'' (pd-tdc), default 0.005; the starting point of --tune");
+  app.add_option("--out", out_path, "time series CSV (formats.md 9.4)");
+  app.add_option("--summary", summary_path, "summary JSON (formats.md 9.4); stdout if neither --out nor --summary");
+  app.add_option("--plot", plot_path, "PNG: joint errors, drill offset, thrust, torque per controller");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  return RunGuarded(kTool, [&]() -> int {
+    std::vector<std::string> kinds;
+    {
+      std::stringstream ss(controllers);
+      std::string k;
+      while (std::getline(ss, k, ',')) {
+        if (k != "pid" && k != "pd" && k != "pd-tdc") {
+          throw std::invalid_argument("--controller: expected pid, pd or pd-tdc, got \"" + k + "\"");
+        }
+        if (std::find(kinds.begin(), kinds.end(), k) != kinds.end()) {
+          throw std::invalid_argument("--controller: \"" + k + "\" given twice");
+        }
+        kinds.push_back(k);
+      }
+    }
+    if (kinds.empty()) throw std::invalid_argument("--controller: expected at least one controller");
+    const bool several = kinds.size() > 1;
+    std::vector<std::pair<std::string, std::string>> outs;
+    for (const auto& k : kinds) {
+      outs.push_back({"--out", WithSuffix(out_path, k, several)});
+      outs.push_back({"--summary", WithSuffix(summary_path, k, several)});
+    }
+    outs.push_back({"--plot", plot_path});
+    CheckDistinctPaths({{"--robot", robot_path}, {"--drill", drill_path}, {"--material", material_path}},
+                       outs);
+    RequireReadableFile(robot_path, "robot file");
+    RequireReadableFile(drill_path, "drill file");
+    RequireReadableFile(material_path, "material file");
+    const io::FlexibleRobotFile robot_file = io::ReadFlexibleRobotFile(robot_path);
+    for (const auto& s : robot_file.unused_sections) {
+      Warn(kTool, robot_path + ": section '" + s + "' is not used by drill-sim");
+    }
+    const io::DrillFile drill = io::ReadDrillFile(drill_path);
+    if (!drill.has_process) {
+      throw InputError({drill_path, 0, 0}, "expected a 'process:' section (feed, speed, posture, hole axis)");
+    }
+    const drilling::DrillingMaterial material = io::ReadMaterialFile(material_path);
+    drilling::FlexibleJointRobot robot(robot_file.chain, robot_file.drives);
+    const int n = robot.num_joints();
+    if (drill.process.initial_posture.size() != n) {
+      throw InputError(drill.initial_posture_at,
+                       "initial_posture_deg: expected " + std::to_string(n) + " angles (one per joint), got " +
+                           std::to_string(drill.process.initial_posture.size()));
+    }
+    std::unique_ptr<drilling::DrillingScenario> sc;
+    try {
+      sc = std::make_unique<drilling::DrillingScenario>(&robot, drill.drill, material, drill.process);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(drill.hole_axis_at, std::string("hole_axis: ") + e.what());
+    }
+    const Eigen::VectorXd limit = Eigen::VectorXd::Constant(n, limit_Nm);
+    if ((sc->holding_torque().cwiseAbs().array() > limit.array()).any()) {
+      throw InputError(drill.initial_posture_at,
+                       "the motors cannot hold the robot at the initial posture within the torque limit "
+                       "(--motor-torque-limit-Nm)");
+    }
+
+    std::map<std::string, drilling::ControllerParameters> given;
+    for (const std::string& text : gain_texts) {
+      const auto eq = text.find('=');
+      const std::string kind = text.substr(0, eq);
+      if (eq == std::string::npos || (kind != "pid" && kind != "pd" && kind != "pd-tdc")) {
+        throw std::invalid_argument("--gains: expected KIND=OMEGA,ZETA[,THIRD] with KIND pid, pd or pd-tdc, got \"" +
+                                    text + "\"");
+      }
+      const std::vector<double> v = ParseNumberList("--gains", text.substr(eq + 1));
+      if (v.size() < 2 || v.size() > 4 || v[0] <= 0 || v[1] <= 0 || (v.size() >= 3 && v[2] <= 0) ||
+          (v.size() == 4 && v[3] < 0)) {
+        throw std::invalid_argument("--gains: expected 2 to 4 positive numbers after " + kind + "=");
+      }
+      drilling::ControllerParameters p = drilling::DefaultParameters(kind);
+      p.omega = v[0];
+      p.zeta = v[1];
+      if (v.size() >= 3) p.third = v[2];
+      if (v.size() == 4) p.filter_time_constant = v[3];
+      given[kind] = p;
+    }
+    std::vector<Run> runs;
+    drilling::SimOptions options;
+    options.motor_torque_limit = limit;
+    for (const std::string& kind : kinds) {
+      Run run;
+      run.parameters = given.count(kind) ? given[kind] : drilling::DefaultParameters(kind);
+      if (tune) {
+        std::cerr << kTool << ": tuning " << kind << " (" << tune_evaluations << " simulations)\n";
+        run.tune = drilling::TuneController(run.parameters, *sc, options, tune_evaluations);
+        run.parameters = run.tune.parameters;
+        run.tuned = true;
+      }
+      auto ctl = drilling::MakeController(run.parameters, *sc, limit);
+      ProgressLine progress(kTool, "simulating " + kind, sc->num_samples());
+      drilling::SimOptions o = options;
+      o.progress = [&](long done, long) { progress.Update(done); };
+      run.result = sc->Run(*ctl, o);
+      progress.Finish();
+      if (kind == "pd-tdc") {
+        const Eigen::VectorXd mbar = sc->effective_inertia().diagonal() * run.parameters.third;
+        run.tde_measure = drilling::TdeStabilityMeasure(sc->effective_inertia(), mbar);
+        if (!(run.tde_measure < 1.0)) {
+          Warn(kTool, "pd-tdc: the TDE stability condition ||I - M^-1 Mbar|| < 1 fails (" +
+                          io::FormatDouble(run.tde_measure) + "); lower the Mbar ratio");
+        }
+      }
+      runs.push_back(std::move(run));
+    }
+
+    // All runs done: write every output (each atomically).
+    int rc = kExitOk;
+    for (const Run& run : runs) {
+      const std::string kind = run.parameters.kind;
+      const nlohmann::json j = Summary(run, *sc, limit);
+      if (!out_path.empty()) io::WriteFileAtomically(WithSuffix(out_path, kind, several), SeriesCsv(run.result));
+      if (!summary_path.empty()) {
+        io::WriteFileAtomically(WithSuffix(summary_path, kind, several), j.dump(2) + "\n");
+      } else if (out_path.empty()) {
+        std::cout << j.dump(2) << "\n";
+      }
+    }
+    if (!plot_path.empty()) Plot(plot_path, runs, n);
+    for (const Run& run : runs) {
+      const drilling::SimResult& r = run.result;
+      std::ostringstream line;
+      line << run.parameters.kind << ": settling "
+           << (std::isnan(r.settling_time) ? std::string("never") : io::FormatDouble(r.settling_time) + " s")
+           << ", max |e| " << io::FormatDouble(RadToDeg(r.max_abs_error.maxCoeff()))
+           << " deg, last 10 % max |e| " << io::FormatDouble(RadToDeg(r.max_abs_error_last_10pc.maxCoeff()))
+           << " deg";
+      std::cerr << kTool << ": " << line.str() << "\n";
+      if (r.diverged) {
+        Warn(kTool, run.parameters.kind + ": the run left the 10 deg error range and was stopped");
+        rc = kExitFlagged;
+      }
+    }
+    return rc;
+  });
+}
+
+}  // namespace robomach::apps
+
+int main(int argc, char** argv) { return robomach::apps::RunDrillSim(argc, argv); }

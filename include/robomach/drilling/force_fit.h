@@ -1,0 +1,58 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "robomach/drilling/drill_forces.h"
+
+namespace robomach::drilling {
+
+/// One row of a measured thrust/torque table (formats.md §9.1), SI.
+struct ForceTableRow {
+  double diameter{0.0};      // D [m]
+  double feed_per_rev{0.0};  // f [m/rev]
+  double thrust{0.0};        // [N]
+  double torque{0.0};        // [N·m]
+};
+
+enum class FitStatus { kConverged, kNotConverged, kFailed };
+
+struct ForceFitOptions {
+  ChiselModel chisel{ChiselModel::kSeedScaling};
+  bool fit_kienzle_exponent{true};   // false: keep initial.kienzle_exponent
+  int max_iterations{200};
+  ForceModelOptions model;
+};
+
+struct ForceFitResult {
+  DrillingMaterial material;          // fitted coefficients
+  double std_dev_shear_stress_thrust{NAN};  // 1 sigma [Pa]
+  double std_dev_shear_stress_torque{NAN};  // 1 sigma [Pa]
+  double std_dev_kienzle_exponent{NAN};     // 1 sigma (0 if held)
+  std::vector<double> thrust_model;   // per row [N]
+  std::vector<double> torque_model;   // per row [N·m]
+  double max_rel_error_thrust{NAN};   // max |model - measured| / measured
+  double max_rel_error_torque{NAN};
+  double rms_rel_error{NAN};          // over all residuals
+  FitStatus status{FitStatus::kFailed};
+  std::string solver_message;         // ceres::Solver::Summary::BriefReport
+};
+
+/// Thrust and torque of the drill fully engaged, without tilt, at row `row`
+/// (its diameter replaces drill.diameter; the web and chisel scale with it).
+DrillForces PredictRow(const DrillGeometry& drill, const DrillingMaterial& material,
+                       const ForceTableRow& row, const ForceModelOptions& options = {});
+
+/// Fits K_TH, K_TQ and the Kienzle exponent m (DrillingMaterial) to the
+/// table by least squares on the relative errors
+/// (model - measured) / measured of thrust and torque (Ceres,
+/// central-difference Jacobians). The parameters are log K_TH, log K_TQ and
+/// m, so the shear stresses stay positive. Standard deviations come from the
+/// covariance at the solution scaled by the residual variance
+/// sigma^2 = sum r^2 / (2 n - p) (no measurement noise is given).
+/// @throws std::invalid_argument for fewer rows than parameters, or a
+///   non-positive or non-finite value in a row.
+ForceFitResult FitDrillingForces(const DrillGeometry& drill, const std::vector<ForceTableRow>& rows,
+                                 const ForceFitOptions& options = {});
+
+}  // namespace robomach::drilling

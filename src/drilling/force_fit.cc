@@ -1,0 +1,132 @@
+#include "robomach/drilling/force_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <ceres/ceres.h>
+
+namespace robomach::drilling {
+namespace {
+
+DrillingMaterial MaterialFromParameters(const DrillingMaterial& base, const double* x) {
+  DrillingMaterial m = base;
+  m.shear_stress_thrust = std::exp(x[0]);
+  m.shear_stress_torque = std::exp(x[1]);
+  m.kienzle_exponent = x[2];
+  return m;
+}
+
+// Residuals of one row: relative thrust and torque errors.
+struct RowResidual {
+  const DrillGeometry* drill;
+  const DrillingMaterial* base;
+  ForceTableRow row;
+  ForceModelOptions options;
+  bool operator()(const double* x, double* r) const {
+    if (!(x[2] > -0.5 && x[2] < 0.95)) return false;  // keep m in a physical range
+    const DrillForces f = PredictRow(*drill, MaterialFromParameters(*base, x), row, options);
+    r[0] = (f.thrust - row.thrust) / row.thrust;
+    r[1] = (f.torque - row.torque) / row.torque;
+    return true;
+  }
+};
+
+}  // namespace
+
+DrillForces PredictRow(const DrillGeometry& drill, const DrillingMaterial& material,
+                       const ForceTableRow& row, const ForceModelOptions& options) {
+  DrillGeometry d = drill;
+  d.diameter = row.diameter;
+  // Deep enough for full engagement: the point length is below D.
+  const DrillState st{.feed_per_rev = row.feed_per_rev, .penetration = 2.0 * row.diameter};
+  return ComputeDrillForces(d, material, st, options);
+}
+
+ForceFitResult FitDrillingForces(const DrillGeometry& drill, const std::vector<ForceTableRow>& rows,
+                                 const ForceFitOptions& options) {
+  const int n_par = options.fit_kienzle_exponent ? 3 : 2;
+  if (static_cast<int>(rows.size()) * 2 <= n_par) {
+    throw std::invalid_argument("force table: expected at least 2 rows to fit the coefficients");
+  }
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const ForceTableRow& r = rows[k];
+    for (double v : {r.diameter, r.feed_per_rev, r.thrust, r.torque}) {
+      if (!(std::isfinite(v) && v > 0.0)) {
+        throw std::invalid_argument("force table row " + std::to_string(k + 1) +
+                                    ": expected positive finite values");
+      }
+    }
+  }
+  DrillingMaterial base;
+  base.chisel = options.chisel;
+  base.kienzle_exponent = options.fit_kienzle_exponent ? 0.25 : base.kienzle_exponent;
+  // Start: K = 1 Pa gives forces proportional to K; scale to the data.
+  double x[3] = {0.0, 0.0, base.kienzle_exponent};
+  {
+    double st = 0.0, sq = 0.0;
+    for (const ForceTableRow& r : rows) {
+      const DrillForces f = PredictRow(drill, MaterialFromParameters(base, x), r, options.model);
+      st += std::log(r.thrust / f.thrust);
+      sq += std::log(r.torque / f.torque);
+    }
+    x[0] = st / rows.size();
+    x[1] = sq / rows.size();
+  }
+  ceres::Problem problem;
+  for (const ForceTableRow& r : rows) {
+    auto* cost = new ceres::NumericDiffCostFunction<RowResidual, ceres::CENTRAL, 2, 3>(
+        new RowResidual{&drill, &base, r, options.model});
+    problem.AddResidualBlock(cost, nullptr, x);
+  }
+  if (!options.fit_kienzle_exponent) {
+    problem.SetManifold(x, new ceres::SubsetManifold(3, {2}));
+  }
+  ceres::Solver::Options so;
+  so.max_num_iterations = options.max_iterations;
+  so.function_tolerance = 1e-12;
+  so.parameter_tolerance = 1e-12;
+  so.gradient_tolerance = 1e-14;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+
+  ForceFitResult out;
+  out.material = MaterialFromParameters(base, x);
+  out.solver_message = summary.BriefReport();
+  out.status = summary.termination_type == ceres::CONVERGENCE ? FitStatus::kConverged
+               : summary.IsSolutionUsable()                   ? FitStatus::kNotConverged
+                                                               : FitStatus::kFailed;
+  double ss = 0.0;
+  out.max_rel_error_thrust = out.max_rel_error_torque = 0.0;
+  for (const ForceTableRow& r : rows) {
+    const DrillForces f = PredictRow(drill, out.material, r, options.model);
+    out.thrust_model.push_back(f.thrust);
+    out.torque_model.push_back(f.torque);
+    const double et = (f.thrust - r.thrust) / r.thrust, eq = (f.torque - r.torque) / r.torque;
+    out.max_rel_error_thrust = std::max(out.max_rel_error_thrust, std::abs(et));
+    out.max_rel_error_torque = std::max(out.max_rel_error_torque, std::abs(eq));
+    ss += et * et + eq * eq;
+  }
+  const int n_res = 2 * static_cast<int>(rows.size());
+  out.rms_rel_error = std::sqrt(ss / n_res);
+  // Covariance of (log K_TH, log K_TQ, m), scaled by the residual variance.
+  const int dof = n_res - n_par;
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  co.null_space_rank = -1;
+  ceres::Covariance cov(co);
+  std::vector<std::pair<const double*, const double*>> blocks{{x, x}};
+  if (dof > 0 && cov.Compute(blocks, &problem)) {
+    double C[9];
+    cov.GetCovarianceBlock(x, x, C);
+    const double s2 = ss / dof;
+    out.std_dev_shear_stress_thrust = out.material.shear_stress_thrust * std::sqrt(s2 * C[0]);
+    out.std_dev_shear_stress_torque = out.material.shear_stress_torque * std::sqrt(s2 * C[4]);
+    out.std_dev_kienzle_exponent =
+        options.fit_kienzle_exponent ? std::sqrt(std::max(0.0, s2 * C[8])) : 0.0;
+  }
+  return out;
+}
+
+}  // namespace robomach::drilling
