@@ -13,7 +13,7 @@ namespace robomach::polishing {
 namespace {
 
 constexpr double kRatioMin = 0.5, kRatioMax = 1.0;        // r / d
-constexpr double kPitchMin = 0.1, kPitchMax = kPi;        // pitch / r
+constexpr double kPitchMin = 0.5, kPitchMax = kPi;        // pitch / r
 
 PathParameters FromUnit(const std::vector<double>& x, const PathParameters& base, const OptimiseOptions& o) {
   PathParameters p = base;

@@ -13,8 +13,9 @@
 //    iterations, stopping after 30 without an improvement beyond 0.001,
 //    fixed random seed.
 // Variables: d in [offset_min, offset_max], r/d in [0.5, 1] (seed limit 3,
-// implies d <= 2r), pitch/r in [0.1, pi] (seed limit 2: v < omega r means
-// pitch < 2 pi r; pi keeps clear loops).
+// implies d <= 2r), pitch/r in [0.5, pi] (seed limit 2: v < omega r means
+// pitch < 2 pi r; pi keeps clear loops; the lower bound keeps the path, and
+// the polishing time, within ~4 pi region-area / d).
 
 #include <functional>
 #include <string>
@@ -29,8 +30,8 @@ enum class Optimiser { kNlopt, kPso };
 struct OptimiseOptions {
   Optimiser method{Optimiser::kNlopt};
   double offset_min{0.004}, offset_max{0.030};  // [m]
-  int global_evaluations{60};   // NLopt DIRECT-L budget
-  int local_evaluations{40};    // NLopt Subplex budget
+  int global_evaluations{40};   // NLopt DIRECT-L budget
+  int local_evaluations{30};    // NLopt Subplex budget
   int pso_particles{10};
   int pso_max_iterations{100};
   int pso_stall_iterations{30};
