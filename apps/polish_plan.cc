@@ -139,7 +139,7 @@ int Run(int argc, char** argv) {
     } catch (const std::domain_error& e) {
       throw InputError({surface_path, 0, 0}, std::string("at the centre of the region: ") + e.what());
     }
-    const double cell = 2.0 * contact_width / 2.0;
+    const double cell = 0.5 * contact_width;  // index cell ~ the contact semi-axis
     const polishing::RemovalSimulator sim(surface, process, grid.points(), grid.normals(), cell);
 
     polishing::PathParameters params;

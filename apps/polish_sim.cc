@@ -74,7 +74,7 @@ int Run(int argc, char** argv) {
     std::vector<double> removal;
     try {
       polishing::AttachToSurface(surface, grid, process.flip_normal, &file.rows);
-      const polishing::RemovalSimulator sim(surface, process, grid.points(), grid.normals(), 0.002);
+      const polishing::RemovalSimulator sim(surface, process, grid.points(), grid.normals(), 0.0015);
       removal = sim.Simulate(file.rows);
     } catch (const polishing::PathRowError& e) {
       throw row_error(e);

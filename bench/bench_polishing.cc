@@ -64,7 +64,7 @@ const Setup& GetSetup() {
 
 void BM_Simulate100kRows150x100mm(benchmark::State& state) {
   const Setup& s = GetSetup();
-  const RemovalSimulator sim(s.plane, s.process, s.grid.points(), s.grid.normals(), 0.003);
+  const RemovalSimulator sim(s.plane, s.process, s.grid.points(), s.grid.normals(), 0.0015);
   for (auto _ : state) {
     std::vector<double> h = sim.Simulate(s.path);
     benchmark::DoNotOptimize(h.data());

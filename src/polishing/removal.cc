@@ -91,10 +91,42 @@ RemovalSimulator::RemovalSimulator(const NurbsSurface& surface, const PolishingP
 
 std::vector<ToolContact> RemovalSimulator::Contacts(const std::vector<PathRow>& path) const {
   std::vector<ToolContact> contacts(path.size());
+  // Consecutive rows with the same relative curvature and force (planes,
+  // cylinders along a generator, ...) share their ellipse: the elliptic
+  // integrals are the cost of a contact.
+  Eigen::Matrix2d last_K = Eigen::Matrix2d::Constant(std::nan(""));
+  double last_force = -1.0;
+  ContactEllipse last;
+  const double e_star = EffectiveModulus(process_);
   for (size_t r = 0; r < path.size(); ++r) {
     try {
       const SurfaceDerivatives d = surface_->Evaluate(path[r].u, path[r].v);
-      contacts[r] = ContactAt(d, path[r].tx, process_, path[r].force > 0 ? path[r].force : process_.force);
+      const double force = path[r].force > 0 ? path[r].force : process_.force;
+      ToolContact& c = contacts[r];
+      c.p = d.S;
+      c.n = UnitNormal(d, process_.flip_normal);
+      const Eigen::Vector3d tx = (path[r].tx - path[r].tx.dot(c.n) * c.n).normalized();
+      const Eigen::Vector3d ty = c.n.cross(tx);
+      Eigen::Matrix2d K = CurvatureTensor(d, tx, ty, process_.flip_normal);
+      K(0, 0) += 1.0 / process_.wheel_radius;
+      K(1, 1) += 1.0 / process_.crown_radius;
+      if (!(K == last_K && force == last_force)) {
+        last = HertzContact(K, force, e_star);
+        last_K = K;
+        last_force = force;
+      }
+      c.a = last.a;
+      c.b = last.b;
+      c.p0 = last.p0;
+      c.e_a = last.dir_a(0) * tx + last.dir_a(1) * ty;
+      c.e_b = last.dir_b(0) * tx + last.dir_b(1) * ty;
+      const double half_width = std::hypot(last.a * last.dir_a(1), last.b * last.dir_b(1));
+      if (2.0 * half_width > process_.belt_width) {
+        std::ostringstream m;
+        m << "contact width " << 2e3 * half_width << " mm across the belt exceeds belt_width_mm "
+          << 1e3 * process_.belt_width;
+        throw std::domain_error(m.str());
+      }
     } catch (const std::domain_error& e) {
       throw PathRowError(static_cast<int>(r), e.what());
     }
@@ -129,6 +161,7 @@ std::vector<double> RemovalSimulator::Simulate(const std::vector<PathRow>& path,
     const int z1 = std::min(nz_ - 1, static_cast<int>(std::floor((hi.z() - origin_.z()) / cell_)));
     if (x0 > x1 || y0 > y1 || z0 > z1) continue;
     const Eigen::Vector2d beta(d.dot(c.e_a) / c.a, d.dot(c.e_b) / c.b);
+    const double bb = beta.squaredNorm();
     for (int iz = z0; iz <= z1; ++iz) {
       for (int iy = y0; iy <= y1; ++iy) {
         const int row = (iz * ny_ + iy) * nx_;
@@ -138,6 +171,9 @@ std::vector<double> RemovalSimulator::Simulate(const std::vector<PathRow>& path,
           // Only the side the tool is on, within the contact's reach normal to it.
           if (std::abs(q.dot(c.n)) > reach || normals_[idx].dot(c.n) <= 0.0) continue;
           const Eigen::Vector2d alpha(q.dot(c.e_a) / c.a, q.dot(c.e_b) / c.b);
+          // Cheap rejection: farther than 1 (elliptic units) from the segment's line.
+          const double cross = alpha.x() * beta.y() - alpha.y() * beta.x();
+          if (cross * cross >= bb && bb > 1e-24) continue;
           const double I = SegmentPressureIntegral(alpha, beta);
           if (I > 0.0) h[idx] += scale * I;
         }
