@@ -169,16 +169,17 @@ int Run(int argc, char** argv) {
       if (params.pattern == polishing::Pattern::kParallel) {
         // One parameter, the row spacing: golden section on [0.3, 1.5] contact widths.
         int evals = 0;
-        auto f = [&](double w) {
+        // In units of contact widths, so the bracket tolerance (1e-3) is relative.
+        auto f = [&](double w_rel) {
           polishing::PathParameters p = base;
-          p.offset = w;
+          p.offset = w_rel * contact_width;
           const double cv = objective(p);
           history.push_back(history.empty() ? cv : std::min(history.back(), cv));
           progress.Update(++evals);
           return -cv;
         };
-        const auto [w, fw] = GoldenSectionMaximum(f, 0.3 * contact_width, 1.5 * contact_width, 25, 1e-3);
-        params.offset = w;
+        const auto [w, fw] = GoldenSectionMaximum(f, 0.3, 1.5, 25, 1e-3);
+        params.offset = w * contact_width;
         opt_json = {{"method", "golden-section search of the row spacing on [0.3, 1.5] contact widths"},
                     {"evaluations", evals}, {"best_cv", -fw}, {"status", "converged"}};
       } else {
