@@ -165,7 +165,12 @@ int Run(int argc, char** argv) {
           return 1e6;  // outside the feasibility limits
         }
       };
-      ProgressLine progress(kTool, "optimising (evaluations/iterations)", optimise == "pso" ? 100 : 100);
+      polishing::OptimiseOptions defaults;
+      ProgressLine progress(kTool, optimise == "pso" ? "PSO iterations" : "optimiser evaluations",
+                            optimise == "pso" ? defaults.pso_max_iterations
+                            : params.pattern == polishing::Pattern::kParallel
+                                ? 27
+                                : defaults.global_evaluations + defaults.local_evaluations);
       if (params.pattern == polishing::Pattern::kParallel) {
         // One parameter, the row spacing: golden section on [0.3, 1.5] contact widths.
         int evals = 0;
@@ -188,7 +193,7 @@ int Run(int argc, char** argv) {
         oo.offset_min = std::max(contact_width, MmToM(2.0));  // rows closer than a contact width only lengthen the path
         oo.offset_max = std::max(oo.offset_min * 1.5, MmToM(opt_offset_max_mm));
         oo.seed = static_cast<unsigned>(seed);
-        oo.progress = [&](int n, double) { progress.Update(std::min(n, 100)); };
+        oo.progress = [&](int n, double) { progress.Update(n); };
         if (params.offset < oo.offset_min || params.offset > oo.offset_max) params.offset = std::clamp(params.offset, oo.offset_min, oo.offset_max);
         const polishing::OptimiseResult r = polishing::OptimiseCycloid(objective, base, oo);
         params.offset = r.best.offset;

@@ -165,5 +165,22 @@ TEST(Removal, RejectsNonIncreasingTimeNamingTheRow) {
   }
 }
 
+
+// formats.md §7: a contact wider than the belt is an error naming the row.
+TEST(Removal, ContactWiderThanTheBeltIsAnError) {
+  const NurbsSurface plane = testing::Plane(0.1, 0.06);
+  PolishingProcess proc;
+  proc.belt_width = 0.002;  // the demo contact is ~7 mm wide on a plane
+  const RemovalSimulator sim(plane, proc, {Eigen::Vector3d(0.05, 0.03, 0)}, {Eigen::Vector3d::UnitZ()}, 0.002);
+  const auto path = StraightPass({0.01, 0.03, 0}, {0.09, 0.03, 0}, 0.02, 3, {0.1, 0.06});
+  try {
+    sim.Simulate(path);
+    FAIL();
+  } catch (const PathRowError& e) {
+    EXPECT_EQ(e.row(), 0);
+    EXPECT_NE(std::string(e.what()).find("exceeds belt_width_mm 2"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace robomach::polishing
