@@ -38,3 +38,33 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
 std::vector<std::string> PicturePaths(const std::string& png, bool with_convergence);
 
 }  // namespace robomach::apps
+
+namespace robomach::dynamics {
+class RobotModel;
+}
+
+namespace robomach::apps {
+
+/// Executability of a path on a robot (issue 11 "on the robot"): the part
+/// frame P placed in the robot base B, each row's contact frame C (z = the
+/// surface normal towards the tool, x = tool x) in B, the flange pose
+/// X_BF = X_BP X_PC X_FC^-1 with the process's contact frame in the flange,
+/// and the inverse kinematics of the arm (KDL LMA, seeded from the previous
+/// row, the first row from `seed`).
+struct RobotCheck {
+  std::vector<Eigen::VectorXd> q;       // [rad]; empty where unreachable
+  std::vector<char> reachable;
+  std::vector<double> limit_margin;     // smallest distance to a joint limit [rad] (< 0: outside)
+  std::vector<double> condition;        // condition number of the 6 x n Jacobian
+  int num_unreachable{0}, num_outside_limits{0}, num_jumps{0}, first_bad_row{-1};
+  double min_limit_margin{1e300}, max_condition{0.0};
+};
+RobotCheck CheckOnRobot(const dynamics::RobotModel& model, const Eigen::Isometry3d& X_BP,
+                        const Eigen::Isometry3d& X_FC, const std::vector<polishing::PathRow>& rows,
+                        const Eigen::VectorXd& seed);
+
+/// Joint trajectory CSV: t_s,q1_deg..qn_deg,reachable,limit_margin_deg,jacobian_condition.
+void WriteJointTrajectory(const std::string& path, const std::vector<polishing::PathRow>& rows,
+                          const RobotCheck& check, int num_joints);
+
+}  // namespace robomach::apps

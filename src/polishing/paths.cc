@@ -153,6 +153,13 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
       sense.push_back(k % 2 == 0 ? 1 : -1);
     }
   }
+  // Tool x along the guide line (seed eq. 16) with one sign for all the
+  // parallel lines: the belt keeps running the same way and the wrist does
+  // not turn half a revolution at every row end.
+  const bool parallel_lines = !(cyc && params.guides == GuideLines::kBoundaryOffsets);
+  auto tool_dir = [&](const Vec2& tangent) {
+    return (parallel_lines && tangent.x() < 0) ? Vec2(-tangent) : tangent;
+  };
 
   PlannedPath out;
   std::vector<double> t;
@@ -164,7 +171,7 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
     for (const Vec2& p : guide.pts) line.push_back(m.Point(p));
     out.guide_lines.push_back(line);
     if (!cyc) {
-      const Vec2 dir = guide.Tangent(0.0);
+      const Vec2 dir = tool_dir(guide.Tangent(0.0));
       if (!out.rows.empty()) StraightMove(m, last_st, guide.pts.front(), dir, vmax, params.row_step, false, &out.rows, &t);
       StraightMove(m, guide.pts.front(), guide.pts.back(), dir, vmax, params.row_step, out.rows.empty(), &out.rows, &t);
       last_st = guide.pts.back();
@@ -185,7 +192,7 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
     for (int i = 0; i <= n; ++i) {
       const double phi = phi_end * i / n;
       const Vec2 st = point(phi);
-      const Vec2 tan = guide.Tangent(pitch * phi / (2 * kPi));
+      const Vec2 tan = tool_dir(guide.Tangent(pitch * phi / (2 * kPi)));
       if (i == 0) {
         if (out.rows.empty()) {
           out.rows.push_back(m.Row(st, tan));

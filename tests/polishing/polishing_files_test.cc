@@ -24,6 +24,9 @@ TEST(PolishingFiles, ReadsTheDemoPatchAndProcess) {
   EXPECT_DOUBLE_EQ(p.belt_speed, 3.0);
   EXPECT_DOUBLE_EQ(p.pad_modulus, 10e6);
   EXPECT_DOUBLE_EQ(p.max_speed, 0.050);
+  // robot.contact_frame_in_flange_mm_deg [0, 0, 250, 180, 0, 0] = the default.
+  EXPECT_NEAR(p.p_FC.z(), 0.25, 1e-15);
+  EXPECT_TRUE(p.R_FC.isApprox(polishing::PolishingProcess{}.R_FC, 1e-12));
 }
 
 TEST(PolishingFiles, BadPatchesGetFileLineColumn) {

@@ -29,9 +29,10 @@ struct PolishingProcess {
   bool flip_normal{false};
   /// Contact frame C (tool frame at the contact point: z = surface normal
   /// towards the tool, x = belt direction) in the robot flange F: p_FC [m],
-  /// R_FC. Only used with --robot.
+  /// R_FC. Only used with --robot. Default: the contact 250 mm along the
+  /// flange z axis, C's z pointing back at the flange (180 deg about x).
   Eigen::Vector3d p_FC{0.0, 0.0, 0.25};
-  Eigen::Matrix3d R_FC{Eigen::Matrix3d::Identity()};
+  Eigen::Matrix3d R_FC{Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal()};
 };
 
 /// @throws std::invalid_argument naming the field, its value and the bound.
