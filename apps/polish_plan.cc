@@ -70,7 +70,7 @@ int Run(int argc, char** argv) {
                                           removal_out, summary_out, plot_out;
   int face = 0;
   double target_um = 0.0, offset_mm = 8.0, radius_mm = 6.0, pitch_mm = 3.0, sample_mm = 0.5, row_step_mm = 0.5;
-  double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0;
+  double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 1.0;
   int seed = 20240404;
   std::string robot_path, part_frame_text = "0,0,0,0,0,0", joints_out, robot_seed_text = "0,-90,90,0,45,0";
   app.add_option("--surface", surface_path, "NURBS patch YAML (formats.md §5)")->required();
@@ -89,6 +89,9 @@ int Run(int argc, char** argv) {
   app.add_option("--row-step-mm", row_step_mm, "largest distance between path rows [mm]")->capture_default_str();
   app.add_option("--opt-sample-mm", opt_sample_mm, "sampling used inside the optimiser [mm]")->capture_default_str();
   app.add_option("--opt-offset-max-mm", opt_offset_max_mm, "largest guide-line spacing the optimiser tries [mm]")->capture_default_str();
+  app.add_option("--opt-offset-min-contact-widths", opt_offset_min_cw,
+                 "smallest guide-line spacing the optimiser tries, in contact widths (closer rows lengthen the path)")
+      ->capture_default_str();
   app.add_option("--seed", seed, "PSO random seed")->capture_default_str();
   app.add_option("--robot", robot_path, "robot config YAML: solve the IK of every tool frame, flag unreachable rows, "
                  "joint-limit and singularity margins");
@@ -116,6 +119,7 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--radius-mm", radius_mm, 0.05, 1000);
     CheckOptionRange("--pitch-mm", pitch_mm, 0.01, 1000);
     CheckOptionRange("--opt-offset-max-mm", opt_offset_max_mm, 1.0, 1000);
+    CheckOptionRange("--opt-offset-min-contact-widths", opt_offset_min_cw, 0.2, 10.0);
     if (optimise != "none" && pattern == "parallel" && optimise == "pso") {
       throw std::invalid_argument("--optimise pso applies to the cycloid; the parallel pattern is optimised with --optimise nlopt");
     }
@@ -211,7 +215,7 @@ int Run(int argc, char** argv) {
       } else {
         polishing::OptimiseOptions oo;
         oo.method = optimise == "nlopt" ? polishing::Optimiser::kNlopt : polishing::Optimiser::kPso;
-        oo.offset_min = std::max(contact_width, MmToM(2.0));  // rows closer than a contact width only lengthen the path
+        oo.offset_min = std::max(opt_offset_min_cw * contact_width, MmToM(0.5));
         oo.offset_max = std::max(oo.offset_min * 1.5, MmToM(opt_offset_max_mm));
         oo.seed = static_cast<unsigned>(seed);
         oo.progress = [&](int n, double) { progress.Update(n); };
