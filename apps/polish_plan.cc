@@ -1,0 +1,321 @@
+// polish-plan: a polishing path (cycloid along guide lines, or the parallel
+// zig-zag) on a NURBS patch, optionally optimised (NLopt or the seed's PSO)
+// for uniform removal, with time stamps that reach a target mean removal
+// within the speed limit; writes the path, the removal map, a summary and
+// pictures (seed 004; formats.md §5-7).
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <iostream>
+#include <optional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_support.h"
+#include "polish_support.h"
+#include "robomach/common/errors.h"
+#include "robomach/common/golden_section.h"
+#include "robomach/common/units.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/number_format.h"
+#include "robomach/io/polishing_files.h"
+#include "robomach/io/robot_config.h"
+#include "robomach/dynamics/robot_model.h"
+#include "robomach/polishing/optimise.h"
+#include "robomach/polishing/paths.h"
+#include "robomach/polishing/removal.h"
+
+namespace robomach::apps {
+namespace {
+
+constexpr char kTool[] = "polish-plan";
+
+struct Evaluated {
+  polishing::PlannedPath path;
+  std::vector<double> removal;
+  polishing::RemovalStats stats;
+};
+
+// Plans and simulates; a contact that fails at a row becomes an InputError
+// on the surface file naming the row and its position.
+Evaluated Evaluate(const polishing::NurbsSurface& surface, const polishing::SampleGrid& grid,
+                   const polishing::RemovalSimulator& sim, const polishing::PathParameters& params,
+                   const polishing::PolishingProcess& process, const std::string& surface_path) {
+  Evaluated e;
+  e.path = polishing::PlanPath(surface, grid, params, process);
+  try {
+    e.removal = sim.Simulate(e.path.rows);
+  } catch (const polishing::PathRowError& err) {
+    const auto& r = e.path.rows[err.row()];
+    std::ostringstream m;
+    m << "planned path row " << err.row() + 1 << " at (" << 1e3 * r.p.x() << ", " << 1e3 * r.p.y() << ", "
+      << 1e3 * r.p.z() << ") mm (u " << r.u << ", v " << r.v << "): " << err.what();
+    throw InputError({surface_path, 0, 0}, m.str());
+  }
+  e.stats = polishing::ComputeRemovalStats(e.removal, grid.areas(), grid.in_region());
+  return e;
+}
+
+int Run(int argc, char** argv) {
+  CLI::App app{
+      "polish-plan: a belt-grinding path on a NURBS patch (formats.md §5) - cycloids along guide lines\n"
+      "(seed 004) or the direction-parallel zig-zag - with Hertz contact and Preston removal, optionally\n"
+      "optimised for uniform removal (--optimise nlopt|pso), timed so that the mean removal over the\n"
+      "polished region equals --target-removal-um within max_speed_mm_per_s. Writes the path (formats.md §6),\n"
+      "the removal map and summary (§7) and PNG pictures (removal map, histogram, path, convergence)."};
+  app.footer(ExitCodeHelp() + "\nExit 3: the target removal cannot be reached within the speed limit "
+                              "(outputs written at the limit).");
+  std::string surface_path, process_path, pattern = "cycloid", guides = "offsets", optimise = "none", path_out,
+                                          removal_out, summary_out, plot_out;
+  int face = 0;
+  double target_um = 0.0, offset_mm = 8.0, radius_mm = 6.0, pitch_mm = 3.0, sample_mm = 0.5, row_step_mm = 0.5;
+  double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 1.0;
+  int seed = 20240404;
+  std::string robot_path, part_frame_text = "0,0,0,0,0,0", joints_out, robot_seed_text = "0,-90,90,0,45,0";
+  app.add_option("--surface", surface_path, "NURBS patch YAML (formats.md §5)")->required();
+  app.add_option("--face", face, "face of a STEP/IGES file (1-based); CAD input not built yet");
+  app.add_option("--process", process_path, "process YAML (formats.md §7), e.g. config/polishing/belt_2N.yaml")->required();
+  app.add_option("--pattern", pattern, "cycloid or parallel")->check(CLI::IsMember({"cycloid", "parallel"}))->capture_default_str();
+  app.add_option("--guides", guides, "cycloid guide lines: offsets (of the region boundary, closed loops) or parallel")
+      ->check(CLI::IsMember({"offsets", "parallel"}))->capture_default_str();
+  app.add_option("--optimise", optimise, "none, nlopt (DIRECT-L then Subplex) or pso (seed eq. 18)")
+      ->check(CLI::IsMember({"none", "nlopt", "pso"}))->capture_default_str();
+  app.add_option("--target-removal-um", target_um, "mean removal over the region [um]; sets the speed (0: run at max speed)")->capture_default_str();
+  app.add_option("--offset-mm", offset_mm, "guide-line spacing d [mm] (parallel pattern: row spacing; default there: one contact width)");
+  app.add_option("--radius-mm", radius_mm, "cycloid radius r [mm]")->capture_default_str();
+  app.add_option("--pitch-mm", pitch_mm, "advance of the cycloid centre per loop [mm] (= 2 pi v / omega)")->capture_default_str();
+  app.add_option("--sample-mm", sample_mm, "removal map sampling in arc length [mm], <= 0.5")->capture_default_str();
+  app.add_option("--row-step-mm", row_step_mm, "largest distance between path rows [mm]")->capture_default_str();
+  app.add_option("--opt-sample-mm", opt_sample_mm, "sampling used inside the optimiser [mm]")->capture_default_str();
+  app.add_option("--opt-offset-max-mm", opt_offset_max_mm, "largest guide-line spacing the optimiser tries [mm]")->capture_default_str();
+  app.add_option("--opt-offset-min-contact-widths", opt_offset_min_cw,
+                 "smallest guide-line spacing the optimiser tries, in contact widths (closer rows lengthen the path)")
+      ->capture_default_str();
+  app.add_option("--seed", seed, "PSO random seed")->capture_default_str();
+  app.add_option("--robot", robot_path, "robot config YAML: solve the IK of every tool frame, flag unreachable rows, "
+                 "joint-limit and singularity margins");
+  app.add_option("--part-frame-mm-deg", part_frame_text, "with --robot: the surface's frame in the robot base, "
+                 "x,y,z [mm], rx,ry,rz [deg] (fixed axes x, y, z)")->capture_default_str();
+  app.add_option("--robot-seed-deg", robot_seed_text, "with --robot: IK start of the first row [deg]")->capture_default_str();
+  app.add_option("--joints", joints_out, "with --robot: joint trajectory CSV t_s,q1_deg..,reachable,limit_margin_deg,jacobian_condition");
+  app.add_option("--path", path_out, "tool path CSV (formats.md §6)");
+  app.add_option("--removal", removal_out, "removal map CSV x_mm,y_mm,z_mm,u,v,removal_um");
+  app.add_option("--summary", summary_out, "summary JSON (formats.md §7 + contact, optimisation, target)");
+  app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png, <stem>_path.png, <stem>_convergence.png");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  const bool offset_given = app.count("--offset-mm") > 0;
+
+  return RunGuarded(kTool, [&]() -> int {
+    CheckOptionRange("--sample-mm", sample_mm, 0.05, 0.5);
+    CheckOptionRange("--row-step-mm", row_step_mm, 0.05, 5.0);
+    CheckOptionRange("--opt-sample-mm", opt_sample_mm, 0.1, 5.0);
+    CheckOptionRange("--target-removal-um", target_um, 0.0, 1e6);
+    CheckOptionRange("--offset-mm", offset_mm, 0.1, 1000);
+    CheckOptionRange("--radius-mm", radius_mm, 0.05, 1000);
+    CheckOptionRange("--pitch-mm", pitch_mm, 0.01, 1000);
+    CheckOptionRange("--opt-offset-max-mm", opt_offset_max_mm, 1.0, 1000);
+    CheckOptionRange("--opt-offset-min-contact-widths", opt_offset_min_cw, 0.2, 10.0);
+    if (optimise != "none" && pattern == "parallel" && optimise == "pso") {
+      throw std::invalid_argument("--optimise pso applies to the cycloid; the parallel pattern is optimised with --optimise nlopt");
+    }
+    RequireReadableFile(surface_path, "surface");
+    RequireReadableFile(process_path, "process file");
+    std::vector<std::pair<std::string, std::string>> outs = {
+        {"--path", path_out}, {"--removal", removal_out}, {"--summary", summary_out}, {"--joints", joints_out}};
+    if (!joints_out.empty() && robot_path.empty()) throw std::invalid_argument("--joints needs --robot");
+    const std::vector<double> part = ParseNumberList("--part-frame-mm-deg", part_frame_text);
+    const std::vector<double> robot_seed = ParseNumberList("--robot-seed-deg", robot_seed_text);
+    if (part.size() != 6) throw std::invalid_argument("--part-frame-mm-deg: expected x,y,z,rx,ry,rz (6 numbers)");
+    if (!robot_path.empty()) RequireReadableFile(robot_path, "robot config");
+    if (!plot_out.empty()) {
+      for (const auto& p : PicturePaths(plot_out, optimise != "none")) outs.push_back({"--plot", p});
+    }
+    CheckDistinctPaths({{"--surface", surface_path}, {"--process", process_path}, {"--robot", robot_path}}, outs);
+    std::shared_ptr<const dynamics::RobotModel> robot;
+    if (!robot_path.empty()) {
+      robot = io::LoadRobotConfig(robot_path).Build();
+      if (static_cast<int>(robot_seed.size()) != robot->num_joints()) {
+        throw std::invalid_argument("--robot-seed-deg: expected " + std::to_string(robot->num_joints()) + " angles");
+      }
+    }
+
+    const polishing::NurbsSurface surface = LoadSurface(surface_path, face);
+    const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
+    auto build_grid = [&](double spacing) {
+      try {
+        return polishing::SampleGrid::Build(surface, MmToM(spacing), process.margin, process.flip_normal);
+      } catch (const std::domain_error& e) {
+        throw InputError({surface_path, 0, 0}, e.what());
+      }
+    };
+    const polishing::SampleGrid grid = build_grid(sample_mm);
+    if (grid.num_in_region() == 0) {
+      throw InputError({process_path, 0, 0}, "process.margin_mm " + io::FormatDouble(1e3 * process.margin) +
+                                                 " leaves no polished region on the patch");
+    }
+    double contact_width = 0;
+    try {
+      contact_width = polishing::ContactWidthAtCentre(surface, grid, process);
+    } catch (const std::domain_error& e) {
+      throw InputError({surface_path, 0, 0}, std::string("at the centre of the region: ") + e.what());
+    }
+    const double cell = 0.5 * contact_width;  // index cell ~ the contact semi-axis
+    const polishing::RemovalSimulator sim(surface, process, grid.points(), grid.normals(), cell);
+
+    polishing::PathParameters params;
+    params.pattern = pattern == "cycloid" ? polishing::Pattern::kCycloid : polishing::Pattern::kParallel;
+    params.guides = guides == "offsets" ? polishing::GuideLines::kBoundaryOffsets : polishing::GuideLines::kParallelLines;
+    params.offset = params.pattern == polishing::Pattern::kParallel && !offset_given ? contact_width : MmToM(offset_mm);
+    params.radius = MmToM(radius_mm);
+    params.pitch = MmToM(pitch_mm);
+    params.row_step = MmToM(row_step_mm);
+    polishing::CheckValid(params);  // std::invalid_argument -> exit 64, naming the limit
+
+    nlohmann::json opt_json;
+    std::vector<double> history;
+    if (optimise != "none") {
+      const polishing::SampleGrid coarse = build_grid(opt_sample_mm);
+      const polishing::RemovalSimulator coarse_sim(surface, process, coarse.points(), coarse.normals(), cell);
+      polishing::PathParameters base = params;
+      base.row_step = std::max(params.row_step, MmToM(opt_sample_mm));
+      auto objective = [&](const polishing::PathParameters& p) {
+        try {
+          return Evaluate(surface, coarse, coarse_sim, p, process, surface_path).stats.cv;
+        } catch (const std::invalid_argument&) {
+          return 1e6;  // outside the feasibility limits
+        }
+      };
+      polishing::OptimiseOptions defaults;
+      ProgressLine progress(kTool, optimise == "pso" ? "PSO iterations" : "optimiser evaluations",
+                            optimise == "pso" ? defaults.pso_max_iterations
+                            : params.pattern == polishing::Pattern::kParallel
+                                ? 27
+                                : defaults.global_evaluations + defaults.local_evaluations);
+      if (params.pattern == polishing::Pattern::kParallel) {
+        // One parameter, the row spacing: golden section on [0.3, 1.5] contact widths.
+        int evals = 0;
+        // In units of contact widths, so the bracket tolerance (1e-3) is relative.
+        auto f = [&](double w_rel) {
+          polishing::PathParameters p = base;
+          p.offset = w_rel * contact_width;
+          const double cv = objective(p);
+          history.push_back(history.empty() ? cv : std::min(history.back(), cv));
+          progress.Update(++evals);
+          return -cv;
+        };
+        const auto [w, fw] = GoldenSectionMaximum(f, 0.3, 1.5, 25, 1e-3);
+        params.offset = w * contact_width;
+        opt_json = {{"method", "golden-section search of the row spacing on [0.3, 1.5] contact widths"},
+                    {"evaluations", evals}, {"best_cv", -fw}, {"status", "converged"}};
+      } else {
+        polishing::OptimiseOptions oo;
+        oo.method = optimise == "nlopt" ? polishing::Optimiser::kNlopt : polishing::Optimiser::kPso;
+        oo.offset_min = std::max(opt_offset_min_cw * contact_width, MmToM(0.5));
+        oo.offset_max = std::max(oo.offset_min * 1.5, MmToM(opt_offset_max_mm));
+        oo.seed = static_cast<unsigned>(seed);
+        oo.progress = [&](int n, double) { progress.Update(n); };
+        if (params.offset < oo.offset_min || params.offset > oo.offset_max) params.offset = std::clamp(params.offset, oo.offset_min, oo.offset_max);
+        const polishing::OptimiseResult r = polishing::OptimiseCycloid(objective, base, oo);
+        params.offset = r.best.offset;
+        params.radius = r.best.radius;
+        params.pitch = r.best.pitch;
+        history = r.history;
+        opt_json = {{"method", r.method}, {"evaluations", r.evaluations}, {"best_cv", r.best_value},
+                    {"status", r.status}, {"sample_mm", opt_sample_mm},
+                    {"bounds", {{"offset_mm", {1e3 * oo.offset_min, 1e3 * oo.offset_max}},
+                                {"radius_over_offset", {0.5, 1.0}}, {"pitch_over_radius", {0.5, kPi}}}}};
+      }
+      progress.Finish();
+      opt_json["history"] = history;
+    }
+
+    Evaluated e = Evaluate(surface, grid, sim, params, process, surface_path);
+    nlohmann::json target_json;
+    bool flagged = false;
+    if (target_um > 0) {
+      const polishing::TargetResult t =
+          polishing::ScaleToTargetRemoval(sim, grid, target_um * 1e-6, process.max_speed, &e.path);
+      e.removal = t.removal;
+      e.stats = polishing::ComputeRemovalStats(e.removal, grid.areas(), grid.in_region());
+      target_json = {{"removal_um", target_um}, {"reached", t.reached}};
+      if (!t.reached) {
+        flagged = true;
+        target_json["message"] = t.message;
+        Warn(kTool, t.message);
+      }
+    }
+    const bool cyc = params.pattern == polishing::Pattern::kCycloid;
+    nlohmann::json summary;
+    summary["removal_um"] = RemovalJson(e.stats);
+    summary["path"] = PathJson(e.path.rows);
+    summary["parameters"] = {{"pattern", pattern},
+                             {"guides", cyc ? guides : "parallel"},
+                             {"offset_mm", 1e3 * params.offset},
+                             {"radius_mm", cyc ? 1e3 * params.radius : 0.0},
+                             {"pitch_mm", cyc ? 1e3 * params.pitch : 0.0},
+                             {"omega_rad_per_s", cyc ? e.path.omega_rad_per_s : 0.0},
+                             {"centre_speed_mm_per_s", cyc ? 1e3 * e.path.centre_speed : 0.0}};
+    summary["region"] = {{"sample_mm", sample_mm}, {"points", grid.num_in_region()}, {"margin_mm", 1e3 * process.margin}};
+    summary["contact"] = {{"width_across_mm", 1e3 * contact_width}};
+    if (!target_json.is_null()) summary["target"] = target_json;
+    if (!opt_json.is_null()) summary["optimisation"] = opt_json;
+    if (e.stats.coverage < 0.99) {
+      Warn(kTool, "coverage " + io::FormatDouble(e.stats.coverage) + " < 0.99: parts of the region are barely polished");
+    }
+
+    RobotCheck robot_check;
+    if (robot) {
+      Eigen::Isometry3d X_BP = Eigen::Isometry3d::Identity();
+      X_BP.translation() = Eigen::Vector3d(part[0], part[1], part[2]) * 1e-3;
+      X_BP.linear() = (Eigen::AngleAxisd(DegToRad(part[5]), Eigen::Vector3d::UnitZ()) *
+                       Eigen::AngleAxisd(DegToRad(part[4]), Eigen::Vector3d::UnitY()) *
+                       Eigen::AngleAxisd(DegToRad(part[3]), Eigen::Vector3d::UnitX()))
+                          .toRotationMatrix();
+      Eigen::Isometry3d X_FC = Eigen::Isometry3d::Identity();
+      X_FC.linear() = process.R_FC;
+      X_FC.translation() = process.p_FC;
+      Eigen::VectorXd q0(robot->num_joints());
+      for (int j = 0; j < q0.size(); ++j) q0(j) = DegToRad(robot_seed[j]);
+      robot_check = CheckOnRobot(*robot, X_BP, X_FC, e.path.rows, q0);
+      summary["robot"] = {{"rows", e.path.rows.size()},
+                          {"unreachable_rows", robot_check.num_unreachable},
+                          {"outside_joint_limits_rows", robot_check.num_outside_limits},
+                          {"joint_jump_rows", robot_check.num_jumps},
+                          {"first_flagged_row", robot_check.first_bad_row >= 0 ? nlohmann::json(robot_check.first_bad_row + 1)
+                                                                                : nlohmann::json(nullptr)},
+                          {"min_joint_limit_margin_deg", RadToDeg(robot_check.min_limit_margin)},
+                          {"max_jacobian_condition", robot_check.max_condition}};
+      if (robot_check.num_unreachable + robot_check.num_outside_limits + robot_check.num_jumps > 0) {
+        flagged = true;
+        Warn(kTool, std::to_string(robot_check.num_unreachable) + " rows unreachable, " +
+                        std::to_string(robot_check.num_outside_limits) + " outside the joint limits, " +
+                        std::to_string(robot_check.num_jumps) + " with a joint jump > 0.5 rad (first: row " +
+                        std::to_string(robot_check.first_bad_row + 1) + ")");
+      }
+    }
+    std::vector<std::pair<std::string, std::string>> meta = {{"pattern", pattern}};
+    meta.push_back({"offset_mm", io::FormatDouble(1e3 * params.offset)});
+    if (cyc) {
+      meta.push_back({"radius_mm", io::FormatDouble(1e3 * params.radius)});
+      meta.push_back({"pitch_mm", io::FormatDouble(1e3 * params.pitch)});
+    }
+    if (!path_out.empty()) io::WritePolishPath(path_out, e.path.rows, meta);
+    if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, e.removal);
+    if (!joints_out.empty()) WriteJointTrajectory(joints_out, e.path.rows, robot_check, robot->num_joints());
+    if (!plot_out.empty()) WritePictures(plot_out, grid, e.removal, e.path.rows, e.path.guide_lines, history, pattern);
+    const std::string text = summary.dump(2) + "\n";
+    if (!summary_out.empty()) io::WriteFileAtomically(summary_out, text);
+    else std::cout << text;
+    return flagged ? kExitFlagged : kExitOk;
+  });
+}
+
+}  // namespace
+}  // namespace robomach::apps
+
+int main(int argc, char** argv) { return robomach::apps::Run(argc, argv); }

@@ -1,0 +1,118 @@
+// polish-sim: the removal a given tool path (formats.md §6; from CAM, a teach
+// pendant or polish-plan) produces on a NURBS patch with the process of
+// formats.md §7: removal map, summary and pictures.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_support.h"
+#include "polish_support.h"
+#include "robomach/common/errors.h"
+#include "robomach/common/units.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/csv_table.h"
+#include "robomach/io/number_format.h"
+#include "robomach/io/polishing_files.h"
+#include "robomach/polishing/paths.h"
+#include "robomach/polishing/removal.h"
+
+namespace robomach::apps {
+namespace {
+
+constexpr char kTool[] = "polish-sim";
+
+int Run(int argc, char** argv) {
+  CLI::App app{
+      "polish-sim: simulate the Preston removal of a tool path (formats.md §6) on a NURBS patch\n"
+      "(formats.md §5) with Hertz contact (formats.md §7); writes the removal map, a summary and pictures."};
+  app.footer(ExitCodeHelp());
+  std::string surface_path, process_path, path_in, removal_out, summary_out, plot_out;
+  int face = 0;
+  double sample_mm = 0.5;
+  app.add_option("--surface", surface_path, "NURBS patch YAML (formats.md §5)")->required();
+  app.add_option("--face", face, "face of a STEP/IGES file (1-based); CAD input not built yet");
+  app.add_option("--process", process_path, "process YAML (formats.md §7)")->required();
+  app.add_option("--path", path_in, "tool path CSV (formats.md §6)")->required();
+  app.add_option("--sample-mm", sample_mm, "removal map sampling in arc length [mm], <= 0.5")->capture_default_str();
+  app.add_option("--removal", removal_out, "removal map CSV x_mm,y_mm,z_mm,u,v,removal_um");
+  app.add_option("--summary", summary_out, "summary JSON (formats.md §7); stdout if omitted");
+  app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png and <stem>_path.png");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  return RunGuarded(kTool, [&]() -> int {
+    CheckOptionRange("--sample-mm", sample_mm, 0.05, 0.5);
+    RequireReadableFile(surface_path, "surface");
+    RequireReadableFile(process_path, "process file");
+    RequireReadableFile(path_in, "tool path");
+    std::vector<std::pair<std::string, std::string>> outs = {{"--removal", removal_out}, {"--summary", summary_out}};
+    if (!plot_out.empty())
+      for (const auto& p : PicturePaths(plot_out, false)) outs.push_back({"--plot", p});
+    CheckDistinctPaths({{"--surface", surface_path}, {"--process", process_path}, {"--path", path_in}}, outs);
+
+    const polishing::NurbsSurface surface = LoadSurface(surface_path, face);
+    const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
+    io::PolishPathFile file = io::ReadPolishPath(path_in);
+    polishing::SampleGrid grid = [&] {
+      try {
+        return polishing::SampleGrid::Build(surface, MmToM(sample_mm), process.margin, process.flip_normal);
+      } catch (const std::domain_error& e) {
+        throw InputError({surface_path, 0, 0}, e.what());
+      }
+    }();
+    if (grid.num_in_region() == 0) {
+      throw InputError({process_path, 0, 0}, "process.margin_mm leaves no polished region on the patch");
+    }
+    auto row_error = [&](const polishing::PathRowError& e) {
+      return InputError({file.path, file.lines[e.row()], 0}, "path row " + std::to_string(e.row() + 1) + ": " + e.what());
+    };
+    std::vector<double> removal;
+    try {
+      polishing::AttachToSurface(surface, grid, process.flip_normal, &file.rows);
+      const polishing::RemovalSimulator sim(surface, process, grid.points(), grid.normals(), 0.0015);
+      removal = sim.Simulate(file.rows);
+    } catch (const polishing::PathRowError& e) {
+      throw row_error(e);
+    }
+    const double vmax = polishing::MaxSpeed(file.rows);
+    bool flagged = false;
+    if (vmax > process.max_speed * (1 + 1e-6)) {
+      flagged = true;
+      Warn(kTool, "the path's traverse speed reaches " + io::FormatDouble(1e3 * vmax) +
+                      " mm/s, above max_speed_mm_per_s " + io::FormatDouble(1e3 * process.max_speed));
+    }
+    const polishing::RemovalStats stats = polishing::ComputeRemovalStats(removal, grid.areas(), grid.in_region());
+    nlohmann::json summary;
+    summary["removal_um"] = RemovalJson(stats);
+    summary["path"] = PathJson(file.rows);
+    auto meta = [&](const char* k) {
+      const auto it = file.metadata.find(k);
+      double v = 0;
+      return it != file.metadata.end() && io::ParseFiniteNumber(it->second, &v) ? v : 0.0;
+    };
+    const auto pat = file.metadata.find("pattern");
+    const std::string pattern = pat != file.metadata.end() ? pat->second : std::string("unknown");
+    summary["parameters"] = {{"pattern", pattern},
+                             {"offset_mm", meta("offset_mm")}, {"radius_mm", meta("radius_mm")},
+                             {"pitch_mm", meta("pitch_mm")}, {"omega_rad_per_s", 0.0},
+                             {"centre_speed_mm_per_s", 0.0}};
+    summary["region"] = {{"sample_mm", sample_mm}, {"points", grid.num_in_region()}, {"margin_mm", 1e3 * process.margin}};
+    summary["speed_limit_exceeded"] = flagged;
+    if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, removal);
+    if (!plot_out.empty()) WritePictures(plot_out, grid, removal, file.rows, {}, {}, "polish-sim");
+    const std::string text = summary.dump(2) + "\n";
+    if (!summary_out.empty()) io::WriteFileAtomically(summary_out, text);
+    else std::cout << text;
+    return flagged ? kExitFlagged : kExitOk;
+  });
+}
+
+}  // namespace
+}  // namespace robomach::apps
+
+int main(int argc, char** argv) { return robomach::apps::Run(argc, argv); }

@@ -1,0 +1,266 @@
+#include "polish_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "cli_support.h"
+#include "robomach/common/errors.h"
+#include "robomach/io/polishing_files.h"
+#include "robomach/report/heat_map.h"
+#include "robomach/report/plot.h"
+
+namespace robomach::apps {
+
+polishing::NurbsSurface LoadSurface(const std::string& path, int face) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  if (ext == ".step" || ext == ".stp" || ext == ".iges" || ext == ".igs") {
+    (void)face;
+    throw InputError({path, 0, 0}, "STEP/IGES surfaces need the OpenCASCADE reader, which this build does not "
+                                   "have yet (issue 11 step 6); give the patch as NURBS YAML (formats.md §5)");
+  }
+  return io::ReadNurbsYaml(path);
+}
+
+nlohmann::json RemovalJson(const polishing::RemovalStats& s) {
+  return {{"mean", 1e6 * s.mean}, {"std", 1e6 * s.std}, {"variance", 1e12 * s.variance}, {"cv", s.cv},
+          {"min", 1e6 * s.min}, {"max", 1e6 * s.max}, {"peak_to_valley", 1e6 * s.peak_to_valley},
+          {"coverage", s.coverage}};
+}
+
+nlohmann::json PathJson(const std::vector<polishing::PathRow>& rows) {
+  double len = 0;
+  for (size_t i = 1; i < rows.size(); ++i) len += (rows[i].p - rows[i - 1].p).norm();
+  return {{"length_mm", 1e3 * len},
+          {"time_s", rows.empty() ? 0.0 : rows.back().t - rows.front().t},
+          {"rows", rows.size()},
+          {"max_speed_mm_per_s", 1e3 * polishing::MaxSpeed(rows)}};
+}
+
+std::vector<std::string> PicturePaths(const std::string& png, bool with_convergence) {
+  const std::filesystem::path p(png);
+  const std::string stem = (p.parent_path() / p.stem()).string();
+  std::vector<std::string> out = {png, stem + "_histogram.png", stem + "_path.png"};
+  if (with_convergence) out.push_back(stem + "_convergence.png");
+  return out;
+}
+
+std::vector<std::string> WritePictures(const std::string& png, const polishing::SampleGrid& grid,
+                                       const std::vector<double>& removal_m,
+                                       const std::vector<polishing::PathRow>& rows,
+                                       const std::vector<std::vector<Eigen::Vector3d>>& guide_lines,
+                                       const std::vector<double>& history, const std::string& title) {
+  const std::vector<std::string> files = PicturePaths(png, !history.empty());
+  // Removal map (seed Fig. 19) on the developed plane.
+  report::HeatMap map;
+  map.title = title + ": removal";
+  map.x_label = "s (arc length along u) [mm]";
+  map.y_label = "t (arc length along v) [mm]";
+  map.colorbar_label = "removal [um]";
+  map.nan_label = "margin (not polished)";
+  // Block-averaged to at most ~150 cells a side: the drawing costs per cell.
+  const int f = std::max(1, static_cast<int>(std::ceil(std::max(grid.ns(), grid.nt()) / 150.0)));
+  map.nx = (grid.ns() + f - 1) / f;
+  map.ny = (grid.nt() + f - 1) / f;
+  const double ds = 1e3 * grid.length_s() / std::max(1, grid.ns() - 1);
+  const double dt = 1e3 * grid.length_t() / std::max(1, grid.nt() - 1);
+  map.dx = ds * f;
+  map.dy = dt * f;
+  map.x0 = 0.5 * (f - 1) * ds;
+  map.y0 = 0.5 * (f - 1) * dt;
+  std::vector<double> sum(map.nx * map.ny, 0.0), cnt(map.nx * map.ny, 0.0);
+  std::vector<double> region;
+  for (int j = 0; j < grid.nt(); ++j) {
+    for (int i = 0; i < grid.ns(); ++i) {
+      const int k = grid.index(i, j);
+      if (!grid.in_region()[k]) continue;
+      const int c = (j / f) * map.nx + i / f;
+      sum[c] += 1e6 * removal_m[k];
+      cnt[c] += 1.0;
+      region.push_back(1e6 * removal_m[k]);
+    }
+  }
+  map.values.assign(map.nx * map.ny, std::nan(""));
+  for (size_t c = 0; c < sum.size(); ++c)
+    if (cnt[c] > 0) map.values[c] = sum[c] / cnt[c];
+  if (f > 1) map.title += " (" + std::to_string(f) + " x " + std::to_string(f) + " point averages)";
+  report::SaveHeatMapPng(map, files[0]);
+  // Histogram (seed Fig. 20).
+  report::Figure hist(1, 1, 900, 420);
+  hist.title = title + ": removal histogram";
+  auto& ax = hist.at(0, 0);
+  ax.x_label = "removal [um]";
+  ax.y_label = "fraction of sample points [%]";
+  if (!region.empty()) {
+    const double lo = *std::min_element(region.begin(), region.end());
+    const double hi = *std::max_element(region.begin(), region.end());
+    const int bins = 40;
+    const double w = (hi - lo) > 0 ? (hi - lo) / bins : 1.0;
+    std::vector<double> count(bins, 0.0);
+    for (double x : region) count[std::min(bins - 1, static_cast<int>((x - lo) / w))] += 100.0 / region.size();
+    report::Series s;
+    s.color = report::PaletteColor(0);
+    for (int b = 0; b < bins; ++b) {  // bars as outlines
+      s.x.insert(s.x.end(), {lo + b * w, lo + b * w, lo + (b + 1) * w, lo + (b + 1) * w});
+      s.y.insert(s.y.end(), {0.0, count[b], count[b], 0.0});
+    }
+    ax.series.push_back(s);
+    ax.y_min = 0.0;
+  }
+  hist.SavePng(files[1]);
+  // Path with guide lines (seed Fig. 18), x-y view.
+  report::Figure fp(1, 1, 900, 700);
+  fp.title = title + ": path (x-y view)";
+  auto& a2 = fp.at(0, 0);
+  a2.x_label = "x [mm]";
+  a2.y_label = "y [mm]";
+  report::Series path;
+  path.label = "contact path";
+  path.color = report::PaletteColor(0);
+  path.thickness = 1;
+  for (const auto& r : rows) {
+    path.x.push_back(1e3 * r.p.x());
+    path.y.push_back(1e3 * r.p.y());
+  }
+  a2.series.push_back(path);
+  for (size_t g = 0; g < guide_lines.size(); ++g) {
+    report::Series s;
+    s.label = g == 0 ? "guide lines" : "";
+    s.color = report::PaletteColor(1);
+    s.dashed = true;
+    for (const auto& p : guide_lines[g]) {
+      s.x.push_back(1e3 * p.x());
+      s.y.push_back(1e3 * p.y());
+    }
+    a2.series.push_back(s);
+  }
+  fp.SavePng(files[2]);
+  if (!history.empty()) {
+    report::Figure fc(1, 1, 900, 420);
+    fc.title = title + ": optimiser convergence";
+    auto& a3 = fc.at(0, 0);
+    a3.x_label = "iteration / evaluation";
+    a3.y_label = "best cv of removal";
+    report::Series s;
+    s.color = report::PaletteColor(2);
+    for (size_t i = 0; i < history.size(); ++i) {
+      s.x.push_back(static_cast<double>(i + 1));
+      s.y.push_back(history[i]);
+    }
+    a3.series.push_back(s);
+    fc.SavePng(files[3]);
+  }
+  return files;
+}
+
+}  // namespace robomach::apps
+
+#include <kdl/chainiksolverpos_lma.hpp>
+
+#include <Eigen/SVD>
+
+#include "robomach/common/units.h"
+#include "robomach/dynamics/robot_model.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/number_format.h"
+#include "robomach/kinematics/serial_chain.h"
+
+namespace robomach::apps {
+
+RobotCheck CheckOnRobot(const dynamics::RobotModel& model, const Eigen::Isometry3d& X_BP,
+                        const Eigen::Isometry3d& X_FC, const std::vector<polishing::PathRow>& rows,
+                        const Eigen::VectorXd& seed) {
+  const kinematics::SerialChain& arm = model.description().arm;
+  const int n = arm.num_joints();
+  KDL::ChainIkSolverPos_LMA lma(arm.kdl(), 1e-6, 500, 1e-15);
+  // Tolerances as in stability-map: far below what matters for polishing.
+  constexpr double kPos = 1e-5, kRot = 1e-4;
+  constexpr double kMaxJointStep = 0.5;  // [rad] between consecutive rows
+  auto solve = [&](const Eigen::Isometry3d& X, const Eigen::VectorXd& from, Eigen::VectorXd* q) {
+    KDL::JntArray q0(n), q1(n);
+    for (int j = 0; j < n; ++j) q0(j) = from(j);
+    lma.CartToJnt(q0, kinematics::ToKdl(X), q1);
+    q->resize(n);
+    for (int j = 0; j < n; ++j) (*q)(j) = q1(j) - 2.0 * kPi * std::round((q1(j) - from(j)) / (2.0 * kPi));
+    const Eigen::Isometry3d got = kinematics::ForwardKinematics(arm, *q);
+    return (got.translation() - X.translation()).norm() < kPos &&
+           Eigen::AngleAxisd(got.linear().transpose() * X.linear()).angle() < kRot;
+  };
+  RobotCheck c;
+  const size_t N = rows.size();
+  c.q.resize(N);
+  c.reachable.assign(N, 0);
+  c.limit_margin.assign(N, std::nan(""));
+  c.condition.assign(N, std::nan(""));
+  Eigen::VectorXd prev = seed;
+  const Eigen::Isometry3d X_CF = X_FC.inverse();
+  for (size_t r = 0; r < N; ++r) {
+    Eigen::Isometry3d X_PC = Eigen::Isometry3d::Identity();
+    X_PC.linear().col(0) = rows[r].tx;
+    X_PC.linear().col(1) = rows[r].n.cross(rows[r].tx);
+    X_PC.linear().col(2) = rows[r].n;
+    X_PC.translation() = rows[r].p;
+    const Eigen::Isometry3d X_BF = X_BP * X_PC * X_CF;
+    Eigen::VectorXd q;
+    bool ok = solve(X_BF, prev, &q);
+    if (!ok) ok = solve(X_BF, seed, &q);
+    if (!ok) {
+      ++c.num_unreachable;
+      if (c.first_bad_row < 0) c.first_bad_row = static_cast<int>(r);
+      continue;
+    }
+    // Of the 2 pi branches of each joint, one inside its limits if there is one.
+    for (int j = 0; j < n; ++j) {
+      const auto& lim = arm.limits()[j];
+      if (!lim.bounded) continue;
+      for (int k = -2; k <= 2 && (q(j) < lim.lower || q(j) > lim.upper); ++k) {
+        const double alt = q(j) + 2.0 * kPi * k;
+        if (alt >= lim.lower && alt <= lim.upper) q(j) = alt;
+      }
+    }
+    // A jump between consecutive rows (a 2 pi branch change to stay inside
+    // the limits, or another IK branch) cannot be executed continuously.
+    if (r > 0 && c.reachable[r - 1] && (q - c.q[r - 1]).cwiseAbs().maxCoeff() > kMaxJointStep) {
+      ++c.num_jumps;
+      if (c.first_bad_row < 0) c.first_bad_row = static_cast<int>(r);
+    }
+    c.reachable[r] = 1;
+    c.q[r] = q;
+    prev = q;
+    double margin = 1e300;
+    for (int j = 0; j < n; ++j) {
+      const auto& lim = arm.limits()[j];
+      if (lim.bounded) margin = std::min({margin, q(j) - lim.lower, lim.upper - q(j)});
+    }
+    c.limit_margin[r] = margin;
+    c.min_limit_margin = std::min(c.min_limit_margin, margin);
+    if (margin < 0) {
+      ++c.num_outside_limits;
+      if (c.first_bad_row < 0) c.first_bad_row = static_cast<int>(r);
+    }
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(kinematics::Jacobian(arm, q));
+    const auto& s = svd.singularValues();
+    c.condition[r] = s(s.size() - 1) > 0 ? s(0) / s(s.size() - 1) : 1e300;
+    c.max_condition = std::max(c.max_condition, c.condition[r]);
+  }
+  return c;
+}
+
+void WriteJointTrajectory(const std::string& path, const std::vector<polishing::PathRow>& rows,
+                          const RobotCheck& check, int num_joints) {
+  io::WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "t_s";
+    for (int j = 0; j < num_joints; ++j) out << ",q" << j + 1 << "_deg";
+    out << ",reachable,limit_margin_deg,jacobian_condition\n";
+    for (size_t r = 0; r < rows.size(); ++r) {
+      out << io::FormatDouble(rows[r].t);
+      for (int j = 0; j < num_joints; ++j) out << ',' << (check.reachable[r] ? io::FormatDouble(RadToDeg(check.q[r](j))) : "");
+      out << ',' << (check.reachable[r] ? 1 : 0) << ','
+          << (check.reachable[r] ? io::FormatDouble(RadToDeg(check.limit_margin[r])) : "") << ','
+          << (check.reachable[r] ? io::FormatDouble(check.condition[r]) : "") << '\n';
+    }
+  });
+}
+
+}  // namespace robomach::apps

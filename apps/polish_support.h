@@ -1,0 +1,70 @@
+#pragma once
+
+// Shared by polish-plan and polish-sim: surface loading, the removal
+// statistics in um, the summary JSON (formats.md §7) and the pictures.
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "robomach/polishing/nurbs_surface.h"
+#include "robomach/polishing/paths.h"
+#include "robomach/polishing/removal.h"
+#include "robomach/polishing/surface_grid.h"
+
+namespace robomach::apps {
+
+/// A NURBS YAML (formats.md §5). CAD files (.step/.stp/.iges/.igs) are
+/// refused with a clear message: OpenCASCADE support is not built yet.
+polishing::NurbsSurface LoadSurface(const std::string& path, int face);
+
+/// formats.md §7 "removal_um" block (area-weighted over the region).
+nlohmann::json RemovalJson(const polishing::RemovalStats& stats_m);
+nlohmann::json PathJson(const std::vector<polishing::PathRow>& rows);
+
+/// Pictures next to `png`: the removal map (png itself, colour scale in
+/// um on the developed s, t plane), <stem>_histogram.png, <stem>_path.png
+/// (path and guide lines, x-y view) and, if `history` is not empty,
+/// <stem>_convergence.png. Returns the paths written.
+std::vector<std::string> WritePictures(const std::string& png, const polishing::SampleGrid& grid,
+                                       const std::vector<double>& removal_m,
+                                       const std::vector<polishing::PathRow>& rows,
+                                       const std::vector<std::vector<Eigen::Vector3d>>& guide_lines,
+                                       const std::vector<double>& history, const std::string& title);
+
+/// The list of picture files WritePictures would write (for clean-up and
+/// distinct-path checks).
+std::vector<std::string> PicturePaths(const std::string& png, bool with_convergence);
+
+}  // namespace robomach::apps
+
+namespace robomach::dynamics {
+class RobotModel;
+}
+
+namespace robomach::apps {
+
+/// Executability of a path on a robot (issue 11 "on the robot"): the part
+/// frame P placed in the robot base B, each row's contact frame C (z = the
+/// surface normal towards the tool, x = tool x) in B, the flange pose
+/// X_BF = X_BP X_PC X_FC^-1 with the process's contact frame in the flange,
+/// and the inverse kinematics of the arm (KDL LMA, seeded from the previous
+/// row, the first row from `seed`).
+struct RobotCheck {
+  std::vector<Eigen::VectorXd> q;       // [rad]; empty where unreachable
+  std::vector<char> reachable;
+  std::vector<double> limit_margin;     // smallest distance to a joint limit [rad] (< 0: outside)
+  std::vector<double> condition;        // condition number of the 6 x n Jacobian
+  int num_unreachable{0}, num_outside_limits{0}, num_jumps{0}, first_bad_row{-1};
+  double min_limit_margin{1e300}, max_condition{0.0};
+};
+RobotCheck CheckOnRobot(const dynamics::RobotModel& model, const Eigen::Isometry3d& X_BP,
+                        const Eigen::Isometry3d& X_FC, const std::vector<polishing::PathRow>& rows,
+                        const Eigen::VectorXd& seed);
+
+/// Joint trajectory CSV: t_s,q1_deg..qn_deg,reachable,limit_margin_deg,jacobian_condition.
+void WriteJointTrajectory(const std::string& path, const std::vector<polishing::PathRow>& rows,
+                          const RobotCheck& check, int num_joints);
+
+}  // namespace robomach::apps

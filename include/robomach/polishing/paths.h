@@ -1,0 +1,94 @@
+#pragma once
+
+// Tool paths on a sampled patch (seed 004 §2.2-3.1; formats.md §6): cycloids
+// (seed eq. 11) rolling along guide lines, and the direction-parallel
+// (zig-zag) pattern for comparison. Paths are laid out in the developed
+// (s, t) plane of the SampleGrid and mapped onto the surface; the tool frame
+// is z = surface normal, x = the guide line's tangent (seed eq. 16).
+//
+// Cycloid parametrisation (the README documents it): guide-line offset d
+// (spacing of adjacent guide lines), radius r, pitch = advance of the
+// circle's centre per loop. With the seed's rolling rate omega [rad/s] and
+// centre speed v: pitch = 2 pi v / omega. The shape depends on (d, r,
+// pitch) only; the time scale (omega, and v = pitch omega / 2 pi) is set
+// afterwards by the speed limit or the target removal.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/polishing/nurbs_surface.h"
+#include "robomach/polishing/process.h"
+#include "robomach/polishing/removal.h"
+#include "robomach/polishing/surface_grid.h"
+
+namespace robomach::polishing {
+
+enum class Pattern { kCycloid, kParallel };
+enum class GuideLines { kBoundaryOffsets, kParallelLines };
+
+struct PathParameters {
+  Pattern pattern{Pattern::kCycloid};
+  GuideLines guides{GuideLines::kBoundaryOffsets};  // cycloid only
+  double offset{0.008};    // d: guide-line spacing (row spacing of the parallel pattern) [m]
+  double radius{0.006};    // r [m] (cycloid)
+  double pitch{0.003};     // centre advance per loop [m] (cycloid)
+  double row_step{0.5e-3}; // largest distance between consecutive rows [m]
+};
+
+/// Seed 004 §3.2 feasibility limits in this parametrisation: d <= 2 r
+/// (no unpolished strip between rows, Fig. 10), 0.5 d <= r <= d (limit 3),
+/// and the centre slower than the rolling point, v < omega r, i.e.
+/// pitch < 2 pi r (limit 2: the curve still loops, Fig. 13).
+/// @throws std::invalid_argument naming the violated limit.
+void CheckValid(const PathParameters& p);
+
+struct PlannedPath {
+  std::vector<PathRow> rows;
+  /// Guide lines (row centre lines of the parallel pattern) on the surface [m].
+  std::vector<std::vector<Eigen::Vector3d>> guide_lines;
+  double length{0.0};            // [m]
+  double omega_rad_per_s{0.0};   // cycloid rolling rate with the current time stamps
+  double centre_speed{0.0};      // [m/s]
+};
+
+/// Plans the path with time stamps at the fastest rate that keeps every
+/// segment at or below process.max_speed.
+PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const PathParameters& params,
+                     const PolishingProcess& process);
+
+/// Multiplies all time stamps by `factor` (> 1 slows down), keeping omega and
+/// the centre speed consistent.
+void ScaleTime(PlannedPath* path, double factor);
+
+/// Largest segment speed of a path [m/s].
+double MaxSpeed(const std::vector<PathRow>& rows);
+
+/// Width of the contact across tool x (2 x the half-width along tool y) on
+/// the surface at the region's centre [m]: the default row spacing of the
+/// parallel pattern (tracks touching).
+double ContactWidthAtCentre(const NurbsSurface& surface, const SampleGrid& grid, const PolishingProcess& process);
+
+struct TargetResult {
+  bool reached{false};   // false: the target needs a speed above max_speed
+  double mean{0.0};      // mean removal over the region after scaling [m]
+  std::vector<double> removal;  // at every grid point [m]
+  std::string message;
+};
+/// Sets the time stamps so that the area-weighted mean removal over the
+/// region equals `target` [m] (a few fixed-point steps: the removal is
+/// inversely proportional to the speed up to v_rel's small dependence on
+/// it). If that needs a speed above process.max_speed, the path runs at the
+/// limit and the result says so.
+TargetResult ScaleToTargetRemoval(const RemovalSimulator& sim, const SampleGrid& grid, double target,
+                                  double max_speed, PlannedPath* path);
+
+/// Rows of a path read from a file: fills u, v by projecting x, y, z on the
+/// surface (from the row's u, v when given), checks the 0.01 mm tolerance
+/// and the tool side.
+/// @throws PathRowError naming the row.
+void AttachToSurface(const NurbsSurface& surface, const SampleGrid& grid, bool flip_normal,
+                     std::vector<PathRow>* rows);
+
+}  // namespace robomach::polishing

@@ -1,0 +1,229 @@
+#include "robomach/io/polishing_files.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "robomach/common/units.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/csv_table.h"
+#include "robomach/io/number_format.h"
+#include "robomach/io/yaml_doc.h"
+
+namespace robomach::io {
+namespace {
+
+std::vector<double> Knots(const YamlDoc& node, int n, int degree, const char* n_name) {
+  std::vector<double> k = node.Numbers();
+  const int expected = n + degree + 1;
+  if (static_cast<int>(k.size()) != expected) {
+    throw node.Error("expected " + std::to_string(expected) + " knots (" + n_name + " " + std::to_string(n) +
+                     " + degree " + std::to_string(degree) + " + 1), got " + std::to_string(k.size()) +
+                     "; the counts must agree: len(knots) = n + degree + 1");
+  }
+  for (size_t i = 1; i < k.size(); ++i) {
+    if (k[i] < k[i - 1]) {
+      throw node.at(static_cast<int>(i)).Error("knots must be non-decreasing, got " + FormatDouble(k[i]) + " after " +
+                                               FormatDouble(k[i - 1]));
+    }
+  }
+  return k;
+}
+
+}  // namespace
+
+polishing::NurbsSurface ReadNurbsYaml(const std::string& path) {
+  const YamlDoc doc = YamlDoc::LoadFile(path);
+  const YamlDoc root = doc["nurbs"];
+  doc.RejectUnknownKeys();
+  const int p = root["degree_u"].IntInRange(1, 15);
+  const int q = root["degree_v"].IntInRange(1, 15);
+  const YamlDoc cp = root["control_points_mm"];
+  if (!cp.IsSequence() || cp.size() < 1) throw cp.Error("expected n_u rows of n_v points [x, y, z]");
+  const int n_u = cp.size();
+  std::vector<std::vector<Eigen::Vector3d>> P(n_u);
+  int n_v = -1;
+  for (int i = 0; i < n_u; ++i) {
+    const YamlDoc row = cp.at(i);
+    if (!row.IsSequence()) throw row.Error("expected a row of points [x, y, z]");
+    if (n_v < 0) n_v = row.size();
+    if (row.size() != n_v) {
+      throw row.Error("row " + std::to_string(i + 1) + " has " + std::to_string(row.size()) + " points, row 1 has " +
+                      std::to_string(n_v));
+    }
+    for (int j = 0; j < n_v; ++j) {
+      const std::vector<double> x = row.at(j).Numbers(3);
+      P[i].emplace_back(MmToM(x[0]), MmToM(x[1]), MmToM(x[2]));
+    }
+  }
+  if (n_u < p + 1) throw cp.Error("expected at least degree_u + 1 = " + std::to_string(p + 1) + " rows, got " + std::to_string(n_u));
+  if (n_v < q + 1) throw cp.Error("expected at least degree_v + 1 = " + std::to_string(q + 1) + " points per row, got " + std::to_string(n_v));
+  std::vector<double> ku = Knots(root["knots_u"], n_u, p, "n_u");
+  std::vector<double> kv = Knots(root["knots_v"], n_v, q, "n_v");
+  std::vector<std::vector<double>> W;
+  if (root.Has("weights")) {
+    const YamlDoc w = root["weights"];
+    if (!w.IsSequence() || w.size() != n_u) throw w.Error("expected " + std::to_string(n_u) + " rows of " + std::to_string(n_v) + " weights");
+    for (int i = 0; i < n_u; ++i) {
+      const YamlDoc row = w.at(i);
+      W.push_back(row.Numbers(n_v));
+      for (int j = 0; j < n_v; ++j) {
+        if (!(W[i][j] > 0.0)) {
+          throw row.at(j).Error("weight of control point (" + std::to_string(i + 1) + ", " + std::to_string(j + 1) +
+                                "): expected a number > 0, got " + FormatDouble(W[i][j]));
+        }
+      }
+    }
+  } else {
+    root.MarkUsed("weights");
+  }
+  root.RejectUnknownKeys();
+  try {
+    return polishing::NurbsSurface::Create(p, q, std::move(ku), std::move(kv), std::move(P), std::move(W));
+  } catch (const std::invalid_argument& e) {
+    throw root.Error(e.what());
+  }
+}
+
+polishing::PolishingProcess ReadPolishingProcess(const std::string& path) {
+  const YamlDoc doc = YamlDoc::LoadFile(path);
+  polishing::PolishingProcess p;
+  const YamlDoc tool = doc["tool"], work = doc["workpiece"], proc = doc["process"];
+  p.wheel_radius = MmToM(tool["wheel_radius_mm"].PositiveNumber());
+  p.crown_radius = MmToM(tool["crown_radius_mm"].PositiveNumber());
+  p.belt_width = MmToM(tool["belt_width_mm"].PositiveNumber());
+  p.pad_modulus = tool["pad_modulus_MPa"].PositiveNumber() * 1e6;
+  p.pad_poisson = tool["pad_poisson"].NumberInRange(0.0, 0.5, true, false);
+  p.belt_speed = tool["belt_speed_m_per_s"].PositiveNumber();
+  tool.RejectUnknownKeys();
+  p.work_modulus = work["modulus_GPa"].PositiveNumber() * 1e9;
+  p.work_poisson = work["poisson"].NumberInRange(0.0, 0.5, true, false);
+  p.preston_coefficient = work["preston_coefficient_m2_per_N"].PositiveNumber();
+  work.RejectUnknownKeys();
+  p.force = proc["force_N"].PositiveNumber();
+  p.margin = MmToM(proc["margin_mm"].NumberInRange(0.0, 1e6));
+  p.max_speed = MmToM(proc["max_speed_mm_per_s"].PositiveNumber());
+  p.flip_normal = proc.Has("flip_normal") ? proc["flip_normal"].Bool() : false;
+  proc.MarkUsed("flip_normal");
+  proc.RejectUnknownKeys();
+  if (doc.Has("robot")) {
+    // Contact frame C in the flange F (our addition, README "polish-plan on
+    // the robot"): position in mm, then fixed-axis x-y-z rotation in degrees.
+    const YamlDoc r = doc["robot"];
+    const std::vector<double> x = r["contact_frame_in_flange_mm_deg"].Numbers(6);
+    r.RejectUnknownKeys();
+    p.p_FC = Eigen::Vector3d(MmToM(x[0]), MmToM(x[1]), MmToM(x[2]));
+    p.R_FC = (Eigen::AngleAxisd(DegToRad(x[5]), Eigen::Vector3d::UnitZ()) *
+              Eigen::AngleAxisd(DegToRad(x[4]), Eigen::Vector3d::UnitY()) *
+              Eigen::AngleAxisd(DegToRad(x[3]), Eigen::Vector3d::UnitX()))
+                 .toRotationMatrix();
+  } else {
+    doc.MarkUsed("robot");
+  }
+  doc.RejectUnknownKeys();
+  try {
+    polishing::CheckValid(p);
+  } catch (const std::invalid_argument& e) {
+    throw InputError({path, 0, 0}, e.what());
+  }
+  return p;
+}
+
+PolishPathFile ReadPolishPath(const std::string& path) {
+  const CsvTable csv = CsvTable::ReadFile(path);
+  PolishPathFile f;
+  f.path = path;
+  f.metadata = csv.metadata();
+  const std::vector<std::string> required = {"t_s", "x_mm", "y_mm", "z_mm", "nx", "ny", "nz", "tx", "ty", "tz"};
+  for (const auto& c : required) csv.RequireColumn(c);
+  std::vector<std::string> known = required;
+  known.insert(known.end(), {"u", "v", "force_N"});
+  const auto unknown = csv.UnknownColumns(known);
+  if (!unknown.empty()) {
+    throw InputError({path, csv.header_line(), 0}, "unknown column '" + unknown[0] + "'; expected t_s,x_mm,y_mm,z_mm,nx,ny,nz,tx,ty,tz[,u,v][,force_N]");
+  }
+  f.has_uv = csv.HasColumn("u") && csv.HasColumn("v");
+  if (csv.HasColumn("u") != csv.HasColumn("v")) {
+    throw InputError({path, csv.header_line(), 0}, "columns u and v go together; found only one of them");
+  }
+  if (csv.num_rows() < 2) throw InputError({path, csv.header_line(), 0}, "a path needs at least 2 rows");
+  for (int r = 0; r < csv.num_rows(); ++r) {
+    polishing::PathRow row;
+    row.t = csv.Number(r, "t_s");
+    row.p = Eigen::Vector3d(csv.Number(r, "x_mm"), csv.Number(r, "y_mm"), csv.Number(r, "z_mm")) * 1e-3;
+    row.n = Eigen::Vector3d(csv.Number(r, "nx"), csv.Number(r, "ny"), csv.Number(r, "nz"));
+    row.tx = Eigen::Vector3d(csv.Number(r, "tx"), csv.Number(r, "ty"), csv.Number(r, "tz"));
+    if (std::abs(row.n.norm() - 1.0) > 1e-3) {
+      throw csv.ErrorAt(r, "nx", "expected a unit normal (nx,ny,nz), got length " + FormatDouble(row.n.norm()));
+    }
+    if (std::abs(row.tx.norm() - 1.0) > 1e-3) {
+      throw csv.ErrorAt(r, "tx", "expected a unit tool x axis (tx,ty,tz), got length " + FormatDouble(row.tx.norm()));
+    }
+    if (std::abs(row.tx.dot(row.n)) > 1e-3) {
+      throw csv.ErrorAt(r, "tx", "tool x (tx,ty,tz) must be normal to (nx,ny,nz); their dot product is " +
+                                     FormatDouble(row.tx.dot(row.n)));
+    }
+    row.n.normalize();
+    row.tx = (row.tx - row.tx.dot(row.n) * row.n).normalized();
+    if (f.has_uv && !csv.IsEmpty(r, "u")) {
+      row.u = csv.Number(r, "u");
+      row.v = csv.Number(r, "v");
+    } else {
+      row.u = row.v = std::nan("");
+    }
+    if (csv.HasColumn("force_N")) {
+      row.force = csv.Number(r, "force_N");
+      if (!(row.force > 0)) throw csv.ErrorAt(r, "force_N", "expected a force > 0, got " + FormatDouble(row.force));
+    }
+    if (r > 0 && !(row.t > f.rows.back().t)) {
+      throw csv.ErrorAt(r, "t_s", "expected t_s strictly increasing, got " + FormatDouble(row.t) + " after " +
+                                      FormatDouble(f.rows.back().t));
+    }
+    f.rows.push_back(row);
+    f.lines.push_back(csv.line(r));
+  }
+  return f;
+}
+
+namespace {
+std::string Fixed(double x, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << (std::abs(x) < 0.5 * std::pow(10.0, -digits) ? 0.0 : x);
+  return s.str();
+}
+}  // namespace
+
+void WritePolishPath(const std::string& path, const std::vector<polishing::PathRow>& rows,
+                     const std::vector<std::pair<std::string, std::string>>& metadata) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    for (const auto& [k, v] : metadata) out << "# " << k << ": " << v << "\n";
+    out << "t_s,x_mm,y_mm,z_mm,nx,ny,nz,tx,ty,tz,u,v\n";
+    for (const auto& r : rows) {
+      // 1e-4 mm and 1e-6 s: far below the 0.01 mm surface tolerance; the
+      // direction cosines to 1e-9.
+      out << Fixed(r.t, 6) << ',' << Fixed(1e3 * r.p.x(), 4) << ',' << Fixed(1e3 * r.p.y(), 4) << ','
+          << Fixed(1e3 * r.p.z(), 4) << ',' << Fixed(r.n.x(), 9) << ',' << Fixed(r.n.y(), 9) << ','
+          << Fixed(r.n.z(), 9) << ',' << Fixed(r.tx.x(), 9) << ',' << Fixed(r.tx.y(), 9) << ','
+          << Fixed(r.tx.z(), 9) << ',' << FormatDouble(r.u) << ',' << FormatDouble(r.v) << '\n';
+    }
+  });
+}
+
+void WriteRemovalMap(const std::string& path, const polishing::SampleGrid& grid, const std::vector<double>& removal_m) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "x_mm,y_mm,z_mm,u,v,removal_um\n";
+    for (int j = 0; j < grid.nt(); ++j) {
+      for (int i = 0; i < grid.ns(); ++i) {
+        const int k = grid.index(i, j);
+        if (!grid.in_region()[k]) continue;
+        const Eigen::Vector3d& p = grid.points()[k];
+        out << Fixed(1e3 * p.x(), 4) << ',' << Fixed(1e3 * p.y(), 4) << ',' << Fixed(1e3 * p.z(), 4) << ','
+            << FormatDouble(grid.u(i)) << ',' << FormatDouble(grid.v(j)) << ',' << Fixed(1e6 * removal_m[k], 6)
+            << '\n';
+      }
+    }
+  });
+}
+
+}  // namespace robomach::io

@@ -1,0 +1,217 @@
+#include "robomach/polishing/removal.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "robomach/polishing/hertz_contact.h"
+
+namespace robomach::polishing {
+
+ToolContact ContactAt(const SurfaceDerivatives& d, const Eigen::Vector3d& tool_x, const PolishingProcess& process,
+                      double force) {
+  ToolContact c;
+  c.p = d.S;
+  c.n = UnitNormal(d, process.flip_normal);
+  const Eigen::Vector3d tx = (tool_x - tool_x.dot(c.n) * c.n).normalized();
+  const Eigen::Vector3d ty = c.n.cross(tx);
+  // Relative curvature in the tool's (x, y) frame: wheel + surface (convex +).
+  Eigen::Matrix2d K = CurvatureTensor(d, tx, ty, process.flip_normal);
+  K(0, 0) += 1.0 / process.wheel_radius;
+  K(1, 1) += 1.0 / process.crown_radius;
+  const ContactEllipse e = HertzContact(K, force, EffectiveModulus(process));
+  c.a = e.a;
+  c.b = e.b;
+  c.p0 = e.p0;
+  c.e_a = e.dir_a(0) * tx + e.dir_a(1) * ty;
+  c.e_b = e.dir_b(0) * tx + e.dir_b(1) * ty;
+  // Half-width across the belt (along tool y).
+  const double half_width = std::hypot(e.a * e.dir_a(1), e.b * e.dir_b(1));
+  if (2.0 * half_width > process.belt_width) {
+    std::ostringstream m;
+    m << "contact width " << 2e3 * half_width << " mm across the belt exceeds belt_width_mm "
+      << 1e3 * process.belt_width;
+    throw std::domain_error(m.str());
+  }
+  return c;
+}
+
+double SegmentPressureIntegral(const Eigen::Vector2d& alpha, const Eigen::Vector2d& beta) {
+  const double bb = beta.squaredNorm();
+  if (bb < 1e-24) return std::sqrt(std::max(0.0, 1.0 - alpha.squaredNorm()));
+  const double lb = std::sqrt(bb);
+  const double tau_star = alpha.dot(beta) / bb;
+  // Squared half-chord of the unit circle on the line: R^2 = 1 - |alpha_perp|^2.
+  const double R2 = 1.0 - alpha.squaredNorm() + tau_star * tau_star * bb;
+  if (R2 <= 0.0) return 0.0;
+  const double R = std::sqrt(R2);
+  const double s0 = std::max(-R, -lb * tau_star), s1 = std::min(R, lb * (1.0 - tau_star));
+  if (s1 <= s0) return 0.0;
+  // Antiderivative of sqrt(R^2 - s^2).
+  auto F = [&](double s) {
+    const double x = std::clamp(s / R, -1.0, 1.0);
+    return 0.5 * (s * std::sqrt(std::max(0.0, R2 - s * s)) + R2 * std::asin(x));
+  };
+  return (F(s1) - F(s0)) / lb;
+}
+
+RemovalSimulator::RemovalSimulator(const NurbsSurface& surface, const PolishingProcess& process,
+                                   std::vector<Eigen::Vector3d> points, std::vector<Eigen::Vector3d> normals,
+                                   double cell_size)
+    : surface_(&surface), process_(process), points_(std::move(points)), normals_(std::move(normals)),
+      cell_(cell_size) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(0.0), hi = lo;
+  if (!points_.empty()) {
+    lo = hi = points_[0];
+    for (const auto& p : points_) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  origin_ = lo;
+  nx_ = static_cast<int>((hi.x() - lo.x()) / cell_) + 1;
+  ny_ = static_cast<int>((hi.y() - lo.y()) / cell_) + 1;
+  nz_ = static_cast<int>((hi.z() - lo.z()) / cell_) + 1;
+  const long cells = static_cast<long>(nx_) * ny_ * nz_;
+  std::vector<int> cell_of(points_.size());
+  cell_start_.assign(cells + 1, 0);
+  for (size_t k = 0; k < points_.size(); ++k) {
+    const Eigen::Vector3d q = (points_[k] - origin_) / cell_;
+    const int ix = std::min(nx_ - 1, static_cast<int>(q.x()));
+    const int iy = std::min(ny_ - 1, static_cast<int>(q.y()));
+    const int iz = std::min(nz_ - 1, static_cast<int>(q.z()));
+    cell_of[k] = (iz * ny_ + iy) * nx_ + ix;
+    ++cell_start_[cell_of[k] + 1];
+  }
+  for (long c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
+  order_.resize(points_.size());
+  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (size_t k = 0; k < points_.size(); ++k) order_[fill[cell_of[k]]++] = static_cast<int>(k);
+}
+
+std::vector<ToolContact> RemovalSimulator::Contacts(const std::vector<PathRow>& path) const {
+  std::vector<ToolContact> contacts(path.size());
+  // Consecutive rows with the same relative curvature and force (planes,
+  // cylinders along a generator, ...) share their ellipse: the elliptic
+  // integrals are the cost of a contact.
+  Eigen::Matrix2d last_K = Eigen::Matrix2d::Constant(std::nan(""));
+  double last_force = -1.0;
+  ContactEllipse last;
+  const double e_star = EffectiveModulus(process_);
+  for (size_t r = 0; r < path.size(); ++r) {
+    try {
+      const SurfaceDerivatives d = surface_->Evaluate(path[r].u, path[r].v);
+      const double force = path[r].force > 0 ? path[r].force : process_.force;
+      ToolContact& c = contacts[r];
+      c.p = d.S;
+      c.n = UnitNormal(d, process_.flip_normal);
+      const Eigen::Vector3d tx = (path[r].tx - path[r].tx.dot(c.n) * c.n).normalized();
+      const Eigen::Vector3d ty = c.n.cross(tx);
+      Eigen::Matrix2d K = CurvatureTensor(d, tx, ty, process_.flip_normal);
+      K(0, 0) += 1.0 / process_.wheel_radius;
+      K(1, 1) += 1.0 / process_.crown_radius;
+      if (!(K == last_K && force == last_force)) {
+        last = HertzContact(K, force, e_star);
+        last_K = K;
+        last_force = force;
+      }
+      c.a = last.a;
+      c.b = last.b;
+      c.p0 = last.p0;
+      c.e_a = last.dir_a(0) * tx + last.dir_a(1) * ty;
+      c.e_b = last.dir_b(0) * tx + last.dir_b(1) * ty;
+      const double half_width = std::hypot(last.a * last.dir_a(1), last.b * last.dir_b(1));
+      if (2.0 * half_width > process_.belt_width) {
+        std::ostringstream m;
+        m << "contact width " << 2e3 * half_width << " mm across the belt exceeds belt_width_mm "
+          << 1e3 * process_.belt_width;
+        throw std::domain_error(m.str());
+      }
+    } catch (const std::domain_error& e) {
+      throw PathRowError(static_cast<int>(r), e.what());
+    }
+  }
+  return contacts;
+}
+
+std::vector<double> RemovalSimulator::Simulate(const std::vector<PathRow>& path) const {
+  return Simulate(path, Contacts(path));
+}
+
+std::vector<double> RemovalSimulator::Simulate(const std::vector<PathRow>& path,
+                                               const std::vector<ToolContact>& contacts) const {
+  std::vector<double> h(points_.size(), 0.0);
+  for (size_t r = 0; r + 1 < path.size(); ++r) {
+    const double dt = path[r + 1].t - path[r].t;
+    if (!(dt > 0.0)) {
+      throw PathRowError(static_cast<int>(r + 1), "t_s must be strictly increasing");
+    }
+    const ToolContact& c = contacts[r];
+    const Eigen::Vector3d d = path[r + 1].p - path[r].p;
+    const double v_rel = (process_.belt_speed * path[r].tx + d / dt).norm();
+    const double scale = process_.preston_coefficient * c.p0 * v_rel * dt;
+    const double reach = std::max(c.a, c.b);
+    const Eigen::Vector3d lo = path[r].p.cwiseMin(path[r + 1].p) - Eigen::Vector3d::Constant(reach);
+    const Eigen::Vector3d hi = path[r].p.cwiseMax(path[r + 1].p) + Eigen::Vector3d::Constant(reach);
+    const int x0 = std::max(0, static_cast<int>(std::floor((lo.x() - origin_.x()) / cell_)));
+    const int y0 = std::max(0, static_cast<int>(std::floor((lo.y() - origin_.y()) / cell_)));
+    const int z0 = std::max(0, static_cast<int>(std::floor((lo.z() - origin_.z()) / cell_)));
+    const int x1 = std::min(nx_ - 1, static_cast<int>(std::floor((hi.x() - origin_.x()) / cell_)));
+    const int y1 = std::min(ny_ - 1, static_cast<int>(std::floor((hi.y() - origin_.y()) / cell_)));
+    const int z1 = std::min(nz_ - 1, static_cast<int>(std::floor((hi.z() - origin_.z()) / cell_)));
+    if (x0 > x1 || y0 > y1 || z0 > z1) continue;
+    const Eigen::Vector2d beta(d.dot(c.e_a) / c.a, d.dot(c.e_b) / c.b);
+    const double bb = beta.squaredNorm();
+    for (int iz = z0; iz <= z1; ++iz) {
+      for (int iy = y0; iy <= y1; ++iy) {
+        const int row = (iz * ny_ + iy) * nx_;
+        for (int k = cell_start_[row + x0]; k < cell_start_[row + x1 + 1]; ++k) {
+          const int idx = order_[k];
+          const Eigen::Vector3d q = points_[idx] - c.p;
+          // Only the side the tool is on, within the contact's reach normal to it.
+          if (std::abs(q.dot(c.n)) > reach || normals_[idx].dot(c.n) <= 0.0) continue;
+          const Eigen::Vector2d alpha(q.dot(c.e_a) / c.a, q.dot(c.e_b) / c.b);
+          // Cheap rejection: farther than 1 (elliptic units) from the segment's line.
+          const double cross = alpha.x() * beta.y() - alpha.y() * beta.x();
+          if (cross * cross >= bb && bb > 1e-24) continue;
+          const double I = SegmentPressureIntegral(alpha, beta);
+          if (I > 0.0) h[idx] += scale * I;
+        }
+      }
+    }
+  }
+  return h;
+}
+
+RemovalStats ComputeRemovalStats(const std::vector<double>& removal, const std::vector<double>& area,
+                                 const std::vector<char>& mask) {
+  RemovalStats s;
+  double w = 0, m = 0;
+  s.min = 1e300;
+  s.max = -1e300;
+  for (size_t k = 0; k < removal.size(); ++k) {
+    if (!mask.empty() && !mask[k]) continue;
+    w += area[k];
+    m += area[k] * removal[k];
+    s.min = std::min(s.min, removal[k]);
+    s.max = std::max(s.max, removal[k]);
+  }
+  if (!(w > 0)) return RemovalStats{};
+  s.mean = m / w;
+  double var = 0;
+  long n = 0, covered = 0;
+  for (size_t k = 0; k < removal.size(); ++k) {
+    if (!mask.empty() && !mask[k]) continue;
+    var += area[k] * (removal[k] - s.mean) * (removal[k] - s.mean);
+    ++n;
+    if (removal[k] > 0.1 * s.mean) ++covered;
+  }
+  s.variance = var / w;
+  s.std = std::sqrt(s.variance);
+  s.cv = s.mean > 0 ? s.std / s.mean : 0.0;
+  s.peak_to_valley = s.max - s.min;
+  s.coverage = n > 0 ? static_cast<double>(covered) / n : 0.0;
+  return s;
+}
+
+}  // namespace robomach::polishing

@@ -1,0 +1,201 @@
+#include "robomach/polishing/paths.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "polishing/test_surfaces.h"
+#include "robomach/common/units.h"
+#include "robomach/polishing/optimise.h"
+
+namespace robomach::polishing {
+namespace {
+
+PolishingProcess Process(double margin = 0.003) {
+  PolishingProcess p;
+  p.margin = margin;
+  return p;
+}
+
+void ExpectValidFrames(const PlannedPath& path, double max_speed) {
+  ASSERT_GT(path.rows.size(), 10u);
+  for (size_t i = 0; i < path.rows.size(); ++i) {
+    const PathRow& r = path.rows[i];
+    EXPECT_NEAR(r.n.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(r.tx.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(r.tx.dot(r.n), 0.0, 1e-12);
+    if (i > 0) {
+      ASSERT_GT(r.t, path.rows[i - 1].t) << i;
+    }
+  }
+  EXPECT_LE(MaxSpeed(path.rows), max_speed * (1 + 1e-9));
+}
+
+TEST(Paths, CycloidOnPlaneStaysNearItsGuideLines) {
+  const NurbsSurface plane = testing::Plane(0.08, 0.05);
+  const PolishingProcess proc = Process();
+  const SampleGrid grid = SampleGrid::Build(plane, 0.5e-3, proc.margin, false);
+  PathParameters p;
+  p.guides = GuideLines::kParallelLines;
+  p.offset = 0.008;
+  p.radius = 0.006;
+  p.pitch = 0.003;
+  const PlannedPath path = PlanPath(plane, grid, p, proc);
+  ExpectValidFrames(path, proc.max_speed);
+  // Guide lines along x at spacing d, centred in the region [3, 47] mm.
+  ASSERT_EQ(path.guide_lines.size(), 6u);
+  EXPECT_NEAR(path.guide_lines[1].front().y() - path.guide_lines[0].front().y(), 0.008, 1e-9);
+  EXPECT_NEAR(0.5 * (path.guide_lines.front().front().y() + path.guide_lines.back().front().y()), 0.025, 1e-9);
+  for (const PathRow& r : path.rows) {
+    EXPECT_NEAR(r.p.z(), 0.0, 1e-15);
+    EXPECT_NEAR(std::abs(r.tx.x()), 1.0, 1e-12);  // tool x along the guide line (seed eq. 16)
+    double nearest = 1e9;
+    for (const auto& g : path.guide_lines) nearest = std::min(nearest, std::abs(r.p.y() - g.front().y()));
+    EXPECT_LE(nearest, p.radius + 1e-9);
+  }
+  // Seed parametrisation: pitch = 2 pi v / omega.
+  EXPECT_NEAR(2 * kPi * path.centre_speed / path.omega_rad_per_s, p.pitch, 1e-12);
+}
+
+TEST(Paths, OffsetLoopsOnCylinderLieOnTheSurface) {
+  const double R = 0.04;
+  const NurbsSurface cyl = testing::Cylinder(R, 0.06);
+  const PolishingProcess proc = Process(0.005);
+  const SampleGrid grid = SampleGrid::Build(cyl, 0.5e-3, proc.margin, false);
+  EXPECT_NEAR(grid.length_s(), 2 * kPi * R, 1e-6);  // arc length of the circle
+  PathParameters p;
+  const PlannedPath path = PlanPath(cyl, grid, p, proc);
+  ExpectValidFrames(path, proc.max_speed);
+  for (const PathRow& r : path.rows) {
+    EXPECT_NEAR(std::hypot(r.p.x(), r.p.y()), R, 1e-12);
+    EXPECT_NEAR(r.n.dot(Eigen::Vector3d(r.p.x(), r.p.y(), 0).normalized()), 1.0, 1e-9);
+  }
+}
+
+TEST(Paths, TargetRemovalSetsTheSpeedOrSaysItCannot) {
+  const NurbsSurface plane = testing::Plane(0.06, 0.04);
+  const PolishingProcess proc = Process();
+  const SampleGrid grid = SampleGrid::Build(plane, 0.5e-3, proc.margin, false);
+  const RemovalSimulator sim(plane, proc, grid.points(), grid.normals(), 0.003);
+  PathParameters p;
+  p.pattern = Pattern::kParallel;
+  p.offset = ContactWidthAtCentre(plane, grid, proc);
+  PlannedPath path = PlanPath(plane, grid, p, proc);
+  const double target = 2e-6;
+  const TargetResult ok = ScaleToTargetRemoval(sim, grid, target, proc.max_speed, &path);
+  EXPECT_TRUE(ok.reached) << ok.message;
+  EXPECT_NEAR(ok.mean / target, 1.0, 1e-6);
+  const auto check = ComputeRemovalStats(sim.Simulate(path.rows), grid.areas(), grid.in_region());
+  EXPECT_NEAR(check.mean / target, 1.0, 1e-6);
+  EXPECT_LE(MaxSpeed(path.rows), proc.max_speed * (1 + 1e-9));
+  // A target so small that it needs more than the speed limit.
+  PlannedPath fast = PlanPath(plane, grid, p, proc);
+  const TargetResult no = ScaleToTargetRemoval(sim, grid, 1e-9, proc.max_speed, &fast);
+  EXPECT_FALSE(no.reached);
+  EXPECT_NE(no.message.find("max_speed_mm_per_s"), std::string::npos);
+  EXPECT_NEAR(MaxSpeed(fast.rows), proc.max_speed, 1e-9);
+  EXPECT_GT(no.mean, 1e-9);
+}
+
+TEST(Paths, AttachFindsParametersAndRejectsRowsOffTheSurface) {
+  const NurbsSurface s = testing::DoublyCurved();
+  const SampleGrid grid = SampleGrid::Build(s, 1e-3, 0.0, false);
+  std::vector<PathRow> rows(3);
+  const double uv[3][2] = {{0.2, 0.3}, {0.5, 0.5}, {0.8, 0.1}};
+  for (int i = 0; i < 3; ++i) {
+    const SurfaceDerivatives d = s.Evaluate(uv[i][0], uv[i][1]);
+    rows[i].p = d.S;
+    rows[i].n = UnitNormal(d);
+    rows[i].tx = d.S_u.normalized();
+    rows[i].u = rows[i].v = std::nan("");
+  }
+  AttachToSurface(s, grid, false, &rows);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(rows[i].u, uv[i][0], 1e-9);
+    EXPECT_NEAR(rows[i].v, uv[i][1], 1e-9);
+  }
+  rows[2].p += 0.02e-3 * rows[2].n;  // 0.02 mm above the surface
+  rows[2].u = rows[2].v = std::nan("");
+  try {
+    AttachToSurface(s, grid, false, &rows);
+    FAIL();
+  } catch (const PathRowError& e) {
+    EXPECT_EQ(e.row(), 2);
+    EXPECT_NE(std::string(e.what()).find("0.02 mm off the surface"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Paths, SeedFeasibilityLimits) {
+  PathParameters p;
+  p.offset = 0.013;
+  p.radius = 0.006;
+  EXPECT_THROW(CheckValid(p), std::invalid_argument);  // d > 2r
+  p.offset = 0.008;
+  p.pitch = 2 * kPi * p.radius;
+  EXPECT_THROW(CheckValid(p), std::invalid_argument);  // no loops
+}
+
+// Both optimisers on a smooth bowl with a known minimum inside the box.
+TEST(Optimise, NloptAndPsoFindAKnownMinimum) {
+  const double d0 = 0.012, ratio0 = 0.8, pr0 = 1.0;
+  auto f = [&](const PathParameters& p) {
+    const double a = (p.offset - d0) / 0.01, b = (p.radius / p.offset - ratio0) / 0.2, c = (p.pitch / p.radius - pr0);
+    return 0.05 + a * a + b * b + c * c;
+  };
+  PathParameters start;
+  for (Optimiser m : {Optimiser::kNlopt, Optimiser::kPso}) {
+    OptimiseOptions o;
+    o.method = m;
+    const OptimiseResult r = OptimiseCycloid(f, start, o);
+    EXPECT_NEAR(r.best.offset, d0, 1e-3) << r.method;
+    EXPECT_NEAR(r.best.radius / r.best.offset, ratio0, 0.03) << r.method;
+    EXPECT_NEAR(r.best.pitch / r.best.radius, pr0, 0.05) << r.method;
+    EXPECT_NEAR(r.best_value, 0.05, 2e-3) << r.method;
+    for (size_t i = 1; i < r.history.size(); ++i) EXPECT_LE(r.history[i], r.history[i - 1]);
+    if (m == Optimiser::kPso) {
+      EXPECT_LE(r.history.size(), 100u);
+      EXPECT_EQ(r.status, "converged");
+    }
+  }
+}
+
+
+// Issue 11 acceptance on a plane (80 x 50 mm, margin 5 mm, the demo
+// process): the NLopt-optimised cycloid is more uniform than the default
+// cycloid and the default zig-zag (rows one contact width apart), with full
+// coverage. cv is scale-free, so no target timing is needed here.
+TEST(Optimise, NloptCycloidBeatsDefaultsOnAPlane) {
+  const NurbsSurface plane = testing::Plane(0.08, 0.05);
+  const PolishingProcess proc = Process(0.005);
+  const SampleGrid fine = SampleGrid::Build(plane, 0.5e-3, proc.margin, false);
+  const SampleGrid coarse = SampleGrid::Build(plane, 1e-3, proc.margin, false);
+  const double w = ContactWidthAtCentre(plane, fine, proc);
+  const RemovalSimulator fine_sim(plane, proc, fine.points(), fine.normals(), 0.5 * w);
+  const RemovalSimulator coarse_sim(plane, proc, coarse.points(), coarse.normals(), 0.5 * w);
+  auto stats = [&](const SampleGrid& g, const RemovalSimulator& sim, const PathParameters& p) {
+    const PlannedPath path = PlanPath(plane, g, p, proc);
+    return ComputeRemovalStats(sim.Simulate(path.rows), g.areas(), g.in_region());
+  };
+  PathParameters cycloid;  // defaults: d 8, r 6, pitch 3 mm
+  PathParameters parallel;
+  parallel.pattern = Pattern::kParallel;
+  parallel.offset = w;
+  const double cv_cycloid = stats(fine, fine_sim, cycloid).cv;
+  const double cv_parallel = stats(fine, fine_sim, parallel).cv;
+  PathParameters base = cycloid;
+  base.row_step = 1e-3;
+  OptimiseOptions o;
+  o.offset_min = w;
+  const OptimiseResult r = OptimiseCycloid(
+      [&](const PathParameters& p) { return stats(coarse, coarse_sim, p).cv; }, base, o);
+  PathParameters best = r.best;
+  best.row_step = 0.5e-3;
+  const RemovalStats opt = stats(fine, fine_sim, best);
+  EXPECT_LT(opt.cv, 0.8 * cv_cycloid) << cv_cycloid;
+  EXPECT_LT(opt.cv, 0.8 * cv_parallel) << cv_parallel;
+  EXPECT_GE(opt.coverage, 0.99);
+  EXPECT_LE(r.evaluations, o.global_evaluations + o.local_evaluations + 2);
+}
+
+}  // namespace
+}  // namespace robomach::polishing
