@@ -125,6 +125,28 @@ void ClampTheta(Eigen::VectorXd* theta, double max_abs_h) {
   for (int j = 1; j < theta->size(); ++j) (*theta)(j) = std::clamp((*theta)(j), lo, hi);
 }
 
+// One Newton step `step` from θ, halved until the cost does not rise (at
+// most 30 times), θ clamped to its bounds. Returns false if no step was
+// accepted; sets *small when the gain or the step is at round-off level.
+template <typename Cost>
+bool DampedStep(const Cost& cost_of, const Eigen::VectorXd& step, double max_abs_h, Eigen::VectorXd* theta,
+                double* cost, bool* small) {
+  double lambda = 1.0;
+  for (int tries = 0; tries < 30; ++tries, lambda *= 0.5) {
+    Eigen::VectorXd t2 = *theta + lambda * step;
+    ClampTheta(&t2, max_abs_h);
+    const double c2 = cost_of(t2);
+    if (c2 <= *cost) {
+      const double gain = *cost - c2;
+      *theta = t2;
+      *cost = c2;
+      *small = gain < 1e-9 * std::max(1.0, std::abs(c2)) || (lambda * step).cwiseAbs().maxCoeff() < 1e-7;
+      return true;
+    }
+  }
+  return false;
+}
+
 struct ScatterFit {
   Eigen::VectorXd theta;
   int iterations{0};
@@ -218,28 +240,11 @@ ScatterFit FitTerms(const dynamics::Frf& frf, const Eigen::VectorXd& a, const Fl
       info.diagonal().array() += 1e-9;
       const Eigen::VectorXd step = info.ldlt().solve(-score);
       if (!step.allFinite()) break;
-      double lambda = 1.0;
-      bool accepted = false;
-      for (int tries = 0; tries < 30; ++tries, lambda *= 0.5) {
-        Eigen::VectorXd t2 = theta + lambda * step;
-        ClampTheta(&t2, max_abs_h);
-        const double c2 = nll(t2);
-        if (c2 <= cost) {
-          const double gain = cost - c2;
-          theta = t2;
-          cost = c2;
-          accepted = true;
-          if (gain < 1e-9 * std::max(1.0, std::abs(cost)) || (lambda * step).cwiseAbs().maxCoeff() < 1e-7) {
-            converged = true;
-          }
-          break;
-        }
-      }
-      if (!accepted) {
-        converged = true;  // no descent left at round-off level
+      // No descent left at round-off level counts as converged too.
+      if (!DampedStep(nll, step, max_abs_h, &theta, &cost, &converged) || converged) {
+        converged = true;
         break;
       }
-      if (converged) break;
     }
     out.converged = converged;
     // Drop the terms where the signal is not smooth on the grid, refit.
@@ -299,22 +304,8 @@ ScatterFit FitToSigma(const dynamics::Frf& frf, const Eigen::VectorXd& a, const 
     A.diagonal().array() += 1e-9;
     const Eigen::VectorXd step = A.ldlt().solve(-grad);
     if (!step.allFinite()) break;
-    double lambda = 1.0;
-    bool accepted = false;
-    for (int tries = 0; tries < 30; ++tries, lambda *= 0.5) {
-      Eigen::VectorXd t2 = theta + lambda * step;
-      ClampTheta(&t2, max_abs_h);
-      const double c2 = cost_of(t2);
-      if (c2 <= cost) {
-        const double gain = cost - c2;
-        theta = t2;
-        cost = c2;
-        accepted = true;
-        if (gain < 1e-10 * std::max(1.0, cost)) out.converged = true;
-        break;
-      }
-    }
-    if (!accepted || out.converged) {
+    bool small = false;
+    if (!DampedStep(cost_of, step, max_abs_h, &theta, &cost, &small) || small) {
       out.converged = true;
       break;
     }
