@@ -8,6 +8,29 @@
 
 namespace robomach::polishing {
 
+namespace {
+
+// The ellipse's axes in the tool frame (tx, ty) and the belt-width check,
+// for ContactAt and RemovalSimulator::Contacts alike.
+// @throws std::domain_error when the contact is wider than the belt.
+void SetEllipse(const ContactEllipse& e, const Eigen::Vector3d& tx, const Eigen::Vector3d& ty, double belt_width,
+                ToolContact* c) {
+  c->a = e.a;
+  c->b = e.b;
+  c->p0 = e.p0;
+  c->e_a = e.dir_a(0) * tx + e.dir_a(1) * ty;
+  c->e_b = e.dir_b(0) * tx + e.dir_b(1) * ty;
+  // Half-width across the belt (along tool y).
+  const double half_width = std::hypot(e.a * e.dir_a(1), e.b * e.dir_b(1));
+  if (2.0 * half_width > belt_width) {
+    std::ostringstream m;
+    m << "contact width " << 2e3 * half_width << " mm across the belt exceeds belt_width_mm " << 1e3 * belt_width;
+    throw std::domain_error(m.str());
+  }
+}
+
+}  // namespace
+
 ToolContact ContactAt(const SurfaceDerivatives& d, const Eigen::Vector3d& tool_x, const PolishingProcess& process,
                       double force) {
   ToolContact c;
@@ -19,20 +42,7 @@ ToolContact ContactAt(const SurfaceDerivatives& d, const Eigen::Vector3d& tool_x
   Eigen::Matrix2d K = CurvatureTensor(d, tx, ty, process.flip_normal);
   K(0, 0) += 1.0 / process.wheel_radius;
   K(1, 1) += 1.0 / process.crown_radius;
-  const ContactEllipse e = HertzContact(K, force, EffectiveModulus(process));
-  c.a = e.a;
-  c.b = e.b;
-  c.p0 = e.p0;
-  c.e_a = e.dir_a(0) * tx + e.dir_a(1) * ty;
-  c.e_b = e.dir_b(0) * tx + e.dir_b(1) * ty;
-  // Half-width across the belt (along tool y).
-  const double half_width = std::hypot(e.a * e.dir_a(1), e.b * e.dir_b(1));
-  if (2.0 * half_width > process.belt_width) {
-    std::ostringstream m;
-    m << "contact width " << 2e3 * half_width << " mm across the belt exceeds belt_width_mm "
-      << 1e3 * process.belt_width;
-    throw std::domain_error(m.str());
-  }
+  SetEllipse(HertzContact(K, force, EffectiveModulus(process)), tx, ty, process.belt_width, &c);
   return c;
 }
 
@@ -115,18 +125,7 @@ std::vector<ToolContact> RemovalSimulator::Contacts(const std::vector<PathRow>& 
         last_K = K;
         last_force = force;
       }
-      c.a = last.a;
-      c.b = last.b;
-      c.p0 = last.p0;
-      c.e_a = last.dir_a(0) * tx + last.dir_a(1) * ty;
-      c.e_b = last.dir_b(0) * tx + last.dir_b(1) * ty;
-      const double half_width = std::hypot(last.a * last.dir_a(1), last.b * last.dir_b(1));
-      if (2.0 * half_width > process_.belt_width) {
-        std::ostringstream m;
-        m << "contact width " << 2e3 * half_width << " mm across the belt exceeds belt_width_mm "
-          << 1e3 * process_.belt_width;
-        throw std::domain_error(m.str());
-      }
+      SetEllipse(last, tx, ty, process_.belt_width, &c);
     } catch (const std::domain_error& e) {
       throw PathRowError(static_cast<int>(r), e.what());
     }
