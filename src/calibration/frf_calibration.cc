@@ -393,6 +393,13 @@ StageOutcome SolveStage(const std::string& stage_name, ModelResidual residual, c
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;
   so.num_threads = 1;
+  // The bounds make the problem constrained, and Ceres then refines every
+  // trust-region step by a projected line search. With its default
+  // (cubic) interpolation each trial point costs a numeric Jacobian,
+  // 2n + 1 model evaluations; bisection needs only the cost there. On
+  // 6 x 2 x 4096-line data this cut a 9-parameter fit from 141 Jacobians
+  // (33 s) to 22 (6 s) with the same result.
+  so.line_search_interpolation_type = ceres::BISECTION;
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
   out.termination = summary.termination_type;

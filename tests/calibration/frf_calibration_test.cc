@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <random>
 #include <set>
 
 #include "robomach/calibration/frf_calibration.h"
@@ -20,6 +21,34 @@ namespace {
 
 using robomach::testing::SourcePath;
 using robomach::testing::TempDir;
+
+// The residual pair without division, atan2 or sin against its definition
+// ln|Hm/H|, 2 sin(arg(Hm/H)/2): random pairs over 12 decades of magnitude
+// and every phase, and phase errors near 0 and near ±π (where the two
+// branches of the chord formula meet their limits).
+TEST(WholeCurveResiduals, MatchTheirDefinition) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> phase(-kPi, kPi), decade(-12.0, 0.0);
+  const auto reference = [](std::complex<double> hm, std::complex<double> h) {
+    const std::complex<double> ratio = hm / h;
+    return std::array<double, 2>{std::log(std::abs(ratio)), 2.0 * std::sin(0.5 * std::arg(ratio))};
+  };
+  const auto check = [&](std::complex<double> hm, std::complex<double> h) {
+    const auto a = WholeCurveResiduals(hm, h);
+    const auto b = reference(hm, h);
+    EXPECT_NEAR(a[0], b[0], 1e-13 * (1.0 + std::abs(b[0]))) << hm << " " << h;
+    EXPECT_NEAR(a[1], b[1], 1e-13) << hm << " " << h;
+  };
+  for (int i = 0; i < 20000; ++i) {
+    const std::complex<double> h = std::polar(std::pow(10.0, decade(rng)), phase(rng));
+    check(std::polar(std::pow(10.0, decade(rng)), phase(rng)), h);
+    // Phase errors of 1e-9..1e-3 rad and within that of ±π.
+    const double d = std::pow(10.0, -9.0 + 6.0 * (i % 1000) / 1000.0) * (i % 2 ? 1.0 : -1.0);
+    check(h * std::polar(1.3, d), h);
+    check(h * std::polar(0.7, kPi - std::abs(d)), h);
+    check(h * std::polar(0.7, -kPi + std::abs(d)), h);
+  }
+}
 
 struct TestCampaign {
   io::RobotConfig cfg;

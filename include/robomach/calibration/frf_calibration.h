@@ -107,9 +107,21 @@ std::vector<ModeMatch> MatchModes(const std::map<std::string, dynamics::PostureD
 /// equals Δφ to O(Δφ³) but, unlike Δφ wrapped to (−π, π], is smooth where
 /// the phase error passes ±π; wrapped phases gave numeric derivatives of
 /// 2π/h there and stalled whole-curve fits for dozens of iterations.
+///
+/// Computed without a complex division, atan2 or sin (the audit evaluates it
+/// for every line at every numeric-derivative step): with z = Hm conj(H),
+/// cos Δφ = Re z/|z|, sin Δφ = Im z/|z|, and 2 sin(Δφ/2) = sin Δφ / cos(Δφ/2)
+/// for cos Δφ >= 0 (no cancellation near Δφ = 0), ±2 √((1 − cos Δφ)/2)
+/// otherwise (none near ±π). Agrees with ln|Hm/H|, 2 sin(arg(Hm/H)/2) to
+/// round-off (tested).
 inline std::array<double, 2> WholeCurveResiduals(std::complex<double> h_model, std::complex<double> h_measured) {
-  const std::complex<double> ratio = h_model / h_measured;
-  return {std::log(std::abs(ratio)), 2.0 * std::sin(0.5 * std::arg(ratio))};
+  const double nm = std::norm(h_model), nh = std::norm(h_measured);
+  const double zr = h_model.real() * h_measured.real() + h_model.imag() * h_measured.imag();
+  const double zi = h_model.imag() * h_measured.real() - h_model.real() * h_measured.imag();
+  const double inv = 1.0 / std::sqrt(nm * nh);  // 1/|z|
+  const double c = zr * inv, s = zi * inv;
+  const double chord = c >= 0.0 ? s / std::sqrt(0.5 * (1.0 + c)) : std::copysign(2.0 * std::sqrt(0.5 * (1.0 - c)), s);
+  return {0.5 * std::log(nm / nh), chord};
 }
 
 /// Whole-curve error of the model against one measured FRF over a band:
