@@ -1,0 +1,243 @@
+// Issue #10 acceptance: the issue #5 table again, on hammer data as they
+// really come. Accelerance files of a 5120 Hz test (0.625..2560 Hz, 4096
+// lines per FRF, through a CSV file and back) at six postures, xx and yy,
+// 2 % relative noise plus an additive floor (flat in acceleration, flat in
+// receptance, raised above the hammer's 1 kHz cutoff): the signal-to-noise
+// ratio falls below 1 a few hundred hertz up and at the lowest lines. The
+// audit runs as model-audit does with its defaults: a noise model per FRF
+// from the scatter of the data (no coherence), the usable lines with their
+// σ, every library effect a candidate. Its errors are in noise units, so
+// the true model's error is about 1 and "explained" means within 1.3 × the
+// noise (AuditOptions::explained_factor).
+//
+// The calibration parameters of the truth are off the config (audit test
+// support: +10 %, −8 %, +20 %, −15 %); each case hides one effect (the same
+// realistic values as audit_acceptance_test.cc), none, two, or one outside
+// the library. The seeds here were not used while tuning the audit (the
+// runs behind the README's table used others).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <iostream>
+#include <set>
+
+#include "audit_test_support.h"
+#include "robomach/calibration/frf_noise.h"
+#include "robomach/common/units.h"
+#include "robomach/io/frf_files.h"
+
+namespace robomach::audit {
+namespace {
+
+using testing::Campaign;
+using testing::Hidden;
+using testing::Truth;
+
+// The five demonstration postures and a sixth far from them, as in the
+// issue's data set.
+Campaign MakeSixPostureCampaign() {
+  Campaign c = testing::MakeCampaign();
+  Eigen::VectorXd q(6);
+  const double deg[6] = {-40, -65, 85, 15, -50, -20};
+  for (int j = 0; j < 6; ++j) q(j) = DegToRad(deg[j]);
+  c.poses.push_back({"P6", q});
+  c.postures["P6"] = q;
+  return c;
+}
+
+calibration::VirtualHammerOptions RealisticTest(unsigned seed) {
+  calibration::VirtualHammerOptions o;
+  o.sample_rate_hz = 5120.0;
+  o.block_samples = 8192;  // Δf = 0.625 Hz
+  o.fmin_hz = 0.625;
+  o.fmax_hz = 2560.0;
+  o.relative_noise = 0.02;
+  o.absolute_noise_m_per_s2_per_N = 1.5e-4;
+  o.absolute_noise_m_per_N = 4e-9;
+  o.hammer_cutoff_hz = 1000.0;
+  o.seed = seed;
+  return o;
+}
+
+struct Outcome {
+  AuditResult result;
+  dynamics::ParameterSet truth;
+  double true_error{0.0};  // the true model's error on the same data, noise units
+};
+
+// Synthesis, the accelerance file and back, the noise model, the audit.
+Outcome Audit(const std::string& name, const std::vector<Hidden>& hidden, unsigned seed,
+              const std::function<void(dynamics::FrfSet*)>& alter = {}) {
+  const Campaign c = MakeSixPostureCampaign();
+  const auto [d, p] = Truth(c, hidden);
+  dynamics::FrfSet synth =
+      calibration::SynthesizeHammerTest(dynamics::RobotModel::Build(d, p), c.poses, RealisticTest(seed));
+  if (alter) alter(&synth);
+  const std::string path = robomach::testing::TempDir("audit_realistic_" + name) + "/hammer.csv";
+  io::WriteFrfCsv(path, synth, io::FrfQuantity::kAccelerance, 0);
+  const dynamics::FrfSet read = io::ReadFrfCsv(path).frfs;
+  const dynamics::FrfSet measured = calibration::UsableData(read, calibration::EstimateNoise(read, {}));
+  AuditOptions o;  // every library effect is a candidate
+  o.progress = [](const std::string& m) { std::cout << "  " << m << std::endl; };
+  const auto t0 = std::chrono::steady_clock::now();
+  Outcome out{RunAudit(c.cfg.description, c.cfg.parameters, c.postures, measured, o), p, 0.0};
+  std::cout << "audit in " << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
+            << " s: " << out.result.verdict << "\n";
+  for (const CandidateResult& cand : out.result.candidates) {
+    std::cout << "  " << cand.name() << ": dBIC " << cand.bic_change << ", error " << cand.errors.total_rms_log_mag
+              << (cand.plausible ? ", plausible" : ", implausible") << " (" << cand.start << ") " << cand.note << "\n";
+  }
+  out.true_error =
+      ComputeErrors(dynamics::RobotModel::Build(d, p), c.postures, measured, 0.0, 1e9, 8).total_rms_log_mag;
+  return out;
+}
+
+// Fitted values within 10 % of the truth or within their 95 % interval.
+// Joint damping: only c_i + alpha k_qi is determined (see
+// audit_acceptance_test.cc), so the truth of c_i is shifted by the fitted
+// alpha's difference from the true one.
+int ExpectParametersNearTruth(const Outcome& o, const std::string& effect, const calibration::CalibrationResult& fit) {
+  int checked = 0;
+  for (const auto& e : fit.estimates) {
+    if (e.name.rfind(effect + ".", 0) != 0) continue;
+    double truth = o.truth.Get(e.name);
+    const std::string prefix = "joint_damping.c";
+    if (e.name.rfind(prefix, 0) == 0) {
+      const std::string joint = e.name.substr(prefix.size(), 1);
+      truth += (o.truth.Get("alpha_s") - fit.parameters.Get("alpha_s")) * o.truth.Get("kq" + joint + "_Nm_per_rad");
+    }
+    const bool within_10 = std::abs(e.value / truth - 1.0) <= 0.10;
+    const bool within_ci = std::abs(e.value - truth) <= 1.96 * e.std_dev;
+    EXPECT_TRUE(within_10 || within_ci) << e.name << " = " << e.value << " ± " << e.std_dev << ", truth " << truth;
+    std::cout << "  " << e.name << " = " << e.value << " ± " << e.std_dev << " (truth " << truth << ")\n";
+    ++checked;
+  }
+  return checked;
+}
+
+struct Case {
+  std::string name;
+  std::vector<Hidden> hidden;
+  unsigned seed;
+};
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
+class HiddenEffectOnRealisticData : public ::testing::TestWithParam<Case> {};
+
+TEST_P(HiddenEffectOnRealisticData, IsFlaggedRankedFirstAndExplained) {
+  const Case& k = GetParam();
+  const Outcome o = Audit(k.name, k.hidden, k.seed);
+  const AuditResult& r = o.result;
+  EXPECT_TRUE(r.significant_failure) << r.errors_before.total_rms_log_mag;
+  ASSERT_FALSE(r.candidates.empty());
+  const CandidateResult& top = r.candidates.front();
+  EXPECT_EQ(top.name(), k.name);
+  EXPECT_LT(top.bic_change, 0.0);
+  EXPECT_TRUE(top.plausible) << top.note;
+  EXPECT_EQ(r.missing_effects, std::vector<std::string>{k.name}) << r.verdict;
+  EXPECT_TRUE(r.explained) << r.verdict;
+  // Errors in noise units: the winner's within the audit's own "explained"
+  // factor of the noise, and as close to the data as the true model's (the
+  // #5 criterion). The true model's own error is printed, not asserted: it
+  // is 0.99 for most cases but 0.84 with the long-reach tool, whose mode
+  // makes the usable band reach 2.5 kHz, where the scatter estimate of the
+  // noise comes out high (README, status of issue #10).
+  EXPECT_LT(top.errors.total_rms_log_mag, 1.3);
+  EXPECT_LT(top.errors.total_rms_log_mag, 1.1 * o.true_error);
+  std::cout << k.name << ": error before " << r.errors_before.total_rms_log_mag << ", after "
+            << top.errors.total_rms_log_mag << ", true model " << o.true_error << "\n";
+  EXPECT_GT(ExpectParametersNearTruth(o, k.name, top.fit), 0);
+}
+
+// The values of audit_acceptance_test.cc (see there for the physical
+// situations); seeds 301.. not used in tuning.
+INSTANTIATE_TEST_SUITE_P(
+    EveryDetectableLibraryEffect, HiddenEffectOnRealisticData,
+    ::testing::Values(
+        Case{"tip_mass", {{"tip_mass", {{"tip_mass.mass_kg", 0.5}}}}, 301},
+        Case{"flange_compliance", {{"flange_compliance", {{"flange_compliance.bending_stiffness_Nm_per_rad", 1e6}}}},
+             302},
+        Case{"joint_damping",
+             {{"joint_damping",
+               {{"joint_damping.c1_Nms_per_rad", 2550.0}, {"joint_damping.c2_Nms_per_rad", 4200.0},
+                {"joint_damping.c3_Nms_per_rad", 1950.0}, {"joint_damping.c4_Nms_per_rad", 60.0},
+                {"joint_damping.c5_Nms_per_rad", 120.0}, {"joint_damping.c6_Nms_per_rad", 10.5}}}},
+             303},
+        Case{"base_compliance",
+             {{"base_compliance",
+               {{"base_compliance.lateral_stiffness_N_per_m", 3e8},
+                {"base_compliance.rocking_stiffness_Nm_per_rad", 2e7}}}},
+             304},
+        Case{"tool_flexibility",
+             {{"tool_flexibility", {{"tool_flexibility.diameter_m", 0.012}, {"tool_flexibility.stick_out_m", 0.06}}}},
+             305},
+        Case{"spindle_interface",
+             {{"spindle_interface",
+               {{"spindle_interface.translational_scale", 1.5}, {"spindle_interface.tilting_scale", 10.0}}}},
+             306}),
+    [](const ::testing::TestParamInfo<Case>& i) { return i.param.name; });
+
+// Nothing missing: no alarm (the issue found "12 of 12 FRFs fail
+// significantly" here before the noise model).
+TEST(NothingMissingOnRealisticData, RaisesNoAlarm) {
+  const Outcome o = Audit("none", {}, 307);
+  EXPECT_FALSE(o.result.significant_failure) << o.result.verdict;
+  EXPECT_TRUE(o.result.missing_effects.empty());
+  EXPECT_LT(o.result.errors_before.total_rms_log_mag, 1.3);
+}
+
+TEST(TwoHiddenEffectsOnRealisticData, AreBothFound) {
+  const Outcome o = Audit("two",
+                          {{"flange_compliance", {{"flange_compliance.bending_stiffness_Nm_per_rad", 1e6}}},
+                           {"base_compliance",
+                            {{"base_compliance.lateral_stiffness_N_per_m", 3e8},
+                             {"base_compliance.rocking_stiffness_Nm_per_rad", 2e7}}}},
+                          308);
+  const AuditResult& r = o.result;
+  EXPECT_TRUE(r.significant_failure);
+  ASSERT_GE(r.best, 0) << r.verdict;
+  std::vector<std::string> found = r.missing_effects;
+  std::sort(found.begin(), found.end());
+  EXPECT_EQ(found, (std::vector<std::string>{"base_compliance", "flange_compliance"})) << r.verdict;
+  EXPECT_TRUE(r.explained) << r.verdict;
+  EXPECT_LT(r.candidates[r.best].errors.total_rms_log_mag, 1.3);
+}
+
+// Outside the library: the accelerometer's mounting resonance (320 Hz, 4 %
+// damping) in every FRF alike, inside the usable band. Reported
+// unexplained, with the pattern: the same band fails at every posture.
+TEST(EffectOutsideTheLibraryOnRealisticData, IsReportedAsUnexplainedWithItsPattern) {
+  const auto mounting = [](dynamics::FrfSet* m) {
+    dynamics::FrfSet out;
+    for (const auto& [key, frf] : *m) {
+      Eigen::VectorXcd h = frf.receptance();
+      for (int i = 0; i < frf.size(); ++i) {
+        const double r = frf.freq_hz()(i) / 320.0;
+        h(i) /= std::complex<double>(1.0 - r * r, 2.0 * 0.04 * r);
+      }
+      out.Insert(key, dynamics::Frf::FromSamples(frf.freq_hz(), h));
+    }
+    *m = out;
+  };
+  const Outcome o = Audit("outside", {}, 309, mounting);
+  const AuditResult& r = o.result;
+  EXPECT_TRUE(r.significant_failure);
+  EXPECT_FALSE(r.explained) << r.verdict;
+  EXPECT_TRUE(r.missing_effects.empty()) << r.verdict;
+  EXPECT_NE(r.verdict.find("unexplained"), std::string::npos) << r.verdict;
+  EXPECT_NE(r.pattern.find("at every posture"), std::string::npos) << r.pattern;
+  // The band with 320 Hz is the worst at every posture, in at least one
+  // direction (the error bands are common to all FRFs).
+  std::set<std::string> poses;
+  for (const CurveError& ce : r.errors_before.curves) {
+    ASSERT_FALSE(ce.bands.empty());
+    if (ce.bands[0].fmin_hz <= 320.0 && ce.bands[0].fmax_hz >= 320.0) poses.insert(ce.key.pose_id);
+  }
+  EXPECT_EQ(poses.size(), 6u);
+}
+
+}  // namespace
+}  // namespace robomach::audit
