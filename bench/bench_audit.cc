@@ -10,6 +10,7 @@
 #include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/io/frf_files.h"
 #include "robomach/io/posture_file.h"
+#include "realistic_hammer_test.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/common/units.h"
 
@@ -63,9 +64,12 @@ void BM_FullAudit_Realistic_6x2x4096(benchmark::State& state) {
   std::vector<calibration::NamedPosture> poses;
   calibration::PostureMap postures;
   for (const auto& p : io::ReadPostureFile(root + "/config/postures_demo.csv", 6)) poses.push_back({p.id, p.q});
-  Eigen::VectorXd q6(6);
-  q6 << -40, -65, 85, 15, -50, -20;
-  poses.push_back({"P6", q6 * kPi / 180.0});
+  {
+    const auto [id, deg] = robomach::testing::SixthPostureDeg();
+    Eigen::VectorXd q6(6);
+    for (int j = 0; j < 6; ++j) q6(j) = DegToRad(deg[j]);
+    poses.push_back({id, q6});
+  }
   for (const auto& p : poses) postures[p.id] = p.q;
   dynamics::RobotDescription d = cfg.description;
   dynamics::ParameterSet p = cfg.parameters;
@@ -87,16 +91,7 @@ void BM_FullAudit_Realistic_6x2x4096(benchmark::State& state) {
   }
   p.Set("m6_kg", cfg.parameters.Get("m6_kg") + 3.0);
   p.Set("d6_m", cfg.parameters.Get("d6_m") + 0.015);
-  calibration::VirtualHammerOptions h;
-  h.sample_rate_hz = 5120.0;
-  h.block_samples = 8192;
-  h.fmin_hz = 0.625;
-  h.fmax_hz = 2560.0;
-  h.relative_noise = 0.02;
-  h.absolute_noise_m_per_s2_per_N = 1.5e-4;
-  h.absolute_noise_m_per_N = 4e-9;
-  h.hammer_cutoff_hz = 1000.0;
-  h.seed = 11;
+  const calibration::VirtualHammerOptions h = robomach::testing::RealisticHammerTest(11);
   const dynamics::FrfSet raw = calibration::SynthesizeHammerTest(dynamics::RobotModel::Build(d, p), poses, h);
   AuditOptions o;
   o.threads = 2;

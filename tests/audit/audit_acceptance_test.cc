@@ -90,48 +90,17 @@ Outcome Audit(const Campaign& c, const std::vector<Hidden>& hidden, unsigned see
   o.progress = [](const std::string& m) { std::cout << "  " << m << std::endl; };
   const auto t0 = std::chrono::steady_clock::now();
   Outcome out{RunAudit(c.cfg.description, c.cfg.parameters, c.postures, measured, o), 0.0, p, measured};
-  std::cout << "audit in " << Seconds(t0) << " s: " << out.result.verdict << "\n";
-  for (const CandidateResult& cand : out.result.candidates) {
-    std::cout << "  " << cand.name() << ": dBIC " << cand.bic_change << ", error " << cand.errors.total_rms_log_mag
-              << (cand.plausible ? ", plausible" : ", implausible") << " (" << cand.start << ") " << cand.note << "\n";
-  }
+  testing::PrintAudit(out.result, Seconds(t0));
   out.true_error =
       ComputeErrors(dynamics::RobotModel::Build(d, p), c.postures, measured, 0.0, 1e9, 8).total_rms_log_mag;
   return out;
-}
-
-// The value a fitted parameter is compared with. Joint damping and the
-// stiffness-proportional Rayleigh term are the same matrix (alpha K_q is
-// the diagonal joint damping alpha k_qi), so only c_i + alpha k_qi is
-// determined (the audit holds alpha_s, at 0): given the fitted alpha, the
-// truth of c_i is c_i,true + (alpha_true − alpha_fit) k_qi.
-double Expected(const Outcome& o, const dynamics::ParameterSet& fitted, const std::string& name) {
-  double v = o.truth.Get(name);
-  const std::string prefix = "joint_damping.c";
-  if (name.rfind(prefix, 0) == 0) {
-    const std::string joint = name.substr(prefix.size(), 1);
-    v += (o.truth.Get("alpha_s") - fitted.Get("alpha_s")) * o.truth.Get("kq" + joint + "_Nm_per_rad");
-  }
-  return v;
 }
 
 // Fitted values within 10 % of the truth or within their 95 % interval.
 int ExpectParametersNearTruth(const Outcome& o, const std::string& effect,
                               const std::vector<calibration::ParameterEstimate>& estimates,
                               const dynamics::ParameterSet& fitted, const std::string& label) {
-  int checked = 0;
-  for (const auto& e : estimates) {
-    if (e.name.rfind(effect + ".", 0) != 0) continue;
-    const double truth = Expected(o, fitted, e.name);
-    const bool within_10 = std::abs(e.value / truth - 1.0) <= 0.10;
-    const bool within_ci = std::abs(e.value - truth) <= 1.96 * e.std_dev;
-    EXPECT_TRUE(within_10 || within_ci)
-        << label << ": " << e.name << " = " << e.value << " ± " << e.std_dev << ", truth " << truth;
-    std::cout << "  " << label << ": " << e.name << " = " << e.value << " ± " << e.std_dev << " (truth " << truth
-              << ")\n";
-    ++checked;
-  }
-  return checked;
+  return testing::ExpectParametersNearTruth(o.truth, effect, estimates, fitted, label);
 }
 
 class HiddenEffect : public ::testing::TestWithParam<Case> {};
@@ -199,10 +168,7 @@ TEST(HiddenEffectBelowDetection, GravityStiffnessIsWithinTheNoiseAndRaisesNoAlar
 TEST(TwoHiddenEffects, AreBothFound) {
   const Campaign c = MakeCampaign();
   const Outcome o = Audit(c,
-                          {{"flange_compliance", {{"flange_compliance.bending_stiffness_Nm_per_rad", 1e6}}},
-                           {"base_compliance",
-                            {{"base_compliance.lateral_stiffness_N_per_m", 3e8},
-                             {"base_compliance.rocking_stiffness_Nm_per_rad", 2e7}}}},
+                          testing::SoftFlangeOnSoftFoundation(),
                           108);
   const AuditResult& r = o.result;
   EXPECT_TRUE(r.significant_failure);
@@ -223,19 +189,8 @@ TEST(TwoHiddenEffects, AreBothFound) {
 // every posture).
 TEST(EffectOutsideTheLibrary, IsReportedAsUnexplainedWithItsPattern) {
   const Campaign c = MakeCampaign();
-  const auto mounting = [](dynamics::FrfSet* m) {
-    dynamics::FrfSet out;
-    for (const auto& [key, frf] : *m) {
-      Eigen::VectorXcd h = frf.receptance();
-      for (int i = 0; i < frf.size(); ++i) {
-        const double r = frf.freq_hz()(i) / 320.0;
-        h(i) /= std::complex<double>(1.0 - r * r, 2.0 * 0.04 * r);
-      }
-      out.Insert(key, dynamics::Frf::FromSamples(frf.freq_hz(), h));
-    }
-    *m = out;
-  };
-  const Outcome o = Audit(c, {}, 109, mounting);
+
+  const Outcome o = Audit(c, {}, 109, testing::ApplyMountingResonance);
   const AuditResult& r = o.result;
   EXPECT_TRUE(r.significant_failure);
   EXPECT_FALSE(r.explained) << r.verdict;

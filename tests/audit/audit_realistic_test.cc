@@ -25,6 +25,7 @@
 #include <set>
 
 #include "audit_test_support.h"
+#include "realistic_hammer_test.h"
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/common/units.h"
 #include "robomach/io/frf_files.h"
@@ -40,26 +41,12 @@ using testing::Truth;
 // issue's data set.
 Campaign MakeSixPostureCampaign() {
   Campaign c = testing::MakeCampaign();
+  const auto [id, deg] = robomach::testing::SixthPostureDeg();
   Eigen::VectorXd q(6);
-  const double deg[6] = {-40, -65, 85, 15, -50, -20};
   for (int j = 0; j < 6; ++j) q(j) = DegToRad(deg[j]);
-  c.poses.push_back({"P6", q});
-  c.postures["P6"] = q;
+  c.poses.push_back({id, q});
+  c.postures[id] = q;
   return c;
-}
-
-calibration::VirtualHammerOptions RealisticTest(unsigned seed) {
-  calibration::VirtualHammerOptions o;
-  o.sample_rate_hz = 5120.0;
-  o.block_samples = 8192;  // Δf = 0.625 Hz
-  o.fmin_hz = 0.625;
-  o.fmax_hz = 2560.0;
-  o.relative_noise = 0.02;
-  o.absolute_noise_m_per_s2_per_N = 1.5e-4;
-  o.absolute_noise_m_per_N = 4e-9;
-  o.hammer_cutoff_hz = 1000.0;
-  o.seed = seed;
-  return o;
 }
 
 struct Outcome {
@@ -74,7 +61,8 @@ Outcome Audit(const std::string& name, const std::vector<Hidden>& hidden, unsign
   const Campaign c = MakeSixPostureCampaign();
   const auto [d, p] = Truth(c, hidden);
   dynamics::FrfSet synth =
-      calibration::SynthesizeHammerTest(dynamics::RobotModel::Build(d, p), c.poses, RealisticTest(seed));
+      calibration::SynthesizeHammerTest(dynamics::RobotModel::Build(d, p), c.poses,
+                                        robomach::testing::RealisticHammerTest(seed));
   if (alter) alter(&synth);
   const std::string path = robomach::testing::TempDir("audit_realistic_" + name) + "/hammer.csv";
   io::WriteFrfCsv(path, synth, io::FrfQuantity::kAccelerance, 0);
@@ -84,38 +72,10 @@ Outcome Audit(const std::string& name, const std::vector<Hidden>& hidden, unsign
   o.progress = [](const std::string& m) { std::cout << "  " << m << std::endl; };
   const auto t0 = std::chrono::steady_clock::now();
   Outcome out{RunAudit(c.cfg.description, c.cfg.parameters, c.postures, measured, o), p, 0.0};
-  std::cout << "audit in " << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
-            << " s: " << out.result.verdict << "\n";
-  for (const CandidateResult& cand : out.result.candidates) {
-    std::cout << "  " << cand.name() << ": dBIC " << cand.bic_change << ", error " << cand.errors.total_rms_log_mag
-              << (cand.plausible ? ", plausible" : ", implausible") << " (" << cand.start << ") " << cand.note << "\n";
-  }
+  testing::PrintAudit(out.result, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   out.true_error =
       ComputeErrors(dynamics::RobotModel::Build(d, p), c.postures, measured, 0.0, 1e9, 8).total_rms_log_mag;
   return out;
-}
-
-// Fitted values within 10 % of the truth or within their 95 % interval.
-// Joint damping: only c_i + alpha k_qi is determined (see
-// audit_acceptance_test.cc), so the truth of c_i is shifted by the fitted
-// alpha's difference from the true one.
-int ExpectParametersNearTruth(const Outcome& o, const std::string& effect, const calibration::CalibrationResult& fit) {
-  int checked = 0;
-  for (const auto& e : fit.estimates) {
-    if (e.name.rfind(effect + ".", 0) != 0) continue;
-    double truth = o.truth.Get(e.name);
-    const std::string prefix = "joint_damping.c";
-    if (e.name.rfind(prefix, 0) == 0) {
-      const std::string joint = e.name.substr(prefix.size(), 1);
-      truth += (o.truth.Get("alpha_s") - fit.parameters.Get("alpha_s")) * o.truth.Get("kq" + joint + "_Nm_per_rad");
-    }
-    const bool within_10 = std::abs(e.value / truth - 1.0) <= 0.10;
-    const bool within_ci = std::abs(e.value - truth) <= 1.96 * e.std_dev;
-    EXPECT_TRUE(within_10 || within_ci) << e.name << " = " << e.value << " ± " << e.std_dev << ", truth " << truth;
-    std::cout << "  " << e.name << " = " << e.value << " ± " << e.std_dev << " (truth " << truth << ")\n";
-    ++checked;
-  }
-  return checked;
 }
 
 struct Case {
@@ -149,7 +109,7 @@ TEST_P(HiddenEffectOnRealisticData, IsFlaggedRankedFirstAndExplained) {
   EXPECT_LT(top.errors.total_rms_log_mag, 1.1 * o.true_error);
   std::cout << k.name << ": error before " << r.errors_before.total_rms_log_mag << ", after "
             << top.errors.total_rms_log_mag << ", true model " << o.true_error << "\n";
-  EXPECT_GT(ExpectParametersNearTruth(o, k.name, top.fit), 0);
+  EXPECT_GT(testing::ExpectParametersNearTruth(o.truth, k.name, top.fit.estimates, top.fit.parameters, "candidate"), 0);
 }
 
 // The values of audit_acceptance_test.cc (see there for the physical
@@ -191,10 +151,7 @@ TEST(NothingMissingOnRealisticData, RaisesNoAlarm) {
 
 TEST(TwoHiddenEffectsOnRealisticData, AreBothFound) {
   const Outcome o = Audit("two",
-                          {{"flange_compliance", {{"flange_compliance.bending_stiffness_Nm_per_rad", 1e6}}},
-                           {"base_compliance",
-                            {{"base_compliance.lateral_stiffness_N_per_m", 3e8},
-                             {"base_compliance.rocking_stiffness_Nm_per_rad", 2e7}}}},
+                          testing::SoftFlangeOnSoftFoundation(),
                           308);
   const AuditResult& r = o.result;
   EXPECT_TRUE(r.significant_failure);
@@ -210,19 +167,7 @@ TEST(TwoHiddenEffectsOnRealisticData, AreBothFound) {
 // damping) in every FRF alike, inside the usable band. Reported
 // unexplained, with the pattern: the same band fails at every posture.
 TEST(EffectOutsideTheLibraryOnRealisticData, IsReportedAsUnexplainedWithItsPattern) {
-  const auto mounting = [](dynamics::FrfSet* m) {
-    dynamics::FrfSet out;
-    for (const auto& [key, frf] : *m) {
-      Eigen::VectorXcd h = frf.receptance();
-      for (int i = 0; i < frf.size(); ++i) {
-        const double r = frf.freq_hz()(i) / 320.0;
-        h(i) /= std::complex<double>(1.0 - r * r, 2.0 * 0.04 * r);
-      }
-      out.Insert(key, dynamics::Frf::FromSamples(frf.freq_hz(), h));
-    }
-    *m = out;
-  };
-  const Outcome o = Audit("outside", {}, 309, mounting);
+  const Outcome o = Audit("outside", {}, 309, testing::ApplyMountingResonance);
   const AuditResult& r = o.result;
   EXPECT_TRUE(r.significant_failure);
   EXPECT_FALSE(r.explained) << r.verdict;

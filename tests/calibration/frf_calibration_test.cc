@@ -14,6 +14,7 @@
 #include "robomach/io/frf_files.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/robot_config.h"
+#include "realistic_hammer_test.h"
 #include "test_support.h"
 
 namespace robomach::calibration {
@@ -172,7 +173,7 @@ TestCampaign MakeRealisticSetup() {
   s.truth.Set("beta_per_s", 0.8 * s.cfg.parameters.Get("beta_per_s"));
   const std::vector<std::pair<std::string, std::vector<double>>> fit = {
       {"P1", {0, -90, 90, 0, 45, 0}},       {"P2", {30, -60, 100, 10, -40, 20}}, {"P3", {0, -45, 60, 0, 60, 0}},
-      {"P4", {-20, -100, 120, 30, 30, 0}}, {"P5", {10, -80, 80, -45, 70, 90}},  {"P6", {-40, -65, 85, 15, -50, -20}}};
+      {"P4", {-20, -100, 120, 30, 30, 0}}, {"P5", {10, -80, 80, -45, 70, 90}},  robomach::testing::SixthPostureDeg()};
   const std::vector<std::pair<std::string, std::vector<double>>> held = {
       {"H1", {15, -70, 95, 20, 50, -30}}, {"H2", {-30, -85, 110, -20, 35, 45}}};
   for (const auto& [list, out] : {std::pair{&fit, &s.fit_postures}, std::pair{&held, &s.holdout_postures}}) {
@@ -187,19 +188,7 @@ TestCampaign MakeRealisticSetup() {
 }
 
 VirtualHammerOptions RealisticTest(unsigned seed, bool coherence) {
-  VirtualHammerOptions o;
-  o.sample_rate_hz = 5120.0;
-  o.block_samples = 8192;  // Δf = 0.625 Hz
-  o.fmin_hz = 0.625;
-  o.fmax_hz = 2560.0;
-  o.relative_noise = 0.02;
-  o.absolute_noise_m_per_s2_per_N = 1.5e-4;
-  o.absolute_noise_m_per_N = 4e-9;
-  o.hammer_cutoff_hz = 1000.0;
-  o.averages = 5;
-  o.coherence = coherence;
-  o.seed = seed;
-  return o;
+  return robomach::testing::RealisticHammerTest(seed, coherence);
 }
 
 // Through an accelerance CSV file and back, as a user's export would come.
