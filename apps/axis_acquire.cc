@@ -130,7 +130,7 @@ int Run(int argc, char** argv) {
         by.clear();
         BinnedMax(s_mm, a_deg, 4000, &bx, &by);
         auto& a1 = fig.at(1, 0);
-        a1.title = "tool axis angle to the programmed axis";
+        a1.title = "tool axis angle to the programmed axis (max of bins)";
         a1.x_label = "path length [mm]";
         a1.y_label = "axis error [deg]";
         a1.series.push_back({bx, by, "", report::PaletteColor(1), 1, false, false});
