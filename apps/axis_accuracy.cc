@@ -2,6 +2,9 @@
 // from positioning runs (formats.md §8.6), as JSON and the standard chart.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <cstdio>
+
 #include <nlohmann/json.hpp>
 
 #include "cli_support.h"
@@ -16,6 +19,19 @@ namespace robomach::apps {
 namespace {
 
 constexpr char kTool[] = "axis-accuracy";
+
+// A chart caption's number: 4 significant digits ("0.009985", "1.2e-05").
+std::string Short(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+int MinRuns(const machine::Iso230Result& r) {
+  int n = 1 << 30;
+  for (const auto& t : r.targets) n = std::min({n, t.runs_up, t.runs_down});
+  return n;
+}
 
 int Run(int argc, char** argv) {
   CLI::App app{
@@ -70,8 +86,8 @@ int Run(int argc, char** argv) {
       for (size_t p = 0; p < results.size(); ++p) {
         const auto& [axis, r] = results[p];
         auto& ax = fig.at(static_cast<int>(p), 0);
-        ax.title = "axis " + axis + ": A = " + std::to_string(r.A) + " " + unit + ", R = " + std::to_string(r.R) +
-                   ", B = " + std::to_string(r.B);
+        ax.title = "axis " + axis + ":  A = " + Short(r.A) + " " + unit + ",  R = " + Short(r.R) + " " + unit +
+                   ",  B = " + Short(r.B) + " " + unit + "  (" + std::to_string(MinRuns(r)) + " runs each way)";
         ax.x_label = "target [" + unit + "]";
         ax.y_label = "deviation [" + unit + "]";
         std::vector<double> x, mu, mu_p, mu_m, md, md_p, md_m;
@@ -85,11 +101,29 @@ int Run(int argc, char** argv) {
           md_m.push_back(t.mean_down - 2 * t.s_down);
         }
         ax.series.push_back({x, mu, "mean, + approach", report::PaletteColor(0), 2, false, false});
+        ax.series.push_back({x, mu, "", report::PaletteColor(0), 2, false, true});  // the targets
         ax.series.push_back({x, mu_p, "+-2s, + approach", report::PaletteColor(0), 1, true, false});
         ax.series.push_back({x, mu_m, "", report::PaletteColor(0), 1, true, false});
         ax.series.push_back({x, md, "mean, - approach", report::PaletteColor(1), 2, false, false});
+        ax.series.push_back({x, md, "", report::PaletteColor(1), 2, false, true});
         ax.series.push_back({x, md_p, "+-2s, - approach", report::PaletteColor(1), 1, true, false});
         ax.series.push_back({x, md_m, "", report::PaletteColor(1), 1, true, false});
+        // The legend (top right, 4 entries: about 85 of the 304 px of the
+        // plot) gets a free band above the curves instead of covering them;
+        // the targets at the ends keep a margin from the frame.
+        double lo = 0.0, hi = 0.0;  // the chart always shows the zero line
+        for (const auto* v : {&mu_p, &mu_m, &md_p, &md_m}) {
+          for (double y : *v) {
+            lo = std::min(lo, y);
+            hi = std::max(hi, y);
+          }
+        }
+        const double span = hi > lo ? hi - lo : 1e-3;
+        ax.y_min = lo - 0.08 * span;
+        ax.y_max = hi + 0.5 * span;
+        const double x_span = x.back() > x.front() ? x.back() - x.front() : 1.0;
+        ax.x_min = x.front() - 0.03 * x_span;
+        ax.x_max = x.back() + 0.03 * x_span;
       }
       fig.SavePng(plot_path);
     }

@@ -11,7 +11,6 @@
 #include "robomach/common/units.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/machine_files.h"
-#include "robomach/io/parallel_rows.h"
 #include "robomach/machine/acquisition.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/posture_json.h"
@@ -91,36 +90,12 @@ int Run(int argc, char** argv) {
     machine::Acquisition acq(mf.machine, comp.empty() ? nullptr : &comp);
     std::optional<machine::ContourTracker> tracker;
     if (path) tracker.emplace(*path);
-    std::vector<double> dist, angle, s_along;
-    if (path) {
-      dist.reserve(rec.rows());
-      angle.reserve(rec.rows());
-      s_along.reserve(rec.rows());
-    }
-    // Chunks of rows: computed in order (the contour tracker follows the
-    // path), then formatted on two threads (formatting 17-digit numbers is
-    // most of the work) and written in order. Constant memory per chunk.
+    // Rows are computed in order (the contour tracker follows the path)
+    // while earlier chunks are formatted and written on two threads
+    // (formatting 17-digit numbers is most of the work).
+    std::vector<machine::ContourError> contour;
     io::WriteFileAtomically(out_path, [&](std::ostream& out) {
-      const io::AcquiredPathWriter w(out, mf.machine.axes, path.has_value());
-      constexpr long kChunk = 1 << 15;
-      std::vector<machine::AcquiredSample> samples(kChunk);
-      std::vector<machine::ContourError> contour(kChunk);
-      for (long first = 0; first < rec.rows(); first += kChunk) {
-        const long last = std::min(rec.rows(), first + kChunk);
-        for (long r = first; r < last; ++r) {
-          samples[r - first] = acq.Process(rec.t_s[r], rec.counts.data() + r * n);
-          if (tracker) {
-            const machine::ContourError e = tracker->Next(samples[r - first].pose);
-            contour[r - first] = e;
-            dist.push_back(e.distance);
-            angle.push_back(e.axis_angle);
-            s_along.push_back(e.s);
-          }
-        }
-        io::WriteRowsInParallel(out, first, last, [&](long r, std::string* buf) {
-          w.AppendRow(buf, rec.t_s[r], samples[r - first], tracker ? &contour[r - first] : nullptr);
-        });
-      }
+      contour = io::WriteAcquiredPath(out, rec, mf.machine.axes, &acq, tracker ? &*tracker : nullptr);
     });
     nlohmann::json j;
     j["rows"] = rec.rows();
@@ -130,11 +105,11 @@ int Run(int argc, char** argv) {
                          {"cross_axis_tables", tables.cross_axis.size()},
                          {"temperature_axes", temps.size()}};
     if (path) {
-      std::vector<double> d_um(dist.size()), a_deg(angle.size()), s_mm(s_along.size());
-      for (size_t i = 0; i < dist.size(); ++i) {
-        d_um[i] = dist[i] * 1e6;
-        a_deg[i] = RadToDeg(angle[i]);
-        s_mm[i] = MToMm(s_along[i]);
+      std::vector<double> d_um(contour.size()), a_deg(contour.size()), s_mm(contour.size());
+      for (size_t i = 0; i < contour.size(); ++i) {
+        d_um[i] = contour[i].distance * 1e6;
+        a_deg[i] = RadToDeg(contour[i].axis_angle);
+        s_mm[i] = MToMm(contour[i].s);
       }
       j["contour_error_um"] = StatsJson(machine::Stats(d_um));
       j["axis_error_deg"] = StatsJson(machine::Stats(a_deg));
@@ -155,7 +130,7 @@ int Run(int argc, char** argv) {
         by.clear();
         BinnedMax(s_mm, a_deg, 4000, &bx, &by);
         auto& a1 = fig.at(1, 0);
-        a1.title = "tool axis angle to the programmed axis";
+        a1.title = "tool axis angle to the programmed axis (max of bins)";
         a1.x_label = "path length [mm]";
         a1.y_label = "axis error [deg]";
         a1.series.push_back({bx, by, "", report::PaletteColor(1), 1, false, false});

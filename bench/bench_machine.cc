@@ -13,7 +13,6 @@
 #include "robomach/common/units.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/machine_files.h"
-#include "robomach/io/parallel_rows.h"
 #include "robomach/machine/synthesis.h"
 
 namespace {
@@ -114,22 +113,10 @@ void BM_AcquirePipeline_60s_8kHz(benchmark::State& state) {
     const machine::CountsRecord rec = io::ReadCountsFile(f.counts_path, f.mf);
     machine::Acquisition acq(f.mf.machine, &comp);
     machine::ContourTracker tracker(path);
-    // As axis-acquire does it: chunks computed in order, formatted on two threads.
+    // As axis-acquire does it: rows computed in order while earlier chunks
+    // are formatted and written, on two threads.
     io::WriteFileAtomically(f.out_path, [&](std::ostream& out) {
-      const io::AcquiredPathWriter w(out, f.mf.machine.axes, true);
-      constexpr long kChunk = 1 << 15;
-      std::vector<machine::AcquiredSample> samples(kChunk);
-      std::vector<machine::ContourError> contour(kChunk);
-      for (long first = 0; first < rec.rows(); first += kChunk) {
-        const long last = std::min(rec.rows(), first + kChunk);
-        for (long r = first; r < last; ++r) {
-          samples[r - first] = acq.Process(rec.t_s[r], rec.counts.data() + r * 5);
-          contour[r - first] = tracker.Next(samples[r - first].pose);
-        }
-        io::WriteRowsInParallel(out, first, last, [&](long r, std::string* buf) {
-          w.AppendRow(buf, rec.t_s[r], samples[r - first], &contour[r - first]);
-        });
-      }
+      benchmark::DoNotOptimize(io::WriteAcquiredPath(out, rec, f.mf.machine.axes, &acq, &tracker));
     });
     rows = rec.rows();
   }

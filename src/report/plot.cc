@@ -28,12 +28,16 @@ std::string TickLabel(double v, bool log) {
   if (v == 0.0) return "0";
   const double a = std::abs(v);
   if (a >= 1e5 || a < 1e-3) {
-    std::snprintf(buf, sizeof(buf), "%.0e", v);
-    // "1e-07" -> "1e-7"
+    // As many mantissa digits as the tick needs ("1.5e-4", not "2e-4":
+    // ticks in steps of 5e-5 must not be rounded to one digit).
+    std::snprintf(buf, sizeof(buf), "%.6e", v);
+    // "1.500000e-07" -> "1.5e-7"
     std::string s(buf);
     const size_t e = s.find('e');
     if (e != std::string::npos) {
       std::string mant = s.substr(0, e), ex = s.substr(e + 1);
+      while (mant.back() == '0') mant.pop_back();
+      if (mant.back() == '.') mant.pop_back();
       bool neg = ex[0] == '-';
       ex = ex.substr(1);
       while (ex.size() > 1 && ex[0] == '0') ex = ex.substr(1);

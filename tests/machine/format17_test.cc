@@ -43,6 +43,30 @@ TEST(Format17, MatchesStdToCharsOnRandomValuesOfEveryScale) {
   }
 }
 
+// The exponent form (|v| < 1e-4, as contour errors in mm and axis errors in
+// degrees often are) and values next to powers of ten, where the decimal
+// exponent is hardest to get right.
+TEST(Format17, MatchesStdToCharsForSmallValuesAndNextToPowersOfTen) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> mant(-1.0, 1.0);
+  std::uniform_int_distribution<int> exp(-14, -3);
+  for (int i = 0; i < 300000; ++i) {
+    const double v = mant(rng) * std::pow(10.0, exp(rng));
+    ASSERT_EQ(Fast(v), Reference(v)) << v;
+  }
+  for (int e = -20; e <= 18; ++e) {
+    const double p = std::pow(10.0, e);
+    for (double v : {p, std::nextafter(p, 0.0), std::nextafter(p, 1e300), 0.99999999999999999 * p, 5.0 * p}) {
+      ASSERT_EQ(Fast(v), Reference(v)) << v;
+      ASSERT_EQ(Fast(-v), Reference(-v)) << -v;
+    }
+  }
+  for (long i = 1; i < 200000; ++i) {  // many exactly representable and many halfway-looking values
+    ASSERT_EQ(Fast(i * 1e-7), Reference(i * 1e-7));
+    ASSERT_EQ(Fast(i * 0.25 * 1e-9), Reference(i * 0.25 * 1e-9));
+  }
+}
+
 TEST(Format17, EdgeCases) {
   for (double v : {0.0, -0.0, 1.0, -1.0, 0.1, 0.5, 1e-4, 9.9999999999999991e-5, 1e15, 999999999999999.88, 1e16, 1e17,
                    123456789012345678.0, 0.30000000000000004, 2.5, 0.00012345, 99999999999999999.0, 1e-300, 1e300,

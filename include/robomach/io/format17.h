@@ -13,4 +13,11 @@ namespace robomach::io {
 /// removed, exponent form for exponents < -4 or >= 17).
 void AppendDouble17(double v, std::string* out);
 
+/// Room WriteDouble17 needs at most ("-1.2345678901234567e-308" is 24).
+inline constexpr int kMaxChars17 = 32;
+
+/// The same text written at `out` (which must have kMaxChars17 bytes of
+/// room); returns the end of the text. No allocation, for bulk output.
+char* WriteDouble17(double v, char* out);
+
 }  // namespace robomach::io

@@ -88,6 +88,17 @@ class AcquiredPathWriter {
   std::string buffer_;
 };
 
+/// axis-acquire's main loop: every row of `record` through `acquisition`
+/// (and `tracker`, if not null) to the acquired path (formats.md §8.5,
+/// header included) on `out`. Rows are computed in order (the tracker follows
+/// the path) while earlier chunks are formatted and written on `threads`
+/// threads (io::WritePipelined). With a tracker, the contour error of every
+/// row is returned (for the statistics and the plot).
+std::vector<machine::ContourError> WriteAcquiredPath(std::ostream& out, const machine::CountsRecord& record,
+                                                     const std::vector<machine::AxisScale>& axes,
+                                                     machine::Acquisition* acquisition,
+                                                     machine::ContourTracker* tracker, int threads = 2);
+
 /// ISO 230-2 runs (formats.md §8.6): approaches per axis name, in file order
 /// of first appearance; deviations in the file's unit (wrapped for rotary).
 struct IsoRuns {
