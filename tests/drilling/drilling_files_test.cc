@@ -7,6 +7,7 @@
 
 #include "robomach/drilling/drilling_sim.h"
 #include "robomach/io/atomic_file.h"
+#include "drilling/drilling_test_models.h"
 #include "test_support.h"
 
 namespace robomach::io {
@@ -106,6 +107,18 @@ TEST(DrillingFiles, FlexibleJointErrorsNameFileAndLine) {
   EXPECT_THAT(CaptureError([&] { ReadFlexibleRobotFile(gear); }),
               HasSubstr("gear.yaml:7:"));
   EXPECT_THAT(CaptureError([&] { ReadFlexibleRobotFile(gear); }), HasSubstr("expected a gear ratio > 0"));
+}
+
+TEST(DrillingFiles, SixAxisUrdfDerivativeMatchesKdlDynamics) {
+  // A URDF chain (six revolute joints plus fixed segments, inertias with
+  // rotated principal axes, centres of mass off the joint axes):
+  // Derivative()'s own dynamics against KDL's ChainDynParam, to rounding.
+  const FlexibleRobotFile rf = ReadFlexibleRobotFile(SourcePath("tests/data/drilling/kr210_flexible.yaml"));
+  drilling::FlexibleJointRobot robot(rf.chain, rf.drives);
+  ASSERT_EQ(robot.num_joints(), 6);
+  const double d = drilling::testing::DerivativeVsKdl(robot, 50, 11);
+  EXPECT_LT(d, 1e-10);
+  std::printf("Derivative vs KDL (KR210): %.2g relative\n", d);
 }
 
 TEST(DrillingFiles, MaterialFileRoundTrip) {

@@ -115,6 +115,18 @@ TEST(FlexibleJointRobot, StaticDeflectionWithMotorsHeldIsInverseStiffnessTimesJa
   EXPECT_LT(x.qd.norm(), 1e-5);
 }
 
+TEST(FlexibleJointRobot, DerivativeMatchesKdlDynamics) {
+  // Derivative() computes M, C q' and G itself; KDL's ChainDynParam is the
+  // second method. Both are exact up to rounding (accelerations of order
+  // K * 1e-3 / M ~ 1e3 rad/s², relative rounding ~1e-15 per operation).
+  for (bool vertical : {true, false}) {
+    FlexibleJointRobot robot(PlanarRodArm(vertical), SeedDrives(3.0));
+    const double d = testing::DerivativeVsKdl(robot, 50, 7);
+    EXPECT_LT(d, 1e-11) << (vertical ? "vertical" : "horizontal");
+    std::printf("Derivative vs KDL (%s arm): %.2g relative\n", vertical ? "vertical" : "horizontal", d);
+  }
+}
+
 TEST(FlexibleJointRobot, TipPoseAndJacobianMatchKinematicsModule) {
   // The robot keeps its own KDL solvers; the kinematics module builds new
   // ones per call. Same chain, same arithmetic: equal to rounding.
