@@ -70,7 +70,7 @@ int Run(int argc, char** argv) {
                                           removal_out, summary_out, plot_out;
   int face = 0;
   double target_um = 0.0, offset_mm = 8.0, radius_mm = 6.0, pitch_mm = 3.0, sample_mm = 0.5, row_step_mm = 0.5;
-  double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 1.0, edge_inset_mm = -1.0;
+  double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 0.3, edge_inset_mm = -1.0;
   int seed = 20240404;
   RobotOptions robot;
   app.add_option("--surface", surface_path, "NURBS patch YAML (formats.md §5)")->required();
@@ -173,7 +173,14 @@ int Run(int argc, char** argv) {
       base.row_step = std::max(params.row_step, MmToM(opt_sample_mm));
       auto objective = [&](const polishing::PathParameters& p) {
         try {
-          return Evaluate(surface, coarse, coarse_sim, p, process, surface_path).stats.cv;
+          const polishing::RemovalStats st = Evaluate(surface, coarse, coarse_sim, p, process, surface_path).stats;
+          // Planned at the speed limit, the path removes st.mean; if that is
+          // more than the target, no speed within the limit reaches the target
+          // (the path is too long for the time the target allows): penalised
+          // in proportion, for both patterns alike.
+          const double target = MmToM(1e-3 * target_um);
+          if (target > 0 && st.mean > target) return st.cv + (st.mean / target - 1.0);
+          return st.cv;
         } catch (const std::invalid_argument&) {
           return 1e6;  // outside the feasibility limits
         }
