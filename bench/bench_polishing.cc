@@ -101,7 +101,7 @@ void BM_OptimiseNloptDemoBlade(benchmark::State& state) {
           try {
             const PlannedPath path = PlanPath(blade, coarse, p, proc);
             const RemovalStats st = ComputeRemovalStats(sim.Simulate(path.rows), coarse.areas(), coarse.in_region());
-            return st.mean > target ? st.cv + (st.mean / target - 1.0) : st.cv;
+            return st.mean > 0.98 * target ? 10.0 + st.mean / target : st.cv;
           } catch (const std::invalid_argument&) {
             return 1e6;
           }
