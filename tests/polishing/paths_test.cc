@@ -224,7 +224,7 @@ PatternCvs ComparePatterns(const NurbsSurface& s) {
   };
   auto objective = [&](const PathParameters& p) {
     const RemovalStats st = stats(coarse, coarse_sim, p);
-    return st.mean > target ? st.cv + (st.mean / target - 1.0) : st.cv;
+    return st.mean > 0.98 * target ? 10.0 + st.mean / target : st.cv;
   };
   PatternCvs out;
   PathParameters cycloid;  // defaults: d 8, r 6, pitch 3 mm
