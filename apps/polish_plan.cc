@@ -70,9 +70,9 @@ int Run(int argc, char** argv) {
                                           removal_out, summary_out, plot_out;
   int face = 0;
   double target_um = 0.0, offset_mm = 8.0, radius_mm = 6.0, pitch_mm = 3.0, sample_mm = 0.5, row_step_mm = 0.5;
-  double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 1.0;
+  double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 0.3, edge_inset_mm = -1.0;
   int seed = 20240404;
-  std::string robot_path, part_frame_text = "0,0,0,0,0,0", joints_out, robot_seed_text = "0,-90,90,0,45,0";
+  RobotOptions robot;
   app.add_option("--surface", surface_path, "NURBS patch YAML (formats.md §5)")->required();
   app.add_option("--face", face, "face of a STEP/IGES file (1-based); CAD input not built yet");
   app.add_option("--process", process_path, "process YAML (formats.md §7), e.g. config/polishing/belt_2N.yaml")->required();
@@ -85,6 +85,9 @@ int Run(int argc, char** argv) {
   app.add_option("--offset-mm", offset_mm, "guide-line spacing d [mm] (parallel pattern: row spacing; default there: one contact width)");
   app.add_option("--radius-mm", radius_mm, "cycloid radius r [mm]")->capture_default_str();
   app.add_option("--pitch-mm", pitch_mm, "advance of the cycloid centre per loop [mm] (= 2 pi v / omega)")->capture_default_str();
+  app.add_option("--edge-inset-mm", edge_inset_mm, "cycloid on offsets: distance of the outermost guide loop from the "
+                                                   "region boundary [mm] (< 0: on it, or r - margin_mm inside if the margin is narrower than r)")
+      ->capture_default_str();
   app.add_option("--sample-mm", sample_mm, "removal map sampling in arc length [mm], <= 0.5")->capture_default_str();
   app.add_option("--row-step-mm", row_step_mm, "largest distance between path rows [mm]")->capture_default_str();
   app.add_option("--opt-sample-mm", opt_sample_mm, "sampling used inside the optimiser [mm]")->capture_default_str();
@@ -93,12 +96,7 @@ int Run(int argc, char** argv) {
                  "smallest guide-line spacing the optimiser tries, in contact widths (closer rows lengthen the path)")
       ->capture_default_str();
   app.add_option("--seed", seed, "PSO random seed")->capture_default_str();
-  app.add_option("--robot", robot_path, "robot config YAML: solve the IK of every tool frame, flag unreachable rows, "
-                 "joint-limit and singularity margins");
-  app.add_option("--part-frame-mm-deg", part_frame_text, "with --robot: the surface's frame in the robot base, "
-                 "x,y,z [mm], rx,ry,rz [deg] (fixed axes x, y, z)")->capture_default_str();
-  app.add_option("--robot-seed-deg", robot_seed_text, "with --robot: IK start of the first row [deg]")->capture_default_str();
-  app.add_option("--joints", joints_out, "with --robot: joint trajectory CSV t_s,q1_deg..,reachable,limit_margin_deg,jacobian_condition");
+  robot.Add(&app);
   app.add_option("--path", path_out, "tool path CSV (formats.md §6)");
   app.add_option("--removal", removal_out, "removal map CSV x_mm,y_mm,z_mm,u,v,removal_um");
   app.add_option("--summary", summary_out, "summary JSON (formats.md §7 + contact, optimisation, target)");
@@ -126,23 +124,12 @@ int Run(int argc, char** argv) {
     RequireReadableFile(surface_path, "surface");
     RequireReadableFile(process_path, "process file");
     std::vector<std::pair<std::string, std::string>> outs = {
-        {"--path", path_out}, {"--removal", removal_out}, {"--summary", summary_out}, {"--joints", joints_out}};
-    if (!joints_out.empty() && robot_path.empty()) throw std::invalid_argument("--joints needs --robot");
-    const std::vector<double> part = ParseNumberList("--part-frame-mm-deg", part_frame_text);
-    const std::vector<double> robot_seed = ParseNumberList("--robot-seed-deg", robot_seed_text);
-    if (part.size() != 6) throw std::invalid_argument("--part-frame-mm-deg: expected x,y,z,rx,ry,rz (6 numbers)");
-    if (!robot_path.empty()) RequireReadableFile(robot_path, "robot config");
+        {"--path", path_out}, {"--removal", removal_out}, {"--summary", summary_out}};
+    robot.Prepare(&outs);
     if (!plot_out.empty()) {
       for (const auto& p : PicturePaths(plot_out, optimise != "none")) outs.push_back({"--plot", p});
     }
-    CheckDistinctPaths({{"--surface", surface_path}, {"--process", process_path}, {"--robot", robot_path}}, outs);
-    std::shared_ptr<const dynamics::RobotModel> robot;
-    if (!robot_path.empty()) {
-      robot = io::LoadRobotConfig(robot_path).Build();
-      if (static_cast<int>(robot_seed.size()) != robot->num_joints()) {
-        throw std::invalid_argument("--robot-seed-deg: expected " + std::to_string(robot->num_joints()) + " angles");
-      }
-    }
+    CheckDistinctPaths({{"--surface", surface_path}, {"--process", process_path}, {"--robot", robot.robot_path()}}, outs);
 
     const polishing::NurbsSurface surface = LoadSurface(surface_path, face);
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
@@ -174,6 +161,7 @@ int Run(int argc, char** argv) {
     params.radius = MmToM(radius_mm);
     params.pitch = MmToM(pitch_mm);
     params.row_step = MmToM(row_step_mm);
+    params.edge_inset = edge_inset_mm < 0 ? -1.0 : MmToM(edge_inset_mm);
     polishing::CheckValid(params);  // std::invalid_argument -> exit 64, naming the limit
 
     nlohmann::json opt_json;
@@ -185,7 +173,15 @@ int Run(int argc, char** argv) {
       base.row_step = std::max(params.row_step, MmToM(opt_sample_mm));
       auto objective = [&](const polishing::PathParameters& p) {
         try {
-          return Evaluate(surface, coarse, coarse_sim, p, process, surface_path).stats.cv;
+          const polishing::RemovalStats st = Evaluate(surface, coarse, coarse_sim, p, process, surface_path).stats;
+          // Planned at the speed limit, the path removes st.mean; if that is
+          // more than the target, no speed within the limit reaches the target
+          // (the path is too long for the time the target allows): infeasible,
+          // for both patterns alike, ranked by how far it misses. 2 % margin
+          // for the difference between the optimiser's grid and the final one.
+          const double target = MmToM(1e-3 * target_um);
+          if (target > 0 && st.mean > 0.98 * target) return 10.0 + st.mean / target;
+          return st.cv;
         } catch (const std::invalid_argument&) {
           return 1e6;  // outside the feasibility limits
         }
@@ -268,36 +264,7 @@ int Run(int argc, char** argv) {
       Warn(kTool, "coverage " + io::FormatDouble(e.stats.coverage) + " < 0.99: parts of the region are barely polished");
     }
 
-    RobotCheck robot_check;
-    if (robot) {
-      Eigen::Isometry3d X_BP = Eigen::Isometry3d::Identity();
-      X_BP.translation() = Eigen::Vector3d(part[0], part[1], part[2]) * 1e-3;
-      X_BP.linear() = (Eigen::AngleAxisd(DegToRad(part[5]), Eigen::Vector3d::UnitZ()) *
-                       Eigen::AngleAxisd(DegToRad(part[4]), Eigen::Vector3d::UnitY()) *
-                       Eigen::AngleAxisd(DegToRad(part[3]), Eigen::Vector3d::UnitX()))
-                          .toRotationMatrix();
-      Eigen::Isometry3d X_FC = Eigen::Isometry3d::Identity();
-      X_FC.linear() = process.R_FC;
-      X_FC.translation() = process.p_FC;
-      Eigen::VectorXd q0(robot->num_joints());
-      for (int j = 0; j < q0.size(); ++j) q0(j) = DegToRad(robot_seed[j]);
-      robot_check = CheckOnRobot(*robot, X_BP, X_FC, e.path.rows, q0);
-      summary["robot"] = {{"rows", e.path.rows.size()},
-                          {"unreachable_rows", robot_check.num_unreachable},
-                          {"outside_joint_limits_rows", robot_check.num_outside_limits},
-                          {"joint_jump_rows", robot_check.num_jumps},
-                          {"first_flagged_row", robot_check.first_bad_row >= 0 ? nlohmann::json(robot_check.first_bad_row + 1)
-                                                                                : nlohmann::json(nullptr)},
-                          {"min_joint_limit_margin_deg", RadToDeg(robot_check.min_limit_margin)},
-                          {"max_jacobian_condition", robot_check.max_condition}};
-      if (robot_check.num_unreachable + robot_check.num_outside_limits + robot_check.num_jumps > 0) {
-        flagged = true;
-        Warn(kTool, std::to_string(robot_check.num_unreachable) + " rows unreachable, " +
-                        std::to_string(robot_check.num_outside_limits) + " outside the joint limits, " +
-                        std::to_string(robot_check.num_jumps) + " with a joint jump > 0.5 rad (first: row " +
-                        std::to_string(robot_check.first_bad_row + 1) + ")");
-      }
-    }
+    if (robot.Check(kTool, process, e.path.rows, &summary)) flagged = true;
     std::vector<std::pair<std::string, std::string>> meta = {{"pattern", pattern}};
     meta.push_back({"offset_mm", io::FormatDouble(1e3 * params.offset)});
     if (cyc) {
@@ -306,7 +273,7 @@ int Run(int argc, char** argv) {
     }
     if (!path_out.empty()) io::WritePolishPath(path_out, e.path.rows, meta);
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, e.removal);
-    if (!joints_out.empty()) WriteJointTrajectory(joints_out, e.path.rows, robot_check, robot->num_joints());
+    robot.WriteJoints(e.path.rows);
     if (!plot_out.empty()) WritePictures(plot_out, grid, e.removal, e.path.rows, e.path.guide_lines, history, pattern);
     const std::string text = summary.dump(2) + "\n";
     if (!summary_out.empty()) io::WriteFileAtomically(summary_out, text);

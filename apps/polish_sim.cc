@@ -40,6 +40,8 @@ int Run(int argc, char** argv) {
   app.add_option("--removal", removal_out, "removal map CSV x_mm,y_mm,z_mm,u,v,removal_um");
   app.add_option("--summary", summary_out, "summary JSON (formats.md §7); stdout if omitted");
   app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png and <stem>_path.png");
+  RobotOptions robot;
+  robot.Add(&app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -53,7 +55,10 @@ int Run(int argc, char** argv) {
     std::vector<std::pair<std::string, std::string>> outs = {{"--removal", removal_out}, {"--summary", summary_out}};
     if (!plot_out.empty())
       for (const auto& p : PicturePaths(plot_out, false)) outs.push_back({"--plot", p});
-    CheckDistinctPaths({{"--surface", surface_path}, {"--process", process_path}, {"--path", path_in}}, outs);
+    robot.Prepare(&outs);
+    CheckDistinctPaths({{"--surface", surface_path}, {"--process", process_path}, {"--path", path_in},
+                        {"--robot", robot.robot_path()}},
+                       outs);
 
     const polishing::NurbsSurface surface = LoadSurface(surface_path, face);
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
@@ -103,7 +108,9 @@ int Run(int argc, char** argv) {
                              {"centre_speed_mm_per_s", 0.0}};
     summary["region"] = {{"sample_mm", sample_mm}, {"points", grid.num_in_region()}, {"margin_mm", 1e3 * process.margin}};
     summary["speed_limit_exceeded"] = flagged;
+    if (robot.Check(kTool, process, file.rows, &summary)) flagged = true;
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, removal);
+    robot.WriteJoints(file.rows);
     if (!plot_out.empty()) WritePictures(plot_out, grid, removal, file.rows, {}, {}, "polish-sim");
     const std::string text = summary.dump(2) + "\n";
     if (!summary_out.empty()) io::WriteFileAtomically(summary_out, text);

@@ -1,11 +1,16 @@
 #include "polish_support.h"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 
 #include "cli_support.h"
 #include "robomach/common/errors.h"
+#include "robomach/common/units.h"
+#include "robomach/dynamics/robot_model.h"
+#include "robomach/io/robot_config.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/report/heat_map.h"
 #include "robomach/report/plot.h"
@@ -261,6 +266,65 @@ void WriteJointTrajectory(const std::string& path, const std::vector<polishing::
           << (check.reachable[r] ? io::FormatDouble(check.condition[r]) : "") << '\n';
     }
   });
+}
+
+void RobotOptions::Add(CLI::App* app) {
+  app->add_option("--robot", robot_path_, "robot config YAML: solve the IK of every tool frame, flag unreachable rows, "
+                                          "joint-limit and singularity margins (summary 'robot' block)");
+  app->add_option("--part-frame-mm-deg", part_frame_text_, "with --robot: the surface's frame in the robot base, "
+                                                           "x,y,z [mm], rx,ry,rz [deg] about fixed x, y, z")
+      ->capture_default_str();
+  app->add_option("--robot-seed-deg", seed_text_, "with --robot: IK start of the first row [deg]")->capture_default_str();
+  app->add_option("--joints", joints_out_,
+                  "with --robot: joint trajectory CSV t_s,q1_deg..,reachable,limit_margin_deg,jacobian_condition");
+}
+
+void RobotOptions::Prepare(std::vector<std::pair<std::string, std::string>>* outs) {
+  outs->push_back({"--joints", joints_out_});
+  if (!joints_out_.empty() && robot_path_.empty()) throw std::invalid_argument("--joints needs --robot");
+  part_ = ParseNumberList("--part-frame-mm-deg", part_frame_text_);
+  seed_deg_ = ParseNumberList("--robot-seed-deg", seed_text_);
+  if (part_.size() != 6) throw std::invalid_argument("--part-frame-mm-deg: expected x,y,z,rx,ry,rz (6 numbers)");
+  if (robot_path_.empty()) return;
+  RequireReadableFile(robot_path_, "robot config");
+  robot_ = io::LoadRobotConfig(robot_path_).Build();
+  if (static_cast<int>(seed_deg_.size()) != robot_->num_joints()) {
+    throw std::invalid_argument("--robot-seed-deg: expected " + std::to_string(robot_->num_joints()) + " angles");
+  }
+}
+
+bool RobotOptions::Check(const std::string& tool, const polishing::PolishingProcess& process,
+                         const std::vector<polishing::PathRow>& rows, nlohmann::json* summary) {
+  if (!robot_) return false;
+  Eigen::Isometry3d X_BP = Eigen::Isometry3d::Identity();
+  X_BP.translation() = Eigen::Vector3d(part_[0], part_[1], part_[2]) * 1e-3;
+  X_BP.linear() = (Eigen::AngleAxisd(DegToRad(part_[5]), Eigen::Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(DegToRad(part_[4]), Eigen::Vector3d::UnitY()) *
+                   Eigen::AngleAxisd(DegToRad(part_[3]), Eigen::Vector3d::UnitX()))
+                      .toRotationMatrix();
+  Eigen::Isometry3d X_FC = Eigen::Isometry3d::Identity();
+  X_FC.linear() = process.R_FC;
+  X_FC.translation() = process.p_FC;
+  Eigen::VectorXd q0(robot_->num_joints());
+  for (int j = 0; j < q0.size(); ++j) q0(j) = DegToRad(seed_deg_[j]);
+  check_ = CheckOnRobot(*robot_, X_BP, X_FC, rows, q0);
+  (*summary)["robot"] = {
+      {"rows", rows.size()},
+      {"unreachable_rows", check_.num_unreachable},
+      {"outside_joint_limits_rows", check_.num_outside_limits},
+      {"joint_jump_rows", check_.num_jumps},
+      {"first_flagged_row", check_.first_bad_row >= 0 ? nlohmann::json(check_.first_bad_row + 1) : nlohmann::json(nullptr)},
+      {"min_joint_limit_margin_deg", RadToDeg(check_.min_limit_margin)},
+      {"max_jacobian_condition", check_.max_condition}};
+  if (check_.num_unreachable + check_.num_outside_limits + check_.num_jumps == 0) return false;
+  Warn(tool, std::to_string(check_.num_unreachable) + " rows unreachable, " + std::to_string(check_.num_outside_limits) +
+                 " outside the joint limits, " + std::to_string(check_.num_jumps) +
+                 " with a joint jump > 0.5 rad (first: row " + std::to_string(check_.first_bad_row + 1) + ")");
+  return true;
+}
+
+void RobotOptions::WriteJoints(const std::vector<polishing::PathRow>& rows) const {
+  if (robot_ && !joints_out_.empty()) WriteJointTrajectory(joints_out_, rows, check_, robot_->num_joints());
 }
 
 }  // namespace robomach::apps

@@ -3,13 +3,16 @@
 // Shared by polish-plan and polish-sim: surface loading, the removal
 // statistics in um, the summary JSON (formats.md §7) and the pictures.
 
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "robomach/polishing/nurbs_surface.h"
 #include "robomach/polishing/paths.h"
+#include "robomach/polishing/process.h"
 #include "robomach/polishing/removal.h"
 #include "robomach/polishing/surface_grid.h"
 
@@ -42,6 +45,9 @@ std::vector<std::string> PicturePaths(const std::string& png, bool with_converge
 namespace robomach::dynamics {
 class RobotModel;
 }
+namespace CLI {
+class App;
+}
 
 namespace robomach::apps {
 
@@ -66,5 +72,32 @@ RobotCheck CheckOnRobot(const dynamics::RobotModel& model, const Eigen::Isometry
 /// Joint trajectory CSV: t_s,q1_deg..qn_deg,reachable,limit_margin_deg,jacobian_condition.
 void WriteJointTrajectory(const std::string& path, const std::vector<polishing::PathRow>& rows,
                           const RobotCheck& check, int num_joints);
+
+/// The "on the robot" options of polish-plan and polish-sim (--robot,
+/// --part-frame-mm-deg, --robot-seed-deg, --joints) and what they do, in one
+/// place for both tools.
+class RobotOptions {
+ public:
+  /// Registers the four options on `app`.
+  void Add(CLI::App* app);
+  /// Checks the options and loads the robot (before any output is written);
+  /// adds --joints to `outs` for the distinct-path check.
+  /// @throws std::invalid_argument (bad command line), InputError (robot config).
+  void Prepare(std::vector<std::pair<std::string, std::string>>* outs);
+  bool enabled() const { return robot_ != nullptr; }
+  const std::string& robot_path() const { return robot_path_; }
+  /// Checks `rows` on the robot, fills summary["robot"], warns on stderr
+  /// under `tool` for flagged rows and returns true if any row is flagged.
+  bool Check(const std::string& tool, const polishing::PolishingProcess& process,
+             const std::vector<polishing::PathRow>& rows, nlohmann::json* summary);
+  /// Writes the joint trajectory if --joints was given.
+  void WriteJoints(const std::vector<polishing::PathRow>& rows) const;
+
+ private:
+  std::string robot_path_, part_frame_text_ = "0,0,0,0,0,0", joints_out_, seed_text_ = "0,-90,90,0,45,0";
+  std::vector<double> part_, seed_deg_;
+  std::shared_ptr<const dynamics::RobotModel> robot_;
+  RobotCheck check_;
+};
 
 }  // namespace robomach::apps

@@ -6,6 +6,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include "robomach/common/units.h"
 #include "robomach/io/polishing_files.h"
@@ -83,8 +84,9 @@ void BM_OptimiseNloptDemoBlade(benchmark::State& state) {
   const NurbsSurface blade = io::ReadNurbsYaml(src + "/config/polishing/blade.yaml");
   const PolishingProcess proc = io::ReadPolishingProcess(src + "/config/polishing/belt_2N.yaml");
   for (auto _ : state) {
-    // What polish-plan does: the contact width sets the index cell and the
-    // lower offset bound; the optimiser works on a 1 mm grid.
+    // What polish-plan --optimise nlopt --target-removal-um 5 does: the
+    // contact width sets the index cell and the lower offset bound (0.3
+    // contact widths); the optimiser works on a 1 mm grid.
     const SampleGrid fine = SampleGrid::Build(blade, 0.5e-3, proc.margin, false);
     const double w = ContactWidthAtCentre(blade, fine, proc);
     const SampleGrid coarse = SampleGrid::Build(blade, 1e-3, proc.margin, false);
@@ -92,11 +94,17 @@ void BM_OptimiseNloptDemoBlade(benchmark::State& state) {
     PathParameters base;
     base.row_step = 1e-3;
     OptimiseOptions o;
-    o.offset_min = w;
+    o.offset_min = 0.3 * w;
+    const double target = 5e-6;  // --target-removal-um 5: paths that cannot reach it are penalised
     const OptimiseResult r = OptimiseCycloid(
         [&](const PathParameters& p) {
-          const PlannedPath path = PlanPath(blade, coarse, p, proc);
-          return ComputeRemovalStats(sim.Simulate(path.rows), coarse.areas(), coarse.in_region()).cv;
+          try {
+            const PlannedPath path = PlanPath(blade, coarse, p, proc);
+            const RemovalStats st = ComputeRemovalStats(sim.Simulate(path.rows), coarse.areas(), coarse.in_region());
+            return st.mean > 0.98 * target ? 10.0 + st.mean / target : st.cv;
+          } catch (const std::invalid_argument&) {
+            return 1e6;
+          }
         },
         base, o);
     state.counters["best_cv"] = r.best_value;

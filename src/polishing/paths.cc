@@ -122,23 +122,41 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   std::vector<Guide> guides;
   std::vector<int> sense;
   const bool cyc = params.pattern == Pattern::kCycloid;
+  std::vector<bool> closed;
   if (cyc && params.guides == GuideLines::kBoundaryOffsets) {
-    double last_inset = -1;
-    for (int k = 0;; ++k) {
-      const double inset = d / 2 + k * d;
-      if (!(W - 2 * inset > 0 && H - 2 * inset > 0)) break;
-      guides.emplace_back(Rectangle(s_lo + inset, t_lo + inset, s_hi - inset, t_hi - inset));
-      sense.push_back(1);
-      last_inset = inset;
-    }
+    // n closed loops at insets e + k de and a centre line (the innermost
+    // loop collapsed) at half the short side, de = (half_min - e) / n <= d:
+    // every pair of adjacent guide lines, the centre line included, is the
+    // same distance apart (a leftover strip narrower or wider than d would
+    // be over- or under-polished along the whole centre).
+    // The outermost loop runs on the region boundary (e = 0) so that the
+    // rolling circle overruns the edge as a belt grinder does; if the
+    // margin is narrower than r, it moves in by r - margin so that the
+    // circle stays on the face. With the loop half a spacing inside (the
+    // layout before), no row outside the edge feeds the outer strip and
+    // the boundary band was the largest source of non-uniformity (README).
     const double half_min = std::min(W, H) / 2;
-    if (last_inset < 0 || half_min - last_inset > d / 2) {
-      // The centre strip the loops do not reach: a centre line along the longer side.
-      const double sc = (s_lo + s_hi) / 2, tc = (t_lo + t_hi) / 2;
-      if (W >= H) guides.emplace_back(std::vector<Vec2>{Vec2(s_lo + half_min, tc), Vec2(s_hi - half_min, tc)});
-      else guides.emplace_back(std::vector<Vec2>{Vec2(sc, t_lo + half_min), Vec2(sc, t_hi - half_min)});
+    const double e = std::min(half_min, params.edge_inset >= 0 ? params.edge_inset
+                                                                : std::max(0.0, r - process.margin));
+    const int n = std::max(1, static_cast<int>(std::ceil((half_min - e) / d - 1e-9)));
+    const double de = (half_min - e) / n;
+    for (int k = 0; k < n; ++k) {
+      const double inset = e + k * de;
+      // Start each loop in the middle of its lower side, not at a corner:
+      // the loops close seamlessly (below), and the transition to the next
+      // loop is a short move across, away from the corners.
+      const double s0 = s_lo + inset, t0 = t_lo + inset, s1 = s_hi - inset, t1 = t_hi - inset;
+      const double sm = (s0 + s1) / 2;
+      guides.emplace_back(std::vector<Vec2>{Vec2(sm, t0), Vec2(s1, t0), Vec2(s1, t1), Vec2(s0, t1), Vec2(s0, t0),
+                                            Vec2(sm, t0)});
       sense.push_back(1);
+      closed.push_back(true);
     }
+    const double sc = (s_lo + s_hi) / 2, tc = (t_lo + t_hi) / 2;
+    if (W >= H) guides.emplace_back(std::vector<Vec2>{Vec2(s_lo + half_min, tc), Vec2(s_hi - half_min, tc)});
+    else guides.emplace_back(std::vector<Vec2>{Vec2(sc, t_lo + half_min), Vec2(sc, t_hi - half_min)});
+    sense.push_back(1);
+    closed.push_back(false);
   } else {
     // Parallel lines along s, centred in the region, boustrophedon.
     const int n = std::max(1, static_cast<int>(std::ceil(H / d - 1e-9)));
@@ -151,6 +169,7 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
       // every row (where the rolling point runs backwards) faces +t and meets
       // the sparse side of the next row (seed §3.1, Fig. 11).
       sense.push_back(k % 2 == 0 ? 1 : -1);
+      closed.push_back(false);
     }
   }
   // Tool x along the guide line (seed eq. 16) with one sign for all the
@@ -181,18 +200,23 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
     // the centre advancing `pitch` per loop; rows staggered by half a loop.
     const double theta = kPi * static_cast<double>(g);
     const double L = guide.length();
-    const double phi_end = std::max(2 * kPi, 2 * kPi * L / pitch);  // at least one loop
+    // On a closed guide a whole number of loops (the pitch adjusted by at
+    // most half a loop over the guide's length) closes the cycloid on
+    // itself: no dense head and tail where it starts and ends.
+    const double loops = closed[g] ? std::max(1.0, std::round(L / pitch)) : std::max(1.0, L / pitch);
+    const double pitch_g = L > 0 ? L / loops : pitch;
+    const double phi_end = 2 * kPi * loops;
     const double dphi = std::min(0.5, params.row_step / (r + pitch / (2 * kPi)));
     const int n = std::max(1, static_cast<int>(std::ceil(phi_end / dphi)));
     auto point = [&](double phi) {
-      const double sigma = pitch * phi / (2 * kPi);
+      const double sigma = pitch_g * phi / (2 * kPi);
       const double ang = sense[g] * phi + theta;
       return Vec2(guide.At(sigma) + r * Vec2(std::cos(ang), std::sin(ang)));
     };
     for (int i = 0; i <= n; ++i) {
       const double phi = phi_end * i / n;
       const Vec2 st = point(phi);
-      const Vec2 tan = tool_dir(guide.Tangent(pitch * phi / (2 * kPi)));
+      const Vec2 tan = tool_dir(guide.Tangent(pitch_g * phi / (2 * kPi)));
       if (i == 0) {
         if (out.rows.empty()) {
           out.rows.push_back(m.Row(st, tan));

@@ -57,12 +57,15 @@ double SegmentPressureIntegral(const Eigen::Vector2d& alpha, const Eigen::Vector
   const double R = std::sqrt(R2);
   const double s0 = std::max(-R, -lb * tau_star), s1 = std::min(R, lb * (1.0 - tau_star));
   if (s1 <= s0) return 0.0;
-  // Antiderivative of sqrt(R^2 - s^2).
-  auto F = [&](double s) {
-    const double x = std::clamp(s / R, -1.0, 1.0);
-    return 0.5 * (s * std::sqrt(std::max(0.0, R2 - s * s)) + R2 * std::asin(x));
-  };
-  return (F(s1) - F(s0)) / lb;
+  // Integral of sqrt(R^2 - s^2) over [s0, s1] with x = s / R, c = sqrt(1 - x^2):
+  // R^2 / 2 [x c + asin x] between the limits. The difference of the two
+  // arcsines is one atan2 of the difference angle's sine and cosine, which
+  // is also well conditioned when s1 - s0 is small against R (the usual
+  // case: a segment much shorter than the contact).
+  const double x0 = std::clamp(s0 / R, -1.0, 1.0), x1 = std::clamp(s1 / R, -1.0, 1.0);
+  const double c0 = std::sqrt(std::max(0.0, 1.0 - x0 * x0)), c1 = std::sqrt(std::max(0.0, 1.0 - x1 * x1));
+  const double dtheta = std::atan2(x1 * c0 - x0 * c1, c0 * c1 + x0 * x1);
+  return 0.5 * R2 * (x1 * c1 - x0 * c0 + dtheta) / lb;
 }
 
 RemovalSimulator::RemovalSimulator(const NurbsSurface& surface, const PolishingProcess& process,
@@ -97,6 +100,17 @@ RemovalSimulator::RemovalSimulator(const NurbsSurface& surface, const PolishingP
   order_.resize(points_.size());
   std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
   for (size_t k = 0; k < points_.size(); ++k) order_[fill[cell_of[k]]++] = static_cast<int>(k);
+  // Points and normals in cell order, one array per coordinate: the inner
+  // loop of Simulate reads them contiguously.
+  sorted_.resize(6 * points_.size());
+  const size_t n = points_.size();
+  for (size_t k = 0; k < n; ++k) {
+    const int i = order_[k];
+    for (int c = 0; c < 3; ++c) {
+      sorted_[c * n + k] = points_[i](c);
+      sorted_[(3 + c) * n + k] = normals_[i](c);
+    }
+  }
 }
 
 std::vector<ToolContact> RemovalSimulator::Contacts(const std::vector<PathRow>& path) const {
@@ -139,7 +153,14 @@ std::vector<double> RemovalSimulator::Simulate(const std::vector<PathRow>& path)
 
 std::vector<double> RemovalSimulator::Simulate(const std::vector<PathRow>& path,
                                                const std::vector<ToolContact>& contacts) const {
-  std::vector<double> h(points_.size(), 0.0);
+  const size_t n = points_.size();
+  const double* px = sorted_.data();
+  const double* py = px + n;
+  const double* pz = py + n;
+  const double* qx = pz + n;
+  const double* qy = qx + n;
+  const double* qz = qy + n;
+  std::vector<double> hs(n, 0.0);  // in cell order
   for (size_t r = 0; r + 1 < path.size(); ++r) {
     const double dt = path[r + 1].t - path[r].t;
     if (!(dt > 0.0)) {
@@ -150,8 +171,15 @@ std::vector<double> RemovalSimulator::Simulate(const std::vector<PathRow>& path,
     const double v_rel = (process_.belt_speed * path[r].tx + d / dt).norm();
     const double scale = process_.preston_coefficient * c.p0 * v_rel * dt;
     const double reach = std::max(c.a, c.b);
-    const Eigen::Vector3d lo = path[r].p.cwiseMin(path[r + 1].p) - Eigen::Vector3d::Constant(reach);
-    const Eigen::Vector3d hi = path[r].p.cwiseMax(path[r + 1].p) + Eigen::Vector3d::Constant(reach);
+    // Bounding box of the ellipse swept along the segment, thickened by the
+    // normal tolerance below: per axis, the ellipse's half-extent plus
+    // reach times the normal's component.
+    Eigen::Vector3d ext;
+    for (int k = 0; k < 3; ++k) {
+      ext(k) = std::hypot(c.a * c.e_a(k), c.b * c.e_b(k)) + reach * std::abs(c.n(k));
+    }
+    const Eigen::Vector3d lo = path[r].p.cwiseMin(path[r + 1].p) - ext;
+    const Eigen::Vector3d hi = path[r].p.cwiseMax(path[r + 1].p) + ext;
     const int x0 = std::max(0, static_cast<int>(std::floor((lo.x() - origin_.x()) / cell_)));
     const int y0 = std::max(0, static_cast<int>(std::floor((lo.y() - origin_.y()) / cell_)));
     const int z0 = std::max(0, static_cast<int>(std::floor((lo.z() - origin_.z()) / cell_)));
@@ -159,26 +187,35 @@ std::vector<double> RemovalSimulator::Simulate(const std::vector<PathRow>& path,
     const int y1 = std::min(ny_ - 1, static_cast<int>(std::floor((hi.y() - origin_.y()) / cell_)));
     const int z1 = std::min(nz_ - 1, static_cast<int>(std::floor((hi.z() - origin_.z()) / cell_)));
     if (x0 > x1 || y0 > y1 || z0 > z1) continue;
-    const Eigen::Vector2d beta(d.dot(c.e_a) / c.a, d.dot(c.e_b) / c.b);
+    // Elliptic coordinates alpha = (q.e_a / a, q.e_b / b) of q = point - centre.
+    const Eigen::Vector3d ea = c.e_a / c.a, eb = c.e_b / c.b;
+    const Eigen::Vector2d beta(d.dot(ea), d.dot(eb));
     const double bb = beta.squaredNorm();
+    const bool moving = bb > 1e-24;
+    const double cx = c.p.x(), cy = c.p.y(), cz = c.p.z();
     for (int iz = z0; iz <= z1; ++iz) {
       for (int iy = y0; iy <= y1; ++iy) {
         const int row = (iz * ny_ + iy) * nx_;
-        for (int k = cell_start_[row + x0]; k < cell_start_[row + x1 + 1]; ++k) {
-          const int idx = order_[k];
-          const Eigen::Vector3d q = points_[idx] - c.p;
+        const int k1 = cell_start_[row + x1 + 1];
+        for (int k = cell_start_[row + x0]; k < k1; ++k) {
+          const double dx = px[k] - cx, dy = py[k] - cy, dz = pz[k] - cz;
           // Only the side the tool is on, within the contact's reach normal to it.
-          if (std::abs(q.dot(c.n)) > reach || normals_[idx].dot(c.n) <= 0.0) continue;
-          const Eigen::Vector2d alpha(q.dot(c.e_a) / c.a, q.dot(c.e_b) / c.b);
+          if (std::abs(dx * c.n.x() + dy * c.n.y() + dz * c.n.z()) > reach ||
+              qx[k] * c.n.x() + qy[k] * c.n.y() + qz[k] * c.n.z() <= 0.0) {
+            continue;
+          }
+          const Eigen::Vector2d alpha(dx * ea.x() + dy * ea.y() + dz * ea.z(), dx * eb.x() + dy * eb.y() + dz * eb.z());
           // Cheap rejection: farther than 1 (elliptic units) from the segment's line.
           const double cross = alpha.x() * beta.y() - alpha.y() * beta.x();
-          if (cross * cross >= bb && bb > 1e-24) continue;
+          if (moving && cross * cross >= bb) continue;
           const double I = SegmentPressureIntegral(alpha, beta);
-          if (I > 0.0) h[idx] += scale * I;
+          if (I > 0.0) hs[k] += scale * I;
         }
       }
     }
   }
+  std::vector<double> h(n, 0.0);
+  for (size_t k = 0; k < n; ++k) h[order_[k]] = hs[k];
   return h;
 }
 

@@ -197,5 +197,81 @@ TEST(Optimise, NloptCycloidBeatsDefaultsOnAPlane) {
   EXPECT_LE(r.evaluations, o.global_evaluations + o.local_evaluations + 2);
 }
 
+// Issue 11 acceptance, the ordering of the patterns on a cylinder and a
+// doubly curved patch (small copies of config/polishing/cylinder_r60.yaml
+// and dome.yaml, to keep the test fast), with the demo process's Kp and a
+// 5 um target: what polish-plan does. The zig-zag's row spacing is
+// searched on [0.3, 1.5] contact widths (25 evaluations); the cycloid is
+// optimised by NLopt with d >= 0.3 contact widths; both are penalised when
+// their path, run at the speed limit, removes more than the target (the
+// target could not be reached). cv is scale-free, so the timing that hits
+// the target is not needed for it.
+struct PatternCvs {
+  double cycloid_default, parallel_default, parallel_opt, cycloid_opt, coverage_opt;
+};
+PatternCvs ComparePatterns(const NurbsSurface& s) {
+  PolishingProcess proc = Process(0.005);
+  proc.preston_coefficient = 1e-11;  // config/polishing/belt_2N.yaml
+  const double target = 5e-6;
+  const SampleGrid fine = SampleGrid::Build(s, 0.5e-3, proc.margin, false);
+  const SampleGrid coarse = SampleGrid::Build(s, 1e-3, proc.margin, false);
+  const double w = ContactWidthAtCentre(s, fine, proc);
+  const RemovalSimulator fine_sim(s, proc, fine.points(), fine.normals(), 0.5 * w);
+  const RemovalSimulator coarse_sim(s, proc, coarse.points(), coarse.normals(), 0.5 * w);
+  auto stats = [&](const SampleGrid& g, const RemovalSimulator& sim, const PathParameters& p) {
+    const PlannedPath path = PlanPath(s, g, p, proc);
+    return ComputeRemovalStats(sim.Simulate(path.rows), g.areas(), g.in_region());
+  };
+  auto objective = [&](const PathParameters& p) {
+    const RemovalStats st = stats(coarse, coarse_sim, p);
+    return st.mean > 0.98 * target ? 10.0 + st.mean / target : st.cv;
+  };
+  PatternCvs out;
+  PathParameters cycloid;  // defaults: d 8, r 6, pitch 3 mm
+  PathParameters parallel;
+  parallel.pattern = Pattern::kParallel;
+  parallel.offset = w;
+  out.cycloid_default = stats(fine, fine_sim, cycloid).cv;
+  out.parallel_default = stats(fine, fine_sim, parallel).cv;
+  double best = 1e300, best_f = 1.0;
+  parallel.row_step = 1e-3;
+  for (int k = 0; k < 25; ++k) {
+    parallel.offset = (0.3 + 0.05 * k) * w;
+    const double f = objective(parallel);
+    if (f < best) best = f, best_f = 0.3 + 0.05 * k;
+  }
+  parallel.offset = best_f * w;
+  parallel.row_step = 0.5e-3;
+  out.parallel_opt = stats(fine, fine_sim, parallel).cv;
+  PathParameters base = cycloid;
+  base.row_step = 1e-3;
+  OptimiseOptions o;
+  o.offset_min = 0.3 * w;
+  const OptimiseResult r = OptimiseCycloid(objective, base, o);
+  PathParameters b = r.best;
+  b.row_step = 0.5e-3;
+  const RemovalStats opt = stats(fine, fine_sim, b);
+  out.cycloid_opt = opt.cv;
+  out.coverage_opt = opt.coverage;
+  return out;
+}
+
+void ExpectCycloidOrdering(const PatternCvs& c) {
+  EXPECT_LT(c.cycloid_opt, c.cycloid_default);
+  EXPECT_LT(c.cycloid_opt, c.parallel_default);
+  EXPECT_LE(c.cycloid_opt, c.parallel_opt);
+  EXPECT_GE(c.coverage_opt, 0.99);
+}
+
+TEST(Optimise, PatternOrderingOnACylinder) {
+  const PatternCvs c = ComparePatterns(testing::CylinderArc(0.04, 0.06));
+  ExpectCycloidOrdering(c);
+}
+
+TEST(Optimise, PatternOrderingOnADome) {
+  const PatternCvs c = ComparePatterns(testing::Dome(0.06, 0.05, 0.005));
+  ExpectCycloidOrdering(c);
+}
+
 }  // namespace
 }  // namespace robomach::polishing

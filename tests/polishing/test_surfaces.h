@@ -67,4 +67,26 @@ inline NurbsSurface DoublyCurved(bool unit_weights = false) {
   return NurbsSurface::Create(3, 2, {0, 0, 0, 0, 1, 1, 1, 1}, {0, 0, 0, 1, 1, 1}, P, W);
 }
 
+/// A 90 degree arc of a cylinder of radius R (axis along y, length L),
+/// convex towards +z: config/polishing/cylinder_r60.yaml for R = 60 mm,
+/// L = 120 mm.
+inline NurbsSurface CylinderArc(double R, double L) {
+  const double c = R * std::sqrt(0.5), w = std::sqrt(0.5);
+  return NurbsSurface::Create(2, 1, {0, 0, 0, 1, 1, 1}, {0, 0, 1, 1},
+                              {{Eigen::Vector3d(-c, 0, c), Eigen::Vector3d(-c, L, c)},
+                               {Eigen::Vector3d(0, 0, 2 * c), Eigen::Vector3d(0, L, 2 * c)},
+                               {Eigen::Vector3d(c, 0, c), Eigen::Vector3d(c, L, c)}},
+                              {{1, 1}, {w, w}, {1, 1}});
+}
+
+/// A biquadratic dome Lx x Ly bulging 2 h towards +z (edges' middles at h):
+/// config/polishing/dome.yaml for 100 x 80 mm, h = 10 mm.
+inline NurbsSurface Dome(double Lx, double Ly, double h) {
+  std::vector<std::vector<Eigen::Vector3d>> P(3);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      P[i].push_back(Eigen::Vector3d(0.5 * Lx * i, 0.5 * Ly * j, h * ((i == 1) + (j == 1))));
+  return NurbsSurface::Create(2, 2, {0, 0, 0, 1, 1, 1}, {0, 0, 0, 1, 1, 1}, P);
+}
+
 }  // namespace robomach::polishing::testing

@@ -35,6 +35,10 @@ struct PathParameters {
   double radius{0.006};    // r [m] (cycloid)
   double pitch{0.003};     // centre advance per loop [m] (cycloid)
   double row_step{0.5e-3}; // largest distance between consecutive rows [m]
+  /// Cycloid on boundary offsets: distance of the outermost guide loop from
+  /// the region boundary [m]; < 0 (default): on the boundary, or r - margin
+  /// inside it if the margin is narrower than r (the circle stays on the face).
+  double edge_inset{-1.0};
 };
 
 /// Seed 004 §3.2 feasibility limits in this parametrisation: d <= 2 r

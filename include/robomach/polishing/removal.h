@@ -75,6 +75,8 @@ class RemovalSimulator {
   double cell_{1.0};
   int nx_{1}, ny_{1}, nz_{1};
   std::vector<int> cell_start_, order_;
+  // x, y, z of the points, then of the normals, in cell order (order_).
+  std::vector<double> sorted_;
 };
 
 /// Area-weighted removal statistics (formats.md §7), in the input's unit.
