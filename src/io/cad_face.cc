@@ -12,6 +12,7 @@
 #include <BRepBuilderAPI_NurbsConvert.hxx>
 #include <BRepGProp.hxx>
 #include <BRepTopAdaptor_FClass2d.hxx>
+#include <BRepTools.hxx>
 #include <BRep_Tool.hxx>
 #include <GCPnts_UniformAbscissa.hxx>
 #include <GProp_GProps.hxx>
@@ -128,6 +129,12 @@ std::vector<double> FlatKnots(const TColStd_Array1OfReal& k) {
   return out;
 }
 
+bool ClampedKnots(const Geom_BSplineSurface& bs) {
+  const int p = bs.UDegree(), q = bs.VDegree();
+  return bs.UMultiplicity(1) == p + 1 && bs.UMultiplicity(bs.NbUKnots()) == p + 1 &&
+         bs.VMultiplicity(1) == q + 1 && bs.VMultiplicity(bs.NbVKnots()) == q + 1;
+}
+
 }  // namespace
 
 bool IsCadFile(const std::string& path) {
@@ -173,9 +180,21 @@ polishing::NurbsSurface ReadCadFace(const std::string& path, int face) {
     if (bs.IsNull()) bs = GeomConvert::SurfaceToBSplineSurface(gs);
     if (bs.IsNull()) throw fail("OpenCASCADE cannot convert its surface to NURBS");
     bs = Handle(Geom_BSplineSurface)::DownCast(bs->Copy());
-    // A periodic patch as a clamped one over the same parameter range.
+    // A periodic patch as a clamped one, cut to the face's parameter box
+    // (Segment keeps the parametrisation and clamps the ends, so the
+    // trimming pcurves still apply).
     if (bs->IsUPeriodic()) bs->SetUNotPeriodic();
     if (bs->IsVPeriodic()) bs->SetVNotPeriodic();
+    {
+      double u0, u1, v0, v1, su0, su1, sv0, sv1;
+      BRepTools::UVBounds(nf, u0, u1, v0, v1);
+      bs->Bounds(su0, su1, sv0, sv1);
+      u0 = std::max(u0, su0), u1 = std::min(u1, su1), v0 = std::max(v0, sv0), v1 = std::min(v1, sv1);
+      if (u1 - u0 > Precision::PConfusion() && v1 - v0 > Precision::PConfusion() &&
+          (u0 > su0 || u1 < su1 || v0 > sv0 || v1 < sv1 || !ClampedKnots(*bs))) {
+        bs->Segment(u0, u1, v0, v1);
+      }
+    }
 
     const bool reversed = nf.Orientation() == TopAbs_REVERSED;
     const int nu = bs->NbUPoles(), nv = bs->NbVPoles();

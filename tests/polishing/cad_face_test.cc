@@ -9,6 +9,8 @@
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRep_Builder.hxx>
 #include <Message.hxx>
 #include <Message_PrinterOStream.hxx>
@@ -149,6 +151,45 @@ TEST(CadFace, IgesPlateWithHole) {
   double area = 0.0;
   for (int k = 0; k < g.size(); ++k) area += g.in_region()[k] ? g.areas()[k] : 0.0;
   EXPECT_NEAR(area * 1e6, 4500.0 - kPi * 225.0, 374.0 * 0.5 / 2);
+}
+
+// Faces of solids made by OpenCASCADE: half of a box's faces are REVERSED
+// in the shell, and a cylinder's side is a periodic surface with a seam.
+// Every face's normal S_u x S_v must point out of the solid; the cylinder
+// side's region (margin from its two circles, not from the seam) is the band
+// 5 <= z <= 45 mm, area 2 pi 30 x 40 mm^2.
+TEST(CadFace, SolidFacesPointOutwardsAndSeamsAreNoBoundary) {
+  const std::string box = TmpPath("box.step"), cyl = TmpPath("cylinder.step");
+  WriteStep(BRepPrimAPI_MakeBox(100, 60, 20).Shape(), box);
+  WriteStep(BRepPrimAPI_MakeCylinder(30, 50).Shape(), cyl);
+  for (const auto& [file, centre] : {std::pair{box, Eigen::Vector3d(0.05, 0.03, 0.01)},
+                                     std::pair{cyl, Eigen::Vector3d(0.0, 0.0, 0.025)}}) {
+    const int n = CountCadFaces(file);
+    ASSERT_EQ(n, file == box ? 6 : 3);
+    for (int i = 1; i <= n; ++i) {
+      const polishing::NurbsSurface s = ReadCadFace(file, i);
+      const double u = 0.5 * (s.u_min() + s.u_max()), v = 0.5 * (s.v_min() + s.v_max());
+      ASSERT_TRUE(s.OnFace(u, v)) << file << " face " << i;
+      const polishing::SurfaceDerivatives d = s.Evaluate(u, v);
+      Eigen::Vector3d out = d.S - centre;
+      const Eigen::Vector3d n_face = polishing::UnitNormal(d);
+      if (file == cyl && std::abs(n_face.z()) < 0.5) out.z() = 0.0;  // the side: radial
+      EXPECT_GT(n_face.dot(out.normalized()), 0.999) << file << " face " << i;
+    }
+  }
+  const polishing::NurbsSurface side = ReadCadFace(cyl, 0);  // the largest face
+  EXPECT_NEAR(side.trim()->area, 2 * kPi * 30 * 50 * 1e-6, 1e-6 * 2 * kPi * 30 * 50 * 1e-6);
+  EXPECT_EQ(side.trim()->boundary.size(), 2u);  // the two circles; the seam is no boundary
+  const auto g = polishing::SampleGrid::Build(side, 0.5e-3, 5e-3, false);
+  double area = 0.0;
+  for (int k = 0; k < g.size(); ++k) {
+    if (!g.in_region()[k]) continue;
+    area += g.areas()[k];
+    EXPECT_GE(g.points()[k].z(), 5e-3 - 1e-6);
+    EXPECT_LE(g.points()[k].z(), 45e-3 + 1e-6);
+  }
+  // Boundary: two circles of 188 mm, each cut cell counted whole or not.
+  EXPECT_NEAR(area * 1e6, 2 * kPi * 30 * 40, 2 * 188.5 * 0.5 / 2);
 }
 
 TEST(CadFace, CorruptAndEmptyFiles) {
