@@ -73,8 +73,8 @@ int Run(int argc, char** argv) {
   double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 0.3, edge_inset_mm = -1.0;
   int seed = 20240404;
   RobotOptions robot;
-  app.add_option("--surface", surface_path, "NURBS patch YAML (formats.md §5)")->required();
-  app.add_option("--face", face, "face of a STEP/IGES file (1-based); CAD input not built yet");
+  app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (formats.md §5)")->required();
+  app.add_option("--face", face, "face of a STEP/IGES file (1-based, in the file's order); default: the largest by area");
   app.add_option("--process", process_path, "process YAML (formats.md §7), e.g. config/polishing/belt_2N.yaml")->required();
   app.add_option("--pattern", pattern, "cycloid or parallel")->check(CLI::IsMember({"cycloid", "parallel"}))->capture_default_str();
   app.add_option("--guides", guides, "cycloid guide lines: offsets (of the region boundary, closed loops) or parallel")
@@ -257,6 +257,17 @@ int Run(int argc, char** argv) {
                              {"omega_rad_per_s", cyc ? e.path.omega_rad_per_s : 0.0},
                              {"centre_speed_mm_per_s", cyc ? 1e3 * e.path.centre_speed : 0.0}};
     summary["region"] = {{"sample_mm", sample_mm}, {"points", grid.num_in_region()}, {"margin_mm", 1e3 * process.margin}};
+    if (surface.trim()) {
+      // Guide lines fill the region's bounding box: on a face with holes or
+      // a curved outline some rows may run off the face (README "CAD faces").
+      const int off = RowsOffFace(surface, e.path.rows);
+      summary["region"]["face"] = surface.trim()->source;
+      summary["region"]["rows_off_face"] = off;
+      if (off > 0) {
+        flagged = true;
+        Warn(kTool, std::to_string(off) + " path rows lie off the trimmed face (in a hole or outside its boundary)");
+      }
+    }
     summary["contact"] = {{"width_across_mm", 1e3 * contact_width}};
     if (!target_json.is_null()) summary["target"] = target_json;
     if (!opt_json.is_null()) summary["optimisation"] = opt_json;

@@ -32,8 +32,8 @@ int Run(int argc, char** argv) {
   std::string surface_path, process_path, path_in, removal_out, summary_out, plot_out;
   int face = 0;
   double sample_mm = 0.5;
-  app.add_option("--surface", surface_path, "NURBS patch YAML (formats.md §5)")->required();
-  app.add_option("--face", face, "face of a STEP/IGES file (1-based); CAD input not built yet");
+  app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (formats.md §5)")->required();
+  app.add_option("--face", face, "face of a STEP/IGES file (1-based, in the file's order); default: the largest by area");
   app.add_option("--process", process_path, "process YAML (formats.md §7)")->required();
   app.add_option("--path", path_in, "tool path CSV (formats.md §6)")->required();
   app.add_option("--sample-mm", sample_mm, "removal map sampling in arc length [mm], <= 0.5")->capture_default_str();

@@ -10,6 +10,7 @@
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/robot_model.h"
+#include "robomach/io/cad_face.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/report/heat_map.h"
@@ -18,14 +19,14 @@
 namespace robomach::apps {
 
 polishing::NurbsSurface LoadSurface(const std::string& path, int face) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  if (ext == ".step" || ext == ".stp" || ext == ".iges" || ext == ".igs") {
-    (void)face;
-    throw InputError({path, 0, 0}, "STEP/IGES surfaces need the OpenCASCADE reader, which this build does not "
-                                   "have yet (issue 11 step 6); give the patch as NURBS YAML (formats.md §5)");
-  }
+  if (io::IsCadFile(path)) return io::ReadCadFace(path, face);
   return io::ReadNurbsYaml(path);
+}
+
+int RowsOffFace(const polishing::NurbsSurface& surface, const std::vector<polishing::PathRow>& rows) {
+  int n = 0;
+  for (const auto& r : rows) n += !surface.OnFace(r.u, r.v);
+  return n;
 }
 
 nlohmann::json RemovalJson(const polishing::RemovalStats& s) {

@@ -18,9 +18,12 @@
 
 namespace robomach::apps {
 
-/// A NURBS YAML (formats.md §5). CAD files (.step/.stp/.iges/.igs) are
-/// refused with a clear message: OpenCASCADE support is not built yet.
+/// A NURBS YAML or face `face` (1-based; 0 = the largest) of a STEP/IGES
+/// file (formats.md §5), by the file's extension.
 polishing::NurbsSurface LoadSurface(const std::string& path, int face);
+
+/// Number of rows whose (u, v) lie off the surface's trimmed face.
+int RowsOffFace(const polishing::NurbsSurface& surface, const std::vector<polishing::PathRow>& rows);
 
 /// formats.md §7 "removal_um" block (area-weighted over the region).
 nlohmann::json RemovalJson(const polishing::RemovalStats& stats_m);

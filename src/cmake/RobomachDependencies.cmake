@@ -40,3 +40,12 @@ if(NOT TARGET robomach_dep::opencv)
 endif()
 find_dependency(nlohmann_json)
 find_package(Threads REQUIRED)
+# OpenCASCADE (Debian's libocct-*-dev 7.6) reads STEP and IGES faces for the
+# polishing tools (io/cad_face). Only the toolkits the reader needs.
+find_dependency(OpenCASCADE)
+if(NOT TARGET robomach_dep::occt)
+  add_library(robomach_dep::occt INTERFACE IMPORTED)
+  set_target_properties(robomach_dep::occt PROPERTIES
+    INTERFACE_LINK_LIBRARIES "TKSTEP;TKIGES;TKXSBase;TKShHealing;TKTopAlgo;TKGeomAlgo;TKBRep;TKGeomBase;TKG3d;TKG2d;TKMath;TKernel"
+    INTERFACE_INCLUDE_DIRECTORIES "${OpenCASCADE_INCLUDE_DIR}")
+endif()

@@ -173,6 +173,12 @@ NurbsSurface NurbsSurface::Create(int degree_u, int degree_v, std::vector<double
   return s;
 }
 
+bool NurbsSurface::OnFace(double u, double v) const {
+  const double eu = 1e-12 * (u_max() - u_min()), ev = 1e-12 * (v_max() - v_min());
+  if (u < u_min() - eu || u > u_max() + eu || v < v_min() - ev || v > v_max() + ev) return false;
+  return trim_ == nullptr || !trim_->contains || trim_->contains(u, v);
+}
+
 SurfaceDerivatives NurbsSurface::Evaluate(double u, double v) const {
   u = std::clamp(u, u_min(), u_max());
   v = std::clamp(v, v_min(), v_max());

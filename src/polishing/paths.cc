@@ -320,6 +320,13 @@ void AttachToSurface(const NurbsSurface& surface, const SampleGrid& grid, bool f
         << dist * 1e3 << " mm off the surface (tolerance 0.01 mm)";
       throw PathRowError(static_cast<int>(r), m.str());
     }
+    if (!surface.OnFace(uu, vv)) {
+      std::ostringstream m;
+      m << "the point (" << row.p.x() * 1e3 << ", " << row.p.y() * 1e3 << ", " << row.p.z() * 1e3
+        << ") mm is off the trimmed face (outside its boundary or in a hole"
+        << (surface.trim()->source.empty() ? "" : " of " + surface.trim()->source) << ")";
+      throw PathRowError(static_cast<int>(r), m.str());
+    }
     const SurfaceDerivatives d = surface.Evaluate(uu, vv);
     const Eigen::Vector3d n = UnitNormal(d, flip_normal);
     if (row.n.dot(n) <= 0.0) {

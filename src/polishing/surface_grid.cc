@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 #include <Eigen/Dense>
 
@@ -54,6 +55,56 @@ void ArcLengthTable(const NurbsSurface& S, bool along_u, std::vector<double>* ta
   }
 }
 
+// Distance from points to a set of 3-D polylines, with the segments bucketed
+// in a uniform grid of cubes of side `cell` so that a query "closer than
+// cell?" looks at 27 cells only.
+class SegmentIndex {
+ public:
+  SegmentIndex(const std::vector<std::vector<Eigen::Vector3d>>& lines, double cell) : cell_(cell) {
+    for (const auto& l : lines)
+      for (size_t i = 1; i < l.size(); ++i) {
+        const int id = static_cast<int>(a_.size());
+        a_.push_back(l[i - 1]);
+        b_.push_back(l[i]);
+        const Eigen::Vector3i lo = Cell(l[i - 1].cwiseMin(l[i])), hi = Cell(l[i - 1].cwiseMax(l[i]));
+        for (int x = lo.x(); x <= hi.x(); ++x)
+          for (int y = lo.y(); y <= hi.y(); ++y)
+            for (int z = lo.z(); z <= hi.z(); ++z) cells_[Key(x, y, z)].push_back(id);
+      }
+  }
+  /// min(distance to the nearest segment, cell).
+  double DistanceCapped(const Eigen::Vector3d& p) const {
+    double best = cell_;
+    const Eigen::Vector3i c = Cell(p);
+    for (int x = c.x() - 1; x <= c.x() + 1; ++x)
+      for (int y = c.y() - 1; y <= c.y() + 1; ++y)
+        for (int z = c.z() - 1; z <= c.z() + 1; ++z) {
+          const auto it = cells_.find(Key(x, y, z));
+          if (it == cells_.end()) continue;
+          for (int id : it->second) {
+            const Eigen::Vector3d ab = b_[id] - a_[id];
+            const double len2 = ab.squaredNorm();
+            const double f = len2 > 0 ? std::clamp((p - a_[id]).dot(ab) / len2, 0.0, 1.0) : 0.0;
+            best = std::min(best, (a_[id] + f * ab - p).norm());
+          }
+        }
+    return best;
+  }
+
+ private:
+  Eigen::Vector3i Cell(const Eigen::Vector3d& p) const {
+    return Eigen::Vector3i(static_cast<int>(std::floor(p.x() / cell_)), static_cast<int>(std::floor(p.y() / cell_)),
+                           static_cast<int>(std::floor(p.z() / cell_)));
+  }
+  static long long Key(int x, int y, int z) {
+    return (static_cast<long long>(x & 0x1fffff) << 42) | (static_cast<long long>(y & 0x1fffff) << 21) |
+           static_cast<long long>(z & 0x1fffff);
+  }
+  double cell_;
+  std::vector<Eigen::Vector3d> a_, b_;
+  std::unordered_map<long long, std::vector<int>> cells_;
+};
+
 }  // namespace
 
 SampleGrid SampleGrid::Build(const NurbsSurface& surface, double max_spacing, double margin, bool flip) {
@@ -95,23 +146,42 @@ SampleGrid SampleGrid::Build(const NurbsSurface& surface, double max_spacing, do
   };
   for (int j = 0; j < g.nt_; ++j)
     for (int i = 0; i < g.ns_; ++i) g.area_[g.index(i, j)] = jac[g.index(i, j)] * half_span(g.u_, i) * half_span(g.v_, j);
-  // Distance to the boundary along the iso-lines through each point.
-  std::vector<double> along_s(N, 0.0), along_t(N, 0.0);
-  for (int j = 0; j < g.nt_; ++j)
-    for (int i = 1; i < g.ns_; ++i)
-      along_s[g.index(i, j)] = along_s[g.index(i - 1, j)] + (g.p_[g.index(i, j)] - g.p_[g.index(i - 1, j)]).norm();
-  for (int i = 0; i < g.ns_; ++i)
-    for (int j = 1; j < g.nt_; ++j)
-      along_t[g.index(i, j)] = along_t[g.index(i, j - 1)] + (g.p_[g.index(i, j)] - g.p_[g.index(i, j - 1)]).norm();
+  // The polished region. A plain patch: distance to the patch boundary along
+  // the iso-lines through each point. A trimmed CAD face: on the face, and at
+  // least `margin` (straight 3-D distance) from every trimming edge, holes
+  // included; the straight distance is the geodesic one to within
+  // margin^3 kappa^2 / 24 (0.04 % for 5 mm on a 50 mm radius).
+  std::vector<char> keep(N, 1);
+  if (const FaceTrim* trim = surface.trim()) {
+    const SegmentIndex index(trim->boundary, std::max(margin, 1e-6));
+    for (int j = 0; j < g.nt_; ++j)
+      for (int i = 0; i < g.ns_; ++i) {
+        const int k = g.index(i, j);
+        keep[k] = surface.OnFace(g.u_[i], g.v_[j]) && (margin <= 0 || index.DistanceCapped(g.p_[k]) >= margin - 1e-12);
+      }
+  } else {
+    std::vector<double> along_s(N, 0.0), along_t(N, 0.0);
+    for (int j = 0; j < g.nt_; ++j)
+      for (int i = 1; i < g.ns_; ++i)
+        along_s[g.index(i, j)] = along_s[g.index(i - 1, j)] + (g.p_[g.index(i, j)] - g.p_[g.index(i - 1, j)]).norm();
+    for (int i = 0; i < g.ns_; ++i)
+      for (int j = 1; j < g.nt_; ++j)
+        along_t[g.index(i, j)] = along_t[g.index(i, j - 1)] + (g.p_[g.index(i, j)] - g.p_[g.index(i, j - 1)]).norm();
+    for (int j = 0; j < g.nt_; ++j)
+      for (int i = 0; i < g.ns_; ++i) {
+        const int k = g.index(i, j);
+        const double ds = std::min(along_s[k], along_s[g.index(g.ns_ - 1, j)] - along_s[k]);
+        const double dt = std::min(along_t[k], along_t[g.index(i, g.nt_ - 1)] - along_t[k]);
+        keep[k] = std::min(ds, dt) >= margin - 1e-12;
+      }
+  }
   g.in_region_.assign(N, 0);
   g.s_lo_ = g.t_lo_ = 1e300;
   g.s_hi_ = g.t_hi_ = -1e300;
   for (int j = 0; j < g.nt_; ++j) {
     for (int i = 0; i < g.ns_; ++i) {
       const int k = g.index(i, j);
-      const double ds = std::min(along_s[k], along_s[g.index(g.ns_ - 1, j)] - along_s[k]);
-      const double dt = std::min(along_t[k], along_t[g.index(i, g.nt_ - 1)] - along_t[k]);
-      if (std::min(ds, dt) >= margin - 1e-12) {
+      if (keep[k]) {
         g.in_region_[k] = 1;
         g.s_lo_ = std::min(g.s_lo_, g.s_[i]);
         g.s_hi_ = std::max(g.s_hi_, g.s_[i]);

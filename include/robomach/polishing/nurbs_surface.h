@@ -6,10 +6,13 @@
 // derivatives (rational quotient rule, The NURBS Book eq. 4.20), the unit
 // normal and the principal curvatures and directions.
 
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+
+#include "robomach/polishing/face_trim.h"
 
 namespace robomach::polishing {
 
@@ -57,12 +60,26 @@ class NurbsSurface {
   SurfaceDerivatives Evaluate(double u, double v) const;
   Eigen::Vector3d Point(double u, double v) const { return Evaluate(u, v).S; }
 
+  /// A CAD face: the patch is the face's underlying surface and `trim` its
+  /// trimming wires; the polished region is then the trimmed face minus the
+  /// margin (SampleGrid). Null for a plain patch (the whole rectangle).
+  const FaceTrim* trim() const { return trim_.get(); }
+  NurbsSurface WithTrim(std::shared_ptr<const FaceTrim> trim) const {
+    NurbsSurface s = *this;
+    s.trim_ = std::move(trim);
+    return s;
+  }
+  /// True if (u, v) is on the surface: inside the parameter rectangle and,
+  /// for a trimmed face, on the face.
+  bool OnFace(double u, double v) const;
+
  private:
   NurbsSurface() = default;
   int p_{0}, q_{0}, n_u_{0}, n_v_{0};
   std::vector<double> knots_u_, knots_v_;
   std::vector<Eigen::Vector3d> points_;  // row-major n_u x n_v
   std::vector<double> weights_;
+  std::shared_ptr<const FaceTrim> trim_;
 };
 
 /// Unit normal (S_u x S_v) / |S_u x S_v|, reversed if `flip`.

@@ -1,0 +1,331 @@
+#include "robomach/io/cad_face.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include <BRepAdaptor_Curve.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_NurbsConvert.hxx>
+#include <BRepGProp.hxx>
+#include <BRepTopAdaptor_FClass2d.hxx>
+#include <BRepTools.hxx>
+#include <BRep_Tool.hxx>
+#include <GCPnts_UniformAbscissa.hxx>
+#include <GProp_GProps.hxx>
+#include <GeomConvert.hxx>
+#include <Geom_BSplineSurface.hxx>
+#include <Geom_Surface.hxx>
+#include <IFSelect_ReturnStatus.hxx>
+#include <IGESControl_Reader.hxx>
+#include <Interface_Static.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <Message_PrinterOStream.hxx>
+#include <Precision.hxx>
+#include <STEPControl_Reader.hxx>
+#include <STEPControl_Writer.hxx>
+#include <Standard_Failure.hxx>
+#include <TColStd_Array1OfInteger.hxx>
+#include <TColStd_Array1OfReal.hxx>
+#include <TColStd_Array2OfReal.hxx>
+#include <TColgp_Array2OfPnt.hxx>
+#include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Shape.hxx>
+#include <gp_Pnt2d.hxx>
+
+#include "robomach/common/errors.h"
+
+namespace robomach::io {
+namespace {
+
+constexpr double kMmToM = 1e-3;
+constexpr double kBoundaryChordMm = 0.25;  // boundary polyline chords (sag < 1 um on r >= 8 mm)
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+std::string Extension(const std::string& path) { return Lower(std::filesystem::path(path).extension().string()); }
+
+bool IsIges(const std::string& path) {
+  const std::string e = Extension(path);
+  return e == ".iges" || e == ".igs";
+}
+
+// OpenCASCADE prints its reader's complaints on stdout by default, which
+// would mix with a summary written to stdout: keep it quiet, we report.
+void SilenceOcct() {
+  static const bool done = [] {
+    const Handle(Message_Messenger)& m = Message::DefaultMessenger();
+    m->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
+    return true;
+  }();
+  (void)done;
+}
+
+std::string OcctWhat(const Standard_Failure& e) {
+  const char* s = e.GetMessageString();
+  return std::string(e.DynamicType()->Name()) + (s && *s ? std::string(": ") + s : std::string());
+}
+
+TopoDS_Shape ReadShape(const std::string& path) {
+  SilenceOcct();
+  const bool iges = IsIges(path);
+  const char* kind = iges ? "IGES" : "STEP";
+  try {
+    Interface_Static::SetCVal("xstep.cascade.unit", "MM");
+    IFSelect_ReturnStatus status;
+    TopoDS_Shape shape;
+    if (iges) {
+      IGESControl_Reader r;
+      status = r.ReadFile(path.c_str());
+      if (status == IFSelect_RetDone) {
+        r.TransferRoots();
+        shape = r.OneShape();
+      }
+    } else {
+      STEPControl_Reader r;
+      status = r.ReadFile(path.c_str());
+      if (status == IFSelect_RetDone) {
+        r.TransferRoots();
+        shape = r.OneShape();
+      }
+    }
+    if (status != IFSelect_RetDone) {
+      throw InputError({path, 0, 0}, std::string("not a readable ") + kind + " file (OpenCASCADE's " + kind +
+                                         " reader failed: " + (status == IFSelect_RetVoid ? "no entities" : "syntax or structure error") + ")");
+    }
+    return shape;
+  } catch (const Standard_Failure& e) {
+    throw InputError({path, 0, 0}, std::string("not a readable ") + kind + " file (OpenCASCADE: " + OcctWhat(e) + ")");
+  }
+}
+
+TopTools_IndexedMapOfShape Faces(const TopoDS_Shape& shape) {
+  TopTools_IndexedMapOfShape faces;
+  if (!shape.IsNull()) TopExp::MapShapes(shape, TopAbs_FACE, faces);
+  return faces;
+}
+
+double FaceArea(const TopoDS_Face& f) {
+  GProp_GProps props;
+  BRepGProp::SurfaceProperties(f, props);
+  return props.Mass();
+}
+
+std::vector<double> FlatKnots(const TColStd_Array1OfReal& k) {
+  std::vector<double> out;
+  for (int i = k.Lower(); i <= k.Upper(); ++i) out.push_back(k(i));
+  return out;
+}
+
+bool ClampedKnots(const Geom_BSplineSurface& bs) {
+  const int p = bs.UDegree(), q = bs.VDegree();
+  return bs.UMultiplicity(1) == p + 1 && bs.UMultiplicity(bs.NbUKnots()) == p + 1 &&
+         bs.VMultiplicity(1) == q + 1 && bs.VMultiplicity(bs.NbVKnots()) == q + 1;
+}
+
+}  // namespace
+
+bool IsCadFile(const std::string& path) {
+  const std::string e = Extension(path);
+  return e == ".step" || e == ".stp" || e == ".iges" || e == ".igs";
+}
+
+int CountCadFaces(const std::string& path) { return Faces(ReadShape(path)).Extent(); }
+
+polishing::NurbsSurface ReadCadFace(const std::string& path, int face) {
+  const TopoDS_Shape shape = ReadShape(path);
+  const TopTools_IndexedMapOfShape faces = Faces(shape);
+  const int n = faces.Extent();
+  if (n == 0) throw InputError({path, 0, 0}, "the file holds no faces (no surface to polish)");
+  const std::string kind = IsIges(path) ? "IGES" : "STEP";
+  if (face < 0 || face > n) {
+    throw InputError({path, 0, 0}, "--face " + std::to_string(face) + ": the " + kind + " file has " +
+                                       std::to_string(n) + " face" + (n == 1 ? "" : "s") + " (1.." +
+                                       std::to_string(n) + ")");
+  }
+  const std::string where = std::filesystem::path(path).filename().string() + ", face ";
+  try {
+    int index = face;
+    if (index == 0) {  // formats.md §5: by default the largest by area
+      double best = -1.0;
+      for (int i = 1; i <= n; ++i) {
+        const double a = FaceArea(TopoDS::Face(faces(i)));
+        if (a > best) best = a, index = i;
+      }
+    }
+    const TopoDS_Face original = TopoDS::Face(faces(index));
+    const std::string source = where + std::to_string(index);
+    auto fail = [&](const std::string& m) { return InputError({path, 0, 0}, "face " + std::to_string(index) + ": " + m); };
+
+    // Exact NURBS of the underlying surface (and of the pcurves), in the
+    // parametrisation the trimming wires refer to.
+    BRepBuilderAPI_NurbsConvert convert(original, Standard_True);
+    if (!convert.IsDone()) throw fail("OpenCASCADE cannot convert its surface to NURBS");
+    TopoDS_Face nf = TopoDS::Face(convert.Shape());
+    const Handle(Geom_Surface) gs = BRep_Tool::Surface(nf);
+    if (gs.IsNull()) throw fail("the face has no surface");
+    Handle(Geom_BSplineSurface) bs = Handle(Geom_BSplineSurface)::DownCast(gs);
+    if (bs.IsNull()) bs = GeomConvert::SurfaceToBSplineSurface(gs);
+    if (bs.IsNull()) throw fail("OpenCASCADE cannot convert its surface to NURBS");
+    bs = Handle(Geom_BSplineSurface)::DownCast(bs->Copy());
+    // A periodic patch as a clamped one, cut to the face's parameter box
+    // (Segment keeps the parametrisation and clamps the ends, so the
+    // trimming pcurves still apply).
+    if (bs->IsUPeriodic()) bs->SetUNotPeriodic();
+    if (bs->IsVPeriodic()) bs->SetVNotPeriodic();
+    {
+      double u0, u1, v0, v1, su0, su1, sv0, sv1;
+      BRepTools::UVBounds(nf, u0, u1, v0, v1);
+      bs->Bounds(su0, su1, sv0, sv1);
+      u0 = std::max(u0, su0), u1 = std::min(u1, su1), v0 = std::max(v0, sv0), v1 = std::min(v1, sv1);
+      if (u1 - u0 > Precision::PConfusion() && v1 - v0 > Precision::PConfusion() &&
+          (u0 > su0 || u1 < su1 || v0 > sv0 || v1 < sv1 || !ClampedKnots(*bs))) {
+        bs->Segment(u0, u1, v0, v1);
+      }
+    }
+
+    const bool reversed = nf.Orientation() == TopAbs_REVERSED;
+    const int nu = bs->NbUPoles(), nv = bs->NbVPoles();
+    std::vector<double> ku = FlatKnots(bs->UKnotSequence()), kv = FlatKnots(bs->VKnotSequence());
+    std::vector<std::vector<Eigen::Vector3d>> P(nu, std::vector<Eigen::Vector3d>(nv));
+    std::vector<std::vector<double>> W(nu, std::vector<double>(nv, 1.0));
+    for (int i = 1; i <= nu; ++i)
+      for (int j = 1; j <= nv; ++j) {
+        const gp_Pnt p = bs->Pole(i, j);
+        const int ii = reversed ? nu - i : i - 1;
+        P[ii][j - 1] = kMmToM * Eigen::Vector3d(p.X(), p.Y(), p.Z());
+        W[ii][j - 1] = bs->Weight(i, j);
+      }
+    // Reversed face: u' = u_lo + u_hi - u keeps the knot range and makes
+    // S_u' x S_v the face's outward normal.
+    const double u_sum = ku.front() + ku.back();
+    if (reversed) {
+      std::reverse(ku.begin(), ku.end());
+      for (double& k : ku) k = u_sum - k;
+    }
+    polishing::NurbsSurface patch = [&] {
+      try {
+        return polishing::NurbsSurface::Create(bs->UDegree(), bs->VDegree(), ku, kv, P, W);
+      } catch (const std::invalid_argument& e) {
+        throw fail(std::string("its NURBS is not usable: ") + e.what());
+      }
+    }();
+
+    auto trim = std::make_shared<polishing::FaceTrim>();
+    trim->source = source;
+    trim->area = FaceArea(original) * kMmToM * kMmToM;
+    auto classifier = std::make_shared<BRepTopAdaptor_FClass2d>(nf, Precision::PConfusion());
+    trim->contains = [classifier, reversed, u_sum](double u, double v) {
+      const TopAbs_State s = classifier->Perform(gp_Pnt2d(reversed ? u_sum - u : u, v), Standard_False);
+      return s == TopAbs_IN || s == TopAbs_ON;
+    };
+    for (TopExp_Explorer w(nf, TopAbs_WIRE); w.More(); w.Next()) ++trim->num_wires;
+    trim->boundary_chord = kMmToM * kBoundaryChordMm;
+    for (TopExp_Explorer e(nf, TopAbs_EDGE); e.More(); e.Next()) {
+      const TopoDS_Edge edge = TopoDS::Edge(e.Current());
+      // A degenerate edge (a pole) and the seam of a closed surface are not
+      // boundaries of the material.
+      if (BRep_Tool::Degenerated(edge) || BRep_Tool::IsClosed(edge, nf)) continue;
+      BRepAdaptor_Curve c(edge);
+      std::vector<Eigen::Vector3d> line;
+      GCPnts_UniformAbscissa ua(c, kBoundaryChordMm);
+      if (ua.IsDone() && ua.NbPoints() >= 2) {
+        for (int k = 1; k <= ua.NbPoints(); ++k) {
+          const gp_Pnt p = c.Value(ua.Parameter(k));
+          line.push_back(kMmToM * Eigen::Vector3d(p.X(), p.Y(), p.Z()));
+        }
+      }
+      const gp_Pnt a = c.Value(c.FirstParameter()), b = c.Value(c.LastParameter());
+      const Eigen::Vector3d pa = kMmToM * Eigen::Vector3d(a.X(), a.Y(), a.Z());
+      const Eigen::Vector3d pb = kMmToM * Eigen::Vector3d(b.X(), b.Y(), b.Z());
+      if (line.empty()) line = {pa, pb};
+      if ((line.front() - pa).norm() > 1e-9) line.insert(line.begin(), pa);
+      if ((line.back() - pb).norm() > 1e-9) line.push_back(pb);
+      trim->boundary.push_back(std::move(line));
+    }
+    return patch.WithTrim(std::move(trim));
+  } catch (const Standard_Failure& e) {
+    throw InputError({path, 0, 0}, "face " + std::to_string(face) + ": OpenCASCADE failed: " + OcctWhat(e));
+  }
+}
+
+void WriteStepFace(const polishing::NurbsSurface& s, const std::string& path, const std::string& comment) {
+  SilenceOcct();
+  const int nu = s.num_u(), nv = s.num_v();
+  TColgp_Array2OfPnt poles(1, nu, 1, nv);
+  TColStd_Array2OfReal weights(1, nu, 1, nv);
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const Eigen::Vector3d p = s.control_point(i, j) / kMmToM;
+      poles(i + 1, j + 1) = gp_Pnt(p.x(), p.y(), p.z());
+      weights(i + 1, j + 1) = s.weight(i, j);
+    }
+  auto compress = [](const std::vector<double>& flat, std::vector<double>* k, std::vector<int>* m) {
+    for (double x : flat) {
+      if (!k->empty() && x == k->back()) ++m->back();
+      else k->push_back(x), m->push_back(1);
+    }
+  };
+  std::vector<double> ku, kv;
+  std::vector<int> mu, mv;
+  compress(s.knots_u(), &ku, &mu);
+  compress(s.knots_v(), &kv, &mv);
+  TColStd_Array1OfReal aku(1, static_cast<int>(ku.size())), akv(1, static_cast<int>(kv.size()));
+  TColStd_Array1OfInteger amu(1, static_cast<int>(mu.size())), amv(1, static_cast<int>(mv.size()));
+  for (size_t i = 0; i < ku.size(); ++i) aku(static_cast<int>(i) + 1) = ku[i], amu(static_cast<int>(i) + 1) = mu[i];
+  for (size_t i = 0; i < kv.size(); ++i) akv(static_cast<int>(i) + 1) = kv[i], amv(static_cast<int>(i) + 1) = mv[i];
+  const std::string tmp = path + ".tmp";
+  try {
+    Handle(Geom_BSplineSurface) bs =
+        new Geom_BSplineSurface(poles, weights, aku, akv, amu, amv, s.degree_u(), s.degree_v());
+    BRepBuilderAPI_MakeFace mk(bs, Precision::Confusion());
+    if (!mk.IsDone()) throw OutputError(path + ": OpenCASCADE cannot make a face of the patch");
+    Interface_Static::SetCVal("write.step.unit", "MM");
+    STEPControl_Writer w;
+    if (w.Transfer(mk.Face(), STEPControl_AsIs) != IFSelect_RetDone || w.Write(tmp.c_str()) != IFSelect_RetDone) {
+      std::remove(tmp.c_str());
+      throw OutputError(path + ": OpenCASCADE's STEP writer failed");
+    }
+  } catch (const Standard_Failure& e) {
+    std::remove(tmp.c_str());
+    throw OutputError(path + ": OpenCASCADE failed: " + OcctWhat(e));
+  }
+  // The comment after the first line (ISO 10303-21 allows /* */ comments).
+  std::ifstream in(tmp);
+  std::stringstream body;
+  body << in.rdbuf();
+  in.close();
+  std::string text = body.str();
+  const size_t eol = text.find('\n');
+  std::string c = comment;
+  for (size_t k; (k = c.find("*/")) != std::string::npos;) c.replace(k, 2, "* /");
+  if (eol != std::string::npos && !c.empty()) text.insert(eol + 1, "/*\n" + c + (c.back() == '\n' ? "" : "\n") + "*/\n");
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << text;
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw OutputError(path + ": cannot write " + tmp);
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw OutputError(path + ": cannot rename " + tmp + " into place: " + ec.message());
+  }
+}
+
+}  // namespace robomach::io

@@ -1,0 +1,211 @@
+#include "robomach/io/cad_face.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <fstream>
+
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
+#include <BRep_Builder.hxx>
+#include <Message.hxx>
+#include <Message_PrinterOStream.hxx>
+#include <IGESControl_Controller.hxx>
+#include <IGESControl_Writer.hxx>
+#include <STEPControl_Writer.hxx>
+#include <TopoDS_Compound.hxx>
+#include <gp_Ax2.hxx>
+#include <gp_Circ.hxx>
+#include <gp_Pln.hxx>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "robomach/common/errors.h"
+#include "robomach/common/units.h"
+#include "robomach/polishing/surface_grid.h"
+
+namespace robomach::io {
+namespace {
+
+std::string TmpPath(const std::string& name) {
+  std::filesystem::create_directories(std::string(ROBOMACH_TEST_TMP_DIR) + "/cad_face");
+  return std::string(ROBOMACH_TEST_TMP_DIR) + "/cad_face/" + name;
+}
+
+// A plate Lx x Ly [mm] in z = 0 with a circular hole of radius r at (cx, cy),
+// made with OpenCASCADE's own builders (not robomach's code) and written
+// with its STEP writer in mm.
+TopoDS_Face PlateWithHole(double Lx, double Ly, double cx, double cy, double r) {
+  const gp_Pln plane(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1));
+  const gp_Pnt a(0, 0, 0), b(Lx, 0, 0), c(Lx, Ly, 0), d(0, Ly, 0);
+  BRepBuilderAPI_MakeWire outer(BRepBuilderAPI_MakeEdge(a, b), BRepBuilderAPI_MakeEdge(b, c),
+                                BRepBuilderAPI_MakeEdge(c, d), BRepBuilderAPI_MakeEdge(d, a));
+  BRepBuilderAPI_MakeFace face(plane, outer.Wire());
+  if (r > 0) {
+    const gp_Circ circle(gp_Ax2(gp_Pnt(cx, cy, 0), gp_Dir(0, 0, 1)), r);
+    TopoDS_Wire hole = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(circle)).Wire();
+    hole.Reverse();  // inner wires run clockwise seen from the normal
+    face.Add(hole);
+  }
+  return face.Face();
+}
+
+void WriteStep(const TopoDS_Shape& shape, const std::string& path) {
+  Message::DefaultMessenger()->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
+  STEPControl_Writer w;
+  ASSERT_EQ(w.Transfer(shape, STEPControl_AsIs), IFSelect_RetDone);
+  ASSERT_EQ(w.Write(path.c_str()), IFSelect_RetDone);
+}
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+// A trimmed face with a hole, built by OpenCASCADE: a 100 x 60 mm plate with
+// a 10 mm radius hole at (50, 30), margin 5 mm. The polished region is
+// analytically 5 <= x <= 95, 5 <= y <= 55, |(x, y) - (50, 30)| >= 15.
+TEST(CadFace, PlateWithHoleRegionMatchesAnalytic) {
+  const std::string file = TmpPath("plate_hole.step");
+  WriteStep(PlateWithHole(100, 60, 50, 30, 10), file);
+  const polishing::NurbsSurface s = ReadCadFace(file, 1);
+  ASSERT_NE(s.trim(), nullptr);
+  EXPECT_EQ(s.trim()->num_wires, 2);
+  EXPECT_NEAR(s.trim()->area, (6000.0 - kPi * 100.0) * 1e-6, 1e-6 * 6000e-6);  // OCCT's own face area
+  auto on_face = [&](double x_mm, double y_mm) {
+    double u = 0.5 * (s.u_min() + s.u_max()), v = 0.5 * (s.v_min() + s.v_max());
+    EXPECT_LT(polishing::ProjectToSurface(s, Eigen::Vector3d(x_mm, y_mm, 0) * 1e-3, &u, &v), 1e-9);
+    return s.OnFace(u, v);
+  };
+  EXPECT_FALSE(on_face(50, 30));    // hole centre
+  EXPECT_FALSE(on_face(59.9, 30));  // in the hole
+  EXPECT_TRUE(on_face(60.1, 30));   // just outside it
+  EXPECT_TRUE(on_face(1, 1));
+  const double margin = 5e-3, h = 0.25e-3;
+  const auto g = polishing::SampleGrid::Build(s, h, margin, false);
+  // Every sample point against the analytic rule, except within 2 um of the
+  // region's boundary (the hole is a polyline of 0.25 mm chords, sag 0.8 um).
+  int wrong = 0, in = 0;
+  double area = 0.0;
+  for (int k = 0; k < g.size(); ++k) {
+    const Eigen::Vector3d p = g.points()[k] * 1e3;  // mm
+    ASSERT_NEAR(p.z(), 0.0, 1e-9);
+    const double dc = std::hypot(p.x() - 50, p.y() - 30) - 15;
+    const double de = std::min({p.x() - 5, 95 - p.x(), p.y() - 5, 55 - p.y()});
+    const double d = std::min(dc, de);  // > 0 inside the analytic region
+    if (g.in_region()[k]) ++in, area += g.areas()[k];
+    if (std::abs(d) < 2e-3) continue;
+    if ((d > 0) != static_cast<bool>(g.in_region()[k])) ++wrong;
+  }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_GT(in, 50000);
+  // Area: the sampled region's area weights against 4500 - pi 15^2 mm^2;
+  // each grid cell cut by the region boundary (length 374 mm) is counted
+  // whole or not at all, so |error| <= 374 mm x h / 2 = 47 mm^2 (1.2 %).
+  const double exact = 4500.0 - kPi * 225.0;
+  EXPECT_NEAR(area * 1e6, exact, 374.0 * 0.25 / 2) << "exact " << exact;
+  std::cout << "plate with hole: region area " << area * 1e6 << " mm^2 sampled, " << exact << " analytic\n";
+}
+
+// Face numbering: 1-based in the file's order; 0 picks the largest; a face
+// number beyond the file's is an error naming the file and the face count.
+TEST(CadFace, FaceNumbersAndMissingFace) {
+  const std::string file = TmpPath("two_plates.step");
+  TopoDS_Compound both;
+  BRep_Builder b;
+  b.MakeCompound(both);
+  b.Add(both, PlateWithHole(20, 20, 0, 0, 0));   // small plate first
+  b.Add(both, PlateWithHole(100, 60, 50, 30, 10));
+  WriteStep(both, file);
+  ASSERT_EQ(CountCadFaces(file), 2);
+  EXPECT_NEAR(ReadCadFace(file, 1).trim()->area, 400e-6, 1e-9);
+  EXPECT_NEAR(ReadCadFace(file, 2).trim()->area, (6000.0 - kPi * 100) * 1e-6, 1e-9);
+  EXPECT_NEAR(ReadCadFace(file, 0).trim()->area, (6000.0 - kPi * 100) * 1e-6, 1e-9);
+  EXPECT_THAT(ErrorOf([&] { ReadCadFace(file, 3); }),
+              ::testing::HasSubstr("two_plates.step: --face 3: the STEP file has 2 faces (1..2)"));
+}
+
+// IGES: the same plate with a hole through OpenCASCADE's IGES writer
+// (trimmed surface entities) reads back with its hole.
+TEST(CadFace, IgesPlateWithHole) {
+  const std::string file = TmpPath("plate_hole.igs");
+  IGESControl_Controller::Init();
+  IGESControl_Writer w("MM", 0);
+  ASSERT_TRUE(w.AddShape(PlateWithHole(100, 60, 50, 30, 10)));
+  w.ComputeModel();
+  ASSERT_TRUE(w.Write(file.c_str()));
+  ASSERT_EQ(CountCadFaces(file), 1);
+  const polishing::NurbsSurface s = ReadCadFace(file, 1);
+  EXPECT_EQ(s.trim()->num_wires, 2);
+  EXPECT_NEAR(s.trim()->area, (6000.0 - kPi * 100.0) * 1e-6, 1e-4 * 6000e-6);
+  const auto g = polishing::SampleGrid::Build(s, 0.5e-3, 5e-3, false);
+  double area = 0.0;
+  for (int k = 0; k < g.size(); ++k) area += g.in_region()[k] ? g.areas()[k] : 0.0;
+  EXPECT_NEAR(area * 1e6, 4500.0 - kPi * 225.0, 374.0 * 0.5 / 2);
+}
+
+// Faces of solids made by OpenCASCADE: half of a box's faces are REVERSED
+// in the shell, and a cylinder's side is a periodic surface with a seam.
+// Every face's normal S_u x S_v must point out of the solid; the cylinder
+// side's region (margin from its two circles, not from the seam) is the band
+// 5 <= z <= 45 mm, area 2 pi 30 x 40 mm^2.
+TEST(CadFace, SolidFacesPointOutwardsAndSeamsAreNoBoundary) {
+  const std::string box = TmpPath("box.step"), cyl = TmpPath("cylinder.step");
+  WriteStep(BRepPrimAPI_MakeBox(100, 60, 20).Shape(), box);
+  WriteStep(BRepPrimAPI_MakeCylinder(30, 50).Shape(), cyl);
+  for (const auto& [file, centre] : {std::pair{box, Eigen::Vector3d(0.05, 0.03, 0.01)},
+                                     std::pair{cyl, Eigen::Vector3d(0.0, 0.0, 0.025)}}) {
+    const int n = CountCadFaces(file);
+    ASSERT_EQ(n, file == box ? 6 : 3);
+    for (int i = 1; i <= n; ++i) {
+      const polishing::NurbsSurface s = ReadCadFace(file, i);
+      const double u = 0.5 * (s.u_min() + s.u_max()), v = 0.5 * (s.v_min() + s.v_max());
+      ASSERT_TRUE(s.OnFace(u, v)) << file << " face " << i;
+      const polishing::SurfaceDerivatives d = s.Evaluate(u, v);
+      Eigen::Vector3d out = d.S - centre;
+      const Eigen::Vector3d n_face = polishing::UnitNormal(d);
+      if (file == cyl && std::abs(n_face.z()) < 0.5) out.z() = 0.0;  // the side: radial
+      EXPECT_GT(n_face.dot(out.normalized()), 0.999) << file << " face " << i;
+    }
+  }
+  const polishing::NurbsSurface side = ReadCadFace(cyl, 0);  // the largest face
+  EXPECT_NEAR(side.trim()->area, 2 * kPi * 30 * 50 * 1e-6, 1e-6 * 2 * kPi * 30 * 50 * 1e-6);
+  EXPECT_EQ(side.trim()->boundary.size(), 2u);  // the two circles; the seam is no boundary
+  const auto g = polishing::SampleGrid::Build(side, 0.5e-3, 5e-3, false);
+  double area = 0.0;
+  for (int k = 0; k < g.size(); ++k) {
+    if (!g.in_region()[k]) continue;
+    area += g.areas()[k];
+    EXPECT_GE(g.points()[k].z(), 5e-3 - 1e-6);
+    EXPECT_LE(g.points()[k].z(), 45e-3 + 1e-6);
+  }
+  // Boundary: two circles of 188 mm, each cut cell counted whole or not.
+  EXPECT_NEAR(area * 1e6, 2 * kPi * 30 * 40, 2 * 188.5 * 0.5 / 2);
+}
+
+TEST(CadFace, CorruptAndEmptyFiles) {
+  const std::string bad = TmpPath("corrupt.step");
+  {
+    std::ofstream out(bad);
+    out << "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('x'),'2;1');\nDATA;\n#1 = B_SPLINE_SURFACE_WITH_KNOTS('',3,3,((#2,\n";
+  }
+  EXPECT_THAT(ErrorOf([&] { ReadCadFace(bad, 1); }), ::testing::HasSubstr("corrupt.step: "));
+  const std::string text = TmpPath("notes.igs");
+  {
+    std::ofstream out(text);
+    out << "this is not an IGES file\n";
+  }
+  EXPECT_THAT(ErrorOf([&] { ReadCadFace(text, 1); }), ::testing::HasSubstr("notes.igs: "));
+}
+
+}  // namespace
+}  // namespace robomach::io
