@@ -125,6 +125,9 @@ void Plot(const std::string& path, const std::vector<Run>& runs, int n) {
   axes(n + 1).y_label = "thrust [N]";
   axes(n + 2).title = "torque";
   axes(n + 2).y_label = "torque [N m]";
+  // Thrust and torque rise to a plateau at the top right: legend below it.
+  axes(n + 1).legend = report::Axes::LegendPosition::kBottomRight;
+  axes(n + 2).legend = report::Axes::LegendPosition::kBottomRight;
   for (int k = 0; k < panels; ++k) axes(k).x_label = "time [s]";
   int c = 0;
   for (const Run& run : runs) {
