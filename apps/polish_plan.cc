@@ -258,8 +258,10 @@ int Run(int argc, char** argv) {
                              {"centre_speed_mm_per_s", cyc ? 1e3 * e.path.centre_speed : 0.0}};
     summary["region"] = {{"sample_mm", sample_mm}, {"points", grid.num_in_region()}, {"margin_mm", 1e3 * process.margin}};
     if (surface.trim()) {
-      // Guide lines fill the region's bounding box: on a face with holes or
-      // a curved outline some rows may run off the face (README "CAD faces").
+      // The guide lines follow the trimmed outline and the holes, and links
+      // that would cross a hole are lifted; a row in contact off the face
+      // would be a planner bug, or the developed plane's distortion on a
+      // strongly doubly curved face (README "CAD faces").
       const int off = RowsOffFace(surface, e.path.rows);
       summary["region"]["face"] = surface.trim()->source;
       summary["region"]["rows_off_face"] = off;

@@ -25,7 +25,7 @@ polishing::NurbsSurface LoadSurface(const std::string& path, int face) {
 
 int RowsOffFace(const polishing::NurbsSurface& surface, const std::vector<polishing::PathRow>& rows) {
   int n = 0;
-  for (const auto& r : rows) n += !surface.OnFace(r.u, r.v);
+  for (const auto& r : rows) n += r.force != 0.0 && !surface.OnFace(r.u, r.v);  // lifted rows may cross holes
   return n;
 }
 
@@ -37,8 +37,13 @@ nlohmann::json RemovalJson(const polishing::RemovalStats& s) {
 
 nlohmann::json PathJson(const std::vector<polishing::PathRow>& rows) {
   double len = 0;
-  for (size_t i = 1; i < rows.size(); ++i) len += (rows[i].p - rows[i - 1].p).norm();
+  int lifts = 0;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    if (rows[i - 1].force != 0.0) len += (rows[i].p - rows[i - 1].p).norm();  // in contact
+    lifts += rows[i].force == 0.0 && rows[i - 1].force != 0.0;
+  }
   return {{"length_mm", 1e3 * len},
+          {"lifts", lifts},
           {"time_s", rows.empty() ? 0.0 : rows.back().t - rows.front().t},
           {"rows", rows.size()},
           {"max_speed_mm_per_s", 1e3 * polishing::MaxSpeed(rows)}};

@@ -38,6 +38,16 @@ if(NOT TARGET robomach_dep::opencv)
     INTERFACE_LINK_LIBRARIES "${ROBOMACH_OPENCV_IMGCODECS};${ROBOMACH_OPENCV_IMGPROC};${ROBOMACH_OPENCV_CORE}"
     INTERFACE_INCLUDE_DIRECTORIES "${ROBOMACH_OPENCV_INCLUDE_DIR}")
 endif()
+# Clipper 6 (Debian's libpolyclipping-dev ships no CMake config): polygon
+# offsets of trimmed polishing regions (polishing/region_outline).
+if(NOT TARGET robomach_dep::clipper)
+  find_path(ROBOMACH_CLIPPER_INCLUDE_DIR polyclipping/clipper.hpp REQUIRED)
+  find_library(ROBOMACH_CLIPPER_LIBRARY polyclipping REQUIRED)
+  add_library(robomach_dep::clipper INTERFACE IMPORTED)
+  set_target_properties(robomach_dep::clipper PROPERTIES
+    INTERFACE_LINK_LIBRARIES "${ROBOMACH_CLIPPER_LIBRARY}"
+    INTERFACE_INCLUDE_DIRECTORIES "${ROBOMACH_CLIPPER_INCLUDE_DIR}")
+endif()
 find_dependency(nlohmann_json)
 find_package(Threads REQUIRED)
 # OpenCASCADE (Debian's libocct-*-dev 7.6) reads STEP and IGES faces for the

@@ -13,9 +13,11 @@
 #include <BRepGProp.hxx>
 #include <BRepTopAdaptor_FClass2d.hxx>
 #include <BRepTools.hxx>
+#include <BRepTools_WireExplorer.hxx>
 #include <BRep_Tool.hxx>
 #include <GCPnts_UniformAbscissa.hxx>
 #include <GProp_GProps.hxx>
+#include <Geom2d_Curve.hxx>
 #include <GeomConvert.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Geom_Surface.hxx>
@@ -254,6 +256,34 @@ polishing::NurbsSurface ReadCadFace(const std::string& path, int face) {
       if ((line.front() - pa).norm() > 1e-9) line.insert(line.begin(), pa);
       if ((line.back() - pb).norm() > 1e-9) line.push_back(pb);
       trim->boundary.push_back(std::move(line));
+    }
+    // The wires in the parameter plane, edge by edge in the wire's order and
+    // sense, through the pcurves (sampled at the 3-D chord spacing).
+    for (TopExp_Explorer w(nf, TopAbs_WIRE); w.More(); w.Next()) {
+      std::vector<Eigen::Vector2d> loop;
+      for (BRepTools_WireExplorer we(TopoDS::Wire(w.Current()), nf); we.More(); we.Next()) {
+        const TopoDS_Edge& edge = we.Current();
+        double f = 0.0, l = 0.0;
+        const Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(edge, nf, f, l);
+        if (pc.IsNull()) throw fail("an edge of the face has no curve in the surface's parameter plane");
+        std::vector<double> params;
+        if (!BRep_Tool::Degenerated(edge)) {
+          BRepAdaptor_Curve c(edge);
+          GCPnts_UniformAbscissa ua(c, kBoundaryChordMm);
+          if (ua.IsDone()) {
+            for (int k = 1; k <= ua.NbPoints(); ++k) params.push_back(ua.Parameter(k));
+          }
+        }
+        if (params.size() < 2) params = {f, 0.5 * (f + l), l};
+        params.front() = f;
+        params.back() = l;
+        if (edge.Orientation() == TopAbs_REVERSED) std::reverse(params.begin(), params.end());
+        for (size_t k = 0; k + 1 < params.size(); ++k) {  // the edge's end is the next edge's start
+          const gp_Pnt2d q = pc->Value(params[k]);
+          loop.emplace_back(reversed ? u_sum - q.X() : q.X(), q.Y());
+        }
+      }
+      if (loop.size() >= 3) trim->wires_uv.push_back(std::move(loop));
     }
     return patch.WithTrim(std::move(trim));
   } catch (const Standard_Failure& e) {

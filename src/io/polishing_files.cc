@@ -1,6 +1,8 @@
 #include "robomach/io/polishing_files.h"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <sstream>
 
 #include "robomach/common/units.h"
@@ -172,7 +174,9 @@ PolishPathFile ReadPolishPath(const std::string& path) {
     }
     if (csv.HasColumn("force_N")) {
       row.force = csv.Number(r, "force_N");
-      if (!(row.force > 0)) throw csv.ErrorAt(r, "force_N", "expected a force > 0, got " + FormatDouble(row.force));
+      if (!(row.force >= 0)) {
+        throw csv.ErrorAt(r, "force_N", "expected a force >= 0 (0: the tool is lifted), got " + FormatDouble(row.force));
+      }
     }
     if (r > 0 && !(row.t > f.rows.back().t)) {
       throw csv.ErrorAt(r, "t_s", "expected t_s strictly increasing, got " + FormatDouble(row.t) + " after " +
@@ -198,14 +202,21 @@ void WritePolishPath(const std::string& path, const std::vector<polishing::PathR
                      const std::vector<std::pair<std::string, std::string>>& metadata) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     for (const auto& [k, v] : metadata) out << "# " << k << ": " << v << "\n";
-    out << "t_s,x_mm,y_mm,z_mm,nx,ny,nz,tx,ty,tz,u,v\n";
+    // force_N only when the path sets it (a planned path with lifts sets it on every row).
+    const bool with_force = std::any_of(rows.begin(), rows.end(), [](const auto& r) { return r.force >= 0; });
+    if (with_force && !std::all_of(rows.begin(), rows.end(), [](const auto& r) { return r.force >= 0; })) {
+      throw std::logic_error("WritePolishPath: some rows have a force and others not");
+    }
+    out << "t_s,x_mm,y_mm,z_mm,nx,ny,nz,tx,ty,tz,u,v" << (with_force ? ",force_N" : "") << "\n";
     for (const auto& r : rows) {
       // 1e-4 mm and 1e-6 s: far below the 0.01 mm surface tolerance; the
       // direction cosines to 1e-9.
       out << Fixed(r.t, 6) << ',' << Fixed(1e3 * r.p.x(), 4) << ',' << Fixed(1e3 * r.p.y(), 4) << ','
           << Fixed(1e3 * r.p.z(), 4) << ',' << Fixed(r.n.x(), 9) << ',' << Fixed(r.n.y(), 9) << ','
           << Fixed(r.n.z(), 9) << ',' << Fixed(r.tx.x(), 9) << ',' << Fixed(r.tx.y(), 9) << ','
-          << Fixed(r.tx.z(), 9) << ',' << FormatDouble(r.u) << ',' << FormatDouble(r.v) << '\n';
+          << Fixed(r.tx.z(), 9) << ',' << FormatDouble(r.u) << ',' << FormatDouble(r.v);
+      if (with_force) out << ',' << FormatDouble(r.force);
+      out << '\n';
     }
   });
 }

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "robomach/common/units.h"
+#include "robomach/polishing/region_outline.h"
 
 namespace robomach::polishing {
 namespace {
@@ -80,10 +82,6 @@ void StraightMove(const Mapper& m, const Vec2& a, const Vec2& b, const Vec2& tan
   }
 }
 
-std::vector<Vec2> Rectangle(double s0, double t0, double s1, double t1) {
-  return {Vec2(s0, t0), Vec2(s1, t0), Vec2(s1, t1), Vec2(s0, t1), Vec2(s0, t0)};
-}
-
 }  // namespace
 
 void CheckValid(const PathParameters& p) {
@@ -108,27 +106,28 @@ void CheckValid(const PathParameters& p) {
   }
 }
 
-PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const PathParameters& params,
-                     const PolishingProcess& process) {
-  CheckValid(params);
-  const Mapper m(surface, grid, process.flip_normal);
-  const double s_lo = grid.s_lo(), s_hi = grid.s_hi(), t_lo = grid.t_lo(), t_hi = grid.t_hi();
-  if (!(s_hi >= s_lo) || !(t_hi >= t_lo)) throw std::invalid_argument("the polished region is empty (margin too large for the patch)");
-  const double W = s_hi - s_lo, H = t_hi - t_lo;
-  const double d = params.offset, r = params.radius, pitch = params.pitch;
-  const double vmax = process.max_speed;
+namespace {
 
-  // Guide lines, in order, with the direction sense of the cycloid.
-  std::vector<Guide> guides;
-  std::vector<int> sense;
-  const bool cyc = params.pattern == Pattern::kCycloid;
-  std::vector<bool> closed;
-  if (cyc && params.guides == GuideLines::kBoundaryOffsets) {
-    // n closed loops at insets e + k de and a centre line (the innermost
-    // loop collapsed) at half the short side, de = (half_min - e) / n <= d:
-    // every pair of adjacent guide lines, the centre line included, is the
-    // same distance apart (a leftover strip narrower or wider than d would
-    // be over- or under-polished along the whole centre).
+struct GuideSpec {
+  Guide guide;
+  int sense;    // +1: the rolling point turns counter-clockwise in (s, t)
+  bool closed;  // a closed loop (whole number of cycloid loops)
+};
+
+// The guide lines of a rectangular region (a plain patch): n closed loops at
+// insets e + k de and a centre line (the innermost loop collapsed) at half
+// the short side, or parallel lines along s.
+std::vector<GuideSpec> RectangleGuides(const SampleGrid& grid, const PathParameters& params,
+                                       const PolishingProcess& process) {
+  const double s_lo = grid.s_lo(), s_hi = grid.s_hi(), t_lo = grid.t_lo(), t_hi = grid.t_hi();
+  const double W = s_hi - s_lo, H = t_hi - t_lo;
+  const double d = params.offset, r = params.radius;
+  std::vector<GuideSpec> guides;
+  if (params.pattern == Pattern::kCycloid && params.guides == GuideLines::kBoundaryOffsets) {
+    // de = (half_min - e) / n <= d: every pair of adjacent guide lines, the
+    // centre line included, is the same distance apart (a leftover strip
+    // narrower or wider than d would be over- or under-polished along the
+    // whole centre).
     // The outermost loop runs on the region boundary (e = 0) so that the
     // rolling circle overruns the edge as a belt grinder does; if the
     // margin is narrower than r, it moves in by r - margin so that the
@@ -147,35 +146,236 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
       // loop is a short move across, away from the corners.
       const double s0 = s_lo + inset, t0 = t_lo + inset, s1 = s_hi - inset, t1 = t_hi - inset;
       const double sm = (s0 + s1) / 2;
-      guides.emplace_back(std::vector<Vec2>{Vec2(sm, t0), Vec2(s1, t0), Vec2(s1, t1), Vec2(s0, t1), Vec2(s0, t0),
-                                            Vec2(sm, t0)});
-      sense.push_back(1);
-      closed.push_back(true);
+      guides.push_back({Guide({Vec2(sm, t0), Vec2(s1, t0), Vec2(s1, t1), Vec2(s0, t1), Vec2(s0, t0), Vec2(sm, t0)}),
+                        1, true});
     }
     const double sc = (s_lo + s_hi) / 2, tc = (t_lo + t_hi) / 2;
-    if (W >= H) guides.emplace_back(std::vector<Vec2>{Vec2(s_lo + half_min, tc), Vec2(s_hi - half_min, tc)});
-    else guides.emplace_back(std::vector<Vec2>{Vec2(sc, t_lo + half_min), Vec2(sc, t_hi - half_min)});
-    sense.push_back(1);
-    closed.push_back(false);
-  } else {
-    // Parallel lines along s, centred in the region, boustrophedon.
-    const int n = std::max(1, static_cast<int>(std::ceil(H / d - 1e-9)));
-    const double first = t_lo + (H - (n - 1) * d) / 2;
-    for (int k = 0; k < n; ++k) {
-      const double tk = first + k * d;
-      if (k % 2 == 0) guides.emplace_back(std::vector<Vec2>{Vec2(s_lo, tk), Vec2(s_hi, tk)});
-      else guides.emplace_back(std::vector<Vec2>{Vec2(s_hi, tk), Vec2(s_lo, tk)});
-      // Mirror the rolling sense on reversed rows so that the dense side of
-      // every row (where the rolling point runs backwards) faces +t and meets
-      // the sparse side of the next row (seed §3.1, Fig. 11).
-      sense.push_back(k % 2 == 0 ? 1 : -1);
-      closed.push_back(false);
+    if (W >= H) guides.push_back({Guide({Vec2(s_lo + half_min, tc), Vec2(s_hi - half_min, tc)}), 1, false});
+    else guides.push_back({Guide({Vec2(sc, t_lo + half_min), Vec2(sc, t_hi - half_min)}), 1, false});
+    return guides;
+  }
+  // Parallel lines along s, centred in the region, boustrophedon.
+  const int n = std::max(1, static_cast<int>(std::ceil(H / d - 1e-9)));
+  const double first = t_lo + (H - (n - 1) * d) / 2;
+  for (int k = 0; k < n; ++k) {
+    const double tk = first + k * d;
+    // Mirror the rolling sense on reversed rows so that the dense side of
+    // every row (where the rolling point runs backwards) faces +t and meets
+    // the sparse side of the next row (seed §3.1, Fig. 11).
+    if (k % 2 == 0) guides.push_back({Guide({Vec2(s_lo, tk), Vec2(s_hi, tk)}), 1, false});
+    else guides.push_back({Guide({Vec2(s_hi, tk), Vec2(s_lo, tk)}), -1, false});
+  }
+  return guides;
+}
+
+// Inserts points so that no edge of the closed polygon is longer than `step`.
+Polygon2 Densify(const Polygon2& p, double step) {
+  Polygon2 out;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const Vec2 &a = p[i], &b = p[(i + 1) % p.size()];
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step)));
+    for (int k = 0; k < n; ++k) out.push_back(a + (double(k) / n) * (b - a));
+  }
+  return out;
+}
+
+// Guide loops of a region that is not a rectangle (a trimmed face, holes):
+// the equidistant inward offsets of its boundary at e + k de, k = 0 .. n-1,
+// the last at half a spacing from the inscribed circle's centre, so that the
+// two innermost loops of a strip between two boundaries are one spacing
+// apart (the rectangle's centre line has no general counterpart). The loops
+// are visited nearest first, each starting at its point nearest to where the
+// previous one ended.
+std::vector<GuideSpec> OffsetGuides(const DevelopedRegion& region, const PathParameters& params,
+                                    const PolishingProcess& process) {
+  const double d = params.offset, r = params.radius;
+  const double R = region.Inradius();
+  // The circle stays kClearance inside the face: the face's outline is a
+  // polygon of chords (sag < 1 um) and the offsets' round joins are chords
+  // too (sag 10 um), both cutting slightly into holes.
+  constexpr double kClearance = 50e-6;
+  double e = params.edge_inset >= 0 ? params.edge_inset : std::max(0.0, r - process.margin) + kClearance;
+  e = std::min(e, 0.5 * R);
+  const int n = std::max(1, static_cast<int>(std::ceil((R - e) / d + 0.5 - 1e-9)));
+  const double de = (R - e) / (n - 0.5);
+  std::vector<Polygon2> loops;
+  for (int k = 0; k < n; ++k) {
+    for (const Polygon2& p : region.Offset(e + k * de)) loops.push_back(Densify(p, std::max(d / 4, 1e-4)));
+  }
+  std::vector<GuideSpec> guides;
+  std::vector<bool> done(loops.size(), false);
+  // Start on the largest loop of the outermost level, at its lowest point.
+  size_t cur = 0;
+  Vec2 pos(0, 0);
+  {
+    double best = -1;
+    for (size_t i = 0; i < loops.size(); ++i) {
+      double a = 0;
+      for (size_t k = 0, j = loops[i].size() - 1; k < loops[i].size(); j = k++)
+        a += loops[i][j].x() * loops[i][k].y() - loops[i][k].x() * loops[i][j].y();
+      if (std::abs(a) > best) best = std::abs(a), cur = i;
+    }
+    pos = loops[cur][0];
+    for (const Vec2& x : loops[cur]) {
+      if (x.y() < pos.y() || (x.y() == pos.y() && x.x() < pos.x())) pos = x;
     }
   }
+  for (size_t visited = 0; visited < loops.size(); ++visited) {
+    if (visited > 0) {
+      double best = 1e300;
+      for (size_t i = 0; i < loops.size(); ++i) {
+        if (done[i]) continue;
+        for (const Vec2& x : loops[i]) {
+          const double dd = (x - pos).squaredNorm();
+          if (dd < best) best = dd, cur = i;
+        }
+      }
+    }
+    const Polygon2& p = loops[cur];
+    size_t k0 = 0;
+    for (size_t k = 1; k < p.size(); ++k) {
+      if ((p[k] - pos).squaredNorm() < (p[k0] - pos).squaredNorm()) k0 = k;
+    }
+    std::vector<Vec2> pts;
+    for (size_t k = 0; k <= p.size(); ++k) pts.push_back(p[(k0 + k) % p.size()]);
+    pos = pts.back();
+    done[cur] = true;
+    guides.push_back({Guide(std::move(pts)), 1, true});
+  }
+  return guides;
+}
+
+// Parallel lines along s clipped to a region that is not a rectangle. The
+// pieces are grouped into cells (consecutive lines whose pieces overlap one
+// to one, a boustrophedon decomposition around holes and notches); each
+// cell is run back and forth, the cells nearest first.
+std::vector<GuideSpec> LineGuides(const DevelopedRegion& region, const PathParameters& params) {
+  const Eigen::Vector4d b = region.Bounds();
+  const double d = params.offset, H = b(3) - b(1);
+  const int n = std::max(1, static_cast<int>(std::ceil(H / d - 1e-9)));
+  const double first = b(1) + (H - (n - 1) * d) / 2;
+  struct Piece {
+    double t, s0, s1;
+  };
+  std::vector<std::vector<Piece>> cells;
+  std::vector<std::pair<double, double>> prev;
+  std::vector<int> prev_cell;
+  for (int k = 0; k < n; ++k) {
+    const double tk = first + k * d;
+    const auto iv = region.Intervals(tk);
+    std::vector<int> cell_of(iv.size(), -1);
+    auto overlaps = [](const std::pair<double, double>& x, const std::pair<double, double>& y) {
+      return x.first < y.second && y.first < x.second;
+    };
+    for (size_t i = 0; i < iv.size(); ++i) {
+      int count = 0, j_hit = -1;
+      for (size_t j = 0; j < prev.size(); ++j)
+        if (overlaps(iv[i], prev[j])) ++count, j_hit = static_cast<int>(j);
+      if (count == 1) {
+        int back = 0;
+        for (const auto& x : iv) back += overlaps(x, prev[j_hit]);
+        if (back == 1) cell_of[i] = prev_cell[j_hit];
+      }
+      if (cell_of[i] < 0) {
+        cell_of[i] = static_cast<int>(cells.size());
+        cells.emplace_back();
+      }
+      cells[cell_of[i]].push_back({tk, iv[i].first, iv[i].second});
+    }
+    prev = iv;
+    prev_cell = cell_of;
+  }
+  std::vector<GuideSpec> guides;
+  std::vector<bool> done(cells.size(), false);
+  Vec2 pos(b(0), b(1));
+  for (size_t visited = 0; visited < cells.size(); ++visited) {
+    // The nearest cell end: bottom or top line, left or right end.
+    double best = 1e300;
+    size_t c_best = 0;
+    bool from_top = false, from_right = false;
+    for (size_t c = 0; c < cells.size(); ++c) {
+      if (done[c]) continue;
+      for (int top = 0; top < 2; ++top) {
+        const Piece& pc = top ? cells[c].back() : cells[c].front();
+        for (int right = 0; right < 2; ++right) {
+          const double dd = (Vec2(right ? pc.s1 : pc.s0, pc.t) - pos).squaredNorm();
+          if (dd < best - 1e-18) best = dd, c_best = c, from_top = top, from_right = right;
+        }
+      }
+    }
+    done[c_best] = true;
+    std::vector<Piece> pieces = cells[c_best];
+    if (from_top) std::reverse(pieces.begin(), pieces.end());
+    bool right_to_left = from_right;
+    for (const Piece& pc : pieces) {
+      const Vec2 a(right_to_left ? pc.s1 : pc.s0, pc.t), z(right_to_left ? pc.s0 : pc.s1, pc.t);
+      guides.push_back({Guide({a, z}), right_to_left ? -1 : 1, false});
+      pos = z;
+      right_to_left = !right_to_left;
+    }
+  }
+  return guides;
+}
+
+constexpr double kLiftTime = 1e-3;  // [s] to lift the tool off or set it down
+
+// Links the end of the path to `to`: a straight move on the surface if it is
+// at most `max_length` long and every row of it is on the face, else the
+// tool is lifted (rows with force 0: it leaves the surface at the last row,
+// travels to `to` and sets down there). A long move in contact would polish
+// a stripe across the region. Returns true for a lift.
+bool Link(const Mapper& m, const NurbsSurface& surface, const Vec2& from, const Vec2& to, const Vec2& tangent,
+          double speed, double step, double max_length, std::vector<PathRow>* rows, std::vector<double>* t) {
+  std::vector<PathRow> move;
+  std::vector<double> tm{t->back()};
+  StraightMove(m, from, to, tangent, speed, step, false, &move, &tm);
+  const bool on_face = (to - from).norm() <= max_length &&
+                       std::all_of(move.begin(), move.end(), [&](const PathRow& r) { return surface.OnFace(r.u, r.v); });
+  if (on_face) {
+    rows->insert(rows->end(), move.begin(), move.end());
+    t->insert(t->end(), tm.begin() + 1, tm.end());
+    return false;
+  }
+  PathRow up = rows->back();
+  up.force = 0.0;
+  rows->push_back(up);
+  t->push_back(t->back() + kLiftTime);
+  PathRow down = m.Row(to, tangent);
+  down.force = 0.0;
+  rows->push_back(down);
+  t->push_back(t->back() + (down.p - up.p).norm() / speed);
+  down.force = -1.0;
+  rows->push_back(down);
+  t->push_back(t->back() + kLiftTime);
+  return true;
+}
+
+}  // namespace
+
+PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const PathParameters& params,
+                     const PolishingProcess& process) {
+  CheckValid(params);
+  const Mapper m(surface, grid, process.flip_normal);
+  if (!(grid.s_hi() >= grid.s_lo()) || !(grid.t_hi() >= grid.t_lo())) {
+    throw std::invalid_argument("the polished region is empty (margin too large for the patch)");
+  }
+  const double r = params.radius, pitch = params.pitch;
+  const double vmax = process.max_speed;
+  const bool cyc = params.pattern == Pattern::kCycloid;
+  const bool parallel_lines = !(cyc && params.guides == GuideLines::kBoundaryOffsets);
+
+  // Guide lines, in order, with the direction sense of the cycloid.
+  const DevelopedRegion region = DevelopedRegion::Build(surface, grid, process.margin);
+  std::vector<GuideSpec> guides;
+  if (region.rectangle()) guides = RectangleGuides(grid, params, process);
+  else if (region.loops().empty()) throw std::invalid_argument("the polished region is empty (margin too large for the face)");
+  else if (parallel_lines) guides = LineGuides(region, params);
+  else guides = OffsetGuides(region, params, process);
+  if (guides.empty()) throw std::invalid_argument("the polished region is narrower than the row spacing: no guide line fits");
+
   // Tool x along the guide line (seed eq. 16) with one sign for all the
   // parallel lines: the belt keeps running the same way and the wrist does
   // not turn half a revolution at every row end.
-  const bool parallel_lines = !(cyc && params.guides == GuideLines::kBoundaryOffsets);
   auto tool_dir = [&](const Vec2& tangent) {
     return (parallel_lines && tangent.x() < 0) ? Vec2(-tangent) : tangent;
   };
@@ -183,15 +383,22 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   PlannedPath out;
   std::vector<double> t;
   Vec2 last_st(0, 0);
+  // The rectangle's links are short by construction (the next loop, the
+  // next line, the centre line); the general layouts lift on long ones.
+  const double max_link = region.rectangle() ? std::numeric_limits<double>::infinity()
+                                             : 2.0 * (params.offset + (cyc ? r : 0.0));
+  auto link = [&](const Vec2& to, const Vec2& tangent) {
+    out.lifts += Link(m, surface, last_st, to, tangent, vmax, params.row_step, max_link, &out.rows, &t);
+  };
   const double omega0 = cyc ? vmax / (r + pitch / (2 * kPi)) : 0.0;  // nominal rolling rate
   for (size_t g = 0; g < guides.size(); ++g) {
-    const Guide& guide = guides[g];
+    const Guide& guide = guides[g].guide;
     std::vector<Eigen::Vector3d> line;
     for (const Vec2& p : guide.pts) line.push_back(m.Point(p));
     out.guide_lines.push_back(line);
     if (!cyc) {
       const Vec2 dir = tool_dir(guide.Tangent(0.0));
-      if (!out.rows.empty()) StraightMove(m, last_st, guide.pts.front(), dir, vmax, params.row_step, false, &out.rows, &t);
+      if (!out.rows.empty()) link(guide.pts.front(), dir);
       StraightMove(m, guide.pts.front(), guide.pts.back(), dir, vmax, params.row_step, out.rows.empty(), &out.rows, &t);
       last_st = guide.pts.back();
       continue;
@@ -203,14 +410,15 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
     // On a closed guide a whole number of loops (the pitch adjusted by at
     // most half a loop over the guide's length) closes the cycloid on
     // itself: no dense head and tail where it starts and ends.
-    const double loops = closed[g] ? std::max(1.0, std::round(L / pitch)) : std::max(1.0, L / pitch);
+    const double loops = guides[g].closed ? std::max(1.0, std::round(L / pitch)) : std::max(1.0, L / pitch);
     const double pitch_g = L > 0 ? L / loops : pitch;
     const double phi_end = 2 * kPi * loops;
     const double dphi = std::min(0.5, params.row_step / (r + pitch / (2 * kPi)));
     const int n = std::max(1, static_cast<int>(std::ceil(phi_end / dphi)));
+    const int sense = guides[g].sense;
     auto point = [&](double phi) {
       const double sigma = pitch_g * phi / (2 * kPi);
-      const double ang = sense[g] * phi + theta;
+      const double ang = sense * phi + theta;
       return Vec2(guide.At(sigma) + r * Vec2(std::cos(ang), std::sin(ang)));
     };
     for (int i = 0; i <= n; ++i) {
@@ -223,7 +431,7 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
           t.push_back(0.0);
         } else {
           // Transition from the end of the previous row, on the surface.
-          StraightMove(m, last_st, st, tan, vmax, params.row_step, false, &out.rows, &t);
+          link(st, tan);
         }
       } else {
         out.rows.push_back(m.Row(st, tan));
@@ -231,6 +439,11 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
       }
       last_st = st;
     }
+  }
+  // With lifts every row says its force (the file's force_N column).
+  if (out.lifts > 0) {
+    for (auto& row : out.rows)
+      if (row.force < 0) row.force = process.force;
   }
   // Enforce the speed limit on the mapped 3-D path (the developed plane
   // distorts lengths on doubly curved patches).
@@ -240,12 +453,29 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   const double vm = MaxSpeed(out.rows);
   if (vm > vmax) ScaleTime(&out, vm / vmax);
   out.length = 0.0;
-  for (size_t i = 1; i < out.rows.size(); ++i) out.length += (out.rows[i].p - out.rows[i - 1].p).norm();
+  for (size_t i = 1; i < out.rows.size(); ++i) {
+    if (out.rows[i - 1].force != 0.0) out.length += (out.rows[i].p - out.rows[i - 1].p).norm();
+  }
   return out;
 }
 
 void ScaleTime(PlannedPath* path, double factor) {
-  for (auto& r : path->rows) r.t *= factor;
+  // Lifting off and setting down (a force step between two rows at the same
+  // point) keep their short duration: scaled, the step before a lift would
+  // be a dwell at full force that leaves a mark.
+  auto& rows = path->rows;
+  double prev = rows.empty() ? 0.0 : rows[0].t;
+  if (!rows.empty()) rows[0].t *= factor;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    if (path->lifts == 0) {
+      rows[i].t *= factor;
+      continue;
+    }
+    const double dt = rows[i].t - prev;
+    prev = rows[i].t;
+    const bool force_step = (rows[i].force == 0.0) != (rows[i - 1].force == 0.0) && rows[i].p == rows[i - 1].p;
+    rows[i].t = rows[i - 1].t + (force_step ? dt : dt * factor);
+  }
   path->omega_rad_per_s /= factor;
   path->centre_speed /= factor;
 }
@@ -320,7 +550,7 @@ void AttachToSurface(const NurbsSurface& surface, const SampleGrid& grid, bool f
         << dist * 1e3 << " mm off the surface (tolerance 0.01 mm)";
       throw PathRowError(static_cast<int>(r), m.str());
     }
-    if (!surface.OnFace(uu, vv)) {
+    if (row.force != 0.0 && !surface.OnFace(uu, vv)) {  // a lifted row may pass over a hole
       std::ostringstream m;
       m << "the point (" << row.p.x() * 1e3 << ", " << row.p.y() * 1e3 << ", " << row.p.z() * 1e3
         << ") mm is off the trimmed face (outside its boundary or in a hole"

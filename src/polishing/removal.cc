@@ -125,12 +125,17 @@ std::vector<ToolContact> RemovalSimulator::Contacts(const std::vector<PathRow>& 
   for (size_t r = 0; r < path.size(); ++r) {
     try {
       const SurfaceDerivatives d = surface_->Evaluate(path[r].u, path[r].v);
-      const double force = path[r].force > 0 ? path[r].force : process_.force;
+      const double force = path[r].force >= 0 ? path[r].force : process_.force;
       ToolContact& c = contacts[r];
       c.p = d.S;
       c.n = UnitNormal(d, process_.flip_normal);
       const Eigen::Vector3d tx = (path[r].tx - path[r].tx.dot(c.n) * c.n).normalized();
       const Eigen::Vector3d ty = c.n.cross(tx);
+      if (force == 0.0) {  // the tool is lifted: no contact (a = b = p0 = 0)
+        c.e_a = tx;
+        c.e_b = ty;
+        continue;
+      }
       Eigen::Matrix2d K = CurvatureTensor(d, tx, ty, process_.flip_normal);
       K(0, 0) += 1.0 / process_.wheel_radius;
       K(1, 1) += 1.0 / process_.crown_radius;
@@ -167,6 +172,10 @@ std::vector<double> RemovalSimulator::Simulate(const std::vector<PathRow>& path,
       throw PathRowError(static_cast<int>(r + 1), "t_s must be strictly increasing");
     }
     const ToolContact& c = contacts[r];
+    // Lifted (force 0 at the segment's start), or lifting off at its end: no
+    // removal. formats.md §6 makes the force linear between rows; a force
+    // step to or from 0 is taken as instantaneous.
+    if (!(c.p0 > 0.0) || path[r + 1].force == 0.0) continue;
     const Eigen::Vector3d d = path[r + 1].p - path[r].p;
     const double v_rel = (process_.belt_speed * path[r].tx + d / dt).norm();
     const double scale = process_.preston_coefficient * c.p0 * v_rel * dt;

@@ -198,6 +198,8 @@ int SampleGrid::num_in_region() const {
 }
 double SampleGrid::UOfS(double s) const { return Interp(table_s_, table_u_, s); }
 double SampleGrid::VOfT(double t) const { return Interp(table_t_, table_v_, t); }
+double SampleGrid::SOfU(double u) const { return Interp(table_u_, table_s_, u); }
+double SampleGrid::TOfV(double v) const { return Interp(table_v_, table_t_, v); }
 double SampleGrid::DuDs(double s) const { return Slope(table_s_, table_u_, s); }
 double SampleGrid::DvDt(double t) const { return Slope(table_t_, table_v_, t); }
 

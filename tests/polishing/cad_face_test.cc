@@ -90,6 +90,21 @@ TEST(CadFace, PlateWithHoleRegionMatchesAnalytic) {
   EXPECT_FALSE(on_face(59.9, 30));  // in the hole
   EXPECT_TRUE(on_face(60.1, 30));   // just outside it
   EXPECT_TRUE(on_face(1, 1));
+  // The wires in the parameter plane (for the guide lines): the outer
+  // rectangle and the hole, every point of them on the edge it samples.
+  ASSERT_EQ(s.trim()->wires_uv.size(), 2u);
+  size_t points = 0;
+  for (const auto& wire : s.trim()->wires_uv) {
+    ASSERT_GE(wire.size(), 8u);
+    for (const Eigen::Vector2d& uv : wire) {
+      const Eigen::Vector3d p = s.Point(uv.x(), uv.y()) * 1e3;  // mm
+      const double d_edge = std::min({std::abs(p.x()), std::abs(p.x() - 100), std::abs(p.y()), std::abs(p.y() - 60)});
+      const double d_hole = std::abs(std::hypot(p.x() - 50, p.y() - 30) - 10);
+      EXPECT_LT(std::min(d_edge, d_hole), 1e-6) << p.transpose();
+      ++points;
+    }
+  }
+  EXPECT_GT(points, (320 + 2 * kPi * 10) / 0.25 * 0.9);  // 0.25 mm chords
   const double margin = 5e-3, h = 0.25e-3;
   const auto g = polishing::SampleGrid::Build(s, h, margin, false);
   // Every sample point against the analytic rule, except within 2 um of the

@@ -1,6 +1,8 @@
 #include "robomach/polishing/paths.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iostream>
 
 #include <gtest/gtest.h>
 
@@ -270,6 +272,128 @@ TEST(Optimise, PatternOrderingOnACylinder) {
 
 TEST(Optimise, PatternOrderingOnADome) {
   const PatternCvs c = ComparePatterns(testing::Dome(0.06, 0.05, 0.005));
+  ExpectCycloidOrdering(c);
+}
+
+// A face with a hole (the plate 100 x 60 mm, hole radius 10 mm at (50, 30),
+// margin 3 mm; the trim is made in the test): the guide loops are
+// equidistant offsets of the region's boundary, outer edge and hole alike,
+// and no row in contact leaves the face. The region's analytic distance
+// function is the reference.
+double PlateRegionDistance(const Eigen::Vector3d& p) {  // [m], > 0 inside the region
+  const double x = p.x() * 1e3, y = p.y() * 1e3;
+  return 1e-3 * std::min({x - 3, 97 - x, y - 3, 57 - y, std::hypot(x - 50, y - 30) - 13});
+}
+void ExpectContactRowsOnThePlate(const PlannedPath& path) {
+  int lifted = 0;
+  for (size_t i = 0; i < path.rows.size(); ++i) {
+    const PathRow& r = path.rows[i];
+    if (r.force == 0.0) {
+      ++lifted;
+      continue;
+    }
+    // On the face: out of the hole, inside the plate (to the 1 um chord sag).
+    EXPECT_GE(std::hypot(r.p.x() - 0.05, r.p.y() - 0.03), 0.010 - 1e-6) << "row " << i;
+    EXPECT_TRUE(r.p.x() >= -1e-9 && r.p.x() <= 0.1 + 1e-9 && r.p.y() >= -1e-9 && r.p.y() <= 0.06 + 1e-9) << i;
+    if (i > 0 && path.rows[i - 1].force != 0.0) {  // the segment in contact, at its midpoint
+      const Eigen::Vector3d m = 0.5 * (r.p + path.rows[i - 1].p);
+      EXPECT_GE(std::hypot(m.x() - 0.05, m.y() - 0.03), 0.010 - 1e-6) << "segment " << i;
+    }
+    // A lift is a force step at one point: off at the last row in contact,
+    // on again at the first.
+    if (i > 0 && path.rows[i - 1].force == 0.0) EXPECT_EQ(r.p, path.rows[i - 1].p) << i;
+    if (i + 1 < path.rows.size() && path.rows[i + 1].force == 0.0) EXPECT_EQ(r.p, path.rows[i + 1].p) << i;
+  }
+  EXPECT_EQ(lifted, 2 * path.lifts);
+}
+
+TEST(Paths, CycloidLoopsAreOffsetsOfAFaceWithAHole) {
+  const NurbsSurface plate = testing::PlateWithHole(0.1, 0.06, 0.05, 0.03, 0.01);
+  PolishingProcess proc = Process(0.003);
+  proc.preston_coefficient = 1e-11;
+  const SampleGrid grid = SampleGrid::Build(plate, 0.5e-3, proc.margin, false);
+  const PathParameters p;  // d 8, r 6, pitch 3 mm
+  const PlannedPath path = PlanPath(plate, grid, p, proc);
+  ExpectValidFrames(path, proc.max_speed);
+  ExpectContactRowsOnThePlate(path);
+  // Each guide loop keeps one distance from the region's boundary; the
+  // outermost is r - margin (+ 0.05 mm clearance) inside it, so that the
+  // circle just reaches the face's edge and the hole's.
+  ASSERT_GE(path.guide_lines.size(), 3u);
+  double outermost = 1e9;
+  bool around_hole = false;
+  for (const auto& loop : path.guide_lines) {
+    double lo = 1e9, hi = -1e9;
+    for (const Eigen::Vector3d& q : loop) {
+      lo = std::min(lo, PlateRegionDistance(q));
+      hi = std::max(hi, PlateRegionDistance(q));
+      around_hole |= std::hypot(q.x() - 0.05, q.y() - 0.03) < 0.020;
+    }
+    EXPECT_LT(hi - lo, 15e-6) << "a guide loop from " << lo * 1e3 << " to " << hi * 1e3 << " mm off the boundary";
+    outermost = std::min(outermost, lo);
+  }
+  EXPECT_NEAR(outermost, p.radius - proc.margin + 50e-6, 15e-6);
+  EXPECT_TRUE(around_hole);
+  const RemovalSimulator sim(plate, proc, grid.points(), grid.normals(), 1.5e-3);
+  const RemovalStats st = ComputeRemovalStats(sim.Simulate(path.rows), grid.areas(), grid.in_region());
+  EXPECT_GE(st.coverage, 0.99);
+}
+
+// Parallel rows on the same face: each row is cut at the hole, the pieces are
+// run cell by cell, and links that would cross the hole or drag the tool a
+// long way across polished area are lifted (rows with force 0).
+TEST(Paths, ParallelRowsStopAtTheHole) {
+  const NurbsSurface plate = testing::PlateWithHole(0.1, 0.06, 0.05, 0.03, 0.01);
+  const PolishingProcess proc = Process(0.003);
+  const SampleGrid grid = SampleGrid::Build(plate, 0.5e-3, proc.margin, false);
+  PathParameters p;
+  p.pattern = Pattern::kParallel;
+  p.offset = 0.004;
+  const PlannedPath path = PlanPath(plate, grid, p, proc);
+  ExpectValidFrames(path, proc.max_speed);
+  ExpectContactRowsOnThePlate(path);
+  // 14 lines at 4 mm (t = 4 .. 56 mm) over the region's 54 mm; those within 13 mm of
+  // the hole's centre line are cut in two.
+  int pieces = 0, expected = 0;
+  for (const auto& g : path.guide_lines) {
+    ++pieces;
+    EXPECT_NEAR(PlateRegionDistance(g.front()), 0.0, 1e-6);
+    EXPECT_NEAR(PlateRegionDistance(g.back()), 0.0, 1e-6);
+  }
+  for (int k = 0; k < 14; ++k) expected += std::abs(0.004 + 0.004 * k - 0.03) < 0.013 ? 2 : 1;
+  EXPECT_EQ(pieces, expected);
+  // Simulated, the lifted links remove nothing: the removal equals that of
+  // the rows in contact alone, simulated piece by piece.
+  const RemovalSimulator sim(plate, proc, grid.points(), grid.normals(), 1.5e-3);
+  const std::vector<double> all = sim.Simulate(path.rows);
+  std::vector<double> sum(all.size(), 0.0);
+  std::vector<PathRow> piece;
+  for (const PathRow& r : path.rows) {
+    if (r.force == 0.0) {
+      if (piece.size() >= 2) {
+        const auto h = sim.Simulate(piece);
+        for (size_t k = 0; k < h.size(); ++k) sum[k] += h[k];
+      }
+      piece.clear();
+      continue;
+    }
+    piece.push_back(r);
+  }
+  const auto h = sim.Simulate(piece);
+  for (size_t k = 0; k < h.size(); ++k) sum[k] += h[k];
+  double max_all = 0, max_diff = 0;
+  for (size_t k = 0; k < all.size(); ++k) max_all = std::max(max_all, all[k]), max_diff = std::max(max_diff, std::abs(all[k] - sum[k]));
+  EXPECT_GT(path.lifts, 0);
+  EXPECT_LT(max_diff, 1e-3 * max_all) << "lifts " << path.lifts;
+}
+
+// Acceptance (issue 11) on a face with a hole: the NLopt cycloid against the
+// default and optimised parallel paths, as on the other surfaces.
+TEST(Optimise, PatternOrderingOnAPlateWithAHole) {
+  const PatternCvs c = ComparePatterns(testing::PlateWithHole(0.1, 0.06, 0.05, 0.03, 0.01));
+  std::cout << "plate with a hole: cycloid default " << c.cycloid_default << ", parallel default "
+            << c.parallel_default << ", parallel optimised " << c.parallel_opt << ", cycloid optimised "
+            << c.cycloid_opt << " (coverage " << c.coverage_opt << ")\n";
   ExpectCycloidOrdering(c);
 }
 

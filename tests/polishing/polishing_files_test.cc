@@ -68,5 +68,28 @@ TEST(PolishingFiles, PathRoundTripsAndBadRowsAreLocated) {
               HasSubstr("bad2.csv:3: column tx: tool x (tx,ty,tz) must be normal to (nx,ny,nz)"));
 }
 
+// force_N (formats.md §6): written when the path sets it (a planned path
+// with lifts), read back; 0 is a lifted row, a negative force an error.
+TEST(PolishingFiles, ForceColumnRoundTripsWithLiftedRows) {
+  const std::string dir = robomach::testing::TempDir("polishing_files");
+  std::vector<polishing::PathRow> rows(3);
+  for (int i = 0; i < 3; ++i) {
+    rows[i].t = 0.1 * i;
+    rows[i].p = Eigen::Vector3d(0.001 * i, 0.0, 0.0);
+    rows[i].n = Eigen::Vector3d::UnitZ();
+    rows[i].tx = Eigen::Vector3d::UnitX();
+    rows[i].force = i == 1 ? 0.0 : 2.5;
+  }
+  WritePolishPath(dir + "/f.csv", rows, {});
+  const PolishPathFile f = ReadPolishPath(dir + "/f.csv");
+  ASSERT_EQ(f.rows.size(), 3u);
+  EXPECT_EQ(f.rows[0].force, 2.5);
+  EXPECT_EQ(f.rows[1].force, 0.0);
+  robomach::testing::WriteText(dir + "/badf.csv",
+                               "t_s,x_mm,y_mm,z_mm,nx,ny,nz,tx,ty,tz,force_N\n0,0,0,0,0,0,1,1,0,0,2\n1,1,0,0,0,0,1,1,0,0,-1\n");
+  EXPECT_THAT(CaptureError([&] { ReadPolishPath(dir + "/badf.csv"); }),
+              HasSubstr("badf.csv:3: column force_N: expected a force >= 0 (0: the tool is lifted), got -1"));
+}
+
 }  // namespace
 }  // namespace robomach::io

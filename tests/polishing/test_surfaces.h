@@ -4,8 +4,10 @@
 // nets (The NURBS Book §7.5 circle, §8.5 surface of revolution).
 
 #include <cmath>
+#include <memory>
 #include <vector>
 
+#include "robomach/polishing/face_trim.h"
 #include "robomach/polishing/nurbs_surface.h"
 
 namespace robomach::polishing::testing {
@@ -87,6 +89,40 @@ inline NurbsSurface Dome(double Lx, double Ly, double h) {
     for (int j = 0; j < 3; ++j)
       P[i].push_back(Eigen::Vector3d(0.5 * Lx * i, 0.5 * Ly * j, h * ((i == 1) + (j == 1))));
   return NurbsSurface::Create(2, 2, {0, 0, 0, 1, 1, 1}, {0, 0, 0, 1, 1, 1}, P);
+}
+
+/// A trimmed face made here, not by the CAD reader: the plate
+/// [0, Lx] x [0, Ly] in z = 0 with a circular hole of radius `hole_r` at
+/// (cx, cy), as a FaceTrim with an analytic inside test, the boundary as
+/// 3-D polylines (0.25 mm chords) and the wires in (u, v) = (x / Lx, y / Ly).
+inline NurbsSurface PlateWithHole(double Lx, double Ly, double cx, double cy, double hole_r) {
+  auto trim = std::make_shared<FaceTrim>();
+  trim->contains = [=](double u, double v) { return std::hypot(u * Lx - cx, v * Ly - cy) >= hole_r; };
+  const std::vector<Eigen::Vector3d> corners = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(Lx, 0, 0),
+                                                Eigen::Vector3d(Lx, Ly, 0), Eigen::Vector3d(0, Ly, 0)};
+  std::vector<Eigen::Vector2d> outer, hole;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d &a = corners[k], &b = corners[(k + 1) % 4];
+    const int n = static_cast<int>(std::ceil((b - a).norm() / 0.25e-3));
+    std::vector<Eigen::Vector3d> line;
+    for (int i = 0; i <= n; ++i) line.push_back(a + (b - a) * (double(i) / n));
+    trim->boundary.push_back(line);
+    for (int i = 0; i < n; ++i) outer.emplace_back(line[i].x() / Lx, line[i].y() / Ly);
+  }
+  const int n = static_cast<int>(std::ceil(2 * M_PI * hole_r / 0.25e-3));
+  std::vector<Eigen::Vector3d> circle;
+  for (int i = 0; i <= n; ++i) {
+    const double a = -2 * M_PI * i / n;  // clockwise: a hole
+    circle.emplace_back(cx + hole_r * std::cos(a), cy + hole_r * std::sin(a), 0.0);
+    if (i < n) hole.emplace_back(circle.back().x() / Lx, circle.back().y() / Ly);
+  }
+  trim->boundary.push_back(circle);
+  trim->wires_uv = {outer, hole};
+  trim->boundary_chord = 0.25e-3;
+  trim->area = Lx * Ly - M_PI * hole_r * hole_r;
+  trim->num_wires = 2;
+  trim->source = "test plate with a hole";
+  return Plane(Lx, Ly).WithTrim(trim);
 }
 
 }  // namespace robomach::polishing::testing

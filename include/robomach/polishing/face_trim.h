@@ -22,6 +22,12 @@ struct FaceTrim {
   /// most `boundary_chord` long and within `boundary_sag` of the edge curve.
   std::vector<std::vector<Eigen::Vector3d>> boundary;
   double boundary_chord{0.0};  // [m]
+  /// The trimming wires in the patch's parameter plane (u, v): one closed
+  /// polygon per wire (the last point is not repeated), the outer wire and
+  /// the holes, each edge sampled as its 3-D polyline above. Seams and
+  /// degenerate edges of closed surfaces are included here: this is the
+  /// boundary of the face's parameter domain.
+  std::vector<std::vector<Eigen::Vector2d>> wires_uv;
   double area{0.0};            // area of the face [m^2] (from the CAD kernel)
   int num_wires{0};            // 1 + number of holes
   std::string source;          // "file.step, face 3" for messages

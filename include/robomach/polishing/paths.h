@@ -55,10 +55,18 @@ struct PlannedPath {
   double length{0.0};            // [m]
   double omega_rad_per_s{0.0};   // cycloid rolling rate with the current time stamps
   double centre_speed{0.0};      // [m/s]
+  /// Links where the tool is lifted (rows with force 0) because the straight
+  /// move on the surface would leave the face (across a hole or a notch of a
+  /// trimmed face). With lifts, every row carries its force.
+  int lifts{0};
 };
 
 /// Plans the path with time stamps at the fastest rate that keeps every
-/// segment at or below process.max_speed.
+/// segment at or below process.max_speed. On a rectangular region (a plain
+/// patch) the guide loops are rectangles and a centre line; on any other
+/// region (a trimmed face: curved outline, holes) they are the region's
+/// equidistant offsets (region_outline.h), and parallel lines are clipped to
+/// it and run cell by cell.
 PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const PathParameters& params,
                      const PolishingProcess& process);
 

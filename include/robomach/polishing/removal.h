@@ -24,7 +24,8 @@ struct PathRow {
   Eigen::Vector3d n;           // tool z, unit surface normal towards the tool
   Eigen::Vector3d tx;          // tool x, unit, normal to n
   double u{0.0}, v{0.0};       // surface parameters of p
-  double force{-1.0};          // [N]; < 0: the process force
+  double force{-1.0};          // [N]; < 0: the process force; 0: the tool is lifted
+                               // (a segment starting or ending at 0 removes nothing)
 };
 
 /// The contact at one path row, in 3-D: ellipse centre p, semi-axes a (along

@@ -47,6 +47,9 @@ class SampleGrid {
   /// Parameters of a developed point (clamped to the patch).
   double UOfS(double s) const;
   double VOfT(double t) const;
+  /// Developed coordinates of parameters (the inverse maps).
+  double SOfU(double u) const;
+  double TOfV(double v) const;
   /// d u / d s and d v / d t at a developed point.
   double DuDs(double s) const;
   double DvDt(double t) const;
