@@ -126,15 +126,40 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
   auto& a2 = fp.at(0, 0);
   a2.x_label = "x [mm]";
   a2.y_label = "y [mm]";
-  report::Series path;
-  path.label = "contact path";
-  path.color = report::PaletteColor(0);
-  path.thickness = 1;
-  for (const auto& r : rows) {
-    path.x.push_back(1e3 * r.p.x());
-    path.y.push_back(1e3 * r.p.y());
+  // The path in contact as one series per stretch between lifts; the lifted
+  // moves (rows with force 0) as thin grey dashes.
+  bool first_piece = true, first_lift = true;
+  report::Series piece;
+  auto flush = [&] {
+    if (piece.x.size() >= 2) {
+      piece.label = first_piece ? "contact path" : "";
+      piece.color = report::PaletteColor(0);
+      piece.thickness = 1;
+      a2.series.push_back(piece);
+      first_piece = false;
+    }
+    piece = report::Series();
+  };
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].force == 0.0) {
+      flush();
+      if (i + 1 < rows.size() && rows[i + 1].force == 0.0) {
+        report::Series lift;
+        lift.label = first_lift ? "lifted" : "";
+        lift.color = report::Rgb{150, 150, 150};
+        lift.thickness = 1;
+        lift.dashed = true;
+        lift.x = {1e3 * rows[i].p.x(), 1e3 * rows[i + 1].p.x()};
+        lift.y = {1e3 * rows[i].p.y(), 1e3 * rows[i + 1].p.y()};
+        a2.series.push_back(lift);
+        first_lift = false;
+      }
+      continue;
+    }
+    piece.x.push_back(1e3 * rows[i].p.x());
+    piece.y.push_back(1e3 * rows[i].p.y());
   }
-  a2.series.push_back(path);
+  flush();
   for (size_t g = 0; g < guide_lines.size(); ++g) {
     report::Series s;
     s.label = g == 0 ? "guide lines" : "";
