@@ -287,7 +287,7 @@ int Run(int argc, char** argv) {
     if (!path_out.empty()) io::WritePolishPath(path_out, e.path.rows, meta);
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, e.removal);
     robot.WriteJoints(e.path.rows);
-    if (!plot_out.empty()) WritePictures(plot_out, grid, e.removal, e.path.rows, e.path.guide_lines, history, pattern);
+    if (!plot_out.empty()) WritePictures(plot_out, grid, e.removal, e.path.rows, e.path.guide_lines_st, history, pattern);
     const std::string text = summary.dump(2) + "\n";
     if (!summary_out.empty()) io::WriteFileAtomically(summary_out, text);
     else std::cout << text;

@@ -60,7 +60,7 @@ std::vector<std::string> PicturePaths(const std::string& png, bool with_converge
 std::vector<std::string> WritePictures(const std::string& png, const polishing::SampleGrid& grid,
                                        const std::vector<double>& removal_m,
                                        const std::vector<polishing::PathRow>& rows,
-                                       const std::vector<std::vector<Eigen::Vector3d>>& guide_lines,
+                                       const std::vector<std::vector<Eigen::Vector2d>>& guide_lines_st,
                                        const std::vector<double>& history, const std::string& title) {
   const std::vector<std::string> files = PicturePaths(png, !history.empty());
   // Removal map (seed Fig. 19) on the developed plane.
@@ -120,12 +120,15 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
     ax.y_min = 0.0;
   }
   hist.SavePng(files[1]);
-  // Path with guide lines (seed Fig. 18), x-y view.
+  // Path with guide lines (seed Fig. 18) in the developed plane, as the
+  // removal map: an x-y view says little about a steep or wrapped face.
   report::Figure fp(1, 1, 900, 700);
-  fp.title = title + ": path (x-y view)";
+  fp.title = title + ": path (developed plane)";
   auto& a2 = fp.at(0, 0);
-  a2.x_label = "x [mm]";
-  a2.y_label = "y [mm]";
+  a2.x_label = "s (arc length along u) [mm]";
+  a2.y_label = "t (arc length along v) [mm]";
+  auto s_mm = [&](const polishing::PathRow& r) { return 1e3 * grid.SOfU(r.u); };
+  auto t_mm = [&](const polishing::PathRow& r) { return 1e3 * grid.TOfV(r.v); };
   // The path in contact as one series per stretch between lifts; the lifted
   // moves (rows with force 0) as thin grey dashes.
   bool first_piece = true, first_lift = true;
@@ -149,23 +152,23 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
         lift.color = report::Rgb{150, 150, 150};
         lift.thickness = 1;
         lift.dashed = true;
-        lift.x = {1e3 * rows[i].p.x(), 1e3 * rows[i + 1].p.x()};
-        lift.y = {1e3 * rows[i].p.y(), 1e3 * rows[i + 1].p.y()};
+        lift.x = {s_mm(rows[i]), s_mm(rows[i + 1])};
+        lift.y = {t_mm(rows[i]), t_mm(rows[i + 1])};
         a2.series.push_back(lift);
         first_lift = false;
       }
       continue;
     }
-    piece.x.push_back(1e3 * rows[i].p.x());
-    piece.y.push_back(1e3 * rows[i].p.y());
+    piece.x.push_back(s_mm(rows[i]));
+    piece.y.push_back(t_mm(rows[i]));
   }
   flush();
-  for (size_t g = 0; g < guide_lines.size(); ++g) {
+  for (size_t g = 0; g < guide_lines_st.size(); ++g) {
     report::Series s;
     s.label = g == 0 ? "guide lines" : "";
     s.color = report::PaletteColor(1);
     s.dashed = true;
-    for (const auto& p : guide_lines[g]) {
+    for (const auto& p : guide_lines_st[g]) {
       s.x.push_back(1e3 * p.x());
       s.y.push_back(1e3 * p.y());
     }

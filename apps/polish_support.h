@@ -31,12 +31,12 @@ nlohmann::json PathJson(const std::vector<polishing::PathRow>& rows);
 
 /// Pictures next to `png`: the removal map (png itself, colour scale in
 /// um on the developed s, t plane), <stem>_histogram.png, <stem>_path.png
-/// (path and guide lines, x-y view) and, if `history` is not empty,
+/// (path, lifted moves and guide lines in the developed s, t plane) and, if `history` is not empty,
 /// <stem>_convergence.png. Returns the paths written.
 std::vector<std::string> WritePictures(const std::string& png, const polishing::SampleGrid& grid,
                                        const std::vector<double>& removal_m,
                                        const std::vector<polishing::PathRow>& rows,
-                                       const std::vector<std::vector<Eigen::Vector3d>>& guide_lines,
+                                       const std::vector<std::vector<Eigen::Vector2d>>& guide_lines_st,
                                        const std::vector<double>& history, const std::string& title);
 
 /// The list of picture files WritePictures would write (for clean-up and

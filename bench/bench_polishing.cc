@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "robomach/common/units.h"
+#include "robomach/io/cad_face.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/optimise.h"
 #include "robomach/polishing/paths.h"
@@ -112,6 +113,29 @@ void BM_OptimiseNloptDemoBlade(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_OptimiseNloptDemoBlade)->Unit(benchmark::kSecond)->Iterations(1);
+
+// Planning on a trimmed face with a hole (tests/data/polishing/plate_hole.step,
+// margin 3 mm, 1 mm optimiser grid): the region's polygons, its inradius and
+// offsets (Clipper) and the cycloid along them, per optimiser evaluation.
+// Arg 0: the default cycloid (d 8, r 6, pitch 3 mm); arg 1: the NLopt optimum
+// of the README (d 2.78, r 1.47, pitch 0.76 mm, ~20 loops).
+void BM_PlanCycloidOnPlateWithHole(benchmark::State& state) {
+  const std::string src = ROBOMACH_SOURCE_DIR;
+  const NurbsSurface plate = io::ReadCadFace(src + "/tests/data/polishing/plate_hole.step", 1);
+  const PolishingProcess proc = io::ReadPolishingProcess(src + "/tests/data/polishing/process_small_margin.yaml");
+  const SampleGrid coarse = SampleGrid::Build(plate, 1e-3, proc.margin, false);
+  PathParameters p;
+  p.row_step = 1e-3;
+  if (state.range(0) == 1) p.offset = 2.78e-3, p.radius = 1.47e-3, p.pitch = 0.76e-3;
+  size_t rows = 0;
+  for (auto _ : state) {
+    const PlannedPath path = PlanPath(plate, coarse, p, proc);
+    rows = path.rows.size();
+    benchmark::DoNotOptimize(path.rows.data());
+  }
+  state.counters["rows"] = static_cast<double>(rows);
+}
+BENCHMARK(BM_PlanCycloidOnPlateWithHole)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

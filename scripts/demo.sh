@@ -22,4 +22,4 @@ echo "  modes.csv     natural frequencies, damping ratios, modal masses, tool-ti
 echo "  details.json  J, cond(J), M_q, K_q, C_q, Cartesian M, K, C and static compliance per posture"
 echo "  frf.png       magnitude and phase of Hxx, Hyy, Hzz at all postures (frf/ has one per posture)"
 echo
-column -s, -t < "$out/modes.csv" | head -n 13
+head -n 13 "$out/modes.csv" | column -s, -t  # head first: with pipefail a closed pipe would fail the demo

@@ -396,6 +396,7 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
     std::vector<Eigen::Vector3d> line;
     for (const Vec2& p : guide.pts) line.push_back(m.Point(p));
     out.guide_lines.push_back(line);
+    out.guide_lines_st.push_back(guide.pts);
     if (!cyc) {
       const Vec2 dir = tool_dir(guide.Tangent(0.0));
       if (!out.rows.empty()) link(guide.pts.front(), dir);

@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <functional>
 #include <fstream>
+#include <iostream>
 
+#include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
@@ -27,6 +29,8 @@
 
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
+#include "robomach/polishing/paths.h"
+#include "robomach/polishing/removal.h"
 #include "robomach/polishing/surface_grid.h"
 
 namespace robomach::io {
@@ -205,6 +209,54 @@ TEST(CadFace, SolidFacesPointOutwardsAndSeamsAreNoBoundary) {
   }
   // Boundary: two circles of 188 mm, each cut cell counted whole or not.
   EXPECT_NEAR(area * 1e6, 2 * kPi * 30 * 40, 2 * 188.5 * 0.5 / 2);
+}
+
+// Planning on a curved trimmed face made by OpenCASCADE's boolean cut (not
+// by robomach): a quarter cylinder R 60 mm, 80 mm high, with a radial hole of
+// radius 10 mm drilled at 45 deg, z = 40 mm. The rows in contact must lie on
+// the cylinder, inside the quarter and outside the drilled hole (distance
+// from the drill's axis >= 10 mm), for the cycloid on offsets and the
+// zig-zag; the default cycloid covers the region.
+TEST(CadFace, PathsOnACurvedFaceWithADrilledHole) {
+  const std::string file = TmpPath("quarter_cylinder_hole.step");
+  const TopoDS_Shape quarter = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 60, 80, kPi / 2).Shape();
+  const gp_Dir radial(std::cos(kPi / 4), std::sin(kPi / 4), 0);
+  const TopoDS_Shape drill = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 40), radial), 10, 100).Shape();
+  BRepAlgoAPI_Cut cut(quarter, drill);
+  ASSERT_TRUE(cut.IsDone());
+  WriteStep(cut.Shape(), file);
+  const polishing::NurbsSurface face = ReadCadFace(file, 0);  // the largest: the drilled cylindrical side
+  ASSERT_NE(face.trim(), nullptr);
+  ASSERT_EQ(face.trim()->num_wires, 2);
+  polishing::PolishingProcess proc;
+  proc.margin = 3e-3;
+  const auto grid = polishing::SampleGrid::Build(face, 0.5e-3, proc.margin, false);
+  const Eigen::Vector3d axis_point(0, 0, 0.040), axis(radial.X(), radial.Y(), 0);
+  for (const auto pattern : {polishing::Pattern::kCycloid, polishing::Pattern::kParallel}) {
+    polishing::PathParameters p;
+    p.pattern = pattern;
+    if (pattern == polishing::Pattern::kParallel) p.offset = 0.004;
+    const polishing::PlannedPath path = polishing::PlanPath(face, grid, p, proc);
+    int in_contact = 0;
+    for (size_t i = 0; i < path.rows.size(); ++i) {
+      const Eigen::Vector3d x = path.rows[i].p;
+      if (path.rows[i].force == 0.0) continue;
+      ++in_contact;
+      ASSERT_NEAR(std::hypot(x.x(), x.y()), 0.060, 1e-6) << i;
+      ASSERT_TRUE(x.x() >= -1e-7 && x.y() >= -1e-7 && x.z() >= -1e-7 && x.z() <= 0.080 + 1e-7) << i;
+      const Eigen::Vector3d q = x - axis_point;
+      ASSERT_GE((q - q.dot(axis) * axis).norm(), 0.010 - 2e-6) << "row " << i << " in the hole";
+      ASSERT_TRUE(face.OnFace(path.rows[i].u, path.rows[i].v)) << i;
+    }
+    EXPECT_GT(in_contact, 1000);
+    if (pattern == polishing::Pattern::kCycloid) {
+      const polishing::RemovalSimulator sim(face, proc, grid.points(), grid.normals(), 1.5e-3);
+      const auto st = polishing::ComputeRemovalStats(sim.Simulate(path.rows), grid.areas(), grid.in_region());
+      EXPECT_GE(st.coverage, 0.99);
+      std::cout << "drilled quarter cylinder: default cycloid cv " << st.cv << ", coverage " << st.coverage
+                << ", lifts " << path.lifts << "\n";
+    }
+  }
 }
 
 TEST(CadFace, CorruptAndEmptyFiles) {

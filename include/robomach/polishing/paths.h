@@ -52,6 +52,8 @@ struct PlannedPath {
   std::vector<PathRow> rows;
   /// Guide lines (row centre lines of the parallel pattern) on the surface [m].
   std::vector<std::vector<Eigen::Vector3d>> guide_lines;
+  /// The same in the developed (s, t) plane of the SampleGrid [m].
+  std::vector<std::vector<Eigen::Vector2d>> guide_lines_st;
   double length{0.0};            // [m]
   double omega_rad_per_s{0.0};   // cycloid rolling rate with the current time stamps
   double centre_speed{0.0};      // [m/s]
