@@ -387,6 +387,38 @@ TEST(Paths, ParallelRowsStopAtTheHole) {
   EXPECT_LT(max_diff, 1e-3 * max_all) << "lifts " << path.lifts;
 }
 
+// A hole so large that the region falls apart into two islands left and
+// right of it (plate 100 x 60 mm, hole radius 26 mm at the centre, margin
+// 5 mm: the hole's margin circle, radius 31 mm, cuts through the top and
+// bottom edges' margin lines). Each island gets its own guide loops or
+// cells, and the tool is lifted from one island to the other.
+TEST(Paths, IslandsAreReachedByLifting) {
+  const NurbsSurface plate = testing::PlateWithHole(0.1, 0.06, 0.05, 0.03, 0.026);
+  PolishingProcess proc = Process(0.005);
+  proc.preston_coefficient = 1e-11;
+  const SampleGrid grid = SampleGrid::Build(plate, 0.5e-3, proc.margin, false);
+  const RemovalSimulator sim(plate, proc, grid.points(), grid.normals(), 1.5e-3);
+  for (const Pattern pattern : {Pattern::kCycloid, Pattern::kParallel}) {
+    PathParameters p;
+    p.pattern = pattern;
+    p.offset = pattern == Pattern::kCycloid ? 0.006 : 0.004;
+    p.radius = 0.004;
+    const PlannedPath path = PlanPath(plate, grid, p, proc);
+    ExpectValidFrames(path, proc.max_speed);
+    int left = 0, right = 0;
+    for (const PathRow& r : path.rows) {
+      if (r.force == 0.0) continue;
+      EXPECT_GE(std::hypot(r.p.x() - 0.05, r.p.y() - 0.03), 0.026 - 1e-6);
+      (r.p.x() < 0.05 ? left : right)++;
+    }
+    EXPECT_GT(left, 100);
+    EXPECT_GT(right, 100);
+    EXPECT_GE(path.lifts, 1);
+    const RemovalStats st = ComputeRemovalStats(sim.Simulate(path.rows), grid.areas(), grid.in_region());
+    EXPECT_GE(st.coverage, 0.99) << (pattern == Pattern::kCycloid ? "cycloid" : "parallel");
+  }
+}
+
 // Acceptance (issue 11) on a face with a hole: the NLopt cycloid against the
 // default and optimised parallel paths, as on the other surfaces.
 TEST(Optimise, PatternOrderingOnAPlateWithAHole) {
