@@ -278,10 +278,13 @@ polishing::NurbsSurface ReadCadFace(const std::string& path, int face) {
         params.front() = f;
         params.back() = l;
         if (edge.Orientation() == TopAbs_REVERSED) std::reverse(params.begin(), params.end());
-        for (size_t k = 0; k + 1 < params.size(); ++k) {  // the edge's end is the next edge's start
+        std::vector<Eigen::Vector2d> line;
+        for (size_t k = 0; k < params.size(); ++k) {
           const gp_Pnt2d q = pc->Value(params[k]);
-          loop.emplace_back(reversed ? u_sum - q.X() : q.X(), q.Y());
+          line.emplace_back(reversed ? u_sum - q.X() : q.X(), q.Y());
         }
+        loop.insert(loop.end(), line.begin(), line.end() - 1);  // the edge's end is the next edge's start
+        if (!BRep_Tool::Degenerated(edge) && !BRep_Tool::IsClosed(edge, nf)) trim->edges_uv.push_back(std::move(line));
       }
       if (loop.size() >= 3) trim->wires_uv.push_back(std::move(loop));
     }

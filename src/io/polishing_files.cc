@@ -209,9 +209,10 @@ void WritePolishPath(const std::string& path, const std::vector<polishing::PathR
     }
     out << "t_s,x_mm,y_mm,z_mm,nx,ny,nz,tx,ty,tz,u,v" << (with_force ? ",force_N" : "") << "\n";
     for (const auto& r : rows) {
-      // 1e-4 mm and 1e-6 s: far below the 0.01 mm surface tolerance; the
-      // direction cosines to 1e-9.
-      out << Fixed(r.t, 6) << ',' << Fixed(1e3 * r.p.x(), 4) << ',' << Fixed(1e3 * r.p.y(), 4) << ','
+      // 1e-4 mm and 1e-9 s: far below the 0.01 mm surface tolerance, and a
+      // path timed at the speed limit stays at it when read back (with 1e-6 s
+      // a 0.01 mm/s excess could appear); the direction cosines to 1e-9.
+      out << Fixed(r.t, 9) << ',' << Fixed(1e3 * r.p.x(), 4) << ',' << Fixed(1e3 * r.p.y(), 4) << ','
           << Fixed(1e3 * r.p.z(), 4) << ',' << Fixed(r.n.x(), 9) << ',' << Fixed(r.n.y(), 9) << ','
           << Fixed(r.n.z(), 9) << ',' << Fixed(r.tx.x(), 9) << ',' << Fixed(r.tx.y(), 9) << ','
           << Fixed(r.tx.z(), 9) << ',' << FormatDouble(r.u) << ',' << FormatDouble(r.v);

@@ -186,16 +186,29 @@ Polygon2 Densify(const Polygon2& p, double step) {
 // apart (the rectangle's centre line has no general counterpart). The loops
 // are visited nearest first, each starting at its point nearest to where the
 // previous one ended.
+// How far inside the region the cycloid's guide lines must stay so that the
+// circle stays on the face: r - margin, plus kClearance for the chords of the
+// face's outline (sag < 1 um) and of the offsets' round joins (sag 10 um),
+// which cut slightly into holes. --edge-inset-mm overrides it.
+double CycloidInset(const PathParameters& params, const PolishingProcess& process) {
+  constexpr double kClearance = 50e-6;
+  return params.edge_inset >= 0 ? params.edge_inset : std::max(0.0, params.radius - process.margin) + kClearance;
+}
+
+[[noreturn]] void RegionTooNarrow(double inradius, double inset, const PathParameters& params) {
+  std::ostringstream m;
+  m << "radius_mm " << params.radius * 1e3 << ": the cycloid does not fit the polished region; its guide lines "
+    << "must stay " << inset * 1e3 << " mm inside it (r - margin_mm) so that the circle stays on the face, and "
+    << "the region's widest spot is " << 2e3 * inradius << " mm across; use a smaller radius";
+  throw std::invalid_argument(m.str());
+}
+
 std::vector<GuideSpec> OffsetGuides(const DevelopedRegion& region, const PathParameters& params,
                                     const PolishingProcess& process) {
-  const double d = params.offset, r = params.radius;
+  const double d = params.offset;
   const double R = region.Inradius();
-  // The circle stays kClearance inside the face: the face's outline is a
-  // polygon of chords (sag < 1 um) and the offsets' round joins are chords
-  // too (sag 10 um), both cutting slightly into holes.
-  constexpr double kClearance = 50e-6;
-  double e = params.edge_inset >= 0 ? params.edge_inset : std::max(0.0, r - process.margin) + kClearance;
-  e = std::min(e, 0.5 * R);
+  const double e = CycloidInset(params, process);
+  if (!(R > e)) RegionTooNarrow(R, e, params);
   const int n = std::max(1, static_cast<int>(std::ceil((R - e) / d + 0.5 - 1e-9)));
   const double de = (R - e) / (n - 0.5);
   std::vector<Polygon2> loops;
@@ -326,6 +339,7 @@ constexpr double kLiftTime = 1e-3;  // [s] to lift the tool off or set it down
 // a stripe across the region. Returns true for a lift.
 bool Link(const Mapper& m, const NurbsSurface& surface, const Vec2& from, const Vec2& to, const Vec2& tangent,
           double speed, double step, double max_length, std::vector<PathRow>* rows, std::vector<double>* t) {
+  if ((to - from).norm() < 1e-12) return false;  // already there
   std::vector<PathRow> move;
   std::vector<double> tm{t->back()};
   StraightMove(m, from, to, tangent, speed, step, false, &move, &tm);
@@ -336,14 +350,19 @@ bool Link(const Mapper& m, const NurbsSurface& surface, const Vec2& from, const 
     t->insert(t->end(), tm.begin() + 1, tm.end());
     return false;
   }
+  // Lifted, the tool follows the surface (rows every `step`, as a move in
+  // contact would), so that the air move does not cut through a convex part
+  // as one long chord would, and the robot sees small steps.
   PathRow up = rows->back();
   up.force = 0.0;
   rows->push_back(up);
   t->push_back(t->back() + kLiftTime);
-  PathRow down = m.Row(to, tangent);
-  down.force = 0.0;
-  rows->push_back(down);
-  t->push_back(t->back() + (down.p - up.p).norm() / speed);
+  for (size_t k = 0; k < move.size(); ++k) {
+    move[k].force = 0.0;
+    rows->push_back(move[k]);
+    t->push_back(tm[k + 1] + kLiftTime);
+  }
+  PathRow down = move.back();
   down.force = -1.0;
   rows->push_back(down);
   t->push_back(t->back() + kLiftTime);
@@ -369,7 +388,14 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   std::vector<GuideSpec> guides;
   if (region.rectangle()) guides = RectangleGuides(grid, params, process);
   else if (region.loops().empty()) throw std::invalid_argument("the polished region is empty (margin too large for the face)");
-  else if (parallel_lines) guides = LineGuides(region, params);
+  else if (parallel_lines && cyc) {
+    // Cycloids along the lines: the lines stop the inset short of the
+    // boundary, holes included, so that the circle stays on the face.
+    const double e = CycloidInset(params, process);
+    const DevelopedRegion inner = DevelopedRegion::FromPolygons(region.Offset(e));
+    if (inner.loops().empty()) RegionTooNarrow(region.Inradius(), e, params);
+    guides = LineGuides(inner, params);
+  } else if (parallel_lines) guides = LineGuides(region, params);
   else guides = OffsetGuides(region, params, process);
   if (guides.empty()) throw std::invalid_argument("the polished region is narrower than the row spacing: no guide line fits");
 

@@ -82,7 +82,31 @@ DevelopedRegion DevelopedRegion::Build(const NurbsSurface& surface, const Sample
     face.push_back(std::move(p));
   }
   DevelopedRegion whole = FromPolygons(face);
-  DevelopedRegion r = FromPolygons(whole.Offset(margin));
+  DevelopedRegion r;
+  if (trim->edges_uv.empty()) {
+    r = FromPolygons(whole.Offset(margin));
+  } else {
+    // The face minus a band of half-width `margin` about its material edges:
+    // seams of closed surfaces and degenerate edges take no margin.
+    std::vector<Polygon2> edges;
+    for (const auto& e : trim->edges_uv) {
+      Polygon2 p;
+      for (const Eigen::Vector2d& uv : e) p.emplace_back(grid.SOfU(uv.x()), grid.TOfV(uv.y()));
+      edges.push_back(std::move(p));
+    }
+    ClipperLib::Paths band;
+    if (margin > 0) {
+      ClipperLib::ClipperOffset co(2.0, kArcTolerance * kScale);
+      co.AddPaths(ToClipper(edges), ClipperLib::jtRound, ClipperLib::etOpenRound);
+      co.Execute(band, margin * kScale);
+    }
+    ClipperLib::Clipper c;
+    c.AddPaths(ToClipper(whole.loops_), ClipperLib::ptSubject, true);
+    c.AddPaths(band, ClipperLib::ptClip, true);
+    ClipperLib::Paths out;
+    c.Execute(ClipperLib::ctDifference, out, ClipperLib::pftEvenOdd, ClipperLib::pftNonZero);
+    r = FromPolygons(FromClipper(out));
+  }
   // A face trimmed to its patch's boundary: the grid's rectangle, as for a
   // plain patch (the same path as the patch's YAML copy).
   if (r.rectangle_) return BoundingRectangle(grid);

@@ -259,6 +259,44 @@ TEST(CadFace, PathsOnACurvedFaceWithADrilledHole) {
   }
 }
 
+// A whole cylinder (R 30 mm, 60 mm high) drilled radially at 90 deg: the
+// side face has a seam at 0 deg, which is no edge of the material. The
+// margin is kept from the two circles and the hole only, so the zig-zag
+// polishes across the seam line: coverage as anywhere else.
+TEST(CadFace, SeamTakesNoMarginOnADrilledCylinder) {
+  const std::string file = TmpPath("cylinder_hole.step");
+  const TopoDS_Shape cyl = BRepPrimAPI_MakeCylinder(30, 60).Shape();
+  const TopoDS_Shape drill = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 30), gp_Dir(0, 1, 0)), 8, 50).Shape();
+  BRepAlgoAPI_Cut cut(cyl, drill);
+  ASSERT_TRUE(cut.IsDone());
+  WriteStep(cut.Shape(), file);
+  const polishing::NurbsSurface face = ReadCadFace(file, 0);
+  ASSERT_NE(face.trim(), nullptr);
+  polishing::PolishingProcess proc;
+  proc.margin = 3e-3;
+  const auto grid = polishing::SampleGrid::Build(face, 0.5e-3, proc.margin, false);
+  polishing::PathParameters p;
+  p.pattern = polishing::Pattern::kParallel;
+  p.offset = 0.003;
+  const polishing::PlannedPath path = polishing::PlanPath(face, grid, p, proc);
+  for (const auto& r : path.rows) {
+    if (r.force != 0.0) ASSERT_TRUE(face.OnFace(r.u, r.v));
+  }
+  const polishing::RemovalSimulator sim(face, proc, grid.points(), grid.normals(), 1.5e-3);
+  const std::vector<double> h = sim.Simulate(path.rows);
+  const auto st = polishing::ComputeRemovalStats(h, grid.areas(), grid.in_region());
+  EXPECT_GE(st.coverage, 0.99);
+  // At the seam (angle within 2 mm of 0 deg) the removal is that of the rest.
+  double seam = 0.0, seam_area = 0.0;
+  for (int k = 0; k < grid.size(); ++k) {
+    const Eigen::Vector3d q = grid.points()[k];
+    if (!grid.in_region()[k] || std::abs(q.z() - 0.030) > 0.015) continue;
+    if (std::abs(std::atan2(q.y(), q.x())) * 0.030 < 0.002) seam += h[k] * grid.areas()[k], seam_area += grid.areas()[k];
+  }
+  ASSERT_GT(seam_area, 0.0);
+  EXPECT_GT(seam / seam_area, 0.8 * st.mean) << "mean at the seam " << seam / seam_area << ", overall " << st.mean;
+}
+
 TEST(CadFace, CorruptAndEmptyFiles) {
   const std::string bad = TmpPath("corrupt.step");
   {

@@ -28,6 +28,10 @@ struct FaceTrim {
   /// degenerate edges of closed surfaces are included here: this is the
   /// boundary of the face's parameter domain.
   std::vector<std::vector<Eigen::Vector2d>> wires_uv;
+  /// The material edges of those wires as open polylines in (u, v): every
+  /// edge but seams and degenerate edges. The margin is measured from these
+  /// only (as for the 3-D `boundary`); empty: from the whole wires.
+  std::vector<std::vector<Eigen::Vector2d>> edges_uv;
   double area{0.0};            // area of the face [m^2] (from the CAD kernel)
   int num_wires{0};            // 1 + number of holes
   std::string source;          // "file.step, face 3" for messages
