@@ -355,6 +355,28 @@ TEST(Paths, CycloidOnParallelLinesStaysOffTheHole) {
   ExpectContactRowsOnThePlate(path);
 }
 
+// A neck: the hole (radius 10 mm at (50, 20) mm, margin 3 mm) leaves a strip
+// 4 mm wide between its margin and the lower edge's. The default cycloid's
+// loops must stay 3.05 mm inside the region, so none passes the neck: the
+// area no circle reaches is reported (and is polished only by the contact's
+// edge); with the hole centred there is none.
+TEST(Paths, UnreachedNeckIsReported) {
+  const PolishingProcess proc = Process(0.003);
+  const PathParameters p;
+  const NurbsSurface neck = testing::PlateWithHole(0.1, 0.06, 0.05, 0.02, 0.01);
+  const SampleGrid g1 = SampleGrid::Build(neck, 0.5e-3, proc.margin, false);
+  const double a1 = UnreachedArea(neck, g1, p, proc, PlanPath(neck, g1, p, proc));
+  const NurbsSurface centred = testing::PlateWithHole(0.1, 0.06, 0.05, 0.03, 0.01);
+  const SampleGrid g2 = SampleGrid::Build(centred, 0.5e-3, proc.margin, false);
+  const double a2 = UnreachedArea(centred, g2, p, proc, PlanPath(centred, g2, p, proc));
+  std::cout << "unreached: neck " << a1 * 1e6 << " mm^2, centred hole " << a2 * 1e6 << " mm^2\n";
+  // The neck is narrower than 2 x 3.05 mm over 14 mm of its length (where
+  // 20 - sqrt(13^2 - dx^2) - 3 < 6.1 mm): tens of mm^2 at most.
+  EXPECT_GT(a1, 10e-6);
+  EXPECT_LT(a1, 100e-6);
+  EXPECT_EQ(a2, 0.0);
+}
+
 // A region too narrow for the circle (a 10 mm strip with a 2 mm hole, margin
 // 1 mm: the region is 8 mm wide; with r 6 mm the guide lines would have to
 // stay 5.05 mm inside it): an error naming the radius, not a path that
