@@ -64,8 +64,10 @@ int Run(int argc, char** argv) {
       "optimised for uniform removal (--optimise nlopt|pso), timed so that the mean removal over the\n"
       "polished region equals --target-removal-um within max_speed_mm_per_s. Writes the path (formats.md §6),\n"
       "the removal map and summary (§7) and PNG pictures (removal map, histogram, path, convergence)."};
-  app.footer(ExitCodeHelp() + "\nExit 3: the target removal cannot be reached within the speed limit "
-                              "(outputs written at the limit).");
+  app.footer(ExitCodeHelp() +
+             "\nExit 3 (outputs written, the reason on stderr): the target removal cannot be reached within the "
+             "speed limit (the path runs at the limit); path rows in contact lie off a trimmed face; with --robot, "
+             "rows are unreachable, outside the joint limits or after a joint jump > 0.5 rad.");
   std::string surface_path, process_path, pattern = "cycloid", guides = "offsets", optimise = "none", path_out,
                                           removal_out, summary_out, plot_out;
   int face = 0;

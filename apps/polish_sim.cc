@@ -29,7 +29,10 @@ int Run(int argc, char** argv) {
   CLI::App app{
       "polish-sim: simulate the Preston removal of a tool path (formats.md §6) on a NURBS patch\n"
       "(formats.md §5) with Hertz contact (formats.md §7); writes the removal map, a summary and pictures."};
-  app.footer(ExitCodeHelp());
+  app.footer(ExitCodeHelp() +
+             "\nExit 3 (outputs written, the reason on stderr): the path's traverse speed exceeds "
+             "max_speed_mm_per_s; with --robot, rows are unreachable, outside the joint limits or after a joint "
+             "jump > 0.5 rad.");
   std::string surface_path, process_path, path_in, removal_out, summary_out, plot_out;
   int face = 0;
   double sample_mm = 0.5;
