@@ -259,24 +259,7 @@ int Run(int argc, char** argv) {
                              {"omega_rad_per_s", cyc ? e.path.omega_rad_per_s : 0.0},
                              {"centre_speed_mm_per_s", cyc ? 1e3 * e.path.centre_speed : 0.0}};
     summary["region"] = {{"sample_mm", sample_mm}, {"points", grid.num_in_region()}, {"margin_mm", 1e3 * process.margin}};
-    {
-      // Necks and lobes of a trimmed region narrower than the cycloid needs
-      // get no guide loop; say how much of the region no guide reaches.
-      double area = 0.0;
-      for (int k = 0; k < grid.size(); ++k) area += grid.in_region()[k] ? grid.areas()[k] : 0.0;
-      const double unreached = polishing::UnreachedArea(surface, grid, params, process, e.path);
-      summary["region"]["area_mm2"] = 1e6 * area;
-      summary["region"]["unreached_area_mm2"] = 1e6 * unreached;
-      if (unreached > 1e-3 * area) {
-        std::ostringstream m;
-        m << 1e6 * unreached << " mm^2 of the region (" << 100 * unreached / area << " %) lies farther than "
-          << (cyc ? "the radius r from every guide line (necks or lobes too narrow for the circle to enter without "
-                    "leaving the face); a smaller radius reaches them"
-                  : "half the row spacing from every row (where rows end at a curved edge or a hole); a smaller "
-                    "row spacing reaches them");
-        Warn(kTool, m.str());
-      }
-    }
+    ReportUnpolished(kTool, e.stats, grid, &summary["region"]);
     if (surface.trim()) {
       // The guide lines follow the trimmed outline and the holes, and links
       // that would cross a hole are lifted; a row in contact off the face

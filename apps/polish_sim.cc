@@ -121,6 +121,7 @@ int Run(int argc, char** argv) {
                              {"pitch_mm", meta("pitch_mm")}, {"omega_rad_per_s", 0.0},
                              {"centre_speed_mm_per_s", 0.0}};
     summary["region"] = {{"sample_mm", sample_mm}, {"points", grid.num_in_region()}, {"margin_mm", 1e3 * process.margin}};
+    ReportUnpolished(kTool, stats, grid, &summary["region"]);
     summary["speed_limit_exceeded"] = flagged;
     if (robot.Check(kTool, process, file.rows, &summary)) flagged = true;
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, removal);

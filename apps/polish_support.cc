@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include "cli_support.h"
 #include "robomach/common/errors.h"
@@ -27,6 +28,22 @@ int RowsOffFace(const polishing::NurbsSurface& surface, const std::vector<polish
   int n = 0;
   for (const auto& r : rows) n += r.force != 0.0 && !surface.OnFace(r.u, r.v);  // lifted rows may cross holes
   return n;
+}
+
+void ReportUnpolished(const std::string& tool, const polishing::RemovalStats& stats,
+                      const polishing::SampleGrid& grid, nlohmann::json* region) {
+  double area = 0.0;
+  for (int k = 0; k < grid.size(); ++k) area += grid.in_region()[k] ? grid.areas()[k] : 0.0;
+  (*region)["area_mm2"] = 1e6 * area;
+  (*region)["unpolished_area_mm2"] = 1e6 * stats.unpolished_area;
+  if (stats.unpolished_area > 0.0) {
+    std::ostringstream m;
+    m << 1e6 * stats.unpolished_area << " mm^2 of the region (" << 100 * stats.unpolished_area / area
+      << " %) gets less than 1 % of the mean removal: gaps between rows, or necks and lobes of a trimmed face "
+         "too narrow for the cycloid's circle to enter without leaving the face (a smaller radius or row "
+         "spacing reaches them)";
+    Warn(tool, m.str());
+  }
 }
 
 nlohmann::json RemovalJson(const polishing::RemovalStats& s) {

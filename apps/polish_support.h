@@ -29,6 +29,11 @@ int RowsOffFace(const polishing::NurbsSurface& surface, const std::vector<polish
 nlohmann::json RemovalJson(const polishing::RemovalStats& stats_m);
 nlohmann::json PathJson(const std::vector<polishing::PathRow>& rows);
 
+/// Adds the region's area and the area left unpolished (removal below 1 %
+/// of the mean) to `region` (mm^2) and warns under `tool` if any is.
+void ReportUnpolished(const std::string& tool, const polishing::RemovalStats& stats,
+                      const polishing::SampleGrid& grid, nlohmann::json* region);
+
 /// Pictures next to `png`: the removal map (png itself, colour scale in
 /// um on the developed s, t plane), <stem>_histogram.png, <stem>_path.png
 /// (path, lifted moves and guide lines in the developed s, t plane) and, if `history` is not empty,

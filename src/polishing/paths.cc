@@ -486,15 +486,6 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   return out;
 }
 
-double UnreachedArea(const NurbsSurface& surface, const SampleGrid& grid, const PathParameters& params,
-                     const PolishingProcess& process, const PlannedPath& path) {
-  const DevelopedRegion region = DevelopedRegion::Build(surface, grid, process.margin);
-  const double reach = params.pattern == Pattern::kCycloid ? params.radius : 0.5 * params.offset;
-  // 1e-9 m^2 (1e-3 mm^2): below that, the sag of the offsets' chords.
-  const double a = region.AreaFartherThan(path.guide_lines_st, reach * (1 + 1e-9));
-  return a > 1e-9 ? a : 0.0;
-}
-
 void ScaleTime(PlannedPath* path, double factor) {
   // Lifting off and setting down (a force step between two rows at the same
   // point) keep their short duration: scaled, the step before a lift would

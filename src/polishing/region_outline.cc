@@ -152,26 +152,6 @@ double DevelopedRegion::Inradius() const {
   return lo;
 }
 
-double DevelopedRegion::AreaFartherThan(const std::vector<std::vector<Eigen::Vector2d>>& lines, double reach) const {
-  ClipperLib::Paths band;
-  {
-    ClipperLib::ClipperOffset co(2.0, kArcTolerance * kScale);
-    for (const auto& l : lines) {
-      if (l.size() < 2) continue;
-      co.AddPaths(ToClipper({Polygon2(l.begin(), l.end())}), ClipperLib::jtRound, ClipperLib::etOpenRound);
-    }
-    co.Execute(band, reach * kScale);
-  }
-  ClipperLib::Clipper c;
-  c.AddPaths(ToClipper(loops_), ClipperLib::ptSubject, true);
-  c.AddPaths(band, ClipperLib::ptClip, true);
-  ClipperLib::Paths out;
-  c.Execute(ClipperLib::ctDifference, out, ClipperLib::pftEvenOdd, ClipperLib::pftNonZero);
-  double a = 0.0;
-  for (const Polygon2& p : FromClipper(out)) a += SignedArea(p);
-  return a;
-}
-
 std::vector<std::pair<double, double>> DevelopedRegion::Intervals(double t) const {
   std::vector<double> s;
   for (const Polygon2& p : loops_) {

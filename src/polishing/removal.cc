@@ -250,6 +250,7 @@ RemovalStats ComputeRemovalStats(const std::vector<double>& removal, const std::
     var += area[k] * (removal[k] - s.mean) * (removal[k] - s.mean);
     ++n;
     if (removal[k] > 0.1 * s.mean) ++covered;
+    if (removal[k] < 0.01 * s.mean) s.unpolished_area += area[k];
   }
   s.variance = var / w;
   s.std = std::sqrt(s.variance);

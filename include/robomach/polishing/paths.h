@@ -72,15 +72,6 @@ struct PlannedPath {
 PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const PathParameters& params,
                      const PolishingProcess& process);
 
-/// Area of the polished region that no guide line comes near enough to
-/// polish [m^2]: farther than r from every guide (the cycloid's circle), or
-/// than half the row spacing from every row (parallel pattern). On trimmed
-/// faces, necks and lobes narrower than the cycloid needs get no guide loop
-/// (the circle would leave the face); this says how much of the region that
-/// is. (Outside the developed plane's distortion, it is exact.)
-double UnreachedArea(const NurbsSurface& surface, const SampleGrid& grid, const PathParameters& params,
-                     const PolishingProcess& process, const PlannedPath& path);
-
 /// Multiplies all time stamps by `factor` (> 1 slows down), keeping omega and
 /// the centre speed consistent.
 void ScaleTime(PlannedPath* path, double factor);

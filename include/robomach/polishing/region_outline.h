@@ -50,10 +50,6 @@ class DevelopedRegion {
   double Inradius() const;
   /// The intervals [s0, s1] (sorted) where the line t = const crosses the region.
   std::vector<std::pair<double, double>> Intervals(double t) const;
-  /// Area of the region farther than `reach` [m] from every polyline of
-  /// `lines` (closed loops are polylines whose last point repeats the first)
-  /// [m^2].
-  double AreaFartherThan(const std::vector<std::vector<Eigen::Vector2d>>& lines, double reach) const;
   /// Even-odd inside test.
   bool Contains(const Eigen::Vector2d& st) const;
   /// Distance from `st` to the nearest boundary edge [m].

@@ -83,6 +83,10 @@ class RemovalSimulator {
 /// Area-weighted removal statistics (formats.md §7), in the input's unit.
 struct RemovalStats {
   double mean{0}, std{0}, variance{0}, cv{0}, min{0}, max{0}, peak_to_valley{0}, coverage{0};
+  /// Area of the points with a removal below 1 % of the mean: left
+  /// unpolished (necks the cycloid cannot enter, gaps between rows) [the
+  /// area's unit].
+  double unpolished_area{0};
 };
 /// Over the entries with mask != 0 (all if mask empty).
 RemovalStats ComputeRemovalStats(const std::vector<double>& removal, const std::vector<double>& area,
