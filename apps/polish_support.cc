@@ -53,14 +53,8 @@ nlohmann::json RemovalJson(const polishing::RemovalStats& s) {
 }
 
 nlohmann::json PathJson(const std::vector<polishing::PathRow>& rows) {
-  double len = 0;
-  int lifts = 0;
-  for (size_t i = 1; i < rows.size(); ++i) {
-    if (rows[i - 1].force != 0.0) len += (rows[i].p - rows[i - 1].p).norm();  // in contact
-    lifts += rows[i].force == 0.0 && rows[i - 1].force != 0.0;
-  }
-  return {{"length_mm", 1e3 * len},
-          {"lifts", lifts},
+  return {{"length_mm", 1e3 * polishing::ContactLength(rows)},
+          {"lifts", polishing::CountLifts(rows)},
           {"time_s", rows.empty() ? 0.0 : rows.back().t - rows.front().t},
           {"rows", rows.size()},
           {"max_speed_mm_per_s", 1e3 * polishing::MaxSpeed(rows)}};
@@ -146,40 +140,38 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
   a2.y_label = "t (arc length along v) [mm]";
   auto s_mm = [&](const polishing::PathRow& r) { return 1e3 * grid.SOfU(r.u); };
   auto t_mm = [&](const polishing::PathRow& r) { return 1e3 * grid.TOfV(r.v); };
-  // The path in contact as one series per stretch between lifts; the lifted
-  // moves (rows with force 0) as thin grey dashes.
-  bool first_piece = true, first_lift = true;
-  report::Series piece;
-  auto flush = [&] {
-    if (piece.x.size() >= 2) {
-      piece.label = first_piece ? "contact path" : "";
-      piece.color = report::PaletteColor(0);
-      piece.thickness = 1;
-      a2.series.push_back(piece);
-      first_piece = false;
+  // One series per stretch in contact (blue) or lifted (rows with force 0,
+  // thin grey dashes); a segment belongs to the stretch of its first row.
+  bool labelled[2] = {false, false};
+  for (size_t i = 0; i < rows.size();) {
+    const bool lifted = rows[i].force == 0.0;
+    report::Series s;
+    size_t j = i;
+    while (j < rows.size() && (rows[j].force == 0.0) == lifted) {
+      s.x.push_back(s_mm(rows[j]));
+      s.y.push_back(t_mm(rows[j]));
+      ++j;
     }
-    piece = report::Series();
-  };
-  for (size_t i = 0; i < rows.size(); ++i) {
-    if (rows[i].force == 0.0) {
-      flush();
-      if (i + 1 < rows.size() && rows[i + 1].force == 0.0) {
-        report::Series lift;
-        lift.label = first_lift ? "lifted" : "";
-        lift.color = report::Rgb{150, 150, 150};
-        lift.thickness = 1;
-        lift.dashed = true;
-        lift.x = {s_mm(rows[i]), s_mm(rows[i + 1])};
-        lift.y = {t_mm(rows[i]), t_mm(rows[i + 1])};
-        a2.series.push_back(lift);
-        first_lift = false;
-      }
-      continue;
+    if (lifted && j < rows.size()) {  // the lifted move ends where the tool sets down
+      s.x.push_back(s_mm(rows[j]));
+      s.y.push_back(t_mm(rows[j]));
     }
-    piece.x.push_back(s_mm(rows[i]));
-    piece.y.push_back(t_mm(rows[i]));
+    if (lifted && s.x.size() > 2) {
+      // A lift is straight in the developed plane: its ends draw it, and the
+      // dashes stay visible (rows every 0.5 mm would draw it solid).
+      s.x = {s.x.front(), s.x.back()};
+      s.y = {s.y.front(), s.y.back()};
+    }
+    if (s.x.size() >= 2) {
+      s.label = labelled[lifted] ? "" : (lifted ? "lifted" : "contact path");
+      s.color = lifted ? report::Rgb{150, 150, 150} : report::PaletteColor(0);
+      s.thickness = 1;
+      s.dashed = lifted;
+      labelled[lifted] = true;
+      a2.series.push_back(s);
+    }
+    i = j;
   }
-  flush();
   for (size_t g = 0; g < guide_lines_st.size(); ++g) {
     report::Series s;
     s.label = g == 0 ? "guide lines" : "";

@@ -179,13 +179,6 @@ Polygon2 Densify(const Polygon2& p, double step) {
   return out;
 }
 
-// Guide loops of a region that is not a rectangle (a trimmed face, holes):
-// the equidistant inward offsets of its boundary at e + k de, k = 0 .. n-1,
-// the last at half a spacing from the inscribed circle's centre, so that the
-// two innermost loops of a strip between two boundaries are one spacing
-// apart (the rectangle's centre line has no general counterpart). The loops
-// are visited nearest first, each starting at its point nearest to where the
-// previous one ended.
 // How far inside the region the cycloid's guide lines must stay so that the
 // circle stays on the face: r - margin, plus kClearance for the chords of the
 // face's outline (sag < 1 um) and of the offsets' round joins (sag 10 um),
@@ -203,6 +196,13 @@ double CycloidInset(const PathParameters& params, const PolishingProcess& proces
   throw std::invalid_argument(m.str());
 }
 
+// Guide loops of a region that is not a rectangle (a trimmed face, holes):
+// the equidistant inward offsets of its boundary at e + k de, k = 0 .. n-1,
+// the last at half a spacing from the inscribed circle's centre, so that the
+// two innermost loops of a strip between two boundaries are one spacing
+// apart (the rectangle's centre line has no general counterpart). The loops
+// are visited nearest first, each starting at its point nearest to where the
+// previous one ended.
 std::vector<GuideSpec> OffsetGuides(const DevelopedRegion& region, const PathParameters& params,
                                     const PolishingProcess& process) {
   const double d = params.offset;
@@ -223,10 +223,8 @@ std::vector<GuideSpec> OffsetGuides(const DevelopedRegion& region, const PathPar
   {
     double best = -1;
     for (size_t i = 0; i < loops.size(); ++i) {
-      double a = 0;
-      for (size_t k = 0, j = loops[i].size() - 1; k < loops[i].size(); j = k++)
-        a += loops[i][j].x() * loops[i][k].y() - loops[i][k].x() * loops[i][j].y();
-      if (std::abs(a) > best) best = std::abs(a), cur = i;
+      const double a = std::abs(SignedArea(loops[i]));
+      if (a > best) best = a, cur = i;
     }
     pos = loops[cur][0];
     for (const Vec2& x : loops[cur]) {
@@ -343,9 +341,9 @@ bool Link(const Mapper& m, const NurbsSurface& surface, const Vec2& from, const 
   std::vector<PathRow> move;
   std::vector<double> tm{t->back()};
   StraightMove(m, from, to, tangent, speed, step, false, &move, &tm);
-  const bool on_face = (to - from).norm() <= max_length &&
-                       std::all_of(move.begin(), move.end(), [&](const PathRow& r) { return surface.OnFace(r.u, r.v); });
-  if (on_face) {
+  const bool in_contact = (to - from).norm() <= max_length &&
+                          std::all_of(move.begin(), move.end(), [&](const PathRow& r) { return surface.OnFace(r.u, r.v); });
+  if (in_contact) {
     rows->insert(rows->end(), move.begin(), move.end());
     t->insert(t->end(), tm.begin() + 1, tm.end());
     return false;
@@ -479,11 +477,22 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   out.centre_speed = cyc ? pitch * omega0 / (2 * kPi) : 0.0;
   const double vm = MaxSpeed(out.rows);
   if (vm > vmax) ScaleTime(&out, vm / vmax);
-  out.length = 0.0;
-  for (size_t i = 1; i < out.rows.size(); ++i) {
-    if (out.rows[i - 1].force != 0.0) out.length += (out.rows[i].p - out.rows[i - 1].p).norm();
-  }
+  out.length = ContactLength(out.rows);
   return out;
+}
+
+double ContactLength(const std::vector<PathRow>& rows) {
+  double len = 0.0;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    if (rows[i - 1].force != 0.0) len += (rows[i].p - rows[i - 1].p).norm();
+  }
+  return len;
+}
+
+int CountLifts(const std::vector<PathRow>& rows) {
+  int n = 0;
+  for (size_t i = 1; i < rows.size(); ++i) n += rows[i].force == 0.0 && rows[i - 1].force != 0.0;
+  return n;
 }
 
 void ScaleTime(PlannedPath* path, double factor) {
@@ -491,17 +500,17 @@ void ScaleTime(PlannedPath* path, double factor) {
   // point) keep their short duration: scaled, the step before a lift would
   // be a dwell at full force that leaves a mark.
   auto& rows = path->rows;
-  double prev = rows.empty() ? 0.0 : rows[0].t;
-  if (!rows.empty()) rows[0].t *= factor;
-  for (size_t i = 1; i < rows.size(); ++i) {
-    if (path->lifts == 0) {
-      rows[i].t *= factor;
-      continue;
+  if (path->lifts == 0 || rows.empty()) {
+    for (auto& r : rows) r.t *= factor;
+  } else {
+    double prev = rows[0].t;
+    rows[0].t *= factor;
+    for (size_t i = 1; i < rows.size(); ++i) {
+      const double dt = rows[i].t - prev;
+      prev = rows[i].t;
+      const bool force_step = (rows[i].force == 0.0) != (rows[i - 1].force == 0.0) && rows[i].p == rows[i - 1].p;
+      rows[i].t = rows[i - 1].t + (force_step ? dt : dt * factor);
     }
-    const double dt = rows[i].t - prev;
-    prev = rows[i].t;
-    const bool force_step = (rows[i].force == 0.0) != (rows[i - 1].force == 0.0) && rows[i].p == rows[i - 1].p;
-    rows[i].t = rows[i - 1].t + (force_step ? dt : dt * factor);
   }
   path->omega_rad_per_s /= factor;
   path->centre_speed /= factor;

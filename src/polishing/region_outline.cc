@@ -40,12 +40,6 @@ std::vector<Polygon2> FromClipper(const ClipperLib::Paths& paths) {
   return out;
 }
 
-double SignedArea(const Polygon2& p) {
-  double a = 0.0;
-  for (size_t i = 0, j = p.size() - 1; i < p.size(); j = i++) a += p[j].x() * p[i].y() - p[i].x() * p[j].y();
-  return 0.5 * a;
-}
-
 // Normalised even-odd region: outer loops counter-clockwise, holes clockwise.
 std::vector<Polygon2> Normalise(const std::vector<Polygon2>& loops) {
   ClipperLib::Paths out;
@@ -59,6 +53,12 @@ DevelopedRegion BoundingRectangle(const SampleGrid& grid) {
 }
 
 }  // namespace
+
+double SignedArea(const Polygon2& p) {
+  double a = 0.0;
+  for (size_t i = 0, j = p.size() - 1; i < p.size(); j = i++) a += p[j].x() * p[i].y() - p[i].x() * p[j].y();
+  return 0.5 * a;
+}
 
 DevelopedRegion DevelopedRegion::FromPolygons(const std::vector<Polygon2>& loops) {
   DevelopedRegion r;

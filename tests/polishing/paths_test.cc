@@ -319,7 +319,8 @@ TEST(Paths, CycloidLoopsAreOffsetsOfAFaceWithAHole) {
   const PlannedPath path = PlanPath(plate, grid, p, proc);
   ExpectValidFrames(path, proc.max_speed);
   ExpectContactRowsOnThePlate(path);
-  // Each guide loop keeps one distance from the region's boundary; the
+  // Each guide loop keeps one distance from the region's boundary (to the
+  // 10 um sag of the offsets' round-join chords, plus the grid); the
   // outermost is r - margin (+ 0.05 mm clearance) inside it, so that the
   // circle just reaches the face's edge and the hole's.
   ASSERT_GE(path.guide_lines.size(), 3u);

@@ -76,6 +76,12 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
 /// the centre speed consistent.
 void ScaleTime(PlannedPath* path, double factor);
 
+/// Length of the path in contact [m]: segments that start at a lifted row
+/// (force 0) are in the air.
+double ContactLength(const std::vector<PathRow>& rows);
+/// Number of lifts: rows with force 0 that follow a row in contact.
+int CountLifts(const std::vector<PathRow>& rows);
+
 /// Largest segment speed of a path [m/s].
 double MaxSpeed(const std::vector<PathRow>& rows);
 

@@ -23,6 +23,9 @@ namespace robomach::polishing {
 /// A closed polygon in the developed plane [m]; the last point is not repeated.
 using Polygon2 = std::vector<Eigen::Vector2d>;
 
+/// Signed area of a closed polygon [m^2]: > 0 counter-clockwise (s right, t up).
+double SignedArea(const Polygon2& p);
+
 class DevelopedRegion {
  public:
   /// The polished region of `surface`: for a plain patch (or a face whose
