@@ -93,6 +93,10 @@ void Warn(const std::string& tool, const std::string& message) {
   std::cerr << tool << ": warning: " << message << '\n';
 }
 
+void Note(const std::string& tool, const std::string& message) {
+  std::cerr << tool << ": note: " << message << '\n';
+}
+
 std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text) {
   const size_t eq = text.find('=');
   double v = 0.0;

@@ -62,6 +62,9 @@ class ProgressLine {
 
 /// Prints "tool: warning: message" on stderr.
 void Warn(const std::string& tool, const std::string& message);
+/// "tool: note: message" on stderr: what a reader inferred or skipped; not
+/// a warning, and no reason for exit 3.
+void Note(const std::string& tool, const std::string& message);
 
 /// Splits "NAME=VALUE"; @throws std::invalid_argument naming the option.
 std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text);
