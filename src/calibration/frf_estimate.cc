@@ -141,7 +141,7 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
   int n = std::numeric_limits<int>::max();
   int n_max = 0;
   for (const ImpactRecord& h : hits) {
-    if (!(h.sample_rate_hz > 0.0) || std::abs(h.sample_rate_hz - fs) > 1e-6 * fs) {
+    if (!(h.sample_rate_hz > 0.0) || std::abs(h.sample_rate_hz - fs) > 1e-4 * fs) {
       throw std::invalid_argument("hit " + h.id + " (" + h.source + "): sample rate " + Num(h.sample_rate_hz, 9) +
                                   " Hz differs from hit " + hits.front().id + "'s " + Num(fs, 9) + " Hz");
     }

@@ -155,7 +155,8 @@ struct FrfEstimateResult {
 
 /// Estimates H1, H2 and the coherence of each response channel from the
 /// hits, after rejecting double hits and overloads (eq. (1)–(3)).
-/// Every record must have the same sample rate (within 1e-6) and
+/// Every record must have the same sample rate (within 1e-4: times rounded
+/// to 1 µs in a CSV give rates a few 1e-6 apart) and
 /// channels.size() response columns; records are cut to the shortest one.
 /// @throws std::invalid_argument for inconsistent records (naming the hit)
 ///   or invalid options.
