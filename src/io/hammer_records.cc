@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 
 namespace robomach::io {
@@ -145,6 +146,15 @@ FileHits ReadOne(const std::string& path, bool prefix_ids) {
     const double dt = (time(n - 1) - time(0)) / (n - 1);
     rec.start_time_s = time(0);
     rec.sample_rate_hz = 1.0 / dt;
+    // Written times are rounded, so 1/dt misses the acquisition's rate by
+    // up to ~2δ/T (δ: the largest deviation of a time from the even grid,
+    // T: the record length). Rates are whole hertz on every acquisition
+    // system we know of (1024, 5120, 51200 Hz): snap to one within that.
+    double dev = 0.0;
+    for (int i = 0; i < n; ++i) dev = std::max(dev, std::abs(time(i) - (time(0) + i * dt)));
+    const double whole = std::round(rec.sample_rate_hz);
+    const double tol = (2.0 * dev / (time(n - 1) - time(0)) + 1e-12) * rec.sample_rate_hz;
+    if (whole > 0.0 && std::abs(whole - rec.sample_rate_hz) <= tol) rec.sample_rate_hz = whole;
     out.hits.push_back(std::move(rec));
   }
   return out;
@@ -217,6 +227,20 @@ HammerRecords ReadHammerRecords(const std::vector<std::string>& paths) {
     }
   }
   return out;
+}
+
+void WriteEstimatedFrfCsv(const std::string& path, const dynamics::FrfSet& frfs, FrfQuantity quantity,
+                          int averages, const std::vector<std::pair<std::string, std::string>>& metadata) {
+  for (const auto& [key, value] : metadata) {
+    if (key.empty() || key.find_first_of(": \t\r\n") != std::string::npos || key == "quantity" ||
+        key == "averages" || value.find_first_of("\r\n") != std::string::npos) {
+      throw std::invalid_argument("WriteEstimatedFrfCsv: bad metadata '" + key + ": " + value + "'");
+    }
+  }
+  WriteFileAtomically(path, [&](std::ostream& os) {
+    for (const auto& [key, value] : metadata) os << "# " << key << ": " << value << '\n';
+    WriteFrfCsv(os, frfs, quantity, averages);
+  });
 }
 
 }  // namespace robomach::io

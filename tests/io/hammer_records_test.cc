@@ -45,11 +45,24 @@ TEST(HammerRecords, HitColumnSplitsHitsAndSuffixesGiveQuantities) {
   EXPECT_EQ(r.hits[1].id, "2");
   EXPECT_EQ(r.hits[1].source, path + ":23");
   EXPECT_DOUBLE_EQ(r.hits[1].start_time_s, 5.0);
-  // 1 ms steps written with 6 significant digits: the rate is 1 kHz to
-  // that precision.
-  EXPECT_NEAR(r.hits[0].sample_rate_hz, 1000.0, 1e-6 * 1000.0);
+  // 1 ms steps written with 6 significant digits: 1/dt is 1 kHz to that
+  // precision, and snapped to it exactly.
+  EXPECT_EQ(r.hits[0].sample_rate_hz, 1000.0);
   EXPECT_EQ(r.hits[0].force_N(2), 100.0);
   EXPECT_DOUBLE_EQ(r.hits[0].response(3, 1), 1.5);
+}
+
+// A rate that is not a whole number of hertz stays as it is: 1/(1.0005 ms)
+// = 999.50 Hz, 0.5 Hz from 1000 while the times' rounding (1e-9 s over
+// 19 ms) allows 1e-4 Hz.
+TEST(HammerRecords, UnevenRateIsNotSnapped) {
+  const std::string dir = TempDir("hammer_records_rate");
+  std::ostringstream s;
+  s.precision(12);
+  s << "time_s,force_N,x_m\n";
+  for (int i = 0; i < 20; ++i) s << i * 0.0010005 << ",0,0\n";
+  const HammerRecords r = ReadHammerRecords({WriteText(dir + "/r.csv", s.str())});
+  EXPECT_NEAR(r.hits[0].sample_rate_hz, 1.0 / 0.0010005, 1e-6);
 }
 
 TEST(HammerRecords, OneFilePerHitNamedByStemColumnsReordered) {
@@ -132,6 +145,34 @@ TEST(HammerRecords, BadInputNamesFileLineAndColumn) {
     const std::string p = WriteText(dir + "/short.csv", head + Rows("", 5));
     EXPECT_THAT(CaptureError([&] { ReadHammerRecords({p}); }), HasSubstr("has 5 samples"));
   }
+}
+
+// The estimate's file reads back with the FRF reader: metadata lines before
+// the format's own are ignored, averages and coherence survive, and the
+// values round-trip exactly (WriteFrfCsv writes them so).
+TEST(HammerRecords, EstimatedFrfFileReadsBack) {
+  const std::string dir = TempDir("hammer_records_write");
+  Eigen::VectorXd f = Eigen::VectorXd::LinSpaced(4, 1.0, 4.0);
+  Eigen::VectorXcd h(4);
+  h << std::complex<double>(1e-6, -2e-7), std::complex<double>(2e-6, -1e-6), std::complex<double>(-1e-6, -3e-6),
+      std::complex<double>(-3e-7, -1e-8);
+  Eigen::VectorXd g(4);
+  g << 0.99, 0.95, 0.5, 0.91;
+  dynamics::FrfSet set;
+  set.Insert({"P1", Axis::kY, Axis::kX}, dynamics::Frf::FromSamples(f, h, g));
+  const std::string p = dir + "/est.csv";
+  WriteEstimatedFrfCsv(p, set, FrfQuantity::kAccelerance, 6,
+                       {{"estimator", "H1"}, {"exponential_window_tau_s", "0.1"}});
+  const FrfReadResult r = ReadFrfCsv(p);
+  EXPECT_EQ(r.averages, 6);
+  EXPECT_EQ(r.file_quantity, FrfQuantity::kAccelerance);
+  const dynamics::Frf& back = r.frfs.at({"P1", Axis::kY, Axis::kX});
+  ASSERT_EQ(back.size(), 4);
+  // Through accelerance and back: −ω² and its inverse, a few ulp.
+  for (int k = 0; k < 4; ++k) EXPECT_LE(std::abs(back.receptance()(k) - h(k)), 1e-15 * std::abs(h(k)));
+  EXPECT_EQ(*back.coherence(), g);
+  EXPECT_THROW(WriteEstimatedFrfCsv(p, set, FrfQuantity::kReceptance, 6, {{"averages", "3"}}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -10,12 +10,16 @@
 //   hit               optional: hit id; the rows of one hit are contiguous
 // One or more response columns. Without a `hit` column a file is one hit,
 // named by the file's stem. `#` lines are comments. Several files may be
-// read together; they must have the same response columns.
+// read together; they must have the same response columns. The sample rate
+// is 1/(mean time step), snapped to a whole number of hertz when that is
+// within the rounding of the written times.
 
 #include <string>
 #include <vector>
 
 #include "robomach/calibration/frf_estimate.h"
+#include "robomach/dynamics/measured_frf.h"
+#include "robomach/io/frf_files.h"
 
 namespace robomach::io {
 
@@ -40,5 +44,15 @@ bool ParseResponseColumn(const std::string& column, calibration::ResponseQuantit
 ///   hit, sample rates that differ between hits by more than 1e-4 (relative), files
 ///   with different response columns, or a duplicate hit id.
 HammerRecords ReadHammerRecords(const std::vector<std::string>& paths);
+
+/// Writes estimated FRFs as the CSV of formats.md §3 (WriteFrfCsv, with
+/// `# averages: N`), preceded by `# key: value` lines that record how they
+/// were estimated (estimator, hits, windows). ReadFrfCsv reads such a file
+/// back (it ignores metadata keys it does not know). Atomic.
+/// @throws std::invalid_argument for a key that is empty, contains ':' or a
+///   space, or is `quantity`/`averages` (written by WriteFrfCsv), or a value
+///   with a line break.
+void WriteEstimatedFrfCsv(const std::string& path, const dynamics::FrfSet& frfs, FrfQuantity quantity,
+                          int averages, const std::vector<std::pair<std::string, std::string>>& metadata);
 
 }  // namespace robomach::io
