@@ -124,7 +124,7 @@ int Run(int argc, char** argv) {
       "rejected and named on stderr and in --summary, never averaged."};
   app.footer(ExitCodeHelp() +
              "\n3 here: fewer accepted hits than --min-hits, or a response that has not decayed by the end of its "
-             "record (leakage). 65 also: every hit rejected (the FRF file is then not written; --summary is).");
+             "record (leakage). 65 also: every hit rejected (the FRF file is then not written; --summary is).\n");
   std::vector<std::string> records, directions;
   std::string out_path, summary_path, plot_path, pose_id = "P1", excitation = "x", quantity = "receptance",
                                                  estimator = "h1";
@@ -215,8 +215,12 @@ int Run(int argc, char** argv) {
       }
       keys.push_back(key);
     }
-    std::cerr << kTool << ": " << rec.hits.size() << " hit(s), " << rec.channels.size() << " response(s) at "
-              << Num(rec.hits.front().sample_rate_hz, 7) << " Hz\n";
+    std::cerr << kTool << ": " << rec.hits.size() << " hit(s) at " << Num(rec.hits.front().sample_rate_hz, 7)
+              << " Hz; pose " << pose_id << ", excitation " << AxisName(exc) << ", responses";
+    for (size_t c = 0; c < keys.size(); ++c) {
+      std::cerr << (c ? ", " : " ") << rec.channel_columns[c] << " -> " << AxisName(keys[c].response);
+    }
+    std::cerr << " (--pose-id, --excitation, --direction)\n";
     const calibration::FrfEstimateResult r = calibration::EstimateFrf(rec.hits, rec.channels, o);
 
     std::vector<std::string> rejected;

@@ -176,6 +176,39 @@ TEST_F(FrfEstimateCampaign, RejectsDoubleAndClippedHitsAndMatchesAnalyticFrf) {
   EXPECT_LT(acc.rms_normalised, 2.0);
 }
 
+// The same checks on hits with another noise draw, not looked at while the
+// noise levels and bounds above were chosen.
+TEST_F(FrfEstimateCampaign, UntunedSeedStaysWithinTheRandomError) {
+  for (const unsigned seed : {2024u, 31337u}) {
+    const FrfEstimateResult r = EstimateFrf(CampaignHits(*sys_, seed, true), testing::SimulatedChannels());
+    ASSERT_EQ(r.averages, 6) << seed;
+    EXPECT_EQ(r.hits[6].status, HitStatus::kDoubleHit);
+    EXPECT_EQ(r.hits[7].status, HitStatus::kOverload);
+    const Comparison rec = Compare(r, 0, [&](double f) { return sys_->Receptance(f)(0, 0); });
+    const Comparison acc = Compare(r, 1, [&](double f) { return sys_->Accelerance(f)(2, 0); });
+    std::printf("seed %u: receptance %d/%d lines within 2 %%, worst %.2f sigma beyond; accelerance %d/%d, %.2f\n",
+                seed, rec.within_2pc, rec.lines, rec.max_excess_sigma, acc.within_2pc, acc.lines,
+                acc.max_excess_sigma);
+    // Bounds as in RejectsDoubleAndClippedHitsAndMatchesAnalyticFrf.
+    EXPECT_LT(rec.max_excess_sigma, 4.0) << seed;
+    EXPECT_LT(acc.max_excess_sigma, 4.0) << seed;
+    EXPECT_LT(rec.rms_normalised, 2.0) << seed;
+    EXPECT_LT(acc.rms_normalised, 2.0) << seed;
+  }
+}
+
+// Every hit rejected: no estimate, a status rather than an exception.
+TEST_F(FrfEstimateCampaign, AllRejectedIsAStatus) {
+  FrfEstimateOptions o;
+  o.force_range_N = 100.0;  // every hit peaks above 100 N
+  const FrfEstimateResult r = EstimateFrf(*hits_, testing::SimulatedChannels(), o);
+  EXPECT_EQ(r.status, FrfEstimateStatus::kNoHits);
+  EXPECT_EQ(r.averages, 0);
+  EXPECT_TRUE(r.channels.empty());
+  ASSERT_EQ(r.hits.size(), 8u);
+  EXPECT_THAT(r.hits[0].notes.back(), HasSubstr("overload: force reaches"));
+}
+
 // The acceptance without sensor noise: the estimator's own errors (windows,
 // offsets, the FFT) on top of the acquisition filter and the simulation's
 // hold (0.2 % at 1600 Hz) are below 2 % on every coherent line, and every
