@@ -69,7 +69,7 @@ struct Comparison {
 };
 
 // The normalised random error of an H1 estimate from n averages with
-// coherence γ² [Bendat & Piersol 2010, §9.3]: |H1| / |H| scatters with
+// coherence γ² [Bendat & Piersol 2010, ch. 9]: |H1| / |H| scatters with
 // ε_r = sqrt(1 − γ²) / (|γ| sqrt(2n)), and so does its phase (in rad); the
 // complex error |H1 − H| / |H| has rms ε_c = √2 ε_r. At γ² = 0.9 and
 // n = 6, ε_r = 9.6 %: the "2 % where the coherence is above 0.9"
@@ -132,7 +132,7 @@ std::vector<ImpactRecord>* FrfEstimateCampaign::hits_ = nullptr;
 // within 2 % + 4 ε_c. A complex Gaussian error exceeds k times its rms with
 // probability e^{−k²}, 1e-7 per line for k = 4; the margin covers the
 // estimated coherence's upward bias with six averages, which makes ε_c
-// come out small [Bendat & Piersol 2010, §9.2.3]. And the errors are the
+// come out small [Bendat & Piersol 2010, ch. 9]. And the errors are the
 // random error and not a bias: their rms in units of ε_c is about 1.
 TEST_F(FrfEstimateCampaign, RejectsDoubleAndClippedHitsAndMatchesAnalyticFrf) {
   const FrfEstimateResult r = EstimateFrf(*hits_, testing::SimulatedChannels());
@@ -326,7 +326,7 @@ TEST(FrfEstimate, ShortRecordIsReportedAsLeakage) {
   EXPECT_FALSE(w.leakage);
 }
 
-// The known biases [Bendat & Piersol 2010, §9.1.4]: noise on the response
+// The known biases [Bendat & Piersol 2010]: noise on the response
 // only leaves H1 unbiased and biases H2 up by 1/γ²; noise on the force only
 // (no force window, so that it stays) leaves H2 unbiased and biases H1 down.
 // Checked at lines with 0.3 < γ² < 0.8, the anti-resonance regions.

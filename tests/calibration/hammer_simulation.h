@@ -9,7 +9,7 @@
 // exact solution for a force linear between samples (first-order hold),
 // from one matrix exponential of the augmented system
 //   d/dt [z; u; u̇] = [A z + B u; u̇; 0]
-// [Franklin, Powell & Workman 1998, §6.3.2]. The force is a half-sine pulse
+// [Franklin, Powell & Workman 1998, ch. 6]. The force is a half-sine pulse
 // evaluated at the fine samples. The fine signals (force, displacement of
 // m1, acceleration of m3) go through one anti-aliasing FIR filter, the same
 // for every channel as in a data-acquisition system, and are decimated;

@@ -5,7 +5,7 @@
 // force window and an exponential window, and the checks that reject a hit
 // (double hit, overload) instead of averaging it.
 //
-// Estimators [Bendat & Piersol 2010, §9.1; Ewins 2000, §3.9]. With F_i(f)
+// Estimators [Bendat & Piersol 2010; Ewins 2000]. With F_i(f)
 // and X_i(f) the discrete Fourier transforms of the windowed force and
 // response of hit i, and the auto and cross spectra summed over the n
 // accepted hits
