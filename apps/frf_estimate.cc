@@ -167,9 +167,10 @@ int Run(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--force-range-N", o.force_range_N, "overload: |force| at or beyond this [N]; 0: unknown")
       ->capture_default_str();
-  app.add_option("--response-range", o.response_range,
-                 "overload: |response| at or beyond this, in each channel's SI unit (m, m/s or m/s^2); 0: unknown")
-      ->capture_default_str();
+  std::vector<std::string> response_ranges;
+  app.add_option("--response-range", response_ranges,
+                 "overload: |response| at or beyond this, NAME=VALUE in the channel's SI unit (m, m/s or m/s^2), "
+                 "e.g. acc_y=490 for a 50 g accelerometer; repeat per channel");
   app.add_option("--min-hits", min_hits, "fewer accepted hits than this: exit 3 (at least 1)")->capture_default_str();
   app.add_option("--summary", summary_path, "JSON summary: hits with status and notes, windows, warnings");
   app.add_option("--plot", plot_path, "PNG of |H| and the coherence");
@@ -214,6 +215,19 @@ int Run(int argc, char** argv) {
         }
       }
       keys.push_back(key);
+    }
+    if (!response_ranges.empty()) {
+      o.response_range.assign(rec.channels.size(), 0.0);
+      for (const std::string& text : response_ranges) {
+        const auto [name, value] = ParseAssignment("--response-range", text);
+        size_t c = 0;
+        while (c < rec.channels.size() && rec.channels[c].name != name) ++c;
+        if (c == rec.channels.size()) {
+          throw std::invalid_argument("--response-range " + text + ": no response channel '" + name + "'");
+        }
+        CheckOptionRange("--response-range " + name, value, 0.0, 1e300);
+        o.response_range[c] = value;
+      }
     }
     std::cerr << kTool << ": " << rec.hits.size() << " hit(s) at " << Num(rec.hits.front().sample_rate_hz, 7)
               << " Hz; pose " << pose_id << ", excitation " << AxisName(exc) << ", responses";

@@ -82,8 +82,10 @@ void CheckValid(const FrfEstimateOptions& o) {
   Require(o.flat_top_samples >= 2, "flat_top_samples", o.flat_top_samples, ">= 2");
   Require(o.force_range_N >= 0.0 && std::isfinite(o.force_range_N), "force_range_N", o.force_range_N,
           ">= 0 [N] (0 = unknown)");
-  Require(o.response_range >= 0.0 && std::isfinite(o.response_range), "response_range", o.response_range,
-          ">= 0 (0 = unknown)");
+  for (size_t c = 0; c < o.response_range.size(); ++c) {
+    Require(o.response_range[c] >= 0.0 && std::isfinite(o.response_range[c]),
+            "response_range[" + std::to_string(c) + "]", o.response_range[c], ">= 0 (0 = unknown)");
+  }
   Require(o.leakage_fraction > 0.0 && o.leakage_fraction < 1.0, "leakage_fraction", o.leakage_fraction,
           "in (0, 1)");
 }
@@ -107,7 +109,11 @@ int DetectFlatTop(const Eigen::VectorXd& x, int min_run) {
     if (d > 0.0) quantum = std::min(quantum, d);
   }
   if (!std::isfinite(quantum)) return -1;  // a constant signal: no pulse at all, not a clip
+  std::vector<double> sorted(x.data(), x.data() + n);
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+  const double median = sorted[n / 2];
   for (const double extreme : {x.maxCoeff(), x.minCoeff()}) {
+    int count = 0, first = -1;
     for (int i = 0; i < n;) {
       if (x(i) != extreme) {
         ++i;
@@ -116,6 +122,8 @@ int DetectFlatTop(const Eigen::VectorXd& x, int min_run) {
       int j = i;
       while (j + 1 < n && x(j + 1) == extreme) ++j;
       const int run = j - i + 1;
+      count += run;
+      if (first < 0) first = i;
       // A smooth peak stays within one quantum of its extreme over the run
       // and falls by at most ~8 quanta over the next `run` samples (a
       // parabola: x''(run/2)²/2 = q gives x''((3/2)run)²/2 = 9q); a clip
@@ -125,6 +133,12 @@ int DetectFlatTop(const Eigen::VectorXd& x, int min_run) {
       if (run >= min_run && std::max(drop_before, drop_after) > 16.0 * quantum) return i;
       i = j + 1;
     }
+    // A fast signal clipped at a few of its peaks: the same extreme value,
+    // to the last digit, in `min_run` or more samples that need not be
+    // neighbours. A decaying response reaches its extreme once; only a
+    // signal a few hundred quanta tall could repeat it by rounding, hence
+    // the 1000 quanta.
+    if (count >= min_run && std::abs(extreme - median) > 1000.0 * quantum) return first;
   }
   return -1;
 }
@@ -136,6 +150,10 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
   result.exponential_tau_s = o.exponential_tau_s;
   const int nc = static_cast<int>(channels.size());
   if (nc == 0) throw std::invalid_argument("EstimateFrf: no response channel");
+  if (!o.response_range.empty() && static_cast<int>(o.response_range.size()) != nc) {
+    throw std::invalid_argument("FrfEstimateOptions::response_range has " + std::to_string(o.response_range.size()) +
+                                " entries; expected none or one per channel (" + std::to_string(nc) + ")");
+  }
   if (hits.empty()) return result;
   const double fs = hits.front().sample_rate_hz;
   int n = std::numeric_limits<int>::max();
@@ -208,7 +226,8 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
         ++j;
       }
       rep.status = HitStatus::kDoubleHit;
-      rep.notes.push_back("double hit: a second force pulse at t = " + time_of(best) + " s, " +
+      rep.notes.push_back(std::string("double hit: ") + (best > p.end ? "a second" : "an earlier") +
+                          " force pulse at t = " + time_of(best) + " s, " +
                           Num(100.0 * std::abs(f(best)) / p.peak_N, 3) + " % of the main pulse's peak (at t = " +
                           time_of(p.peak) + " s)");
     }
@@ -236,7 +255,8 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
     check_channel(f, "force", o.force_range_N, "N");
     for (int c = 0; c < nc; ++c) {
       static const char* kUnits[] = {"m", "m/s", "m/s^2"};
-      check_channel(rec.response.col(c).head(n), "response " + channels[c].name, o.response_range,
+      check_channel(rec.response.col(c).head(n), "response " + channels[c].name,
+                    o.response_range.empty() ? 0.0 : o.response_range[c],
                     kUnits[static_cast<int>(channels[c].quantity)]);
     }
     if (rep.status == HitStatus::kAccepted) longest_pulse_s = std::max(longest_pulse_s, rep.pulse_duration_s);

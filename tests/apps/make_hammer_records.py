@@ -5,7 +5,7 @@ struck on m1 with a 2 ms half-sine (a soft tip), integrated by classical
 Runge-Kutta at 1/16 of the sample interval, sampled at 1024 Hz for 0.5 s
 per hit, with seeded sensor noise. Five hits: 1-3 good, 4 a double hit
 (rebound 15 ms later at 40 %), 5 a hard hit that clips the accelerometer at
-+-12 m/s^2.
++-90 m/s^2 (hits 1-3 peak at 53-77 m/s^2).
 
 Writes to OUTDIR: hits.csv (hit column; tip_x_m = displacement of m1,
 acc_y_m_per_s2 = acceleration of m3), hit_a.csv and hit_b.csv (hits 1 and
@@ -93,7 +93,7 @@ def main():
         ("2", [(0.031, 220.0)], None),
         ("3", [(0.017, 150.0)], None),
         ("4", [(0.022, 200.0), (0.037, 80.0)], None),
-        ("5", [(0.025, 400.0)], 12.0),
+        ("5", [(0.025, 600.0)], 90.0),
     ]
     lines = ["# smoke-test hammer records (tests/apps/make_hammer_records.py)",
              "hit,time_s,force_N,tip_x_m,acc_y_m_per_s2"]

@@ -143,7 +143,7 @@ TEST_F(FrfEstimateCampaign, RejectsDoubleAndClippedHitsAndMatchesAnalyticFrf) {
   EXPECT_EQ(r.hits[6].status, HitStatus::kDoubleHit);
   ASSERT_FALSE(r.hits[6].notes.empty());
   // The rebound: 12 ms after the start at 0.020 s, peak 0.3 ms later.
-  EXPECT_THAT(r.hits[6].notes[0], HasSubstr("second force pulse at t = 0.032"));
+  EXPECT_THAT(r.hits[6].notes[0], HasSubstr("double hit: a second force pulse at t = 0.032"));
   EXPECT_EQ(r.hits[7].status, HitStatus::kOverload);
   ASSERT_FALSE(r.hits[7].notes.empty());
   EXPECT_THAT(r.hits[7].notes[0], HasSubstr("response a3 is clipped"));
@@ -388,6 +388,18 @@ TEST(DetectFlatTop, ClippedVersusQuantised) {
   EXPECT_EQ(DetectFlatTop(quantised, 3), -1);
   Eigen::VectorXd q_clip = quantised.cwiseMin(0.8);
   EXPECT_GE(DetectFlatTop(q_clip, 3), 0);
+  // A fast decaying response (6 samples per cycle) clipped at 0.6 of its
+  // first peak: single clipped samples in three cycles (rule b); unclipped,
+  // its maximum occurs once.
+  Eigen::VectorXd fast(600);
+  for (int i = 0; i < 600; ++i) fast(i) = std::exp(-i / 60.0) * std::sin(2 * kPi * i / 6.0 + 0.3);
+  EXPECT_EQ(DetectFlatTop(fast, 3), -1);
+  const Eigen::VectorXd fast_clip = fast.cwiseMin(0.6);
+  EXPECT_EQ(DetectFlatTop(fast_clip, 3), 1);
+  // Quantised to 1/5000 of its peak it still is not clipped: the peak
+  // occurs once.
+  const Eigen::VectorXd fast_q = (fast * 5000.0).array().round() / 5000.0;
+  EXPECT_EQ(DetectFlatTop(fast_q, 3), -1);
 }
 
 TEST(CorrectExponentialWindowDamping, FirstOrderShift) {

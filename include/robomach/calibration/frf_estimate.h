@@ -94,7 +94,9 @@ struct FrfEstimateOptions {
   /// beyond a given range.
   int flat_top_samples{3};
   double force_range_N{0.0};    // 0 = unknown
-  double response_range{0.0};   // in each channel's SI unit; 0 = unknown
+  /// Per response channel, in its SI unit (m, m/s, m/s²); 0 = unknown.
+  /// Empty: unknown for all; else one entry per channel.
+  std::vector<double> response_range;
   /// Leakage check: a (windowed) response whose rms over the last 5 % of
   /// the record is above this fraction of its peak, and above 2 × the rms
   /// of the pre-trigger samples (the noise), has not decayed.
@@ -117,8 +119,9 @@ struct HitReport {
   double hit_time_s{NAN};      // t_hit [s] (record time)
   double peak_force_N{NAN};
   double pulse_duration_s{NAN};
-  /// Why the hit was rejected, e.g. "double hit: second pulse at
-  /// t = 0.0213 s, 42 % of the peak"; empty for accepted hits.
+  /// Why the hit was rejected, e.g. "double hit: a second force pulse at
+  /// t = 0.0213 s, 42 % of the main pulse's peak (...)"; empty for
+  /// accepted hits.
   std::vector<std::string> notes;
 };
 
@@ -164,14 +167,20 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits,
                               const std::vector<ResponseChannel>& channels,
                               const FrfEstimateOptions& options = {});
 
-/// The first run of at least `min_run` consecutive samples exactly equal to
-/// the signal's maximum (or minimum) where the signal, `run` samples before
-/// or after the run, is more than 16 quanta away from that value (the
-/// quantum: the smallest nonzero sample-to-sample step): a clipped converter
-/// or amplifier. A smooth peak of a quantised signal also repeats its
-/// extreme value, but stays within about 8 quanta of it over that distance
-/// (a parabola within one quantum over the run is within 9 at 1.5 runs from
-/// its apex). Returns the index of the run's first sample, or −1.
+/// Clipping of a converter or amplifier, as the first sample of either
+///  (a) a run of at least `min_run` consecutive samples exactly equal to the
+///      signal's maximum (or minimum) where the signal, `run` samples before
+///      or after the run, is more than 16 quanta away from that value (the
+///      quantum: the smallest nonzero sample-to-sample step). A smooth peak
+///      of a quantised signal also repeats its extreme value, but stays
+///      within about 8 quanta of it over that distance (a parabola within
+///      one quantum over the run is within 9 at 1.5 runs from its apex); or
+///  (b) the extreme value, to the last digit, in `min_run` or more samples
+///      in all (a fast signal clipped at several of its peaks for one or two
+///      samples each), when it is more than 1000 quanta from the median: a
+///      decaying response reaches its extreme once, and only a signal a few
+///      hundred quanta tall could repeat it by rounding.
+/// Returns the index of that sample, or −1.
 int DetectFlatTop(const Eigen::VectorXd& x, int min_run);
 
 /// The true damping of a mode measured through an exponential window of
