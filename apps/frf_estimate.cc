@@ -64,6 +64,9 @@ void SavePlot(const std::string& path, const calibration::FrfEstimateResult& r, 
               const std::string& estimator) {
   report::Figure fig(2, 1, 1000, 400);
   fig.title = "frf-estimate: " + estimator + " of " + std::to_string(r.averages) + " hits";
+  if (r.exponential_tau_s > 0.0) {
+    fig.title += ", exponential window tau = " + Num(r.exponential_tau_s, 3) + " s (adds damping)";
+  }
   report::Axes& mag = fig.at(0, 0);
   report::Axes& coh = fig.at(1, 0);
   const std::string unit = quantity == io::FrfQuantity::kReceptance ? "m/N"

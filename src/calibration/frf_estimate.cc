@@ -279,11 +279,13 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
   std::vector<std::complex<double>> spec_f, spec_x;
   const int tail = std::max(1, n / 20);
   std::vector<int> leaky_hits(nc, 0);
+  double shortest_decay_s = std::numeric_limits<double>::infinity();
   std::vector<double> worst_tail(nc, 0.0);
   for (size_t h = 0; h < hits.size(); ++h) {
     if (result.hits[h].status != HitStatus::kAccepted) continue;
     const ImpactRecord& rec = hits[h];
     const Pulse& p = pulses[h];
+    shortest_decay_s = std::min(shortest_decay_s, (n - p.start) / fs);
     // Offsets: the mean of the samples before the force window (pre-trigger),
     // if there are at least 8 of them.
     const int pre_end = std::max(0, p.start - static_cast<int>(std::ceil((pre + taper) * fs)));
@@ -331,7 +333,10 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
                               std::to_string(leaky_hits[c]) + " of " + std::to_string(result.averages) +
                               " accepted hits (rms of the last 5 % up to " + Num(100.0 * worst_tail[c], 3) +
                               " % of the peak): leakage widens the peaks and overstates the damping; use longer "
-                              "records or an exponential window");
+                              "records or an exponential window (tau = " + Num(shortest_decay_s / 6.0, 3) +
+                              " s, a sixth of the shortest time from a hit to its record's end, leaves e^-6 = "
+                              "0.25 %" + (o.exponential_tau_s > 0.0 ? "; the window now has tau = " +
+                                          Num(o.exponential_tau_s, 3) + " s" : std::string()) + ")");
   }
   result.freq_hz = Eigen::VectorXd::LinSpaced(lines, df, lines * df);
   if (result.averages == 0) {
