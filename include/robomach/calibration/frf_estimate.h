@@ -146,7 +146,7 @@ struct FrfEstimateResult {
   int averages{0};                    // accepted hits
   std::vector<HitReport> hits;        // one per input record, in input order
   double sample_rate_hz{0.0};
-  int block_samples{0};               // N: the shortest record
+  int block_samples{0};               // N: the shortest record, cut to a 2·3·5-smooth length
   double force_window_s{0.0};         // the width used (after "automatic") [s]; < 0: off
   double force_window_pre_s{0.0};     // the lead used [s]
   double exponential_tau_s{0.0};      // [s]; 0: none
@@ -160,7 +160,9 @@ struct FrfEstimateResult {
 /// hits, after rejecting double hits and overloads (eq. (1)–(3)).
 /// Every record must have the same sample rate (within 1e-4: times rounded
 /// to 1 µs in a CSV give rates a few 1e-6 apart) and
-/// channels.size() response columns; records are cut to the shortest one.
+/// channels.size() response columns; records are cut to the shortest one,
+/// and then to the largest length ≤ it with only the factors 2, 3 and 5
+/// (the FFT's fast radices; a warning names the samples dropped).
 /// @throws std::invalid_argument for inconsistent records (naming the hit)
 ///   or invalid options.
 FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits,
