@@ -48,6 +48,21 @@ robomach_app_test(frf_estimate.missing_file RC 66
 robomach_app_test(frf_estimate.unknown_direction RC 64
   CMD $<TARGET_FILE:frf-estimate> ${EST_TMP}/records/hits.csv --out ${EST_TMP}/dir.csv --direction acc=z
   STDERR "--direction acc=z: no response channel 'acc'")
-set_tests_properties(frf_estimate.defaults frf_estimate.too_few_hits frf_estimate.all_rejected
+# Records too short for the decay: leakage, exit 3, with a proposed tau;
+# with that exponential window the result is clean and records its tau.
+robomach_app_test(frf_estimate.leakage RC 3 CLEAN ${EST_TMP}/short
+  CMD $<TARGET_FILE:frf-estimate> ${EST_TMP}/records/short.csv --out ${EST_TMP}/short/frf.csv
+  FILES ${EST_TMP}/short/frf.csv
+  STDERR "response tip_x: has not decayed by the end of the record in 4 of 4.*tau = 0.0133 s")
+robomach_app_test(frf_estimate.exponential_window RC 0 CLEAN ${EST_TMP}/short_exp
+  CMD $<TARGET_FILE:frf-estimate> ${EST_TMP}/records/short.csv --out ${EST_TMP}/short_exp/frf.csv
+      --exp-window-tau-s 0.0133
+  FILES ${EST_TMP}/short_exp/frf.csv)
+add_test(NAME frf_estimate.exponential_window_recorded
+  COMMAND python3 -c "import sys; L=open(sys.argv[1]).read().splitlines(); print(L[:6]); sys.exit(0 if '# exponential_window_tau_s: 0.0133' in L else 1)"
+          ${EST_TMP}/short_exp/frf.csv)
+set_tests_properties(frf_estimate.exponential_window_recorded PROPERTIES DEPENDS frf_estimate.exponential_window)
+set_tests_properties(frf_estimate.leakage frf_estimate.exponential_window
+                     frf_estimate.defaults frf_estimate.too_few_hits frf_estimate.all_rejected
                      frf_estimate.bad_number frf_estimate.missing_file frf_estimate.unknown_direction
                      PROPERTIES FIXTURES_REQUIRED frf_estimate_records)

@@ -9,7 +9,9 @@ per hit, with seeded sensor noise. Five hits: 1-3 good, 4 a double hit
 
 Writes to OUTDIR: hits.csv (hit column; tip_x_m = displacement of m1,
 acc_y_m_per_s2 = acceleration of m3), hit_a.csv and hit_b.csv (hits 1 and
-2, one file each), broken.csv (hits.csv with a NaN at line 9, column 4).
+2, one file each), broken.csv (hits.csv with a NaN at line 9, column 4),
+short.csv (four good hits of 96 samples, 94 ms: the 42 Hz mode, decay time
+0.09 s, is still ringing at the end).
 
 usage: make_hammer_records.py OUTDIR
 """
@@ -45,12 +47,12 @@ def force(t, hit):
     return v
 
 
-def simulate(hit, rng, clip=None):
+def simulate(hit, rng, clip=None, samples=N):
     h = 1.0 / (FS * SUB)
     x = [0.0, 0.0, 0.0]
     v = [0.0, 0.0, 0.0]
     rows = []
-    for k in range(N):
+    for k in range(samples):
         t = k / FS
         f = force(t, hit)
         a = accel(x, v, f)
@@ -112,6 +114,11 @@ def main():
     broken[8] = ",".join(cells)
     with open(os.path.join(outdir, "broken.csv"), "w") as f:
         f.write("\n".join(broken) + "\n")
+    short = ["hit,time_s,force_N,tip_x_m,acc_y_m_per_s2"]
+    for hid, t0 in (("a", 0.010), ("b", 0.012), ("c", 0.011), ("d", 0.013)):
+        short += fmt(simulate([(t0, 200.0)], rng, samples=96), hid)
+    with open(os.path.join(outdir, "short.csv"), "w") as f:
+        f.write("\n".join(short) + "\n")
 
 
 if __name__ == "__main__":
