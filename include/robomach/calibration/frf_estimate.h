@@ -85,13 +85,12 @@ struct FrfEstimateOptions {
   /// The pulse starts and ends where |force| crosses this fraction of the
   /// peak.
   double trigger_fraction{0.05};
-  /// A second pulse is any force sample outside the first pulse above this
-  /// fraction of the peak (once the first pulse has fallen below
-  /// `trigger_fraction`).
+  /// Double hit: any force sample outside the main pulse (the run of
+  /// samples around the peak above `trigger_fraction`), before or after it,
+  /// above this fraction of the peak.
   double double_hit_fraction{0.10};
-  /// Overload: at least this many consecutive samples equal to the record's
-  /// extreme value (a flat top; see DetectFlatTop), or any sample at or
-  /// beyond a given range.
+  /// Overload: a channel clipped (DetectFlatTop with this many samples), or
+  /// any sample at or beyond a given range.
   int flat_top_samples{3};
   double force_range_N{0.0};    // 0 = unknown
   /// Per response channel, in its SI unit (m, m/s, m/s²); 0 = unknown.
