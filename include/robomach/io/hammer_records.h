@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "robomach/calibration/frf_estimate.h"
+#include "robomach/calibration/impact_record.h"
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/io/frf_files.h"
 
