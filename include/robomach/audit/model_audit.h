@@ -54,8 +54,8 @@ struct AuditOptions {
   /// every alternative with as many effects or fewer (the other candidates
   /// of its round and of the rounds before it, and the calibrated current
   /// model) by more than this. 10 is "very strong" evidence on the scale of
-  /// Kass & Raftery, J. Am. Stat. Assoc. 90 (1995) 773-795, §3.2 (ΔBIC =
-  /// 2 ln B > 10, a Bayes factor above ~150).
+  /// Kass & Raftery, J. Am. Stat. Assoc. 90 (1995) 773-795, for 2 ln B
+  /// (ΔBIC ≈ 2 ln B > 10: a Bayes factor above ~150).
   double clear_bic_gap{10.0};
   /// Try a second effect on top of the best one if the best alone does not
   /// explain the data.
