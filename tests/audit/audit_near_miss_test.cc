@@ -311,6 +311,47 @@ INSTANTIATE_TEST_SUITE_P(
              1802}),
     [](const ::testing::TestParamInfo<Case>& i) { return i.param.name; });
 
+// The other grades on virtual hammer tests (audit test support: five
+// postures, 2 % noise, no noise model, the floor from the scatter): nothing
+// hidden is "no failure"; a hidden library effect, tip_mass 2 kg, with
+// itself the only candidate (seconds instead of a minute) is "explained",
+// graded on the accepted candidate, with the fraction near 1.
+TEST(AuditGrade, NoFailureAndExplained) {
+  const Campaign c = testing::MakeCampaign();
+  {
+    const auto [d, p] = testing::Truth(c, {});
+    const AuditResult r = RunAudit(c.cfg.description, c.cfg.parameters, c.postures, testing::Synthesize(c, d, p, 1803));
+    EXPECT_EQ(r.grade, AuditGrade::kNoFailure) << r.verdict;
+    EXPECT_TRUE(r.explained);
+    EXPECT_TRUE(r.missing_effects.empty());
+    EXPECT_EQ(r.graded, -1);
+    EXPECT_TRUE(std::isnan(r.fraction_removed));
+    EXPECT_EQ(r.headline.rfind("No significant failure", 0), 0u) << r.headline;
+  }
+  {
+    const auto [d, p] = testing::Truth(c, {{"tip_mass", {{"tip_mass.mass_kg", 2.0}}}});
+    AuditOptions o;
+    o.candidates = {"tip_mass"};
+    const AuditResult r =
+        RunAudit(c.cfg.description, c.cfg.parameters, c.postures, testing::Synthesize(c, d, p, 1804), o);
+    std::cout << r.headline << "\n";
+    EXPECT_EQ(r.grade, AuditGrade::kExplained) << r.verdict;
+    EXPECT_TRUE(r.explained);
+    EXPECT_EQ(r.missing_effects, std::vector<std::string>{"tip_mass"});
+    EXPECT_EQ(r.graded, r.best);
+    EXPECT_EQ(r.runner_up, "current model");  // the only alternative
+    EXPECT_GT(r.bic_gap, o.clear_bic_gap);
+    // Down to the true model's error, which is the noise floor within the
+    // ±10 % of the floor estimate (model_audit_test.cc): the fraction is
+    // within 0.1 / (before − 1) of 1; ≥ 0.9 holds for before ≥ 2.
+    EXPECT_GE(r.error_before_noise_units, 2.0);
+    EXPECT_GE(r.fraction_removed, 0.9);
+    EXPECT_TRUE(r.reasons.empty());
+    EXPECT_TRUE(r.pattern.empty());
+    EXPECT_EQ(r.headline.rfind("Explained: the missing effect is tip_mass", 0), 0u) << r.headline;
+  }
+}
+
 // The grade's arithmetic: errors in noise units b, a; fraction (b − a)/(b − 1).
 TEST(AuditGrade, FractionRemovedIsTheShareOfTheExcessMisfit) {
   EXPECT_DOUBLE_EQ(FractionRemoved(16.3, 2.09, 1.0), (16.3 - 2.09) / 15.3);
