@@ -352,14 +352,20 @@ int Run(int argc, char** argv) {
     }
     if (has_worst) {
       const auto& wc = r.errors_before.curves[worst];
+      // The error of the curve drawn thin (the shown candidate's), if any.
+      const bool has_after = shown && worst < shown->errors.curves.size();
       h << "<p><img src=\"worst_frf.png\" alt=\"worst FRF before and after\"><br>The FRF the current model fits "
            "worst, "
-        << Html(KeyLabel(wc.key)) << " (error " << Num(wc.rms_log_mag / r.noise_floor, 3) << " → "
-        << Num(after.curves[worst].rms_log_mag / r.noise_floor, 3)
-        << " × the noise floor): measured (wide, with its noise where known), the calibrated current model (dashed)"
-        << (shown ? " and the model with " + Html(shown->name()) + (best ? "" : ", not accepted,") + " (thin line)"
-                  : std::string())
-        << ".</p>\n";
+        << Html(KeyLabel(wc.key)) << " (error " << Num(wc.rms_log_mag / r.noise_floor, 3) << " × the noise floor";
+      if (has_after) {
+        h << "; " << Num(shown->errors.curves[worst].rms_log_mag / r.noise_floor, 3) << " with "
+          << Html(shown->name());
+      }
+      h << "): measured (wide, with its noise where known), the calibrated current model (dashed)";
+      if (shown) {
+        h << " and the model with " << Html(shown->name()) << " (" << (best ? "" : "not accepted; ") << "thin line)";
+      }
+      h << ".</p>\n";
     }
     h << "<h2>Verdict</h2>\n";
     if (r.grade == audit::AuditGrade::kMostlyExplained) {
