@@ -90,6 +90,7 @@ int Run(int argc, char** argv) {
       "within 1.3 x the noise); mostly explained (the named effect removes at least 80 % of the error\n"
       "above the noise and is ahead of every alternative with as many effects or fewer by a BIC gap\n"
       "above 10); or unexplained."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              " Exit 3 when the failure is significant and not explained within the noise: unexplained, or mostly "
              "explained (the effect is named and effects.yaml written, but a misfit remains), or a fit failed (the "
