@@ -43,7 +43,7 @@ int Run(int argc, char** argv) {
   std::string runs_path, out_path, plot_path;
   app.add_option("--runs", runs_path, "runs CSV axis,target_mm,run,direction,measured_mm (or _deg)")->required();
   app.add_option("--out", out_path, "ISO 230-2 JSON (stdout if omitted)");
-  app.add_option("--plot", plot_path, "PNG chart, one panel per axis");
+  app.add_option("--plot", plot_path, "PNG chart, one panel per axis")->check(PngFileName());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -60,7 +60,7 @@ int Run(int argc, char** argv) {
   app.add_option("--program", program_path, "programmed path CSV x_mm,y_mm,z_mm,i,j,k (workpiece coordinates)");
   app.add_option("--out", out_path, "acquired path CSV (formats.md §8.5)")->required();
   app.add_option("--summary", summary_path, "summary JSON (rows, duration, contour error statistics)");
-  app.add_option("--plot", plot_path, "PNG of the contour error along the path (needs --program)");
+  app.add_option("--plot", plot_path, "PNG of the contour error along the path (needs --program)")->check(PngFileName());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

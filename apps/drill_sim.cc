@@ -181,7 +181,7 @@ int RunDrillSim(int argc, char** argv) {
                  "or q'' (pd-tdc), default 0.005; the starting point of --tune");
   app.add_option("--out", out_path, "time series CSV (formats.md 9.4)");
   app.add_option("--summary", summary_path, "summary JSON (formats.md 9.4); stdout if neither --out nor --summary");
-  app.add_option("--plot", plot_path, "PNG: joint errors, drill offset, thrust, torque per controller");
+  app.add_option("--plot", plot_path, "PNG: joint errors, drill offset, thrust, torque per controller")->check(PngFileName());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

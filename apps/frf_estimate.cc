@@ -177,7 +177,7 @@ int Run(int argc, char** argv) {
                  "e.g. acc_y=490 for a 50 g accelerometer; repeat per channel");
   app.add_option("--min-hits", min_hits, "fewer accepted hits than this: exit 3 (at least 1)")->capture_default_str();
   app.add_option("--summary", summary_path, "JSON summary: hits with status and notes, windows, warnings");
-  app.add_option("--plot", plot_path, "PNG of |H| and the coherence");
+  app.add_option("--plot", plot_path, "PNG of |H| and the coherence")->check(PngFileName());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -85,7 +85,7 @@ int Run(int argc, char** argv) {
   app.add_option("--out", out_path, "predicted FRFs, CSV receptance [m/N]; stdout if omitted");
   app.add_option("--modes", modes_path, "modal table CSV: freq_hz, damping_ratio, modal_mass_kg, ux,uy,uz");
   app.add_option("--details", details_path, "per-posture JSON: J, cond(J), M_q, K_q, C_q, Cartesian M, K, C, compliance, modes");
-  app.add_option("--plot", plot_path, "one PNG sheet with all postures (magnitude and phase)");
+  app.add_option("--plot", plot_path, "one PNG sheet with all postures (magnitude and phase)")->check(PngFileName());
   app.add_option("--plot-dir", plot_dir, "folder for one PNG per posture (<pose_id>.png)");
   app.add_option("--fmin-hz", fmin_hz, "lowest frequency line [Hz]")->capture_default_str();
   app.add_option("--fmax-hz", fmax_hz, "highest frequency line [Hz]")->capture_default_str();

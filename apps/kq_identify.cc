@@ -253,7 +253,7 @@ int Run(int argc, char** argv) {
                  "kq.yaml to paste into the robot config (stdout if omitted); with --merge a full robot "
                  "config; with --plan the plan CSV");
   app.add_option("--residuals", residuals_path, "residual of every case, CSV [mm]");
-  app.add_option("--plot", plot_path, "residual plot, PNG");
+  app.add_option("--plot", plot_path, "residual plot, PNG")->check(PngFileName());
   app.add_option("--json", json_path, "the full result as JSON (stiffness, covariance, residuals, advice)");
   app.add_option("--robust", robust,
                  "robust loss against outlier cases: cauchy or huber (outliers are then left out)")

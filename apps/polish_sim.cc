@@ -45,7 +45,7 @@ int Run(int argc, char** argv) {
   app.add_option("--sample-mm", sample_mm, "removal map sampling in arc length [mm], <= 0.5")->capture_default_str();
   app.add_option("--removal", removal_out, "removal map CSV x_mm,y_mm,z_mm,u,v,removal_um");
   app.add_option("--summary", summary_out, "summary JSON (formats.md §7); stdout if omitted");
-  app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png and <stem>_path.png");
+  app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png and <stem>_path.png")->check(PngFileName());
   RobotOptions robot;
   robot.Add(&app);
   try {

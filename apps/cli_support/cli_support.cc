@@ -95,6 +95,16 @@ void Warn(const std::string& tool, const std::string& message) {
   std::cerr << tool << ": warning: " << message << '\n';
 }
 
+std::function<std::string(const std::string&)> PngFileName() {
+  return [](const std::string& path) -> std::string {
+    const std::string ext = std::filesystem::path(path).extension().string();
+    std::string low = ext;
+    for (char& c : low) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (low == ".png") return "";
+    return "expected a .png file name (robomach draws PNG pictures only), got \"" + path + "\"";
+  };
+}
+
 void AddVersionFlag(CLI::App& app, const std::string& tool) {
   app.set_version_flag("--version", tool + " " + Version(), "print the version (and git commit) and exit");
 }
