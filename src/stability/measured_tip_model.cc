@@ -1,0 +1,94 @@
+#include "robomach/stability/measured_tip_model.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "robomach/common/units.h"
+
+namespace robomach::stability {
+
+void CheckValid(const DirectFrfFitOptions& o) {
+  calibration::CheckValid(o.noise);
+  if (!(o.max_noise_rms >= 1.0) || !std::isfinite(o.max_noise_rms)) {
+    throw std::invalid_argument("DirectFrfFitOptions: max_noise_rms must be finite and >= 1, got " +
+                                std::to_string(o.max_noise_rms));
+  }
+}
+
+DirectFrfFit FitDirectFrf(const dynamics::Frf& measured, const DirectFrfFitOptions& o) {
+  CheckValid(o);
+  DirectFrfFit out{measured, calibration::EstimateFrfNoise(measured, o.noise), {}, NAN, true, ""};
+  std::vector<int> lines;
+  for (int i = 0; i < measured.size(); ++i) {
+    if (out.noise.usable[i]) lines.push_back(i);
+  }
+  if (lines.empty()) {
+    out.fit.message = "no usable line";
+    out.problem = "no line reaches a signal-to-noise ratio of " + std::to_string(o.noise.min_snr);
+    return out;
+  }
+  const dynamics::Frf usable = measured.WithNoise(out.noise.sigma_m_per_N).Select(lines);
+  out.fit = calibration::FitModes(usable, o.fit);
+  if (out.fit.status != calibration::ModalFitStatus::kOk || out.fit.modes.empty()) {
+    out.problem = "modal fit: " + out.fit.message;
+    return out;
+  }
+  double s = 0.0;
+  for (int k = 0; k < usable.size(); ++k) {
+    s += std::norm((out.fit.Evaluate(usable.freq_hz()(k)) - usable.receptance()(k)) / (*usable.noise_sigma())(k));
+  }
+  out.noise_rms = std::sqrt(s / usable.size());
+  out.poor = !(out.noise_rms <= o.max_noise_rms);
+  if (out.poor) {
+    std::ostringstream m;
+    m.precision(3);
+    m << "the fitted modes miss the data by " << out.noise_rms << " times the noise (rms over the "
+      << usable.size() << " usable lines; limit " << o.max_noise_rms << ")";
+    out.problem = m.str();
+  }
+  return out;
+}
+
+TipModalModel ModesAlong(const calibration::ModalFitResult& fit, const Eigen::Vector3d& e,
+                         std::vector<double>* dropped_hz) {
+  const Eigen::Vector3d u = e.normalized();
+  std::vector<double> w, z;
+  std::vector<Eigen::Vector3d> p;
+  for (const calibration::FittedMode& m : fit.modes) {
+    const double A = m.modal_constant.real();  // φ_a² [1/kg]
+    if (!(A > 0.0) || !(m.damping_ratio >= 0.0 && m.damping_ratio < 1.0)) {
+      if (dropped_hz) dropped_hz->push_back(m.freq_hz);
+      continue;
+    }
+    w.push_back(HzToRadPerSec(m.freq_hz));
+    z.push_back(m.damping_ratio);
+    p.push_back(std::sqrt(A) * u);
+  }
+  TipModalModel out;
+  out.omega_rad_s = Eigen::Map<Eigen::VectorXd>(w.data(), static_cast<Eigen::Index>(w.size()));
+  out.zeta = Eigen::Map<Eigen::VectorXd>(z.data(), static_cast<Eigen::Index>(z.size()));
+  out.p.resize(3, static_cast<Eigen::Index>(p.size()));
+  for (size_t k = 0; k < p.size(); ++k) out.p.col(static_cast<Eigen::Index>(k)) = p[k];
+  return out;
+}
+
+TipModalModel Concatenate(const std::vector<TipModalModel>& models) {
+  Eigen::Index n = 0;
+  for (const TipModalModel& m : models) n += m.num_modes();
+  TipModalModel out;
+  out.omega_rad_s.resize(n);
+  out.zeta.resize(n);
+  out.p.resize(3, n);
+  Eigen::Index k = 0;
+  for (const TipModalModel& m : models) {
+    const Eigen::Index c = m.num_modes();
+    out.omega_rad_s.segment(k, c) = m.omega_rad_s;
+    out.zeta.segment(k, c) = m.zeta;
+    out.p.middleCols(k, c) = m.p;
+    k += c;
+  }
+  return out;
+}
+
+}  // namespace robomach::stability
