@@ -50,6 +50,13 @@ struct TapTestOptions {
   double relative_noise{0.01};
   /// Additive complex noise floor [m/N], flat in receptance (0: none).
   double absolute_noise_m_per_N{0.0};
+  /// Additive floor flat in accelerance [(m/s²)/N] (the accelerometer's
+  /// own noise), i.e. floor/ω² in receptance; above the hammer's band limit
+  /// (0: none) every additive floor rises as (f/limit)⁸ (the force spectrum
+  /// of the hammer tip falls by 24 dB per octave there, and the floor of
+  /// the ratio response/force rises with its square).
+  double absolute_noise_m_per_s2_per_N{0.0};
+  double band_limit_hz{0.0};
   /// Drift: rms envelope D(f) = drift_ratio · peak · (1/f² − 1/f_d²) /
   /// (1/20² − 1/f_d²) below f_d = drift_below_hz (continuous, zero at f_d),
   /// D(20 Hz) = drift_ratio × the largest |H| of the modes; f ≥ 1 Hz in it
@@ -110,7 +117,11 @@ inline TapTest MakeTapTest(const TapTestOptions& o = {}) {
                                     (1.0 / 400.0 - 1.0 / (fd * fd))
                               : 0.0;
     const double s = o.relative_noise * std::abs(t.truth(i)) / std::sqrt(2.0);
-    const double a = o.absolute_noise_m_per_N / std::sqrt(2.0);
+    const double w = 2.0 * 3.14159265358979323846 * std::max(t.freq_hz(i), o.df_hz);
+    const double lift = o.band_limit_hz > 0.0 && t.freq_hz(i) > o.band_limit_hz
+                            ? std::pow(t.freq_hz(i) / o.band_limit_hz, 8)
+                            : 1.0;
+    const double a = lift * (o.absolute_noise_m_per_N + o.absolute_noise_m_per_s2_per_N / (w * w)) / std::sqrt(2.0);
     t.measured(i) = t.truth(i) + std::complex<double>(s * g(rng), s * g(rng)) +
                     std::complex<double>(a * g(rng), a * g(rng)) + env * drift;
   }
