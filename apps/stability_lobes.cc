@@ -367,7 +367,9 @@ void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
     if (diff > 0.10) {
       Warn(kTool, m.str() + ": they differ by " + io::FormatDouble(std::round(diff * 1000.0) / 10.0) +
                       " % (more than 10 % at a radial immersion of " + io::FormatDouble(cut.process.radial_immersion) +
-                      ", where they should agree): check the modal fit (--fit-plot) and the SD's steps (--sd-steps)");
+                      ", where they should agree): check " +
+                      (t.fits.empty() ? std::string("") : "the modal fit (--fit-plot), ") +
+                      "the modes the SD keeps (--sd-modes) and its steps per tooth period (--sd-steps)");
       *flagged = true;
     } else {
       std::cerr << kTool << ": " << m.str() << " (they agree within 10 %)\n";
@@ -392,6 +394,7 @@ void WriteFittedModes(const std::string& path, const std::vector<TipDynamics>& t
       Eigen::Index big = 0;
       m.p_T.cwiseAbs().maxCoeff(&big);
       m.shape_T = m.p_T.normalized() * (m.p_T(big) < 0.0 ? -1.0 : 1.0);
+      for (int i = 0; i < 3; ++i) m.shape_T(i) = m.shape_T(i) == 0.0 ? 0.0 : m.shape_T(i);  // no "-0"
       modes.back().push_back(m);
     }
   }
@@ -449,8 +452,8 @@ int Run(int argc, char** argv) {
   app.add_option("--fit-plot", fit_plot_path,
                  "with --frf: PNG of each direct FRF with its modal fit (magnitude, phase, noise floor, usable band)");
   app.add_option("--modes-out", modes_out_path,
-                 "with --frf: the modal table the SD used (formats.md §4, readable by --modal-table with the same "
-                 "--tool-axis and cut file)");
+                 "with --frf: the modal table the SD used (formats.md §4), in the frame of the FRF file; --modal-table "
+                 "reads it back (with the same --tool-axis, and --sd-modes of at least its number of modes)");
   app.add_option("--modal-table", modal_path, "modal table CSV (formats.md §4): freq_hz, damping_ratio, modal_mass_kg or modal_stiffness_N_per_m, ux,uy,uz");
   app.add_option("--tool-axis", tool_axis_text, "with --frf/--modal-table: tool axis from tip to spindle in the FRF frame, x,y,z")->capture_default_str();
   app.add_option("--method", method, "zoa, sd or both")->check(CLI::IsMember({"zoa", "sd", "both"}))->capture_default_str();

@@ -32,26 +32,35 @@ void FillModalFitPanels(const dynamics::Frf& measured, const calibration::FrfNoi
     floor(k) = noise.floor_m_per_N(i);
   }
   std::vector<FrfCurve> curves;
+  // The model wide and underneath, the measured lines thin on top, so
+  // that both stay visible where they agree.
   curves.push_back({f, left_out, "measured, not used (below the SNR limit)", Rgb{185, 185, 185}, false, 1});
-  curves.push_back({f, used, "measured, usable (fitted)", PaletteColor(0), false, 2});
   if (!fit.modes.empty()) {
     char label[96];
     std::snprintf(label, sizeof(label), "modal fit (%zu modes)", fit.modes.size());
-    curves.push_back({f, model, label, PaletteColor(1), true, 2});
+    curves.push_back({f, model, label, PaletteColor(1), false, 5});
   }
+  curves.push_back({f, used, "measured, usable (fitted)", PaletteColor(0), false, 1});
   FrfCurve fl{f, floor, "noise floor", PaletteColor(3), true, 1};
   fl.magnitude_only = true;
   curves.push_back(fl);
   std::vector<double> modes;
   for (const calibration::FittedMode& m : fit.modes) modes.push_back(m.freq_hz);
   FillFrfPanels(curves, modes, title, mag, phase);
-  for (const auto& [lo, hi] : noise.usable_bands) {
-    char a[48], b[48];
+  // The edges of the usable stretches; only the outer two are labelled,
+  // and an edge at the end of the FRF is not marked.
+  const double f_first = n > 0 ? f(0) : 0.0, f_last = n > 0 ? f(n - 1) : 0.0;
+  for (size_t b = 0; b < noise.usable_bands.size(); ++b) {
+    const auto [lo, hi] = noise.usable_bands[b];
+    char a[48], c[48];
     std::snprintf(a, sizeof(a), "usable from %.4g Hz", lo);
-    std::snprintf(b, sizeof(b), "usable to %.4g Hz", hi);
+    std::snprintf(c, sizeof(c), "usable to %.4g Hz", hi);
     for (Axes* ax : {mag, phase}) {
-      ax->markers.push_back({lo, ax == mag ? a : "", PaletteColor(2)});
-      ax->markers.push_back({hi, ax == mag ? b : "", PaletteColor(2)});
+      const bool label = ax == mag;
+      if (lo > f_first) ax->markers.push_back({lo, label && b == 0 ? a : "", PaletteColor(2)});
+      if (hi < f_last) {
+        ax->markers.push_back({hi, label && b + 1 == noise.usable_bands.size() ? c : "", PaletteColor(2)});
+      }
     }
   }
 }
