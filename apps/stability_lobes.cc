@@ -268,7 +268,35 @@ std::vector<TipDynamics> FrfTips(const std::string& frf_path, const std::string&
         for (int a : dirs) {
           for (int b : dirs) cross |= a != b && s.present[a][b];
         }
-        if (cross) {
+        if (cross && dirs.size() == 2) {
+          // Two base directions span the cutting plane: a mode seen in both
+          // direct FRFs is one mode whose shape's sign the cross FRF gives.
+          const int a = dirs[0], b = dirs[1];
+          const int r = s.present[a][b] ? a : b, c = s.present[a][b] ? b : a;
+          double lo = -INFINITY, hi = INFINITY;
+          for (const DirectionFit& d : t.fits) {
+            if (d.fit.noise.usable_bands.empty()) continue;
+            lo = std::max(lo, d.fit.noise.usable_bands.front().first);
+            hi = std::min(hi, d.fit.noise.usable_bands.back().second);
+          }
+          std::vector<int> lines;
+          for (Eigen::Index k = 0; k < s.freq_hz.size(); ++k) {
+            if (s.freq_hz(k) >= lo && s.freq_hz(k) <= hi) lines.push_back(static_cast<int>(k));
+          }
+          if (lines.size() >= 8) {
+            Eigen::VectorXcd h(s.freq_hz.size());
+            for (Eigen::Index k = 0; k < h.size(); ++k) h(k) = s.H[k](r, c);
+            const dynamics::Frf cross_frf = dynamics::Frf::FromSamples(s.freq_hz, h).Select(lines);
+            t.modes_C = stability::DominantModes(
+                stability::ModesOfTwoDirections(t.fits[0].fit.fit, Eigen::Vector3d::Unit(a), t.fits[1].fit.fit,
+                                                Eigen::Vector3d::Unit(b), cross_frf)
+                    .Rotated(R),
+                2 * sd_modes);
+            std::cerr << kTool << ": note: " << id << ": a mode found in both H" << "xyz"[a] << "xyz"[a] << " and H"
+                      << "xyz"[b] << "xyz"[b] << " is one mode of the SD's model, its shape's sign from the cross FRF H"
+                      << "xyz"[r] << "xyz"[c] << "\n";
+          }
+        } else if (cross) {
           std::cerr << kTool << ": note: " << id << ": the SD's modal model is fitted to the direct FRFs; the "
                     "cross FRFs of the file are used by the ZOA only\n";
         }

@@ -73,6 +73,62 @@ TipModalModel ModesAlong(const calibration::ModalFitResult& fit, const Eigen::Ve
   return out;
 }
 
+TipModalModel ModesOfTwoDirections(const calibration::ModalFitResult& fit_a, const Eigen::Vector3d& e_a,
+                                   const calibration::ModalFitResult& fit_b, const Eigen::Vector3d& e_b,
+                                   const dynamics::Frf& cross, std::vector<double>* dropped_hz) {
+  const TipModalModel ma = ModesAlong(fit_a, e_a, dropped_hz), mb = ModesAlong(fit_b, e_b, dropped_hz);
+  // Pair the modes of the two directions (each used once, nearest first).
+  std::vector<int> partner(ma.num_modes(), -1);
+  std::vector<char> taken(mb.num_modes(), 0);
+  for (int i = 0; i < ma.num_modes(); ++i) {
+    double best = INFINITY;
+    for (int j = 0; j < mb.num_modes(); ++j) {
+      const double d = std::abs(ma.omega_rad_s(i) - mb.omega_rad_s(j));
+      const double zbar = 0.5 * (ma.zeta(i) + mb.zeta(j));
+      if (!taken[j] && d < 0.2 * 2.0 * zbar * ma.omega_rad_s(i) && d < best) {
+        best = d;
+        partner[i] = j;
+      }
+    }
+    if (partner[i] >= 0) taken[partner[i]] = 1;
+  }
+  std::vector<std::complex<double>> poles;
+  for (int i = 0; i < ma.num_modes(); ++i) {
+    if (partner[i] < 0) continue;
+    const double w = 0.5 * (ma.omega_rad_s(i) + mb.omega_rad_s(partner[i]));
+    const double z = 0.5 * (ma.zeta(i) + mb.zeta(partner[i]));
+    poles.push_back({-z * w, w * std::sqrt(1.0 - z * z)});
+  }
+  calibration::ModalFitResult cr;
+  if (!poles.empty()) calibration::FitResidues(cross, poles, false, &cr);
+  std::vector<TipModalModel> parts;
+  int shared = 0;
+  for (int i = 0; i < ma.num_modes(); ++i) {
+    TipModalModel m;
+    m.omega_rad_s = Eigen::VectorXd::Constant(1, ma.omega_rad_s(i));
+    m.zeta = Eigen::VectorXd::Constant(1, ma.zeta(i));
+    m.p = ma.p.col(i);
+    if (partner[i] >= 0) {
+      const int j = partner[i];
+      const double sign = cr.modes.at(shared).modal_constant.real() < 0.0 ? -1.0 : 1.0;
+      m.omega_rad_s(0) = std::abs(poles[shared]);
+      m.zeta(0) = -poles[shared].real() / std::abs(poles[shared]);
+      m.p.col(0) += sign * mb.p.col(j);
+      ++shared;
+    }
+    parts.push_back(m);
+  }
+  for (int j = 0; j < mb.num_modes(); ++j) {
+    if (taken[j]) continue;
+    TipModalModel m;
+    m.omega_rad_s = Eigen::VectorXd::Constant(1, mb.omega_rad_s(j));
+    m.zeta = Eigen::VectorXd::Constant(1, mb.zeta(j));
+    m.p = mb.p.col(j);
+    parts.push_back(m);
+  }
+  return Concatenate(parts);
+}
+
 TipModalModel Concatenate(const std::vector<TipModalModel>& models) {
   Eigen::Index n = 0;
   for (const TipModalModel& m : models) n += m.num_modes();

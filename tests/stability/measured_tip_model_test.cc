@@ -70,6 +70,43 @@ TEST(ModesAlong, ReproducesTheFittedDrivingPointFrf) {
   }
 }
 
+// ModesOfTwoDirections: the direct fits of a mode family along
+// (1, −2, 0)/√5 see A_xx = A/5, A_yy = 4A/5; the cross FRF (made from the
+// same modes, H_xy = −2/5 H) gives the negative sign. The coupled model
+// must reproduce all three FRFs to rounding (1e-12), and a mode seen in one
+// direction only stays along it.
+TEST(ModesOfTwoDirections, CouplesSharedModesWithTheCrossFrfSign) {
+  auto mode = [](double f, double z, double A) {
+    calibration::FittedMode fm;
+    const double wn = HzToRadPerSec(f), wd = wn * std::sqrt(1.0 - z * z);
+    fm.pole = {-z * wn, wd};
+    fm.freq_hz = f;
+    fm.damping_ratio = z;
+    fm.modal_constant = A;
+    fm.residue = fm.modal_constant / std::complex<double>(0.0, 2.0 * wd);
+    return fm;
+  };
+  const double A1 = 2.0, A2 = 5.0;  // 1/m [1/kg]
+  calibration::ModalFitResult fx, fy;
+  fx.modes = {mode(900.0, 0.03, A1 / 5.0), mode(2100.0, 0.02, A2)};  // the 2100 Hz mode moves along x only
+  fy.modes = {mode(900.0, 0.03, 4.0 * A1 / 5.0)};
+  calibration::ModalFitResult fxy;
+  fxy.modes = {mode(900.0, 0.03, -2.0 * A1 / 5.0)};
+  const Eigen::VectorXd f = Eigen::VectorXd::LinSpaced(400, 100.0, 3000.0);
+  Eigen::VectorXcd hxy(f.size());
+  for (int i = 0; i < f.size(); ++i) hxy(i) = fxy.Evaluate(f(i));
+  const TipModalModel m = ModesOfTwoDirections(fx, Eigen::Vector3d::UnitX(), fy, Eigen::Vector3d::UnitY(),
+                                               dynamics::Frf::FromSamples(f, hxy));
+  ASSERT_EQ(m.num_modes(), 2);
+  const std::vector<Eigen::Matrix3cd> H = ModalReceptance(m, f);
+  for (int i = 0; i < f.size(); ++i) {
+    const std::complex<double> xx = fx.Evaluate(f(i)), yy = fy.Evaluate(f(i));
+    EXPECT_LE(std::abs(H[i](0, 0) - xx), 1e-12 * std::abs(xx)) << f(i);
+    EXPECT_LE(std::abs(H[i](1, 1) - yy), 1e-12 * std::abs(yy)) << f(i);
+    EXPECT_LE(std::abs(H[i](0, 1) - hxy(i)), 1e-12 * std::abs(hxy(i))) << f(i);
+  }
+}
+
 // Issue #18's acceptance: the synthetic tap test (tests/tap_test_synth.h:
 // modes 1074, 1961, 2617 Hz, ζ = 0.03, 1 % noise, drift 5× the peak at
 // 20 Hz below 100 Hz), Hxx = Hyy, no cross terms, the cut of

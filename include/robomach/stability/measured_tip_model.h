@@ -77,6 +77,21 @@ DirectFrfFit FitDirectFrf(const dynamics::Frf& measured, const DirectFrfFitOptio
 TipModalModel ModesAlong(const calibration::ModalFitResult& fit, const Eigen::Vector3d& e,
                          std::vector<double>* dropped_hz = nullptr);
 
+/// The modes of two direct FRFs H_aa and H_bb (fits `fit_a`, `fit_b`) with
+/// their cross FRF H_ab, along the orthogonal unit directions e_a, e_b: a
+/// mode found in both direct FRFs (natural frequencies within a fifth of
+/// the half-power bandwidth 2ζf of each other) is one mode of shape
+/// p = √A_aa e_a ± √A_bb e_b, the sign that of the cross FRF's modal
+/// constant A_ab = φ_a φ_b at that pole (a linear least-squares fit of the
+/// cross FRF's residues with the poles fixed, FitResidues, on `cross`'s
+/// lines); a mode found in one direction only stays along it. Without the
+/// cross FRF the sign, and so the coupling, is unknown: use ModesAlong for
+/// each direction (H_ab = 0). The frequency and damping of a shared mode
+/// are the means of the two fits'.
+TipModalModel ModesOfTwoDirections(const calibration::ModalFitResult& fit_a, const Eigen::Vector3d& e_a,
+                                   const calibration::ModalFitResult& fit_b, const Eigen::Vector3d& e_b,
+                                   const dynamics::Frf& cross, std::vector<double>* dropped_hz = nullptr);
+
 /// Concatenates the modes of several models (same frame).
 TipModalModel Concatenate(const std::vector<TipModalModel>& models);
 
