@@ -459,7 +459,11 @@ int Run(int argc, char** argv) {
       "axial depth) by the zero-order approximation (Altintas-Budak) and/or first-order\n"
       "semi-discretization (Insperger-Stepan), for the robot model at postures, a measured\n"
       "FRF file (formats.md §3) or a modal table (§4)."};
-  app.footer(ExitCodeHelp());
+  app.footer(ExitCodeHelp() +
+             " Exit 3 when some speeds have no stability boundary, when a measured FRF's modal fit is poor "
+             "(misfit above 3 x the noise), finds no mode (then no SD lobes) or a mode at the edge of the usable "
+             "band, or when --method both finds the "
+             "SD's and the ZOA's smallest depths more than 10 % apart at a radial immersion of 0.3 or more.");
   std::string robot_path, cut_path, postures_path, frf_path, frf_y_path, modal_path, out_path, plot_path,
       fit_plot_path, modes_out_path, method = "zoa", tool_axis_text = "0,0,1";
   std::vector<std::string> pose_ids;
@@ -483,7 +487,8 @@ int Run(int argc, char** argv) {
                  "with --frf: the modal table the SD used (formats.md §4), in the frame of the FRF file; --modal-table "
                  "reads it back (with the same --tool-axis, and --sd-modes of at least its number of modes)");
   app.add_option("--modal-table", modal_path, "modal table CSV (formats.md §4): freq_hz, damping_ratio, modal_mass_kg or modal_stiffness_N_per_m, ux,uy,uz");
-  app.add_option("--tool-axis", tool_axis_text, "with --frf/--modal-table: tool axis from tip to spindle in the FRF frame, x,y,z")->capture_default_str();
+  app.add_option("--tool-axis", tool_axis_text, "with --frf/--modal-table: tool axis from tip to spindle in the FRF frame, x,y,z (not used for a "
+                 "file with one direct FRF, a symmetric tool, except for the frame of --modes-out)")->capture_default_str();
   app.add_option("--method", method, "zoa, sd or both")->check(CLI::IsMember({"zoa", "sd", "both"}))->capture_default_str();
   app.add_option("--out", out_path, "lobes CSV (spindle_speed_rpm, critical_depth_mm, chatter_freq_hz, lobe_index, method); stdout if omitted");
   app.add_option("--plot", plot_path, "lobe diagram PNG (speed [rpm] against depth [mm])");
@@ -613,6 +618,13 @@ int Run(int argc, char** argv) {
     bool flagged = false;
     for (const TipDynamics& t : tips) {
       for (const DirectionFit& d : t.fits) {
+        for (double f : d.fit.edge_modes_hz) {
+          Warn(kTool, d.label + ": the mode at " + io::FormatDouble(std::round(f * 10.0) / 10.0) +
+                          " Hz reaches past the edge of the usable band (" + calibration::DescribeUsable(d.fit.noise) +
+                          "): the fit saw one flank only, and it may model the drift or the noise floor beyond "
+                          "the band rather than the tool (see --fit-plot)");
+          flagged = true;
+        }
         if (d.fit.poor) {
           Warn(kTool, d.label + ": " + d.fit.problem +
                           (d.fit.fit.modes.empty() ? "" : "; the SD uses these modes all the same (see --fit-plot)"));

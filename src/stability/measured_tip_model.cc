@@ -34,6 +34,12 @@ DirectFrfFit FitDirectFrf(const dynamics::Frf& measured, const DirectFrfFitOptio
     out.problem = "modal fit: " + out.fit.message;
     return out;
   }
+  const double f_lo = usable.freq_hz()(0), f_hi = usable.freq_hz()(usable.size() - 1);
+  for (const calibration::FittedMode& m : out.fit.modes) {
+    if (m.freq_hz * (1.0 - m.damping_ratio) < f_lo || m.freq_hz * (1.0 + m.damping_ratio) > f_hi) {
+      out.edge_modes_hz.push_back(m.freq_hz);
+    }
+  }
   double s = 0.0;
   for (int k = 0; k < usable.size(); ++k) {
     s += std::norm((out.fit.Evaluate(usable.freq_hz()(k)) - usable.receptance()(k)) / (*usable.noise_sigma())(k));

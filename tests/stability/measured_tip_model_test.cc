@@ -107,6 +107,18 @@ TEST(ModesOfTwoDirections, CouplesSharedModesWithTheCrossFrfSign) {
   }
 }
 
+// A band that ends on a mode's flank (1 Hz lines to 2630 Hz: the 2617 Hz
+// mode's half-power band reaches 2695 Hz) flags that mode as seen on one
+// flank only; the two modes inside the band are not flagged.
+TEST(MeasuredTipModel, ModeCutByTheBandEdgeIsFlagged) {
+  testing::TapTestOptions o;
+  o.fmax_hz = 2630.0;
+  const testing::TapTest t = testing::MakeTapTest(o);
+  const DirectFrfFit d = FitDirectFrf(dynamics::Frf::FromSamples(t.freq_hz, t.measured));
+  ASSERT_EQ(d.edge_modes_hz.size(), 1u) << d.fit.message;
+  EXPECT_NEAR(d.edge_modes_hz[0], 2617.0, 2617.0 * 0.03);
+}
+
 // Issue #18's acceptance: the synthetic tap test (tests/tap_test_synth.h:
 // modes 1074, 1961, 2617 Hz, ζ = 0.03, 1 % noise, drift 5× the peak at
 // 20 Hz below 100 Hz), Hxx = Hyy, no cross terms, the cut of
@@ -124,6 +136,7 @@ TEST(MeasuredTipModel, TapTestSdAndZoaAgreeWithTheSdOfTheTrueModes) {
   const DirectFrfFit d = FitDirectFrf(dynamics::Frf::FromSamples(t.freq_hz, t.measured));
   ASSERT_FALSE(d.poor) << d.problem;
   ASSERT_EQ(d.fit.modes.size(), 3u) << d.fit.message;
+  EXPECT_TRUE(d.edge_modes_hz.empty());
   const TipModalModel fitted = Concatenate({ModesAlong(d.fit, Eigen::Vector3d::UnitX()),
                                             ModesAlong(d.fit, Eigen::Vector3d::UnitY())});
   TipModalModel truth;

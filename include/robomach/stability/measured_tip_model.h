@@ -44,6 +44,11 @@ struct DirectFrfFit {
   bool poor{true};
   /// For people, when poor: what went wrong.
   std::string problem;
+  /// Fitted modes whose half-power band f (1 ± ζ) reaches below the lowest
+  /// usable line or above the highest: the fit saw only one flank, so the
+  /// mode may model the drift or the floor beyond the band rather than the
+  /// structure [Hz].
+  std::vector<double> edge_modes_hz;
 };
 
 /// The noise model (EstimateFrfNoise), then FitModes on the usable lines
