@@ -146,7 +146,7 @@ int Run(int argc, char** argv) {
     }
     const MeasuredData measured_read = ReadMeasuredFiles(kTool, measured_files, pose_files, "measured FRF file");
     const MeasuredData holdout_read =
-        ReadMeasuredFiles(kTool, validate_files, validate_pose_files, "validation FRF file");
+        ReadMeasuredFiles(kTool, validate_files, validate_pose_files, "validation FRF file", "--validate-pose");
     for (const auto* set : {&measured_read.frfs, &holdout_read.frfs}) {
       for (const std::string& id : set->pose_ids()) {
         if (!postures.count(id)) {

@@ -89,11 +89,12 @@ int Run(int argc, char** argv) {
              " Exit 3 when the failure is significant and no candidate explains it, or a fit failed (the report is "
              "complete; candidates.csv says which and why).");
   std::string robot_path, postures_path, report_dir, compare_dir, candidates_list;
-  std::vector<std::string> measured_files, adds;
+  std::vector<std::string> measured_files, pose_files, adds;
   audit::AuditOptions opt;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
-  app.add_option("--measured", measured_files, "measured FRFs, CSV or UFF58; repeatable")->required();
+  app.add_option("--measured", measured_files, "measured FRFs, CSV or UFF58 (.uff/.unv/.ufb); repeatable");
+  app.add_option("--pose", pose_files, "a UFF58 file of one posture whose records lack pose=ID: ID=file.uff; repeatable");
   app.add_option("--report", report_dir, "report folder (created)")->required();
   app.add_option("--add", adds, "switch on an effect before the audit (e.g. the winner of a previous one); its fittable parameters are calibrated too; repeatable");
   app.add_option("--compare", compare_dir, "a previous audit's report folder: its errors are shown next to these");
@@ -131,7 +132,11 @@ int Run(int argc, char** argv) {
       std::vector<std::pair<std::string, std::string>> inputs = {{"--robot", robot_path},
                                                                   {"--postures", postures_path}};
       for (const auto& f : measured_files) inputs.push_back({"--measured", f});
+      for (const auto& f : pose_files) inputs.push_back({"--pose", f.substr(f.find('=') + 1)});
       CheckDistinctPaths(inputs, {{"--report", report_dir}});
+    }
+    if (measured_files.empty() && pose_files.empty()) {
+      throw std::invalid_argument("no measured FRFs: give --measured FILE or --pose ID=file.uff");
     }
     std::stringstream cl(candidates_list);
     for (std::string n; std::getline(cl, n, ',');) {
@@ -154,7 +159,7 @@ int Run(int argc, char** argv) {
     for (const io::Posture& p : io::ReadPostureFile(postures_path, cfg.description.arm.num_joints())) {
       postures[p.id] = p.q;
     }
-    const MeasuredData measured_read = ReadMeasuredFiles(kTool, measured_files, {}, "measured FRF file");
+    const MeasuredData measured_read = ReadMeasuredFiles(kTool, measured_files, pose_files, "measured FRF file");
     for (const auto& [key, frf] : measured_read.frfs) {
       if (!postures.count(key.pose_id)) {
         throw InputError({postures_path, 0, 0}, "posture " + key.pose_id + " of " + measured_read.file.at(key) +
@@ -170,7 +175,7 @@ int Run(int argc, char** argv) {
       int lines = 0;
       for (const auto& [key, frf] : measured) lines += frf.Band(opt.fmin_hz, opt.fmax_hz).size();
       if (lines < 3) {
-        throw InputError({measured_files.front(), 0, 0},
+        throw InputError({measured_read.file.begin()->second, 0, 0},
                          "the measured FRFs have " + std::to_string(lines) + " lines in the band " +
                              Num(opt.fmin_hz) + ".." + Num(opt.fmax_hz) + " Hz (--fmin-hz, --fmax-hz); need at least 3");
       }

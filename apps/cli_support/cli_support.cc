@@ -1,5 +1,6 @@
 #include "cli_support.h"
 
+#include <CLI/CLI.hpp>
 #include <glog/logging.h>
 
 #include <unistd.h>
@@ -10,6 +11,7 @@
 #include <stdexcept>
 
 #include "robomach/common/errors.h"
+#include "robomach/common/version.h"
 #include "robomach/io/csv_table.h"
 
 namespace robomach::apps {
@@ -91,6 +93,14 @@ void ProgressLine::Finish() {
 
 void Warn(const std::string& tool, const std::string& message) {
   std::cerr << tool << ": warning: " << message << '\n';
+}
+
+void AddVersionFlag(CLI::App& app, const std::string& tool) {
+  app.set_version_flag("--version", tool + " " + Version(), "print the version (and git commit) and exit");
+}
+
+void Note(const std::string& tool, const std::string& message) {
+  std::cerr << tool << ": note: " << message << '\n';
 }
 
 std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text) {

@@ -12,13 +12,20 @@
 namespace robomach::apps {
 
 MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::string>& files,
-                               const std::vector<std::string>& pose_files, const std::string& what) {
+                               const std::vector<std::string>& pose_files, const std::string& what,
+                               const std::string& pose_option) {
   MeasuredData all;
   auto add = [&](const std::string& path, const std::string& pose) {
     RequireReadableFile(path, what);
     const io::FrfReadResult r = io::ReadFrfFile(path, pose);
     for (const std::string& w : r.warnings) Warn(tool, w);
+    for (const std::string& n : r.notes) Note(tool, n);
     for (const auto& [key, frf] : r.frfs) {
+      if (key.pose_id.empty()) {
+        throw InputError({path, 0, 0}, "the FRFs of this file name no posture: give it as " + pose_option + " P1=" + path +
+                                           " (P1 a pose_id of the posture file), or put pose=P1 in ID line 1 of "
+                                           "each UFF58 record");
+      }
       if (all.frfs.contains(key)) {
         throw InputError({path, 0, 0}, "FRF " + key.ToString() + " was already read from " + all.file.at(key));
       }
@@ -31,7 +38,7 @@ MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::s
   for (const std::string& a : pose_files) {
     const auto eq = a.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == a.size()) {
-      throw std::invalid_argument("--pose '" + a + "': expected ID=file.uff, e.g. --pose P1=p1.uff");
+      throw std::invalid_argument(pose_option + " '" + a + "': expected ID=file.uff, e.g. " + pose_option + " P1=p1.uff");
     }
     add(a.substr(eq + 1), a.substr(0, eq));
   }

@@ -27,10 +27,13 @@ struct MeasuredData {
 };
 
 /// Reads `files` (CSV or UFF58) and `pose_files` ("ID=file.uff") into one
-/// set; warnings go to stderr under `tool`. @throws InputError for an FRF
-/// read twice, std::invalid_argument for a malformed ID=file.
+/// set; warnings and notes go to stderr under `tool`. @throws InputError for
+/// an FRF read twice or one without a posture (the message suggests
+/// --pose, so every tool that calls this has that option),
+/// std::invalid_argument for a malformed ID=file.
 MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::string>& files,
-                               const std::vector<std::string>& pose_files, const std::string& what);
+                               const std::vector<std::string>& pose_files, const std::string& what,
+                               const std::string& pose_option = "--pose");
 
 /// The noise options of the command line.
 struct NoiseCliOptions {

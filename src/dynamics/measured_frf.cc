@@ -116,8 +116,10 @@ Frf Frf::Select(const std::vector<int>& lines) const {
 }
 
 std::string FrfKey::ToString() const {
-  return "pose " + pose_id + ", response " + AxisName(response) + ", excitation " +
-         AxisName(excitation);
+  // A posture-free FRF (a tap test on a machine tool, a UFF record that
+  // names no posture) has an empty pose id.
+  return (pose_id.empty() ? std::string() : "pose " + pose_id + ", ") + "response " + AxisName(response) +
+         ", excitation " + AxisName(excitation);
 }
 
 void FrfSet::Insert(FrfKey key, Frf frf) {

@@ -14,6 +14,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/number_format.h"
+#include "robomach/io/uff58.h"
 
 namespace robomach::io {
 namespace {
@@ -318,307 +319,425 @@ void WriteFrfCsv(const std::string& path, const FrfSet& frfs, FrfQuantity quanti
 
 namespace {
 
-struct UffLine {
-  std::string text;
-  int line{0};  // 1-based
+struct Direction {
+  bool known{false};
+  Axis axis{Axis::kX};
+  int sign{1};
+  int node{0};           // from the entity name, when it has one
+  bool from_name{false};
 };
 
-// Numbers of a free-format line; Fortran 'D' exponents are accepted.
-std::vector<double> Numbers(const std::string& path, const UffLine& l, const std::string& what) {
-  std::vector<double> v;
-  std::istringstream in(l.text);
-  std::string tok;
-  while (in >> tok) {
-    for (char& c : tok) {
-      if (c == 'D' || c == 'd') c = 'E';
-    }
-    double x = 0.0;
-    if (!ParseFiniteNumber(tok, &x)) {
-      throw InputError({path, l.line, 0}, what + ": expected a number, got \"" + tok + "\"");
-    }
-    v.push_back(x);
+// The direction of one end of a record: record 6's code, or, when that is 0
+// (a scalar DOF), the entity name as test software writes it: ".1.Z-",
+// "1:+X", "12Y-", "Pt3-Z".
+Direction RecordDirection(const std::string& path, int line, int column, int code, const std::string& entity,
+                          const std::string& which) {
+  Direction d;
+  static const std::regex name_re(R"(^(.*?)([+-]?)([XYZxyz])([+-]?)$)");
+  static const std::regex node_re(R"((\d+)\D*$)");
+  std::smatch m;
+  const bool name_has_axis = std::regex_match(entity, m, name_re) &&
+                             (m[1].str().empty() || !std::isalpha(static_cast<unsigned char>(m[1].str().back())));
+  if (name_has_axis) {
+    std::smatch n;
+    const std::string head = m[1].str();
+    if (std::regex_search(head, n, node_re)) d.node = std::stoi(n[1].str());
   }
-  return v;
-}
-
-std::string Field(const std::string& s, size_t b, size_t e) {
-  if (b >= s.size()) return "";
-  return Trim(s.substr(b, std::min(e, s.size()) - b));
-}
-
-int IntField(const std::string& path, const UffLine& l, size_t b, size_t e, const std::string& what) {
-  const std::string f = Field(l.text, b, e);
-  double x = 0.0;
-  if (!ParseFiniteNumber(f, &x) || x != std::floor(x)) {
-    throw InputError({path, l.line, static_cast<int>(b) + 1},
-                     what + ": expected an integer in columns " + std::to_string(b + 1) + "-" +
-                         std::to_string(e) + ", got \"" + f + "\"");
-  }
-  return static_cast<int>(x);
-}
-
-bool DirectionAxis(int code, Axis* axis, int* sign) {
   const int a = std::abs(code);
-  if (a < 1 || a > 3) return false;
-  *axis = static_cast<Axis>(a - 1);
-  *sign = code < 0 ? -1 : 1;
-  return true;
+  if (a >= 1 && a <= 3) {
+    d.known = true;
+    d.axis = static_cast<Axis>(a - 1);
+    d.sign = code < 0 ? -1 : 1;
+    return d;
+  }
+  if (a >= 4 && a <= 6) {
+    throw InputError({path, line, column},
+                     "record 6: " + which + " direction " + std::to_string(code) +
+                         " is rotational; robomach reads translational tool-tip FRFs (codes 1/-1 x, 2/-2 y, 3/-3 z)");
+  }
+  if (code != 0) {
+    throw InputError({path, line, column}, "record 6: " + which + " direction " + std::to_string(code) +
+                                               " is not a UFF direction code (0 scalar, 1-3 translational, 4-6 "
+                                               "rotational, negative for -axis)");
+  }
+  if (name_has_axis) {
+    d.known = true;
+    d.from_name = true;
+    d.axis = ParseAxis(m[3].str(), &d.axis) ? d.axis : Axis::kX;
+    d.sign = (m[2].str() == "-") != (m[4].str() == "-") ? -1 : 1;
+  }
+  return d;
 }
 
-void RejectNonSiLabel(const std::string& path, const UffLine& l, const std::string& label,
-                      const std::string& what) {
-  static const std::vector<std::string> kNonSi = {"mm", "mm/s", "mm/s^2", "mm/s2", "g", "g's",
-                                                  "in", "in/s", "in/s^2", "inch", "lbf", "lb",
-                                                  "kn", "um", "µm", "rpm", "ft", "ft/s"};
-  const std::string low = Lower(Trim(label));
-  if (std::find(kNonSi.begin(), kNonSi.end(), low) != kNonSi.end()) {
-    throw InputError({path, l.line, 0}, what + " unit label is \"" + Trim(label) +
-                                            "\"; robomach reads UFF58 in SI units only "
-                                            "(m, m/s, m/s^2 per N; Hz): convert the export");
+// The quantity of an FRF's ordinate from the record's axis label word.
+std::optional<FrfQuantity> QuantityFromWord(const std::string& label) {
+  const std::string l = Lower(label);
+  if (l.find("receptance") != std::string::npos || l.find("compliance") != std::string::npos) {
+    return FrfQuantity::kReceptance;
+  }
+  if (l.find("mobility") != std::string::npos || l.find("admittance") != std::string::npos) {
+    return FrfQuantity::kMobility;
+  }
+  if (l.find("accelerance") != std::string::npos || l.find("inertance") != std::string::npos) {
+    return FrfQuantity::kAccelerance;
+  }
+  return std::nullopt;
+}
+
+std::string UnitOf(FrfQuantity q) {
+  switch (q) {
+    case FrfQuantity::kReceptance: return "m/N";
+    case FrfQuantity::kMobility: return "(m/s)/N";
+    case FrfQuantity::kAccelerance: return "(m/s^2)/N";
+  }
+  return "?";
+}
+
+UnitDimension ParseLabelAt(const std::string& path, const UffAxis& a, const std::string& record) {
+  try {
+    return ParseUnitLabel(a.units);
+  } catch (const std::invalid_argument& e) {
+    throw InputError({path, a.line, 48}, record + " units label: " + e.what());
   }
 }
 
-struct UffCoherence {
+struct RecordUnits {
+  FrfQuantity quantity{FrfQuantity::kReceptance};
+  double factor{1.0};  // SI ordinate = factor × stored ordinate
+};
+
+// The quantity and SI factor of an FRF record (records 9 and 10, the unit
+// labels, dataset 164), with notes for what was inferred.
+RecordUnits FrfRecordUnits(const std::string& path, const Uff58Record& r, const UffUnits* units,
+                           std::vector<std::string>* notes, std::vector<std::string>* warnings) {
+  const std::string at = path + ":" + std::to_string(r.ordinate.line);
+  // 1. The specific data types.
+  std::optional<FrfQuantity> by_code;
+  switch (r.ordinate.specific_type) {
+    case 8: by_code = FrfQuantity::kReceptance; break;
+    case 11: by_code = FrfQuantity::kMobility; break;
+    case 12: by_code = FrfQuantity::kAccelerance; break;
+    case 0: case 1: break;
+    default:
+      throw InputError({path, r.ordinate.line, 1},
+                       "record 9: ordinate specific data type " + std::to_string(r.ordinate.specific_type) +
+                           " is not 8 (displacement), 11 (velocity) or 12 (acceleration), so this FRF is not a "
+                           "receptance, mobility or accelerance");
+  }
+  const int den = r.denominator.specific_type;
+  if (den != 0 && den != 1 && den != 9 && den != 13) {
+    throw InputError({path, r.denominator.line, 1},
+                     "record 10: denominator specific data type " + std::to_string(den) +
+                         " is not a force (13 excitation force, 9 reaction force) or 0 (unknown)");
+  }
+  // 2. The unit labels.
+  const UnitDimension nu = ParseLabelAt(path, r.ordinate, "record 9");
+  UnitDimension de = ParseLabelAt(path, r.denominator, "record 10");
+  std::optional<FrfQuantity> by_unit;
+  double label_factor = 1.0;
+  if (nu.given || de.given) {
+    UnitDimension q = nu;
+    if (de.given) {
+      q.factor /= de.factor;
+      q.length -= de.length;
+      q.force -= de.force;
+      q.time -= de.time;
+    } else if (nu.force == 0) {
+      // "m/s^2" over an unlabelled force: the excitation in N.
+      q.force -= 1;
+      notes->push_back(at + ": record 10 gives no unit; the excitation force is taken in N");
+    }
+    const std::string shown = (nu.given ? r.ordinate.units : std::string("1")) +
+                              (de.given ? " per " + r.denominator.units : std::string());
+    if (q.length == 1 && q.force == -1 && q.time == 0) by_unit = FrfQuantity::kReceptance;
+    else if (q.length == 1 && q.force == -1 && q.time == -1) by_unit = FrfQuantity::kMobility;
+    else if (q.length == 1 && q.force == -1 && q.time == -2) by_unit = FrfQuantity::kAccelerance;
+    else {
+      throw InputError({path, r.ordinate.line, 48},
+                       "record 9-10 units \"" + shown + "\" are m^" + std::to_string(q.length) + " N^" +
+                           std::to_string(q.force) + " s^" + std::to_string(q.time) +
+                           ", not a receptance (m/N), mobility ((m/s)/N) or accelerance ((m/s^2)/N)");
+    }
+    label_factor = q.factor;
+  }
+  // 3. Dataset 164 with the records' exponents.
+  double f164 = 1.0;
+  const bool exponents = r.ordinate.length_exponent || r.ordinate.force_exponent || r.denominator.length_exponent ||
+                         r.denominator.force_exponent;
+  if (units && exponents) {
+    f164 = std::pow(units->length, -r.ordinate.length_exponent) * std::pow(units->force, -r.ordinate.force_exponent) *
+           std::pow(units->length, r.denominator.length_exponent) * std::pow(units->force, r.denominator.force_exponent);
+  }
+  if (by_code && by_unit && *by_code != *by_unit) {
+    throw InputError({path, r.ordinate.line, 1},
+                     "record 9 says " + QuantityName(*by_code) + " (specific data type " +
+                         std::to_string(r.ordinate.specific_type) + ") but the unit labels say " +
+                         QuantityName(*by_unit) + " (" + UnitOf(*by_unit) + "); correct one of them in the export");
+  }
+  RecordUnits out;
+  if (by_unit && units && exponents && std::abs(f164 / label_factor - 1.0) > 1e-6) {
+    std::ostringstream m;
+    m << "the unit labels (\"" << r.ordinate.units << "\" per \"" << r.denominator.units << "\", factor "
+      << label_factor << " to SI) and dataset 164 at line " << units->line << " (" << units->description
+      << ", factor " << f164 << " with the exponents of records 9-10) disagree; correct the export";
+    throw InputError({path, r.ordinate.line, 48}, m.str());
+  }
+  out.factor = by_unit ? label_factor : f164;
+  const std::optional<FrfQuantity> by_word = QuantityFromWord(r.ordinate.label);
+  if (by_code || by_unit) {
+    out.quantity = by_unit ? *by_unit : *by_code;
+    const bool word_differs = by_word && *by_word != out.quantity;
+    if (!by_code || word_differs) {
+      std::string n = at + ": ";
+      if (!by_code) {
+        n += "record 9 gives no physical ordinate type (" + std::to_string(r.ordinate.specific_type) + "); ";
+      }
+      n += "its unit " + (by_unit ? r.ordinate.units + (de.given ? " per " + r.denominator.units : "")
+                                  : std::string("(specific data type)")) +
+           " makes it a " + QuantityName(out.quantity);
+      if (word_differs) n += ", although its axis label says \"" + r.ordinate.label + "\"";
+      notes->push_back(n + "; read as " + QuantityName(out.quantity));
+    }
+  } else if (by_word) {
+    out.quantity = *by_word;
+    warnings->push_back(at + ": record 9 gives neither a physical ordinate type nor a unit; read as " +
+                        QuantityName(out.quantity) + " [" + UnitOf(out.quantity) + "] from its axis label \"" +
+                        r.ordinate.label + "\", in SI units");
+  } else {
+    out.quantity = FrfQuantity::kReceptance;
+    warnings->push_back(at + ": record 9 gives no physical ordinate type (" +
+                        std::to_string(r.ordinate.specific_type) + ") and no unit; read as receptance [m/N]");
+  }
+  return out;
+}
+
+// Hz per stored abscissa unit.
+double AbscissaToHz(const std::string& path, const Uff58Record& r) {
+  const int spec = r.abscissa.specific_type;
+  if (spec == 17) {
+    throw InputError({path, r.abscissa.line, 1}, "record 8: the abscissa is time (specific data type 17), but a " +
+                                                     UffFunctionTypeName(r.function_type) +
+                                                     " is a function of frequency");
+  }
+  if (spec != 0 && spec != 1 && spec != 18) {
+    throw InputError({path, r.abscissa.line, 1},
+                     "record 8: abscissa specific data type " + std::to_string(spec) +
+                         (spec == 19 ? " (rpm)" : spec == 20 ? " (order)" : "") + " is not frequency (18)");
+  }
+  const std::string u = Lower(r.abscissa.units);
+  if (u.find("rad") != std::string::npos) {
+    const UnitDimension d = ParseLabelAt(path, r.abscissa, "record 8");
+    if (d.time != -1 || d.length || d.force) {
+      throw InputError({path, r.abscissa.line, 48}, "record 8: abscissa unit \"" + r.abscissa.units + "\" is not a frequency");
+    }
+    return d.factor / (2.0 * M_PI);
+  }
+  const UnitDimension d = ParseLabelAt(path, r.abscissa, "record 8");
+  if (!d.given) return 1.0;
+  if (d.time != -1 || d.length || d.force) {
+    throw InputError({path, r.abscissa.line, 48}, "record 8: abscissa unit \"" + r.abscissa.units + "\" is not a frequency");
+  }
+  return d.factor;
+}
+
+struct FrfRecord {
   FrfKey key;
-  Eigen::VectorXd f, c;
+  int resp_node{0}, ref_node{0};
   int line{0};
 };
+
+std::string NodeText(int resp_node, Axis ra, int ref_node, Axis ea) {
+  return "response " + std::to_string(resp_node) + AxisName(ra) + ", reference " + std::to_string(ref_node) +
+         AxisName(ea);
+}
 
 }  // namespace
 
 FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose_id) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError({path, 0, 0}, "cannot open file for reading");
-  std::vector<UffLine> lines;
-  {
-    std::string s;
-    int n = 0;
-    while (std::getline(in, s)) {
-      ++n;
-      if (!s.empty() && s.back() == '\r') s.pop_back();
-      lines.push_back({s, n});
-    }
-  }
+  const UffFile file = ReadUffFile(path);
   FrfReadResult out;
   bool quantity_set = false;
-  std::vector<UffCoherence> coherences;
-  const std::regex pose_re(R"(pose=([^\s,]+))");
-  size_t i = 0;
-  auto is_delim = [&](size_t k) { return Trim(lines[k].text) == "-1"; };
-  int records = 0;
-  while (i < lines.size()) {
-    if (Trim(lines[i].text).empty()) {
-      ++i;
+  static const std::regex pose_re(R"(pose=([^\s,]+))");
+  std::vector<FrfRecord> frf_records;
+  struct Coherence {
+    const Uff58Record* r;
+    std::string pose;
+    int resp_node, ref_node;
+    Axis ra, ea;
+  };
+  std::vector<Coherence> coherences;
+  std::map<std::string, std::vector<int>> not_frf;  // function name -> lines
+  for (size_t i = 0; i < file.records.size(); ++i) {
+    const Uff58Record& r = file.records[i];
+    const UffUnits* units = file.record_units[i] >= 0 ? &file.units[file.record_units[i]] : nullptr;
+    const std::string where = path + ":" + std::to_string(r.line);
+    if (r.function_type != 4 && r.function_type != 6) {
+      not_frf[UffFunctionTypeName(r.function_type) + " (function type " + std::to_string(r.function_type) + ")"]
+          .push_back(r.line);
       continue;
     }
-    if (!is_delim(i)) {
-      throw InputError({path, lines[i].line, 0},
-                       "expected the UFF record delimiter \"    -1\", got \"" + Trim(lines[i].text) + "\"");
+    const Direction rd = RecordDirection(path, r.record6_line, 52, r.response_direction, r.response_entity, "response");
+    const Direction ed = RecordDirection(path, r.record6_line, 77, r.reference_direction, r.reference_entity, "reference");
+    Axis ra = rd.axis, ea = ed.axis;
+    if (!rd.known || !ed.known) {
+      if (rd.known) ea = ra;
+      else if (ed.known) ra = ea;
+      out.warnings.push_back(where + ": record 6 gives no " + std::string(!rd.known && !ed.known ? "direction" : !rd.known ? "response direction" : "reference direction") +
+                             " (codes " + std::to_string(r.response_direction) + " and " + std::to_string(r.reference_direction) +
+                             ", entities \"" + r.response_entity + "\" and \"" + r.reference_entity + "\"); read as the direct FRF " +
+                             AxisName(ra) + AxisName(ea) + " (a symmetric tool, or the one direction of a tap test)");
+    } else if (rd.from_name || ed.from_name) {
+      out.notes.push_back(where + ": directions from the entity names \"" + r.response_entity + "\" and \"" +
+                          r.reference_entity + "\" (record 6 codes " + std::to_string(r.response_direction) + " and " +
+                          std::to_string(r.reference_direction) + "): response " + (rd.sign < 0 ? "-" : "+") +
+                          AxisName(ra) + ", reference " + (ed.sign < 0 ? "-" : "+") + AxisName(ea));
     }
-    const size_t start = i;
-    if (i + 1 >= lines.size()) break;
-    const UffLine& type_line = lines[i + 1];
-    const std::string type = Trim(type_line.text);
-    // The record ends at the next delimiter.
-    size_t end = i + 2;
-    while (end < lines.size() && !is_delim(end)) ++end;
-    if (end >= lines.size()) {
-      throw InputError({path, lines[start].line, 0},
-                       "UFF record starting here has no closing \"    -1\" line");
+    const int resp_node = r.response_node != 0 ? r.response_node : rd.node;
+    const int ref_node = r.reference_node != 0 ? r.reference_node : ed.node;
+    const double hz = AbscissaToHz(path, r);
+    if (r.trailing_values > 0) {
+      (r.trailing_all_zero ? out.notes : out.warnings)
+          .push_back(where + ": " + std::to_string(r.trailing_values) + (r.trailing_all_zero ? " padding zeros" : " values") +
+                     " after the " + std::to_string(r.num_points) + " points record 7 announces are ignored");
     }
-    i = end + 1;
-    const std::string type_word = type.substr(0, type.find_first_of(" \t"));
-    if (type_word == "151") continue;  // header: no data
-    if (type_word != "58") {
-      std::string hint;
-      if (Lower(type_word) == "58b") hint = " (binary 58b: export ASCII dataset 58 instead)";
-      throw InputError({path, type_line.line, 0},
-                       "UFF dataset " + type_word + " is not supported" + hint +
-                           "; robomach reads ASCII dataset 58 (function at nodal DOF) records and "
-                           "skips 151 headers");
-    }
-    ++records;
-    const size_t b = start + 2;  // ID line 1
-    if (end - b < 11) {
-      throw InputError({path, type_line.line, 0},
-                       "UFF58 record has " + std::to_string(end - b) +
-                           " lines before its closing -1; expected 11 header lines and data");
-    }
-    const std::string where_rec = "UFF58 record at line " + std::to_string(type_line.line);
-    // Record 1: ID line 1 may name the posture.
     std::string pose = default_pose_id;
-    std::smatch m;
-    if (std::regex_search(lines[b].text, m, pose_re)) pose = m[1].str();
-    if (pose.empty()) {
-      throw InputError({path, lines[b].line, 0},
-                       "no posture for this record: put 'pose=P1' in ID line 1, or give the file on "
-                       "the command line as --pose P1=" + path);
-    }
-    // Record 6: DOF identification, format 2(I5,I10),2(1X,10A1,I10,I4).
-    const UffLine& r6 = lines[b + 5];
-    const int func_type = IntField(path, r6, 0, 5, "record 6 function type");
-    const int resp_dir = IntField(path, r6, 51, 55, "record 6 response direction");
-    const int ref_dir = IntField(path, r6, 76, 80, "record 6 reference direction");
-    // Record 7: data form, format 3I10,3E13.5.
-    const UffLine& r7 = lines[b + 6];
-    const std::vector<double> f7 = Numbers(path, r7, "record 7");
-    if (f7.size() < 5) {
-      throw InputError({path, r7.line, 0}, "record 7: expected ordinate type, number of points, "
-                                           "spacing, abscissa minimum and increment");
-    }
-    const int ord_type = static_cast<int>(f7[0]);
-    const long npts = static_cast<long>(f7[1]);
-    const int spacing = static_cast<int>(f7[2]);
-    const double xmin = f7[3], dx = f7[4];
-    // Records 8-10: abscissa, ordinate numerator and denominator, format I10,3I5,2(1X,20A1).
-    const UffLine& r8 = lines[b + 7];
-    const UffLine& r9 = lines[b + 8];
-    const UffLine& r10 = lines[b + 9];
-    RejectNonSiLabel(path, r8, Field(r8.text, 47, 67), "abscissa (record 8)");
-    RejectNonSiLabel(path, r9, Field(r9.text, 47, 67), "ordinate (record 9)");
-    RejectNonSiLabel(path, r10, Field(r10.text, 47, 67), "ordinate denominator (record 10)");
-    const int ord_specific = IntField(path, r9, 0, 10, "record 9 specific data type");
-
-    FrfKey key;
-    key.pose_id = pose;
-    int s_resp = 1, s_ref = 1;
-    if (!DirectionAxis(resp_dir, &key.response, &s_resp) ||
-        !DirectionAxis(ref_dir, &key.excitation, &s_ref)) {
-      throw InputError({path, r6.line, 52},
-                       "record 6: response direction " + std::to_string(resp_dir) +
-                           " and reference direction " + std::to_string(ref_dir) +
-                           ": expected translational codes 1/-1 (x), 2/-2 (y), 3/-3 (z)");
-    }
-    const bool complex_data = ord_type == 5 || ord_type == 6;
-    const bool real_data = ord_type == 2 || ord_type == 4;
-    if (!complex_data && !real_data) {
-      throw InputError({path, r7.line, 0}, "record 7: ordinate data type " + std::to_string(ord_type) +
-                                               " is not one of 2, 4 (real) or 5, 6 (complex)");
-    }
-    if (func_type == 4 && !complex_data) {
-      throw InputError({path, r7.line, 0},
-                       "record 7: an FRF (function type 4) needs complex ordinates (data type 5 or "
-                       "6), got " + std::to_string(ord_type));
-    }
-    if (func_type == 6 && !real_data) {
-      throw InputError({path, r7.line, 0}, "record 7: coherence (function type 6) must be real (data "
-                                           "type 2 or 4), got " + std::to_string(ord_type));
-    }
-    if (func_type != 4 && func_type != 6) {
-      throw InputError({path, r6.line, 1},
-                       "record 6: function type " + std::to_string(func_type) +
-                           " is not supported; robomach reads FRFs (4) and their coherence (6)");
-    }
-    if (spacing != 0 && spacing != 1) {
-      throw InputError({path, r7.line, 0}, "record 7: abscissa spacing must be 0 (uneven) or 1 "
-                                           "(even), got " + std::to_string(spacing));
-    }
-    if (npts <= 0) throw InputError({path, r7.line, 0}, "record 7: number of data points must be > 0");
-    if (spacing == 1 && !(dx > 0.0)) {
-      throw InputError({path, r7.line, 0}, "record 7: abscissa increment must be > 0 for even spacing");
-    }
-    // Record 12: the data.
-    std::vector<double> data;
-    for (size_t k = b + 11; k < end; ++k) {
-      const std::vector<double> v = Numbers(path, lines[k], where_rec + " data");
-      data.insert(data.end(), v.begin(), v.end());
-    }
-    const int per_point = (complex_data ? 2 : 1) + (spacing == 0 ? 1 : 0);
-    if (static_cast<long>(data.size()) != npts * per_point) {
-      throw InputError({path, r7.line, 0},
-                       "record 7 announces " + std::to_string(npts) + " points (" +
-                           std::to_string(npts * per_point) + " numbers), but the data lines " +
-                           std::to_string(lines[b + 11].line) + "-" + std::to_string(lines[end - 1].line) +
-                           " hold " + std::to_string(data.size()) + " numbers");
-    }
-    Eigen::VectorXd f(npts);
-    Eigen::VectorXcd v(npts);
-    Eigen::VectorXd real_v(npts);
-    for (long p = 0; p < npts; ++p) {
-      const double* d = data.data() + p * per_point;
-      int o = 0;
-      if (spacing == 0) {
-        f(p) = d[0];
-        o = 1;
-      } else {
-        f(p) = xmin + p * dx;
+    if (std::smatch m; std::regex_search(r.id_lines[0], m, pose_re)) pose = m[1].str();
+    if (r.function_type == 6) {
+      if (r.complex()) {
+        throw InputError({path, r.record7_line, 0}, "record 7: coherence (function type 6) must be real (data type 2 or "
+                                                    "4), got " + std::to_string(r.ordinate_type));
       }
-      if (complex_data) v(p) = std::complex<double>(d[o], d[o + 1]);
-      else real_v(p) = d[o];
-    }
-    if (func_type == 6) {
-      coherences.push_back({key, f, real_v, type_line.line});
+      coherences.push_back({&r, pose, resp_node, ref_node, ra, ea});
       continue;
     }
-    FrfQuantity q = FrfQuantity::kReceptance;
-    if (ord_specific == 8) q = FrfQuantity::kReceptance;
-    else if (ord_specific == 11) q = FrfQuantity::kMobility;
-    else if (ord_specific == 12) q = FrfQuantity::kAccelerance;
-    else if (ord_specific == 0 || ord_specific == 1) {
-      out.warnings.push_back(path + ":" + std::to_string(r9.line) +
-                             ": record 9 gives no physical ordinate type (" +
-                             std::to_string(ord_specific) + "); read as receptance [m/N]");
-    } else {
-      throw InputError({path, r9.line, 1},
-                       "record 9: ordinate specific data type " + std::to_string(ord_specific) +
-                           " is not 8 (displacement), 11 (velocity) or 12 (acceleration)");
+    if (!r.complex()) {
+      out.warnings.push_back(where + ": this FRF has real ordinates (record 7 data type " +
+                             std::to_string(r.ordinate_type) + "): read with a zero imaginary part, so without phase");
     }
+    const RecordUnits u = FrfRecordUnits(path, r, units, &out.notes, &out.warnings);
     if (!quantity_set) {
-      out.file_quantity = q;
+      out.file_quantity = u.quantity;
       quantity_set = true;
     }
-    const double sign = s_resp * s_ref;
+    FrfKey key;
+    key.pose_id = pose;
+    key.response = ra;
+    key.excitation = ea;
+    for (const FrfRecord& o : frf_records) {
+      if (o.key == key) {
+        throw InputError({path, r.line, 0},
+                         "this FRF (" + NodeText(resp_node, ra, ref_node, ea) + ") and the one at line " +
+                             std::to_string(o.line) + " (" + NodeText(o.resp_node, ra, o.ref_node, ea) +
+                             ") are both " + key.ToString() +
+                             "; a file for robomach holds the FRFs of one tool-tip point per posture: split the "
+                             "export, or name the postures with pose=ID in ID line 1");
+      }
+    }
+    const double sign = rd.sign * ed.sign;
     std::vector<double> fk;
     std::vector<std::complex<double>> hk;
-    for (long p = 0; p < npts; ++p) {
-      if (f(p) == 0.0 && q != FrfQuantity::kReceptance) {
-        out.warnings.push_back(path + ":" + std::to_string(type_line.line) + ": the 0 Hz line of a " +
-                               QuantityName(q) + " FRF has no receptance equivalent; it is skipped");
+    int zero_lines = 0;
+    for (long p = 0; p < r.num_points; ++p) {
+      const double f = r.x(p) * hz;
+      if (f == 0.0 && u.quantity != FrfQuantity::kReceptance) {
+        ++zero_lines;
         continue;
       }
-      fk.push_back(f(p));
-      hk.push_back(sign * ToReceptance(q, f(p), v(p)));
+      fk.push_back(f);
+      hk.push_back(sign * ToReceptance(u.quantity, f, u.factor * r.y(p)));
+    }
+    if (zero_lines > 0) {
+      out.notes.push_back(where + ": the 0 Hz line of " +
+                          (u.quantity == FrfQuantity::kAccelerance ? "an " : "a ") + QuantityName(u.quantity) +
+                          " FRF has no receptance equivalent; it is skipped");
     }
     try {
       Frf frf = Frf::FromSamples(Eigen::Map<Eigen::VectorXd>(fk.data(), fk.size()),
                                  Eigen::Map<Eigen::VectorXcd>(hk.data(), hk.size()));
-      if (q == FrfQuantity::kReceptance) {
-        CheckLowFrequencyTrend(key, frf, path + ":" + std::to_string(type_line.line), &out.warnings);
-      }
+      if (u.quantity == FrfQuantity::kReceptance) CheckLowFrequencyTrend(key, frf, where, &out.warnings);
       out.frfs.Insert(key, std::move(frf));
     } catch (const std::invalid_argument& e) {
-      throw InputError({path, type_line.line, 0}, where_rec + ": " + e.what());
+      throw InputError({path, r.line, 0}, "dataset 58 record: " + std::string(e.what()));
     }
+    frf_records.push_back({key, resp_node, ref_node, r.line});
   }
-  if (records == 0) throw InputError({path, 0, 0}, "no UFF dataset 58 record found");
-  // Attach coherence records to their FRFs (same posture and directions, same grid).
-  for (const UffCoherence& c : coherences) {
-    if (!out.frfs.contains(c.key)) {
-      throw InputError({path, c.line, 0}, "coherence record for " + c.key.ToString() +
-                                              " has no FRF record with the same directions");
+  if (out.frfs.empty()) {
+    std::string held;
+    for (const auto& [name, lines] : not_frf) {
+      held += (held.empty() ? "" : "; ") + name + " at line" + (lines.size() > 1 ? "s " : " ");
+      for (size_t k = 0; k < lines.size() && k < 5; ++k) held += (k ? ", " : "") + std::to_string(lines[k]);
+      if (lines.size() > 5) held += ", ...";
     }
-    const Frf& frf = out.frfs.at(c.key);
+    if (!coherences.empty()) {
+      held += std::string(held.empty() ? "" : "; ") + "coherence (function type 6) without its FRF at line " +
+              std::to_string(coherences[0].r->line);
+    }
+    std::string others;
+    for (const auto& [n, lines] : file.skipped) others += (others.empty() ? "" : ", ") + n;
+    throw InputError({path, 0, 0}, "no frequency response function (dataset 58, function type 4) in the file" +
+                                       (held.empty() ? std::string() : ": it holds a " + held) +
+                                       (others.empty() ? std::string() : (held.empty() ? ": " : "; ") +
+                                                                             std::string("datasets ") + others));
+  }
+  for (const auto& [name, lines] : not_frf) {
+    out.notes.push_back(path + ": skipped " + std::to_string(lines.size()) + " record" + (lines.size() > 1 ? "s" : "") +
+                        " that are not FRFs: " + name + " at line " + std::to_string(lines[0]) +
+                        (lines.size() > 1 ? " and others" : ""));
+  }
+  if (!file.skipped.empty()) {
+    std::string s;
+    for (const auto& [n, lines] : file.skipped) {
+      s += (s.empty() ? "" : ", ") + n + " (" + std::to_string(lines.size()) + "x, first at line " + std::to_string(lines[0]) + ")";
+    }
+    out.notes.push_back(path + ": skipped datasets other than 58 and 164: " + s);
+  }
+  for (const UffUnits& u : file.units) {
+    out.notes.push_back(path + ":" + std::to_string(u.line) + ": units of dataset 164: " + u.description +
+                        " (length factor " + Fmt(u.length) + ", force factor " + Fmt(u.force) +
+                        "), applied to the records that follow it");
+  }
+  // Attach coherence records to their FRFs (same nodes and directions, same grid).
+  for (const Coherence& c : coherences) {
+    const Uff58Record& r = *c.r;
+    const std::string where = path + ":" + std::to_string(r.line);
+    const FrfRecord* match = nullptr;
+    for (const FrfRecord& o : frf_records) {
+      if (o.key.pose_id == c.pose && o.key.response == c.ra && o.key.excitation == c.ea &&
+          o.resp_node == c.resp_node && o.ref_node == c.ref_node) {
+        match = &o;
+      }
+    }
+    if (!match) {
+      out.notes.push_back(where + ": coherence record (" + NodeText(c.resp_node, c.ra, c.ref_node, c.ea) +
+                          ") has no FRF record with the same nodes and directions; skipped");
+      continue;
+    }
+    const Frf& frf = out.frfs.at(match->key);
     if (frf.coherence()) {
-      throw InputError({path, c.line, 0}, "second coherence record for " + c.key.ToString());
+      throw InputError({path, r.line, 0}, "second coherence record for " + match->key.ToString() +
+                                              " (the first is attached already)");
     }
+    const double hz = AbscissaToHz(path, r);
     // The FRF may have lost a 0 Hz line; align by frequency.
     Eigen::VectorXd coh(frf.size());
-    int j = 0;
+    long j = 0;
     for (int p = 0; p < frf.size(); ++p) {
-      while (j < c.f.size() && c.f(j) < frf.freq_hz()(p) - 1e-9 * std::max(1.0, frf.freq_hz()(p))) ++j;
-      if (j >= c.f.size() || std::abs(c.f(j) - frf.freq_hz()(p)) > 1e-6 * std::max(1.0, frf.freq_hz()(p))) {
-        throw InputError({path, c.line, 0}, "coherence record for " + c.key.ToString() +
-                                                " is not on the grid of its FRF");
+      const double fp = frf.freq_hz()(p), tol = 1e-6 * std::max(1.0, fp);
+      while (j < r.num_points && r.x(j) * hz < fp - tol) ++j;
+      if (j >= r.num_points || std::abs(r.x(j) * hz - fp) > tol) {
+        throw InputError({path, r.line, 0}, "coherence record for " + match->key.ToString() +
+                                                " is not on the grid of its FRF (line " + std::to_string(match->line) +
+                                                ") at " + Fmt(fp) + " Hz");
       }
-      coh(p) = c.c(j);
+      coh(p) = r.y(j).real();
     }
     try {
       Frf with = Frf::FromSamples(frf.freq_hz(), frf.receptance(), coh);
       FrfSet rebuilt;
-      for (const auto& [k, g] : out.frfs) rebuilt.Insert(k, k == c.key ? with : g);
+      for (const auto& [k, g] : out.frfs) rebuilt.Insert(k, k == match->key ? with : g);
       out.frfs = std::move(rebuilt);
     } catch (const std::invalid_argument& e) {
-      throw InputError({path, c.line, 0}, "coherence record for " + c.key.ToString() + ": " + e.what());
+      throw InputError({path, r.line, 0}, "coherence record for " + match->key.ToString() + ": " + e.what());
     }
   }
   return out;
@@ -720,7 +839,9 @@ void WriteUff58(const std::string& path, const FrfSet& frfs, FrfQuantity quantit
 FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_pose_id) {
   std::string ext;
   if (auto dot = path.find_last_of('.'); dot != std::string::npos) ext = Lower(path.substr(dot + 1));
-  if (ext == "uff" || ext == "unv" || ext == "uf") return ReadUff58(path, default_pose_id);
+  if (ext == "uff" || ext == "unv" || ext == "uf" || ext == "ufb" || LooksLikeUff(path)) {
+    return ReadUff58(path, default_pose_id);
+  }
   return ReadFrfCsv(path);
 }
 

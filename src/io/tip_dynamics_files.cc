@@ -12,11 +12,12 @@
 namespace robomach::io {
 
 std::vector<FrfSetOfPose> ReadTipFrfs(const std::string& path, const std::string& default_pose_id,
-                                      std::vector<std::string>* warnings) {
+                                      std::vector<std::string>* warnings, std::vector<std::string>* notes) {
   // The measured-FRF reader (CSV or UFF58 by extension) validates every
   // FRF; here they are grouped per posture onto one shared grid.
   FrfReadResult read = ReadFrfFile(path, default_pose_id);
   if (warnings) warnings->insert(warnings->end(), read.warnings.begin(), read.warnings.end());
+  if (notes) notes->insert(notes->end(), read.notes.begin(), read.notes.end());
   if (read.frfs.empty()) throw InputError({path, 0, 0}, "no FRF in the file");
   std::vector<FrfSetOfPose> out;
   for (const std::string& pose : read.frfs.pose_ids()) {

@@ -266,30 +266,38 @@ TEST(FrfCsv, WarnsWhenAccelerancesIsDeclaredAsReceptance) {
   EXPECT_TRUE(ReadFrfCsv(dir + "/rec.csv").warnings.empty());
 }
 
-TEST(FrfUff58, RejectsUnsupportedRecordsAndMissingPose) {
+// Issue #18: other datasets are skipped, not refused; a record without a
+// posture is a posture-free FRF (the tool decides whether it needs one); a
+// record that is not an FRF is named as what it is.
+TEST(FrfUff58, SkipsOtherDatasetsAndReadsPostureFreeRecords) {
   const std::string dir = TempDir("frf_uff_bad");
   const std::string ds55 = WriteText(dir + "/d55.uff", "    -1\n    55\nsomething\n    -1\n");
   EXPECT_THAT(CaptureError([&] { ReadUff58(ds55); }),
-              HasSubstr("d55.uff:2: UFF dataset 55 is not supported"));
+              HasSubstr("d55.uff: no frequency response function (dataset 58, function type 4) in the file: "
+                        "datasets 55"));
   const std::string bin = WriteText(dir + "/b.uff", "    -1\n    58b     1     1\nx\n    -1\n");
-  EXPECT_THAT(CaptureError([&] { ReadUff58(bin); }), HasSubstr("binary 58b"));
-  // A valid record without pose= in ID line 1 needs --pose.
+  EXPECT_THAT(CaptureError([&] { ReadUff58(bin); }),
+              HasSubstr("b.uff:2: 58b header: expected byte order, floating-point format, number of ASCII lines and "
+                        "number of bytes"));
+  // A valid record without pose= in ID line 1: no posture unless one is given.
   FrfSet s = SampleSet(false);
   WriteUff58(dir + "/ok.uff", s.ForPose("P1"));
   std::ifstream in(dir + "/ok.uff");
   std::string text((std::istreambuf_iterator<char>(in)), {});
   for (size_t p; (p = text.find("pose=P1")) != std::string::npos;) text.replace(p, 7, "posture");
   WriteText(dir + "/nopose.uff", text);
-  EXPECT_THAT(CaptureError([&] { ReadUff58(dir + "/nopose.uff"); }),
-              HasSubstr("nopose.uff:3: no posture for this record: put 'pose=P1' in ID line 1"));
+  EXPECT_TRUE(ReadUff58(dir + "/nopose.uff").frfs.contains({"", Axis::kX, Axis::kX}));
   const FrfReadResult r = ReadUff58(dir + "/nopose.uff", "P9");
   EXPECT_TRUE(r.frfs.contains({"P9", Axis::kX, Axis::kX}));
-  // Function type 1 (time response) is not an FRF.
+  // Function type 1 (time response) is not an FRF: skipped and named.
   std::string t1 = text;
   t1.replace(t1.find("    4         0"), 5, "    1");
   WriteText(dir + "/t1.uff", t1);
-  EXPECT_THAT(CaptureError([&] { ReadUff58(dir + "/t1.uff", "P1"); }),
-              HasSubstr("t1.uff:8:1: record 6: function type 1 is not supported"));
+  const FrfReadResult r1 = ReadUff58(dir + "/t1.uff", "P1");
+  EXPECT_EQ(r1.frfs.size(), 1);
+  ASSERT_FALSE(r1.notes.empty());
+  EXPECT_THAT(r1.notes.back(), HasSubstr("t1.uff: skipped 1 record that are not FRFs: time response (function type 1) "
+                                         "at line 2"));
 }
 
 }  // namespace

@@ -36,7 +36,13 @@ struct FrfReadResult {
   FrfQuantity file_quantity{FrfQuantity::kReceptance};
   /// Number of averages behind the coherence (`# averages: N`); 0 if not given.
   int averages{0};
+  /// Something the caller should hear about: a reading that may be wrong
+  /// (a quantity assumed, nonzero values past the announced count).
   std::vector<std::string> warnings;     // "path:line: ..." each
+  /// What the reader inferred or skipped, for the record: directions from
+  /// entity names, a quantity from unit labels, padding, datasets and
+  /// records that are not FRFs. Tools print them as notes, not warnings.
+  std::vector<std::string> notes;
 };
 
 /// Reads the long CSV format of formats.md §3: columns pose_id, response,
@@ -62,27 +68,40 @@ void WriteFrfCsv(const std::string& path, const dynamics::FrfSet& frfs,
 void WriteFrfCsv(std::ostream& os, const dynamics::FrfSet& frfs,
                  FrfQuantity quantity = FrfQuantity::kReceptance, int averages = 0);
 
-/// Reads a Universal File Format file of ASCII dataset 58 records (one
-/// function per record; [SDRC 1993], record layout below). Supported:
-/// function type 4 (frequency response function) with complex ordinates
-/// (data types 5 and 6), and function type 6 (coherence, real ordinates
-/// 2 and 4) attached to the FRF with the same directions; even (record 7
-/// field 3 = 1) or uneven abscissa spacing. The ordinate's specific data type
-/// (record 9 field 1: 8 displacement, 11 velocity, 12 acceleration) gives
-/// the quantity; 0 or 1 (unknown, general) is read as receptance with a
-/// warning. Direction codes 1/−1 = x, 2/−2 = y, 3/−3 = z; a negative code
-/// means the transducer points along −axis, so the value is negated once per
-/// negative code. Values are taken as SI (m, m/s, m/s² per N); an ordinate
-/// or abscissa unit label that says otherwise ("mm", "g", "lbf", "in", "rpm")
-/// is an error. Dataset 151 (a header without data) is skipped; any other
-/// dataset number, binary 58b, rotational direction codes, and other
-/// function types are rejected with a message naming the record's line.
+/// Reads the FRFs of a Universal File Format file as modal-analysis
+/// software and acquisition systems export it (io/uff58.h reads the
+/// records: ASCII 58 and binary 58b, dataset 164 units; other datasets are
+/// skipped and named in a note).
 ///
-/// The posture is `pose=ID` in ID line 1 of the record; otherwise
-/// `default_pose_id` (from `--pose ID=file.uff`); neither is an error.
-///
-/// - [SDRC 1993] Structural Dynamics Research Corporation, I-DEAS Universal
-///   File Format, dataset 58 "Function at Nodal DOF" (records 1–12).
+/// - Function type 4 records are FRFs (complex ordinates); function type 6
+///   (coherence, real) is attached to the FRF with the same response and
+///   reference node and direction. Every other function (time response,
+///   spectrum, ...) is skipped with a note naming it; a file with no FRF at
+///   all is an error that says what it holds.
+/// - Directions: record 6 codes 1/-1 = x, 2/-2 = y, 3/-3 = z; a negative
+///   code (or a '-' in the entity name) means the transducer points along
+///   -axis, so the value is negated once per negative end. Code 0 (scalar):
+///   the direction is read from the entity name (".1.Z-", "12:+X"); with
+///   none, the FRF is read as a direct FRF xx with a warning (a symmetric
+///   tool, as a tap test on one axis gives). Rotational codes are errors.
+/// - Quantity and units: the ordinate's specific data type (record 9: 8
+///   displacement, 11 velocity, 12 acceleration), else the unit labels of
+///   records 9 and 10 ("(m/s)/N", "g/lbf", "mm/s^2" over "N" ...; see
+///   ParseUnitLabel), else the axis label's word ("Mobility", "Inertance"
+///   ...) with a warning, else receptance with a warning. A code and a label
+///   that disagree are an error. Values are converted to SI by the labels'
+///   factors, or, for unlabelled axes, by dataset 164's factors with the
+///   records' length and force exponents; labels that disagree with 164
+///   are an error. Mobility and accelerance are converted to receptance
+///   (the 0 Hz line, which has no receptance, is dropped).
+/// - The abscissa is frequency in Hz (a label "rad/s" or "kHz" is converted);
+///   time, rpm and order abscissae are errors for an FRF.
+/// - The posture is `pose=ID` in ID line 1 of the record; otherwise
+///   `default_pose_id` (from `--pose ID=file.uff`); otherwise the FRF has no
+///   posture (empty pose id): a tool that needs one says so.
+/// - Two FRF records of the same posture and directions (other nodes) are
+///   an error: a file holds the FRFs of one tool-tip point per posture.
+/// @throws InputError "file:line[:col]: ..." naming the record and field.
 FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose_id = "");
 
 /// Writes one dataset 58 record per FRF (complex double, format 4E20.12;
@@ -95,8 +114,9 @@ void WriteUff58(const std::string& path, const dynamics::FrfSet& frfs,
 void WriteUff58(std::ostream& os, const dynamics::FrfSet& frfs,
                 FrfQuantity quantity = FrfQuantity::kReceptance);
 
-/// Reads a measured-FRF file by its extension: `.uff`, `.unv` or `.uf` as
-/// UFF58, anything else as CSV. `default_pose_id` applies to UFF only.
+/// Reads a measured-FRF file: UFF for the extensions `.uff`, `.unv`, `.uf`,
+/// `.ufb` or a file that starts with the UFF delimiter "-1", else CSV.
+/// `default_pose_id` applies to UFF only.
 FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_pose_id = "");
 
 /// Rounds to 13 significant digits, the precision of UFF58's E20.12 field.

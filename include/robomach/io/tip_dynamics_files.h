@@ -24,11 +24,13 @@ struct FrfSetOfPose {
 /// or UFF58 by extension; io/frf_files.h validates them and converts
 /// mobility and accelerance to receptance) and groups them per posture. All
 /// FRFs of one posture must share one frequency grid. `default_pose_id`
-/// names the posture of a UFF file whose records do not. Reader warnings are
-/// appended to `warnings` if given.
+/// names the posture of a UFF file whose records do not (else their pose id
+/// is empty: a posture-free FRF). Reader warnings are appended to
+/// `warnings` and notes to `notes` if given.
 /// @throws InputError naming file, line and column.
 std::vector<FrfSetOfPose> ReadTipFrfs(const std::string& path, const std::string& default_pose_id = "",
-                                      std::vector<std::string>* warnings = nullptr);
+                                      std::vector<std::string>* warnings = nullptr,
+                                      std::vector<std::string>* notes = nullptr);
 
 /// One posture of a modal table.
 struct ModalTableEntry {
