@@ -462,7 +462,8 @@ int Run(int argc, char** argv) {
   app.footer(ExitCodeHelp() +
              " Exit 3 when some speeds have no stability boundary, when a measured FRF's modal fit is poor "
              "(misfit above 3 x the noise), finds no mode (then no SD lobes) or a mode at the edge of the usable "
-             "band, or when --method both finds the "
+             "band, when the FRF is not a passive driving point (Im H > 0 on more than 5 % of its usable lines), "
+             "or when --method both finds the "
              "SD's and the ZOA's smallest depths more than 10 % apart at a radial immersion of 0.3 or more.");
   std::string robot_path, cut_path, postures_path, frf_path, frf_y_path, modal_path, out_path, plot_path,
       fit_plot_path, modes_out_path, method = "zoa", tool_axis_text = "0,0,1";
@@ -618,6 +619,14 @@ int Run(int argc, char** argv) {
     bool flagged = false;
     for (const TipDynamics& t : tips) {
       for (const DirectionFit& d : t.fits) {
+        if (d.fit.not_driving_point) {
+          Warn(kTool, d.label + ": Im H > 0 (beyond twice the noise) on " +
+                          io::FormatDouble(std::round(d.fit.active_fraction * 1000.0) / 10.0) +
+                          " % of the usable lines: this is not the driving-point receptance of a passive structure "
+                          "(response and excitation at different points, e.g. a transfer FRF, or in opposite "
+                          "directions, or another sign convention), so the lobes from it do not describe a tool tip");
+          flagged = true;
+        }
         for (double f : d.fit.edge_modes_hz) {
           Warn(kTool, d.label + ": the mode at " + io::FormatDouble(std::round(f * 10.0) / 10.0) +
                           " Hz reaches past the edge of the usable band (" + calibration::DescribeUsable(d.fit.noise) +

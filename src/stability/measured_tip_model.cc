@@ -10,6 +10,10 @@ namespace robomach::stability {
 
 void CheckValid(const DirectFrfFitOptions& o) {
   calibration::CheckValid(o.noise);
+  if (!(o.max_active_fraction >= 0.0 && o.max_active_fraction <= 1.0)) {
+    throw std::invalid_argument("DirectFrfFitOptions: max_active_fraction must be in [0, 1], got " +
+                                std::to_string(o.max_active_fraction));
+  }
   if (!(o.max_noise_rms >= 1.0) || !std::isfinite(o.max_noise_rms)) {
     throw std::invalid_argument("DirectFrfFitOptions: max_noise_rms must be finite and >= 1, got " +
                                 std::to_string(o.max_noise_rms));
@@ -29,6 +33,15 @@ DirectFrfFit FitDirectFrf(const dynamics::Frf& measured, const DirectFrfFitOptio
     return out;
   }
   const dynamics::Frf usable = measured.WithNoise(out.noise.sigma_m_per_N).Select(lines);
+  int active = 0, positive_f = 0;
+  for (int k = 0; k < usable.size(); ++k) {
+    if (!(usable.freq_hz()(k) > 0.0)) continue;
+    ++positive_f;
+    // σ is the complex noise's rms; each part has σ/√2.
+    active += usable.receptance()(k).imag() > 2.0 * (*usable.noise_sigma())(k) / std::sqrt(2.0);
+  }
+  out.active_fraction = positive_f > 0 ? static_cast<double>(active) / positive_f : 0.0;
+  out.not_driving_point = out.active_fraction > o.max_active_fraction;
   out.fit = calibration::FitModes(usable, o.fit);
   if (out.fit.status != calibration::ModalFitStatus::kOk || out.fit.modes.empty()) {
     out.problem = "modal fit: " + out.fit.message;

@@ -28,6 +28,10 @@ struct DirectFrfFitOptions {
   /// thousands of lines, and a missed mode or an unmodelled drift pushes
   /// the rms far above 3 in the band where it lies.
   double max_noise_rms{3.0};
+  /// See DirectFrfFit::active_fraction. 0.05: with the 2σ threshold, noise
+  /// alone puts about 2 % of the lines of a lightly damped receptance above
+  /// it (Im H ≈ 0 only far from the modes; P(N(0,1) > 2) = 2.3 %).
+  double max_active_fraction{0.05};
 };
 
 /// @throws std::invalid_argument naming the field for a bad option.
@@ -44,6 +48,15 @@ struct DirectFrfFit {
   bool poor{true};
   /// For people, when poor: what went wrong.
   std::string problem;
+  /// Fraction of the usable lines where Im H > 2σ. A driving-point
+  /// receptance of a passive structure has Im H(ω) ≤ 0 at every ω > 0 (the
+  /// power it absorbs, ½ω|F|² (−Im H), is not negative) [Ewins 2000, §2.3],
+  /// so more than `max_active_fraction` of such lines means the FRF is not
+  /// one: response and excitation at different points (a transfer FRF), in
+  /// opposite directions, or another sign convention. Neither the SD's modes
+  /// nor the ZOA's lobes from it describe a tool tip then.
+  double active_fraction{0.0};
+  bool not_driving_point{false};
   /// Fitted modes whose half-power band f (1 ± ζ) reaches below the lowest
   /// usable line or above the highest: the fit saw only one flank, so the
   /// mode may model the drift or the floor beyond the band rather than the
