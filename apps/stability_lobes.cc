@@ -390,8 +390,7 @@ void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
     }
     const double diff = std::abs(sd - zoa) / std::min(sd, zoa);
     std::ostringstream m;
-    m << t.id << ": smallest critical depth SD " << io::FormatDouble(std::round(MToMm(sd) * 1e3) / 1e3)
-      << " mm, ZOA " << io::FormatDouble(std::round(MToMm(zoa) * 1e3) / 1e3) << " mm";
+    m << t.id << ": smallest critical depth SD " << Sig4(MToMm(sd)) << " mm, ZOA " << Sig4(MToMm(zoa)) << " mm";
     if (diff > 0.10) {
       Warn(kTool, m.str() + ": they differ by " + io::FormatDouble(std::round(diff * 1000.0) / 10.0) +
                       " % (more than 10 % at a radial immersion of " + io::FormatDouble(cut.process.radial_immersion) +
