@@ -38,6 +38,7 @@ int Run(int argc, char** argv) {
       "axis-accuracy: ISO 230-2 figures per axis (A, A_up, A_down, E, E_up, E_down, M, R, R_up, R_down, B,\n"
       "B_mean, in the file's unit) and per target from positioning runs (formats.md §8.6), with the standard\n"
       "chart: mean deviation and +-2s bands per approach direction over the targets."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string runs_path, out_path, plot_path;
   app.add_option("--runs", runs_path, "runs CSV axis,target_mm,run,direction,measured_mm (or _deg)")->required();

@@ -50,6 +50,7 @@ int Run(int argc, char** argv) {
       "measured = origin + count x resolution (eq. 1); real = measured + the controller's compensation\n"
       "($AA_ENC_COMP, $AN_CEC, temperature; eqs. 2-5); then the machine's kinematics with its rotary errors\n"
       "(formats.md §8.3). With --program, the contour error of every sample against the programmed polyline."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string machine_path, counts_path, comp_path, temp_path, program_path, out_path, summary_path, plot_path;
   app.add_option("--machine", machine_path, "machine file YAML (formats.md §8.3)")->required();

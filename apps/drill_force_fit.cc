@@ -94,6 +94,7 @@ void Plot(const std::string& path, const io::ForceTableFile& table,
 int RunDrillForceFit(int argc, char** argv) {
   CLI::App app{"drill-force-fit: fit the twist-drill force model (oblique-cutting lips, dynamic "
                "rake, Kienzle size effect; seed 003) to a thrust/torque table"};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string table_path, drill_path, out_path, plot_path, predict_path, predictions_path;
   std::string chisel = "seed_scaling";

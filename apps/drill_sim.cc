@@ -22,6 +22,7 @@
 #include "robomach/io/drilling_files.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
+#include "robomach/report/posture_json.h"
 
 namespace robomach::apps {
 namespace {
@@ -153,6 +154,7 @@ void Plot(const std::string& path, const std::vector<Run>& runs, int n) {
 int RunDrillSim(int argc, char** argv) {
   CLI::App app{"drill-sim: flexible-joint robot drilling a hole (seed 003): joint deflection, "
                "drill tilt and forces under PID, PD or PD with time-delay estimation"};
+  AddVersionFlag(app, kTool);
   app.footer("With several controllers each output gets the controller's name before its "
              "extension (run.csv -> run_pid.csv, run_pd-tdc.csv); the plot overlays them.\n" +
              ExitCodeHelp());
@@ -298,9 +300,9 @@ int RunDrillSim(int argc, char** argv) {
       const nlohmann::json j = Summary(run, *sc, limit);
       if (!out_path.empty()) io::WriteFileAtomically(WithSuffix(out_path, kind, several), SeriesCsv(run.result));
       if (!summary_path.empty()) {
-        io::WriteFileAtomically(WithSuffix(summary_path, kind, several), j.dump(2) + "\n");
+        io::WriteFileAtomically(WithSuffix(summary_path, kind, several), report::DumpJson(j));
       } else if (out_path.empty()) {
-        std::cout << j.dump(2) << "\n";
+        std::cout << report::DumpJson(j);
       }
     }
     if (!plot_path.empty()) Plot(plot_path, runs, n);

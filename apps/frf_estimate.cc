@@ -125,6 +125,7 @@ int Run(int argc, char** argv) {
       "frf-calibrate and model-audit) with '# averages: N' and the windows as metadata.\n"
       "Hits with a second force pulse (double hit) or a clipped/over-range channel (overload) are\n"
       "rejected and named on stderr and in --summary, never averaged."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              "\n3 here: fewer accepted hits than --min-hits, or a response that has not decayed by the end of its "
              "record (leakage). 65 also: every hit rejected (the FRF file is then not written; --summary is).\n");

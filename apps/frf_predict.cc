@@ -73,6 +73,7 @@ int Run(int argc, char** argv) {
       "Reads a robot config and a posture file (formats.md §1); writes the 3x3 tool-tip\n"
       "receptance per posture (formats.md §3), the modal table (§4), per-posture details\n"
       "(JSON) and plots (PNG)."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string robot_path, postures_path, out_path, modes_path, plot_path, plot_dir, details_path,
       freq_file, directions = "all", method = "modal";

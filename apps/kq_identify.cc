@@ -236,6 +236,7 @@ int Run(int argc, char** argv) {
       "D = J_T Kq^-1 J_L^T W. Reports every joint's stiffness with standard deviation, 95 %\n"
       "interval and whether the data determine it; residuals per case; outliers.\n"
       "With --plan N it plans N test postures and rope directions instead (D-optimal)."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              "\nExit code 3 also means: a joint is weakly or not determined, the fit did not converge,\n"
              "or outliers were found without --robust (the outputs are written).");

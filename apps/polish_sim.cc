@@ -19,6 +19,7 @@
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/removal.h"
+#include "robomach/report/posture_json.h"
 
 namespace robomach::apps {
 namespace {
@@ -29,6 +30,7 @@ int Run(int argc, char** argv) {
   CLI::App app{
       "polish-sim: simulate the Preston removal of a tool path (formats.md §6) on a NURBS patch\n"
       "(formats.md §5) with Hertz contact (formats.md §7); writes the removal map, a summary and pictures."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              "\nExit 3 (outputs written, the reason on stderr): the path's traverse speed exceeds "
              "max_speed_mm_per_s; with --robot, rows are unreachable, outside the joint limits or after a joint "
@@ -127,7 +129,7 @@ int Run(int argc, char** argv) {
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, removal);
     robot.WriteJoints(file.rows);
     if (!plot_out.empty()) WritePictures(plot_out, grid, removal, file.rows, {}, {}, "polish-sim");
-    const std::string text = summary.dump(2) + "\n";
+    const std::string text = report::DumpJson(summary);
     if (!summary_out.empty()) io::WriteFileAtomically(summary_out, text);
     else std::cout << text;
     return flagged ? kExitFlagged : kExitOk;

@@ -36,6 +36,7 @@ int Run(int argc, char** argv) {
       "mode-coupling chatter (eigenvalues of the posture's 3-D tool-tip dynamics under the\n"
       "cutting stiffness) and regenerative chatter (ZOA lobes at the cut's speed or the best\n"
       "speed of its range); optionally the rotation about the tool axis that maximises the depth."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string robot_path, cut_path, region_path, path_path, out_path, plot_path;
   int threads = 0, speeds = 0, rotation_evals = 20;
