@@ -458,6 +458,7 @@ int Run(int argc, char** argv) {
       "axial depth) by the zero-order approximation (Altintas-Budak) and/or first-order\n"
       "semi-discretization (Insperger-Stepan), for the robot model at postures, a measured\n"
       "FRF file (formats.md §3) or a modal table (§4)."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              " Exit 3 when some speeds have no stability boundary, when a measured FRF's modal fit is poor "
              "(misfit above 3 x the noise), finds no mode (then no SD lobes) or a mode at the edge of the usable "
