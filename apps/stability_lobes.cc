@@ -483,7 +483,8 @@ int Run(int argc, char** argv) {
                  "with --frf: a second file with the one direct FRF normal to the feed in the cutting plane; --frf is "
                  "then the FRF along the feed (no cross terms)");
   app.add_option("--fit-plot", fit_plot_path,
-                 "with --frf: PNG of each direct FRF with its modal fit (magnitude, phase, noise floor, usable band)");
+                 "with --frf: PNG of each direct FRF with its modal fit (magnitude, phase, noise floor, usable band)")
+      ->check(PngFileName());
   app.add_option("--modes-out", modes_out_path,
                  "with --frf: the modal table the SD used (formats.md §4), in the frame of the FRF file; --modal-table "
                  "reads it back (with the same --tool-axis, and --sd-modes of at least its number of modes)");
@@ -492,7 +493,7 @@ int Run(int argc, char** argv) {
                  "file with one direct FRF, a symmetric tool, except for the frame of --modes-out)")->capture_default_str();
   app.add_option("--method", method, "zoa, sd or both")->check(CLI::IsMember({"zoa", "sd", "both"}))->capture_default_str();
   app.add_option("--out", out_path, "lobes CSV (spindle_speed_rpm, critical_depth_mm, chatter_freq_hz, lobe_index, method); stdout if omitted");
-  app.add_option("--plot", plot_path, "lobe diagram PNG (speed [rpm] against depth [mm])");
+  app.add_option("--plot", plot_path, "lobe diagram PNG (speed [rpm] against depth [mm])")->check(PngFileName());
   app.add_option("--speeds", speeds, "ZOA: number of spindle speeds in the cut's range (default: the cut file's spindle_speed_count)");
   app.add_option("--max-lobe", max_lobe, "ZOA: highest lobe index traced")->capture_default_str();
   app.add_option("--sd-speeds", sd_speeds, "SD: number of spindle speeds in the cut's range")->capture_default_str();
