@@ -60,6 +60,20 @@ Evaluated Evaluate(const polishing::NurbsSurface& surface, const polishing::Samp
   return e;
 }
 
+std::string Short(double x) {
+  std::ostringstream o;
+  o.precision(4);
+  o << x;
+  return o.str();
+}
+
+std::string Short6(double x) {
+  std::ostringstream o;
+  o.precision(6);
+  o << x;
+  return o.str();
+}
+
 std::string CsvField(const std::string& x) {
   if (x.find_first_of(",\"\n") == std::string::npos) return x;
   std::string q = "\"";
@@ -69,7 +83,8 @@ std::string CsvField(const std::string& x) {
 
 // --list-faces: one CSV row per face of a STEP/IGES file (formats.md §5).
 int ListFaces(const std::string& surface_path, const std::string& process_path, const std::string& out,
-              const SurfaceChoice& choice, const std::string& pattern, double radius_mm, double sample_mm) {
+              const SurfaceChoice& choice, const std::string& pattern, double radius_mm, double sample_mm,
+              double offset_mm, double pitch_mm, double row_step_mm) {
   if (!io::IsCadFile(surface_path)) {
     throw std::invalid_argument("--list-faces: " + surface_path + " is a NURBS YAML (one patch); --list-faces lists "
                                 "the faces of a STEP/IGES file");
@@ -79,6 +94,9 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
   polishing::PathParameters params;
   params.pattern = pattern == "cycloid" ? polishing::Pattern::kCycloid : polishing::Pattern::kParallel;
   params.radius = MmToM(radius_mm);
+  params.offset = MmToM(offset_mm);
+  params.pitch = MmToM(pitch_mm);
+  params.row_step = MmToM(row_step_mm);
   polishing::PolishableOptions po;
   po.sample_spacing = MmToM(sample_mm);
   io::CadReadOptions options;
@@ -100,8 +118,8 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
   std::ostringstream csv;
   csv << "face,surface_type,area_mm2,u_size_mm,v_size_mm,trimmed,holes,polishable,reason\n";
   for (const auto& r : rows) {
-    csv << r.face << ',' << r.surface_type << ',' << io::FormatDouble(r.area_mm2) << ','
-        << io::FormatDouble(r.u_size_mm) << ',' << io::FormatDouble(r.v_size_mm) << ',' << (r.trimmed ? 1 : 0) << ','
+    csv << r.face << ',' << r.surface_type << ',' << Short6(r.area_mm2) << ',' << Short6(r.u_size_mm) << ','
+        << Short6(r.v_size_mm) << ',' << (r.trimmed ? 1 : 0) << ','
         << r.holes << ',' << (r.polishable ? 1 : 0) << ',' << CsvField(r.reason) << '\n';
   }
   if (out.empty()) std::cout << csv.str();
@@ -112,30 +130,29 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
 // Refuses a face too large to sample at --sample-mm (naming it, its size and
 // the estimate), and warns with the estimate before long work.
 void CheckFaceSize(const polishing::NurbsSurface& surface, const std::string& surface_path, double sample_mm,
-                   const std::string& pattern, double offset_mm, double radius_mm, double pitch_mm, double row_step_mm) {
+                   const polishing::PathParameters& params) {
   const polishing::SurfaceSize size = polishing::MeasureSurface(surface);
   const double points = polishing::EstimateGridPoints(size, MmToM(sample_mm));
-  const double limit = polishing::PolishableOptions{}.max_grid_points;
-  const double area_mm2 = 1e6 * (surface.trim() ? surface.trim()->area : size.length_u * size.length_v);
-  // Path length: the area swept row by row at the guide spacing, the cycloid
-  // running about 2 pi r per pitch of advance.
-  const double factor = pattern == "cycloid" ? std::max(1.0, 2 * kPi * radius_mm / pitch_mm) : 1.0;
-  const double rows = area_mm2 / offset_mm * factor / row_step_mm;
+  const polishing::PolishableOptions limits;
+  const double area = surface.trim() ? surface.trim()->area : size.length_u * size.length_v;
+  const double rows = polishing::EstimatePathRows(area, params);
   std::ostringstream m;
   m.precision(3);
   m << polishing::SurfaceName(surface) << " (" << 1e3 * size.length_u << " x " << 1e3 * size.length_v
-    << " mm, mean arc lengths along u and v; " << area_mm2 << " mm^2)";
+    << " mm, mean arc lengths along u and v; " << 1e6 * area << " mm^2)";
   const std::string what = m.str();
   m.str("");
   m << points << " grid points at --sample-mm " << sample_mm << " (~" << points * 90e-9 << " GB) and a path of ~" << rows
     << " rows";
   const std::string estimate = m.str();
-  if (!(points <= limit)) {
-    throw InputError({surface_path, 0, 0}, what + " is too large to plan: " + estimate + "; the limit is " +
-                                               io::FormatDouble(limit) + " grid points (check the file's unit: "
-                                               "--cad-unit-scale; or choose a smaller face, --list-faces)");
+  if (!(points <= limits.max_grid_points) || !(rows <= limits.max_path_rows)) {
+    m.str("");
+    m << what << " is too large to plan within the limits (" << limits.max_grid_points << " grid points, "
+      << limits.max_path_rows << " path rows; about a minute and 2 GB): " << estimate
+      << " (check the file's unit: --cad-unit-scale; or choose a smaller face, --list-faces)";
+    throw InputError({surface_path, 0, 0}, m.str());
   }
-  if (points > 1e6 || rows > 2e6) Warn(kTool, what + " is large: " + estimate + "; planning may take minutes");
+  if (points > 2e5 || rows > 1e5) Warn(kTool, what + " is large: " + estimate + "; planning may take a minute");
 }
 
 int Run(int argc, char** argv) {
@@ -221,11 +238,20 @@ int Run(int argc, char** argv) {
     }
     CheckDistinctPaths({{"--surface", surface_path}, {"--process", process_path}, {"--robot", robot.robot_path()}}, outs);
 
-    if (list_faces) return ListFaces(surface_path, process_path, list_out, choice, pattern, radius_mm, sample_mm);
+    if (list_faces) return ListFaces(surface_path, process_path, list_out, choice, pattern, radius_mm, sample_mm, offset_mm,
+                                     pitch_mm, row_step_mm);
     if (!list_out.empty()) throw std::invalid_argument("--out goes with --list-faces");
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
     const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
-    CheckFaceSize(surface, surface_path, sample_mm, pattern, offset_mm, radius_mm, pitch_mm, row_step_mm);
+    {
+      polishing::PathParameters p;
+      p.pattern = pattern == "cycloid" ? polishing::Pattern::kCycloid : polishing::Pattern::kParallel;
+      p.offset = MmToM(offset_mm);
+      p.radius = MmToM(radius_mm);
+      p.pitch = MmToM(pitch_mm);
+      p.row_step = MmToM(row_step_mm);
+      CheckFaceSize(surface, surface_path, sample_mm, p);
+    }
     auto build_grid = [&](double spacing) {
       try {
         return polishing::SampleGrid::Build(surface, MmToM(spacing), process.margin, process.flip_normal);
@@ -237,9 +263,8 @@ int Run(int argc, char** argv) {
     if (grid.num_in_region() == 0) {
       throw InputError({process_path, 0, 0}, "process.margin_mm " + io::FormatDouble(1e3 * process.margin) +
                                                  " leaves no polished region on " + polishing::SurfaceName(surface) +
-                                                 " (" + io::FormatDouble(1e3 * grid.length_s()) + " x " +
-                                                 io::FormatDouble(1e3 * grid.length_t()) +
-                                                 " mm, mean arc lengths along u and v)");
+                                                 " (" + Short(1e3 * grid.length_s()) + " x " +
+                                                 Short(1e3 * grid.length_t()) + " mm, mean arc lengths along u and v)");
     }
     double contact_width = 0;
     try {

@@ -55,6 +55,11 @@ void CheckCircleFits(const NurbsSurface& surface, const SampleGrid& grid, const 
   throw FaceTooNarrowError(m.str());
 }
 
+double EstimatePathRows(double area, const PathParameters& params) {
+  const double factor = params.pattern == Pattern::kCycloid ? std::max(1.0, 2 * M_PI * params.radius / params.pitch) : 1.0;
+  return area / params.offset * factor / params.row_step;
+}
+
 Polishability CheckPolishable(const NurbsSurface& surface, const PolishingProcess& process,
                               const PathParameters& params, const PolishableOptions& options) {
   Polishability p;
@@ -92,6 +97,17 @@ Polishability CheckPolishable(const NurbsSurface& surface, const PolishingProces
       return p;
     }
     CheckCircleFits(surface, grid, region, params, process);
+    const double area = surface.trim() ? surface.trim()->area : size.length_u * size.length_v;
+    const double rows = EstimatePathRows(area, params);
+    if (rows > options.max_path_rows) {
+      std::ostringstream m;
+      m.precision(3);
+      m << name << " (" << size_text << ", " << area * 1e6 << " mm^2) is too large: its path would have ~" << rows
+        << " rows (offset " << Mm(params.offset) << " mm, row step " << Mm(params.row_step) << " mm), above the limit of "
+        << options.max_path_rows;
+      p.reason = m.str();
+      return p;
+    }
     p.polishable = true;
   } catch (const std::exception& e) {  // FaceTooNarrowError, a degenerate point, a size that is not finite
     p.reason = e.what();

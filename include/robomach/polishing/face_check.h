@@ -39,7 +39,11 @@ void CheckCircleFits(const NurbsSurface& surface, const SampleGrid& grid, const 
 
 struct PolishableOptions {
   double sample_spacing{0.5e-3};   // the planner's sampling [m]
-  double max_grid_points{4e6};     // refuse larger faces (~0.4 GB of grid, minutes of planning)
+  /// Refuse larger faces: the issue 19 budget is 60 s and 2 GB per face;
+  /// OCCT's hammer face 32 read as mm (1.24e6 points, ~4.9e5 rows) took
+  /// 190 s and 0.4 GB on the shared 2-core machine.
+  double max_grid_points{1e6};
+  double max_path_rows{3e5};
   /// The region is measured on a grid of at most this many points (the
   /// margin and width are then known to one coarse spacing).
   double check_grid_points{2e4};
@@ -53,11 +57,17 @@ struct Polishability {
   double contact_width{0};         // [m], 0 if not reached
 };
 
+/// Rows of a path over `area` [m^2] (order of magnitude): the area swept row
+/// by row at params.offset, the cycloid running ~2 pi r per pitch of advance,
+/// a row every params.row_step.
+double EstimatePathRows(double area, const PathParameters& params);
+
 /// Whether `surface` can be polished with `process` and the circle of
 /// `params` (cycloid) or the parallel rows: not too large to sample at
 /// options.sample_spacing, a region left after the margin, the contact
 /// defined at its centre (convex enough) and, for the cycloid, the circle
-/// fitting the region (CheckCircleFits). Never throws for a bad face: the
+/// fitting the region (CheckCircleFits), and the estimated path not longer
+/// than options.max_path_rows. Never throws for a bad face: the
 /// reason says what is wrong, naming the face and its size.
 Polishability CheckPolishable(const NurbsSurface& surface, const PolishingProcess& process,
                               const PathParameters& params, const PolishableOptions& options = {});
