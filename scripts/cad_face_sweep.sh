@@ -3,7 +3,8 @@
 # of OpenCASCADE's test parts in ../shared/external/cad_freeform either plans
 # within 60 s and 2 GB or is refused with a message naming the face, its size
 # and the reason. Reads the files where they lie; writes only to OUT_DIR.
-#   scripts/cad_face_sweep.sh [BUILD_DIR] [OUT_DIR] [extra polish-plan options...]
+#   [FILES="occt_bearing.iges"] scripts/cad_face_sweep.sh [BUILD_DIR] [OUT_DIR] [extra polish-plan options...]
+# e.g. FILES=occt_bearing.iges scripts/cad_face_sweep.sh build /tmp/s --cad-unit-scale 1000
 # Prints one line per face (file, face, exit code, time_s, peak RSS MB, the
 # last stderr line) and a table per file; times and RSS from /usr/bin/time.
 set -u
@@ -20,7 +21,7 @@ if [ ! -d "$EXT" ]; then echo "cad_face_sweep: $EXT absent (../shared not here):
 mkdir -p "$OUT"
 RESULTS=$OUT/sweep.csv
 echo "file,face,rc,time_s,rss_mb,message" > "$RESULTS"
-for f in occt_linkrods.step occt_hammer.iges occt_bearing.iges; do
+for f in ${FILES:-occt_linkrods.step occt_hammer.iges occt_bearing.iges}; do
   "$PLAN" --surface "$EXT/$f" --process "$PROCESS" --list-faces --out "$OUT/${f}_faces.csv" "$@" 2>"$OUT/${f}_list.err"
   for face in $(awk -F, 'NR > 1 && $2 == "bspline" {print $1}' "$OUT/${f}_faces.csv"); do
     err=$OUT/${f}_$face.err
