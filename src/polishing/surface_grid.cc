@@ -188,7 +188,17 @@ SampleGrid SampleGrid::Build(const NurbsSurface& surface, double max_spacing, do
       const SurfaceDerivatives d = surface.Evaluate(g.u_[i], g.v_[j]);
       const int k = g.index(i, j);
       g.p_[k] = d.S;
-      g.n_[k] = UnitNormal(d, flip);
+      try {
+        g.n_[k] = UnitNormal(d, flip);
+      } catch (const std::domain_error& e) {
+        // A pole of the patch (a degenerate edge: cone apex, sphere pole,
+        // a collapsed B-spline boundary): name the face, its size and where.
+        std::ostringstream m;
+        m << SurfaceName(surface) << " (" << Mm(g.length_s_) << " x " << Mm(g.length_t_) << " mm): " << e.what()
+          << " at u " << g.u_[i] << ", v " << g.v_[j] << " (a pole of the patch, e.g. a collapsed edge; faces "
+          << "with poles cannot be sampled)";
+        throw std::domain_error(m.str());
+      }
       jac[k] = d.S_u.cross(d.S_v).norm();
     }
   }
