@@ -36,10 +36,10 @@ int Run(int argc, char** argv) {
              "max_speed_mm_per_s; with --robot, rows are unreachable, outside the joint limits or after a joint "
              "jump > 0.5 rad.");
   std::string surface_path, process_path, path_in, removal_out, summary_out, plot_out;
-  int face = 0;
   double sample_mm = 0.5;
   app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (formats.md §5)")->required();
-  app.add_option("--face", face, "face of a STEP/IGES file (1-based, in the file's order); default: the largest by area");
+  SurfaceChoice choice;
+  AddSurfaceChoiceOptions(&app, &choice);
   app.add_option("--process", process_path, "process YAML (formats.md §7)")->required();
   app.add_option("--path", path_in, "tool path CSV (formats.md §6)")->required();
   app.add_option("--sample-mm", sample_mm, "removal map sampling in arc length [mm], <= 0.5")->capture_default_str();
@@ -53,6 +53,7 @@ int Run(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
+  choice.face_given = app.count("--face") > 0;
   return RunGuarded(kTool, [&]() -> int {
     CheckOptionRange("--sample-mm", sample_mm, 0.05, 0.5);
     RequireReadableFile(surface_path, "surface");
@@ -66,7 +67,7 @@ int Run(int argc, char** argv) {
                         {"--robot", robot.robot_path()}},
                        outs);
 
-    const polishing::NurbsSurface surface = LoadSurface(surface_path, face);
+    const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
     io::PolishPathFile file = io::ReadPolishPath(path_in);
     polishing::SampleGrid grid = [&] {

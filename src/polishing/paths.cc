@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "robomach/common/units.h"
+#include "robomach/polishing/face_check.h"
 #include "robomach/polishing/region_outline.h"
 
 namespace robomach::polishing {
@@ -383,6 +384,7 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
 
   // Guide lines, in order, with the direction sense of the cycloid.
   const DevelopedRegion region = DevelopedRegion::Build(surface, grid, process.margin);
+  if (cyc) CheckCircleFits(surface, grid, region, params, process);  // never rows clamped onto the edges
   std::vector<GuideSpec> guides;
   if (region.rectangle()) guides = RectangleGuides(grid, params, process);
   else if (region.loops().empty()) throw std::invalid_argument("the polished region is empty (margin too large for the face)");
