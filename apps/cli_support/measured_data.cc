@@ -56,6 +56,10 @@ void AddNoiseOptions(CLI::App& app, NoiseCliOptions* o) {
                  "a line is used where |H| is at least this many times the additive noise floor (3: the "
                  "log-magnitude and phase residuals are unbiased there; see README)")
       ->capture_default_str();
+  app.add_flag("--drift-floor", o->drift_floor,
+               "tap tests whose integrated accelerometer drifts at low frequency: the noise floor also from "
+               "second differences over 8 and 16 lines of the residual about the modal fit, so that no mode is "
+               "fitted in the drift (off by default: it can also count a smooth model misfit as noise)");
   app.add_option("--averages", o->averages,
                  "number of averaged impacts behind the coherence, for files without '# averages: N' (UFF58)");
 }
@@ -74,6 +78,7 @@ calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const Meas
     no.min_snr = o.min_snr;
     no.averages = o.averages > 0 ? o.averages : data.averages.at(key);
     no.use_coherence = o.model != "scatter";
+    no.wide_floor = o.drift_floor;
     if (o.model == "coherence") {
       if (!frf.coherence()) {
         throw std::invalid_argument("--noise-model coherence: " + key.ToString() + " (" + data.file.at(key) +

@@ -43,9 +43,10 @@ struct NoiseCliOptions {
   std::string model{"auto"};
   double min_snr{calibration::NoiseOptions{}.min_snr};
   int averages{0};  // 0: from the file
+  bool drift_floor{false};  // calibration::NoiseOptions::wide_floor
 };
 
-/// --noise-model, --min-snr, --averages.
+/// --noise-model, --min-snr, --averages, --drift-floor.
 void AddNoiseOptions(CLI::App& app, NoiseCliOptions* options);
 
 /// The noise model of every FRF (empty for --noise-model none), one line per

@@ -489,7 +489,7 @@ FrfNoise EstimateFrfNoise(const dynamics::Frf& frf, const NoiseOptions& o) {
       // The residual about the fit on every line, for the wide floor.
       Eigen::VectorXcd resid(n);
       for (int i = 0; i < n; ++i) resid(i) = frf.receptance()(i) - mf.Evaluate(frf.freq_hz()(i));
-      wide_floor2 = WideFloor2(dynamics::Frf::FromSamples(frf.freq_hz(), resid), signal, basis);
+      if (o.wide_floor) wide_floor2 = WideFloor2(dynamics::Frf::FromSamples(frf.freq_hz(), resid), signal, basis);
       const ScatterFit refined = FitTerms(frf, signal, basis, terms);
       // The first pass can only overstate rel (the signal's curvature adds
       // to the scatter); a second pass that raises it is describing the

@@ -22,7 +22,7 @@ void CheckValid(const DirectFrfFitOptions& o) {
 
 DirectFrfFit FitDirectFrf(const dynamics::Frf& measured, const DirectFrfFitOptions& o) {
   CheckValid(o);
-  DirectFrfFit out{measured, calibration::EstimateFrfNoise(measured, o.noise), {}, NAN, true, ""};
+  DirectFrfFit out{measured, calibration::EstimateFrfNoise(measured, o.noise), {}, NAN, true, "", 0.0, false, {}};
   std::vector<int> lines;
   for (int i = 0; i < measured.size(); ++i) {
     if (out.noise.usable[i]) lines.push_back(i);

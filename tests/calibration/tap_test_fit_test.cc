@@ -22,7 +22,9 @@ struct FitOfTap {
 
 FitOfTap FitTap(const testing::TapTest& t) {
   const dynamics::Frf frf = dynamics::Frf::FromSamples(t.freq_hz, t.measured);
-  FitOfTap out{EstimateFrfNoise(frf), {}};
+  NoiseOptions no;
+  no.wide_floor = true;  // a tap test with integrated-accelerometer drift
+  FitOfTap out{EstimateFrfNoise(frf, no), {}};
   std::vector<int> lines;
   for (int i = 0; i < frf.size(); ++i) {
     if (out.noise.usable[i]) lines.push_back(i);

@@ -49,6 +49,18 @@ struct NoiseOptions {
   /// Scatter estimate: a second pass about the modal fit of the usable
   /// lines (see EstimateFrfNoise).
   bool refine_with_modal_fit{true};
+  /// Scatter estimate with the modal-fit pass: also take the additive floor
+  /// from second differences over 8 and 16 lines of the residual about the
+  /// modal fit (the larger floor wins). A tap test's integrated-accelerometer
+  /// drift below ~100 Hz is smooth over a few lines, so the one-line second
+  /// differences take it for signal and a modal fit puts modes in it; the
+  /// wide ones see it as noise (issue #18). Off by default: where the model,
+  /// not the measurement, is smooth-wrong over a few lines (the residual of
+  /// a missing effect), the wide floor would count that misfit as noise and
+  /// hide the failure an audit looks for (issue #10's hidden tip mass is no
+  /// longer flagged with it on). stability-lobes --frf turns it on;
+  /// frf-calibrate and model-audit with --drift-floor.
+  bool wide_floor{false};
 };
 
 /// @throws std::invalid_argument naming the field for a bad option.

@@ -20,7 +20,14 @@
 namespace robomach::stability {
 
 struct DirectFrfFitOptions {
-  calibration::NoiseOptions noise;
+  /// The noise model of the measured FRF; the wide floor is on, since a
+  /// measured tool-tip FRF is typically a tap test whose integrated
+  /// accelerometer drifts below ~100 Hz (see NoiseOptions::wide_floor).
+  calibration::NoiseOptions noise = [] {
+    calibration::NoiseOptions n;
+    n.wide_floor = true;
+    return n;
+  }();
   calibration::ModalFitOptions fit;
   /// The fit is flagged poor when its residual on the usable lines, in
   /// units of the noise σ (rms of |H_fit − H| / σ, 1 for a perfect model),
