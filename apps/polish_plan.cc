@@ -75,7 +75,7 @@ int Run(int argc, char** argv) {
   double target_um = 0.0, offset_mm = 8.0, radius_mm = 6.0, pitch_mm = 3.0, sample_mm = 0.5, row_step_mm = 0.5;
   double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 0.3, edge_inset_mm = -1.0;
   int seed = 20240404, threads = 2;
-  double max_time_s = 50.0, stagger_loops = 0.5, line_angle_deg = 0.0;
+  double max_time_s = 50.0, stagger_loops = 0.5, line_angle_deg = 0.0, edge_overrun_mm = 0.0;
   RobotOptions robot;
   app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (formats.md §5)")->required();
   app.add_option("--face", face, "face of a STEP/IGES file (1-based, in the file's order); default: the largest by area");
@@ -104,6 +104,9 @@ int Run(int argc, char** argv) {
                                                   "the gap between two loops of the next row)")->capture_default_str();
   app.add_option("--line-angle-deg", line_angle_deg, "direction of the parallel guide lines / zig-zag rows in the developed "
                                                     "plane [deg], 0: along u (s), 90: along v (t)")->capture_default_str();
+  app.add_option("--edge-overrun-mm", edge_overrun_mm, "plain patches: how far guide lines / zig-zag rows run beyond the "
+                                                      "polished region into the margin [mm] (at most margin_mm - r, zig-zag margin_mm)")
+      ->capture_default_str();
   app.add_option("--max-time-s", max_time_s, "time budget of --optimise [s]; it stops earlier on convergence")->capture_default_str();
   app.add_option("--threads", threads, "threads of --optimise")->capture_default_str();
   app.add_option("--seed", seed, "PSO random seed")->capture_default_str();
@@ -131,6 +134,7 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--opt-offset-max-mm", opt_offset_max_mm, 1.0, 1000);
     CheckOptionRange("--opt-offset-min-contact-widths", opt_offset_min_cw, 0.2, 10.0);
     CheckOptionRange("--stagger-loops", stagger_loops, 0.0, 1.0);
+    CheckOptionRange("--edge-overrun-mm", edge_overrun_mm, 0.0, 1000.0);
     CheckOptionRange("--line-angle-deg", line_angle_deg, -360.0, 360.0);
     CheckOptionRange("--max-time-s", max_time_s, 1.0, 86400.0);
     CheckOptionRange("--threads", threads, 1, 64);
@@ -179,6 +183,7 @@ int Run(int argc, char** argv) {
     params.row_step = MmToM(row_step_mm);
     params.edge_inset = edge_inset_mm < 0 ? -1.0 : MmToM(edge_inset_mm);
     params.stagger = stagger_loops;
+    params.edge_overrun = MmToM(edge_overrun_mm);
     params.line_angle = line_angle_deg * kPi / 180.0;
     polishing::CheckValid(params);  // std::invalid_argument -> exit 64, naming the limit
 
@@ -242,6 +247,8 @@ int Run(int argc, char** argv) {
                             {"guides", c ? polishing::FamilyName({ev.params.guides, ev.params.line_angle})
                                          : polishing::FamilyName({polishing::GuideLines::kParallelLines, ev.params.line_angle})},
                             {"offset_mm", 1e3 * ev.params.offset},
+                            {"line_angle_deg", ev.params.line_angle * 180.0 / kPi},
+                            {"edge_overrun_mm", 1e3 * std::min(ev.params.edge_overrun, polishing::MaxEdgeOverrun(ev.params, process))},
                             {"cv", ev.cv},
                             {"mean_at_max_speed_um", 1e6 * ev.mean},
                             {"feasible", ev.feasible}};
@@ -267,7 +274,8 @@ int Run(int argc, char** argv) {
         opt_json["bounds"] = {{"offset_mm", {1e3 * oo.offset_min, 1e3 * oo.offset_max}},
                               {"radius_over_offset", {0.5, 1.0}},
                               {"pitch_over_radius", {0.5, kPi}},
-                              {"stagger_loops", {0.0, 1.0}}};
+                              {"stagger_loops", {0.0, 1.0}},
+                              {"edge_overrun_over_its_largest", {0.0, 1.0}}};
         nlohmann::json fams = nlohmann::json::array();
         for (const auto& f : opt.family_best) fams.push_back(family_json(f));
         opt_json["families"] = fams;
@@ -330,7 +338,8 @@ int Run(int argc, char** argv) {
         Warn(kTool, "the optimised zig-zag is better than the optimised cycloid: cv " + io::FormatDouble(z.stats.cv) +
                         (z_reached ? "" : " (target not reached)") + " against " + io::FormatDouble(e.stats.cv) +
                         (cycloid_ok ? "" : " (target not reached)") + "; plan it with --pattern parallel --offset-mm " +
-                        io::FormatDouble(1e3 * pp.offset) + " --line-angle-deg " + io::FormatDouble(pp.line_angle * 180.0 / kPi));
+                        io::FormatDouble(1e3 * pp.offset) + " --line-angle-deg " + io::FormatDouble(pp.line_angle * 180.0 / kPi) +
+                        " --edge-overrun-mm " + io::FormatDouble(1e3 * pp.edge_overrun));
       }
     }
     summary["removal_um"] = RemovalJson(e.stats);
@@ -341,6 +350,7 @@ int Run(int argc, char** argv) {
                              {"guides", guides_used},
                              {"line_angle_deg", params.line_angle * 180.0 / kPi},
                              {"stagger_loops", cyc ? params.stagger : 0.0},
+                             {"edge_overrun_mm", 1e3 * std::min(params.edge_overrun, polishing::MaxEdgeOverrun(params, process))},
                              {"offset_mm", 1e3 * params.offset},
                              {"radius_mm", cyc ? 1e3 * params.radius : 0.0},
                              {"pitch_mm", cyc ? 1e3 * params.pitch : 0.0},
@@ -371,6 +381,7 @@ int Run(int argc, char** argv) {
     if (robot.Check(kTool, process, e.path.rows, &summary)) flagged = true;
     std::vector<std::pair<std::string, std::string>> meta = {{"pattern", pattern}};
     meta.push_back({"offset_mm", io::FormatDouble(1e3 * params.offset)});
+    meta.push_back({"edge_overrun_mm", io::FormatDouble(1e3 * std::min(params.edge_overrun, polishing::MaxEdgeOverrun(params, process)))});
     if (cyc) {
       meta.push_back({"guides", guides_used});
       meta.push_back({"radius_mm", io::FormatDouble(1e3 * params.radius)});

@@ -266,19 +266,21 @@ class Book {
   double best_cv_{std::numeric_limits<double>::quiet_NaN()};
 };
 
-constexpr int kDim = 4;  // d, r/d, pitch/r, stagger
+constexpr int kDim = 5;  // d, r/d, pitch/r, stagger, edge overrun / its largest value
 
 PathParameters CycloidFromUnit(const double* x, const PathParameters& base, const GuideFamily& fam,
-                               const PlanOptimiseOptions& o) {
+                               const PlanOptimiseOptions& o, const PolishingProcess& process) {
   PathParameters p = base;
   p.pattern = Pattern::kCycloid;
   p.guides = fam.guides;
   p.line_angle = fam.line_angle;
-  p.offset = o.offset_min + std::clamp(x[0], 0.0, 1.0) * (o.offset_max - o.offset_min);
+  // d on a log scale: the good spacings are a few contact widths or less,
+  // and a step in d matters relative to d.
+  p.offset = o.offset_min * std::pow(o.offset_max / o.offset_min, std::clamp(x[0], 0.0, 1.0));
   p.radius = p.offset * (kRatioMin + std::clamp(x[1], 0.0, 1.0) * (kRatioMax - kRatioMin));
-  // Just below pi r at the top: pitch < 2 pi r holds with room.
   p.pitch = p.radius * (kPitchMin + std::clamp(x[2], 0.0, 1.0) * (kPitchMax - kPitchMin));
   p.stagger = std::clamp(x[3], 0.0, 1.0);
+  p.edge_overrun = std::clamp(x[4], 0.0, 1.0) * MaxEdgeOverrun(p, process);
   return p;
 }
 
@@ -299,7 +301,7 @@ struct LocalRun {
   const PlanEvaluation& At(const double* x) {
     if (last_x.size() == kDim && std::equal(last_x.begin(), last_x.end(), x)) return last;
     last_x.assign(x, x + kDim);
-    last = book->Evaluate(CycloidFromUnit(x, *base, fam, *o));
+    last = book->Evaluate(CycloidFromUnit(x, *base, fam, *o, *pb->process));
     if (!have_best || Better(last, best)) best = last, have_best = true;
     return last;
   }
@@ -316,11 +318,13 @@ struct LocalRun {
   }
 };
 
-std::vector<double> CycloidToUnit(const PathParameters& p, const PlanOptimiseOptions& o) {
-  return {std::clamp((p.offset - o.offset_min) / (o.offset_max - o.offset_min), 0.0, 1.0),
+std::vector<double> CycloidToUnit(const PathParameters& p, const PlanOptimiseOptions& o, const PolishingProcess& process) {
+  const double max_over = MaxEdgeOverrun(p, process);
+  return {std::clamp(std::log(p.offset / o.offset_min) / std::log(o.offset_max / o.offset_min), 0.0, 1.0),
           std::clamp((p.radius / p.offset - kRatioMin) / (kRatioMax - kRatioMin), 0.0, 1.0),
           std::clamp((p.pitch / p.radius - kPitchMin) / (kPitchMax - kPitchMin), 0.0, 1.0),
-          std::clamp(p.stagger, 0.0, 1.0)};
+          std::clamp(p.stagger, 0.0, 1.0),
+          max_over > 0 ? std::clamp(p.edge_overrun / max_over, 0.0, 1.0) : 0.0};
 }
 
 bool SameFamily(const PathParameters& p, const GuideFamily& f) {
@@ -334,11 +338,14 @@ PlanEvaluation OptimiseParallel(const PlanProblem& pb, const PathParameters& sta
   const double w = pb.contact_width;
   std::vector<PathParameters> scan;
   for (double angle : {0.0, kPi / 2}) {
-    for (int k = 0; k < 25; ++k) {
-      PathParameters p = base;
-      p.line_angle = angle;
-      p.offset = (0.3 + 0.05 * k) * w;
-      scan.push_back(p);
+    for (double over : {0.0, 0.5, 1.0}) {
+      for (int k = 0; k < 13; ++k) {
+        PathParameters p = base;
+        p.line_angle = angle;
+        p.offset = (0.3 + 0.1 * k) * w;
+        p.edge_overrun = over * pb.process->margin;
+        scan.push_back(p);
+      }
     }
   }
   std::vector<PlanEvaluation> ev = book->Batch(scan);
@@ -371,7 +378,7 @@ PlanEvaluation OptimiseParallel(const PlanProblem& pb, const PathParameters& sta
       }
       return e.feasible ? -e.cv : -10.0 - e.mean / std::max(pb.target, 1e-30);
     };
-    GoldenSectionMaximum(f, std::max(0.3, w0 - 0.05), std::min(1.5, w0 + 0.05), 8, 1e-3);
+    GoldenSectionMaximum(f, std::max(0.3, w0 - 0.1), std::min(1.5, w0 + 0.1), 8, 1e-3);
   });
   return best;
 }
@@ -385,8 +392,8 @@ PlanOptimiseResult OptimisePlan(const PlanProblem& pb, const PathParameters& sta
   if (!cyc || o.compare_parallel) res.best_parallel = OptimiseParallel(pb, start, &book);
   if (!cyc) {
     res.best = res.best_parallel;
-    res.method = "zig-zag row spacing: 25-point scan on [0.3, 1.5] contact widths and golden-section refinement, "
-                 "rows along s and along t";
+    res.method = "zig-zag: row spacing scanned on [0.3, 1.5] contact widths (13 points) x edge overrun (0, 0.5, 1 "
+                 "margin) x rows along s and t, then golden-section refinement of the spacing";
     res.status = book.OutOfTime() ? "max_time" : "converged";
     res.seconds = book.Elapsed();
     return res;
@@ -423,14 +430,16 @@ PlanOptimiseResult OptimisePlan(const PlanProblem& pb, const PathParameters& sta
     res.status = r.status;
   } else {
     // 1. Coarse grid per family at the half-loop stagger.
-    const double gd[] = {0.05, 0.3, 0.6}, gr[] = {0.3, 1.0}, gp[] = {0.15, 0.5, 0.85};
+    const double gd[] = {0.0, 0.2, 0.45}, gr[] = {0.3, 1.0}, gp[] = {0.15, 0.5, 0.85};
     std::vector<PathParameters> grid_pts;
     for (const GuideFamily& f : fams)
       for (double a : gd)
         for (double b : gr)
           for (double c : gp) {
-            const double x[kDim] = {a, b, c, 0.5};
-            grid_pts.push_back(CycloidFromUnit(x, start, f, o));
+            {
+              const double x[kDim] = {a, b, c, 0.5, 1.0};  // rows to the patch's edge
+              grid_pts.push_back(CycloidFromUnit(x, start, f, o, *pb.process));
+            }
           }
     std::vector<PlanEvaluation> ev = book.Batch(grid_pts);
     {
@@ -440,11 +449,14 @@ PlanOptimiseResult OptimisePlan(const PlanProblem& pb, const PathParameters& sta
     for (const auto& e : ev) consider(e);
     // 2. Starts: the best of each family, then the next best overall.
     std::sort(ev.begin(), ev.end(), Better);
+    // A family whose best grid point is far behind the best (cv > 1.5 x,
+    // or infeasible when a feasible point exists) gets no local search.
     std::vector<PlanEvaluation> starts;
     for (const GuideFamily& f : fams) {
       for (const auto& e : ev)
         if (e.valid && SameFamily(e.params, f)) {
-          starts.push_back(e);
+          const bool close = !ev[0].feasible || (e.feasible && e.cv <= 1.5 * ev[0].cv);
+          if (close && static_cast<int>(starts.size()) < std::max(o.starts, 1)) starts.push_back(e);
           break;
         }
     }
@@ -470,11 +482,11 @@ PlanOptimiseResult OptimisePlan(const PlanProblem& pb, const PathParameters& sta
       opt.set_min_objective(LocalRun::Objective, &run);
       opt.add_inequality_constraint(LocalRun::Constraint, &run, 1e-4);
       opt.set_ftol_rel(o.ftol_rel);
-      opt.set_xtol_abs(2e-3);  // 2e-3 of the box: 0.05 mm of d, below the grid's resolution
+      opt.set_xtol_abs(5e-3);  // 5e-3 of the box: ~1 % of d, below what the grid resolves
       opt.set_maxeval(o.max_local_evaluations);
       opt.set_maxtime(std::max(0.1, book.Remaining()));
-      opt.set_initial_step(std::vector<double>{0.08, 0.15, 0.1, 0.15});
-      std::vector<double> x = CycloidToUnit(starts[i].params, o);
+      opt.set_initial_step(std::vector<double>{0.08, 0.15, 0.1, 0.15, 0.25});
+      std::vector<double> x = CycloidToUnit(starts[i].params, o, *pb.process);
       double f = 0;
       std::string st;
       try {

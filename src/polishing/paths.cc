@@ -84,6 +84,10 @@ void StraightMove(const Mapper& m, const Vec2& a, const Vec2& b, const Vec2& tan
 
 }  // namespace
 
+double MaxEdgeOverrun(const PathParameters& p, const PolishingProcess& process) {
+  return p.pattern == Pattern::kCycloid ? std::max(0.0, process.margin - p.radius) : process.margin;
+}
+
 void CheckValid(const PathParameters& p) {
   auto fail = [](const std::string& m) { throw std::invalid_argument(m); };
   auto mm = [](double x) {
@@ -138,7 +142,9 @@ std::vector<GuideSpec> RectangleGuides(const SampleGrid& grid, const PathParamet
     // the boundary band was the largest source of non-uniformity (README).
     const double half_min = std::min(W, H) / 2;
     const double e = std::min(half_min, params.edge_inset >= 0 ? params.edge_inset
-                                                                : std::max(0.0, r - process.margin));
+                                        : r >= process.margin ? r - process.margin
+                                                              : -std::min(std::max(0.0, params.edge_overrun),
+                                                                          MaxEdgeOverrun(params, process)));
     const int n = std::max(1, static_cast<int>(std::ceil((half_min - e) / d - 1e-9)));
     const double de = (half_min - e) / n;
     for (int k = 0; k < n; ++k) {
@@ -390,7 +396,8 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   const double ca = std::cos(params.line_angle), sa = std::sin(params.line_angle);
   const Vec2 e_dir(ca, sa), nrm(-sa, ca);
   const bool rotated = parallel_lines && std::abs(params.line_angle) > 1e-12;
-  if (region.rectangle() && !rotated) guides = RectangleGuides(grid, params, process);
+  const double overrun = region.rectangle() ? std::clamp(params.edge_overrun, 0.0, MaxEdgeOverrun(params, process)) : 0.0;
+  if (region.rectangle() && !(parallel_lines && (rotated || overrun > 0))) guides = RectangleGuides(grid, params, process);
   else if (region.loops().empty()) throw std::invalid_argument("the polished region is empty (margin too large for the face)");
   else if (parallel_lines) {
     // Lines along e_dir: laid out along s in the region turned by -angle,
@@ -399,7 +406,13 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
     std::vector<Polygon2> loops = region.loops();
     for (auto& loop : loops)
       for (auto& x : loop) x = turn(x, ca, -sa);
-    const DevelopedRegion turned = rotated ? DevelopedRegion::FromPolygons(loops) : region;
+    DevelopedRegion turned = rotated ? DevelopedRegion::FromPolygons(loops) : region;
+    if (overrun > 0 && turned.rectangle()) {
+      // The lines (rows) run `overrun` into the margin all round.
+      const Eigen::Vector4d b = turned.Bounds();
+      const double x0 = b(0) - overrun, y0 = b(1) - overrun, x1 = b(2) + overrun, y1 = b(3) + overrun;
+      turned = DevelopedRegion::FromPolygons({{Vec2(x0, y0), Vec2(x1, y0), Vec2(x1, y1), Vec2(x0, y1)}});
+    }
     if (cyc && !region.rectangle()) {
       // Cycloids along the lines: the lines stop the inset short of the
       // boundary, holes included, so that the circle stays on the face.

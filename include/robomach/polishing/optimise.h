@@ -128,8 +128,8 @@ struct PlanOptimiseOptions {
   std::vector<GuideFamily> families;
   double offset_min{0.004}, offset_max{0.030};  // cycloid d bounds [m]
   double feasibility_margin{0.98};  // grid difference optimiser -> final grid
-  int starts{4};                    // local searches
-  double ftol_rel{2e-3};            // local stop: relative change of the cv
+  int starts{3};                    // local searches
+  double ftol_rel{5e-3};            // local stop: relative change of the cv
   int max_local_evaluations{120};   // per local search (a safety net)
   double max_time_s{50.0};          // all of it
   int threads{2};

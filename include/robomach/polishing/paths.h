@@ -54,7 +54,17 @@ struct PathParameters {
   /// Direction of the parallel guide lines (cycloid) and of the zig-zag's
   /// rows in the developed (s, t) plane [rad], 0: along s, pi/2: along t.
   double line_angle{0.0};
+  /// Plain patches (rectangular regions): how far the guide lines (the
+  /// zig-zag's rows) run beyond the polished region into the margin [m],
+  /// at most margin - r for the cycloid (the circle stays on the patch) and
+  /// margin for the zig-zag (PlanPath clips to that). Boundary offsets: the
+  /// outermost loop that far outside the region. Rows that stop at the
+  /// region's edge leave it half polished (issue 19). Ignored on trimmed faces.
+  double edge_overrun{0.0};
 };
+
+/// The largest edge_overrun PlanPath uses for `p` [m].
+double MaxEdgeOverrun(const PathParameters& p, const PolishingProcess& process);
 
 /// Seed 004 §3.2 feasibility limits in this parametrisation: d <= 2 r
 /// (no unpolished strip between rows, Fig. 10), 0.5 d <= r <= d (limit 3),
