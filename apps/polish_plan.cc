@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <sstream>
 
@@ -239,8 +240,17 @@ int Run(int argc, char** argv) {
       }
       params = opt.best.params;
       params.row_step = MmToM(row_step_mm);
-      history = opt.best_history;
-      evaluated = opt.cv_history;
+      // The convergence plot: the optimised pattern's evaluations only (the
+      // zig-zag's, made for the comparison, are in the summary's counts).
+      double best_so_far = std::numeric_limits<double>::quiet_NaN();
+      for (size_t i = 0; i < opt.cv_history.size(); ++i) {
+        const bool par = opt.history_parallel[i] != 0;
+        if (par != (params.pattern == polishing::Pattern::kParallel)) continue;
+        const double cv = opt.cv_history[i];
+        if (std::isfinite(cv) && !(cv >= best_so_far)) best_so_far = cv;
+        evaluated.push_back(cv);
+        history.push_back(best_so_far);
+      }
       auto family_json = [&](const polishing::PlanEvaluation& ev) {
         const bool c = ev.params.pattern == polishing::Pattern::kCycloid;
         nlohmann::json j = {{"pattern", c ? "cycloid" : "parallel"},
@@ -251,6 +261,7 @@ int Run(int argc, char** argv) {
                             {"edge_overrun_mm", 1e3 * std::min(ev.params.edge_overrun, polishing::MaxEdgeOverrun(ev.params, process))},
                             {"cv", ev.cv},
                             {"mean_at_max_speed_um", 1e6 * ev.mean},
+                            {"coverage", ev.coverage},
                             {"feasible", ev.feasible}};
         if (c) {
           j["radius_mm"] = 1e3 * ev.params.radius;
@@ -270,6 +281,8 @@ int Run(int argc, char** argv) {
                   {"best_cv", opt.best.cv},
                   {"feasible", opt.best.feasible},
                   {"best", family_json(opt.best)}};
+      opt_json["history"] = history;      // best feasible cv so far (null before the first)
+      opt_json["history_cv"] = evaluated; // each evaluation's cv (null: infeasible)
       if (params.pattern == polishing::Pattern::kCycloid) {
         opt_json["bounds"] = {{"offset_mm", {1e3 * oo.offset_min, 1e3 * oo.offset_max}},
                               {"radius_over_offset", {0.5, 1.0}},
@@ -285,8 +298,9 @@ int Run(int argc, char** argv) {
         flagged = true;
         const std::string m = target_um > 0
             ? "no plan the optimiser saw reaches the target removal " + io::FormatDouble(target_um) +
-                  " um within max_speed_mm_per_s: every one removes more at the limit (least: " +
-                  io::FormatDouble(1e6 * opt.best.mean) + " um); the least infeasible is written"
+                  " um within max_speed_mm_per_s and covers the region: every covering one removes more at the "
+                  "limit (written: the least infeasible, " + io::FormatDouble(1e6 * opt.best.mean) +
+                  " um at the limit, coverage " + io::FormatDouble(opt.best.coverage) + ")"
             : "the optimiser found no feasible plan";
         opt_json["message"] = m;
         Warn(kTool, m);

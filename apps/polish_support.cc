@@ -191,6 +191,7 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
     auto& a3 = fc.at(0, 0);
     a3.x_label = "iteration / evaluation";
     a3.y_label = "cv of removal";
+    a3.log_y = true;  // the best is 10-100 x below the first and the worst evaluations
     if (!evaluated.empty()) {
       report::Series e;
       e.color = report::PaletteColor(0);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <atomic>
+#include <cstdio>
 #include <chrono>
 #include <exception>
 #include <mutex>
@@ -168,7 +169,8 @@ PlanEvaluation EvaluatePlan(const PlanProblem& pb, const PathParameters& p, doub
     if (!e.valid) e.error = "the path removes nothing in the region";
     e.cv = st.cv;
     e.mean = st.mean;
-    e.feasible = e.valid && (pb.target <= 0 || st.mean <= margin * pb.target);
+    e.coverage = st.coverage;
+    e.feasible = e.valid && (pb.target <= 0 || st.mean <= margin * pb.target) && st.coverage >= kMinCoverage;
   } catch (const std::invalid_argument& err) {
     e.valid = false;
     e.error = err.what();
@@ -188,12 +190,20 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+std::string io_ftol(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
 // Ranks evaluations: feasible before infeasible; feasible by cv; infeasible
 // by how far they miss the target (mean), invalid last.
 bool Better(const PlanEvaluation& a, const PlanEvaluation& b) {
   if (a.feasible != b.feasible) return a.feasible;
   if (a.feasible) return a.cv < b.cv;
   if (a.valid != b.valid) return a.valid;
+  const bool ca = a.coverage >= kMinCoverage, cb = b.coverage >= kMinCoverage;
+  if (ca != cb) return ca;
   return a.mean < b.mean;
 }
 
@@ -212,6 +222,7 @@ class Book {
     ++res_.evaluations;
     const double nan = std::numeric_limits<double>::quiet_NaN();
     res_.cv_history.push_back(e.feasible ? e.cv : nan);
+    res_.history_parallel.push_back(p.pattern == Pattern::kParallel);
     if (e.feasible && (!std::isfinite(best_cv_) || e.cv < best_cv_)) best_cv_ = e.cv;
     res_.best_history.push_back(std::isfinite(best_cv_) ? best_cv_ : nan);
     if (o_.progress) o_.progress(res_.evaluations, best_cv_, Elapsed());
@@ -315,6 +326,10 @@ struct LocalRun {
     if (r->pb->target <= 0) return -1.0;
     if (!e.valid) return 1.0;
     return e.mean / (r->o->feasibility_margin * r->pb->target) - 1.0;
+  }
+  static double CoverageConstraint(unsigned, const double* x, double*, void* data) {
+    const PlanEvaluation& e = static_cast<LocalRun*>(data)->At(x);
+    return e.valid ? kMinCoverage - e.coverage : 1.0;
   }
 };
 
@@ -473,20 +488,21 @@ PlanOptimiseResult OptimisePlan(const PlanProblem& pb, const PathParameters& sta
     std::mutex mu;
     int converged = 0, ran = 0;
     std::vector<std::string> statuses;
-    book.RunParallel(static_cast<int>(starts.size()), [&](int i) {
-      if (book.OutOfTime()) return;
-      LocalRun run{&book, &start, {starts[i].params.guides, starts[i].params.line_angle}, &o, &pb, {}, {}, {}, false};
+    // One COBYLA run from `from`; returns its status and records its best.
+    auto local = [&](const PathParameters& from) {
+      LocalRun run{&book, &start, {from.guides, from.line_angle}, &o, &pb, {}, {}, {}, false};
       nlopt::opt opt(nlopt::LN_COBYLA, kDim);
       opt.set_lower_bounds(std::vector<double>(kDim, 0.0));
       opt.set_upper_bounds(std::vector<double>(kDim, 1.0));
       opt.set_min_objective(LocalRun::Objective, &run);
       opt.add_inequality_constraint(LocalRun::Constraint, &run, 1e-4);
+      opt.add_inequality_constraint(LocalRun::CoverageConstraint, &run, 1e-4);
       opt.set_ftol_rel(o.ftol_rel);
       opt.set_xtol_abs(5e-3);  // 5e-3 of the box: ~1 % of d, below what the grid resolves
       opt.set_maxeval(o.max_local_evaluations);
       opt.set_maxtime(std::max(0.1, book.Remaining()));
       opt.set_initial_step(std::vector<double>{0.08, 0.15, 0.1, 0.15, 0.25});
-      std::vector<double> x = CycloidToUnit(starts[i].params, o, *pb.process);
+      std::vector<double> x = CycloidToUnit(from, o, *pb.process);
       double f = 0;
       std::string st;
       try {
@@ -507,17 +523,35 @@ PlanOptimiseResult OptimisePlan(const PlanProblem& pb, const PathParameters& sta
         consider(run.best);
         ev.push_back(run.best);
       }
+    };
+    book.RunParallel(static_cast<int>(starts.size()), [&](int i) {
+      if (!book.OutOfTime()) local(starts[i].params);
     });
+    // 3. Restarts from the best point (COBYLA's simplex shrinks early on a
+    // sampled objective): a fresh run from it and one a quarter loop of
+    // stagger away (the stagger's landscape has several valleys), repeated
+    // while the best improves by more than ftol_rel.
+    for (int round = 0; round < 5 && have && best.feasible && !book.OutOfTime(); ++round) {
+      const double before = best.cv;
+      const PathParameters b = best.params;
+      book.RunParallel(2, [&](int i) {
+        if (book.OutOfTime()) return;
+        PathParameters from = b;
+        if (i == 1) from.stagger = std::fmod(b.stagger + (round % 2 ? 0.75 : 0.25), 1.0);
+        local(from);
+      });
+      if (!(best.cv < before * (1 - o.ftol_rel))) break;
+    }
     res.local_searches = ran;
     res.local_converged = converged;
     res.status = ran == 0 ? "max_time" : converged == ran ? "converged" : "max_time";
     for (const auto& s : statuses)
       if (s == "max_evaluations") res.status = "max_evaluations";
-    if (ran < static_cast<int>(starts.size())) res.status = "max_time";
+    if (ran < static_cast<int>(starts.size()) || book.OutOfTime()) res.status = "max_time";
     res.method = "NLopt: coarse grid over (d, r/d, pitch/r) for each guide family (" + std::to_string(fams.size()) +
                  "), then COBYLA from " + std::to_string(starts.size()) +
-                 " starts over (d, r/d, pitch/r, stagger) with the target as a constraint, ftol_rel " +
-                 std::to_string(o.ftol_rel);
+                 " starts over (d, r/d, pitch/r, stagger, edge overrun) with the target as a constraint, then restarts "
+                 "from the best while it improves; ftol_rel " + io_ftol(o.ftol_rel);
     // Best per family, from the grid and the local searches.
     for (const GuideFamily& f : fams) {
       PlanEvaluation fb;

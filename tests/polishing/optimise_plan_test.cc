@@ -181,15 +181,20 @@ Outcome RunCase(const std::string& name, NurbsSurface surface) {
   const auto t3 = std::chrono::steady_clock::now();
   std::sort(pts.begin(), pts.end(), [](const PlanEvaluation& a, const PlanEvaluation& b) { return a.cv < b.cv; });
   double grid_best = 1e300;
+  PathParameters gb;
   for (size_t i = 0; i < std::min<size_t>(6, pts.size()); ++i) {
     PathParameters p = pts[i].params;
     p.row_step = 1e-3;
     const PlanEvaluation e = EvaluatePlan(fine, p, 0.98);
-    if (e.feasible) grid_best = std::min(grid_best, e.cv);
+    if (e.feasible && e.cv < grid_best) grid_best = e.cv, gb = p;
   }
+  std::cout << name << ": grid search best " << FamilyName({gb.guides, gb.line_angle}) << ", d " << 1e3 * gb.offset
+            << " r " << 1e3 * gb.radius << " pitch " << 1e3 * gb.pitch << " mm, stagger " << gb.stagger
+            << ", overrun " << 1e3 * gb.edge_overrun << " mm\n";
   std::cout << name << ": NLopt cycloid cv " << best.cv << " (" << FamilyName({best.params.guides, best.params.line_angle})
             << ", d " << 1e3 * best.params.offset << " r " << 1e3 * best.params.radius << " pitch "
-            << 1e3 * best.params.pitch << " mm, stagger " << best.params.stagger << "; removes " << 1e6 * best.mean
+            << 1e3 * best.params.pitch << " mm, stagger " << best.params.stagger << ", overrun "
+            << 1e3 * best.params.edge_overrun << " mm; removes " << 1e6 * best.mean
             << " um at the limit, " << r.evaluations << " evaluations, " << secs << " s, " << r.status
             << "), zig-zag cv " << par << ", grid search cv " << grid_best << " (" << pts.size()
             << " feasible points); zig-zag scan " << std::chrono::duration<double>(t2 - t1).count()

@@ -64,24 +64,34 @@ OptimiseResult OptimiseCycloid(const std::function<double(const PathParameters&)
 // A plan is evaluated on the optimiser's (coarse) grid, planned at the speed
 // limit: it removes `mean` there, the least any speed within the limit
 // gives. It is feasible if mean <= feasibility_margin x target (no target:
-// always): slowing down then reaches the target exactly.
+// always): slowing down then reaches the target exactly; and if it covers
+// the region (coverage >= kMinCoverage, polish-plan's warning threshold: a
+// plan that barely touches the region reaches any small target).
 //
-// Cycloid: the variables are, in the unit box, d in [offset_min,
-// offset_max], r/d in [0.5, 1], pitch/r in [0.5, pi] (OptimiseCycloid's
-// box) and the stagger in [0, 1] loops; the guide family is a discrete
-// choice, each tried: boundary offsets, parallel lines along s, parallel
-// lines along t (those given in `families`). Method (NLopt):
-//  1. a coarse grid per family (d x r/d x pitch/r at the half-loop stagger);
-//  2. multi-start: from the best feasible grid point of each family and the
-//     next-best points overall (`starts` in all), COBYLA (LN_COBYLA) with
-//     the constraint mean / (margin target) - 1 <= 0 and the cv as the
-//     objective, each run stopping on a relative change of the cv below
-//     ftol_rel (or on max_local_evaluations), all under max_time_s;
-//  3. the best feasible evaluation seen anywhere is returned; only if none
-//     was seen, the least infeasible one (feasible = false).
-// The zig-zag (and the cycloid's comparison): the row spacing on [0.3, 1.5]
-// contact widths, a 25-point scan and a golden-section refinement, along s
-// and along t, the best feasible kept.
+// Cycloid: the variables are, in the unit box, d on a log scale over
+// [offset_min, offset_max], r/d in [0.5, 1], pitch/r in [0.5, pi]
+// (OptimiseCycloid's box), the stagger in [0, 1] loops and the edge overrun
+// in [0, 1] x MaxEdgeOverrun; the guide family is a discrete choice, each
+// tried: boundary offsets, parallel lines along s, parallel lines along t
+// (those given in `families`). Method (NLopt):
+//  1. a coarse grid per family (d x r/d x pitch/r = 3 x 2 x 3 at the
+//     half-loop stagger and full overrun), plus the start plan;
+//  2. multi-start: from the best grid point of each family within 1.5 x of
+//     the best, then the next best points (`starts` in all), COBYLA
+//     (LN_COBYLA) with the constraint mean / (margin target) - 1 <= 0 and
+//     the cv as the objective, each run stopping on a relative change of
+//     the cv below ftol_rel (or x below 0.005 of the box, or
+//     max_local_evaluations);
+//  3. restarts from the best point, a fresh run and one a quarter loop of
+//     stagger away, while the best improves by more than ftol_rel (at most
+//     5 rounds);
+//  all under max_time_s; the best feasible evaluation seen anywhere is
+//  returned; only if none was seen, the least infeasible one (feasible =
+//  false).
+// The zig-zag (and the cycloid's comparison): the row spacing scanned on
+// [0.3, 1.5] contact widths (13 points) x edge overrun (0, 0.5, 1 margin) x
+// rows along s and t, then a golden-section refinement of the spacing per
+// direction; the best feasible kept.
 // PSO: OptimiseCycloid's seed PSO on the first family, the same
 // feasibility bookkeeping.
 // Evaluations run on `threads` threads (the simulator is immutable).
@@ -89,6 +99,8 @@ OptimiseResult OptimiseCycloid(const std::function<double(const PathParameters&)
 
 class RemovalSimulator;
 struct PolishingProcess;
+
+constexpr double kMinCoverage = 0.99;
 
 /// What is optimised: plans on `grid` simulated by `sim` (built on the same grid).
 struct PlanProblem {
@@ -106,6 +118,7 @@ struct PlanEvaluation {
   bool feasible{false};  // valid and reaches the target within the speed limit
   double cv{0.0};        // cv of the removal at the speed limit
   double mean{0.0};      // mean removal at the speed limit [m]
+  double coverage{0.0};  // RemovalStats::coverage
   std::string error;     // why not valid
 };
 
@@ -147,6 +160,8 @@ struct PlanOptimiseResult {
   /// Per evaluation, in order: its cv if feasible (NaN if not), and the
   /// best feasible cv so far (NaN before the first feasible one).
   std::vector<double> cv_history, best_history;
+  /// Per evaluation: 1 if it was a zig-zag (the cycloid's comparison).
+  std::vector<char> history_parallel;
   int evaluations{0};
   int local_searches{0}, local_converged{0};
   std::string status;  // "converged" (every local search met ftol_rel), "max_time", "max_evaluations"
