@@ -24,9 +24,9 @@
 // 0.0065 at 1 mm and 0.0188 at 0.5 mm).
 // The ratios 0.9 and 1.1 are the acceptance, not tolerances.
 // These are the long polishing tests (OptimisePlanLong.*, in their own
-// executable polishing_optimise_tests): 222, 345 and 146 s for the three
-// surfaces on the shared 2-core machine at load ~8 (so roughly a third of
-// that on an idle core); the grid search is 1008 plans per surface.
+// executable polishing_optimise_tests): 46, 142 and 92 s for the three
+// surfaces on the shared 2-core machine at load ~4 (2 optimiser threads);
+// the grid search is 1008 plans per surface.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
