@@ -38,11 +38,12 @@ int Run(int argc, char** argv) {
       "axis-accuracy: ISO 230-2 figures per axis (A, A_up, A_down, E, E_up, E_down, M, R, R_up, R_down, B,\n"
       "B_mean, in the file's unit) and per target from positioning runs (formats.md §8.6), with the standard\n"
       "chart: mean deviation and +-2s bands per approach direction over the targets."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string runs_path, out_path, plot_path;
   app.add_option("--runs", runs_path, "runs CSV axis,target_mm,run,direction,measured_mm (or _deg)")->required();
   app.add_option("--out", out_path, "ISO 230-2 JSON (stdout if omitted)");
-  app.add_option("--plot", plot_path, "PNG chart, one panel per axis");
+  app.add_option("--plot", plot_path, "PNG chart, one panel per axis")->check(PngFileName());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

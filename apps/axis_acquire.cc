@@ -50,6 +50,7 @@ int Run(int argc, char** argv) {
       "measured = origin + count x resolution (eq. 1); real = measured + the controller's compensation\n"
       "($AA_ENC_COMP, $AN_CEC, temperature; eqs. 2-5); then the machine's kinematics with its rotary errors\n"
       "(formats.md §8.3). With --program, the contour error of every sample against the programmed polyline."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string machine_path, counts_path, comp_path, temp_path, program_path, out_path, summary_path, plot_path;
   app.add_option("--machine", machine_path, "machine file YAML (formats.md §8.3)")->required();
@@ -59,7 +60,7 @@ int Run(int argc, char** argv) {
   app.add_option("--program", program_path, "programmed path CSV x_mm,y_mm,z_mm,i,j,k (workpiece coordinates)");
   app.add_option("--out", out_path, "acquired path CSV (formats.md §8.5)")->required();
   app.add_option("--summary", summary_path, "summary JSON (rows, duration, contour error statistics)");
-  app.add_option("--plot", plot_path, "PNG of the contour error along the path (needs --program)");
+  app.add_option("--plot", plot_path, "PNG of the contour error along the path (needs --program)")->check(PngFileName());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

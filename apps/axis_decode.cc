@@ -25,6 +25,7 @@ int Run(int argc, char** argv) {
       "axis-decode: decode a raw quadrature capture (formats.md §8.2: little-endian uint16 words, bits 2k/2k+1 =\n"
       "A/B of the k-th axis of the machine file) into encoder counts (formats.md §8.1), 4x, with error events\n"
       "(A and B of one axis changing in one sample) counted per axis. Streams captures of any size."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() + "\nExit 3: outputs written, but the capture had error events (positions uncertain).");
   std::string machine_path, capture_path, out_path, summary_path;
   double rate_hz = 0.0;

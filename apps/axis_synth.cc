@@ -27,6 +27,7 @@ int Run(int argc, char** argv) {
       "temperature log) is undone to get the measured positions, quantised to counts of each axis's resolution.\n"
       "The first counts row is the reference position: the machine file's origins must be the measured start\n"
       "position, or --machine-out writes a copy of the machine file with those origins."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string machine_path, program_path, comp_path, temp_path, out_path, machine_out, capture_path;
   double feed_mm_min = 2000.0, rate_hz = 8000.0, dwell_s = 0.0, start_b_deg = -90.0, glitch_p = 0.0;

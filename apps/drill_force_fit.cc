@@ -94,6 +94,7 @@ void Plot(const std::string& path, const io::ForceTableFile& table,
 int RunDrillForceFit(int argc, char** argv) {
   CLI::App app{"drill-force-fit: fit the twist-drill force model (oblique-cutting lips, dynamic "
                "rake, Kienzle size effect; seed 003) to a thrust/torque table"};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string table_path, drill_path, out_path, plot_path, predict_path, predictions_path;
   std::string chisel = "seed_scaling";
@@ -104,7 +105,7 @@ int RunDrillForceFit(int argc, char** argv) {
   app.add_option("--drill", drill_path,
                  "drill YAML (formats.md 9.2); a row's diameter_mm overrides the drill's")->required();
   app.add_option("--out", out_path, "material YAML with the fitted coefficients; stdout if omitted");
-  app.add_option("--plot", plot_path, "PNG: measured and model thrust and torque against feed, one curve per diameter");
+  app.add_option("--plot", plot_path, "PNG: measured and model thrust and torque against feed, one curve per diameter")->check(PngFileName());
   app.add_option("--predict", predict_path, "CSV of rows to predict (diameter_mm, feed_mm_per_rev[, speed_rpm])");
   app.add_option("--predictions", predictions_path, "CSV written for --predict: diameter_mm, feed_mm_per_rev, thrust_N, torque_Nm[, speed_rpm]");
   app.add_option("--chisel", chisel, "chisel-edge model: seed_scaling (F_A = 2.5 F_L, T_A = 1.67 T), orthogonal, none")

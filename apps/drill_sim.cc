@@ -22,6 +22,7 @@
 #include "robomach/io/drilling_files.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
+#include "robomach/report/posture_json.h"
 
 namespace robomach::apps {
 namespace {
@@ -153,6 +154,7 @@ void Plot(const std::string& path, const std::vector<Run>& runs, int n) {
 int RunDrillSim(int argc, char** argv) {
   CLI::App app{"drill-sim: flexible-joint robot drilling a hole (seed 003): joint deflection, "
                "drill tilt and forces under PID, PD or PD with time-delay estimation"};
+  AddVersionFlag(app, kTool);
   app.footer("With several controllers each output gets the controller's name before its "
              "extension (run.csv -> run_pid.csv, run_pd-tdc.csv); the plot overlays them.\n" +
              ExitCodeHelp());
@@ -179,7 +181,7 @@ int RunDrillSim(int argc, char** argv) {
                  "or q'' (pd-tdc), default 0.005; the starting point of --tune");
   app.add_option("--out", out_path, "time series CSV (formats.md 9.4)");
   app.add_option("--summary", summary_path, "summary JSON (formats.md 9.4); stdout if neither --out nor --summary");
-  app.add_option("--plot", plot_path, "PNG: joint errors, drill offset, thrust, torque per controller");
+  app.add_option("--plot", plot_path, "PNG: joint errors, drill offset, thrust, torque per controller")->check(PngFileName());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -298,9 +300,9 @@ int RunDrillSim(int argc, char** argv) {
       const nlohmann::json j = Summary(run, *sc, limit);
       if (!out_path.empty()) io::WriteFileAtomically(WithSuffix(out_path, kind, several), SeriesCsv(run.result));
       if (!summary_path.empty()) {
-        io::WriteFileAtomically(WithSuffix(summary_path, kind, several), j.dump(2) + "\n");
+        io::WriteFileAtomically(WithSuffix(summary_path, kind, several), report::DumpJson(j));
       } else if (out_path.empty()) {
-        std::cout << j.dump(2) << "\n";
+        std::cout << report::DumpJson(j);
       }
     }
     if (!plot_path.empty()) Plot(plot_path, runs, n);

@@ -76,6 +76,7 @@ int Run(int argc, char** argv) {
       "frequency and peak amplitude per posture, model vs measurement, relative error), one\n"
       "<pose>.png overlay per posture (measured, model before, model after), stabilisation_<pose>.png\n"
       "(the modal fits' stabilisation diagrams), summary.json."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() + " Exit 3 also when the fit did not converge or a parameter is weakly identified.");
   std::string robot_path, postures_path, out_path, report_dir, objective = "modal-two-stage";
   std::vector<std::string> measured_files, pose_files, validate_files, validate_pose_files, frees, sets, adds;

@@ -73,6 +73,7 @@ int Run(int argc, char** argv) {
       "Reads a robot config and a posture file (formats.md §1); writes the 3x3 tool-tip\n"
       "receptance per posture (formats.md §3), the modal table (§4), per-posture details\n"
       "(JSON) and plots (PNG)."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string robot_path, postures_path, out_path, modes_path, plot_path, plot_dir, details_path,
       freq_file, directions = "all", method = "modal";
@@ -84,7 +85,7 @@ int Run(int argc, char** argv) {
   app.add_option("--out", out_path, "predicted FRFs, CSV receptance [m/N]; stdout if omitted");
   app.add_option("--modes", modes_path, "modal table CSV: freq_hz, damping_ratio, modal_mass_kg, ux,uy,uz");
   app.add_option("--details", details_path, "per-posture JSON: J, cond(J), M_q, K_q, C_q, Cartesian M, K, C, compliance, modes");
-  app.add_option("--plot", plot_path, "one PNG sheet with all postures (magnitude and phase)");
+  app.add_option("--plot", plot_path, "one PNG sheet with all postures (magnitude and phase)")->check(PngFileName());
   app.add_option("--plot-dir", plot_dir, "folder for one PNG per posture (<pose_id>.png)");
   app.add_option("--fmin-hz", fmin_hz, "lowest frequency line [Hz]")->capture_default_str();
   app.add_option("--fmax-hz", fmax_hz, "highest frequency line [Hz]")->capture_default_str();

@@ -33,6 +33,7 @@ int Run(int argc, char** argv) {
       "mobility or accelerance, raised where the hammer's force spectrum rolls off above fc.\n"
       "--coherence writes the H1 coherence of that noise for --averages impacts:\n"
       "gamma^2 = |H|^2 / (|H|^2 + (n-1) sigma^2), sigma^2 = (rel |H|)^2 + floor^2."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string robot_path, postures_path, out_path, directions = "xx,yy", quantity = "receptance";
   std::vector<std::string> sets, adds;

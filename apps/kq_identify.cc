@@ -236,6 +236,7 @@ int Run(int argc, char** argv) {
       "D = J_T Kq^-1 J_L^T W. Reports every joint's stiffness with standard deviation, 95 %\n"
       "interval and whether the data determine it; residuals per case; outliers.\n"
       "With --plan N it plans N test postures and rope directions instead (D-optimal)."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              "\nExit code 3 also means: a joint is weakly or not determined, the fit did not converge,\n"
              "or outliers were found without --robust (the outputs are written).");
@@ -252,7 +253,7 @@ int Run(int argc, char** argv) {
                  "kq.yaml to paste into the robot config (stdout if omitted); with --merge a full robot "
                  "config; with --plan the plan CSV");
   app.add_option("--residuals", residuals_path, "residual of every case, CSV [mm]");
-  app.add_option("--plot", plot_path, "residual plot, PNG");
+  app.add_option("--plot", plot_path, "residual plot, PNG")->check(PngFileName());
   app.add_option("--json", json_path, "the full result as JSON (stiffness, covariance, residuals, advice)");
   app.add_option("--robust", robust,
                  "robust loss against outlier cases: cauchy or huber (outliers are then left out)")

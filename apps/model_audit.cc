@@ -3,6 +3,7 @@
 // failure and writes the YAML lines that add the best one (issue #5).
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -84,10 +85,16 @@ int Run(int argc, char** argv) {
       "error against posture descriptors, an error map of postures against modes, and modes without a\n"
       "counterpart either way. Writes REPORT/summary.json, index.html, errors.csv, candidates.csv,\n"
       "trends.csv, posture_descriptors.csv, mode_errors.csv, unmatched_modes.csv, trends.png,\n"
-      "mode_error_map.png, overlay_<pose>.png and (with an accepted candidate) effects.yaml."};
+      "mode_error_map.png, worst_frf.png, overlay_<pose>.png and (with an accepted or named candidate)\n"
+      "effects.yaml. The verdict is graded: no failure; explained (the named effect brings the error\n"
+      "within 1.3 x the noise); mostly explained (the named effect removes at least 80 % of the error\n"
+      "above the noise and is ahead of every alternative with as many effects or fewer by a BIC gap\n"
+      "above 10); or unexplained."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
-             " Exit 3 when the failure is significant and no candidate explains it, or a fit failed (the report is "
-             "complete; candidates.csv says which and why).");
+             " Exit 3 when the failure is significant and not explained within the noise: unexplained, or mostly "
+             "explained (the effect is named and effects.yaml written, but a misfit remains), or a fit failed (the "
+             "report is complete; candidates.csv says which and why).");
   std::string robot_path, postures_path, report_dir, compare_dir, candidates_list;
   std::vector<std::string> measured_files, pose_files, adds;
   audit::AuditOptions opt;
@@ -182,7 +189,11 @@ int Run(int argc, char** argv) {
     }
 
     const audit::AuditResult r = audit::RunAudit(cfg.description, cfg.parameters, postures, measured, opt);
-    const audit::CandidateResult* best = r.best >= 0 ? &r.candidates[r.best] : nullptr;
+    // The candidate the report shows as the model after: the named one
+    // (explained or mostly explained), else the accepted one.
+    const bool named = r.grade == audit::AuditGrade::kExplained || r.grade == audit::AuditGrade::kMostlyExplained;
+    const audit::CandidateResult* best =
+        named ? &r.candidates[r.graded] : (r.best >= 0 ? &r.candidates[r.best] : nullptr);
     const audit::ModelErrors& after = best ? best->errors : r.errors_before;
 
     // ---- where it fails: trends, error map, modes without a counterpart.
@@ -250,10 +261,21 @@ int Run(int argc, char** argv) {
       for (const auto& e : c.fit.estimates) cj["parameters"][e.name] = {{"value", e.value}, {"std", e.std_dev}};
       j["candidates"].push_back(cj);
     }
-    j["verdict"] = {{"missing_effects", r.missing_effects},
+    // Numbers that are undefined (no candidate) are null.
+    const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    j["verdict"] = {{"grade", audit::AuditGradeName(r.grade)},
+                    {"missing_effects", r.missing_effects},
                     {"explained", r.explained},
+                    {"headline", r.headline},
                     {"text", r.verdict},
-                    {"pattern", r.pattern}};
+                    {"pattern", r.pattern},
+                    {"candidate", r.graded >= 0 ? json(r.candidates[r.graded].name()) : json(nullptr)},
+                    {"error_before_noise_units", number(r.error_before_noise_units)},
+                    {"remainder_noise_units", number(r.remainder_noise_units)},
+                    {"fraction_removed", number(r.fraction_removed)},
+                    {"bic_gap", number(r.bic_gap)},
+                    {"runner_up", r.runner_up},
+                    {"reasons", r.reasons}};
     // The YAML to paste: the accepted candidate's effects, or else the
     // effects switched on with --add, with their calibrated values.
     std::string yaml;
@@ -294,13 +316,82 @@ int Run(int argc, char** argv) {
            << ',' << (c.plausible ? "yes" : "no") << ',' << note << '\n';
     }
 
-    // ---- index.html (self-contained; PNGs by relative path)
+    // Overlays: the calibrated current model against the named or accepted
+    // candidate; without one, against the best-ranked candidate, labelled
+    // as not accepted, so that the unexplained pattern can be seen; with no
+    // candidate fitted, the current model alone.
+    const audit::CandidateResult* shown = best ? best : (r.candidates.empty() ? nullptr : &r.candidates[0]);
+    const std::string before_label = "current model (calibrated)";
+    const std::string after_label =
+        shown ? "with " + shown->name() +
+                    (!best ? " (not accepted)"
+                           : r.grade == audit::AuditGrade::kMostlyExplained ? " (mostly explains)" : "")
+              : "";
+    // The FRF the current model fits worst (whole-curve error before).
+    size_t worst = 0;
+    for (size_t i = 1; i < r.errors_before.curves.size(); ++i) {
+      if (r.errors_before.curves[i].rms_log_mag > r.errors_before.curves[worst].rms_log_mag) worst = i;
+    }
+    const bool has_worst = !r.errors_before.curves.empty();
+
+    // ---- index.html (self-contained; PNGs by relative path): the verdict in
+    // one sentence and the worst FRF before and after first, the tables after.
     std::ostringstream h;
     h << "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>model-audit</title><style>"
          "body{font-family:sans-serif;max-width:70em;margin:auto}table{border-collapse:collapse}"
          "td,th{border:1px solid #999;padding:2px 6px;text-align:right}pre{background:#eee;padding:6px}"
+         ".headline{font-size:1.3em;padding:8px;border-left:6px solid "
+      << (r.grade == audit::AuditGrade::kUnexplained         ? "#c0392b"
+          : r.grade == audit::AuditGrade::kMostlyExplained ? "#e67e22"
+                                                            : "#27ae60")
+      << ";background:#f6f6f6}img{max-width:100%}"
          "</style></head><body><h1>model-audit: " << Html(robot_path) << "</h1>\n";
-    h << "<p><b>Verdict:</b> " << Html(r.verdict) << "</p>\n<p>Whole-curve error (rms of ln|H<sub>model</sub>| − "
+    {
+      // The library's plain-text arrows and times signs, typeset.
+      std::string line = Html(r.headline);
+      for (const auto& [from, to] : {std::pair<std::string, std::string>{" -&gt; ", " → "}, {" x the noise", " × the noise"}}) {
+        for (size_t at = line.find(from); at != std::string::npos; at = line.find(from, at + to.size())) {
+          line.replace(at, from.size(), to);
+        }
+      }
+      h << "<p class=\"headline\">" << line << "</p>\n";
+    }
+    if (has_worst) {
+      const auto& wc = r.errors_before.curves[worst];
+      // The error of the curve drawn thin (the shown candidate's), if any.
+      const bool has_after = shown && worst < shown->errors.curves.size();
+      h << "<p><img src=\"worst_frf.png\" alt=\"worst FRF before and after\"><br>The FRF the current model fits "
+           "worst, "
+        << Html(KeyLabel(wc.key)) << " (error " << Num(wc.rms_log_mag / r.noise_floor, 3) << " × the noise floor";
+      if (has_after) {
+        h << "; " << Num(shown->errors.curves[worst].rms_log_mag / r.noise_floor, 3) << " with "
+          << Html(shown->name());
+      }
+      h << "): measured (wide, with its noise where known), the calibrated current model (dashed)";
+      if (shown) {
+        h << " and the model with " << Html(shown->name()) << " (" << (best ? "" : "not accepted; ") << "thin line)";
+      }
+      h << ".</p>\n";
+    }
+    h << "<h2>Verdict</h2>\n";
+    if (r.grade == audit::AuditGrade::kMostlyExplained) {
+      // The verdict's parts one by one (summary.json's verdict.text has them
+      // in one sentence).
+      h << "<p>Likely reasons for the remainder:</p><ul>";
+      for (const auto& reason : r.reasons) h << "<li>" << Html(reason) << "</li>";
+      h << "</ul>\n<p>Pattern of the remainder: " << Html(r.pattern) << ".</p>\n";
+    } else {
+      h << "<p>" << Html(r.verdict) << "</p>\n";
+    }
+    if (r.graded >= 0) {
+      h << "<p>Graded on " << Html(r.candidates[r.graded].name()) << ": error " << Num(r.error_before_noise_units, 3)
+        << " → " << Num(r.remainder_noise_units, 3) << " × the noise floor, "
+        << Num(100.0 * r.fraction_removed, 3) << " % of the excess misfit (error/noise − 1) removed; BIC "
+        << Num(r.bic_gap, 4) << " below the runner-up, " << Html(r.runner_up) << ". \"Mostly explained\" takes "
+        << Num(100.0 * opt.mostly_explained_fraction, 3) << " % or more and a BIC gap above "
+        << Num(opt.clear_bic_gap, 3) << " (very strong evidence, Kass &amp; Raftery 1995).</p>\n";
+    }
+    h << "<p>Whole-curve error (rms of ln|H<sub>model</sub>| − "
       << "ln|H<sub>measured</sub>|" << (noise.empty() ? "" : ", each line in units of its noise: 1 is a model that is right")
       << "): before " << Num(r.errors_before.total_rms_log_mag) << ", after "
       << Num(after.total_rms_log_mag) << "; noise floor " << Num(r.noise_floor) << " ("
@@ -368,13 +459,6 @@ int Run(int argc, char** argv) {
       h << "</td></tr>\n";
     }
     h << "</table>\n";
-    // Overlays: the calibrated current model against the accepted candidate;
-    // without one, against the best-ranked candidate, labelled as not
-    // accepted, so that the unexplained pattern can be seen; with no
-    // candidate fitted, the current model alone.
-    const audit::CandidateResult* shown = best ? best : (r.candidates.empty() ? nullptr : &r.candidates[0]);
-    const std::string before_label = "current model (calibrated)";
-    const std::string after_label = shown ? "with " + shown->name() + (best ? "" : " (not accepted)") : "";
     if (!yaml.empty()) {
       h << "<h2>" << (best ? "Add the effect" : "The added effects, calibrated")
         << "</h2><p>Append to the robot config (merge into its <code>effects:</code> list if it has one):</p><pre>"
@@ -407,6 +491,27 @@ int Run(int argc, char** argv) {
                                                                    ea->Evaluate(postures.at(pose)))
                                       : report::MakePostureOverlay(pose, measured_read.frfs, db);
         report::AddNoise(noise, &o);
+        if (has_worst && pose == r.errors_before.curves[worst].key.pose_id) {
+          // The worst FRF alone: its row of the posture's overlay.
+          const dynamics::FrfKey& wk = r.errors_before.curves[worst].key;
+          report::PostureOverlay w = o;
+          w.keys.clear(), w.freq_hz.clear(), w.measured.clear(), w.before.clear(), w.after.clear();
+          w.noise_sigma.clear(), w.usable.clear();
+          for (size_t k = 0; k < o.keys.size(); ++k) {
+            if (!(o.keys[k] == wk)) continue;
+            w.keys.push_back(o.keys[k]);
+            w.freq_hz.push_back(o.freq_hz[k]);
+            w.measured.push_back(o.measured[k]);
+            w.before.push_back(o.before[k]);
+            if (k < o.after.size()) w.after.push_back(o.after[k]);
+            if (k < o.noise_sigma.size()) w.noise_sigma.push_back(o.noise_sigma[k]);
+            if (k < o.usable.size()) w.usable.push_back(o.usable[k]);
+          }
+          report::WriteOverlayPng((dir / "worst_frf.png").string(), w,
+                                  "model-audit: worst FRF " + KeyLabel(wk) + ", measured vs " + before_label +
+                                      (shown ? " and " + after_label : std::string()),
+                                  before_label, after_label);
+        }
         report::WriteOverlayPng((dir / ("overlay_" + pose + ".png")).string(), o,
                                 "model-audit: posture " + pose + ", measured vs " + before_label +
                                     (shown ? " and " + after_label : std::string()),

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -23,6 +24,8 @@
 #include "robomach/io/polishing_files.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/dynamics/robot_model.h"
+#include "robomach/io/cad_face.h"
+#include "robomach/polishing/face_check.h"
 #include "robomach/polishing/optimise.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/removal.h"
@@ -58,6 +61,101 @@ Evaluated Evaluate(const polishing::NurbsSurface& surface, const polishing::Samp
   return e;
 }
 
+std::string Short(double x) {
+  std::ostringstream o;
+  o.precision(4);
+  o << x;
+  return o.str();
+}
+
+std::string Short6(double x) {
+  std::ostringstream o;
+  o.precision(6);
+  o << x;
+  return o.str();
+}
+
+std::string CsvField(const std::string& x) {
+  if (x.find_first_of(",\"\n") == std::string::npos) return x;
+  std::string q = "\"";
+  for (char c : x) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
+  return q + "\"";
+}
+
+// --list-faces: one CSV row per face of a STEP/IGES file (formats.md §5).
+int ListFaces(const std::string& surface_path, const std::string& process_path, const std::string& out,
+              const SurfaceChoice& choice, const std::string& pattern, double radius_mm, double sample_mm,
+              double offset_mm, double pitch_mm, double row_step_mm) {
+  if (!io::IsCadFile(surface_path)) {
+    throw std::invalid_argument("--list-faces: " + surface_path + " is a NURBS YAML (one patch); --list-faces lists "
+                                "the faces of a STEP/IGES file");
+  }
+  if (choice.face_given) throw std::invalid_argument("--list-faces lists every face; drop --face");
+  const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
+  polishing::PathParameters params;
+  params.pattern = pattern == "cycloid" ? polishing::Pattern::kCycloid : polishing::Pattern::kParallel;
+  params.radius = MmToM(radius_mm);
+  params.offset = MmToM(offset_mm);
+  params.pitch = MmToM(pitch_mm);
+  params.row_step = MmToM(row_step_mm);
+  polishing::PolishableOptions po;
+  po.sample_spacing = MmToM(sample_mm);
+  io::CadReadOptions options;
+  options.unit_scale = choice.cad_unit_scale;
+  io::CadPartInfo info;
+  std::unique_ptr<ProgressLine> progress;
+  const auto rows = io::ListCadFaces(
+      surface_path,
+      [&](const polishing::NurbsSurface& s) {
+        const polishing::Polishability p = polishing::CheckPolishable(s, process, params, po);
+        return std::make_pair(p.polishable, p.reason);
+      },
+      options, &info, [&](int done, int total) {
+        if (!progress) progress = std::make_unique<ProgressLine>(kTool, "faces", total);
+        progress->Update(done);
+      });
+  if (progress) progress->Finish();
+  if (!info.unit_warning.empty()) Warn(kTool, surface_path + ": " + info.unit_warning);
+  std::ostringstream csv;
+  csv << "face,surface_type,area_mm2,u_size_mm,v_size_mm,trimmed,holes,polishable,reason\n";
+  for (const auto& r : rows) {
+    csv << r.face << ',' << r.surface_type << ',' << Short6(r.area_mm2) << ',' << Short6(r.u_size_mm) << ','
+        << Short6(r.v_size_mm) << ',' << (r.trimmed ? 1 : 0) << ','
+        << r.holes << ',' << (r.polishable ? 1 : 0) << ',' << CsvField(r.reason) << '\n';
+  }
+  if (out.empty()) std::cout << csv.str();
+  else io::WriteFileAtomically(out, csv.str());
+  return kExitOk;
+}
+
+// Refuses a face too large to sample at --sample-mm (naming it, its size and
+// the estimate), and warns with the estimate before long work.
+void CheckFaceSize(const polishing::NurbsSurface& surface, const std::string& surface_path, double sample_mm,
+                   const polishing::PathParameters& params) {
+  const polishing::SurfaceSize size = polishing::MeasureSurface(surface);
+  const double points = polishing::EstimateGridPoints(size, MmToM(sample_mm));
+  const polishing::PolishableOptions limits;
+  const double area = surface.trim() ? surface.trim()->area : size.length_u * size.length_v;
+  const double rows = polishing::EstimatePathRows(area, params);
+  std::ostringstream m;
+  m.precision(3);
+  m << polishing::SurfaceName(surface) << " (" << 1e3 * size.length_u << " x " << 1e3 * size.length_v
+    << " mm, mean arc lengths along u and v; " << 1e6 * area << " mm^2)";
+  const std::string what = m.str();
+  m.str("");
+  m << points << " grid points at --sample-mm " << sample_mm << " (~" << points * 90e-9 << " GB) and a path of ~" << rows
+    << " rows";
+  const std::string estimate = m.str();
+  if (!(points <= limits.max_grid_points) || !(rows <= limits.max_path_rows)) {
+    m.str("");
+    m << what << " is too large to plan within the limits (" << limits.max_grid_points << " grid points, "
+      << limits.max_path_rows << " path rows; about a minute and 2 GB): " << estimate
+      << " (check the file's unit: --cad-unit-scale; or choose a smaller face, --list-faces)";
+    throw InputError({surface_path, 0, 0}, m.str());
+  }
+  if (points > 2e5 || rows > 1e5) Warn(kTool, what + " is large: " + estimate + "; planning may take a minute");
+}
+
 int Run(int argc, char** argv) {
   CLI::App app{
       "polish-plan: a belt-grinding path on a NURBS patch (formats.md §5) - cycloids along guide lines\n"
@@ -72,14 +170,20 @@ int Run(int argc, char** argv) {
              "rows are unreachable, outside the joint limits or after a joint jump > 0.5 rad.");
   std::string surface_path, process_path, pattern = "cycloid", guides = "offsets", optimise = "none", path_out,
                                           removal_out, summary_out, plot_out;
-  int face = 0;
+  SurfaceChoice choice;
+  bool list_faces = false;
+  std::string list_out;
   double target_um = 0.0, offset_mm = 8.0, radius_mm = 6.0, pitch_mm = 3.0, sample_mm = 0.5, row_step_mm = 0.5;
   double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 0.3, edge_inset_mm = -1.0;
   int seed = 20240404, threads = 2;
   double max_time_s = 50.0, stagger_loops = 0.5, line_angle_deg = 0.0, edge_overrun_mm = 0.0;
   RobotOptions robot;
   app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (formats.md §5)")->required();
-  app.add_option("--face", face, "face of a STEP/IGES file (1-based, in the file's order); default: the largest by area");
+  AddSurfaceChoiceOptions(&app, &choice);
+  app.add_flag("--list-faces", list_faces,
+               "list the faces of a STEP/IGES file as CSV (face, surface_type, area_mm2, u_size_mm, v_size_mm, "
+               "trimmed, holes, polishable, reason; polishable with --process, --pattern and --radius-mm) and stop");
+  app.add_option("--out", list_out, "with --list-faces: write the CSV here instead of stdout");
   app.add_option("--process", process_path, "process YAML (formats.md §7), e.g. config/polishing/belt_2N.yaml")->required();
   app.add_option("--pattern", pattern, "cycloid or parallel")->check(CLI::IsMember({"cycloid", "parallel"}))->capture_default_str();
   app.add_option("--guides", guides, "cycloid guide lines: offsets (of the region boundary, closed loops) or parallel")
@@ -123,6 +227,7 @@ int Run(int argc, char** argv) {
   }
   const bool offset_given = app.count("--offset-mm") > 0;
   const bool guides_given = app.count("--guides") > 0;
+  choice.face_given = app.count("--face") > 0;
 
   return RunGuarded(kTool, [&]() -> int {
     CheckOptionRange("--sample-mm", sample_mm, 0.05, 0.5);
@@ -152,8 +257,20 @@ int Run(int argc, char** argv) {
     }
     CheckDistinctPaths({{"--surface", surface_path}, {"--process", process_path}, {"--robot", robot.robot_path()}}, outs);
 
-    const polishing::NurbsSurface surface = LoadSurface(surface_path, face);
+    if (list_faces) return ListFaces(surface_path, process_path, list_out, choice, pattern, radius_mm, sample_mm, offset_mm,
+                                     pitch_mm, row_step_mm);
+    if (!list_out.empty()) throw std::invalid_argument("--out goes with --list-faces");
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
+    const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
+    {
+      polishing::PathParameters p;
+      p.pattern = pattern == "cycloid" ? polishing::Pattern::kCycloid : polishing::Pattern::kParallel;
+      p.offset = MmToM(offset_mm);
+      p.radius = MmToM(radius_mm);
+      p.pitch = MmToM(pitch_mm);
+      p.row_step = MmToM(row_step_mm);
+      CheckFaceSize(surface, surface_path, sample_mm, p);
+    }
     auto build_grid = [&](double spacing) {
       try {
         return polishing::SampleGrid::Build(surface, MmToM(spacing), process.margin, process.flip_normal);
@@ -164,7 +281,9 @@ int Run(int argc, char** argv) {
     const polishing::SampleGrid grid = build_grid(sample_mm);
     if (grid.num_in_region() == 0) {
       throw InputError({process_path, 0, 0}, "process.margin_mm " + io::FormatDouble(1e3 * process.margin) +
-                                                 " leaves no polished region on the patch");
+                                                 " leaves no polished region on " + polishing::SurfaceName(surface) +
+                                                 " (" + Short(1e3 * grid.length_s()) + " x " +
+                                                 Short(1e3 * grid.length_t()) + " mm, mean arc lengths along u and v)");
     }
     double contact_width = 0;
     try {
@@ -187,6 +306,16 @@ int Run(int argc, char** argv) {
     params.edge_overrun = MmToM(edge_overrun_mm);
     params.line_angle = line_angle_deg * kPi / 180.0;
     polishing::CheckValid(params);  // std::invalid_argument -> exit 64, naming the limit
+    if (optimise == "none" && params.pattern == polishing::Pattern::kCycloid) {
+      // A face too narrow for the circle is an error in the input (exit 65),
+      // never rows clamped onto its edges (PlanPath checks it again).
+      try {
+        polishing::CheckCircleFits(surface, grid, polishing::DevelopedRegion::Build(surface, grid, process.margin), params,
+                                   process);
+      } catch (const polishing::FaceTooNarrowError& e) {
+        throw InputError({surface_path, 0, 0}, e.what());
+      }
+    }
 
     nlohmann::json opt_json;
     std::vector<double> history, evaluated;

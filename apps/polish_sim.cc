@@ -19,6 +19,7 @@
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/removal.h"
+#include "robomach/report/posture_json.h"
 
 namespace robomach::apps {
 namespace {
@@ -29,21 +30,22 @@ int Run(int argc, char** argv) {
   CLI::App app{
       "polish-sim: simulate the Preston removal of a tool path (formats.md §6) on a NURBS patch\n"
       "(formats.md §5) with Hertz contact (formats.md §7); writes the removal map, a summary and pictures."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              "\nExit 3 (outputs written, the reason on stderr): the path's traverse speed exceeds "
              "max_speed_mm_per_s; with --robot, rows are unreachable, outside the joint limits or after a joint "
              "jump > 0.5 rad.");
   std::string surface_path, process_path, path_in, removal_out, summary_out, plot_out;
-  int face = 0;
   double sample_mm = 0.5;
   app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (formats.md §5)")->required();
-  app.add_option("--face", face, "face of a STEP/IGES file (1-based, in the file's order); default: the largest by area");
+  SurfaceChoice choice;
+  AddSurfaceChoiceOptions(&app, &choice);
   app.add_option("--process", process_path, "process YAML (formats.md §7)")->required();
   app.add_option("--path", path_in, "tool path CSV (formats.md §6)")->required();
   app.add_option("--sample-mm", sample_mm, "removal map sampling in arc length [mm], <= 0.5")->capture_default_str();
   app.add_option("--removal", removal_out, "removal map CSV x_mm,y_mm,z_mm,u,v,removal_um");
   app.add_option("--summary", summary_out, "summary JSON (formats.md §7); stdout if omitted");
-  app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png and <stem>_path.png");
+  app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png and <stem>_path.png")->check(PngFileName());
   RobotOptions robot;
   robot.Add(&app);
   try {
@@ -51,6 +53,7 @@ int Run(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
+  choice.face_given = app.count("--face") > 0;
   return RunGuarded(kTool, [&]() -> int {
     CheckOptionRange("--sample-mm", sample_mm, 0.05, 0.5);
     RequireReadableFile(surface_path, "surface");
@@ -64,7 +67,7 @@ int Run(int argc, char** argv) {
                         {"--robot", robot.robot_path()}},
                        outs);
 
-    const polishing::NurbsSurface surface = LoadSurface(surface_path, face);
+    const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
     io::PolishPathFile file = io::ReadPolishPath(path_in);
     polishing::SampleGrid grid = [&] {
@@ -127,7 +130,7 @@ int Run(int argc, char** argv) {
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, removal);
     robot.WriteJoints(file.rows);
     if (!plot_out.empty()) WritePictures(plot_out, grid, removal, file.rows, {}, {}, "polish-sim");
-    const std::string text = summary.dump(2) + "\n";
+    const std::string text = report::DumpJson(summary);
     if (!summary_out.empty()) io::WriteFileAtomically(summary_out, text);
     else std::cout << text;
     return flagged ? kExitFlagged : kExitOk;

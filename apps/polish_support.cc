@@ -19,9 +19,41 @@
 
 namespace robomach::apps {
 
-polishing::NurbsSurface LoadSurface(const std::string& path, int face) {
-  if (io::IsCadFile(path)) return io::ReadCadFace(path, face);
-  return io::ReadNurbsYaml(path);
+polishing::NurbsSurface LoadSurface(const std::string& tool, const std::string& path, const SurfaceChoice& choice) {
+  if (!io::IsCadFile(path)) {
+    if (choice.face_given) {
+      throw std::invalid_argument("--face " + std::to_string(choice.face) + ": " + path +
+                                  " is a NURBS YAML (one patch); --face picks a face of a STEP/IGES file");
+    }
+    if (choice.cad_unit_scale != 1.0) {
+      throw std::invalid_argument("--cad-unit-scale: " + path + " is a NURBS YAML (lengths in mm by formats.md §5); "
+                                  "the option applies to STEP/IGES files");
+    }
+    return io::ReadNurbsYaml(path);
+  }
+  io::CadReadOptions options;
+  options.unit_scale = choice.cad_unit_scale;
+  io::CadPartInfo info;
+  polishing::NurbsSurface s = io::ReadCadFace(path, choice.face, options, &info);
+  if (!info.unit_warning.empty()) Warn(tool, path + ": " + info.unit_warning);
+  if (choice.face == 0 && s.trim()) {
+    std::ostringstream m;
+    m << "--face 0: " << s.trim()->source << ", the largest of " << info.num_faces << " faces by area ("
+      << 1e6 * s.trim()->area << " mm^2); --list-faces lists them all";
+    Note(tool, m.str());
+  }
+  return s;
+}
+
+void AddSurfaceChoiceOptions(CLI::App* app, SurfaceChoice* choice) {
+  app->add_option("--face", choice->face,
+                  "face of a STEP/IGES file (1-based, in the file's order; polish-plan --list-faces lists them); "
+                  "0 or not given: the largest by area (named on stderr). An error with a YAML surface")
+      ->capture_default_str();
+  app->add_option("--cad-unit-scale", choice->cad_unit_scale,
+                  "multiply a STEP/IGES file's lengths (as read in mm) by this: 1000 for a file that says mm but "
+                  "holds metres (the reader warns when a part is under 1 mm or over 10 m)")
+      ->capture_default_str();
 }
 
 int RowsOffFace(const polishing::NurbsSurface& surface, const std::vector<polishing::PathRow>& rows) {

@@ -16,11 +16,30 @@
 #include "robomach/polishing/removal.h"
 #include "robomach/polishing/surface_grid.h"
 
+namespace CLI {
+class App;
+}
+
 namespace robomach::apps {
 
-/// A NURBS YAML or face `face` (1-based; 0 = the largest) of a STEP/IGES
-/// file (formats.md §5), by the file's extension.
-polishing::NurbsSurface LoadSurface(const std::string& path, int face);
+/// Which surface of the --surface file: --face, whether it was given, and
+/// --cad-unit-scale.
+struct SurfaceChoice {
+  int face{0};              // 1-based; 0: the largest by area
+  bool face_given{false};
+  double cad_unit_scale{1.0};
+};
+
+/// A NURBS YAML or face `choice.face` (1-based; 0 = the largest, named in a
+/// note on stderr) of a STEP/IGES file (formats.md §5), by the file's
+/// extension. Warns under `tool` when the CAD part is under 1 mm or over
+/// 10 m (units plausibility).
+/// @throws std::invalid_argument (exit 64) for --face or --cad-unit-scale
+/// with a YAML surface.
+polishing::NurbsSurface LoadSurface(const std::string& tool, const std::string& path, const SurfaceChoice& choice);
+
+/// Registers --face and --cad-unit-scale on `app` (polish-plan, polish-sim).
+void AddSurfaceChoiceOptions(CLI::App* app, SurfaceChoice* choice);
 
 /// Number of rows whose (u, v) lie off the surface's trimmed face.
 int RowsOffFace(const polishing::NurbsSurface& surface, const std::vector<polishing::PathRow>& rows);

@@ -36,6 +36,7 @@ int Run(int argc, char** argv) {
       "mode-coupling chatter (eigenvalues of the posture's 3-D tool-tip dynamics under the\n"
       "cutting stiffness) and regenerative chatter (ZOA lobes at the cut's speed or the best\n"
       "speed of its range); optionally the rotation about the tool axis that maximises the depth."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string robot_path, cut_path, region_path, path_path, out_path, plot_path;
   int threads = 0, speeds = 0, rotation_evals = 20;
@@ -45,7 +46,7 @@ int Run(int argc, char** argv) {
   app.add_option("--region", region_path, "region file YAML (config/region_demo.yaml)");
   app.add_option("--path", path_path, "tool-path CSV: x_mm,y_mm,z_mm,tool_i,tool_j,tool_k[,feed_i,feed_j,feed_k][,rotation_deg][,point_id]; the tool axis points from the tip to the spindle; rotation_deg is added to the region's rotation about the tool axis; the region file gives the seed posture");
   app.add_option("--out", out_path, "per-point CSV; stdout if omitted");
-  app.add_option("--plot", plot_path, "heat map PNG of the critical depth [mm] (grid only)");
+  app.add_option("--plot", plot_path, "heat map PNG of the critical depth [mm] (grid only)")->check(PngFileName());
   app.add_option("--threads", threads, "worker threads, 0 = all cores")->capture_default_str();
   app.add_option("--speeds", speeds, "speeds scanned for the best one (default: the cut file's spindle_speed_count)");
   app.add_option("--max-depth-mm", max_depth_mm, "largest depth searched for mode coupling [mm]")->capture_default_str();

@@ -27,6 +27,7 @@ int Run(int argc, char** argv) {
       "For every posture, pulley and mass: the static deflection of the target under the rope\n"
       "force (large-displacement equilibrium with the config's joint stiffness), tracker readings\n"
       "with Gaussian noise, optional gross outliers. Seeded: the same options give the same file."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string robot_path, out_path, postures_path, plan_path, masses = "10,20,30", load_point = "150,0,100",
                                                    target = "0,120,50", form = "rope";

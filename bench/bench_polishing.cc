@@ -6,6 +6,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <fstream>
 #include <stdexcept>
 
 #include "robomach/common/units.h"
@@ -144,6 +145,43 @@ void BM_PlanCycloidOnPlateWithHole(benchmark::State& state) {
   state.counters["rows"] = static_cast<double>(rows);
 }
 BENCHMARK(BM_PlanCycloidOnPlateWithHole)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// Planning the largest faces of OpenCASCADE's test parts (issue 19 scope 5;
+// ../shared/external/cad_freeform, read where it lies, skipped when absent):
+// the face read and converted, sampled at 0.5 mm, its region (margin 5 mm),
+// the cycloid (d 8, r 6, pitch 3 mm) planned and its removal simulated, as
+// `polish-plan` does without the optimiser.
+// Arg 0: occt_hammer.iges face 32 (the issue's, 1.25 m x 0.25 m as read,
+// refused by size) at --cad-unit-scale 0.1: 125 x 25 mm.
+// Arg 1: occt_bearing.iges face 190 (its largest) at --cad-unit-scale 1000.
+void BM_PlanSharedCadFace(benchmark::State& state) {
+  const std::string dir = std::string(ROBOMACH_SOURCE_DIR) + "/../shared/external/cad_freeform/";
+  const bool hammer = state.range(0) == 0;
+  const std::string file = dir + (hammer ? "occt_hammer.iges" : "occt_bearing.iges");
+  if (!std::ifstream(file)) {
+    state.SkipWithError((file + " absent (../shared not here)").c_str());
+    return;
+  }
+  io::CadReadOptions options;
+  options.unit_scale = hammer ? 0.1 : 1000.0;
+  const int face = hammer ? 32 : 190;
+  PolishingProcess proc;  // margin 5 mm, 2 N, 50 mm/s
+  PathParameters p;       // cycloid d 8, r 6, pitch 3 mm
+  size_t rows = 0, points = 0;
+  for (auto _ : state) {
+    const NurbsSurface s = io::ReadCadFace(file, face, options);
+    const SampleGrid grid = SampleGrid::Build(s, 0.5e-3, proc.margin, false);
+    const PlannedPath path = PlanPath(s, grid, p, proc);
+    const RemovalSimulator sim(s, proc, grid.points(), grid.normals(), 0.5 * ContactWidthAtCentre(s, grid, proc));
+    const std::vector<double> removal = sim.Simulate(path.rows);
+    rows = path.rows.size();
+    points = grid.num_in_region();
+    benchmark::DoNotOptimize(removal.data());
+  }
+  state.counters["rows"] = static_cast<double>(rows);
+  state.counters["region_points"] = static_cast<double>(points);
+}
+BENCHMARK(BM_PlanSharedCadFace)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace
 

@@ -11,7 +11,7 @@
 #include "robomach/io/posture_file.h"
 #include "robomach/io/region_file.h"
 #include "robomach/io/robot_config.h"
-#include "robomach/stability/modal_fit.h"
+#include "robomach/stability/tool_tip_model.h"
 #include "robomach/stability/mode_coupling.h"
 #include "robomach/stability/posture_stability.h"
 #include "robomach/stability/semi_discretization.h"

@@ -13,8 +13,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev
   libocct-data-exchange-dev libpolyclipping-dev
-  python3          # four polishing tests compare JSON summaries with python3 -c
-  bsdextrautils    # column(1), which demo.sh uses to print the modal table
+  python3          # demo.sh (index.html), polishing and frf-estimate tests
 )
 
 missing=()

@@ -1,5 +1,6 @@
 #include "cli_support.h"
 
+#include <CLI/CLI.hpp>
 #include <glog/logging.h>
 
 #include <unistd.h>
@@ -10,6 +11,7 @@
 #include <stdexcept>
 
 #include "robomach/common/errors.h"
+#include "robomach/common/version.h"
 #include "robomach/io/csv_table.h"
 
 namespace robomach::apps {
@@ -94,6 +96,20 @@ void ProgressLine::Finish() {
 
 void Warn(const std::string& tool, const std::string& message) {
   std::cerr << tool << ": warning: " << message << '\n';
+}
+
+std::function<std::string(const std::string&)> PngFileName() {
+  return [](const std::string& path) -> std::string {
+    const std::string ext = std::filesystem::path(path).extension().string();
+    std::string low = ext;
+    for (char& c : low) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (low == ".png") return "";
+    return "expected a .png file name (robomach draws PNG pictures only), got \"" + path + "\"";
+  };
+}
+
+void AddVersionFlag(CLI::App& app, const std::string& tool) {
+  app.set_version_flag("--version", tool + " " + Version(), "print the version (and git commit) and exit");
 }
 
 void Note(const std::string& tool, const std::string& message) {

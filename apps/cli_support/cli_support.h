@@ -11,6 +11,10 @@
 #include <Eigen/Core>
 
 #include "robomach/io/robot_config.h"
+
+namespace CLI {
+class App;
+}  // namespace CLI
 #include <iostream>
 #include <string>
 #include <vector>
@@ -67,6 +71,15 @@ void Warn(const std::string& tool, const std::string& message);
 /// "tool: note: message" on stderr: what a reader inferred or skipped; not
 /// a warning, and no reason for exit 3.
 void Note(const std::string& tool, const std::string& message);
+
+/// Adds --version to `app`: prints "tool 0.1.0 (git <commit>)" and exits 0.
+void AddVersionFlag(CLI::App& app, const std::string& tool);
+
+/// Checks a picture option's file name when the command line is parsed:
+/// robomach draws PNG only, so another extension (x.svg, x.pdf) is a bad
+/// command line (exit 64), before any work; a message names the option.
+/// Use as app.add_option("--plot", path, "...")->check(PngFileName()).
+std::function<std::string(const std::string&)> PngFileName();
 
 /// Splits "NAME=VALUE"; @throws std::invalid_argument naming the option.
 std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text);

@@ -33,6 +33,13 @@ void CheckValid(const AuditOptions& o) {
   if (!(o.significance_factor > 1.0) || !(o.explained_factor > 1.0)) {
     throw std::invalid_argument("AuditOptions: significance_factor and explained_factor must be > 1");
   }
+  if (!(o.mostly_explained_fraction > 0.0) || !(o.mostly_explained_fraction <= 1.0)) {
+    throw std::invalid_argument("AuditOptions::mostly_explained_fraction must be in (0, 1], got " +
+                                std::to_string(o.mostly_explained_fraction));
+  }
+  if (!(o.clear_bic_gap >= 0.0)) {
+    throw std::invalid_argument("AuditOptions::clear_bic_gap must be >= 0, got " + std::to_string(o.clear_bic_gap));
+  }
   if (o.max_iterations < 1) throw std::invalid_argument("AuditOptions::max_iterations must be >= 1");
   if (o.fit_line_stride < 0) throw std::invalid_argument("AuditOptions::fit_line_stride must be >= 0 (0: automatic)");
   if (o.threads < 1) throw std::invalid_argument("AuditOptions::threads must be >= 1");
@@ -127,6 +134,26 @@ double EstimateNoiseFloor(const dynamics::FrfSet& measured, double fmin_hz, doub
   std::nth_element(d.begin(), mid, d.end());
   // median |N(0, σ_d)| = 0.6745 σ_d, σ_d = √6 s.
   return *mid / (0.6745 * std::sqrt(6.0));
+}
+
+std::string AuditGradeName(AuditGrade grade) {
+  switch (grade) {
+    case AuditGrade::kNoFailure:
+      return "no_failure";
+    case AuditGrade::kExplained:
+      return "explained";
+    case AuditGrade::kMostlyExplained:
+      return "mostly_explained";
+    case AuditGrade::kUnexplained:
+      return "unexplained";
+  }
+  return "unexplained";
+}
+
+double FractionRemoved(double before, double after, double noise_floor) {
+  const double b = before / noise_floor, a = after / noise_floor;
+  if (!std::isfinite(b) || !std::isfinite(a) || !(b > 1.0)) return NAN;
+  return (b - a) / (b - 1.0);
 }
 
 std::string CandidateResult::name() const {
@@ -621,6 +648,7 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
     m.precision(3);
     if (chi2 >= o.identifiable_chi2) {
       c.plausible = false;
+      c.pinned.push_back(e.name);
       m << e.name << " pinned at a bound (the data push it there)";
     } else {
       m << e.name << " at its bound " << e.value << ", which the data cannot tell from " << inside;
@@ -673,6 +701,213 @@ std::vector<CandidateResult> RunAll(int n, int threads, const std::function<Cand
     for (int i = 0; i < static_cast<int>(batch.size()); ++i) out[start + i] = batch[i].get();
   }
   return out;
+}
+
+// The likely reasons why the accepted candidate `b` leaves a remainder
+// (AuditResult::reasons): its fitted parameters on a bound, its damping
+// parameter on one, otherwise its form.
+std::vector<std::string> LikelyReasons(const CandidateResult& b) {
+  std::vector<std::string> bounded, damping;
+  const auto is_damping = [](const std::string& n) {
+    return n.find("damping") != std::string::npos || n == "alpha_s" || n == "beta_per_s";
+  };
+  // Effect parameters the data push onto a bound (not those the data
+  // cannot tell from the interior), and calibration parameters on a bound.
+  for (const auto& e : b.fit.estimates) {
+    const bool effect = e.name.find('.') != std::string::npos;
+    if (!e.at_bound || (effect && !Contains(b.pinned, e.name))) continue;
+    const dynamics::ParameterSpec& spec = b.fit.parameters.spec(e.name);
+    const bool lower = std::abs(e.value - spec.lower) <= std::abs(e.value - spec.upper);
+    std::ostringstream m;
+    m.precision(3);
+    m << e.name << " on its " << (lower ? "lower" : "upper") << " bound " << e.value;
+    (is_damping(e.name) ? damping : bounded).push_back(m.str());
+  }
+  std::vector<std::string> out;
+  if (!bounded.empty()) {
+    std::string s = "parameters on bounds (the data push them there: the effect stands in for a form it does not "
+                    "have, or needs values beyond its range): ";
+    for (size_t i = 0; i < bounded.size(); ++i) s += (i ? ", " : "") + bounded[i];
+    out.push_back(s);
+  }
+  if (!damping.empty()) {
+    std::string s = "its damping (on a bound: the real damping may follow another law than the model's): ";
+    for (size_t i = 0; i < damping.size(); ++i) s += (i ? ", " : "") + damping[i];
+    out.push_back(s);
+  }
+  if (out.empty()) {
+    out.push_back("its form: no fitted parameter is pushed onto a bound, so the effect as the library models it "
+                  "cannot take the shape of the data (the real part differs in its kinematics, mass or damping law)");
+  }
+  return out;
+}
+
+// AuditResult::headline.
+std::string Headline(const AuditResult& r, const AuditOptions& o) {
+  std::ostringstream m;
+  m.precision(3);
+  const double before = r.errors_before.total_rms_log_mag / r.noise_floor;
+  const CandidateResult* b = r.graded >= 0 ? &r.candidates[r.graded] : nullptr;
+  const double after = b ? b->errors.total_rms_log_mag / r.noise_floor : NAN;
+  switch (r.grade) {
+    case AuditGrade::kNoFailure:
+      m << "No significant failure: the model agrees with the measurement within the noise (error " << before
+        << " x the noise floor).";
+      break;
+    case AuditGrade::kExplained:
+      m << "Explained: the missing effect is " << b->name() << "; with it the error falls from " << before << " to "
+        << after << " x the noise floor.";
+      break;
+    case AuditGrade::kMostlyExplained:
+      m << "Mostly explained by " << b->name() << ": it removes " << std::lround(100.0 * r.fraction_removed)
+        << " % of the excess misfit (error " << before << " -> " << after
+        << " x the noise floor); a remainder is left.";
+      break;
+    case AuditGrade::kUnexplained:
+      if (b && r.best >= 0) {
+        m << "Unexplained: the best candidate, " << b->name() << ", takes the error only from " << before << " to "
+          << after << " x the noise floor (" << std::lround(100.0 * r.fraction_removed) << " % of the excess misfit";
+        if (r.fraction_removed >= o.mostly_explained_fraction) {
+          m << ", but it is not clearly ahead of " << r.runner_up << " by BIC";
+        }
+        m << ").";
+      } else if (b) {
+        m << "Unexplained: the error is " << before
+          << " x the noise floor and no library effect lowers the BIC with plausible parameters (the closest fit, "
+          << b->name() << ", reaches " << after << ").";
+      } else if (r.candidates.empty()) {
+        m << "Unexplained: the error is " << before << " x the noise floor and no candidate effect was tried.";
+      } else {
+        m << "Unexplained: the error is " << before
+          << " x the noise floor and no library effect lowers the BIC with plausible parameters.";
+      }
+      break;
+  }
+  return m.str();
+}
+
+// The graded verdict (issue #18): grade, graded candidate, its numbers,
+// verdict, pattern, reasons and headline.
+void GradeVerdict(const AuditOptions& o, AuditResult* r) {
+  r->grade = AuditGrade::kUnexplained;
+  r->explained = false;
+  r->graded = -1;
+  // The numbers of candidate i against the current model and the runner-up:
+  // every other model with as many effects or fewer, the current model
+  // included.
+  struct Grading {
+    double fraction{NAN}, gap{NAN};
+    std::string runner_up;
+  };
+  const auto grading = [&](int i) {
+    const CandidateResult& b = r->candidates[i];
+    Grading g;
+    g.fraction = FractionRemoved(r->errors_before.total_rms_log_mag, b.errors.total_rms_log_mag, r->noise_floor);
+    g.gap = r->baseline_bic - b.bic;
+    g.runner_up = "current model";
+    for (size_t k = 0; k < r->candidates.size(); ++k) {
+      const CandidateResult& c = r->candidates[k];
+      if (static_cast<int>(k) == i || c.effects.size() > b.effects.size() || !(c.bic - b.bic < g.gap)) continue;
+      g.gap = c.bic - b.bic;
+      g.runner_up = c.name();
+    }
+    return g;
+  };
+  const auto mostly = [&](const Grading& g) {
+    return g.fraction >= o.mostly_explained_fraction && g.gap > o.clear_bic_gap;
+  };
+  if (r->best >= 0 &&
+      r->candidates[r->best].errors.total_rms_log_mag <= o.explained_factor * r->noise_floor) {
+    r->graded = r->best;
+    r->grade = AuditGrade::kExplained;
+  } else {
+    // Mostly explained: the fewest effects that do it. Per number of
+    // effects (single candidates, then the greedy pairs) the one with the
+    // lowest BIC among the fits that converged, plausible or not: a
+    // parameter pinned at a bound is a likely reason for the remainder
+    // (a base that is rigid vertically needs the vertical stiffness at its
+    // upper bound), not a reason to name nothing.
+    for (size_t n = 1; n <= 2 && r->graded < 0; ++n) {
+      int top = -1;
+      for (size_t i = 0; i < r->candidates.size(); ++i) {
+        const CandidateResult& c = r->candidates[i];
+        if (c.effects.size() != n || c.fit.status != calibration::FitStatus::kConverged) continue;
+        if (top < 0 || c.bic < r->candidates[top].bic) top = static_cast<int>(i);
+      }
+      if (top >= 0 && mostly(grading(top))) {
+        r->graded = top;
+        r->grade = AuditGrade::kMostlyExplained;
+      }
+    }
+    if (r->graded < 0) {
+      // Unexplained: the numbers of the accepted candidate, else of the
+      // lowest-BIC single candidate whose fit converged.
+      r->graded = r->best;
+      for (size_t i = 0; i < r->candidates.size() && r->graded < 0; ++i) {
+        const CandidateResult& c = r->candidates[i];
+        if (c.effects.size() == 1 && c.fit.status == calibration::FitStatus::kConverged) {
+          r->graded = static_cast<int>(i);
+        }
+      }
+    }
+  }
+  std::ostringstream m;
+  m.precision(3);
+  if (r->graded >= 0) {
+    const CandidateResult& b = r->candidates[r->graded];
+    const Grading g = grading(r->graded);
+    r->error_before_noise_units = r->errors_before.total_rms_log_mag / r->noise_floor;
+    r->remainder_noise_units = b.errors.total_rms_log_mag / r->noise_floor;
+    r->fraction_removed = g.fraction;
+    r->bic_gap = g.gap;
+    r->runner_up = g.runner_up;
+    if (r->grade != AuditGrade::kUnexplained) r->missing_effects = b.effects;
+    if (r->grade == AuditGrade::kExplained) {
+      r->explained = true;
+      r->verdict = "missing effect found: " + b.name();
+    } else if (r->grade == AuditGrade::kMostlyExplained) {
+      r->reasons = LikelyReasons(b);
+      m << "mostly explained by " << b.name() << ": it removes " << 100.0 * r->fraction_removed
+        << " % of the excess misfit (error " << r->error_before_noise_units << " -> " << r->remainder_noise_units
+        << " x the noise floor) and is ahead of " << r->runner_up << " by " << r->bic_gap
+        << " in BIC; the remainder is likely due to ";
+      for (size_t i = 0; i < r->reasons.size(); ++i) m << (i ? "; " : "") << r->reasons[i];
+      r->verdict = m.str();
+    } else if (r->best >= 0) {
+      m << "unexplained: the best candidate (" << b.name() << ") lowers the error to " << b.errors.total_rms_log_mag
+        << " but not near the noise floor " << r->noise_floor << " (it removes " << 100.0 * r->fraction_removed
+        << " % of the excess misfit";
+      if (r->fraction_removed >= o.mostly_explained_fraction) {
+        m << ", but is only " << r->bic_gap << " ahead of " << r->runner_up << " in BIC";
+      }
+      m << "); the failure is not attributed to it";
+      r->verdict = m.str();
+    } else {
+      m << "unexplained: no candidate effect lowers the BIC with plausible parameters (the closest fit, " << b.name()
+        << ", removes " << 100.0 * r->fraction_removed << " % of the excess misfit)";
+      r->verdict = m.str();
+    }
+  } else {
+    r->verdict = "unexplained: no candidate effect lowers the BIC with plausible parameters";
+  }
+  if (!r->significant_failure && r->grade != AuditGrade::kExplained) {
+    // Ranked without a failure (rank_only_if_failing off): nothing to explain.
+    r->grade = AuditGrade::kNoFailure;
+    r->explained = true;
+    r->missing_effects.clear();
+    r->reasons.clear();
+    r->verdict = "the model agrees with the measurement within the noise floor; no effect is missing";
+  }
+  if (!r->explained) {
+    // Where the error that is left lies: after the named candidate, else
+    // after the accepted one (as before issue #18), else before.
+    const int after = r->grade == AuditGrade::kMostlyExplained ? r->graded : r->best;
+    r->pattern = DescribePattern(after >= 0 ? r->candidates[after].errors : r->errors_before, r->noise_floor,
+                                 o.significance_factor);
+    r->verdict += "; pattern" + std::string(r->grade == AuditGrade::kMostlyExplained ? " of the remainder" : "") +
+                  ": " + r->pattern;
+  }
+  r->headline = Headline(*r, o);
 }
 
 }  // namespace
@@ -812,7 +1047,9 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   }
   if (!r.significant_failure && o.rank_only_if_failing) {
     r.explained = true;
+    r.grade = AuditGrade::kNoFailure;
     r.verdict = "the model agrees with the measurement within the noise floor; no effect is missing";
+    r.headline = Headline(r, o);
     return r;
   }
   const auto explains = [&](const CandidateResult& c) {
@@ -880,7 +1117,10 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   }
   r.candidates = singles;
   if (singles.empty()) {
+    r.grade = r.significant_failure ? AuditGrade::kUnexplained : AuditGrade::kNoFailure;
+    r.explained = !r.significant_failure;
     r.verdict = "no candidate effects to try";
+    r.headline = Headline(r, o);
     return r;
   }
   // The best plausible single candidate that lowers the BIC is accepted.
@@ -919,27 +1159,7 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
       r.best = static_cast<int>(singles.size());
     }
   }
-  if (r.best >= 0) {
-    const CandidateResult& b = r.candidates[r.best];
-    r.explained = explains(b);
-    if (r.explained) {
-      r.missing_effects = b.effects;
-      r.verdict = "missing effect found: " + b.name();
-    } else {
-      std::ostringstream m;
-      m.precision(3);
-      m << "unexplained: the best candidate (" << b.name() << ") lowers the error to " << b.errors.total_rms_log_mag
-        << " but not near the noise floor " << r.noise_floor << "; the failure is not attributed to it";
-      r.verdict = m.str();
-    }
-  } else {
-    r.verdict = "unexplained: no candidate effect lowers the BIC with plausible parameters";
-  }
-  if (!r.explained) {
-    r.pattern = DescribePattern(r.best >= 0 ? r.candidates[r.best].errors : r.errors_before, r.noise_floor,
-                                o.significance_factor);
-    r.verdict += "; pattern: " + r.pattern;
-  }
+  GradeVerdict(o, &r);
   return r;
 }
 

@@ -4,10 +4,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <cmath>
 #include <memory>
 #include <sstream>
 
 #include <BRepAdaptor_Curve.hxx>
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepBndLib.hxx>
+#include <Bnd_Box.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_NurbsConvert.hxx>
 #include <BRepGProp.hxx>
@@ -23,6 +27,10 @@
 #include <Geom_Surface.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESControl_Reader.hxx>
+#include <IGESData_GlobalSection.hxx>
+#include <IGESData_IGESModel.hxx>
+#include <TColStd_SequenceOfAsciiString.hxx>
+#include <TCollection_HAsciiString.hxx>
 #include <Interface_Static.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
@@ -45,12 +53,18 @@
 #include <gp_Pnt2d.hxx>
 
 #include "robomach/common/errors.h"
+#include "robomach/polishing/surface_grid.h"
 
 namespace robomach::io {
 namespace {
 
 constexpr double kMmToM = 1e-3;
 constexpr double kBoundaryChordMm = 0.25;  // boundary polyline chords (sag < 1 um on r >= 8 mm)
+// On faces larger than 1 m the chords grow with the face (diagonal / 4000),
+// so that the outline, the region's offsets and their round joins stay
+// bounded in points: the 45 m faces of OCCT's hammer.iges read as mm had
+// 150 000 points per edge at 0.25 mm, and the planner ran out of memory.
+constexpr double kMaxChordsPerDiagonal = 4000.0;
 
 std::string Lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -80,34 +94,46 @@ std::string OcctWhat(const Standard_Failure& e) {
   return std::string(e.DynamicType()->Name()) + (s && *s ? std::string(": ") + s : std::string());
 }
 
-TopoDS_Shape ReadShape(const std::string& path) {
+struct ReadResult {
+  TopoDS_Shape shape;
+  std::string unit;  // declared length unit of the file, "" if unknown
+};
+
+ReadResult ReadShape(const std::string& path) {
   SilenceOcct();
   const bool iges = IsIges(path);
   const char* kind = iges ? "IGES" : "STEP";
   try {
     Interface_Static::SetCVal("xstep.cascade.unit", "MM");
     IFSelect_ReturnStatus status;
-    TopoDS_Shape shape;
+    ReadResult out;
     if (iges) {
       IGESControl_Reader r;
       status = r.ReadFile(path.c_str());
       if (status == IFSelect_RetDone) {
         r.TransferRoots();
-        shape = r.OneShape();
+        out.shape = r.OneShape();
+        if (!r.IGESModel().IsNull()) {
+          const Handle(TCollection_HAsciiString) u = r.IGESModel()->GlobalSection().UnitName();
+          if (!u.IsNull()) out.unit = u->ToCString();
+        }
       }
     } else {
       STEPControl_Reader r;
       status = r.ReadFile(path.c_str());
       if (status == IFSelect_RetDone) {
         r.TransferRoots();
-        shape = r.OneShape();
+        out.shape = r.OneShape();
+        TColStd_SequenceOfAsciiString len, ang, solid;
+        r.FileUnits(len, ang, solid);
+        if (len.Length() > 0) out.unit = len.Value(1).ToCString();
       }
     }
     if (status != IFSelect_RetDone) {
       throw InputError({path, 0, 0}, std::string("not a readable ") + kind + " file (OpenCASCADE's " + kind +
                                          " reader failed: " + (status == IFSelect_RetVoid ? "no entities" : "syntax or structure error") + ")");
     }
-    return shape;
+    return out;
   } catch (const Standard_Failure& e) {
     throw InputError({path, 0, 0}, std::string("not a readable ") + kind + " file (OpenCASCADE: " + OcctWhat(e) + ")");
   }
@@ -144,29 +170,66 @@ bool IsCadFile(const std::string& path) {
   return e == ".step" || e == ".stp" || e == ".iges" || e == ".igs";
 }
 
-int CountCadFaces(const std::string& path) { return Faces(ReadShape(path)).Extent(); }
+int CountCadFaces(const std::string& path) { return Faces(ReadShape(path).shape).Extent(); }
 
-polishing::NurbsSurface ReadCadFace(const std::string& path, int face) {
-  const TopoDS_Shape shape = ReadShape(path);
-  const TopTools_IndexedMapOfShape faces = Faces(shape);
-  const int n = faces.Extent();
-  if (n == 0) throw InputError({path, 0, 0}, "the file holds no faces (no surface to polish)");
-  const std::string kind = IsIges(path) ? "IGES" : "STEP";
-  if (face < 0 || face > n) {
-    throw InputError({path, 0, 0}, "--face " + std::to_string(face) + ": the " + kind + " file has " +
-                                       std::to_string(n) + " face" + (n == 1 ? "" : "s") + " (1.." +
-                                       std::to_string(n) + ")");
+namespace {
+
+std::string Fmt(double x) {
+  std::ostringstream o;
+  o.precision(3);
+  o << x;
+  return o.str();
+}
+
+std::string SizeText(const Eigen::Vector3d& s) { return Fmt(s.x()) + " x " + Fmt(s.y()) + " x " + Fmt(s.z()) + " mm"; }
+
+CadPartInfo PartInfo(const ReadResult& rr, int num_faces, const CadReadOptions& options) {
+  CadPartInfo info;
+  info.num_faces = num_faces;
+  info.file_unit = rr.unit;
+  info.unit_scale = options.unit_scale;
+  Bnd_Box box;
+  BRepBndLib::Add(rr.shape, box, Standard_False);  // without triangulation: the poles' box (may be a little loose)
+  if (!box.IsVoid()) {
+    double x0, y0, z0, x1, y1, z1;
+    box.Get(x0, y0, z0, x1, y1, z1);
+    info.bbox_size_mm = options.unit_scale * Eigen::Vector3d(x1 - x0, y1 - y0, z1 - z0);
   }
+  const double big = info.bbox_size_mm.maxCoeff();
+  const std::string says = rr.unit.empty() ? "the file's unit" : "the file says " + rr.unit;
+  const std::string scaled = options.unit_scale != 1.0 ? " (after --cad-unit-scale " + Fmt(options.unit_scale) + ")" : "";
+  if (big > 0 && big < 1.0) {
+    info.unit_warning = says + "; the part is " + SizeText(info.bbox_size_mm) + scaled + ", a part under 1 mm is probably "
+                        "in metres (or inches); --cad-unit-scale 1000 (metres) or 25.4 (inches) to override";
+  } else if (big > 1e4) {
+    info.unit_warning = says + "; the part is " + SizeText(info.bbox_size_mm) + scaled + ", a part over 10 m is probably "
+                        "in another unit (um, or 1/1000 of what it says); --cad-unit-scale 0.001 to override";
+  }
+  return info;
+}
+
+std::string SurfaceType(const TopoDS_Face& f) {
+  switch (BRepAdaptor_Surface(f, Standard_False).GetType()) {
+    case GeomAbs_Plane: return "plane";
+    case GeomAbs_Cylinder: return "cylinder";
+    case GeomAbs_Cone: return "cone";
+    case GeomAbs_Sphere: return "sphere";
+    case GeomAbs_Torus: return "torus";
+    case GeomAbs_BezierSurface: return "bezier";
+    case GeomAbs_BSplineSurface: return "bspline";
+    case GeomAbs_SurfaceOfRevolution: return "revolution";
+    case GeomAbs_SurfaceOfExtrusion: return "extrusion";
+    case GeomAbs_OffsetSurface: return "offset";
+    default: return "other";
+  }
+}
+
+// Face `index` (1-based) of `faces` as a trimmed NURBS patch in metres.
+polishing::NurbsSurface ConvertFace(const std::string& path, const TopTools_IndexedMapOfShape& faces, int index,
+                                    double unit_scale) {
   const std::string where = std::filesystem::path(path).filename().string() + ", face ";
+  const double to_m = kMmToM * unit_scale;  // file lengths (as OpenCASCADE gives them, mm) to metres
   try {
-    int index = face;
-    if (index == 0) {  // formats.md §5: by default the largest by area
-      double best = -1.0;
-      for (int i = 1; i <= n; ++i) {
-        const double a = FaceArea(TopoDS::Face(faces(i)));
-        if (a > best) best = a, index = i;
-      }
-    }
     const TopoDS_Face original = TopoDS::Face(faces(index));
     const std::string source = where + std::to_string(index);
     auto fail = [&](const std::string& m) { return InputError({path, 0, 0}, "face " + std::to_string(index) + ": " + m); };
@@ -207,7 +270,7 @@ polishing::NurbsSurface ReadCadFace(const std::string& path, int face) {
       for (int j = 1; j <= nv; ++j) {
         const gp_Pnt p = bs->Pole(i, j);
         const int ii = reversed ? nu - i : i - 1;
-        P[ii][j - 1] = kMmToM * Eigen::Vector3d(p.X(), p.Y(), p.Z());
+        P[ii][j - 1] = to_m * Eigen::Vector3d(p.X(), p.Y(), p.Z());
         W[ii][j - 1] = bs->Weight(i, j);
       }
     // Reversed face: u' = u_lo + u_hi - u keeps the knot range and makes
@@ -227,14 +290,22 @@ polishing::NurbsSurface ReadCadFace(const std::string& path, int face) {
 
     auto trim = std::make_shared<polishing::FaceTrim>();
     trim->source = source;
-    trim->area = FaceArea(original) * kMmToM * kMmToM;
+    trim->area = FaceArea(original) * to_m * to_m;
     auto classifier = std::make_shared<BRepTopAdaptor_FClass2d>(nf, Precision::PConfusion());
     trim->contains = [classifier, reversed, u_sum](double u, double v) {
       const TopAbs_State s = classifier->Perform(gp_Pnt2d(reversed ? u_sum - u : u, v), Standard_False);
       return s == TopAbs_IN || s == TopAbs_ON;
     };
     for (TopExp_Explorer w(nf, TopAbs_WIRE); w.More(); w.Next()) ++trim->num_wires;
-    trim->boundary_chord = kMmToM * kBoundaryChordMm;
+    // Chords of 0.25 mm, longer on faces over 1 m (bounded point count).
+    double chord_mm = kBoundaryChordMm;
+    {
+      Bnd_Box fb;
+      BRepBndLib::Add(original, fb, Standard_False);
+      if (!fb.IsVoid()) chord_mm = std::max(chord_mm, unit_scale * std::sqrt(fb.SquareExtent()) / kMaxChordsPerDiagonal);
+    }
+    const double chord_file = chord_mm / unit_scale;  // in the lengths OpenCASCADE gives
+    trim->boundary_chord = kMmToM * chord_mm;
     for (TopExp_Explorer e(nf, TopAbs_EDGE); e.More(); e.Next()) {
       const TopoDS_Edge edge = TopoDS::Edge(e.Current());
       // A degenerate edge (a pole) and the seam of a closed surface are not
@@ -242,16 +313,16 @@ polishing::NurbsSurface ReadCadFace(const std::string& path, int face) {
       if (BRep_Tool::Degenerated(edge) || BRep_Tool::IsClosed(edge, nf)) continue;
       BRepAdaptor_Curve c(edge);
       std::vector<Eigen::Vector3d> line;
-      GCPnts_UniformAbscissa ua(c, kBoundaryChordMm);
+      GCPnts_UniformAbscissa ua(c, chord_file);
       if (ua.IsDone() && ua.NbPoints() >= 2) {
         for (int k = 1; k <= ua.NbPoints(); ++k) {
           const gp_Pnt p = c.Value(ua.Parameter(k));
-          line.push_back(kMmToM * Eigen::Vector3d(p.X(), p.Y(), p.Z()));
+          line.push_back(to_m * Eigen::Vector3d(p.X(), p.Y(), p.Z()));
         }
       }
       const gp_Pnt a = c.Value(c.FirstParameter()), b = c.Value(c.LastParameter());
-      const Eigen::Vector3d pa = kMmToM * Eigen::Vector3d(a.X(), a.Y(), a.Z());
-      const Eigen::Vector3d pb = kMmToM * Eigen::Vector3d(b.X(), b.Y(), b.Z());
+      const Eigen::Vector3d pa = to_m * Eigen::Vector3d(a.X(), a.Y(), a.Z());
+      const Eigen::Vector3d pb = to_m * Eigen::Vector3d(b.X(), b.Y(), b.Z());
       if (line.empty()) line = {pa, pb};
       if ((line.front() - pa).norm() > 1e-9) line.insert(line.begin(), pa);
       if ((line.back() - pb).norm() > 1e-9) line.push_back(pb);
@@ -269,7 +340,7 @@ polishing::NurbsSurface ReadCadFace(const std::string& path, int face) {
         std::vector<double> params;
         if (!BRep_Tool::Degenerated(edge)) {
           BRepAdaptor_Curve c(edge);
-          GCPnts_UniformAbscissa ua(c, kBoundaryChordMm);
+          GCPnts_UniformAbscissa ua(c, chord_file);
           if (ua.IsDone()) {
             for (int k = 1; k <= ua.NbPoints(); ++k) params.push_back(ua.Parameter(k));
           }
@@ -290,8 +361,113 @@ polishing::NurbsSurface ReadCadFace(const std::string& path, int face) {
     }
     return patch.WithTrim(std::move(trim));
   } catch (const Standard_Failure& e) {
-    throw InputError({path, 0, 0}, "face " + std::to_string(face) + ": OpenCASCADE failed: " + OcctWhat(e));
+    throw InputError({path, 0, 0}, "face " + std::to_string(index) + ": OpenCASCADE failed: " + OcctWhat(e));
   }
+}
+
+// True if a point of the face's outer wire lies inside its patch's
+// parameter box (by more than 1e-6 of the box): the wires cut the patch.
+bool TrimmedInside(const polishing::NurbsSurface& s) {
+  if (!s.trim()) return false;
+  const double tu = 1e-6 * (s.u_max() - s.u_min()), tv = 1e-6 * (s.v_max() - s.v_min());
+  for (const auto& wire : s.trim()->wires_uv)
+    for (const Eigen::Vector2d& p : wire) {
+      const bool on_u = std::abs(p.x() - s.u_min()) <= tu || std::abs(p.x() - s.u_max()) <= tu;
+      const bool on_v = std::abs(p.y() - s.v_min()) <= tv || std::abs(p.y() - s.v_max()) <= tv;
+      if (!on_u && !on_v) return true;
+    }
+  return false;
+}
+
+int LargestFace(const TopTools_IndexedMapOfShape& faces) {
+  int index = 1;
+  double best = -1.0;
+  for (int i = 1; i <= faces.Extent(); ++i) {
+    const double a = FaceArea(TopoDS::Face(faces(i)));
+    if (a > best) best = a, index = i;
+  }
+  return index;
+}
+
+void CheckScale(const std::string& path, const CadReadOptions& options) {
+  if (!(options.unit_scale > 0) || !std::isfinite(options.unit_scale)) {
+    throw std::invalid_argument("--cad-unit-scale: expected a number > 0, got " + Fmt(options.unit_scale) + " (for " + path + ")");
+  }
+}
+
+}  // namespace
+
+polishing::NurbsSurface ReadCadFace(const std::string& path, int face, const CadReadOptions& options, CadPartInfo* info) {
+  CheckScale(path, options);
+  const ReadResult rr = ReadShape(path);
+  const TopTools_IndexedMapOfShape faces = Faces(rr.shape);
+  const int n = faces.Extent();
+  if (n == 0) throw InputError({path, 0, 0}, "the file holds no faces (no surface to polish)");
+  const std::string kind = IsIges(path) ? "IGES" : "STEP";
+  if (face < 0 || face > n) {
+    throw InputError({path, 0, 0}, "--face " + std::to_string(face) + ": the " + kind + " file has " +
+                                       std::to_string(n) + " face" + (n == 1 ? "" : "s") + " (1.." +
+                                       std::to_string(n) + ")");
+  }
+  if (info) *info = PartInfo(rr, n, options);
+  int index = face;
+  if (index == 0) {  // formats.md §5: by default the largest by area
+    try {
+      index = LargestFace(faces);
+    } catch (const Standard_Failure& e) {
+      throw InputError({path, 0, 0}, "finding the largest face: OpenCASCADE failed: " + OcctWhat(e));
+    }
+  }
+  return ConvertFace(path, faces, index, options.unit_scale);
+}
+
+std::vector<CadFaceRow> ListCadFaces(const std::string& path, const FaceCheck& check, const CadReadOptions& options,
+                                     CadPartInfo* info, const std::function<void(int, int)>& progress) {
+  CheckScale(path, options);
+  const ReadResult rr = ReadShape(path);
+  const TopTools_IndexedMapOfShape faces = Faces(rr.shape);
+  const int n = faces.Extent();
+  if (n == 0) throw InputError({path, 0, 0}, "the file holds no faces (no surface to polish)");
+  if (info) *info = PartInfo(rr, n, options);
+  std::vector<CadFaceRow> rows;
+  for (int i = 1; i <= n; ++i) {
+    CadFaceRow row;
+    row.face = i;
+    const TopoDS_Face f = TopoDS::Face(faces(i));
+    try {
+      row.surface_type = SurfaceType(f);
+      row.area_mm2 = FaceArea(f) * options.unit_scale * options.unit_scale;
+      int wires = 0;
+      for (TopExp_Explorer w(f, TopAbs_WIRE); w.More(); w.Next()) ++wires;
+      row.holes = std::max(0, wires - 1);
+    } catch (const Standard_Failure& e) {
+      row.reason = "OpenCASCADE failed: " + OcctWhat(e);
+      rows.push_back(row);
+      if (progress) progress(i, n);
+      continue;
+    }
+    try {
+      const polishing::NurbsSurface s = ConvertFace(path, faces, i, options.unit_scale);
+      const polishing::SurfaceSize size = polishing::MeasureSurface(s);
+      row.u_size_mm = 1e3 * size.length_u;
+      row.v_size_mm = 1e3 * size.length_v;
+      row.trimmed = row.holes > 0 || TrimmedInside(s);
+      if (check) {
+        const auto [ok, reason] = check(s);
+        row.polishable = ok;
+        row.reason = reason;
+      } else {
+        row.polishable = true;
+      }
+    } catch (const InputError& e) {
+      row.reason = e.what();
+    } catch (const std::exception& e) {
+      row.reason = e.what();
+    }
+    rows.push_back(row);
+    if (progress) progress(i, n);
+  }
+  return rows;
 }
 
 void WriteStepFace(const polishing::NurbsSurface& s, const std::string& path, const std::string& comment) {

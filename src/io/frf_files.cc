@@ -594,6 +594,12 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
     }
     const int resp_node = r.response_node != 0 ? r.response_node : rd.node;
     const int ref_node = r.reference_node != 0 ? r.reference_node : ed.node;
+    if (r.function_type == 4 && resp_node != 0 && ref_node != 0 && resp_node != ref_node) {
+      out.warnings.push_back(where + ": a transfer FRF between two points (response node " + std::to_string(resp_node) +
+                             ", reference node " + std::to_string(ref_node) +
+                             "); a tool-tip FRF is a driving-point FRF (hammer and sensor at the tool tip), so the "
+                             "tools read it as one only if the export numbered one point twice");
+    }
     const double hz = AbscissaToHz(path, r);
     if (r.trailing_values > 0) {
       (r.trailing_all_zero ? out.notes : out.warnings)

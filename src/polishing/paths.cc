@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "robomach/common/units.h"
+#include "robomach/polishing/face_check.h"
 #include "robomach/polishing/region_outline.h"
 
 namespace robomach::polishing {
@@ -391,6 +392,7 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
 
   // Guide lines, in order, with the direction sense of the cycloid.
   const DevelopedRegion region = DevelopedRegion::Build(surface, grid, process.margin);
+  if (cyc) CheckCircleFits(surface, grid, region, params, process);  // never rows clamped onto the edges
   std::vector<GuideSpec> guides;
   // Direction of parallel lines: e (along the lines), nrm (across them).
   const double ca = std::cos(params.line_angle), sa = std::sin(params.line_angle);

@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <sstream>
 #include <unordered_map>
 
 #include <Eigen/Dense>
+
+#include "robomach/polishing/face_trim.h"
 
 namespace robomach::polishing {
 namespace {
@@ -28,8 +32,8 @@ double Slope(const std::vector<double>& xs, const std::vector<double>& ys, doubl
 // Mean arc length along one parameter (over several iso-lines of the other)
 // as a table of (arc length, parameter).
 void ArcLengthTable(const NurbsSurface& S, bool along_u, std::vector<double>* table_len,
-                    std::vector<double>* table_par, double* max_len) {
-  constexpr int kFine = 2000, kLines = 9;
+                    std::vector<double>* table_par, double* max_len, int kFine = 2000) {
+  constexpr int kLines = 9;
   const double a0 = along_u ? S.u_min() : S.v_min(), a1 = along_u ? S.u_max() : S.v_max();
   const double b0 = along_u ? S.v_min() : S.u_min(), b1 = along_u ? S.v_max() : S.u_max();
   table_par->resize(kFine + 1);
@@ -105,15 +109,63 @@ class SegmentIndex {
   std::unordered_map<long long, std::vector<int>> cells_;
 };
 
+std::string Mm(double x_m) {
+  std::ostringstream o;
+  o.precision(4);
+  o << 1e3 * x_m;
+  return o.str();
+}
+
 }  // namespace
 
-SampleGrid SampleGrid::Build(const NurbsSurface& surface, double max_spacing, double margin, bool flip) {
+SurfaceSize MeasureSurface(const NurbsSurface& surface, int fine) {
+  SurfaceSize z;
+  std::vector<double> len, par;
+  ArcLengthTable(surface, true, &len, &par, &z.max_u, std::max(2, fine));
+  z.length_u = len.back();
+  ArcLengthTable(surface, false, &len, &par, &z.max_v, std::max(2, fine));
+  z.length_v = len.back();
+  return z;
+}
+
+double EstimateGridPoints(const SurfaceSize& size, double max_spacing) {
+  if (!std::isfinite(size.max_u) || !std::isfinite(size.max_v) || !(max_spacing > 0)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return (std::ceil(size.max_u / max_spacing) + 1) * (std::ceil(size.max_v / max_spacing) + 1);
+}
+
+std::string SurfaceName(const NurbsSurface& surface) {
+  return surface.trim() && !surface.trim()->source.empty() ? surface.trim()->source : "the patch";
+}
+
+SampleGrid SampleGrid::Build(const NurbsSurface& surface, double max_spacing, double margin, bool flip,
+                             double max_points) {
   SampleGrid g;
   double max_s = 0, max_t = 0;
   ArcLengthTable(surface, true, &g.table_s_, &g.table_u_, &max_s);
   ArcLengthTable(surface, false, &g.table_t_, &g.table_v_, &max_t);
   g.length_s_ = g.table_s_.back();
   g.length_t_ = g.table_t_.back();
+  // The grid's size, validated before any cast to int (issue 22: a mutated
+  // patch gave NaN or 1e300 here, and ns * nt overflowed).
+  if (!std::isfinite(max_s) || !std::isfinite(max_t) || !std::isfinite(g.length_s_) || !std::isfinite(g.length_t_)) {
+    throw std::domain_error(SurfaceName(surface) + ": the patch's size is not finite (a NaN or infinite control "
+                            "point or weight?)");
+  }
+  if (!(max_spacing > 0) || !std::isfinite(max_spacing)) {
+    throw std::domain_error("sampling spacing must be a finite number > 0, got " + Mm(max_spacing) + " mm");
+  }
+  const double points = EstimateGridPoints({g.length_s_, g.length_t_, max_s, max_t}, max_spacing);
+  if (!(points <= max_points)) {
+    std::ostringstream m;
+    m.precision(3);
+    m << SurfaceName(surface) << " is too large to sample: " << Mm(g.length_s_) << " x " << Mm(g.length_t_)
+      << " mm (mean arc lengths along u and v) at " << Mm(max_spacing) << " mm spacing needs " << points
+      << " grid points (~" << points * 90e-9 << " GB), above the limit of " << max_points
+      << " (check the file's unit, or use a coarser sampling)";
+    throw std::domain_error(m.str());
+  }
   // The longest iso-line decides the count, so no spacing exceeds max_spacing
   // (up to the parametrisation's non-uniformity, checked below).
   g.ns_ = static_cast<int>(std::ceil(max_s / max_spacing)) + 1;
@@ -136,7 +188,17 @@ SampleGrid SampleGrid::Build(const NurbsSurface& surface, double max_spacing, do
       const SurfaceDerivatives d = surface.Evaluate(g.u_[i], g.v_[j]);
       const int k = g.index(i, j);
       g.p_[k] = d.S;
-      g.n_[k] = UnitNormal(d, flip);
+      try {
+        g.n_[k] = UnitNormal(d, flip);
+      } catch (const std::domain_error& e) {
+        // A pole of the patch (a degenerate edge: cone apex, sphere pole,
+        // a collapsed B-spline boundary): name the face, its size and where.
+        std::ostringstream m;
+        m << SurfaceName(surface) << " (" << Mm(g.length_s_) << " x " << Mm(g.length_t_) << " mm): " << e.what()
+          << " at u " << g.u_[i] << ", v " << g.v_[j] << " (a pole of the patch, e.g. a collapsed edge; faces "
+          << "with poles cannot be sampled)";
+        throw std::domain_error(m.str());
+      }
       jac[k] = d.S_u.cross(d.S_v).norm();
     }
   }

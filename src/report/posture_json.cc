@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "robomach/common/version.h"
+
 namespace robomach::report {
 namespace {
 
@@ -76,6 +78,11 @@ nlohmann::json PostureToJson(const std::string& pose_id, const dynamics::Posture
   return j;
 }
 
-std::string DumpJson(const nlohmann::json& j) { return j.dump(2) + "\n"; }
+std::string DumpJson(const nlohmann::json& j) {
+  if (!j.is_object() || j.contains("robomach_version")) return j.dump(2) + "\n";
+  nlohmann::json stamped = j;
+  stamped["robomach_version"] = Version();
+  return stamped.dump(2) + "\n";
+}
 
 }  // namespace robomach::report

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <vector>
 #include <stdexcept>
 #include <string>
 
@@ -133,6 +135,29 @@ Eigen::VectorXd LobeFrequencyGrid(const TipModalModel& m, int teeth, double max_
   const double f_hi = std::max(1.5 * RadPerSecToHz(m.omega_rad_s.maxCoeff()),
                                1.05 * teeth * max_speed_rad_s / (2.0 * kPi));
   return LogFrequencyGrid(f_lo, std::max(f_hi, 2.0 * f_lo), lines);
+}
+
+TipModalModel DominantModes(const TipModalModel& modes_C, int count) {
+  const int n = modes_C.num_modes();
+  if (count >= n) return modes_C;
+  std::vector<int> idx(n);
+  std::iota(idx.begin(), idx.end(), 0);
+  auto compliance = [&](int k) {
+    return modes_C.p.col(k).head<2>().squaredNorm() / std::pow(modes_C.omega_rad_s(k), 2);
+  };
+  std::sort(idx.begin(), idx.end(), [&](int a, int b) { return compliance(a) > compliance(b); });
+  idx.resize(std::max(0, count));
+  std::sort(idx.begin(), idx.end());
+  TipModalModel out;
+  out.omega_rad_s.resize(idx.size());
+  out.zeta.resize(idx.size());
+  out.p.resize(3, idx.size());
+  for (size_t j = 0; j < idx.size(); ++j) {
+    out.omega_rad_s(j) = modes_C.omega_rad_s(idx[j]);
+    out.zeta(j) = modes_C.zeta(idx[j]);
+    out.p.col(j) = modes_C.p.col(idx[j]);
+  }
+  return out;
 }
 
 }  // namespace robomach::stability

@@ -532,6 +532,9 @@ TEST(Uff58External, MeasuredMobilityFrf) {
   EXPECT_THAT(notes, HasSubstr("directions from the entity names \".1.Z-\" and \".56.Z\""));
   EXPECT_THAT(notes, HasSubstr("4 padding zeros after the 1600 points"));
   EXPECT_THAT(notes, HasSubstr("record 9 gives no physical ordinate type (0); its unit (m/s)/N makes it a mobility"));
+  // Points 1 and 56 (from the entity names): not a tool-tip (driving-point) FRF.
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_THAT(r.warnings[0], HasSubstr("a transfer FRF between two points (response node 1, reference node 56)"));
 }
 
 TEST(Uff58External, CoherenceTimeAndSpectrumAreNamedNotMisread) {

@@ -5,6 +5,7 @@
 // library, added and fitted together with the calibration parameters,
 // explains the failure best (ranked by BIC, greedily for a second effect).
 
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <string>
@@ -38,6 +39,24 @@ struct AuditOptions {
   /// A model "explains" the data if its total error is within this factor of
   /// the noise floor (the same bound as significance_factor).
   double explained_factor{1.3};
+  /// Graded verdict (issue #18): a candidate that does not explain the data
+  /// but removes at least this fraction of the excess misfit, with errors in
+  /// units of the noise floor, (before − after) / (before − 1), and is
+  /// clearly ahead by BIC (clear_bic_gap) "mostly explains" it and is named.
+  /// 0.8: the remainder is at most a fifth of what the calibrated model
+  /// missed, so the effect accounts for the bulk of the failure; the issue's
+  /// held-out cases of effects not quite of library form (a base rocking
+  /// about its floor point with Rayleigh damping, a holder with its own
+  /// mass on interface springs) reached 0.93 and 0.996, a sensor-mounting
+  /// resonance outside the library 0.01.
+  double mostly_explained_fraction{0.8};
+  /// "Clearly ahead by BIC": the named candidate's BIC is below that of
+  /// every alternative with as many effects or fewer (the other candidates
+  /// of its round and of the rounds before it, and the calibrated current
+  /// model) by more than this. 10 is "very strong" evidence on the scale of
+  /// Kass & Raftery, J. Am. Stat. Assoc. 90 (1995) 773-795, for 2 ln B
+  /// (ΔBIC ≈ 2 ln B > 10: a Bayes factor above ~150).
+  double clear_bic_gap{10.0};
   /// Try a second effect on top of the best one if the best alone does not
   /// explain the data.
   bool greedy_second_round{true};
@@ -110,6 +129,35 @@ ModelErrors ComputeErrors(const std::shared_ptr<const dynamics::RobotModel>& mod
 /// FRF carries a noise model the errors are already in its units: 1.
 double EstimateNoiseFloor(const dynamics::FrfSet& measured, double fmin_hz, double fmax_hz);
 
+/// The graded verdict of an audit (issue #18).
+enum class AuditGrade {
+  /// No significant failure: the current model agrees with the measurement
+  /// within significance_factor × the noise floor; nothing is missing.
+  kNoFailure,
+  /// A significant failure that the named effect(s) bring within
+  /// explained_factor × the noise floor.
+  kExplained,
+  /// A significant failure that the named effect(s) do not bring within the
+  /// noise, but reduce by at least mostly_explained_fraction of the excess
+  /// misfit while clearly ahead by BIC (clear_bic_gap): the effect is real
+  /// but not exactly of the library's form, or its parameters are bounded.
+  kMostlyExplained,
+  /// A significant failure that no candidate explains or mostly explains.
+  kUnexplained,
+};
+
+/// "no_failure", "explained", "mostly_explained", "unexplained" (the JSON
+/// summary's verdict.grade).
+std::string AuditGradeName(AuditGrade grade);
+
+/// The fraction of the excess misfit a model with error `after` removes
+/// from one with error `before`: (b − a) / (b − 1) with b, a the errors in
+/// units of `noise_floor` (1 is a model that is right). 1 when `after` is at
+/// the noise, 0 when nothing changed, negative when it got worse; NaN when
+/// `before` is within the noise (no excess to remove) or an input is not
+/// finite.
+double FractionRemoved(double before, double after, double noise_floor);
+
 /// One candidate effect (or pair, in the greedy round) fitted to the data.
 struct CandidateResult {
   std::vector<std::string> effects;  // the added effects, in order of addition
@@ -131,6 +179,10 @@ struct CandidateResult {
   /// from the calibrated model) or "defaults" (library defaults with the
   /// model's own start values; tried when the first did not explain the data).
   std::string start;
+  /// Effect parameters on a bound that the data push there (moving one into
+  /// the interior raises χ² by identifiable_chi2 or more): they make the
+  /// candidate implausible, and a mostly-explained verdict lists them.
+  std::vector<std::string> pinned;
   /// Every fitted effect parameter converged, inside its bounds and not pinned at one.
   bool plausible{false};
   std::string note;         // why not plausible, or the fit's message
@@ -147,14 +199,52 @@ struct AuditResult {
   bool significant_failure{false};
   /// Best first (by BIC); the greedy pairs follow the single candidates.
   std::vector<CandidateResult> candidates;
-  /// Index in `candidates` of the accepted explanation, -1 if none.
+  /// Index in `candidates` of the accepted candidate, -1 if none: the best
+  /// plausible one that lowers the BIC (the explanation when the grade is
+  /// kExplained; see `graded` for the one a kMostlyExplained grade names).
   int best{-1};
+  /// The named effects: the accepted candidate's when the grade is
+  /// kExplained or kMostlyExplained, empty otherwise.
   std::vector<std::string> missing_effects;
+  AuditGrade grade{AuditGrade::kUnexplained};
+  /// grade is kNoFailure or kExplained: the model (with the named effects)
+  /// agrees with the measurement within the noise. False for
+  /// kMostlyExplained: an effect is named, but a misfit remains.
   bool explained{false};
-  std::string verdict;  // one sentence for people
+  std::string verdict;  // one sentence for people (with the pattern and the reasons)
+  /// The verdict in one short sentence, for the first line of a report: the
+  /// grade, the named effect and the errors before and after in units of
+  /// the noise floor (the fraction removed when mostly explained).
+  std::string headline;
+  /// Index in `candidates` of the candidate the grade was decided on, -1 if
+  /// none: the named one for kExplained (= best) and kMostlyExplained;
+  /// for kUnexplained the accepted one (best), else the single candidate
+  /// with the lowest BIC whose fit converged. The numbers below are its.
+  /// kMostlyExplained names, per number of effects (singles first, then
+  /// the greedy pairs), the candidate with the lowest BIC among the fits
+  /// that converged, plausible or not (a parameter pinned at a bound is a
+  /// likely reason for the remainder), so `graded` may differ from `best`.
+  int graded{-1};
+  /// The graded candidate against the current model, errors in units of the
+  /// noise floor; NaN without one.
+  double error_before_noise_units{NAN};  // errors_before.total_rms_log_mag / noise_floor
+  double remainder_noise_units{NAN};     // the accepted candidate's error / noise_floor
+  double fraction_removed{NAN};          // FractionRemoved(before, after, noise_floor)
+  /// BIC of the runner-up minus that of the accepted candidate, and the
+  /// runner-up's name: the alternative with the lowest BIC among the other
+  /// candidates with as many effects or fewer and the calibrated current
+  /// model ("current model"). Compared with AuditOptions::clear_bic_gap.
+  double bic_gap{NAN};
+  std::string runner_up;
   /// When not explained: where the remaining error lies (see DescribePattern),
   /// also appended to the verdict; empty otherwise.
   std::string pattern;
+  /// kMostlyExplained: the likely reasons for the remainder, one phrase each:
+  /// fitted parameters of the named effects (or calibration parameters) on
+  /// a bound, the effect's damping parameter on a bound ("its damping"),
+  /// and, when no parameter is on a bound, "its form" (the real effect is
+  /// not exactly of the library's form). Empty otherwise.
+  std::vector<std::string> reasons;
   /// Trouble that did not stop the audit (a failed fit of an effect given
   /// with --add), for the caller to report.
   std::vector<std::string> warnings;

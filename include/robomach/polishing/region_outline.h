@@ -49,7 +49,8 @@ class DevelopedRegion {
   /// convention; empty once the region has vanished.
   std::vector<Polygon2> Offset(double distance) const;
   /// The largest distance from the boundary of a point of the region
-  /// (radius of the largest inscribed circle) [m], to 1e-6 m.
+  /// (radius of the largest inscribed circle) [m], to 1e-6 m or 1e-6 of the
+  /// region's size, whichever is larger.
   double Inradius() const;
   /// The intervals [s0, s1] (sorted) where the line t = const crosses the region.
   std::vector<std::pair<double, double>> Intervals(double t) const;

@@ -7,6 +7,7 @@
 // u and v, so that (s, t) -> (u(s), v(t)) -> S is a length-preserving map on
 // planes and cylinders and a mild distortion on doubly curved patches.
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -15,12 +16,35 @@
 
 namespace robomach::polishing {
 
+/// Size of a patch: mean and largest arc length of its iso-parameter lines
+/// along u and v [m] (the sampling grid's spacing follows the largest).
+struct SurfaceSize {
+  double length_u{0}, length_v{0};  // mean over 9 iso-lines
+  double max_u{0}, max_v{0};        // longest iso-line
+};
+/// `fine` chords per iso-line (SampleGrid::Build uses 2000).
+SurfaceSize MeasureSurface(const NurbsSurface& surface, int fine = 400);
+
+/// Grid points SampleGrid::Build makes at `max_spacing` (a double: it may be
+/// far beyond int; +inf for a non-finite size).
+double EstimateGridPoints(const SurfaceSize& size, double max_spacing);
+
+/// The largest grid SampleGrid::Build makes (~90 bytes a point: 0.9 GB).
+constexpr double kMaxGridPoints = 1e7;
+
+/// "file.step, face 3" for a CAD face, "the patch" otherwise (for messages).
+std::string SurfaceName(const NurbsSurface& surface);
+
 class SampleGrid {
  public:
   /// Samples `surface` with at most `max_spacing` [m] between neighbouring
   /// points along either parameter direction.
-  /// @throws std::domain_error at a degenerate point (no normal).
-  static SampleGrid Build(const NurbsSurface& surface, double max_spacing, double margin, bool flip_normal);
+  /// @throws std::domain_error at a degenerate point (no normal), for a patch
+  /// whose size is not finite (NaN or infinite control points), or when the
+  /// grid would exceed `max_points` (the message gives the face, its size and
+  /// the count).
+  static SampleGrid Build(const NurbsSurface& surface, double max_spacing, double margin, bool flip_normal,
+                          double max_points = kMaxGridPoints);
 
   int ns() const { return ns_; }
   int nt() const { return nt_; }

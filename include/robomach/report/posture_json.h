@@ -14,7 +14,10 @@ namespace robomach::report {
 /// arrays of rows.
 nlohmann::json PostureToJson(const std::string& pose_id, const dynamics::PostureDynamics& d);
 
-/// Dumps JSON with non-finite numbers written as null.
+/// Dumps JSON with non-finite numbers written as null. A JSON object gets a
+/// `robomach_version` field (robomach::Version(): the version and git
+/// commit that made it) unless it has one, so every JSON output of the
+/// tools can be traced to its code.
 std::string DumpJson(const nlohmann::json& j);
 
 }  // namespace robomach::report

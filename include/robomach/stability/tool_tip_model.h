@@ -67,6 +67,11 @@ Eigen::VectorXd LogFrequencyGrid(double f_lo_hz, double f_hi_hz, int lines);
 Eigen::VectorXd LobeFrequencyGrid(const TipModalModel& m, int teeth, double max_speed_rad_s,
                                   int lines);
 
+/// The `count` modes with the largest in-plane static compliance
+/// |p_xy|²/ω² (the ones that dominate chatter in the plane), in the order
+/// of frequency; all if count >= the number of modes.
+TipModalModel DominantModes(const TipModalModel& modes_C, int count);
+
 /// - [Ewins 2000] D. J. Ewins, Modal Testing: Theory, Practice and
 ///   Application, 2nd ed., Research Studies Press, 2000.
 

@@ -1,0 +1,378 @@
+// frf-estimate: tool-tip FRFs (H1 or H2, with coherence) from raw
+// impact-hammer time records, averaged over hits, with force and
+// exponential windows; double hits and overloads are rejected by name
+// (issue #18, item 4; docs/frf-estimate.md).
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_support.h"
+#include "robomach/calibration/frf_estimate.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/frf_files.h"
+#include "robomach/io/hammer_records.h"
+#include "robomach/io/number_format.h"
+#include "robomach/report/plot.h"
+#include "robomach/report/posture_json.h"
+
+namespace robomach::apps {
+namespace {
+
+constexpr char kTool[] = "frf-estimate";
+
+std::string Num(double v, int digits = 4) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+io::FrfQuantity QuantityOf(calibration::ResponseQuantity q) {
+  switch (q) {
+    case calibration::ResponseQuantity::kDisplacement: return io::FrfQuantity::kReceptance;
+    case calibration::ResponseQuantity::kVelocity: return io::FrfQuantity::kMobility;
+    case calibration::ResponseQuantity::kAcceleration: return io::FrfQuantity::kAccelerance;
+  }
+  return io::FrfQuantity::kReceptance;
+}
+
+Axis ParseAxisOption(const std::string& option, const std::string& text) {
+  if (text == "x") return Axis::kX;
+  if (text == "y") return Axis::kY;
+  if (text == "z") return Axis::kZ;
+  throw std::invalid_argument(option + ": expected x, y or z, got '" + text + "'");
+}
+
+// A channel's direction: --direction NAME=AXIS, else a name that is x, y or
+// z or ends in _x, _y or _z.
+Axis ChannelDirection(const std::string& name, const std::map<std::string, std::string>& given) {
+  if (auto it = given.find(name); it != given.end()) return ParseAxisOption("--direction " + name, it->second);
+  const char last = name.empty() ? '\0' : name.back();
+  const bool suffix = name.size() == 1 || (name.size() >= 2 && name[name.size() - 2] == '_');
+  if (suffix && (last == 'x' || last == 'y' || last == 'z')) return static_cast<Axis>(last - 'x');
+  throw std::invalid_argument("response channel '" + name +
+                              "': its direction is not in its name (…_x, …_y, …_z); give --direction " + name +
+                              "=x (or y, z)");
+}
+
+void SavePlot(const std::string& path, const calibration::FrfEstimateResult& r, const dynamics::FrfSet& frfs,
+              const std::vector<std::string>& labels, const std::vector<int>& channel_of, io::FrfQuantity quantity,
+              const std::string& estimator) {
+  report::Figure fig(2, 1, 1000, 400);
+  fig.title = "frf-estimate: " + estimator + " of " + std::to_string(r.averages) + " hits";
+  if (r.exponential_tau_s > 0.0) {
+    fig.title += ", exponential window tau = " + Num(r.exponential_tau_s, 3) + " s (adds damping)";
+  }
+  report::Axes& mag = fig.at(0, 0);
+  report::Axes& coh = fig.at(1, 0);
+  const std::string unit = quantity == io::FrfQuantity::kReceptance ? "m/N"
+                           : quantity == io::FrfQuantity::kMobility ? "(m/s)/N"
+                                                                    : "(m/s^2)/N";
+  mag.title = "|" + estimator + "| (" + io::QuantityName(quantity) + ")";
+  mag.x_label = "frequency [Hz]";
+  mag.y_label = "|H| [" + unit + "]";
+  mag.log_y = true;
+  coh.title = "coherence";
+  coh.x_label = "frequency [Hz]";
+  coh.y_label = "gamma^2 [-]";
+  coh.y_min = 0.0;
+  coh.y_max = 1.05;
+  coh.legend = report::Axes::LegendPosition::kBottomLeft;
+  int i = 0;
+  for (const auto& [key, frf] : frfs) {
+    report::Series m, c;
+    for (int k = 0; k < frf.size(); ++k) {
+      const double f = frf.freq_hz()(k);
+      const double v = std::abs(io::FromReceptance(quantity, f, frf.receptance()(k)));
+      if (!(v > 0.0)) continue;
+      m.x.push_back(f);
+      m.y.push_back(v);
+    }
+    const auto& g = r.channels[channel_of[i]].coherence;
+    for (int k = 0; k < g.size(); ++k) {
+      c.x.push_back(r.freq_hz(k));
+      c.y.push_back(g(k));
+    }
+    m.label = c.label = labels[i];
+    m.color = c.color = report::PaletteColor(i);
+    m.thickness = c.thickness = 1;
+    mag.series.push_back(std::move(m));
+    coh.series.push_back(std::move(c));
+    ++i;
+  }
+  report::Series limit;
+  limit.x = {r.freq_hz(0), r.freq_hz(r.freq_hz.size() - 1)};
+  limit.y = {0.9, 0.9};
+  limit.label = "0.9";
+  limit.color = {150, 150, 150};
+  limit.dashed = true;
+  limit.thickness = 1;
+  coh.series.push_back(limit);
+  fig.SavePng(path);
+}
+
+int Run(int argc, char** argv) {
+  CLI::App app{
+      "frf-estimate: tool-tip FRFs from raw impact-hammer time records (docs/frf-estimate.md).\n"
+      "Input CSV: time_s, force_N, one or more responses named by unit (<name>_m displacement,\n"
+      "<name>_m_per_s velocity, <name>_m_per_s2 acceleration), and an optional hit column (else one\n"
+      "file per hit). Per response: H1 = Gfx/Gff (or H2 = Gxx/Gxf) averaged over the accepted hits,\n"
+      "with the coherence, written as the FRF CSV of formats.md section 3 (re-readable by\n"
+      "frf-calibrate and model-audit) with '# averages: N' and the windows as metadata.\n"
+      "Hits with a second force pulse (double hit) or a clipped/over-range channel (overload) are\n"
+      "rejected and named on stderr and in --summary, never averaged."};
+  AddVersionFlag(app, kTool);
+  app.footer(ExitCodeHelp() +
+             "\n3 here: fewer accepted hits than --min-hits, or a response that has not decayed by the end of its "
+             "record (leakage). 65 also: every hit rejected (the FRF file is then not written; --summary is).\n");
+  std::vector<std::string> records, directions;
+  std::string out_path, summary_path, plot_path, pose_id = "P1", excitation = "x", quantity = "receptance",
+                                                 estimator = "h1";
+  calibration::FrfEstimateOptions o;
+  int min_hits = 3;
+  app.add_option("records", records, "hammer record CSV file(s)")->required();
+  app.add_option("--out", out_path, "output FRF CSV (formats.md section 3)")->required();
+  app.add_option("--pose-id", pose_id, "pose id written in the FRF file")->capture_default_str();
+  app.add_option("--excitation", excitation, "hammer direction at the tool tip: x, y or z")->capture_default_str();
+  app.add_option("--direction", directions,
+                 "response direction per channel, NAME=AXIS (e.g. acc_tip=y); default from a name ending in "
+                 "_x/_y/_z (or named x/y/z)");
+  app.add_option("--quantity", quantity, "output quantity: receptance, mobility or accelerance")
+      ->check(CLI::IsMember({"receptance", "mobility", "accelerance"}))
+      ->capture_default_str();
+  app.add_option("--estimator", estimator, "h1 (noise on the response) or h2 (noise on the force)")
+      ->check(CLI::IsMember({"h1", "h2"}))
+      ->capture_default_str();
+  app.add_option("--fmax-hz", o.fmax_hz, "highest line written [Hz]; 0: sample rate / 2.56")->capture_default_str();
+  app.add_option("--force-window-s", o.force_window_s,
+                 "force window length after the hit [s]; 0: automatic (3 pulse lengths + 32 samples); "
+                 "negative: no force window")
+      ->capture_default_str();
+  app.add_option("--force-window-pre-s", o.force_window_pre_s,
+                 "force window lead before the hit [s]; 0: automatic (16 samples)")->capture_default_str();
+  app.add_option("--force-window-taper-s", o.force_window_taper_s,
+                 "cosine taper at each end of the force window [s]; 0: automatic (8 samples)")->capture_default_str();
+  app.add_option("--exp-window-tau-s", o.exponential_tau_s,
+                 "exponential window exp(-t/tau) from the hit on force and responses [s]; 0: none. Adds "
+                 "1/(tau*omega_n) to every damping ratio (recorded in the output; see the docs)")
+      ->capture_default_str();
+  app.add_option("--double-hit-fraction", o.double_hit_fraction,
+                 "a force sample outside the main pulse above this fraction of its peak is a double hit [-]")
+      ->capture_default_str();
+  app.add_option("--trigger-fraction", o.trigger_fraction,
+                 "the pulse starts and ends where |force| crosses this fraction of the peak [-]")
+      ->capture_default_str();
+  app.add_option("--flat-top-samples", o.flat_top_samples,
+                 "overload: this many consecutive samples at a channel's extreme value (clipping)")
+      ->capture_default_str();
+  app.add_option("--force-range-N", o.force_range_N, "overload: |force| at or beyond this [N]; 0: unknown")
+      ->capture_default_str();
+  std::vector<std::string> response_ranges;
+  app.add_option("--response-range", response_ranges,
+                 "overload: |response| at or beyond this, NAME=VALUE in the channel's SI unit (m, m/s or m/s^2), "
+                 "e.g. acc_y=490 for a 50 g accelerometer; repeat per channel");
+  app.add_option("--min-hits", min_hits, "fewer accepted hits than this: exit 3 (at least 1)")->capture_default_str();
+  app.add_option("--summary", summary_path, "JSON summary: hits with status and notes, windows, warnings");
+  app.add_option("--plot", plot_path, "PNG of |H| and the coherence")->check(PngFileName());
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  return RunGuarded(kTool, [&]() -> int {
+    CheckOptionRange("--min-hits", min_hits, 1, 1e6);
+    calibration::CheckValid(o);
+    const Axis exc = ParseAxisOption("--excitation", excitation);
+    std::map<std::string, std::string> dir_given;
+    for (const std::string& d : directions) {
+      const size_t eq = d.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        throw std::invalid_argument("--direction: expected NAME=AXIS, got '" + d + "'");
+      }
+      dir_given[d.substr(0, eq)] = d.substr(eq + 1);
+    }
+    std::vector<std::pair<std::string, std::string>> inputs;
+    for (const std::string& r : records) {
+      RequireReadableFile(r, "hammer record file");
+      inputs.push_back({"records", r});
+    }
+    CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}, {"--plot", plot_path}});
+
+    const io::HammerRecords rec = io::ReadHammerRecords(records);
+    // Keys before the work, so that a naming problem is reported at once.
+    std::vector<dynamics::FrfKey> keys;
+    for (const auto& [name, v] : dir_given) {
+      bool known = false;
+      for (const auto& c : rec.channels) known = known || c.name == name;
+      if (!known) throw std::invalid_argument("--direction " + name + "=" + v + ": no response channel '" + name + "'");
+    }
+    for (const auto& ch : rec.channels) {
+      dynamics::FrfKey key{pose_id, ChannelDirection(ch.name, dir_given), exc};
+      for (size_t k = 0; k < keys.size(); ++k) {
+        if (keys[k] == key) {
+          throw std::invalid_argument("response channels '" + rec.channels[k].name + "' and '" + ch.name +
+                                      "' both give " + key.ToString() + "; give --direction for one of them");
+        }
+      }
+      keys.push_back(key);
+    }
+    if (!response_ranges.empty()) {
+      o.response_range.assign(rec.channels.size(), 0.0);
+      for (const std::string& text : response_ranges) {
+        const auto [name, value] = ParseAssignment("--response-range", text);
+        size_t c = 0;
+        while (c < rec.channels.size() && rec.channels[c].name != name) ++c;
+        if (c == rec.channels.size()) {
+          throw std::invalid_argument("--response-range " + text + ": no response channel '" + name + "'");
+        }
+        CheckOptionRange("--response-range " + name, value, 0.0, 1e300);
+        o.response_range[c] = value;
+      }
+    }
+    std::cerr << kTool << ": " << rec.hits.size() << " hit(s) at " << Num(rec.hits.front().sample_rate_hz, 7)
+              << " Hz; pose " << pose_id << ", excitation " << AxisName(exc) << ", responses";
+    for (size_t c = 0; c < keys.size(); ++c) {
+      std::cerr << (c ? ", " : " ") << rec.channel_columns[c] << " -> " << AxisName(keys[c].response);
+    }
+    std::cerr << " (--pose-id, --excitation, --direction)\n";
+    const calibration::FrfEstimateResult r = calibration::EstimateFrf(rec.hits, rec.channels, o);
+
+    std::vector<std::string> rejected;
+    for (const auto& h : r.hits) {
+      if (h.status == calibration::HitStatus::kAccepted) continue;
+      rejected.push_back(h.id + " (" + calibration::HitStatusName(h.status) + ")");
+      for (const std::string& note : h.notes) {
+        std::cerr << kTool << ": hit " << h.id << " (" << h.source << ", hit at t = " << Num(h.hit_time_s, 6)
+                  << " s) rejected: " << note << '\n';
+      }
+    }
+    for (const std::string& w : r.warnings) Warn(kTool, w);
+
+    int rc = kExitOk;
+    std::vector<std::string> flags;
+    if (r.averages < min_hits && r.averages > 0) {
+      flags.push_back(std::to_string(r.averages) + " accepted hit(s), fewer than --min-hits " +
+                      std::to_string(min_hits));
+    }
+    if (r.averages > 0 && r.averages < 3) {
+      Warn(kTool, "only " + std::to_string(r.averages) +
+                      " hit(s) averaged: the coherence needs at least 3 to mean much, 5 or more are usual");
+    }
+    if (r.leakage) flags.push_back("leakage (a response has not decayed by the end of its record)");
+    for (const std::string& f : flags) Warn(kTool, "result flagged: " + f);
+    if (!flags.empty()) rc = kExitFlagged;
+
+    // The FRFs, in receptance inside; written in --quantity.
+    const io::FrfQuantity out_q = io::ParseQuantity(quantity);
+    dynamics::FrfSet frfs;
+    std::vector<std::string> labels;
+    std::vector<int> channel_of;
+    if (r.status == calibration::FrfEstimateStatus::kOk) {
+      std::vector<std::pair<dynamics::FrfKey, int>> order;
+      for (size_t c = 0; c < keys.size(); ++c) order.push_back({keys[c], static_cast<int>(c)});
+      std::sort(order.begin(), order.end());
+      for (const auto& [key, c] : order) {
+        const auto& ch = r.channels[c];
+        const Eigen::VectorXcd& h = estimator == "h1" ? ch.h1 : ch.h2;
+        const io::FrfQuantity in_q = QuantityOf(rec.channels[c].quantity);
+        Eigen::VectorXcd hr(h.size());
+        for (int k = 0; k < h.size(); ++k) hr(k) = io::ToReceptance(in_q, r.freq_hz(k), h(k));
+        frfs.Insert(key, dynamics::Frf::FromSamples(r.freq_hz, hr, ch.coherence));
+        labels.push_back(rec.channels[c].name + " (H" + std::string(1, AxisName(key.response)) +
+                         std::string(1, AxisName(key.excitation)) + ")");
+        channel_of.push_back(c);
+      }
+      std::vector<std::pair<std::string, std::string>> meta;
+      meta.push_back({"estimator", estimator == "h1" ? "H1" : "H2"});
+      meta.push_back({"hits_averaged", std::to_string(r.averages) + " of " + std::to_string(r.hits.size())});
+      if (!rejected.empty()) {
+        std::string s;
+        for (const auto& x : rejected) s += (s.empty() ? "" : ", ") + x;
+        meta.push_back({"hits_rejected", s});
+      }
+      meta.push_back({"force_window_s", r.force_window_s < 0 ? std::string("off") : io::FormatDouble(r.force_window_s)});
+      meta.push_back({"exponential_window_tau_s",
+                      r.exponential_tau_s > 0 ? io::FormatDouble(r.exponential_tau_s) : std::string("none")});
+      if (r.exponential_tau_s > 0) {
+        meta.push_back({"exponential_window_note",
+                        "fitted damping ratios are too high by 1/(tau*omega_n); correct them with "
+                        "calibration::CorrectExponentialWindowDamping"});
+      }
+      io::WriteEstimatedFrfCsv(out_path, frfs, out_q, r.averages, meta);
+    }
+    if (!plot_path.empty() && r.status == calibration::FrfEstimateStatus::kOk) {
+      SavePlot(plot_path, r, frfs, labels, channel_of, out_q, estimator == "h1" ? "H1" : "H2");
+    }
+    if (r.status != calibration::FrfEstimateStatus::kOk) rc = kExitDataError;
+
+    if (!summary_path.empty()) {
+      nlohmann::json j;
+      j["tool"] = kTool;
+      j["records"] = records;
+      j["exit_code"] = rc;
+      j["sample_rate_hz"] = r.sample_rate_hz;
+      j["block_samples"] = r.block_samples;
+      j["line_spacing_hz"] = r.block_samples > 0 ? r.sample_rate_hz / r.block_samples : 0.0;
+      j["estimator"] = estimator == "h1" ? "H1" : "H2";
+      j["averages"] = r.averages;
+      j["force_window_s"] = r.force_window_s;
+      j["force_window_pre_s"] = r.force_window_pre_s;
+      j["exponential_window_tau_s"] = r.exponential_tau_s;
+      j["leakage"] = r.leakage;
+      j["warnings"] = r.warnings;
+      j["flags"] = flags;
+      nlohmann::json hits = nlohmann::json::array();
+      for (const auto& h : r.hits) {
+        hits.push_back({{"id", h.id},
+                        {"source", h.source},
+                        {"status", calibration::HitStatusName(h.status)},
+                        {"hit_time_s", h.hit_time_s},
+                        {"peak_force_N", h.peak_force_N},
+                        {"pulse_duration_s", h.pulse_duration_s},
+                        {"notes", h.notes}});
+      }
+      j["hits"] = hits;
+      nlohmann::json chans = nlohmann::json::array();
+      for (size_t c = 0; c < rec.channels.size(); ++c) {
+        nlohmann::json cj = {{"name", rec.channels[c].name},
+                             {"column", rec.channel_columns[c]},
+                             {"quantity", io::QuantityName(QuantityOf(rec.channels[c].quantity))},
+                             {"response", std::string(1, AxisName(keys[c].response))},
+                             {"excitation", std::string(1, AxisName(keys[c].excitation))}};
+        if (r.status == calibration::FrfEstimateStatus::kOk) {
+          const auto& g = r.channels[c].coherence;
+          cj["lines"] = g.size();
+          cj["lines_coherence_above_0_9"] = (g.array() > 0.9).count();
+          cj["min_coherence"] = g.minCoeff();
+        }
+        chans.push_back(cj);
+      }
+      j["channels"] = chans;
+      io::WriteFileAtomically(summary_path, report::DumpJson(j));
+    }
+    if (r.status != calibration::FrfEstimateStatus::kOk) {
+      std::cerr << kTool << ": every hit was rejected; no FRF written to " << out_path << '\n';
+      return rc;
+    }
+    std::ostringstream msg;
+    msg << kTool << ": " << r.averages << " of " << r.hits.size() << " hits averaged";
+    if (!rejected.empty()) {
+      msg << " (rejected: ";
+      for (size_t i = 0; i < rejected.size(); ++i) msg << (i ? ", " : "") << rejected[i];
+      msg << ")";
+    }
+    msg << "; " << frfs.size() << " FRF(s) of " << r.freq_hz.size() << " lines, " << Num(r.freq_hz(0)) << " to "
+        << Num(r.freq_hz(r.freq_hz.size() - 1), 6) << " Hz, written to " << out_path << '\n';
+    std::cerr << msg.str();
+    return rc;
+  });
+}
+
+}  // namespace
+}  // namespace robomach::apps
+
+int main(int argc, char** argv) { return robomach::apps::Run(argc, argv); }

@@ -1,0 +1,58 @@
+#pragma once
+
+// Raw impact-hammer time records (issue #18, item 4; docs/frf-estimate.md):
+// CSV with a header row and
+//   time_s            time [s], strictly increasing, evenly spaced per hit
+//   force_N           hammer force [N]
+//   <name>_m          a displacement response [m]           (receptance)
+//   <name>_m_per_s    a velocity response [m/s]             (mobility)
+//   <name>_m_per_s2   an acceleration response [m/s²]       (accelerance)
+//   hit               optional: hit id; the rows of one hit are contiguous
+// One or more response columns. Without a `hit` column a file is one hit,
+// named by the file's stem. `#` lines are comments. Several files may be
+// read together; they must have the same response columns. The sample rate
+// is 1/(mean time step), snapped to a whole number of hertz when that is
+// within the rounding of the written times.
+
+#include <string>
+#include <vector>
+
+#include "robomach/calibration/impact_record.h"
+#include "robomach/dynamics/measured_frf.h"
+#include "robomach/io/frf_files.h"
+
+namespace robomach::io {
+
+struct HammerRecords {
+  std::vector<calibration::ResponseChannel> channels;  // in the first file's column order
+  std::vector<calibration::ImpactRecord> hits;         // in file and row order
+  /// Column names of the channels as in the files ("acc_x_m_per_s2").
+  std::vector<std::string> channel_columns;
+};
+
+/// The response quantity of a column name by its unit suffix, and the
+/// channel name without it; false for a name without such a suffix.
+bool ParseResponseColumn(const std::string& column, calibration::ResponseQuantity* quantity, std::string* name);
+
+/// Reads hammer records from one or more files (format above). Hit ids are
+/// the `hit` cells, or the file stem; with several files the stem is put in
+/// front of a hit cell ("run2#3") so that ids stay unique.
+/// @throws InputError "file:line:column: ..." for a missing or unknown
+///   column, a bad number (with a hint for a decimal comma, nan, inf), a
+///   time that does not increase or is not evenly spaced (a step more than
+///   1 % off the hit's median step), a hit whose rows are split, fewer than 16 samples in a
+///   hit, sample rates that differ between hits by more than 1e-4 (relative), files
+///   with different response columns, or a duplicate hit id.
+HammerRecords ReadHammerRecords(const std::vector<std::string>& paths);
+
+/// Writes estimated FRFs as the CSV of formats.md §3 (WriteFrfCsv, with
+/// `# averages: N`), preceded by `# key: value` lines that record how they
+/// were estimated (estimator, hits, windows). ReadFrfCsv reads such a file
+/// back (it ignores metadata keys it does not know). Atomic.
+/// @throws std::invalid_argument for a key that is empty, contains ':' or a
+///   space, or is `quantity`/`averages` (written by WriteFrfCsv), or a value
+///   with a line break.
+void WriteEstimatedFrfCsv(const std::string& path, const dynamics::FrfSet& frfs, FrfQuantity quantity,
+                          int averages, const std::vector<std::pair<std::string, std::string>>& metadata);
+
+}  // namespace robomach::io

@@ -1,0 +1,246 @@
+#include "robomach/io/hammer_records.h"
+
+#include <cmath>
+#include <cstdio>
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/csv_table.h"
+
+namespace robomach::io {
+namespace {
+
+using calibration::ImpactRecord;
+using calibration::ResponseQuantity;
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() > suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string Num(double v) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+// A number of a required column, with the column's position in the error.
+double NumberAt(const CsvTable& t, int row, int col) {
+  try {
+    return t.Number(row, t.header()[col]);
+  } catch (const InputError& e) {
+    throw InputError({e.where().path, e.where().line, col + 1}, e.message());
+  }
+}
+
+InputError ErrorAtCell(const CsvTable& t, int row, int col, const std::string& message) {
+  return InputError({t.path(), t.line(row), col + 1}, "column " + t.header()[col] + ": " + message);
+}
+
+struct FileHits {
+  std::vector<std::string> channel_columns;
+  std::vector<ImpactRecord> hits;
+};
+
+FileHits ReadOne(const std::string& path, bool prefix_ids) {
+  const CsvTable t = CsvTable::ReadFile(path);
+  const std::string stem = std::filesystem::path(path).stem().string();
+  for (const std::string& h : t.header()) {
+    if (h.find(';') != std::string::npos || h.find('\t') != std::string::npos) {
+      throw InputError({path, t.header_line(), 0},
+                       "the header '" + h + "' looks separated by ';' or tabs; this format is comma-separated "
+                       "with '.' decimals (columns time_s, force_N, responses <name>_m, <name>_m_per_s or "
+                       "<name>_m_per_s2, optional hit)");
+    }
+  }
+  t.RequireColumn("time_s");
+  t.RequireColumn("force_N");
+  const int c_time = t.ColumnIndex("time_s"), c_force = t.ColumnIndex("force_N"), c_hit = t.ColumnIndex("hit");
+  FileHits out;
+  std::vector<int> c_resp;
+  for (int c = 0; c < static_cast<int>(t.header().size()); ++c) {
+    const std::string& h = t.header()[c];
+    if (c == c_time || c == c_force || c == c_hit) continue;
+    ResponseQuantity q;
+    std::string name;
+    if (!ParseResponseColumn(h, &q, &name)) {
+      throw InputError({path, t.header_line(), c + 1},
+                       "unknown column '" + h + "'; expected time_s, force_N, hit, or a response named "
+                       "<name>_m (displacement), <name>_m_per_s (velocity) or <name>_m_per_s2 (acceleration)");
+    }
+    c_resp.push_back(c);
+    out.channel_columns.push_back(h);
+  }
+  if (c_resp.empty()) {
+    throw InputError({path, t.header_line(), 0},
+                     "no response column; name one <name>_m, <name>_m_per_s or <name>_m_per_s2 (the unit is "
+                     "part of the name)");
+  }
+  if (t.num_rows() == 0) throw InputError({path, t.header_line(), 0}, "no data rows after the header");
+
+  // Split into hits: contiguous blocks of equal `hit` cells.
+  struct Block {
+    std::string id;
+    int first, last;  // rows
+  };
+  std::vector<Block> blocks;
+  std::map<std::string, int> seen;  // id -> block index
+  for (int r = 0; r < t.num_rows(); ++r) {
+    std::string id = stem;
+    if (c_hit >= 0) {
+      id = t.Cell(r, c_hit);
+      if (id.empty()) throw ErrorAtCell(t, r, c_hit, "expected a hit id, got an empty cell");
+    }
+    if (!blocks.empty() && blocks.back().id == id) {
+      blocks.back().last = r;
+      continue;
+    }
+    if (auto it = seen.find(id); it != seen.end()) {
+      const Block& b = blocks[it->second];
+      throw ErrorAtCell(t, r, c_hit, "hit '" + id + "' appears again (its rows were lines " +
+                                         std::to_string(t.line(b.first)) + "-" + std::to_string(t.line(b.last)) +
+                                         "); the rows of one hit must be contiguous");
+    }
+    seen[id] = static_cast<int>(blocks.size());
+    blocks.push_back({id, r, r});
+  }
+  for (const Block& b : blocks) {
+    const int n = b.last - b.first + 1;
+    ImpactRecord rec;
+    rec.id = c_hit >= 0 && prefix_ids ? stem + "#" + b.id : b.id;
+    rec.source = path + ":" + std::to_string(t.line(b.first));
+    rec.force_N.resize(n);
+    rec.response.resize(n, static_cast<int>(c_resp.size()));
+    Eigen::VectorXd time(n);
+    for (int i = 0; i < n; ++i) {
+      const int r = b.first + i;
+      time(i) = NumberAt(t, r, c_time);
+      if (i > 0 && !(time(i) > time(i - 1))) {
+        throw ErrorAtCell(t, r, c_time, "expected a time > " + Num(time(i - 1)) + " (the previous row), got " +
+                                            Num(time(i)) + "; time must increase within a hit");
+      }
+      rec.force_N(i) = NumberAt(t, r, c_force);
+      for (size_t k = 0; k < c_resp.size(); ++k) rec.response(i, static_cast<int>(k)) = NumberAt(t, r, c_resp[k]);
+    }
+    if (n < 16) {
+      throw InputError({path, t.line(b.first), 0}, "hit '" + b.id + "' has " + std::to_string(n) +
+                                                       " samples (lines " + std::to_string(t.line(b.first)) + "-" +
+                                                       std::to_string(t.line(b.last)) + "); at least 16 are needed");
+    }
+    // The median step finds the odd row out; the mean over the record
+    // gives the rate to the precision of the written times.
+    std::vector<double> steps(n - 1);
+    for (int i = 1; i < n; ++i) steps[i - 1] = time(i) - time(i - 1);
+    std::nth_element(steps.begin(), steps.begin() + (n - 1) / 2, steps.end());
+    const double median = steps[(n - 1) / 2];
+    for (int i = 1; i < n; ++i) {
+      const double step = time(i) - time(i - 1);
+      if (std::abs(step - median) > 0.01 * median) {
+        throw ErrorAtCell(t, b.first + i, c_time,
+                          "uneven sampling: step " + Num(step) + " s from the previous row, the hit's usual "
+                          "step is " + Num(median) + " s (more than 1 % apart; a missing or repeated sample?)");
+      }
+    }
+    const double dt = (time(n - 1) - time(0)) / (n - 1);
+    rec.start_time_s = time(0);
+    rec.sample_rate_hz = 1.0 / dt;
+    // Written times are rounded, so 1/dt misses the acquisition's rate by
+    // up to ~2δ/T (δ: the largest deviation of a time from the even grid,
+    // T: the record length). Rates are whole hertz on every acquisition
+    // system we know of (1024, 5120, 51200 Hz): snap to one within that.
+    double dev = 0.0;
+    for (int i = 0; i < n; ++i) dev = std::max(dev, std::abs(time(i) - (time(0) + i * dt)));
+    const double whole = std::round(rec.sample_rate_hz);
+    const double tol = (2.0 * dev / (time(n - 1) - time(0)) + 1e-12) * rec.sample_rate_hz;
+    if (whole > 0.0 && std::abs(whole - rec.sample_rate_hz) <= tol) rec.sample_rate_hz = whole;
+    out.hits.push_back(std::move(rec));
+  }
+  return out;
+}
+
+}  // namespace
+
+bool ParseResponseColumn(const std::string& column, ResponseQuantity* quantity, std::string* name) {
+  // Longest suffix first: "_m_per_s2" also ends in "_m_per_s"'s prefix.
+  static const std::pair<const char*, ResponseQuantity> kSuffixes[] = {
+      {"_m_per_s2", ResponseQuantity::kAcceleration},
+      {"_m_per_s", ResponseQuantity::kVelocity},
+      {"_m", ResponseQuantity::kDisplacement}};
+  for (const auto& [suffix, q] : kSuffixes) {
+    if (EndsWith(column, suffix)) {
+      *quantity = q;
+      *name = column.substr(0, column.size() - std::string(suffix).size());
+      return true;
+    }
+  }
+  return false;
+}
+
+HammerRecords ReadHammerRecords(const std::vector<std::string>& paths) {
+  if (paths.empty()) throw std::invalid_argument("ReadHammerRecords: no file given");
+  HammerRecords out;
+  std::map<std::string, std::string> where;  // hit id -> source
+  for (size_t f = 0; f < paths.size(); ++f) {
+    FileHits fh = ReadOne(paths[f], paths.size() > 1);
+    if (f == 0) {
+      out.channel_columns = fh.channel_columns;
+      for (const std::string& c : fh.channel_columns) {
+        calibration::ResponseChannel ch;
+        ParseResponseColumn(c, &ch.quantity, &ch.name);
+        out.channels.push_back(ch);
+      }
+    } else if (std::set<std::string>(fh.channel_columns.begin(), fh.channel_columns.end()) !=
+               std::set<std::string>(out.channel_columns.begin(), out.channel_columns.end())) {
+      std::string a, b;
+      for (const auto& c : out.channel_columns) a += (a.empty() ? "" : ", ") + c;
+      for (const auto& c : fh.channel_columns) b += (b.empty() ? "" : ", ") + c;
+      throw InputError({paths[f], 0, 0}, "response columns " + b + " differ from those of " + paths[0] + " (" + a +
+                                             "); every file must have the same responses");
+    } else {
+      // Same set, maybe another order: reorder to the first file's.
+      for (ImpactRecord& rec : fh.hits) {
+        Eigen::MatrixXd r(rec.response.rows(), rec.response.cols());
+        for (size_t k = 0; k < out.channel_columns.size(); ++k) {
+          const auto it = std::find(fh.channel_columns.begin(), fh.channel_columns.end(), out.channel_columns[k]);
+          r.col(static_cast<int>(k)) = rec.response.col(static_cast<int>(it - fh.channel_columns.begin()));
+        }
+        rec.response = std::move(r);
+      }
+    }
+    for (ImpactRecord& rec : fh.hits) {
+      if (auto it = where.find(rec.id); it != where.end()) {
+        throw InputError({paths[f], 0, 0}, "hit id '" + rec.id + "' (" + rec.source + ") was already read from " +
+                                               it->second + "; hit ids must be unique");
+      }
+      where[rec.id] = rec.source;
+      if (!out.hits.empty()) {
+        const double fs0 = out.hits.front().sample_rate_hz;
+        if (std::abs(rec.sample_rate_hz - fs0) > 1e-4 * fs0) {
+          throw InputError({paths[f], 0, 0}, "hit '" + rec.id + "' (" + rec.source + ") is sampled at " +
+                                                 Num(rec.sample_rate_hz) + " Hz, hit '" + out.hits.front().id +
+                                                 "' at " + Num(fs0) + " Hz; all hits need one sample rate");
+        }
+      }
+      out.hits.push_back(std::move(rec));
+    }
+  }
+  return out;
+}
+
+void WriteEstimatedFrfCsv(const std::string& path, const dynamics::FrfSet& frfs, FrfQuantity quantity,
+                          int averages, const std::vector<std::pair<std::string, std::string>>& metadata) {
+  for (const auto& [key, value] : metadata) {
+    if (key.empty() || key.find_first_of(": \t\r\n") != std::string::npos || key == "quantity" ||
+        key == "averages" || value.find_first_of("\r\n") != std::string::npos) {
+      throw std::invalid_argument("WriteEstimatedFrfCsv: bad metadata '" + key + ": " + value + "'");
+    }
+  }
+  WriteFileAtomically(path, [&](std::ostream& os) {
+    for (const auto& [key, value] : metadata) os << "# " << key << ": " << value << '\n';
+    WriteFrfCsv(os, frfs, quantity, averages);
+  });
+}
+
+}  // namespace robomach::io

@@ -1,0 +1,179 @@
+// Reader of raw hammer records (docs/frf-estimate.md): layouts, units by
+// column suffix, and bad input located by file:line:column.
+#include "robomach/io/hammer_records.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "test_support.h"
+
+namespace robomach::io {
+namespace {
+
+using calibration::ResponseQuantity;
+using ::testing::HasSubstr;
+using robomach::testing::CaptureError;
+using robomach::testing::TempDir;
+using robomach::testing::WriteText;
+
+// n rows of one hit at 1 kHz starting at t0, with a hit column if `hit` is
+// not empty.
+std::string Rows(const std::string& hit, int n, double t0 = 0.0) {
+  std::ostringstream s;
+  for (int i = 0; i < n; ++i) {
+    if (!hit.empty()) s << hit << ',';
+    s << t0 + i * 0.001 << ',' << (i == 2 ? 100.0 : 0.0) << ',' << 1e-6 * i << ',' << 0.5 * i << '\n';
+  }
+  return s.str();
+}
+
+TEST(HammerRecords, HitColumnSplitsHitsAndSuffixesGiveQuantities) {
+  const std::string dir = TempDir("hammer_records_hits");
+  const std::string path = WriteText(dir + "/run.csv", "# two hits\nhit,time_s,force_N,tip_x_m,acc_y_m_per_s2\n" +
+                                                           Rows("1", 20) + Rows("2", 20, 5.0));
+  const HammerRecords r = ReadHammerRecords({path});
+  ASSERT_EQ(r.channels.size(), 2u);
+  EXPECT_EQ(r.channels[0].name, "tip_x");
+  EXPECT_EQ(r.channels[0].quantity, ResponseQuantity::kDisplacement);
+  EXPECT_EQ(r.channels[1].name, "acc_y");
+  EXPECT_EQ(r.channels[1].quantity, ResponseQuantity::kAcceleration);
+  ASSERT_EQ(r.hits.size(), 2u);
+  EXPECT_EQ(r.hits[0].id, "1");
+  EXPECT_EQ(r.hits[1].id, "2");
+  EXPECT_EQ(r.hits[1].source, path + ":23");
+  EXPECT_DOUBLE_EQ(r.hits[1].start_time_s, 5.0);
+  // 1 ms steps written with 6 significant digits: 1/dt is 1 kHz to that
+  // precision, and snapped to it exactly.
+  EXPECT_EQ(r.hits[0].sample_rate_hz, 1000.0);
+  EXPECT_EQ(r.hits[0].force_N(2), 100.0);
+  EXPECT_DOUBLE_EQ(r.hits[0].response(3, 1), 1.5);
+}
+
+// A rate that is not a whole number of hertz stays as it is: 1/(1.0005 ms)
+// = 999.50 Hz, 0.5 Hz from 1000 while the times' rounding (1e-9 s over
+// 19 ms) allows 1e-4 Hz.
+TEST(HammerRecords, UnevenRateIsNotSnapped) {
+  const std::string dir = TempDir("hammer_records_rate");
+  std::ostringstream s;
+  s.precision(12);
+  s << "time_s,force_N,x_m\n";
+  for (int i = 0; i < 20; ++i) s << i * 0.0010005 << ",0,0\n";
+  const HammerRecords r = ReadHammerRecords({WriteText(dir + "/r.csv", s.str())});
+  EXPECT_NEAR(r.hits[0].sample_rate_hz, 1.0 / 0.0010005, 1e-6);
+}
+
+TEST(HammerRecords, OneFilePerHitNamedByStemColumnsReordered) {
+  const std::string dir = TempDir("hammer_records_files");
+  const std::string a = WriteText(dir + "/hit_01.csv", "time_s,force_N,v_z_m_per_s,x_m\n" + Rows("", 16));
+  // Same responses in another order: the values follow their names.
+  std::string rows = Rows("", 16);
+  const std::string b = WriteText(dir + "/hit_02.csv", "time_s,force_N,x_m,v_z_m_per_s\n" + rows);
+  const HammerRecords r = ReadHammerRecords({a, b});
+  ASSERT_EQ(r.hits.size(), 2u);
+  EXPECT_EQ(r.hits[0].id, "hit_01");
+  EXPECT_EQ(r.hits[1].id, "hit_02");
+  EXPECT_EQ(r.channels[0].quantity, ResponseQuantity::kVelocity);
+  // In hit_02 the third column (1e-6 i) is x_m, the fourth (0.5 i) v_z.
+  EXPECT_DOUBLE_EQ(r.hits[1].response(4, 0), 2.0);   // v_z
+  EXPECT_DOUBLE_EQ(r.hits[1].response(4, 1), 4e-6);  // x
+}
+
+TEST(HammerRecords, BadInputNamesFileLineAndColumn) {
+  const std::string dir = TempDir("hammer_records_bad");
+  const std::string head = "time_s,force_N,x_m,a_m_per_s2\n";
+  // Line 1 header, data from line 2; row 6 (line 7) goes back in time.
+  std::string rows = Rows("", 20);
+  {
+    std::istringstream in(rows);
+    std::string line, out;
+    for (int i = 0; std::getline(in, line); ++i) out += (i == 5 ? "0.0035,0,0,0" : line) + "\n";
+    const std::string p = WriteText(dir + "/back.csv", head + out);
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({p}); }),
+                HasSubstr("back.csv:7:1: column time_s: expected a time > 0.004 (the previous row), got 0.0035"));
+  }
+  {
+    const std::string p = WriteText(dir + "/noforce.csv", "time_s,x_m\n" + std::string("0,1\n"));
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({p}); }),
+                HasSubstr("noforce.csv:1: missing required column 'force_N'"));
+  }
+  {
+    std::string out = head;
+    for (int i = 0; i < 20; ++i) out += std::to_string(i * 0.001) + ",0," + (i == 9 ? "nan" : "0") + ",0\n";
+    const std::string p = WriteText(dir + "/nan.csv", out);
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({p}); }),
+                HasSubstr("nan.csv:11:3: column x_m: expected a number, got \"nan\" (nan and inf are not allowed)"));
+  }
+  {
+    // A decimal comma in a quoted cell, and unquoted (more cells).
+    const std::string p = WriteText(dir + "/comma.csv", head + "0,\"12,5\",0,0\n");
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({p}); }),
+                HasSubstr("comma.csv:2:2: column force_N: expected a number, got \"12,5\" (decimal comma?)"));
+    const std::string q = WriteText(dir + "/comma2.csv", head + "0,12,5,0,0\n");
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({q}); }), HasSubstr("comma2.csv:2: expected at most 4 cells"));
+    const std::string s = WriteText(dir + "/semicolon.csv", "time_s;force_N;x_m\n0;12,5;0\n");
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({s}); }), HasSubstr("semicolon.csv:2: expected at most 1 cells"));
+    const std::string s2 = WriteText(dir + "/semicolon2.csv", "time_s;force_N;x_m\n0;12.5;0\n");
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({s2}); }), HasSubstr("semicolon2.csv:1: the header"));
+  }
+  {
+    const std::string p = WriteText(dir + "/unit.csv", "time_s,force_N,x_mm\n" + std::string("0,0,0\n"));
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({p}); }), HasSubstr("unit.csv:1:3: unknown column 'x_mm'"));
+  }
+  {
+    const std::string p = WriteText(dir + "/split.csv", "hit,time_s,force_N,x_m,a_m_per_s2\n" + Rows("1", 20) +
+                                                             Rows("2", 20) + Rows("1", 20, 1.0));
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({p}); }),
+                HasSubstr("split.csv:42:1: column hit: hit '1' appears again (its rows were lines 2-21)"));
+  }
+  {
+    std::string out = head;
+    for (int i = 0; i < 20; ++i) out += std::to_string((i < 10 ? i : i + 1) * 0.001) + ",0,0,0\n";
+    const std::string p = WriteText(dir + "/gap.csv", out);
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({p}); }), HasSubstr("gap.csv:12:1: column time_s: uneven sampling"));
+  }
+  {
+    const std::string a = WriteText(dir + "/a.csv", head + Rows("", 16));
+    std::string rows3;
+    for (int i = 0; i < 16; ++i) rows3 += std::to_string(i * 0.001) + ",0,0\n";
+    const std::string b = WriteText(dir + "/b.csv", "time_s,force_N,x_m\n" + rows3);
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({a, b}); }), HasSubstr("b.csv: response columns x_m differ"));
+  }
+  {
+    const std::string p = WriteText(dir + "/short.csv", head + Rows("", 5));
+    EXPECT_THAT(CaptureError([&] { ReadHammerRecords({p}); }), HasSubstr("has 5 samples"));
+  }
+}
+
+// The estimate's file reads back with the FRF reader: metadata lines before
+// the format's own are ignored, averages and coherence survive, and the
+// values round-trip exactly (WriteFrfCsv writes them so).
+TEST(HammerRecords, EstimatedFrfFileReadsBack) {
+  const std::string dir = TempDir("hammer_records_write");
+  Eigen::VectorXd f = Eigen::VectorXd::LinSpaced(4, 1.0, 4.0);
+  Eigen::VectorXcd h(4);
+  h << std::complex<double>(1e-6, -2e-7), std::complex<double>(2e-6, -1e-6), std::complex<double>(-1e-6, -3e-6),
+      std::complex<double>(-3e-7, -1e-8);
+  Eigen::VectorXd g(4);
+  g << 0.99, 0.95, 0.5, 0.91;
+  dynamics::FrfSet set;
+  set.Insert({"P1", Axis::kY, Axis::kX}, dynamics::Frf::FromSamples(f, h, g));
+  const std::string p = dir + "/est.csv";
+  WriteEstimatedFrfCsv(p, set, FrfQuantity::kAccelerance, 6,
+                       {{"estimator", "H1"}, {"exponential_window_tau_s", "0.1"}});
+  const FrfReadResult r = ReadFrfCsv(p);
+  EXPECT_EQ(r.averages, 6);
+  EXPECT_EQ(r.file_quantity, FrfQuantity::kAccelerance);
+  const dynamics::Frf& back = r.frfs.at({"P1", Axis::kY, Axis::kX});
+  ASSERT_EQ(back.size(), 4);
+  // Through accelerance and back: −ω² and its inverse, a few ulp.
+  for (int k = 0; k < 4; ++k) EXPECT_LE(std::abs(back.receptance()(k) - h(k)), 1e-15 * std::abs(h(k)));
+  EXPECT_EQ(*back.coherence(), g);
+  EXPECT_THROW(WriteEstimatedFrfCsv(p, set, FrfQuantity::kReceptance, 6, {{"averages", "3"}}),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace robomach::io
