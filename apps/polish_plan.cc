@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -164,7 +165,8 @@ int Run(int argc, char** argv) {
       "the removal map and summary (§7) and PNG pictures (removal map, histogram, path, convergence)."};
   app.footer(ExitCodeHelp() +
              "\nExit 3 (outputs written, the reason on stderr): the target removal cannot be reached within the "
-             "speed limit (the path runs at the limit); path rows in contact lie off a trimmed face; with --robot, "
+             "speed limit (the path runs at the limit), or --optimise found no plan that reaches it; the optimised zig-zag "
+             "is more uniform than the optimised cycloid (the message names it); path rows in contact lie off a trimmed face; with --robot, "
              "rows are unreachable, outside the joint limits or after a joint jump > 0.5 rad.");
   std::string surface_path, process_path, pattern = "cycloid", guides = "offsets", optimise = "none", path_out,
                                           removal_out, summary_out, plot_out;
@@ -173,7 +175,8 @@ int Run(int argc, char** argv) {
   std::string list_out;
   double target_um = 0.0, offset_mm = 8.0, radius_mm = 6.0, pitch_mm = 3.0, sample_mm = 0.5, row_step_mm = 0.5;
   double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 0.3, edge_inset_mm = -1.0;
-  int seed = 20240404;
+  int seed = 20240404, threads = 2;
+  double max_time_s = 50.0, stagger_loops = 0.5, line_angle_deg = 0.0, edge_overrun_mm = 0.0;
   RobotOptions robot;
   app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (formats.md §5)")->required();
   AddSurfaceChoiceOptions(&app, &choice);
@@ -185,7 +188,8 @@ int Run(int argc, char** argv) {
   app.add_option("--pattern", pattern, "cycloid or parallel")->check(CLI::IsMember({"cycloid", "parallel"}))->capture_default_str();
   app.add_option("--guides", guides, "cycloid guide lines: offsets (of the region boundary, closed loops) or parallel")
       ->check(CLI::IsMember({"offsets", "parallel"}))->capture_default_str();
-  app.add_option("--optimise", optimise, "none, nlopt (DIRECT-L then Subplex) or pso (seed eq. 18)")
+  app.add_option("--optimise", optimise, "none, nlopt (grid, then COBYLA multi-start with the target as a constraint; "
+                                        "guide family chosen unless --guides is given) or pso (seed eq. 18)")
       ->check(CLI::IsMember({"none", "nlopt", "pso"}))->capture_default_str();
   app.add_option("--target-removal-um", target_um, "mean removal over the region [um]; sets the speed (0: run at max speed)")->capture_default_str();
   app.add_option("--offset-mm", offset_mm, "guide-line spacing d [mm] (parallel pattern: row spacing; default there: one contact width)");
@@ -201,6 +205,15 @@ int Run(int argc, char** argv) {
   app.add_option("--opt-offset-min-contact-widths", opt_offset_min_cw,
                  "smallest guide-line spacing the optimiser tries, in contact widths (closer rows lengthen the path)")
       ->capture_default_str();
+  app.add_option("--stagger-loops", stagger_loops, "cycloid: phase of adjacent rows, in loops, [0, 1] (0.5: a loop faces "
+                                                  "the gap between two loops of the next row)")->capture_default_str();
+  app.add_option("--line-angle-deg", line_angle_deg, "direction of the parallel guide lines / zig-zag rows in the developed "
+                                                    "plane [deg], 0: along u (s), 90: along v (t)")->capture_default_str();
+  app.add_option("--edge-overrun-mm", edge_overrun_mm, "plain patches: how far guide lines / zig-zag rows run beyond the "
+                                                      "polished region into the margin [mm] (at most margin_mm - r, zig-zag margin_mm)")
+      ->capture_default_str();
+  app.add_option("--max-time-s", max_time_s, "time budget of --optimise [s]; it stops earlier on convergence")->capture_default_str();
+  app.add_option("--threads", threads, "threads of --optimise")->capture_default_str();
   app.add_option("--seed", seed, "PSO random seed")->capture_default_str();
   robot.Add(&app);
   app.add_option("--path", path_out, "tool path CSV (formats.md §6)");
@@ -213,6 +226,7 @@ int Run(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   const bool offset_given = app.count("--offset-mm") > 0;
+  const bool guides_given = app.count("--guides") > 0;
   choice.face_given = app.count("--face") > 0;
 
   return RunGuarded(kTool, [&]() -> int {
@@ -225,6 +239,11 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--pitch-mm", pitch_mm, 0.01, 1000);
     CheckOptionRange("--opt-offset-max-mm", opt_offset_max_mm, 1.0, 1000);
     CheckOptionRange("--opt-offset-min-contact-widths", opt_offset_min_cw, 0.2, 10.0);
+    CheckOptionRange("--stagger-loops", stagger_loops, 0.0, 1.0);
+    CheckOptionRange("--edge-overrun-mm", edge_overrun_mm, 0.0, 1000.0);
+    CheckOptionRange("--line-angle-deg", line_angle_deg, -360.0, 360.0);
+    CheckOptionRange("--max-time-s", max_time_s, 1.0, 86400.0);
+    CheckOptionRange("--threads", threads, 1, 64);
     if (optimise != "none" && pattern == "parallel" && optimise == "pso") {
       throw std::invalid_argument("--optimise pso applies to the cycloid; the parallel pattern is optimised with --optimise nlopt");
     }
@@ -283,6 +302,9 @@ int Run(int argc, char** argv) {
     params.pitch = MmToM(pitch_mm);
     params.row_step = MmToM(row_step_mm);
     params.edge_inset = edge_inset_mm < 0 ? -1.0 : MmToM(edge_inset_mm);
+    params.stagger = stagger_loops;
+    params.edge_overrun = MmToM(edge_overrun_mm);
+    params.line_angle = line_angle_deg * kPi / 180.0;
     polishing::CheckValid(params);  // std::invalid_argument -> exit 64, naming the limit
     if (optimise == "none" && params.pattern == polishing::Pattern::kCycloid) {
       // A face too narrow for the circle is an error in the input (exit 65),
@@ -296,74 +318,130 @@ int Run(int argc, char** argv) {
     }
 
     nlohmann::json opt_json;
-    std::vector<double> history;
+    std::vector<double> history, evaluated;
+    bool flagged = false;
+    polishing::PlanOptimiseResult opt;
     if (optimise != "none") {
       const polishing::SampleGrid coarse = build_grid(opt_sample_mm);
       const polishing::RemovalSimulator coarse_sim(surface, process, coarse.points(), coarse.normals(), cell);
       polishing::PathParameters base = params;
       base.row_step = std::max(params.row_step, MmToM(opt_sample_mm));
-      auto objective = [&](const polishing::PathParameters& p) {
-        try {
-          const polishing::RemovalStats st = Evaluate(surface, coarse, coarse_sim, p, process, surface_path).stats;
-          // Planned at the speed limit, the path removes st.mean; if that is
-          // more than the target, no speed within the limit reaches the target
-          // (the path is too long for the time the target allows): infeasible,
-          // for both patterns alike, ranked by how far it misses. 2 % margin
-          // for the difference between the optimiser's grid and the final one.
-          const double target = MmToM(1e-3 * target_um);
-          if (target > 0 && st.mean > 0.98 * target) return 10.0 + st.mean / target;
-          return st.cv;
-        } catch (const std::invalid_argument&) {
-          return 1e6;  // outside the feasibility limits
-        }
+      polishing::PlanProblem pb;
+      pb.surface = &surface;
+      pb.grid = &coarse;
+      pb.sim = &coarse_sim;
+      pb.process = &process;
+      pb.target = MmToM(1e-3 * target_um);
+      pb.contact_width = contact_width;
+      polishing::PlanOptimiseOptions oo;
+      oo.method = optimise == "nlopt" ? polishing::Optimiser::kNlopt : polishing::Optimiser::kPso;
+      oo.pattern = params.pattern;
+      if (guides_given) {
+        // The user chose the family: offsets, or parallel lines (both directions).
+        if (params.guides == polishing::GuideLines::kBoundaryOffsets) oo.families = {{params.guides, 0.0}};
+        else oo.families = {{params.guides, 0.0}, {params.guides, kPi / 2}};
+      }
+      oo.offset_min = std::max(opt_offset_min_cw * contact_width, MmToM(0.5));
+      oo.offset_max = std::max(oo.offset_min * 1.5, MmToM(opt_offset_max_mm));
+      oo.max_time_s = max_time_s;
+      oo.threads = threads;
+      oo.seed = static_cast<unsigned>(seed);
+      // The progress line counts per mille of the time budget (the optimiser
+      // stops on convergence, usually before it).
+      ProgressLine progress(kTool, "optimiser, per mille of --max-time-s", 1000);
+      oo.progress = [&](int n, double best, double elapsed) {
+        std::ostringstream d;
+        d << n << " evaluations, best feasible cv " << (std::isfinite(best) ? io::FormatDouble(best) : "none yet");
+        progress.Update(std::min(1000L, static_cast<long>(1000 * elapsed / max_time_s)), d.str());
       };
-      polishing::OptimiseOptions defaults;
-      ProgressLine progress(kTool, optimise == "pso" ? "PSO iterations" : "optimiser evaluations",
-                            optimise == "pso" ? defaults.pso_max_iterations
-                            : params.pattern == polishing::Pattern::kParallel
-                                ? 27
-                                : defaults.global_evaluations + defaults.local_evaluations);
-      if (params.pattern == polishing::Pattern::kParallel) {
-        // One parameter, the row spacing: golden section on [0.3, 1.5] contact widths.
-        int evals = 0;
-        // In units of contact widths, so the bracket tolerance (1e-3) is relative.
-        auto f = [&](double w_rel) {
-          polishing::PathParameters p = base;
-          p.offset = w_rel * contact_width;
-          const double cv = objective(p);
-          history.push_back(history.empty() ? cv : std::min(history.back(), cv));
-          progress.Update(++evals);
-          return -cv;
-        };
-        const auto [w, fw] = GoldenSectionMaximum(f, 0.3, 1.5, 25, 1e-3);
-        params.offset = w * contact_width;
-        opt_json = {{"method", "golden-section search of the row spacing on [0.3, 1.5] contact widths"},
-                    {"evaluations", evals}, {"best_cv", -fw}, {"status", "converged"}};
-      } else {
-        polishing::OptimiseOptions oo;
-        oo.method = optimise == "nlopt" ? polishing::Optimiser::kNlopt : polishing::Optimiser::kPso;
-        oo.offset_min = std::max(opt_offset_min_cw * contact_width, MmToM(0.5));
-        oo.offset_max = std::max(oo.offset_min * 1.5, MmToM(opt_offset_max_mm));
-        oo.seed = static_cast<unsigned>(seed);
-        oo.progress = [&](int n, double) { progress.Update(n); };
-        if (params.offset < oo.offset_min || params.offset > oo.offset_max) params.offset = std::clamp(params.offset, oo.offset_min, oo.offset_max);
-        const polishing::OptimiseResult r = polishing::OptimiseCycloid(objective, base, oo);
-        params.offset = r.best.offset;
-        params.radius = r.best.radius;
-        params.pitch = r.best.pitch;
-        history = r.history;
-        opt_json = {{"method", r.method}, {"evaluations", r.evaluations}, {"best_cv", r.best_value},
-                    {"status", r.status}, {"sample_mm", opt_sample_mm},
-                    {"bounds", {{"offset_mm", {1e3 * oo.offset_min, 1e3 * oo.offset_max}},
-                                {"radius_over_offset", {0.5, 1.0}}, {"pitch_over_radius", {0.5, kPi}}}}};
+      if (params.offset < oo.offset_min || params.offset > oo.offset_max) {
+        base.offset = std::clamp(base.offset, oo.offset_min, oo.offset_max);
+        base.radius = std::clamp(base.radius, 0.5 * base.offset, base.offset);
+      }
+      try {
+        opt = polishing::OptimisePlan(pb, base, oo);
+      } catch (const polishing::PathRowError& err) {
+        throw InputError({surface_path, 0, 0}, std::string("while optimising: ") + err.what());
       }
       progress.Finish();
-      opt_json["history"] = history;
+      if (!opt.best.valid) {
+        throw std::runtime_error("the optimiser found no plan that fits the region: " + opt.best.error);
+      }
+      params = opt.best.params;
+      params.row_step = MmToM(row_step_mm);
+      // The convergence plot: the optimised pattern's evaluations only (the
+      // zig-zag's, made for the comparison, are in the summary's counts).
+      double best_so_far = std::numeric_limits<double>::quiet_NaN();
+      for (size_t i = 0; i < opt.cv_history.size(); ++i) {
+        const bool par = opt.history_parallel[i] != 0;
+        if (par != (params.pattern == polishing::Pattern::kParallel)) continue;
+        const double cv = opt.cv_history[i];
+        if (std::isfinite(cv) && !(cv >= best_so_far)) best_so_far = cv;
+        evaluated.push_back(cv);
+        history.push_back(best_so_far);
+      }
+      auto family_json = [&](const polishing::PlanEvaluation& ev) {
+        const bool c = ev.params.pattern == polishing::Pattern::kCycloid;
+        nlohmann::json j = {{"pattern", c ? "cycloid" : "parallel"},
+                            {"guides", c ? polishing::FamilyName({ev.params.guides, ev.params.line_angle})
+                                         : polishing::FamilyName({polishing::GuideLines::kParallelLines, ev.params.line_angle})},
+                            {"offset_mm", 1e3 * ev.params.offset},
+                            {"line_angle_deg", ev.params.line_angle * 180.0 / kPi},
+                            {"edge_overrun_mm", 1e3 * std::min(ev.params.edge_overrun, polishing::MaxEdgeOverrun(ev.params, process))},
+                            {"cv", ev.cv},
+                            {"mean_at_max_speed_um", 1e6 * ev.mean},
+                            {"coverage", ev.coverage},
+                            {"feasible", ev.feasible}};
+        if (c) {
+          j["radius_mm"] = 1e3 * ev.params.radius;
+          j["pitch_mm"] = 1e3 * ev.params.pitch;
+          j["stagger_loops"] = ev.params.stagger;
+        }
+        return j;
+      };
+      opt_json = {{"method", opt.method},
+                  {"evaluations", opt.evaluations},
+                  {"seconds", opt.seconds},
+                  {"max_time_s", max_time_s},
+                  {"status", opt.status},
+                  {"local_searches", opt.local_searches},
+                  {"local_searches_converged", opt.local_converged},
+                  {"sample_mm", opt_sample_mm},
+                  {"best_cv", opt.best.cv},
+                  {"feasible", opt.best.feasible},
+                  {"best", family_json(opt.best)}};
+      opt_json["history"] = history;      // best feasible cv so far (null before the first)
+      opt_json["history_cv"] = evaluated; // each evaluation's cv (null: infeasible)
+      if (params.pattern == polishing::Pattern::kCycloid) {
+        opt_json["bounds"] = {{"offset_mm", {1e3 * oo.offset_min, 1e3 * oo.offset_max}},
+                              {"radius_over_offset", {0.5, 1.0}},
+                              {"pitch_over_radius", {0.5, kPi}},
+                              {"stagger_loops", {0.0, 1.0}},
+                              {"edge_overrun_over_its_largest", {0.0, 1.0}}};
+        nlohmann::json fams = nlohmann::json::array();
+        for (const auto& f : opt.family_best) fams.push_back(family_json(f));
+        opt_json["families"] = fams;
+        if (opt.best_parallel.valid) opt_json["parallel"] = family_json(opt.best_parallel);
+      }
+      if (!opt.best.feasible) {
+        flagged = true;
+        const std::string m = target_um > 0
+            ? "no plan the optimiser saw reaches the target removal " + io::FormatDouble(target_um) +
+                  " um within max_speed_mm_per_s and covers the region: every covering one removes more at the "
+                  "limit (written: the least infeasible, " + io::FormatDouble(1e6 * opt.best.mean) +
+                  " um at the limit, coverage " + io::FormatDouble(opt.best.coverage) + ")"
+            : "the optimiser found no feasible plan";
+        opt_json["message"] = m;
+        Warn(kTool, m);
+      }
+      if (opt.status == "max_time") {
+        Note(kTool, "the optimiser stopped at --max-time-s " + io::FormatDouble(max_time_s) +
+                        " before its local searches converged; the best plan so far is written");
+      }
     }
 
     Evaluated e = Evaluate(surface, grid, sim, params, process, surface_path);
     nlohmann::json target_json;
-    bool flagged = false;
     if (target_um > 0) {
       const polishing::TargetResult t =
           polishing::ScaleToTargetRemoval(sim, grid, target_um * 1e-6, process.max_speed, &e.path);
@@ -378,10 +456,44 @@ int Run(int argc, char** argv) {
     }
     const bool cyc = params.pattern == polishing::Pattern::kCycloid;
     nlohmann::json summary;
+    if (cyc && optimise != "none" && opt.best_parallel.valid) {
+      // The cycloid against the optimised zig-zag, both on the final grid
+      // and timed for the target as the written path is (issue 19).
+      polishing::PathParameters pp = opt.best_parallel.params;
+      pp.row_step = MmToM(row_step_mm);
+      Evaluated z = Evaluate(surface, grid, sim, pp, process, surface_path);
+      bool z_reached = true;
+      if (target_um > 0) {
+        const polishing::TargetResult t = polishing::ScaleToTargetRemoval(sim, grid, target_um * 1e-6, process.max_speed, &z.path);
+        z.stats = polishing::ComputeRemovalStats(t.removal, grid.areas(), grid.in_region());
+        z_reached = t.reached;
+      }
+      const bool cycloid_ok = target_um <= 0 || target_json.value("reached", true);
+      const bool zigzag_better = (z_reached && !cycloid_ok) || (z_reached == cycloid_ok && z.stats.cv < e.stats.cv);
+      summary["comparison"] = {{"cycloid_cv", e.stats.cv},
+                               {"parallel_cv", z.stats.cv},
+                               {"parallel_offset_mm", 1e3 * pp.offset},
+                               {"parallel_line_angle_deg", pp.line_angle * 180.0 / kPi},
+                               {"parallel_reaches_target", z_reached},
+                               {"better", zigzag_better ? "parallel" : "cycloid"}};
+      if (zigzag_better) {
+        flagged = true;
+        Warn(kTool, "the optimised zig-zag is better than the optimised cycloid: cv " + io::FormatDouble(z.stats.cv) +
+                        (z_reached ? "" : " (target not reached)") + " against " + io::FormatDouble(e.stats.cv) +
+                        (cycloid_ok ? "" : " (target not reached)") + "; plan it with --pattern parallel --offset-mm " +
+                        io::FormatDouble(1e3 * pp.offset) + " --line-angle-deg " + io::FormatDouble(pp.line_angle * 180.0 / kPi) +
+                        " --edge-overrun-mm " + io::FormatDouble(1e3 * pp.edge_overrun));
+      }
+    }
     summary["removal_um"] = RemovalJson(e.stats);
     summary["path"] = PathJson(e.path.rows);
+    const std::string guides_used = !cyc ? "parallel"
+                                    : params.guides == polishing::GuideLines::kBoundaryOffsets ? "offsets" : "parallel";
     summary["parameters"] = {{"pattern", pattern},
-                             {"guides", cyc ? guides : "parallel"},
+                             {"guides", guides_used},
+                             {"line_angle_deg", params.line_angle * 180.0 / kPi},
+                             {"stagger_loops", cyc ? params.stagger : 0.0},
+                             {"edge_overrun_mm", 1e3 * std::min(params.edge_overrun, polishing::MaxEdgeOverrun(params, process))},
                              {"offset_mm", 1e3 * params.offset},
                              {"radius_mm", cyc ? 1e3 * params.radius : 0.0},
                              {"pitch_mm", cyc ? 1e3 * params.pitch : 0.0},
@@ -412,14 +524,20 @@ int Run(int argc, char** argv) {
     if (robot.Check(kTool, process, e.path.rows, &summary)) flagged = true;
     std::vector<std::pair<std::string, std::string>> meta = {{"pattern", pattern}};
     meta.push_back({"offset_mm", io::FormatDouble(1e3 * params.offset)});
+    meta.push_back({"edge_overrun_mm", io::FormatDouble(1e3 * std::min(params.edge_overrun, polishing::MaxEdgeOverrun(params, process)))});
     if (cyc) {
+      meta.push_back({"guides", guides_used});
       meta.push_back({"radius_mm", io::FormatDouble(1e3 * params.radius)});
       meta.push_back({"pitch_mm", io::FormatDouble(1e3 * params.pitch)});
+      meta.push_back({"stagger_loops", io::FormatDouble(params.stagger)});
+    }
+    if (!cyc || params.guides == polishing::GuideLines::kParallelLines) {
+      meta.push_back({"line_angle_deg", io::FormatDouble(params.line_angle * 180.0 / kPi)});
     }
     if (!path_out.empty()) io::WritePolishPath(path_out, e.path.rows, meta);
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, e.removal);
     robot.WriteJoints(e.path.rows);
-    if (!plot_out.empty()) WritePictures(plot_out, grid, e.removal, e.path.rows, e.path.guide_lines_st, history, pattern);
+    if (!plot_out.empty()) WritePictures(plot_out, grid, e.removal, e.path.rows, e.path.guide_lines_st, history, pattern, evaluated);
     const std::string text = summary.dump(2) + "\n";
     if (!summary_out.empty()) io::WriteFileAtomically(summary_out, text);
     else std::cout << text;

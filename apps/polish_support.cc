@@ -104,7 +104,8 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
                                        const std::vector<double>& removal_m,
                                        const std::vector<polishing::PathRow>& rows,
                                        const std::vector<std::vector<Eigen::Vector2d>>& guide_lines_st,
-                                       const std::vector<double>& history, const std::string& title) {
+                                       const std::vector<double>& history, const std::string& title,
+                                       const std::vector<double>& evaluated) {
   const std::vector<std::string> files = PicturePaths(png, !history.empty());
   // Removal map (seed Fig. 19) on the developed plane.
   report::HeatMap map;
@@ -221,10 +222,25 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
     fc.title = title + ": optimiser convergence";
     auto& a3 = fc.at(0, 0);
     a3.x_label = "iteration / evaluation";
-    a3.y_label = "best cv of removal";
+    a3.y_label = "cv of removal";
+    a3.log_y = true;  // the best is 10-100 x below the first and the worst evaluations
+    if (!evaluated.empty()) {
+      report::Series e;
+      e.color = report::PaletteColor(0);
+      e.markers = true;
+      e.label = "cv of each feasible evaluation";
+      for (size_t i = 0; i < evaluated.size(); ++i) {
+        if (!std::isfinite(evaluated[i])) continue;
+        e.x.push_back(static_cast<double>(i + 1));
+        e.y.push_back(evaluated[i]);
+      }
+      a3.series.push_back(e);
+    }
     report::Series s;
     s.color = report::PaletteColor(2);
+    s.label = evaluated.empty() ? "" : "best so far";
     for (size_t i = 0; i < history.size(); ++i) {
+      if (!std::isfinite(history[i])) continue;  // before the first feasible evaluation
       s.x.push_back(static_cast<double>(i + 1));
       s.y.push_back(history[i]);
     }

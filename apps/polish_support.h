@@ -56,12 +56,14 @@ void ReportUnpolished(const std::string& tool, const polishing::RemovalStats& st
 /// Pictures next to `png`: the removal map (png itself, colour scale in
 /// um on the developed s, t plane), <stem>_histogram.png, <stem>_path.png
 /// (path, lifted moves and guide lines in the developed s, t plane) and, if `history` is not empty,
-/// <stem>_convergence.png. Returns the paths written.
+/// <stem>_convergence.png: `history` the best cv so far per evaluation, `evaluated` the cv of each
+/// (NaN entries: infeasible evaluations, not drawn). Returns the paths written.
 std::vector<std::string> WritePictures(const std::string& png, const polishing::SampleGrid& grid,
                                        const std::vector<double>& removal_m,
                                        const std::vector<polishing::PathRow>& rows,
                                        const std::vector<std::vector<Eigen::Vector2d>>& guide_lines_st,
-                                       const std::vector<double>& history, const std::string& title);
+                                       const std::vector<double>& history, const std::string& title,
+                                       const std::vector<double>& evaluated = {});
 
 /// The list of picture files WritePictures would write (for clean-up and
 /// distinct-path checks).

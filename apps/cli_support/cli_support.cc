@@ -73,7 +73,9 @@ ProgressLine::ProgressLine(std::string tool, std::string what, long total)
       active_(total >= 200),
       start_(std::chrono::steady_clock::now()) {}
 
-void ProgressLine::Update(long done) {
+void ProgressLine::Update(long done) { Update(done, ""); }
+
+void ProgressLine::Update(long done, const std::string& detail) {
   if (!active_ || total_ <= 0) return;
   const int decile = static_cast<int>(10 * done / total_);
   if (decile == last_decile_) return;
@@ -81,9 +83,10 @@ void ProgressLine::Update(long done) {
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   if (tty_) {
     std::cerr << '\r' << tool_ << ": " << what_ << ' ' << done << '/' << total_ << " (" << s << " s)"
-              << std::flush;
+              << (detail.empty() ? "" : " ") << detail << std::flush;
   } else {
-    std::cerr << tool_ << ": " << what_ << ' ' << done << '/' << total_ << " (" << s << " s)\n";
+    std::cerr << tool_ << ": " << what_ << ' ' << done << '/' << total_ << " (" << s << " s)"
+              << (detail.empty() ? "" : " ") << detail << '\n';
   }
 }
 

@@ -53,6 +53,8 @@ class ProgressLine {
  public:
   ProgressLine(std::string tool, std::string what, long total);
   void Update(long done);
+  /// The same with a short text after the count (e.g. the best value so far).
+  void Update(long done, const std::string& detail);
   void Finish();
 
  private:

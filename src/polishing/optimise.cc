@@ -3,11 +3,20 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <atomic>
+#include <cstdio>
+#include <chrono>
+#include <exception>
+#include <mutex>
 #include <random>
+#include <thread>
 
 #include <nlopt.hpp>
 
+#include "robomach/common/golden_section.h"
 #include "robomach/common/units.h"
+#include "robomach/polishing/process.h"
+#include "robomach/polishing/removal.h"
 
 namespace robomach::polishing {
 namespace {
@@ -143,6 +152,417 @@ OptimiseResult OptimiseCycloid(const std::function<double(const PathParameters&)
     }
   }
   res.best = FromUnit(t.best_x, start, o);
+  return res;
+}
+
+
+// ---------------------------------------------------------------------------
+// OptimisePlan
+
+PlanEvaluation EvaluatePlan(const PlanProblem& pb, const PathParameters& p, double margin) {
+  PlanEvaluation e;
+  e.params = p;
+  try {
+    const PlannedPath path = PlanPath(*pb.surface, *pb.grid, p, *pb.process);
+    const RemovalStats st = ComputeRemovalStats(pb.sim->Simulate(path.rows), pb.grid->areas(), pb.grid->in_region());
+    e.valid = std::isfinite(st.cv) && st.mean > 0;
+    if (!e.valid) e.error = "the path removes nothing in the region";
+    e.cv = st.cv;
+    e.mean = st.mean;
+    e.coverage = st.coverage;
+    e.feasible = e.valid && (pb.target <= 0 || st.mean <= margin * pb.target) && st.coverage >= kMinCoverage;
+  } catch (const std::invalid_argument& err) {
+    e.valid = false;
+    e.error = err.what();
+  }
+  return e;
+}
+
+std::string FamilyName(const GuideFamily& f) {
+  if (f.guides == GuideLines::kBoundaryOffsets) return "offsets";
+  const double deg = f.line_angle * 180.0 / kPi;
+  if (std::abs(deg) < 1e-9) return "parallel lines along s";
+  if (std::abs(deg - 90.0) < 1e-9) return "parallel lines along t";
+  return "parallel lines at " + std::to_string(deg) + " deg";
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string io_ftol(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
+// Ranks evaluations: feasible before infeasible; feasible by cv; infeasible
+// by how far they miss the target (mean), invalid last.
+bool Better(const PlanEvaluation& a, const PlanEvaluation& b) {
+  if (a.feasible != b.feasible) return a.feasible;
+  if (a.feasible) return a.cv < b.cv;
+  if (a.valid != b.valid) return a.valid;
+  const bool ca = a.coverage >= kMinCoverage, cb = b.coverage >= kMinCoverage;
+  if (ca != cb) return ca;
+  return a.mean < b.mean;
+}
+
+// Shared state of one OptimisePlan run: the evaluation log, the history and
+// the progress callback, behind one mutex.
+class Book {
+ public:
+  Book(const PlanProblem& pb, const PlanOptimiseOptions& o) : pb_(pb), o_(o), t0_(Clock::now()) {}
+  double Elapsed() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
+  double Remaining() const { return o_.max_time_s - Elapsed(); }
+  bool OutOfTime() const { return Remaining() <= 0; }
+
+  PlanEvaluation Evaluate(const PathParameters& p) {
+    PlanEvaluation e = EvaluatePlan(pb_, p, o_.feasibility_margin);
+    std::lock_guard<std::mutex> lock(mu_);
+    ++res_.evaluations;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    res_.cv_history.push_back(e.feasible ? e.cv : nan);
+    res_.history_parallel.push_back(p.pattern == Pattern::kParallel);
+    if (e.feasible && (!std::isfinite(best_cv_) || e.cv < best_cv_)) best_cv_ = e.cv;
+    res_.best_history.push_back(std::isfinite(best_cv_) ? best_cv_ : nan);
+    if (o_.progress) o_.progress(res_.evaluations, best_cv_, Elapsed());
+    return e;
+  }
+  // Evaluates all of `ps` on the threads (stops starting new ones when out of time).
+  std::vector<PlanEvaluation> Batch(const std::vector<PathParameters>& ps) {
+    std::vector<PlanEvaluation> out(ps.size());
+    std::vector<char> done(ps.size(), 0);
+    RunParallel(static_cast<int>(ps.size()), [&](int i) {
+      if (OutOfTime()) return;
+      out[i] = Evaluate(ps[i]);
+      done[i] = 1;
+    });
+    std::vector<PlanEvaluation> kept;
+    for (size_t i = 0; i < ps.size(); ++i)
+      if (done[i]) kept.push_back(out[i]);
+    return kept;
+  }
+  // Runs job(0..n-1) on o.threads threads; the first exception is rethrown.
+  void RunParallel(int n, const std::function<void(int)>& job) {
+    std::atomic<int> next{0};
+    std::exception_ptr err;
+    std::mutex err_mu;
+    auto worker = [&]() {
+      for (int i = next++; i < n; i = next++) {
+        try {
+          job(i);
+        } catch (...) {
+          std::lock_guard<std::mutex> lock(err_mu);
+          if (!err) err = std::current_exception();
+          next = n;
+        }
+      }
+    };
+    const int nt = std::max(1, std::min(o_.threads, n));
+    std::vector<std::thread> pool;
+    for (int k = 1; k < nt; ++k) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+    if (err) std::rethrow_exception(err);
+  }
+  PlanOptimiseResult& result() { return res_; }
+  std::mutex& mutex() { return mu_; }
+
+ private:
+  const PlanProblem& pb_;
+  const PlanOptimiseOptions& o_;
+  Clock::time_point t0_;
+  std::mutex mu_;
+  PlanOptimiseResult res_;
+  double best_cv_{std::numeric_limits<double>::quiet_NaN()};
+};
+
+constexpr int kDim = 5;  // d, r/d, pitch/r, stagger, edge overrun / its largest value
+
+PathParameters CycloidFromUnit(const double* x, const PathParameters& base, const GuideFamily& fam,
+                               const PlanOptimiseOptions& o, const PolishingProcess& process) {
+  PathParameters p = base;
+  p.pattern = Pattern::kCycloid;
+  p.guides = fam.guides;
+  p.line_angle = fam.line_angle;
+  // d on a log scale: the good spacings are a few contact widths or less,
+  // and a step in d matters relative to d.
+  p.offset = o.offset_min * std::pow(o.offset_max / o.offset_min, std::clamp(x[0], 0.0, 1.0));
+  p.radius = p.offset * (kRatioMin + std::clamp(x[1], 0.0, 1.0) * (kRatioMax - kRatioMin));
+  p.pitch = p.radius * (kPitchMin + std::clamp(x[2], 0.0, 1.0) * (kPitchMax - kPitchMin));
+  p.stagger = std::clamp(x[3], 0.0, 1.0);
+  p.edge_overrun = std::clamp(x[4], 0.0, 1.0) * MaxEdgeOverrun(p, process);
+  return p;
+}
+
+// One local search (COBYLA, the target as an inequality constraint).
+struct LocalRun {
+  Book* book;
+  const PathParameters* base;
+  GuideFamily fam;
+  const PlanOptimiseOptions* o;
+  const PlanProblem* pb;
+  // The last evaluation (NLopt asks for the objective and the constraint
+  // at the same x one after the other).
+  std::vector<double> last_x;
+  PlanEvaluation last;
+  PlanEvaluation best;
+  bool have_best{false};
+
+  const PlanEvaluation& At(const double* x) {
+    if (last_x.size() == kDim && std::equal(last_x.begin(), last_x.end(), x)) return last;
+    last_x.assign(x, x + kDim);
+    last = book->Evaluate(CycloidFromUnit(x, *base, fam, *o, *pb->process));
+    if (!have_best || Better(last, best)) best = last, have_best = true;
+    return last;
+  }
+  static double Objective(unsigned, const double* x, double*, void* data) {
+    const PlanEvaluation& e = static_cast<LocalRun*>(data)->At(x);
+    return e.valid ? e.cv : 10.0;  // invalid: far worse than any cv
+  }
+  static double Constraint(unsigned, const double* x, double*, void* data) {
+    LocalRun* r = static_cast<LocalRun*>(data);
+    const PlanEvaluation& e = r->At(x);
+    if (r->pb->target <= 0) return -1.0;
+    if (!e.valid) return 1.0;
+    return e.mean / (r->o->feasibility_margin * r->pb->target) - 1.0;
+  }
+  static double CoverageConstraint(unsigned, const double* x, double*, void* data) {
+    const PlanEvaluation& e = static_cast<LocalRun*>(data)->At(x);
+    return e.valid ? kMinCoverage - e.coverage : 1.0;
+  }
+};
+
+std::vector<double> CycloidToUnit(const PathParameters& p, const PlanOptimiseOptions& o, const PolishingProcess& process) {
+  const double max_over = MaxEdgeOverrun(p, process);
+  return {std::clamp(std::log(p.offset / o.offset_min) / std::log(o.offset_max / o.offset_min), 0.0, 1.0),
+          std::clamp((p.radius / p.offset - kRatioMin) / (kRatioMax - kRatioMin), 0.0, 1.0),
+          std::clamp((p.pitch / p.radius - kPitchMin) / (kPitchMax - kPitchMin), 0.0, 1.0),
+          std::clamp(p.stagger, 0.0, 1.0),
+          max_over > 0 ? std::clamp(p.edge_overrun / max_over, 0.0, 1.0) : 0.0};
+}
+
+bool SameFamily(const PathParameters& p, const GuideFamily& f) {
+  return p.guides == f.guides && (f.guides == GuideLines::kBoundaryOffsets || std::abs(p.line_angle - f.line_angle) < 1e-9);
+}
+
+// The zig-zag: spacing scan and golden-section refinement, both directions.
+PlanEvaluation OptimiseParallel(const PlanProblem& pb, const PathParameters& start, Book* book) {
+  PathParameters base = start;
+  base.pattern = Pattern::kParallel;
+  const double w = pb.contact_width;
+  std::vector<PathParameters> scan;
+  for (double angle : {0.0, kPi / 2}) {
+    for (double over : {0.0, 0.5, 1.0}) {
+      for (int k = 0; k < 13; ++k) {
+        PathParameters p = base;
+        p.line_angle = angle;
+        p.offset = (0.3 + 0.1 * k) * w;
+        p.edge_overrun = over * pb.process->margin;
+        scan.push_back(p);
+      }
+    }
+  }
+  std::vector<PlanEvaluation> ev = book->Batch(scan);
+  PlanEvaluation best;
+  bool have = false;
+  for (const auto& e : ev)
+    if (!have || Better(e, best)) best = e, have = true;
+  if (!have) return best;
+  // Refine around the best scan point of each direction that is feasible
+  // (the cv is not unimodal over the whole range: rows resonate with the
+  // contact's width).
+  std::vector<double> angles = {0.0, kPi / 2};
+  std::vector<PlanEvaluation> seeds(2);
+  std::vector<bool> has(2, false);
+  for (const auto& e : ev) {
+    const int a = e.params.line_angle > 0 ? 1 : 0;
+    if (!has[a] || Better(e, seeds[a])) seeds[a] = e, has[a] = true;
+  }
+  std::mutex mu;
+  book->RunParallel(2, [&](int a) {
+    if (!has[a] || !seeds[a].feasible || book->OutOfTime()) return;
+    const double w0 = seeds[a].params.offset / w;
+    auto f = [&](double wr) {
+      PathParameters p = seeds[a].params;
+      p.offset = wr * w;
+      const PlanEvaluation e = book->Evaluate(p);
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        if (Better(e, best)) best = e;
+      }
+      return e.feasible ? -e.cv : -10.0 - e.mean / std::max(pb.target, 1e-30);
+    };
+    GoldenSectionMaximum(f, std::max(0.3, w0 - 0.1), std::min(1.5, w0 + 0.1), 8, 1e-3);
+  });
+  return best;
+}
+
+}  // namespace
+
+PlanOptimiseResult OptimisePlan(const PlanProblem& pb, const PathParameters& start, const PlanOptimiseOptions& o) {
+  Book book(pb, o);
+  PlanOptimiseResult& res = book.result();
+  const bool cyc = o.pattern == Pattern::kCycloid;
+  if (!cyc || o.compare_parallel) res.best_parallel = OptimiseParallel(pb, start, &book);
+  if (!cyc) {
+    res.best = res.best_parallel;
+    res.method = "zig-zag: row spacing scanned on [0.3, 1.5] contact widths (13 points) x edge overrun (0, 0.5, 1 "
+                 "margin) x rows along s and t, then golden-section refinement of the spacing";
+    res.status = book.OutOfTime() ? "max_time" : "converged";
+    res.seconds = book.Elapsed();
+    return res;
+  }
+  std::vector<GuideFamily> fams = o.families;
+  if (fams.empty()) fams = {{GuideLines::kBoundaryOffsets, 0.0}, {GuideLines::kParallelLines, 0.0},
+                            {GuideLines::kParallelLines, kPi / 2}};
+  PlanEvaluation best;
+  bool have = false;
+  auto consider = [&](const PlanEvaluation& e) {
+    if (!have || Better(e, best)) best = e, have = true;
+  };
+
+  if (o.method == Optimiser::kPso) {
+    // The seed's PSO over (d, r, pitch) on the first family, half-loop stagger.
+    PathParameters base = start;
+    base.guides = fams[0].guides;
+    base.line_angle = fams[0].line_angle;
+    std::mutex mu;
+    OptimiseOptions po;
+    po.method = Optimiser::kPso;
+    po.offset_min = o.offset_min;
+    po.offset_max = o.offset_max;
+    po.seed = o.seed;
+    OptimiseResult r = OptimiseCycloid(
+        [&](const PathParameters& p) {
+          const PlanEvaluation e = book.Evaluate(p);
+          consider(e);
+          if (!e.valid) return 1e6;
+          return e.feasible ? e.cv : 10.0 + e.mean / pb.target;
+        },
+        base, po);
+    res.method = r.method + ", the target as a penalty, the best feasible point kept";
+    res.status = r.status;
+  } else {
+    // 1. Coarse grid per family at the half-loop stagger.
+    const double gd[] = {0.0, 0.2, 0.45}, gr[] = {0.3, 1.0}, gp[] = {0.15, 0.5, 0.85};
+    std::vector<PathParameters> grid_pts;
+    for (const GuideFamily& f : fams)
+      for (double a : gd)
+        for (double b : gr)
+          for (double c : gp) {
+            {
+              const double x[kDim] = {a, b, c, 0.5, 1.0};  // rows to the patch's edge
+              grid_pts.push_back(CycloidFromUnit(x, start, f, o, *pb.process));
+            }
+          }
+    std::vector<PlanEvaluation> ev = book.Batch(grid_pts);
+    {
+      PlanEvaluation s0 = book.Evaluate(start);  // the user's (or default) start point
+      if (s0.valid) ev.push_back(s0);
+    }
+    for (const auto& e : ev) consider(e);
+    // 2. Starts: the best of each family, then the next best overall.
+    std::sort(ev.begin(), ev.end(), Better);
+    // A family whose best grid point is far behind the best (cv > 1.5 x,
+    // or infeasible when a feasible point exists) gets no local search.
+    std::vector<PlanEvaluation> starts;
+    for (const GuideFamily& f : fams) {
+      for (const auto& e : ev)
+        if (e.valid && SameFamily(e.params, f)) {
+          const bool close = !ev[0].feasible || (e.feasible && e.cv <= 1.5 * ev[0].cv);
+          if (close && static_cast<int>(starts.size()) < std::max(o.starts, 1)) starts.push_back(e);
+          break;
+        }
+    }
+    for (const auto& e : ev) {
+      if (static_cast<int>(starts.size()) >= std::max<int>(o.starts, 1)) break;
+      if (!e.valid) continue;
+      bool dup = false;
+      for (const auto& s : starts) dup |= s.params.offset == e.params.offset && s.params.radius == e.params.radius &&
+                                          s.params.pitch == e.params.pitch && SameFamily(s.params, {e.params.guides, e.params.line_angle});
+      if (!dup) starts.push_back(e);
+    }
+    // Local searches, most promising first.
+    std::sort(starts.begin(), starts.end(), Better);
+    std::mutex mu;
+    int converged = 0, ran = 0;
+    std::vector<std::string> statuses;
+    // One COBYLA run from `from`; returns its status and records its best.
+    auto local = [&](const PathParameters& from) {
+      LocalRun run{&book, &start, {from.guides, from.line_angle}, &o, &pb, {}, {}, {}, false};
+      nlopt::opt opt(nlopt::LN_COBYLA, kDim);
+      opt.set_lower_bounds(std::vector<double>(kDim, 0.0));
+      opt.set_upper_bounds(std::vector<double>(kDim, 1.0));
+      opt.set_min_objective(LocalRun::Objective, &run);
+      opt.add_inequality_constraint(LocalRun::Constraint, &run, 1e-4);
+      opt.add_inequality_constraint(LocalRun::CoverageConstraint, &run, 1e-4);
+      opt.set_ftol_rel(o.ftol_rel);
+      opt.set_xtol_abs(5e-3);  // 5e-3 of the box: ~1 % of d, below what the grid resolves
+      opt.set_maxeval(o.max_local_evaluations);
+      opt.set_maxtime(std::max(0.1, book.Remaining()));
+      opt.set_initial_step(std::vector<double>{0.08, 0.15, 0.1, 0.15, 0.25});
+      std::vector<double> x = CycloidToUnit(from, o, *pb.process);
+      double f = 0;
+      std::string st;
+      try {
+        const nlopt::result r = opt.optimize(x, f);
+        st = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : r == nlopt::MAXTIME_REACHED ? "max_time" : "converged";
+      } catch (const nlopt::roundoff_limited&) {
+        st = "converged";  // at the objective's noise level
+      } catch (const nlopt::forced_stop&) {
+        st = "max_time";
+      } catch (const std::invalid_argument&) {
+        st = "failed";
+      }
+      std::lock_guard<std::mutex> lock(mu);
+      ++ran;
+      converged += st == "converged";
+      statuses.push_back(st);
+      if (run.have_best) {
+        consider(run.best);
+        ev.push_back(run.best);
+      }
+    };
+    book.RunParallel(static_cast<int>(starts.size()), [&](int i) {
+      if (!book.OutOfTime()) local(starts[i].params);
+    });
+    // 3. Restarts from the best point (COBYLA's simplex shrinks early on a
+    // sampled objective): a fresh run from it and one a quarter loop of
+    // stagger away (the stagger's landscape has several valleys), repeated
+    // while the best improves by more than ftol_rel.
+    for (int round = 0; round < 5 && have && best.feasible && !book.OutOfTime(); ++round) {
+      const double before = best.cv;
+      const PathParameters b = best.params;
+      book.RunParallel(2, [&](int i) {
+        if (book.OutOfTime()) return;
+        PathParameters from = b;
+        if (i == 1) from.stagger = std::fmod(b.stagger + (round % 2 ? 0.75 : 0.25), 1.0);
+        local(from);
+      });
+      if (!(best.cv < before * (1 - o.ftol_rel))) break;
+    }
+    res.local_searches = ran;
+    res.local_converged = converged;
+    res.status = ran == 0 ? "max_time" : converged == ran ? "converged" : "max_time";
+    for (const auto& s : statuses)
+      if (s == "max_evaluations") res.status = "max_evaluations";
+    if (ran < static_cast<int>(starts.size()) || book.OutOfTime()) res.status = "max_time";
+    res.method = "NLopt: coarse grid over (d, r/d, pitch/r) for each guide family (" + std::to_string(fams.size()) +
+                 "), then COBYLA from " + std::to_string(starts.size()) +
+                 " starts over (d, r/d, pitch/r, stagger, edge overrun) with the target as a constraint, then restarts "
+                 "from the best while it improves; ftol_rel " + io_ftol(o.ftol_rel);
+    // Best per family, from the grid and the local searches.
+    for (const GuideFamily& f : fams) {
+      PlanEvaluation fb;
+      bool h = false;
+      for (const auto& e : ev)
+        if (SameFamily(e.params, f) && (!h || Better(e, fb))) fb = e, h = true;
+      if (h) res.family_best.push_back(fb);
+    }
+  }
+  res.best = best;
+  res.seconds = book.Elapsed();
   return res;
 }
 

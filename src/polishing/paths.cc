@@ -85,6 +85,10 @@ void StraightMove(const Mapper& m, const Vec2& a, const Vec2& b, const Vec2& tan
 
 }  // namespace
 
+double MaxEdgeOverrun(const PathParameters& p, const PolishingProcess& process) {
+  return p.pattern == Pattern::kCycloid ? std::max(0.0, process.margin - p.radius) : process.margin;
+}
+
 void CheckValid(const PathParameters& p) {
   auto fail = [](const std::string& m) { throw std::invalid_argument(m); };
   auto mm = [](double x) {
@@ -94,7 +98,9 @@ void CheckValid(const PathParameters& p) {
   };
   if (!(p.offset > 0) || !std::isfinite(p.offset)) fail("offset_mm: expected > 0, got " + mm(p.offset));
   if (!(p.row_step > 0)) fail("row step must be > 0");
+  if (!std::isfinite(p.line_angle)) fail("line angle: expected a finite number of radians");
   if (p.pattern == Pattern::kParallel) return;
+  if (!(p.stagger >= 0.0 && p.stagger <= 1.0)) fail("stagger: expected in [0, 1] loops, got " + std::to_string(p.stagger));
   if (!(p.radius > 0)) fail("radius_mm: expected > 0, got " + mm(p.radius));
   if (!(p.pitch > 0)) fail("pitch_mm: expected > 0, got " + mm(p.pitch));
   if (p.offset > 2 * p.radius * (1 + 1e-12)) {
@@ -137,7 +143,9 @@ std::vector<GuideSpec> RectangleGuides(const SampleGrid& grid, const PathParamet
     // the boundary band was the largest source of non-uniformity (README).
     const double half_min = std::min(W, H) / 2;
     const double e = std::min(half_min, params.edge_inset >= 0 ? params.edge_inset
-                                                                : std::max(0.0, r - process.margin));
+                                        : r >= process.margin ? r - process.margin
+                                                              : -std::min(std::max(0.0, params.edge_overrun),
+                                                                          MaxEdgeOverrun(params, process)));
     const int n = std::max(1, static_cast<int>(std::ceil((half_min - e) / d - 1e-9)));
     const double de = (half_min - e) / n;
     for (int k = 0; k < n; ++k) {
@@ -386,24 +394,52 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   const DevelopedRegion region = DevelopedRegion::Build(surface, grid, process.margin);
   if (cyc) CheckCircleFits(surface, grid, region, params, process);  // never rows clamped onto the edges
   std::vector<GuideSpec> guides;
-  if (region.rectangle()) guides = RectangleGuides(grid, params, process);
+  // Direction of parallel lines: e (along the lines), nrm (across them).
+  const double ca = std::cos(params.line_angle), sa = std::sin(params.line_angle);
+  const Vec2 e_dir(ca, sa), nrm(-sa, ca);
+  const bool rotated = parallel_lines && std::abs(params.line_angle) > 1e-12;
+  const double overrun = region.rectangle() ? std::clamp(params.edge_overrun, 0.0, MaxEdgeOverrun(params, process)) : 0.0;
+  if (region.rectangle() && !(parallel_lines && (rotated || overrun > 0))) guides = RectangleGuides(grid, params, process);
   else if (region.loops().empty()) throw std::invalid_argument("the polished region is empty (margin too large for the face)");
-  else if (parallel_lines && cyc) {
-    // Cycloids along the lines: the lines stop the inset short of the
-    // boundary, holes included, so that the circle stays on the face.
-    const double e = CycloidInset(params, process);
-    const DevelopedRegion inner = DevelopedRegion::FromPolygons(region.Offset(e));
-    if (inner.loops().empty()) RegionTooNarrow(region.Inradius(), e, params);
-    guides = LineGuides(inner, params);
-  } else if (parallel_lines) guides = LineGuides(region, params);
-  else guides = OffsetGuides(region, params, process);
+  else if (parallel_lines) {
+    // Lines along e_dir: laid out along s in the region turned by -angle,
+    // then turned back (a rotation keeps the rolling sense).
+    auto turn = [](const Vec2& p, double c, double s) { return Vec2(c * p.x() - s * p.y(), s * p.x() + c * p.y()); };
+    std::vector<Polygon2> loops = region.loops();
+    for (auto& loop : loops)
+      for (auto& x : loop) x = turn(x, ca, -sa);
+    DevelopedRegion turned = rotated ? DevelopedRegion::FromPolygons(loops) : region;
+    if (overrun > 0 && turned.rectangle()) {
+      // The lines (rows) run `overrun` into the margin all round.
+      const Eigen::Vector4d b = turned.Bounds();
+      const double x0 = b(0) - overrun, y0 = b(1) - overrun, x1 = b(2) + overrun, y1 = b(3) + overrun;
+      turned = DevelopedRegion::FromPolygons({{Vec2(x0, y0), Vec2(x1, y0), Vec2(x1, y1), Vec2(x0, y1)}});
+    }
+    if (cyc && !region.rectangle()) {
+      // Cycloids along the lines: the lines stop the inset short of the
+      // boundary, holes included, so that the circle stays on the face.
+      const double e = CycloidInset(params, process);
+      const DevelopedRegion inner = DevelopedRegion::FromPolygons(turned.Offset(e));
+      if (inner.loops().empty()) RegionTooNarrow(region.Inradius(), e, params);
+      guides = LineGuides(inner, params);
+    } else {
+      guides = LineGuides(turned, params);
+    }
+    if (rotated) {
+      for (auto& g : guides) {
+        std::vector<Vec2> pts = g.guide.pts;
+        for (auto& x : pts) x = turn(x, ca, sa);
+        g.guide = Guide(std::move(pts));
+      }
+    }
+  } else guides = OffsetGuides(region, params, process);
   if (guides.empty()) throw std::invalid_argument("the polished region is narrower than the row spacing: no guide line fits");
 
   // Tool x along the guide line (seed eq. 16) with one sign for all the
   // parallel lines: the belt keeps running the same way and the wrist does
   // not turn half a revolution at every row end.
   auto tool_dir = [&](const Vec2& tangent) {
-    return (parallel_lines && tangent.x() < 0) ? Vec2(-tangent) : tangent;
+    return (parallel_lines && tangent.dot(e_dir) < 0) ? Vec2(-tangent) : tangent;
   };
 
   PlannedPath out;
@@ -431,8 +467,16 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
       continue;
     }
     // Cycloid (seed eq. 11): x = xc + r cos(omega t + theta), y = yc + r sin(...),
-    // the centre advancing `pitch` per loop; rows staggered by half a loop.
-    const double theta = kPi * static_cast<double>(g);
+    // the centre advancing `pitch` per loop; adjacent rows staggered by
+    // params.stagger loops. On parallel lines the phase is tied to the
+    // position along e_dir (paths.h), so that the stagger between
+    // neighbours does not depend on the lines' lengths or run direction.
+    double theta = 2 * kPi * params.stagger * static_cast<double>(g);
+    if (parallel_lines) {
+      const Vec2& a = guide.pts.front();
+      const double k = std::round((a - guides[0].guide.pts.front()).dot(nrm) / params.offset);
+      theta = 2 * kPi * (a.dot(e_dir) / pitch + params.stagger * k);
+    }
     const double L = guide.length();
     // On a closed guide a whole number of loops (the pitch adjusted by at
     // most half a loop over the guide's length) closes the cycloid on

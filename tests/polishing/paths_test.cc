@@ -506,3 +506,167 @@ TEST(Optimise, PatternOrderingOnAPlateWithAHole) {
 
 }  // namespace
 }  // namespace robomach::polishing
+
+namespace robomach::polishing {
+namespace {
+
+// Issue 19: the stagger is spatial on parallel lines (paths.h): a row of
+// line k lies at c + r (cos a, sin a) with the centre c = (x, t_k) and
+// a = 2 pi (x / pitch + stagger k), whichever way the boustrophedon runs
+// the line (line 0 forward, line 1 backward). Reference: that formula,
+// solved for each interior row (sin a from its t, then x from its s) and
+// the angle residual wrapped to (-pi, pi]. The region (73 x 8 mm) holds
+// two lines 4 mm apart, 73 mm long: not a whole number of pitches, so a
+// phase counted from each line's start (the old layout) fails. Rows are
+// exact points of the curve on a plane: tolerance 1e-6 rad (asin near
+// +-1 loses half the digits). The wrong stagger (a quarter loop off) must
+// miss somewhere by > 0.5 rad (a row may match the other asin branch by
+// chance, so the largest residual is tested).
+double AngleResidual(const Eigen::Vector2d& q, double tk, const PathParameters& p, int k) {
+  const double sn = std::clamp((q.y() - tk) / p.radius, -1.0, 1.0);
+  double best = 1e9;
+  for (double a : {std::asin(sn), kPi - std::asin(sn)}) {
+    const double x = q.x() - p.radius * std::cos(a);
+    const double want = 2 * kPi * (x / p.pitch + p.stagger * k);
+    best = std::min(best, std::abs(std::remainder(a - want, 2 * kPi)));
+  }
+  return best;
+}
+TEST(Paths, StaggerIsASpatialShiftBetweenAdjacentLines) {
+  const NurbsSurface plane = testing::Plane(0.083, 0.018);
+  const PolishingProcess proc = Process(0.005);
+  const SampleGrid grid = SampleGrid::Build(plane, 0.5e-3, proc.margin, false);
+  for (double stagger : {0.5, 0.3}) {
+    PathParameters p;
+    p.guides = GuideLines::kParallelLines;
+    p.offset = 0.004;
+    p.radius = 0.002;
+    p.pitch = 0.0017;
+    p.row_step = 0.25e-3;
+    p.stagger = stagger;
+    const PlannedPath path = PlanPath(plane, grid, p, proc);
+    ASSERT_EQ(path.guide_lines.size(), 2u);
+    const double t[2] = {path.guide_lines[0].front().y(), path.guide_lines[1].front().y()};
+    ASSERT_NEAR(t[1] - t[0], p.offset, 1e-12);
+    EXPECT_GT(path.guide_lines[1].front().x(), path.guide_lines[1].back().x());  // line 1 runs backwards
+    PathParameters wrong = p;
+    wrong.stagger = stagger + 0.25;
+    int n[2] = {0, 0};
+    double worst = 0, worst_wrong = 0;
+    for (const PathRow& r : path.rows) {
+      const Eigen::Vector2d q(r.p.x(), r.p.y());
+      if (q.x() < 0.012 || q.x() > 0.071) continue;  // the lines' ends and the link
+      if (std::abs(q.y() - 0.5 * (t[0] + t[1])) < 1e-6) continue;  // where the two curves touch
+      const int k = q.y() < 0.5 * (t[0] + t[1]) ? 0 : 1;
+      ++n[k];
+      worst = std::max(worst, AngleResidual(q, t[k], p, k));
+      if (k == 1) worst_wrong = std::max(worst_wrong, AngleResidual(q, t[k], wrong, k));
+    }
+    EXPECT_GT(n[0], 200);
+    EXPECT_GT(n[1], 200);
+    EXPECT_LT(worst, 1e-6) << "stagger " << stagger;
+    EXPECT_GT(worst_wrong, 0.5) << "stagger " << stagger;
+  }
+}
+
+// Issue 19: parallel lines along t (line angle 90 deg), and the edge
+// overrun into the margin (plain patches). Reference: the region's
+// rectangle [5, 75] x [5, 45] mm of an 80 x 50 mm plane, margin 5 mm.
+TEST(Paths, LineAngleAndEdgeOverrun) {
+  const NurbsSurface plane = testing::Plane(0.08, 0.05);
+  const PolishingProcess proc = Process(0.005);
+  const SampleGrid grid = SampleGrid::Build(plane, 0.5e-3, proc.margin, false);
+  PathParameters z;
+  z.pattern = Pattern::kParallel;
+  z.offset = 0.004;
+  z.line_angle = kPi / 2;
+  for (double over : {0.0, 0.003, 0.02}) {  // 0.02: more than the margin, clipped to it
+    z.edge_overrun = over;
+    const PlannedPath path = PlanPath(plane, grid, z, proc);
+    ExpectValidFrames(path, proc.max_speed);
+    const double e = std::min(over, proc.margin);
+    double lo_t = 1, hi_t = -1, lo_s = 1, hi_s = -1;
+    for (const auto& g : path.guide_lines_st) {
+      ASSERT_EQ(g.size(), 2u);
+      EXPECT_NEAR(g.front().x(), g.back().x(), 1e-12);  // rows along t
+      lo_t = std::min({lo_t, g.front().y(), g.back().y()});
+      hi_t = std::max({hi_t, g.front().y(), g.back().y()});
+      lo_s = std::min(lo_s, g.front().x());
+      hi_s = std::max(hi_s, g.front().x());
+    }
+    EXPECT_NEAR(lo_t, 0.005 - e, 1e-9);
+    EXPECT_NEAR(hi_t, 0.045 + e, 1e-9);
+    // Rows 4 mm apart, centred on the band 70 + 2 e wide.
+    EXPECT_NEAR(0.5 * (lo_s + hi_s), 0.04, 1e-9);
+    EXPECT_LE(hi_s - lo_s, 0.07 + 2 * e + 1e-9);
+    EXPECT_GT(hi_s - lo_s, 0.07 + 2 * e - 0.004 - 1e-9);
+    for (const PathRow& r : path.rows) EXPECT_NEAR(std::abs(r.tx.y()), 1.0, 1e-12);
+  }
+  // The cycloid's lines stop at margin - r outside the region (the circle
+  // stays on the patch).
+  PathParameters c;
+  c.guides = GuideLines::kParallelLines;
+  c.offset = 0.004;
+  c.radius = 0.003;
+  c.pitch = 0.002;
+  c.edge_overrun = 0.01;
+  EXPECT_NEAR(MaxEdgeOverrun(c, proc), 0.002, 1e-15);
+  const PlannedPath path = PlanPath(plane, grid, c, proc);
+  double lo = 1, hi = -1;
+  for (const PathRow& r : path.rows) lo = std::min(lo, r.p.x()), hi = std::max(hi, r.p.x());
+  EXPECT_NEAR(lo, 0.0, 1e-6);   // 5 - 2 - 3 mm: the patch's edge
+  EXPECT_NEAR(hi, 0.08, 1e-6);
+}
+
+// Issue 19, feasibility: with a target only sparse plans reach within the
+// speed limit, OptimisePlan returns a feasible plan (re-evaluated here: at
+// the limit it removes at most the target); with a target no plan reaches
+// it returns the least infeasible one, flagged. Small plane, 2 mm grid,
+// a 20 s cap (the test takes a few seconds).
+TEST(Optimise, PlanReturnsFeasibleOrSaysSo) {
+  const NurbsSurface plane = testing::Plane(0.05, 0.04);
+  PolishingProcess proc = Process(0.005);
+  proc.preston_coefficient = 1e-11;
+  const SampleGrid g = SampleGrid::Build(plane, 2e-3, proc.margin, false);
+  const double w = ContactWidthAtCentre(plane, g, proc);
+  const RemovalSimulator sim(plane, proc, g.points(), g.normals(), 0.5 * w);
+  PlanProblem pb;
+  pb.surface = &plane;
+  pb.grid = &g;
+  pb.sim = &sim;
+  pb.process = &proc;
+  pb.contact_width = w;
+  PathParameters start;
+  start.row_step = 2e-3;
+  PlanOptimiseOptions o;
+  o.offset_min = 0.3 * w;
+  o.max_time_s = 20;
+  // The default cycloid at the limit: its mean sets the scale.
+  const double m0 = EvaluatePlan(pb, start).mean;
+  pb.target = 0.6 * m0;
+  const PlanOptimiseResult r = OptimisePlan(pb, start, o);
+  ASSERT_TRUE(r.best.feasible);
+  const PlanEvaluation again = EvaluatePlan(pb, r.best.params, 1.0);
+  EXPECT_LE(again.mean, 0.98 * pb.target * (1 + 1e-12));
+  EXPECT_NEAR(again.cv, r.best.cv, 1e-12);  // the same plan
+  EXPECT_TRUE(r.best_parallel.feasible);
+  // History: NaN until the first feasible evaluation, then non-increasing.
+  ASSERT_EQ(r.best_history.size(), static_cast<size_t>(r.evaluations));
+  double prev = 1e9;
+  for (double h : r.best_history) {
+    if (std::isnan(h)) continue;
+    EXPECT_LE(h, prev);
+    prev = h;
+  }
+  EXPECT_NEAR(prev, std::min(r.best.cv, r.best_parallel.cv), 1e-12);
+  // Nothing reaches 1e-4 of the default's removal.
+  pb.target = 1e-4 * m0;
+  o.max_time_s = 5;
+  const PlanOptimiseResult none = OptimisePlan(pb, start, o);
+  EXPECT_FALSE(none.best.feasible);
+  EXPECT_TRUE(none.best.valid);
+  EXPECT_GT(none.best.mean, pb.target);
+}
+
+}  // namespace
+}  // namespace robomach::polishing

@@ -57,4 +57,120 @@ struct OptimiseResult {
 OptimiseResult OptimiseCycloid(const std::function<double(const PathParameters&)>& objective,
                                const PathParameters& start, const OptimiseOptions& options);
 
+// ---------------------------------------------------------------------------
+// OptimisePlan (issue 19): the whole optimisation polish-plan --optimise
+// does, with the speed limit and the target as a constraint.
+//
+// A plan is evaluated on the optimiser's (coarse) grid, planned at the speed
+// limit: it removes `mean` there, the least any speed within the limit
+// gives. It is feasible if mean <= feasibility_margin x target (no target:
+// always): slowing down then reaches the target exactly; and if it covers
+// the region (coverage >= kMinCoverage, polish-plan's warning threshold: a
+// plan that barely touches the region reaches any small target).
+//
+// Cycloid: the variables are, in the unit box, d on a log scale over
+// [offset_min, offset_max], r/d in [0.5, 1], pitch/r in [0.5, pi]
+// (OptimiseCycloid's box), the stagger in [0, 1] loops and the edge overrun
+// in [0, 1] x MaxEdgeOverrun; the guide family is a discrete choice, each
+// tried: boundary offsets, parallel lines along s, parallel lines along t
+// (those given in `families`). Method (NLopt):
+//  1. a coarse grid per family (d x r/d x pitch/r = 3 x 2 x 3 at the
+//     half-loop stagger and full overrun), plus the start plan;
+//  2. multi-start: from the best grid point of each family within 1.5 x of
+//     the best, then the next best points (`starts` in all), COBYLA
+//     (LN_COBYLA) with the constraint mean / (margin target) - 1 <= 0 and
+//     the cv as the objective, each run stopping on a relative change of
+//     the cv below ftol_rel (or x below 0.005 of the box, or
+//     max_local_evaluations);
+//  3. restarts from the best point, a fresh run and one a quarter loop of
+//     stagger away, while the best improves by more than ftol_rel (at most
+//     5 rounds);
+//  all under max_time_s; the best feasible evaluation seen anywhere is
+//  returned; only if none was seen, the least infeasible one (feasible =
+//  false).
+// The zig-zag (and the cycloid's comparison): the row spacing scanned on
+// [0.3, 1.5] contact widths (13 points) x edge overrun (0, 0.5, 1 margin) x
+// rows along s and t, then a golden-section refinement of the spacing per
+// direction; the best feasible kept.
+// PSO: OptimiseCycloid's seed PSO on the first family, the same
+// feasibility bookkeeping.
+// Evaluations run on `threads` threads (the simulator is immutable).
+// ---------------------------------------------------------------------------
+
+class RemovalSimulator;
+struct PolishingProcess;
+
+constexpr double kMinCoverage = 0.99;
+
+/// What is optimised: plans on `grid` simulated by `sim` (built on the same grid).
+struct PlanProblem {
+  const NurbsSurface* surface{nullptr};
+  const SampleGrid* grid{nullptr};
+  const RemovalSimulator* sim{nullptr};
+  const PolishingProcess* process{nullptr};
+  double target{0.0};         // mean removal [m]; 0: no target, every plan feasible
+  double contact_width{0.0};  // ContactWidthAtCentre [m]: the zig-zag's spacing unit
+};
+
+struct PlanEvaluation {
+  PathParameters params;
+  bool valid{false};     // planned: inside the seed limits, fits the region
+  bool feasible{false};  // valid and reaches the target within the speed limit
+  double cv{0.0};        // cv of the removal at the speed limit
+  double mean{0.0};      // mean removal at the speed limit [m]
+  double coverage{0.0};  // RemovalStats::coverage
+  std::string error;     // why not valid
+};
+
+/// Plans `p` at the speed limit on the problem's grid and simulates it.
+/// Bad contact (PathRowError) propagates; std::invalid_argument (seed
+/// limits, region too narrow) gives valid = false.
+PlanEvaluation EvaluatePlan(const PlanProblem& problem, const PathParameters& p, double feasibility_margin = 0.98);
+
+/// A guide family of the cycloid.
+struct GuideFamily {
+  GuideLines guides{GuideLines::kBoundaryOffsets};
+  double line_angle{0.0};  // parallel lines [rad]
+};
+std::string FamilyName(const GuideFamily& f);
+
+struct PlanOptimiseOptions {
+  Optimiser method{Optimiser::kNlopt};
+  Pattern pattern{Pattern::kCycloid};
+  /// Cycloid guide families tried (empty: offsets, lines along s, along t).
+  std::vector<GuideFamily> families;
+  double offset_min{0.004}, offset_max{0.030};  // cycloid d bounds [m]
+  double feasibility_margin{0.98};  // grid difference optimiser -> final grid
+  int starts{3};                    // local searches
+  double ftol_rel{5e-3};            // local stop: relative change of the cv
+  int max_local_evaluations{120};   // per local search (a safety net)
+  double max_time_s{50.0};          // all of it
+  int threads{2};
+  bool compare_parallel{true};      // cycloid: optimise the zig-zag too
+  unsigned seed{20240404};          // PSO
+  /// After each evaluation (from any thread, serialised): the count, the
+  /// best feasible cv so far (NaN before the first), elapsed seconds.
+  std::function<void(int, double, double)> progress;
+};
+
+struct PlanOptimiseResult {
+  PlanEvaluation best;           // of options.pattern
+  PlanEvaluation best_parallel;  // the optimised zig-zag (pattern parallel: = best)
+  std::vector<PlanEvaluation> family_best;  // cycloid: the best per family tried
+  /// Per evaluation, in order: its cv if feasible (NaN if not), and the
+  /// best feasible cv so far (NaN before the first feasible one).
+  std::vector<double> cv_history, best_history;
+  /// Per evaluation: 1 if it was a zig-zag (the cycloid's comparison).
+  std::vector<char> history_parallel;
+  int evaluations{0};
+  int local_searches{0}, local_converged{0};
+  std::string status;  // "converged" (every local search met ftol_rel), "max_time", "max_evaluations"
+  std::string method;
+  double seconds{0.0};
+};
+
+/// @throws PathRowError for a contact that fails on the surface.
+PlanOptimiseResult OptimisePlan(const PlanProblem& problem, const PathParameters& start,
+                                const PlanOptimiseOptions& options);
+
 }  // namespace robomach::polishing

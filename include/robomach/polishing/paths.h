@@ -12,6 +12,12 @@
 // centre speed v: pitch = 2 pi v / omega. The shape depends on (d, r,
 // pitch) only; the time scale (omega, and v = pitch omega / 2 pi) is set
 // afterwards by the speed limit or the target removal.
+//
+// Two more shape parameters (issue 19): the stagger, the phase of the loops
+// of one guide line against the previous one, in loops (0.5: half a loop,
+// seed 004 §3.1 Fig. 11: a loop of one row faces the gap between two loops
+// of the next); and, for parallel guide lines and the zig-zag, the lines'
+// direction in the developed plane (line_angle, 0: along s).
 
 #include <string>
 #include <vector>
@@ -39,7 +45,26 @@ struct PathParameters {
   /// the region boundary [m]; < 0 (default): on the boundary, or r - margin
   /// inside it if the margin is narrower than r (the circle stays on the face).
   double edge_inset{-1.0};
+  /// Phase of adjacent cycloid rows, in loops, [0, 1). On parallel guide
+  /// lines it is spatial: the rolling angle at the centre position c of
+  /// line k (k-th line across) is 2 pi (c . e / pitch + stagger k), e the
+  /// lines' direction, whichever way the boustrophedon runs the line. On
+  /// boundary offsets loop k starts at the phase 2 pi stagger k.
+  double stagger{0.5};
+  /// Direction of the parallel guide lines (cycloid) and of the zig-zag's
+  /// rows in the developed (s, t) plane [rad], 0: along s, pi/2: along t.
+  double line_angle{0.0};
+  /// Plain patches (rectangular regions): how far the guide lines (the
+  /// zig-zag's rows) run beyond the polished region into the margin [m],
+  /// at most margin - r for the cycloid (the circle stays on the patch) and
+  /// margin for the zig-zag (PlanPath clips to that). Boundary offsets: the
+  /// outermost loop that far outside the region. Rows that stop at the
+  /// region's edge leave it half polished (issue 19). Ignored on trimmed faces.
+  double edge_overrun{0.0};
 };
+
+/// The largest edge_overrun PlanPath uses for `p` [m].
+double MaxEdgeOverrun(const PathParameters& p, const PolishingProcess& process);
 
 /// Seed 004 §3.2 feasibility limits in this parametrisation: d <= 2 r
 /// (no unpolished strip between rows, Fig. 10), 0.5 d <= r <= d (limit 3),
