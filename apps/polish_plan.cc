@@ -163,6 +163,7 @@ int Run(int argc, char** argv) {
       "optimised for uniform removal (--optimise nlopt|pso), timed so that the mean removal over the\n"
       "polished region equals --target-removal-um within max_speed_mm_per_s. Writes the path (formats.md §6),\n"
       "the removal map and summary (§7) and PNG pictures (removal map, histogram, path, convergence)."};
+  AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              "\nExit 3 (outputs written, the reason on stderr): the target removal cannot be reached within the "
              "speed limit (the path runs at the limit), or --optimise found no plan that reaches it; the optimised zig-zag "
@@ -219,7 +220,7 @@ int Run(int argc, char** argv) {
   app.add_option("--path", path_out, "tool path CSV (formats.md §6)");
   app.add_option("--removal", removal_out, "removal map CSV x_mm,y_mm,z_mm,u,v,removal_um");
   app.add_option("--summary", summary_out, "summary JSON (formats.md §7 + contact, optimisation, target)");
-  app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png, <stem>_path.png, <stem>_convergence.png");
+  app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png, <stem>_path.png, <stem>_convergence.png")->check(PngFileName());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
