@@ -1,5 +1,5 @@
 // axis-accuracy: ISO 230-2 positioning accuracy and repeatability per axis
-// from positioning runs (formats.md §8.6), as JSON and the standard chart.
+// from positioning runs (docs/formats.md §8.6), as JSON and the standard chart.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -36,7 +36,7 @@ int MinRuns(const machine::Iso230Result& r) {
 int Run(int argc, char** argv) {
   CLI::App app{
       "axis-accuracy: ISO 230-2 figures per axis (A, A_up, A_down, E, E_up, E_down, M, R, R_up, R_down, B,\n"
-      "B_mean, in the file's unit) and per target from positioning runs (formats.md §8.6), with the standard\n"
+      "B_mean, in the file's unit) and per target from positioning runs (docs/formats.md §8.6), with the standard\n"
       "chart: mean deviation and +-2s bands per approach direction over the targets."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());

@@ -1,6 +1,6 @@
-// axis-acquire: encoder counts (formats.md §8.1) + machine file + the
+// axis-acquire: encoder counts (docs/formats.md §8.1) + machine file + the
 // controller's compensation -> the tool tip and axis in workpiece coordinates
-// at the card's rate (formats.md §8.5), with the contour error against a
+// at the card's rate (docs/formats.md §8.5), with the contour error against a
 // programmed path.
 #include <CLI/CLI.hpp>
 
@@ -49,16 +49,16 @@ int Run(int argc, char** argv) {
       "axis-acquire: the tool tip and tool axis in workpiece coordinates from encoder counts (seed 002):\n"
       "measured = origin + count x resolution (eq. 1); real = measured + the controller's compensation\n"
       "($AA_ENC_COMP, $AN_CEC, temperature; eqs. 2-5); then the machine's kinematics with its rotary errors\n"
-      "(formats.md §8.3). With --program, the contour error of every sample against the programmed polyline."};
+      "(docs/formats.md §8.3). With --program, the contour error of every sample against the programmed polyline."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string machine_path, counts_path, comp_path, temp_path, program_path, out_path, summary_path, plot_path;
-  app.add_option("--machine", machine_path, "machine file YAML (formats.md §8.3)")->required();
-  app.add_option("--counts", counts_path, "encoder counts CSV (formats.md §8.1)")->required();
-  app.add_option("--compensation", comp_path, "Siemens 840D sl compensation tables (formats.md §8.4)");
-  app.add_option("--temperature", temp_path, "temperature log t_s,axis,K0_mm,tan_beta,P0_mm (formats.md §8.4)");
+  app.add_option("--machine", machine_path, "machine file YAML (docs/formats.md §8.3)")->required();
+  app.add_option("--counts", counts_path, "encoder counts CSV (docs/formats.md §8.1)")->required();
+  app.add_option("--compensation", comp_path, "Siemens 840D sl compensation tables (docs/formats.md §8.4)");
+  app.add_option("--temperature", temp_path, "temperature log t_s,axis,K0_mm,tan_beta,P0_mm (docs/formats.md §8.4)");
   app.add_option("--program", program_path, "programmed path CSV x_mm,y_mm,z_mm,i,j,k (workpiece coordinates)");
-  app.add_option("--out", out_path, "acquired path CSV (formats.md §8.5)")->required();
+  app.add_option("--out", out_path, "acquired path CSV (docs/formats.md §8.5)")->required();
   app.add_option("--summary", summary_path, "summary JSON (rows, duration, contour error statistics)");
   app.add_option("--plot", plot_path, "PNG of the contour error along the path (needs --program)")->check(PngFileName());
   try {

@@ -1,5 +1,5 @@
-// axis-decode: raw quadrature capture (formats.md §8.2) to encoder counts
-// (formats.md §8.1), streamed in constant memory.
+// axis-decode: raw quadrature capture (docs/formats.md §8.2) to encoder counts
+// (docs/formats.md §8.1), streamed in constant memory.
 #include <CLI/CLI.hpp>
 
 #include <bit>
@@ -22,8 +22,8 @@ constexpr char kTool[] = "axis-decode";
 
 int Run(int argc, char** argv) {
   CLI::App app{
-      "axis-decode: decode a raw quadrature capture (formats.md §8.2: little-endian uint16 words, bits 2k/2k+1 =\n"
-      "A/B of the k-th axis of the machine file) into encoder counts (formats.md §8.1), 4x, with error events\n"
+      "axis-decode: decode a raw quadrature capture (docs/formats.md §8.2: little-endian uint16 words, bits 2k/2k+1 =\n"
+      "A/B of the k-th axis of the machine file) into encoder counts (docs/formats.md §8.1), 4x, with error events\n"
       "(A and B of one axis changing in one sample) counted per axis. Streams captures of any size."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() + "\nExit 3: outputs written, but the capture had error events (positions uncertain).");
@@ -31,7 +31,7 @@ int Run(int argc, char** argv) {
   double rate_hz = 0.0;
   long every = 1;
   int filter = 0;
-  app.add_option("--machine", machine_path, "machine file YAML (formats.md §8.3): axis names and order")->required();
+  app.add_option("--machine", machine_path, "machine file YAML (docs/formats.md §8.3): axis names and order")->required();
   app.add_option("--capture", capture_path, "raw capture, uint16 little-endian words")->required();
   app.add_option("--sample-rate-hz", rate_hz, "capture sample rate [Hz]")->required();
   app.add_option("--every", every, "write the counts at samples 0, N, 2N, ...")->capture_default_str();

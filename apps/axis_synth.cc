@@ -1,6 +1,6 @@
 // axis-synth: what a five-axis machine with given errors and compensation
-// tables would record for a programmed path: encoder counts (formats.md §8.1)
-// and optionally the raw quadrature capture (formats.md §8.2) behind them.
+// tables would record for a programmed path: encoder counts (docs/formats.md §8.1)
+// and optionally the raw quadrature capture (docs/formats.md §8.2) behind them.
 #include <CLI/CLI.hpp>
 
 #include <bit>
@@ -33,11 +33,11 @@ int Run(int argc, char** argv) {
   double feed_mm_min = 2000.0, rate_hz = 8000.0, dwell_s = 0.0, start_b_deg = -90.0, glitch_p = 0.0;
   int capture_every = 10, settle = 2;
   unsigned seed = 1;
-  app.add_option("--machine", machine_path, "machine file YAML (formats.md §8.3)")->required();
+  app.add_option("--machine", machine_path, "machine file YAML (docs/formats.md §8.3)")->required();
   app.add_option("--program", program_path, "programmed path CSV x_mm,y_mm,z_mm,i,j,k (workpiece coordinates)")
       ->required();
-  app.add_option("--out", out_path, "counts CSV to write (formats.md §8.1)")->required();
-  app.add_option("--compensation", comp_path, "Siemens 840D sl table file (formats.md §8.4) the controller applies");
+  app.add_option("--out", out_path, "counts CSV to write (docs/formats.md §8.1)")->required();
+  app.add_option("--compensation", comp_path, "Siemens 840D sl table file (docs/formats.md §8.4) the controller applies");
   app.add_option("--temperature", temp_path, "temperature log t_s,axis,K0_mm,tan_beta,P0_mm");
   app.add_option("--feed-mm-min", feed_mm_min, "tool tip speed along the path [mm/min]")->capture_default_str();
   app.add_option("--sample-rate-hz", rate_hz, "counts rows per second [Hz]")->capture_default_str();
@@ -46,7 +46,7 @@ int Run(int argc, char** argv) {
                  "B near which the first point's inverse kinematics is chosen (then: nearest previous) [deg]")
       ->capture_default_str();
   app.add_option("--machine-out", machine_out, "write the machine file with origins = measured start position");
-  app.add_option("--capture", capture_path, "also write the raw quadrature capture (formats.md §8.2)");
+  app.add_option("--capture", capture_path, "also write the raw quadrature capture (docs/formats.md §8.2)");
   app.add_option("--capture-every", capture_every, "capture samples per counts row (capture rate = rate x this)")
       ->capture_default_str();
   app.add_option("--capture-settle", settle,
@@ -111,7 +111,7 @@ int Run(int argc, char** argv) {
                          "axis " + ax.name + ": the path starts at measured " + io::FormatDouble(res.start_measured[a] * scale) +
                              (ax.kind == machine::AxisKind::kLinear ? " mm" : " deg") + ", " + std::to_string(rec.counts[a]) +
                              " counts from origin " + io::FormatDouble(ax.origin * scale) +
-                             "; the first counts row must be the reference position (formats.md §8.1): set the "
+                             "; the first counts row must be the reference position (docs/formats.md §8.1): set the "
                              "origins to the start position or pass --machine-out");
       }
     }

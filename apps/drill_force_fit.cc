@@ -1,6 +1,6 @@
 // drill-force-fit: fits the drilling force model (K_TH, K_TQ, Kienzle
-// exponent) to a measured thrust/torque table (formats.md §9.1) and writes
-// the material file (formats.md §9.2); optionally predicts other rows.
+// exponent) to a measured thrust/torque table (docs/formats.md §9.1) and writes
+// the material file (docs/formats.md §9.2); optionally predicts other rows.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -100,10 +100,10 @@ int RunDrillForceFit(int argc, char** argv) {
   std::string chisel = "seed_scaling";
   bool verbose = false;
   app.add_option("--table", table_path,
-                 "measured force table CSV (formats.md 9.1): diameter_mm, feed_mm_per_rev, thrust_N, "
+                 "measured force table CSV (docs/formats.md 9.1): diameter_mm, feed_mm_per_rev, thrust_N, "
                  "torque_Nm[, speed_rpm]")->required();
   app.add_option("--drill", drill_path,
-                 "drill YAML (formats.md 9.2); a row's diameter_mm overrides the drill's")->required();
+                 "drill YAML (docs/formats.md 9.2); a row's diameter_mm overrides the drill's")->required();
   app.add_option("--out", out_path, "material YAML with the fitted coefficients; stdout if omitted");
   app.add_option("--plot", plot_path, "PNG: measured and model thrust and torque against feed, one curve per diameter")->check(PngFileName());
   app.add_option("--predict", predict_path, "CSV of rows to predict (diameter_mm, feed_mm_per_rev[, speed_rpm])");

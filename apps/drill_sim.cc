@@ -2,7 +2,7 @@
 // holds a posture and feeds the drill along the hole axis; the drilling
 // thrust, torque and tilt imbalance deflect the joints; a controller
 // (PID, PD or PD with time-delay estimation) corrects. Writes the time series
-// and summary of formats.md §9.4 and a plot like the seed's Figs. 6-7.
+// and summary of docs/formats.md §9.4 and a plot like the seed's Figs. 6-7.
 #include <CLI/CLI.hpp>
 
 #include <nlohmann/json.hpp>
@@ -163,8 +163,8 @@ int RunDrillSim(int argc, char** argv) {
   bool tune = false;
   int tune_evaluations = 30;
   double limit_Nm = 10.0;
-  app.add_option("--robot", robot_path, "flexible-joint robot YAML (formats.md 9.3)")->required();
-  app.add_option("--drill", drill_path, "drill and process YAML (formats.md 9.2) with process:")->required();
+  app.add_option("--robot", robot_path, "flexible-joint robot YAML (docs/formats.md 9.3)")->required();
+  app.add_option("--drill", drill_path, "drill and process YAML (docs/formats.md 9.2) with process:")->required();
   app.add_option("--material", material_path, "material YAML written by drill-force-fit")->required();
   app.add_option("--controller", controllers, "comma-separated: pid, pd, pd-tdc")->capture_default_str();
   app.add_flag("--tune", tune, "tune every controller's gains with NLopt against one cost "
@@ -179,8 +179,8 @@ int RunDrillSim(int argc, char** argv) {
                  "K_P, K_D per joint from the effective inertia; THIRD is r of K_I = K_P OMEGA / r "
                  "(pid) or the Mbar ratio (pd-tdc); FILTER_S the low-pass time constant [s] on e' (pid, pd) "
                  "or q'' (pd-tdc), default 0.005; the starting point of --tune");
-  app.add_option("--out", out_path, "time series CSV (formats.md 9.4)");
-  app.add_option("--summary", summary_path, "summary JSON (formats.md 9.4); stdout if neither --out nor --summary");
+  app.add_option("--out", out_path, "time series CSV (docs/formats.md 9.4)");
+  app.add_option("--summary", summary_path, "summary JSON (docs/formats.md 9.4); stdout if neither --out nor --summary");
   app.add_option("--plot", plot_path, "PNG: joint errors, drill offset, thrust, torque per controller")->check(PngFileName());
   try {
     app.parse(argc, argv);

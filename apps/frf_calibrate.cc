@@ -70,7 +70,7 @@ std::string CalibratedConfigText(const std::string& input_path, const std::strin
 int Run(int argc, char** argv) {
   CLI::App app{
       "frf-calibrate: tune named model parameters to measured tool-tip FRFs (hammer tests).\n"
-      "Reads a robot config, a posture file (formats.md §1) and measured FRFs (CSV of formats.md §3\n"
+      "Reads a robot config, a posture file (docs/formats.md §1) and measured FRFs (CSV of docs/formats.md §3\n"
       "or UFF58 ASCII; mobility and accelerance are converted to receptance). Writes the calibrated\n"
       "config (the input plus a `parameters:` block) and a report folder: table3.csv/.md (natural\n"
       "frequency and peak amplitude per posture, model vs measurement, relative error), one\n"
@@ -206,7 +206,7 @@ int Run(int argc, char** argv) {
       sets_out.push_back(h);
     }
 
-    // Outputs: each complete or absent (formats.md §4).
+    // Outputs: each complete or absent (docs/formats.md §4).
     std::string config_text = CalibratedConfigText(
         robot_path, out_path, io::ParametersYaml(result.parameters, dynamics::DefaultParameters(cfg.description)));
     if (!adds.empty()) {

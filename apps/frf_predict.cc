@@ -70,8 +70,8 @@ report::Figure PostureFigure(const std::vector<const io::PosturePrediction*>& pr
 int Run(int argc, char** argv) {
   CLI::App app{
       "frf-predict: pose-dependent tool-tip frequency response of a robot model.\n"
-      "Reads a robot config and a posture file (formats.md §1); writes the 3x3 tool-tip\n"
-      "receptance per posture (formats.md §3), the modal table (§4), per-posture details\n"
+      "Reads a robot config and a posture file (docs/formats.md §1); writes the 3x3 tool-tip\n"
+      "receptance per posture (docs/formats.md §3), the modal table (§4), per-posture details\n"
       "(JSON) and plots (PNG)."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
@@ -190,7 +190,7 @@ int Run(int argc, char** argv) {
     }
     progress.Finish();
 
-    // Every output is complete before it appears (formats.md §4).
+    // Every output is complete before it appears (docs/formats.md §4).
     if (out_path.empty()) {
       io::WritePredictedFrfCsv(std::cout, preds, pairs);
     } else {

@@ -24,7 +24,7 @@ int Run(int argc, char** argv) {
   CLI::App app{
       "frf-synth: a virtual hammer test with known truth.\n"
       "Writes the tool-tip FRFs of a robot model at the postures of a posture file\n"
-      "(formats.md §1) on a hammer-test grid with seeded noise, as the CSV of formats.md §3\n"
+      "(docs/formats.md §1) on a hammer-test grid with seeded noise, as the CSV of docs/formats.md §3\n"
       "or UFF58 (chosen by the extension of --out: .uff/.unv = UFF58). Grid: lines k*df with\n"
       "df = fs/N; defaults fs from the config's hammer_test.sample_rate_hz (else 5120 Hz) and\n"
       "N = 20480 samples (a 4 s record, df = 0.25 Hz), band 0.25..500 Hz (2000 lines).\n"
@@ -41,7 +41,7 @@ int Run(int argc, char** argv) {
   double fs_hz = NAN;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
-  app.add_option("--out", out_path, "output file: .csv (formats.md §3) or .uff/.unv (UFF58 ASCII)")->required();
+  app.add_option("--out", out_path, "output file: .csv (docs/formats.md §3) or .uff/.unv (UFF58 ASCII)")->required();
   app.add_option("--set", sets, "override a model parameter, NAME=VALUE in its unit (e.g. m6_kg=31.5)");
   app.add_option("--add", adds, "switch on an effect by name with its default parameters (e.g. tip_mass)");
   app.add_option("--directions", directions, "response/excitation pairs, e.g. xx,yy,xy")->capture_default_str();

@@ -1,5 +1,5 @@
 // kq-identify: joint stiffness of a robot from laser-tracker load tests
-// (formats.md §2), with uncertainty, outliers and a word on what the data
+// (docs/formats.md §2), with uncertainty, outliers and a word on what the data
 // cannot determine; or, with --plan N, a D-optimal test plan.
 #include <CLI/CLI.hpp>
 
@@ -231,7 +231,7 @@ std::vector<double> ParsePositiveList(const std::string& option, const std::stri
 int Run(int argc, char** argv) {
   CLI::App app{
       "kq-identify: joint stiffness from laser-tracker load tests.\n"
-      "Reads a robot config and a tracker file (formats.md §2: force components fx_N..fz_N, or\n"
+      "Reads a robot config and a tracker file (docs/formats.md §2: force components fx_N..fz_N, or\n"
       "mass_kg with rope points ax_mm..bz_mm) and fits the diagonal joint stiffness of\n"
       "D = J_T Kq^-1 J_L^T W. Reports every joint's stiffness with standard deviation, 95 %\n"
       "interval and whether the data determine it; residuals per case; outliers.\n"
@@ -248,7 +248,7 @@ int Run(int argc, char** argv) {
   bool merge = false, as_parameters = false, verbose = false;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml); its stiffness is the prior")
       ->required();
-  app.add_option("--tracker", tracker_path, "tracker load-test CSV (formats.md §2)");
+  app.add_option("--tracker", tracker_path, "tracker load-test CSV (docs/formats.md §2)");
   app.add_option("--out", out_path,
                  "kq.yaml to paste into the robot config (stdout if omitted); with --merge a full robot "
                  "config; with --plan the plan CSV");
@@ -331,7 +331,7 @@ int Run(int argc, char** argv) {
         *model, cases, opt, [&](long done, long) { progress.Update(done); });
     progress.Finish();
 
-    // Outputs, each complete or absent (formats.md §4).
+    // Outputs, each complete or absent (docs/formats.md §4).
     const std::vector<std::string> header{
         "kq-identify: joint stiffness identified from " + tracker_path + " with robot " + robot_path,
         "tracker noise " + io::FormatDouble(noise_mm) + " mm (1 sigma per coordinate); loss " +

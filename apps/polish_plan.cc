@@ -2,7 +2,7 @@
 // zig-zag) on a NURBS patch, optionally optimised (NLopt or the seed's PSO)
 // for uniform removal, with time stamps that reach a target mean removal
 // within the speed limit; writes the path, the removal map, a summary and
-// pictures (seed 004; formats.md §5-7).
+// pictures (seed 004; docs/formats.md §5-7).
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -82,7 +82,7 @@ std::string CsvField(const std::string& x) {
   return q + "\"";
 }
 
-// --list-faces: one CSV row per face of a STEP/IGES file (formats.md §5).
+// --list-faces: one CSV row per face of a STEP/IGES file (docs/formats.md §5).
 int ListFaces(const std::string& surface_path, const std::string& process_path, const std::string& out,
               const SurfaceChoice& choice, const std::string& pattern, double radius_mm, double sample_mm,
               double offset_mm, double pitch_mm, double row_step_mm) {
@@ -158,10 +158,10 @@ void CheckFaceSize(const polishing::NurbsSurface& surface, const std::string& su
 
 int Run(int argc, char** argv) {
   CLI::App app{
-      "polish-plan: a belt-grinding path on a NURBS patch (formats.md §5) - cycloids along guide lines\n"
+      "polish-plan: a belt-grinding path on a NURBS patch (docs/formats.md §5) - cycloids along guide lines\n"
       "(seed 004) or the direction-parallel zig-zag - with Hertz contact and Preston removal, optionally\n"
       "optimised for uniform removal (--optimise nlopt|pso), timed so that the mean removal over the\n"
-      "polished region equals --target-removal-um within max_speed_mm_per_s. Writes the path (formats.md §6),\n"
+      "polished region equals --target-removal-um within max_speed_mm_per_s. Writes the path (docs/formats.md §6),\n"
       "the removal map and summary (§7) and PNG pictures (removal map, histogram, path, convergence)."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
@@ -179,13 +179,13 @@ int Run(int argc, char** argv) {
   int seed = 20240404, threads = 2;
   double max_time_s = 50.0, stagger_loops = 0.5, line_angle_deg = 0.0, edge_overrun_mm = 0.0;
   RobotOptions robot;
-  app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (formats.md §5)")->required();
+  app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (docs/formats.md §5)")->required();
   AddSurfaceChoiceOptions(&app, &choice);
   app.add_flag("--list-faces", list_faces,
                "list the faces of a STEP/IGES file as CSV (face, surface_type, area_mm2, u_size_mm, v_size_mm, "
                "trimmed, holes, polishable, reason; polishable with --process, --pattern and --radius-mm) and stop");
   app.add_option("--out", list_out, "with --list-faces: write the CSV here instead of stdout");
-  app.add_option("--process", process_path, "process YAML (formats.md §7), e.g. config/polishing/belt_2N.yaml")->required();
+  app.add_option("--process", process_path, "process YAML (docs/formats.md §7), e.g. config/polishing/belt_2N.yaml")->required();
   app.add_option("--pattern", pattern, "cycloid or parallel")->check(CLI::IsMember({"cycloid", "parallel"}))->capture_default_str();
   app.add_option("--guides", guides, "cycloid guide lines: offsets (of the region boundary, closed loops) or parallel")
       ->check(CLI::IsMember({"offsets", "parallel"}))->capture_default_str();
@@ -217,9 +217,9 @@ int Run(int argc, char** argv) {
   app.add_option("--threads", threads, "threads of --optimise")->capture_default_str();
   app.add_option("--seed", seed, "PSO random seed")->capture_default_str();
   robot.Add(&app);
-  app.add_option("--path", path_out, "tool path CSV (formats.md §6)");
+  app.add_option("--path", path_out, "tool path CSV (docs/formats.md §6)");
   app.add_option("--removal", removal_out, "removal map CSV x_mm,y_mm,z_mm,u,v,removal_um");
-  app.add_option("--summary", summary_out, "summary JSON (formats.md §7 + contact, optimisation, target)");
+  app.add_option("--summary", summary_out, "summary JSON (docs/formats.md §7 + contact, optimisation, target)");
   app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png, <stem>_path.png, <stem>_convergence.png")->check(PngFileName());
   try {
     app.parse(argc, argv);

@@ -1,6 +1,6 @@
-// polish-sim: the removal a given tool path (formats.md §6; from CAM, a teach
+// polish-sim: the removal a given tool path (docs/formats.md §6; from CAM, a teach
 // pendant or polish-plan) produces on a NURBS patch with the process of
-// formats.md §7: removal map, summary and pictures.
+// docs/formats.md §7: removal map, summary and pictures.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -28,8 +28,8 @@ constexpr char kTool[] = "polish-sim";
 
 int Run(int argc, char** argv) {
   CLI::App app{
-      "polish-sim: simulate the Preston removal of a tool path (formats.md §6) on a NURBS patch\n"
-      "(formats.md §5) with Hertz contact (formats.md §7); writes the removal map, a summary and pictures."};
+      "polish-sim: simulate the Preston removal of a tool path (docs/formats.md §6) on a NURBS patch\n"
+      "(docs/formats.md §5) with Hertz contact (docs/formats.md §7); writes the removal map, a summary and pictures."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              "\nExit 3 (outputs written, the reason on stderr): the path's traverse speed exceeds "
@@ -37,14 +37,14 @@ int Run(int argc, char** argv) {
              "jump > 0.5 rad.");
   std::string surface_path, process_path, path_in, removal_out, summary_out, plot_out;
   double sample_mm = 0.5;
-  app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (formats.md §5)")->required();
+  app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (docs/formats.md §5)")->required();
   SurfaceChoice choice;
   AddSurfaceChoiceOptions(&app, &choice);
-  app.add_option("--process", process_path, "process YAML (formats.md §7)")->required();
-  app.add_option("--path", path_in, "tool path CSV (formats.md §6)")->required();
+  app.add_option("--process", process_path, "process YAML (docs/formats.md §7)")->required();
+  app.add_option("--path", path_in, "tool path CSV (docs/formats.md §6)")->required();
   app.add_option("--sample-mm", sample_mm, "removal map sampling in arc length [mm], <= 0.5")->capture_default_str();
   app.add_option("--removal", removal_out, "removal map CSV x_mm,y_mm,z_mm,u,v,removal_um");
-  app.add_option("--summary", summary_out, "summary JSON (formats.md §7); stdout if omitted");
+  app.add_option("--summary", summary_out, "summary JSON (docs/formats.md §7); stdout if omitted");
   app.add_option("--plot", plot_out, "removal map PNG; also <stem>_histogram.png and <stem>_path.png")->check(PngFileName());
   RobotOptions robot;
   robot.Add(&app);

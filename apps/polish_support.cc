@@ -26,7 +26,7 @@ polishing::NurbsSurface LoadSurface(const std::string& tool, const std::string& 
                                   " is a NURBS YAML (one patch); --face picks a face of a STEP/IGES file");
     }
     if (choice.cad_unit_scale != 1.0) {
-      throw std::invalid_argument("--cad-unit-scale: " + path + " is a NURBS YAML (lengths in mm by formats.md §5); "
+      throw std::invalid_argument("--cad-unit-scale: " + path + " is a NURBS YAML (lengths in mm by docs/formats.md §5); "
                                   "the option applies to STEP/IGES files");
     }
     return io::ReadNurbsYaml(path);

@@ -405,7 +405,7 @@ void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
 }
 
 // --modes-out: the modes the SD used, in the frame of the file's FRFs
-// (p_B = R_BC p_C), as formats.md §4's modal table.
+// (p_B = R_BC p_C), as docs/formats.md §4's modal table.
 void WriteFittedModes(const std::string& path, const std::vector<TipDynamics>& tips) {
   std::vector<std::string> ids;
   std::vector<std::vector<dynamics::Mode>> modes;
@@ -457,7 +457,7 @@ int Run(int argc, char** argv) {
       "stability-lobes: regenerative chatter stability lobes (spindle speed against critical\n"
       "axial depth) by the zero-order approximation (Altintas-Budak) and/or first-order\n"
       "semi-discretization (Insperger-Stepan), for the robot model at postures, a measured\n"
-      "FRF file (formats.md §3) or a modal table (§4)."};
+      "FRF file (docs/formats.md §3) or a modal table (§4)."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              " Exit 3 when some speeds have no stability boundary, when a measured FRF's modal fit is poor "
@@ -477,7 +477,7 @@ int Run(int argc, char** argv) {
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg");
   app.add_option("--posture", pose_ids, "pose_id to analyse (repeatable); all postures of the file if omitted");
   app.add_option("--frf", frf_path,
-                 "tool-tip FRF file, CSV of formats.md §3 or UFF58 (.uff/.unv; receptance, mobility or accelerance); "
+                 "tool-tip FRF file, CSV of docs/formats.md §3 or UFF58 (.uff/.unv; receptance, mobility or accelerance); "
                  "one direct FRF (any direction) = a symmetric tool, the same FRF in both in-plane directions of the cut");
   app.add_option("--frf-y", frf_y_path,
                  "with --frf: a second file with the one direct FRF normal to the feed in the cutting plane; --frf is "
@@ -486,9 +486,9 @@ int Run(int argc, char** argv) {
                  "with --frf: PNG of each direct FRF with its modal fit (magnitude, phase, noise floor, usable band)")
       ->check(PngFileName());
   app.add_option("--modes-out", modes_out_path,
-                 "with --frf: the modal table the SD used (formats.md §4), in the frame of the FRF file; --modal-table "
+                 "with --frf: the modal table the SD used (docs/formats.md §4), in the frame of the FRF file; --modal-table "
                  "reads it back (with the same --tool-axis, and --sd-modes of at least its number of modes)");
-  app.add_option("--modal-table", modal_path, "modal table CSV (formats.md §4): freq_hz, damping_ratio, modal_mass_kg or modal_stiffness_N_per_m, ux,uy,uz");
+  app.add_option("--modal-table", modal_path, "modal table CSV (docs/formats.md §4): freq_hz, damping_ratio, modal_mass_kg or modal_stiffness_N_per_m, ux,uy,uz");
   app.add_option("--tool-axis", tool_axis_text, "with --frf/--modal-table: tool axis from tip to spindle in the FRF frame, x,y,z (not used for a "
                  "file with one direct FRF, a symmetric tool, except for the frame of --modes-out)")->capture_default_str();
   app.add_option("--method", method, "zoa, sd or both")->check(CLI::IsMember({"zoa", "sd", "both"}))->capture_default_str();

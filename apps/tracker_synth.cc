@@ -1,5 +1,5 @@
 // tracker-synth: simulates a laser-tracker load-test campaign from a robot
-// config and writes it in the tracker format (formats.md §2), to rehearse a
+// config and writes it in the tracker format (docs/formats.md §2), to rehearse a
 // campaign or to test kq-identify.
 #include <CLI/CLI.hpp>
 
@@ -23,7 +23,7 @@ constexpr char kTool[] = "tracker-synth";
 
 int Run(int argc, char** argv) {
   CLI::App app{
-      "tracker-synth: simulate a laser-tracker load-test campaign (formats.md §2).\n"
+      "tracker-synth: simulate a laser-tracker load-test campaign (docs/formats.md §2).\n"
       "For every posture, pulley and mass: the static deflection of the target under the rope\n"
       "force (large-displacement equilibrium with the config's joint stiffness), tracker readings\n"
       "with Gaussian noise, optional gross outliers. Seeded: the same options give the same file."};
@@ -37,7 +37,7 @@ int Run(int argc, char** argv) {
   unsigned seed = 1;
   app.add_option("--robot", robot_path, "robot config YAML; its joint stiffness is the truth")->required();
   app.add_option("--out", out_path, "tracker CSV to write (stdout if omitted)");
-  app.add_option("--postures", postures_path, "posture file CSV (formats.md §1); default: random postures");
+  app.add_option("--postures", postures_path, "posture file CSV (docs/formats.md §1); default: random postures");
   app.add_option("--plan-file", plan_path,
                  "a plan from kq-identify --plan: its postures and pulleys (and load point and target "
                  "unless given here)");
