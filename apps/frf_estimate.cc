@@ -128,7 +128,7 @@ int Run(int argc, char** argv) {
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              "\n3 here: fewer accepted hits than --min-hits, or a response that has not decayed by the end of its "
-             "record (leakage). 65 also: every hit rejected (the FRF file is then not written; --summary is).\n");
+             "record (leakage), or a receptance outside 1e-12..1e-3 m/N (a unit mistake in a column name). 65 also: every hit rejected (the FRF file is then not written; --summary is).\n");
   std::vector<std::string> records, directions;
   std::string out_path, summary_path, plot_path, pose_id = "P1", excitation = "x", quantity = "receptance",
                                                  estimator = "h1";
@@ -263,6 +263,7 @@ int Run(int argc, char** argv) {
                       " hit(s) averaged: the coherence needs at least 3 to mean much, 5 or more are usual");
     }
     if (r.leakage) flags.push_back("leakage (a response has not decayed by the end of its record)");
+    if (r.implausible) flags.push_back("a receptance outside the plausible range: a unit mistake (see the warning)");
     for (const std::string& f : flags) Warn(kTool, "result flagged: " + f);
     if (!flags.empty()) rc = kExitFlagged;
 

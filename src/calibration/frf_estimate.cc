@@ -385,6 +385,28 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
   if (result.averages == 1) {
     result.warnings.push_back("one accepted hit: the coherence is 1 on every line by construction and says nothing");
   }
+  // Unit plausibility: the largest receptance on the coherent lines.
+  for (int c = 0; c < nc; ++c) {
+    const int p = static_cast<int>(channels[c].quantity);  // 0 displacement, 1 velocity, 2 acceleration
+    double peak = 0.0;
+    for (int k = 0; k < lines; ++k) {
+      if (result.channels[c].coherence(k) < 0.5) continue;
+      const double w = 2.0 * M_PI * result.freq_hz(k);
+      peak = std::max(peak, std::abs(result.channels[c].h1(k)) / std::pow(w, p));
+    }
+    if (peak == 0.0) continue;
+    if (peak > kMaxPlausibleReceptance || peak < kMinPlausibleReceptance) {
+      result.implausible = true;
+      result.warnings.push_back(
+          "response " + channels[c].name + ": the largest receptance on the coherent lines is " + Num(peak, 3) +
+          " m/N, outside the plausible " + Num(kMinPlausibleReceptance, 1) + " to " + Num(kMaxPlausibleReceptance, 1) +
+          " m/N of a machine structure: " +
+          (peak > kMaxPlausibleReceptance ? "the response was probably recorded in mm or um (or the force in kN) "
+                                            "under a column named in m (and N)"
+                                          : "the force was probably recorded in mN, or the response in km") +
+          "; check the units in the column names");
+    }
+  }
   // Roll-off of the force spectrum: 20 dB below its level at the lowest lines.
   const int ref_lines = std::max(1, std::min(lines, 5));
   const double ref = result.force_autospectrum.head(ref_lines).mean();

@@ -326,6 +326,33 @@ TEST(FrfEstimate, ShortRecordIsReportedAsLeakage) {
   EXPECT_FALSE(w.leakage);
 }
 
+// Wrong units on purpose: responses recorded in mm under columns named in m
+// (x 1000), or a force in kN under force_N (/ 1000), give receptances three
+// decades too large; the simulated chain's peaks are ~1e-5 m/N, so the
+// estimate must be flagged implausible, and the same hits in SI must not be.
+TEST(FrfEstimate, ResponsesInMillimetresAreFlaggedAsAUnitMistake) {
+  const ThreeDofChain sys = ThreeDofChain::Default();
+  std::mt19937 rng(5);
+  HammerSimulator sim(sys, AcquisitionSpec{});
+  std::vector<ImpactRecord> si, mm, kn;
+  for (int i = 0; i < 3; ++i) si.push_back(sim.Simulate(HitSpec{}, &rng, std::to_string(i + 1)));
+  for (ImpactRecord h : si) {
+    h.response *= 1000.0;
+    mm.push_back(h);
+  }
+  for (ImpactRecord h : si) {
+    h.force_N /= 1000.0;
+    kn.push_back(h);
+  }
+  EXPECT_FALSE(EstimateFrf(si, testing::SimulatedChannels()).implausible);
+  const FrfEstimateResult r = EstimateFrf(mm, testing::SimulatedChannels());
+  EXPECT_TRUE(r.implausible);
+  bool named = false;
+  for (const std::string& w : r.warnings) named = named || w.find("probably recorded in mm") != std::string::npos;
+  EXPECT_TRUE(named);
+  EXPECT_TRUE(EstimateFrf(kn, testing::SimulatedChannels()).implausible);
+}
+
 // A prime record length (4099) is cut to 4096 for the FFT, with a warning,
 // and the estimate is still the analytic FRF (clean data, 2 %).
 TEST(FrfEstimate, PrimeLengthIsCutToAFastLength) {

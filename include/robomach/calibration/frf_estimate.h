@@ -133,7 +133,19 @@ struct FrfEstimateResult {
   /// each a sentence naming the hit or the frequency.
   std::vector<std::string> warnings;
   bool leakage{false};  // a response had not decayed by the end of its window
+  /// A channel's receptance (converted from its quantity) is outside
+  /// [kMinPlausibleReceptance, kMaxPlausibleReceptance] on its coherent
+  /// lines: almost surely a unit mistake (mm or um under an _m column, kN
+  /// under force_N); a warning names the channel and the likely mistake.
+  bool implausible{false};
 };
+
+/// Plausible peak receptance of a tool tip or a machine structure [m/N]:
+/// 1 mm/N would move a tool 10 cm under a 100 N tap; 1e-12 m/N is stiffer
+/// than any steel structure a hammer can excite (a 1 m cube of steel under
+/// a point load is ~1e-10 m/N).
+inline constexpr double kMaxPlausibleReceptance = 1e-3;
+inline constexpr double kMinPlausibleReceptance = 1e-12;
 
 /// Estimates H1, H2 and the coherence of each response channel from the
 /// hits, after rejecting double hits and overloads (eq. (1)–(3)).
