@@ -635,7 +635,9 @@ UffFile ReadUffFile(const std::string& path) {
       r.line = tl;
       ReadHeader(path, body, &r);
       std::vector<double> numbers;
-      numbers.reserve(static_cast<size_t>(r.num_points) * 3);
+      // Bounded by what the lines can hold (a corrupt count must not allocate
+      // gigabytes before the data say it is wrong): at most 6 numbers a line.
+      numbers.reserve(std::min(static_cast<size_t>(r.num_points) * 3, (body.size() - 11) * 6));
       for (size_t k = 11; k < body.size(); ++k) ScanNumbers(path, body[k].first, body[k].second, &numbers);
       FromNumbers(path, numbers, &r);
       out.records.push_back(std::move(r));
