@@ -7,7 +7,6 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-#include <Eigen/SVD>
 
 #include "dynamics/internal/rigid_chain.h"
 #include "robomach/common/units.h"

@@ -84,7 +84,7 @@ struct PostureDynamics {
   Eigen::MatrixXd C_q() const { return system.C.topLeftCorner(system.num_joints, system.num_joints); }
 };
 
-/// Evaluates postures of one model with reusable KDL solvers and buffers.
+/// Evaluates postures of one model with reusable buffers and solvers.
 /// Not thread-safe: use one evaluator per thread (they may share the model).
 class PostureEvaluator {
  public:
