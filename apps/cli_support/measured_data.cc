@@ -54,7 +54,7 @@ void AddNoiseOptions(CLI::App& app, NoiseCliOptions* o) {
       ->capture_default_str();
   app.add_option("--min-snr", o->min_snr,
                  "a line is used where |H| is at least this many times the additive noise floor (3: the "
-                 "log-magnitude and phase residuals are unbiased there; see README)")
+                 "log-magnitude and phase residuals are unbiased there; see docs/noise-model.md)")
       ->capture_default_str();
   app.add_flag("--drift-floor", o->drift_floor,
                "tap tests whose integrated accelerometer drifts at low frequency: the noise floor also from "
