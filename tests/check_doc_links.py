@@ -113,7 +113,8 @@ def main(root):
     for f in sorted(os.listdir(img)) if os.path.isdir(img) else []:
         size = os.path.getsize(os.path.join(img, f))
         if size > MAX_IMAGE_BYTES:
-            problems.append(f'docs/img/{f}: {size} bytes, above {MAX_IMAGE_BYTES}')
+            problems.append(f'docs/img/{f}: {size} bytes, above {MAX_IMAGE_BYTES} '
+                            '(scripts/recompress-png.py shrinks a plot without changing a pixel)')
     for p in problems:
         print(p)
     print(f'docs.links: {len(pages)} pages, {len(tools)} tools, {len(problems)} problem(s)')
