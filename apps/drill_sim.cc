@@ -31,7 +31,7 @@ constexpr char kTool[] = "drill-sim";
 
 // "run.csv" + "pd-tdc" -> "run_pd-tdc.csv" (several controllers: one file each).
 std::string WithSuffix(const std::string& path, const std::string& name, bool several) {
-  if (!several || path.empty()) return path;
+  if (!several || path.empty() || path == "-") return path;  // "-": stdout, one after the other
   const std::filesystem::path p(path);
   return (p.parent_path() / (p.stem().string() + "_" + name + p.extension().string())).string();
 }
@@ -302,7 +302,7 @@ int RunDrillSim(int argc, char** argv) {
       if (!summary_path.empty()) {
         io::WriteFileAtomically(WithSuffix(summary_path, kind, several), report::DumpJson(j));
       } else if (out_path.empty()) {
-        std::cout << report::DumpJson(j);
+        io::WriteFileAtomically("-", report::DumpJson(j));
       }
     }
     if (!plot_path.empty()) Plot(plot_path, runs, n);

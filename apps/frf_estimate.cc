@@ -357,6 +357,7 @@ int Run(int argc, char** argv) {
     }
     if (r.status != calibration::FrfEstimateStatus::kOk) {
       std::cerr << kTool << ": every hit was rejected; no FRF written to " << out_path << '\n';
+      CommitOutputsNow();  // the summary says why (exit 65 otherwise writes nothing)
       return rc;
     }
     std::ostringstream msg;

@@ -241,7 +241,7 @@ void OutputRun::Discard() {
 
 void OutputRun::Commit() {
   std::lock_guard<std::mutex> lock(g_mutex);
-  assert(!state_->done && "OutputRun committed or discarded twice");
+  if (state_->done) return;  // committed (or discarded) already
   State& st = *state_;
   if (g_active == this) g_active = nullptr;  // later writes are no longer staged
   struct Placed {

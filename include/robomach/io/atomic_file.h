@@ -70,7 +70,8 @@ class OutputRun {
   OutputRun(const OutputRun&) = delete;
   OutputRun& operator=(const OutputRun&) = delete;
 
-  /// Puts every staged output into place (see above).
+  /// Puts every staged output into place (see above); the run ends, and
+  /// later writes are no longer staged. A second call does nothing.
   /// @throws OutputError; then nothing of the run remains.
   void Commit();
   /// Removes every staged file and created directory; the run ends.
