@@ -86,7 +86,7 @@ int Run(int argc, char** argv) {
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
   app.add_option("--measured", measured_files, "measured FRFs, CSV or UFF58 (.uff/.unv); repeatable");
   app.add_option("--pose", pose_files, "a UFF58 file of one posture whose records lack pose=ID: ID=file.uff; repeatable");
-  app.add_option("--out", out_path, "calibrated robot config YAML")->required();
+  app.add_option("--out", out_path, "calibrated robot config YAML; '-' = stdout")->required();
   app.add_option("--report", report_dir, "report folder (created)")->required();
   app.add_option("--summary", summary_path, "also write the report's summary.json here ('-' = stdout)");
   app.add_option("--validate", validate_files, "held-out measured FRFs scored with the calibrated model; repeatable");

@@ -236,3 +236,20 @@ robomach_app_test(polish-sim.all_or_nothing RC 73 CLEAN ${O}/polish_sim STDERR "
       --summary ${O}/polish_sim/missing/summary.json
   NO_FILES ${O}/polish_sim/removal.csv ${O}/polish_sim/sim.png ${O}/polish_sim/sim_histogram.png
            ${O}/polish_sim/sim_path.png)
+
+# frf-calibrate and model-audit: --summary FILE is a copy of the report's
+# summary.json (which stays).
+add_test(NAME model-audit.summary_copy
+  COMMAND ${CMAKE_COMMAND}
+    "-DCMD=$<TARGET_FILE:model-audit>;--robot;${ROBOT};--postures;${DATA}/calibration/postures_two.csv;--measured;${tmp}/hammer.csv;--report;${O}/audit_summary/report;--summary;${O}/audit_summary/summary.json"
+    -DEXPECT_RC=0 "-DFILES=${O}/audit_summary/report/summary.json;${O}/audit_summary/summary.json"
+    "-DJSON=${O}/audit_summary/summary.json" "-DJSON_KEYS=robomach_version;verdict.grade;postures.P1"
+    "-DCLEAN=${O}/audit_summary" -P ${check})
+add_test(NAME frf-calibrate.summary_copy
+  COMMAND ${CMAKE_COMMAND}
+    "-DCMD=$<TARGET_FILE:frf-calibrate>;${CAL_ARGS};--out;${O}/cal_summary/calibrated.yaml;--report;${O}/cal_summary/report;--summary;${O}/cal_summary/summary.json"
+    -DEXPECT_RC=0 "-DFILES=${O}/cal_summary/report/summary.json;${O}/cal_summary/summary.json"
+    "-DJSON=${O}/cal_summary/summary.json" "-DJSON_KEYS=robomach_version;misfit.calibrated;calibrated_config"
+    "-DCLEAN=${O}/cal_summary/report;${O}/cal_summary/summary.json;${O}/cal_summary/calibrated.yaml" -P ${check})
+file(MAKE_DIRECTORY ${O}/cal_summary)
+set_tests_properties(model-audit.summary_copy frf-calibrate.summary_copy PROPERTIES FIXTURES_REQUIRED hammer_csv)
