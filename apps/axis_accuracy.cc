@@ -42,7 +42,7 @@ int Run(int argc, char** argv) {
   app.footer(ExitCodeHelp());
   std::string runs_path, out_path, plot_path;
   app.add_option("--runs", runs_path, "runs CSV axis,target_mm,run,direction,measured_mm (or _deg)")->required();
-  app.add_option("--out", out_path, "ISO 230-2 JSON (stdout if omitted)");
+  app.add_option("--out,--summary", out_path, "ISO 230-2 JSON, the tool's summary (stdout if omitted or '-')");
   app.add_option("--plot", plot_path, "PNG chart, one panel per axis")->check(PngFileName());
   try {
     app.parse(argc, argv);
@@ -129,11 +129,7 @@ int Run(int argc, char** argv) {
       fig.SavePng(plot_path);
     }
     const std::string text = report::DumpJson(j);
-    if (out_path.empty()) {
-      std::cout << text;
-    } else {
-      io::WriteFileAtomically(out_path, text);
-    }
+    io::WriteFileAtomically(out_path.empty() ? "-" : out_path, text);
     if (min_runs < 5) Warn(kTool, "fewer than the 5 runs per target and direction ISO 230-2 asks for (" + std::to_string(min_runs) + ")");
     return kExitOk;
   });

@@ -58,7 +58,7 @@ int Run(int argc, char** argv) {
   app.add_option("--compensation", comp_path, "Siemens 840D sl compensation tables (docs/formats.md §8.4)");
   app.add_option("--temperature", temp_path, "temperature log t_s,axis,K0_mm,tan_beta,P0_mm (docs/formats.md §8.4)");
   app.add_option("--program", program_path, "programmed path CSV x_mm,y_mm,z_mm,i,j,k (workpiece coordinates)");
-  app.add_option("--out", out_path, "acquired path CSV (docs/formats.md §8.5)")->required();
+  app.add_option("--out", out_path, "acquired path CSV (docs/formats.md §8.5); '-' = stdout")->required();
   app.add_option("--summary", summary_path, "summary JSON (rows, duration, contour error statistics)");
   app.add_option("--plot", plot_path, "PNG of the contour error along the path (needs --program)")->check(PngFileName());
   try {

@@ -148,8 +148,7 @@ int RunDrillForceFit(int argc, char** argv) {
     }
     // Everything computed: now write (each file atomically).
     const std::string yaml = io::MaterialYaml(fit, drill.drill, table);
-    if (out_path.empty() || out_path == "-") std::cout << yaml;
-    else io::WriteFileAtomically(out_path, yaml);
+    io::WriteFileAtomically(out_path.empty() ? "-" : out_path, yaml);
     if (!plot_path.empty()) Plot(plot_path, table, drill.drill, fit.material);
     if (predict) io::WriteFileAtomically(predictions_path, PredictionsCsv(*predict, drill.drill, fit.material));
 

@@ -31,7 +31,7 @@ constexpr char kTool[] = "drill-sim";
 
 // "run.csv" + "pd-tdc" -> "run_pd-tdc.csv" (several controllers: one file each).
 std::string WithSuffix(const std::string& path, const std::string& name, bool several) {
-  if (!several || path.empty()) return path;
+  if (!several || path.empty() || path == "-") return path;  // "-": stdout, one after the other
   const std::filesystem::path p(path);
   return (p.parent_path() / (p.stem().string() + "_" + name + p.extension().string())).string();
 }
@@ -179,7 +179,7 @@ int RunDrillSim(int argc, char** argv) {
                  "K_P, K_D per joint from the effective inertia; THIRD is r of K_I = K_P OMEGA / r "
                  "(pid) or the Mbar ratio (pd-tdc); FILTER_S the low-pass time constant [s] on e' (pid, pd) "
                  "or q'' (pd-tdc), default 0.005; the starting point of --tune");
-  app.add_option("--out", out_path, "time series CSV (docs/formats.md 9.4)");
+  app.add_option("--out", out_path, "time series CSV (docs/formats.md 9.4); '-' = stdout");
   app.add_option("--summary", summary_path, "summary JSON (docs/formats.md 9.4); stdout if neither --out nor --summary");
   app.add_option("--plot", plot_path, "PNG: joint errors, drill offset, thrust, torque per controller")->check(PngFileName());
   try {
@@ -302,7 +302,7 @@ int RunDrillSim(int argc, char** argv) {
       if (!summary_path.empty()) {
         io::WriteFileAtomically(WithSuffix(summary_path, kind, several), report::DumpJson(j));
       } else if (out_path.empty()) {
-        std::cout << report::DumpJson(j);
+        io::WriteFileAtomically("-", report::DumpJson(j));
       }
     }
     if (!plot_path.empty()) Plot(plot_path, runs, n);
