@@ -41,11 +41,14 @@ int ResolveThreadCount(int threads);
 /// once every thread has stopped it is rethrown in the caller. Nothing ever
 /// calls std::terminate because a body threw.
 ///
-/// Threads are started per call (std::thread) and joined before the return:
-/// about 40 µs per call on the 2-core development machine, against
-/// milliseconds to seconds per call for every caller in the library
-/// (bench/bench_parallel.cc compares this with a fixed pool). A body may
-/// itself call ParallelFor (the threads multiply; no deadlock).
+/// Threads are started per call (std::thread) and joined before the return.
+/// That costs about 0.1 ms per call on the loaded 2-core development
+/// machine, against a few µs for a fixed pool (bench/bench_parallel.cc,
+/// BM_ParallelForCallOverhead), but every caller in the library spends
+/// milliseconds to seconds per call (map points, SD speeds, plan
+/// evaluations, audit candidate fits, row formatting), so no global state is
+/// worth it. A body may itself call ParallelFor (the threads multiply; no
+/// pool to deadlock on).
 /// @throws std::invalid_argument if the options are invalid (see Validate).
 void ParallelForChunks(long begin, long end,
                        const std::function<void(long first, long last, int thread)>& body,
