@@ -3,17 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <atomic>
 #include <cstdio>
 #include <chrono>
-#include <exception>
 #include <mutex>
 #include <random>
-#include <thread>
 
 #include <nlopt.hpp>
 
 #include "robomach/common/golden_section.h"
+#include "robomach/common/parallel.h"
 #include "robomach/common/units.h"
 #include "robomach/polishing/process.h"
 #include "robomach/polishing/removal.h"
@@ -244,26 +242,10 @@ class Book {
   }
   // Runs job(0..n-1) on o.threads threads; the first exception is rethrown.
   void RunParallel(int n, const std::function<void(int)>& job) {
-    std::atomic<int> next{0};
-    std::exception_ptr err;
-    std::mutex err_mu;
-    auto worker = [&]() {
-      for (int i = next++; i < n; i = next++) {
-        try {
-          job(i);
-        } catch (...) {
-          std::lock_guard<std::mutex> lock(err_mu);
-          if (!err) err = std::current_exception();
-          next = n;
-        }
-      }
-    };
-    const int nt = std::max(1, std::min(o_.threads, n));
-    std::vector<std::thread> pool;
-    for (int k = 1; k < nt; ++k) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
-    if (err) std::rethrow_exception(err);
+    ParallelForOptions po;
+    po.threads = std::max(1, o_.threads);
+    po.chunk_size = 1;  // one plan evaluation each (milliseconds to seconds)
+    ParallelFor(0, n, [&](long i, int) { job(static_cast<int>(i)); }, po);
   }
   PlanOptimiseResult& result() { return res_; }
   std::mutex& mutex() { return mu_; }
