@@ -1,6 +1,8 @@
 #include "robomach/dynamics/measured_frf.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -157,6 +159,37 @@ FrfSet FrfSet::ForPose(const std::string& pose_id) const {
 
 void FrfSet::Merge(const FrfSet& other) {
   for (const auto& [k, f] : other.frfs_) Insert(k, f);
+}
+
+std::string ReceptancePeakFinding(const std::string& what, double peak) {
+  if (!(peak > kMaxPlausibleReceptance || (peak > 0.0 && peak < kMinPlausibleReceptance))) return "";
+  char b[160];
+  std::snprintf(b, sizeof b, ": the largest receptance is %.3g m/N, outside the plausible %.0e to %.0e m/N of a machine structure: ",
+                peak, kMinPlausibleReceptance, kMaxPlausibleReceptance);
+  return what + b +
+         (peak > kMaxPlausibleReceptance
+              ? "the response was probably recorded in mm or um (or the force in kN) under a column named in m (and "
+                "N), or a mobility or accelerance was read as receptance (the file's quantity or unit labels)"
+              : "the force was probably recorded in mN, or the response in km") +
+         "; check the units in the column names";
+}
+
+double PeakReceptance(const Frf& frf) {
+  double peak = 0.0;
+  for (int k = 0; k < frf.size(); ++k) {
+    if (frf.coherence() && (*frf.coherence())(k) < 0.5) continue;
+    peak = std::max(peak, std::abs(frf.receptance()(k)));
+  }
+  return peak;
+}
+
+std::vector<std::string> ReceptanceUnitFindings(const FrfSet& frfs, const std::string& source) {
+  std::vector<std::string> out;
+  for (const auto& [key, frf] : frfs) {
+    const std::string f = ReceptancePeakFinding(source + ": " + key.ToString(), PeakReceptance(frf));
+    if (!f.empty()) out.push_back(f);
+  }
+  return out;
 }
 
 }  // namespace robomach::dynamics

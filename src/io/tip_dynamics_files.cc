@@ -1,5 +1,6 @@
 #include "robomach/io/tip_dynamics_files.h"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <map>
@@ -103,6 +104,24 @@ std::vector<ModalTableEntry> ReadModalTable(const std::string& path) {
       e.modes.p.col(k) = u.normalized() / std::sqrt(m);
     }
     out.push_back(std::move(e));
+  }
+  return out;
+}
+
+std::vector<std::string> ReceptanceUnitFindings(const std::vector<FrfSetOfPose>& sets) {
+  std::vector<std::string> out;
+  for (const FrfSetOfPose& s : sets) {
+    double peak = 0.0;
+    for (const Eigen::Matrix3cd& h : s.H) {
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+          if (s.present[i][j]) peak = std::max(peak, std::abs(h(i, j)));
+        }
+      }
+    }
+    const std::string f = dynamics::ReceptancePeakFinding(
+        s.source + (s.pose_id.empty() ? std::string() : ": posture " + s.pose_id), peak);
+    if (!f.empty()) out.push_back(f);
   }
   return out;
 }
