@@ -174,13 +174,30 @@ std::string ReceptancePeakFinding(const std::string& what, double peak) {
          "; check the units in the column names";
 }
 
-double PeakReceptance(const Frf& frf) {
+namespace {
+
+// The largest median of three neighbouring values.
+double RobustPeak(const std::vector<double>& magnitude) {
+  const int n = static_cast<int>(magnitude.size());
+  if (n < 3) return n == 0 ? 0.0 : *std::min_element(magnitude.begin(), magnitude.end());
   double peak = 0.0;
-  for (int k = 0; k < frf.size(); ++k) {
-    if (frf.coherence() && (*frf.coherence())(k) < 0.5) continue;
-    peak = std::max(peak, std::abs(frf.receptance()(k)));
+  for (int k = 1; k + 1 < n; ++k) {
+    double a = magnitude[k - 1], b = magnitude[k], c = magnitude[k + 1];
+    peak = std::max(peak, std::max(std::min(a, b), std::min(std::max(a, b), c)));  // median of three
   }
   return peak;
+}
+
+}  // namespace
+
+double PeakReceptance(const Frf& frf) {
+  std::vector<double> m;
+  for (int k = 0; k < frf.size(); ++k) {
+    if (frf.freq_hz()(k) <= 0.0) continue;
+    if (frf.coherence() && (*frf.coherence())(k) < 0.5) continue;
+    m.push_back(std::abs(frf.receptance()(k)));
+  }
+  return RobustPeak(m);
 }
 
 std::vector<std::string> ReceptanceUnitFindings(const FrfSet& frfs, const std::string& source) {

@@ -112,11 +112,12 @@ std::vector<std::string> ReceptanceUnitFindings(const std::vector<FrfSetOfPose>&
   std::vector<std::string> out;
   for (const FrfSetOfPose& s : sets) {
     double peak = 0.0;
-    for (const Eigen::Matrix3cd& h : s.H) {
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) {
-          if (s.present[i][j]) peak = std::max(peak, std::abs(h(i, j)));
-        }
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        if (!s.present[i][j]) continue;
+        Eigen::VectorXcd h(static_cast<int>(s.H.size()));
+        for (size_t k = 0; k < s.H.size(); ++k) h(static_cast<int>(k)) = s.H[k](i, j);
+        peak = std::max(peak, dynamics::PeakReceptance(dynamics::Frf::FromSamples(s.freq_hz, h)));
       }
     }
     const std::string f = dynamics::ReceptancePeakFinding(

@@ -33,7 +33,8 @@ std::vector<FrfSetOfPose> ReadTipFrfs(const std::string& path, const std::string
                                       std::vector<std::string>* notes = nullptr);
 
 /// The unit plausibility of the FRFs read (dynamics::ReceptancePeakFinding
-/// of the largest |H| of each posture's FRFs, all lines): one finding per
+/// of the largest dynamics::PeakReceptance of each posture's FRFs): one
+/// finding per
 /// posture out of range, naming the file and posture (a mobility or
 /// accelerance read as receptance, a response in mm under _m).
 std::vector<std::string> ReceptanceUnitFindings(const std::vector<FrfSetOfPose>& sets);
