@@ -25,6 +25,41 @@ class CaptureConsoleBridge final : public console_bridge::OutputHandler {
   std::vector<std::string> messages;
 };
 
+// Line and column (1-based) of the first whitespace-separated token equal to
+// `token` inside a quoted attribute value; line 0 if there is none.
+SourceLocation LocateAttributeToken(const std::string& xml, const std::string& path, const std::string& token) {
+  if (token.empty()) return {path, 0, 0};
+  bool in_value = false;
+  char quote = 0;
+  int line = 1, col = 0;
+  for (size_t i = 0; i < xml.size(); ++i) {
+    const char c = xml[i];
+    ++col;
+    if (c == '\n') {
+      ++line;
+      col = 0;
+      continue;
+    }
+    if (!in_value) {
+      if ((c == '"' || c == '\'') && i > 0 && xml[i - 1] == '=') {
+        in_value = true;
+        quote = c;
+      }
+      continue;
+    }
+    if (c == quote) {
+      in_value = false;
+      continue;
+    }
+    const bool starts = xml[i - 1] == quote || xml[i - 1] == ' ' || xml[i - 1] == '\t';
+    if (starts && xml.compare(i, token.size(), token) == 0) {
+      const char after = i + token.size() < xml.size() ? xml[i + token.size()] : ' ';
+      if (after == quote || after == ' ' || after == '\t') return {path, line, col};
+    }
+  }
+  return {path, 0, 0};
+}
+
 // 1-based line of the first `<tag ... name="name"`, 0 if not found.
 int FindElementLine(const std::string& xml, const std::string& tag, const std::string& name) {
   const std::string needle = "name=\"" + name + "\"";
@@ -61,7 +96,16 @@ kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string
       std::string reason;
       for (const auto& m : capture.messages) reason += (reason.empty() ? "" : "; ") + m;
       if (reason.empty()) reason = "urdfdom gave no reason";
-      throw InputError({path, 0, 0}, "not a valid URDF model: " + reason);
+      // urdfdom names a number it could not parse ("Unable to parse
+      // component [nan] to a double") but not where: the first attribute
+      // value holding that token gives the line and column.
+      SourceLocation at{path, 0, 0};
+      const std::string key = "Unable to parse component [";
+      if (const size_t k = reason.find(key); k != std::string::npos) {
+        const size_t e = reason.find(']', k + key.size());
+        if (e != std::string::npos) at = LocateAttributeToken(xml, path, reason.substr(k + key.size(), e - k - key.size()));
+      }
+      throw InputError(at, "not a valid URDF model: " + reason);
     }
   }
   auto link_error = [&](const std::string& role, const std::string& name) {

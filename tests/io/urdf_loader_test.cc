@@ -51,6 +51,21 @@ TEST(UrdfLoader, MalformedXmlKeepsUrdfdomsReason) {
               HasSubstr("link 'b' is not unique"));
 }
 
+// NaN or inf in a number: urdfdom names the token but not where it is; the
+// loader adds the line and column of the attribute value holding it (line
+// 11, column 22 of the two-link arm: `    <origin xyz="0.5 nan 0"/>`).
+TEST(UrdfLoader, NanOrInfIsRejectedWithLineAndColumn) {
+  const std::string dir = TempDir("urdf_nan");
+  for (const std::string t : {"nan", "inf", "-inf"}) {
+    std::string text = Urdf(kGoodInertia);
+    const std::string origin = "<origin xyz=\"0.5 0 0\"/>";
+    text.replace(text.find(origin), origin.size(), "<origin xyz=\"0.5 " + t + " 0\"/>");
+    const std::string path = WriteText(dir + "/r.urdf", text);
+    EXPECT_THAT(CaptureError([&] { LoadUrdfChain(path, "world", "b"); }),
+                HasSubstr("r.urdf:11:22: not a valid URDF model: Unable to parse component [" + t + "]"));
+  }
+}
+
 TEST(UrdfLoader, MissingLinksAreNamedWithTheAvailableOnes) {
   const std::string dir = TempDir("urdf_link");
   const std::string path = WriteText(dir + "/r.urdf", Urdf(kGoodInertia));
