@@ -43,7 +43,7 @@ CASES = [
     (C + '/region_demo.yaml', [],
      'stability-map --robot ' + C + '/kr210.yaml --cut ' + C + '/cut_demo.yaml --region {f} --out {o}/m.csv'),
     (T + '/stability/path_demo.csv', [],
-     'stability-map --robot ' + C + '/kr210.yaml --cut ' + C + '/cut_demo.yaml --path {f} --out {o}/m.csv'),
+     'stability-map --robot ' + C + '/kr210.yaml --cut ' + C + '/cut_demo.yaml --region ' + C + '/region_demo.yaml --path {f} --out {o}/m.csv'),
     (C + '/demo/hammer.csv', [],
      'model-audit --robot ' + C + '/kr210.yaml --postures ' + C + '/demo/postures.csv --measured {f} --report {o}/r'),
     (C + '/demo/postures.csv', [],
@@ -116,6 +116,8 @@ def fields(path):
                 continue
         if ext == '.mpf' and s.lstrip().startswith(';'):
             continue
+        if ext == '.urdf' and s.lstrip().startswith('<?'):
+            continue  # the XML declaration
         if ext == '.yaml':
             m = re.match(r'^\s*(?:- )?[A-Za-z_][\w]*:\s*', s)
             if not m and not s.strip().startswith(('-', '[')):
@@ -124,6 +126,8 @@ def fields(path):
             a, b = m.start(), m.end()
             if a > 0 and s[a - 1].isalnum() or s[a - 1:a] == '_':
                 continue  # part of a name (AX1, joint_3)
+            if ext == '.urdf' and s[:a].count('"') % 2 == 0:
+                continue  # URDF: attribute values only (not comments)
             if ext == '.mpf' and s[a - 1:a] != '=':
                 continue  # Siemens tables: values follow '=' (not indices, CHANDATA(1))
             if b < len(s) and (s[b].isalpha() or s[b] == '_'):

@@ -1,6 +1,7 @@
 #include "robomach/io/urdf_loader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -25,10 +26,12 @@ class CaptureConsoleBridge final : public console_bridge::OutputHandler {
   std::vector<std::string> messages;
 };
 
-// Line and column (1-based) of the first whitespace-separated token equal to
-// `token` inside a quoted attribute value; line 0 if there is none.
-SourceLocation LocateAttributeToken(const std::string& xml, const std::string& path, const std::string& token) {
-  if (token.empty()) return {path, 0, 0};
+// Line and column (1-based) of the first whitespace-separated token inside a
+// quoted attribute value that equals `token` (or, with `token` empty, that
+// reads as NaN or inf: "nan", "-inf", "Infinity"...), and the token; line 0
+// if there is none.
+SourceLocation LocateAttributeToken(const std::string& xml, const std::string& path, const std::string& token,
+                                    std::string* found = nullptr) {
   bool in_value = false;
   char quote = 0;
   int line = 1, col = 0;
@@ -52,9 +55,20 @@ SourceLocation LocateAttributeToken(const std::string& xml, const std::string& p
       continue;
     }
     const bool starts = xml[i - 1] == quote || xml[i - 1] == ' ' || xml[i - 1] == '\t';
-    if (starts && xml.compare(i, token.size(), token) == 0) {
-      const char after = i + token.size() < xml.size() ? xml[i + token.size()] : ' ';
-      if (after == quote || after == ' ' || after == '\t') return {path, line, col};
+    if (!starts || c == ' ' || c == '\t') continue;
+    size_t e = i;
+    while (e < xml.size() && xml[e] != quote && xml[e] != ' ' && xml[e] != '\t' && xml[e] != '\n') ++e;
+    std::string t = xml.substr(i, e - i);
+    bool match = t == token;
+    if (token.empty()) {
+      std::string low = t;
+      for (char& ch : low) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+      if (!low.empty() && (low[0] == '+' || low[0] == '-')) low.erase(0, 1);
+      match = low.rfind("nan", 0) == 0 || low.rfind("inf", 0) == 0;
+    }
+    if (match) {
+      if (found) *found = t;
+      return {path, line, col};
     }
   }
   return {path, 0, 0};
@@ -87,6 +101,14 @@ kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string xml = ss.str();
+
+  // NaN and inf: urdfdom reads some of them as numbers (an inertial origin
+  // of "nan" passes), so every attribute value is checked first.
+  {
+    std::string token;
+    const SourceLocation at = LocateAttributeToken(xml, path, "", &token);
+    if (at.line > 0) throw InputError(at, "expected a finite number, got \"" + token + "\"");
+  }
 
   urdf::ModelInterfaceSharedPtr model;
   {
