@@ -64,17 +64,12 @@ TEST(DrillingFiles, UnitMistakesInForceTablesAndDrillFilesAreNamed) {
 
   const std::string dir = TempDir("drilling_files_units");
   const std::string mm_min = WriteText(dir + "/mm_min.csv",
-                                       "diameter_mm,feed_mm_per_rev,thrust_N,torque_Nm,speed_rpm
-"
-                                       "5,0.08,676,1.010,1782.5
-5,152.79,794,1.200,1527.9
-");
+                                       "diameter_mm,feed_mm_per_rev,thrust_N,torque_Nm,speed_rpm\n"
+                                       "5,0.08,676,1.010,1782.5\n5,152.79,794,1.200,1527.9\n");
   EXPECT_THAT(CaptureError([&] { ReadForceTable(mm_min); }),
               HasSubstr("mm_min.csv:3: column feed_mm_per_rev: expected 0.005 to 1 mm/rev (twist-drilling practice), "
                         "got 152.79: a feed in mm/min"));
-  const std::string d_m = WriteText(dir + "/d_m.csv", "diameter_mm,feed_mm_per_rev,thrust_N,torque_Nm
-0.005,0.08,676,1
-");
+  const std::string d_m = WriteText(dir + "/d_m.csv", "diameter_mm,feed_mm_per_rev,thrust_N,torque_Nm\n0.005,0.08,676,1\n");
   EXPECT_THAT(CaptureError([&] { ReadForceTable(d_m); }),
               HasSubstr("d_m.csv:2: column diameter_mm: expected 0.1 to 100 mm"));
 
