@@ -94,6 +94,8 @@ CASES = [
 # Hammer records (frf-estimate) are made by the plain-Python simulation of
 # the frf-estimate smoke tests.
 REC = tempfile.mkdtemp(prefix='naninf_records')
+import atexit
+atexit.register(shutil.rmtree, REC, True)
 subprocess.run(['python3', SRC + '/tests/apps/make_hammer_records.py', REC], check=True, capture_output=True)
 CASES.append((REC + '/hit_a.csv', [], 'frf-estimate {f} ' + REC + '/hit_b.csv --out {o}/frf.csv'))
 
