@@ -51,7 +51,8 @@ int Run(int argc, char** argv) {
       "($AA_ENC_COMP, $AN_CEC, temperature; eqs. 2-5); then the machine's kinematics with its rotary errors\n"
       "(docs/formats.md §8.3). With --program, the contour error of every sample against the programmed polyline."};
   AddVersionFlag(app, kTool);
-  app.footer(ExitCodeHelp());
+  app.footer(ExitCodeHelp() + "\n3 here: with --program, a contour error over 1 mm or a tool axis error over "
+                              "1 deg (swapped count columns or a unit mistake; docs/plausibility.md).");
   std::string machine_path, counts_path, comp_path, temp_path, program_path, out_path, summary_path, plot_path;
   app.add_option("--machine", machine_path, "machine file YAML (docs/formats.md §8.3)")->required();
   app.add_option("--counts", counts_path, "encoder counts CSV (docs/formats.md §8.1)")->required();
@@ -143,6 +144,9 @@ int Run(int argc, char** argv) {
       std::cerr << kTool << ": " << rec.rows() << " samples; contour error max " << j["contour_error_um"]["max"].get<double>()
                 << " um, rms " << j["contour_error_um"]["rms"].get<double>() << " um; axis error max "
                 << j["axis_error_deg"]["max"].get<double>() << " deg\n";
+      const std::vector<std::string> units = machine::ContourUnitFindings(contour, *path);
+      for (const std::string& f : units) Warn(kTool, "implausible (unit or column mistake?): " + f);
+      if (!units.empty()) return kExitFlagged;
     }
     return kExitOk;
   });

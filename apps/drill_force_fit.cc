@@ -14,6 +14,7 @@
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/drilling/force_fit.h"
+#include "robomach/drilling/plausibility.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/drilling_files.h"
 #include "robomach/io/number_format.h"
@@ -95,7 +96,10 @@ int RunDrillForceFit(int argc, char** argv) {
   CLI::App app{"drill-force-fit: fit the twist-drill force model (oblique-cutting lips, dynamic "
                "rake, Kienzle size effect; seed 003) to a thrust/torque table"};
   AddVersionFlag(app, kTool);
-  app.footer(ExitCodeHelp());
+  app.footer(ExitCodeHelp() +
+             "\n3 here also: a torque/(thrust x diameter) ratio or fitted coefficient outside the range of "
+             "metals (a unit mistake, e.g. torque in N·mm). 65 also: a diameter or feed outside drilling practice "
+             "(docs/plausibility.md).");
   std::string table_path, drill_path, out_path, plot_path, predict_path, predictions_path;
   std::string chisel = "seed_scaling";
   bool verbose = false;
@@ -167,6 +171,13 @@ int RunDrillForceFit(int argc, char** argv) {
       Warn(kTool, "the model misses a row by more than 10 %; check the table and the drill geometry");
       rc = kExitFlagged;
     }
+    // Unit plausibility (drilling/plausibility.h): outputs stay written, exit 3.
+    std::vector<std::string> units = drilling::ForceTableFindings(table.rows);
+    for (const auto& more : {drilling::MaterialFindings(fit.material), drilling::ToolingFindings(drill.drill, nullptr)}) {
+      units.insert(units.end(), more.begin(), more.end());
+    }
+    for (const std::string& f : units) Warn(kTool, "implausible (unit mistake?): " + f);
+    if (!units.empty()) rc = kExitFlagged;
     return rc;
   });
 }

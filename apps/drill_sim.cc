@@ -18,6 +18,7 @@
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/drilling/drilling_sim.h"
+#include "robomach/drilling/plausibility.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/drilling_files.h"
 #include "robomach/io/number_format.h"
@@ -157,7 +158,9 @@ int RunDrillSim(int argc, char** argv) {
   AddVersionFlag(app, kTool);
   app.footer("With several controllers each output gets the controller's name before its "
              "extension (run.csv -> run_pid.csv, run_pd-tdc.csv); the plot overlays them.\n" +
-             ExitCodeHelp());
+             ExitCodeHelp() +
+             "\n3 here also: a drill diameter, feed, spindle or cutting speed, or material coefficient outside "
+             "drilling practice (a unit mistake; docs/plausibility.md).");
   std::string robot_path, drill_path, material_path, out_path, summary_path, plot_path;
   std::string controllers = "pd-tdc";
   bool tune = false;
@@ -320,6 +323,11 @@ int RunDrillSim(int argc, char** argv) {
         rc = kExitFlagged;
       }
     }
+    // Unit plausibility (drilling/plausibility.h): outputs stay written, exit 3.
+    std::vector<std::string> units = drilling::ToolingFindings(drill.drill, &drill.process);
+    for (const std::string& f : drilling::MaterialFindings(material)) units.push_back(material_path + ": " + f);
+    for (const std::string& f : units) Warn(kTool, "implausible (unit mistake?): " + f);
+    if (!units.empty()) rc = kExitFlagged;
     return rc;
   });
 }

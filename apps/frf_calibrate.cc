@@ -77,7 +77,8 @@ int Run(int argc, char** argv) {
       "<pose>.png overlay per posture (measured, model before, model after), stabilisation_<pose>.png\n"
       "(the modal fits' stabilisation diagrams), summary.json."};
   AddVersionFlag(app, kTool);
-  app.footer(ExitCodeHelp() + " Exit 3 also when the fit did not converge or a parameter is weakly identified.");
+  app.footer(ExitCodeHelp() + " Exit 3 also when the fit did not converge or a parameter is weakly identified, "
+                                "or a measured receptance is outside 1e-12..1e-3 m/N (a unit mistake).");
   std::string robot_path, postures_path, out_path, report_dir, summary_path, objective = "modal-two-stage";
   std::vector<std::string> measured_files, pose_files, validate_files, validate_pose_files, frees, sets, adds;
   bool only_free = false;
@@ -229,8 +230,9 @@ int Run(int argc, char** argv) {
     report::WriteTable3Csv((dir / "table3.csv").string(), sets_out);
     report::WriteTable3Markdown((dir / "table3.md").string(), sets_out,
                                 "frf-calibrate: " + robot_path + " against the measured FRFs");
-    bool flagged = false;
-    std::vector<std::string> flags;
+    std::vector<std::string> flags = measured_read.unit_findings;  // implausible units, warned when read
+    flags.insert(flags.end(), holdout_read.unit_findings.begin(), holdout_read.unit_findings.end());
+    bool flagged = !flags.empty();
     double per_residual = NAN;
     if (result.status == calibration::FitStatus::kNotImproved) {
       Warn(kTool, "the calibration did not improve on the start values; " + out_path +

@@ -94,7 +94,8 @@ int Run(int argc, char** argv) {
   app.footer(ExitCodeHelp() +
              " Exit 3 when the failure is significant and not explained within the noise: unexplained, or mostly "
              "explained (the effect is named and effects.yaml written, but a misfit remains), or a fit failed (the "
-             "report is complete; candidates.csv says which and why).");
+             "report is complete; candidates.csv says which and why), or a measured receptance is outside 1e-12..1e-3 "
+             "m/N (a unit mistake).");
   std::string robot_path, postures_path, report_dir, compare_dir, candidates_list, summary_path;
   std::vector<std::string> measured_files, pose_files, adds;
   audit::AuditOptions opt;
@@ -562,8 +563,11 @@ int Run(int argc, char** argv) {
     if (failed_candidate) Warn(kTool, "a candidate's fit failed; its row in candidates.csv says why");
     io::WriteFileAtomically("-", yaml);
     if (summary_path == "-") io::WriteFileAtomically("-", report::DumpJson(j));
-    return (r.significant_failure && !r.explained) || !r.warnings.empty() || failed_candidate ? kExitFlagged
-                                                                                              : kExitOk;
+    // measured_read.unit_findings: receptances outside the plausible range, warned when read.
+    return (r.significant_failure && !r.explained) || !r.warnings.empty() || failed_candidate ||
+                   !measured_read.unit_findings.empty()
+               ? kExitFlagged
+               : kExitOk;
   });
 }
 

@@ -67,11 +67,17 @@ struct LobeRow {
   stability::LobePoint point;
 };
 
-// FRF files, CSV or UFF58 by extension; reader warnings go to stderr.
+// FRF files, CSV or UFF58 by extension; reader warnings go to stderr, and
+// so do receptances outside the plausible range (counted: exit 3).
+int g_implausible_frfs = 0;
 std::vector<io::FrfSetOfPose> ReadFrfFile(const std::string& path) {
   std::vector<std::string> warnings;
   auto sets = io::ReadTipFrfs(path, "", &warnings);
   for (const std::string& w : warnings) Warn(kTool, w);
+  for (const std::string& f : io::ReceptanceUnitFindings(sets)) {
+    Warn(kTool, "implausible (unit mistake?): " + f);
+    ++g_implausible_frfs;
+  }
   return sets;
 }
 
@@ -462,7 +468,8 @@ int Run(int argc, char** argv) {
       "FRF file (docs/formats.md §3) or a modal table (§4)."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
-             " Exit 3 when some speeds have no stability boundary, when a measured FRF's modal fit is poor "
+             " Exit 3 when some speeds have no stability boundary, when a measured receptance is outside "
+             "1e-12..1e-3 m/N (a unit mistake, e.g. a mobility read as receptance), when a measured FRF's modal fit is poor "
              "(misfit above 3 x the noise), finds no mode (then no SD lobes) or a mode at the edge of the usable "
              "band, when the FRF is not a passive driving point (Im H > 0 on more than 5 % of its usable lines), "
              "or when --method both finds the "
@@ -622,7 +629,7 @@ int Run(int argc, char** argv) {
       }
       if (tips.empty()) throw InputError({modal_path, 0, 0}, "none of the requested postures is in the file");
     }
-    bool flagged = false;
+    bool flagged = g_implausible_frfs > 0;
     for (const TipDynamics& t : tips) {
       for (const DirectionFit& d : t.fits) {
         if (d.fit.not_driving_point) {
