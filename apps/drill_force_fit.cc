@@ -141,7 +141,14 @@ int RunDrillForceFit(int argc, char** argv) {
       throw InputError({table_path, table.lines.back(), 0},
                        "expected at least 2 rows to fit 3 coefficients to thrust and torque");
     }
-    const drilling::ForceFitResult fit = drilling::FitDrillingForces(drill.drill, table.rows, options);
+    const drilling::ForceFitResult fit = [&] {
+      try {
+        return drilling::FitDrillingForces(drill.drill, table.rows, options);
+      } catch (const drilling::ForceTableRowError& e) {
+        // Bad data (exit 65) at the row's line, not a bad command line.
+        throw InputError({table_path, table.lines.at(e.row()), 0}, e.what());
+      }
+    }();
     if (fit.status == drilling::FitStatus::kFailed) {
       std::cerr << kTool << ": the fit failed: " << fit.solver_message << "\n";
       return kExitSoftware;

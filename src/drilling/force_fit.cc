@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include <ceres/ceres.h>
@@ -53,8 +54,8 @@ ForceFitResult FitDrillingForces(const DrillGeometry& drill, const std::vector<F
     const ForceTableRow& r = rows[k];
     for (double v : {r.diameter, r.feed_per_rev, r.thrust, r.torque}) {
       if (!(std::isfinite(v) && v > 0.0)) {
-        throw std::invalid_argument("force table row " + std::to_string(k + 1) +
-                                    ": expected positive finite values");
+        throw ForceTableRowError(k, "force table row " + std::to_string(k + 1) +
+                                        ": expected positive finite values");
       }
     }
   }
@@ -65,8 +66,19 @@ ForceFitResult FitDrillingForces(const DrillGeometry& drill, const std::vector<F
   double x[3] = {0.0, 0.0, base.kienzle_exponent};
   {
     double st = 0.0, sq = 0.0;
-    for (const ForceTableRow& r : rows) {
+    for (size_t k = 0; k < rows.size(); ++k) {
+      const ForceTableRow& r = rows[k];
       const DrillForces f = PredictRow(drill, MaterialFromParameters(base, x), r, options.model);
+      // The model's forces are proportional to K; where they are not
+      // positive at K = 1 Pa, no K fits the row (the dynamic rake of a feed
+      // of ~diameter per revolution turns the thrust negative).
+      if (!(std::isfinite(f.thrust) && f.thrust > 0.0 && std::isfinite(f.torque) && f.torque > 0.0)) {
+        std::ostringstream m;
+        m << "force table row " << k + 1 << ": feed_mm_per_rev " << r.feed_per_rev * 1e3 << " with diameter_mm "
+          << r.diameter * 1e3 << " is outside the force model's range (it gives a thrust of " << f.thrust
+          << " N per Pa of shear stress); is the feed in mm/min instead of mm/rev?";
+        throw ForceTableRowError(k, m.str());
+      }
       st += std::log(r.thrust / f.thrust);
       sq += std::log(r.torque / f.torque);
     }
