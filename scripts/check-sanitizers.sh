@@ -12,6 +12,8 @@
 #   ROBOMACH_SAN_TARGETS    space-separated targets to build (default: all)
 #   ROBOMACH_SAN_JOBS       parallel build and test jobs (default: 2)
 #   ROBOMACH_SAN_NICE       nice level of the build and the tests (default: 5)
+#   ROBOMACH_SAN_EXTRA_FLAGS  more compile flags (the fuzz build: -fsanitize=fuzzer-no-link)
+#   ROBOMACH_SAN_CMAKE_ARGS   more cmake arguments (the fuzz build: -DROBOMACH_FUZZ=ON)
 #   CXX                     compiler (default: clang++ when installed, else g++)
 # Exit: 0 clean; 1 a test failed or a sanitizer reported something; 2 the
 # build failed.
@@ -35,7 +37,8 @@ fi
 # covariance hands its results back this way) is a bad free. The define makes
 # both sides use malloc/free, which is what the uninstrumented Ceres does.
 san_flags="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
-cxx_flags="-O1 -g $san_flags -DEIGEN_MALLOC_ALREADY_ALIGNED=1"
+cxx_flags="-O1 -g $san_flags -DEIGEN_MALLOC_ALREADY_ALIGNED=1 ${ROBOMACH_SAN_EXTRA_FLAGS:-}"
+read -r -a extra_cmake_args <<<"${ROBOMACH_SAN_CMAKE_ARGS:-}"
 
 launcher=()
 if command -v ccache >/dev/null 2>&1; then
@@ -50,15 +53,18 @@ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DBUILD_TESTIN
   -DROBOMACH_BUILD_BENCHMARKS=OFF -DCMAKE_CXX_COMPILER="$CXX" \
   -DCMAKE_CXX_FLAGS="$cxx_flags" \
   -DCMAKE_EXE_LINKER_FLAGS="$san_flags" -DCMAKE_SHARED_LINKER_FLAGS="$san_flags" \
-  "${launcher[@]}" >/dev/null
+  "${launcher[@]}" "${extra_cmake_args[@]}" >/dev/null
 
-# Reports go to files as well as to the test's output, so that a report in a
-# tool whose test expects a non-zero exit (or swallows stderr) is not missed.
+# ASan and LSan reports go to files, so that a report in a tool whose test
+# expects a non-zero exit (or swallows stderr) is not missed. UBSan cannot
+# share that (with ASan's log_path set, gcc's runtime prints a halting UBSan
+# report on stderr only), so its reports are found in the tests' output
+# (Testing/Temporary/LastTest.log holds every test's output, passed or not).
 logs="$build/sanitizer-logs"
 rm -rf "$logs"; mkdir -p "$logs"
 export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:check_initialization_order=1:log_path=$logs/asan"
 export LSAN_OPTIONS="suppressions=$root/scripts/lsan.supp:print_suppressions=0"
-export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:log_path=$logs/ubsan"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 
 targets=()
 if [ -n "${ROBOMACH_SAN_TARGETS:-}" ]; then
@@ -73,7 +79,18 @@ fi
 
 status=0
 cd "$build"
+rm -f Testing/Temporary/LastTest*.log
 nice -n "$nice_level" ctest --output-on-failure --parallel "$jobs" "$@" || status=1
+
+pattern='runtime error:|ERROR: AddressSanitizer|ERROR: LeakSanitizer|SUMMARY: UndefinedBehaviorSanitizer'
+for f in Testing/Temporary/LastTest*.log; do
+  [ -f "$f" ] || continue
+  if grep -qE "$pattern" "$f"; then
+    echo "check-sanitizers: sanitizer report(s) in the tests' output ($build/$f):" >&2
+    grep -nE -A12 "$pattern" "$f" | head -200 >&2
+    status=1
+  fi
+done
 
 # Any log file means a sanitizer spoke, whatever the test concluded.
 shopt -s nullglob
