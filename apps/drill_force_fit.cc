@@ -171,6 +171,12 @@ int RunDrillForceFit(int argc, char** argv) {
       Warn(kTool, "the fit did not converge: " + fit.solver_message);
       rc = kExitFlagged;
     }
+    if (fit.kienzle_exponent_at_bound) {
+      Warn(kTool, "the Kienzle exponent ended on its bound (" + io::FormatDouble(fit.material.kienzle_exponent) +
+                      ", range 0..0.95): the forces do not grow with the feed as a size effect can; check the "
+                      "units of feed_mm_per_rev, thrust_N and torque_Nm");
+      rc = kExitFlagged;
+    }
     if (fit.max_rel_error_thrust > 0.10 || fit.max_rel_error_torque > 0.10) {
       Warn(kTool, "the model misses a row by more than 10 %; check the table and the drill geometry");
       rc = kExitFlagged;

@@ -50,6 +50,10 @@ struct ForceFitResult {
   double max_rel_error_thrust{NAN};   // max |model - measured| / measured
   double max_rel_error_torque{NAN};
   double rms_rel_error{NAN};          // over all residuals
+  /// The fitted Kienzle exponent ended on its bound (0 or 0.95, within 1e-3): the forces
+  /// grow with the feed faster than linearly or hardly at all, which
+  /// usually means a unit mistake in the table.
+  bool kienzle_exponent_at_bound{false};
   FitStatus status{FitStatus::kFailed};
   std::string solver_message;         // ceres::Solver::Summary::BriefReport
 };
