@@ -145,7 +145,14 @@ int RunDrillForceFit(int argc, char** argv) {
       throw InputError({table_path, table.lines.back(), 0},
                        "expected at least 2 rows to fit 3 coefficients to thrust and torque");
     }
-    const drilling::ForceFitResult fit = drilling::FitDrillingForces(drill.drill, table.rows, options);
+    const drilling::ForceFitResult fit = [&] {
+      try {
+        return drilling::FitDrillingForces(drill.drill, table.rows, options);
+      } catch (const drilling::ForceTableRowError& e) {
+        // Bad data (exit 65) at the row's line, not a bad command line.
+        throw InputError({table_path, table.lines.at(e.row()), 0}, e.what());
+      }
+    }();
     if (fit.status == drilling::FitStatus::kFailed) {
       std::cerr << kTool << ": the fit failed: " << fit.solver_message << "\n";
       return kExitSoftware;
@@ -165,6 +172,12 @@ int RunDrillForceFit(int argc, char** argv) {
     int rc = kExitOk;
     if (fit.status != drilling::FitStatus::kConverged) {
       Warn(kTool, "the fit did not converge: " + fit.solver_message);
+      rc = kExitFlagged;
+    }
+    if (fit.kienzle_exponent_at_bound) {
+      Warn(kTool, "the Kienzle exponent ended on its bound (" + io::FormatDouble(fit.material.kienzle_exponent) +
+                      ", range 0..0.95): the forces do not grow with the feed as a size effect can; check the "
+                      "units of feed_mm_per_rev, thrust_N and torque_Nm");
       rc = kExitFlagged;
     }
     if (fit.max_rel_error_thrust > 0.10 || fit.max_rel_error_torque > 0.10) {

@@ -15,6 +15,7 @@
 
 #include "robomach/audit/error_patterns.h"
 #include "robomach/calibration/frf_noise.h"
+#include "robomach/common/errors.h"
 #include "robomach/common/golden_section.h"
 #include "robomach/common/parallel.h"
 #include "robomach/dynamics/effect.h"
@@ -291,8 +292,8 @@ Eigen::VectorXd WholeCurveResidualVector(const dynamics::RobotDescription& desc,
       }
     }
     return out.allFinite() ? out : Eigen::VectorXd();
-  } catch (const std::exception&) {
-    return Eigen::VectorXd();
+  } catch (const NumericalError&) {
+    return Eigen::VectorXd();  // not evaluable at these values; anything else propagates
   }
 }
 
@@ -653,11 +654,11 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
       const bool better = Doubtful(c) != Doubtful(third) ? !Doubtful(third) : third.bic < c.bic;
       if (better) c = std::move(third);
     }
-  } catch (const std::exception& e) {
-    // Any trouble in one candidate (an eigensolver failing at an extreme
-    // parameter value, a value the model rejects) is that candidate's
-    // status, reported in its row, not the audit's end: the other
-    // candidates and everything already computed are kept.
+  } catch (const NumericalError& e) {
+    // Numerical trouble in one candidate (an eigensolver failing at an
+    // extreme parameter value) is that candidate's status, reported in its
+    // row, not the audit's end: the other candidates and everything already
+    // computed are kept. Bad input and bugs propagate.
     c.fit.status = calibration::FitStatus::kFailed;
     c.fit.message = e.what();
     c.note = std::string("fit failed: ") + e.what();

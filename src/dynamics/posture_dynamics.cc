@@ -13,6 +13,7 @@
 #include <kdl/chainjnttojacsolver.hpp>
 
 #include "kinematics/internal/kdl_status.h"
+#include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 
@@ -162,7 +163,7 @@ PostureDynamics PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const Postu
     Eigen::VectorXd eigenvalues;
     Eigen::MatrixXd eigenvectors;
     if (!SolveGeneralized(sys.K, sys.M, &eigenvalues, &eigenvectors)) {
-      throw std::runtime_error("modal analysis failed: the assembled mass matrix is not positive "
+      throw NumericalError("modal analysis failed: the assembled mass matrix is not positive "
                                "definite (check link and effect inertias)");
     }
     out.modes.resize(N);

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 
 namespace robomach::dynamics {
@@ -77,7 +78,7 @@ namespace {
 // output matrix Cout (3×2N): H(s) = Cout (sI − A)⁻¹ Bin = Σ R_k / (s − λ_k).
 ComplexModalModel FromStateSpace(const Eigen::MatrixXd& A, const Eigen::MatrixXd& Bin, const Eigen::MatrixXd& Cout) {
   Eigen::EigenSolver<Eigen::MatrixXd> es(A);
-  if (es.info() != Eigen::Success) throw std::runtime_error("complex modal analysis failed");
+  if (es.info() != Eigen::Success) throw NumericalError("complex modal analysis failed");
   const Eigen::MatrixXcd V = es.eigenvectors();
   const Eigen::MatrixXcd W = V.inverse();
   ComplexModalModel out;

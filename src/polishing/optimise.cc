@@ -42,6 +42,11 @@ struct Tracker {
   const OptimiseOptions* o;
   OptimiseResult* res;
   std::vector<double> best_x;
+  // An exception from the objective. NLopt's C++ wrapper would turn it into
+  // a generic failure ("nlopt failure"), so NloptThunk keeps it and stops
+  // the run, and RunNlopt rethrows it: an objective that throws is a bug or
+  // bad input, not an optimiser status.
+  std::exception_ptr error;
   double Eval(const std::vector<double>& x) {
     double v = (*f)(FromUnit(x, *base, *o));
     if (!std::isfinite(v)) v = 1e6;
@@ -56,7 +61,13 @@ struct Tracker {
 
 double NloptThunk(unsigned, const double* x, double*, void* data) {
   Tracker* t = static_cast<Tracker*>(data);
-  const double v = t->Eval(std::vector<double>(x, x + 3));
+  double v = 0.0;
+  try {
+    v = t->Eval(std::vector<double>(x, x + 3));
+  } catch (...) {
+    t->error = std::current_exception();
+    throw nlopt::forced_stop();
+  }
   t->res->history.push_back(t->res->best_value);
   if (t->o->progress) t->o->progress(t->res->evaluations, t->res->best_value);
   return v;
@@ -78,7 +89,12 @@ void RunNlopt(nlopt::algorithm alg, int budget, std::vector<double>* x, Tracker*
     *status = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : "converged";
   } catch (const nlopt::roundoff_limited&) {
     *status = "roundoff_limited";
+  } catch (const nlopt::forced_stop&) {
+    if (t->error) std::rethrow_exception(t->error);
+    *status = "forced_stop";
   } catch (const std::runtime_error& e) {
+    // NLopt's own failure (NLOPT_FAILURE); the objective's exceptions are
+    // rethrown above.
     *status = std::string("failed: ") + e.what();
   }
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <stdexcept>
 
 #include <kdl/chainiksolverpos_lma.hpp>
@@ -239,11 +240,24 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
       opt.set_maxeval(std::max(1, options.rotation_evaluations - kScan));
       opt.set_xtol_abs(1e-3);
       opt.set_initial_step(0.25 * h);
+      // An exception in the objective is kept and rethrown after the run, as
+      // in the scan above: NLopt's wrapper would report it as a generic
+      // "nlopt failure" status.
+      struct Objective {
+        decltype(consider)* f;
+        std::exception_ptr error;
+      } objective{&consider, nullptr};
       opt.set_max_objective(
           [](unsigned, const double* x, double*, void* data) {
-            return (*static_cast<decltype(consider)*>(data))(x[0]);
+            auto* o = static_cast<Objective*>(data);
+            try {
+              return (*o->f)(x[0]);
+            } catch (...) {
+              o->error = std::current_exception();
+              throw nlopt::forced_stop();
+            }
           },
-          &consider);
+          &objective);
       std::vector<double> x{best_rot};
       double fx = 0.0;
       try {
@@ -251,8 +265,11 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
         p.optimiser_status = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : "converged";
       } catch (const nlopt::roundoff_limited&) {
         p.optimiser_status = "roundoff_limited";
+      } catch (const nlopt::forced_stop&) {
+        if (objective.error) std::rethrow_exception(objective.error);
+        p.optimiser_status = "forced_stop";
       } catch (const std::runtime_error& e) {
-        p.optimiser_status = std::string("failed: ") + e.what();
+        p.optimiser_status = std::string("failed: ") + e.what();  // NLopt's own failure
       }
       p.rotation = best_rot;
     }
