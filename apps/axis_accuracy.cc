@@ -39,10 +39,11 @@ int Run(int argc, char** argv) {
       "B_mean, in the file's unit) and per target from positioning runs (docs/formats.md §8.6), with the standard\n"
       "chart: mean deviation and +-2s bands per approach direction over the targets."};
   AddVersionFlag(app, kTool);
-  app.footer(ExitCodeHelp());
+  app.footer(ExitCodeHelp() + "\n3 here: deviations too large for positioning errors (a unit mistake, e.g. um "
+                              "under _mm headers; docs/plausibility.md).");
   std::string runs_path, out_path, plot_path;
   app.add_option("--runs", runs_path, "runs CSV axis,target_mm,run,direction,measured_mm (or _deg)")->required();
-  app.add_option("--out", out_path, "ISO 230-2 JSON (stdout if omitted)");
+  app.add_option("--out,--summary", out_path, "ISO 230-2 JSON, the tool's summary (stdout if omitted or '-')");
   app.add_option("--plot", plot_path, "PNG chart, one panel per axis")->check(PngFileName());
   try {
     app.parse(argc, argv);
@@ -60,6 +61,7 @@ int Run(int argc, char** argv) {
     j["axes"] = nlohmann::json::object();
     std::vector<std::pair<std::string, machine::Iso230Result>> results;
     int min_runs = 1 << 30;
+    std::vector<std::string> units;  // unit plausibility findings: exit 3
     for (const std::string& axis : runs.axis_order) {
       machine::Iso230Result r;
       try {
@@ -79,6 +81,7 @@ int Run(int argc, char** argv) {
         min_runs = std::min({min_runs, t.runs_up, t.runs_down});
       }
       j["axes"][axis] = a;
+      for (const std::string& f : machine::Iso230UnitFindings(axis, r, runs.rotary)) units.push_back(f);
       results.emplace_back(axis, r);
     }
     if (!plot_path.empty()) {
@@ -129,13 +132,10 @@ int Run(int argc, char** argv) {
       fig.SavePng(plot_path);
     }
     const std::string text = report::DumpJson(j);
-    if (out_path.empty()) {
-      std::cout << text;
-    } else {
-      io::WriteFileAtomically(out_path, text);
-    }
+    io::WriteFileAtomically(out_path.empty() ? "-" : out_path, text);
     if (min_runs < 5) Warn(kTool, "fewer than the 5 runs per target and direction ISO 230-2 asks for (" + std::to_string(min_runs) + ")");
-    return kExitOk;
+    for (const std::string& f : units) Warn(kTool, "implausible (unit mistake?): " + f);
+    return units.empty() ? kExitOk : kExitFlagged;
   });
 }
 

@@ -51,14 +51,15 @@ int Run(int argc, char** argv) {
       "($AA_ENC_COMP, $AN_CEC, temperature; eqs. 2-5); then the machine's kinematics with its rotary errors\n"
       "(docs/formats.md §8.3). With --program, the contour error of every sample against the programmed polyline."};
   AddVersionFlag(app, kTool);
-  app.footer(ExitCodeHelp());
+  app.footer(ExitCodeHelp() + "\n3 here: with --program, a contour error over 1 mm or a tool axis error over "
+                              "1 deg (swapped count columns or a unit mistake; docs/plausibility.md).");
   std::string machine_path, counts_path, comp_path, temp_path, program_path, out_path, summary_path, plot_path;
   app.add_option("--machine", machine_path, "machine file YAML (docs/formats.md §8.3)")->required();
   app.add_option("--counts", counts_path, "encoder counts CSV (docs/formats.md §8.1)")->required();
   app.add_option("--compensation", comp_path, "Siemens 840D sl compensation tables (docs/formats.md §8.4)");
   app.add_option("--temperature", temp_path, "temperature log t_s,axis,K0_mm,tan_beta,P0_mm (docs/formats.md §8.4)");
   app.add_option("--program", program_path, "programmed path CSV x_mm,y_mm,z_mm,i,j,k (workpiece coordinates)");
-  app.add_option("--out", out_path, "acquired path CSV (docs/formats.md §8.5)")->required();
+  app.add_option("--out", out_path, "acquired path CSV (docs/formats.md §8.5); '-' = stdout")->required();
   app.add_option("--summary", summary_path, "summary JSON (rows, duration, contour error statistics)");
   app.add_option("--plot", plot_path, "PNG of the contour error along the path (needs --program)")->check(PngFileName());
   try {
@@ -143,6 +144,9 @@ int Run(int argc, char** argv) {
       std::cerr << kTool << ": " << rec.rows() << " samples; contour error max " << j["contour_error_um"]["max"].get<double>()
                 << " um, rms " << j["contour_error_um"]["rms"].get<double>() << " um; axis error max "
                 << j["axis_error_deg"]["max"].get<double>() << " deg\n";
+      const std::vector<std::string> units = machine::ContourUnitFindings(contour, *path);
+      for (const std::string& f : units) Warn(kTool, "implausible (unit or column mistake?): " + f);
+      if (!units.empty()) return kExitFlagged;
     }
     return kExitOk;
   });

@@ -39,7 +39,7 @@ int Run(int argc, char** argv) {
                  "accept a new level of a channel only after N equal samples (0 or 1: off); edges are then "
                  "seen N-1 samples late")
       ->capture_default_str();
-  app.add_option("--out", out_path, "counts CSV to write")->required();
+  app.add_option("--out", out_path, "counts CSV to write; '-' = stdout")->required();
   app.add_option("--summary", summary_path, "JSON {\"error_events\": {axis: n}, \"samples\": n, ...}");
   try {
     app.parse(argc, argv);

@@ -36,7 +36,7 @@ int Run(int argc, char** argv) {
   app.add_option("--machine", machine_path, "machine file YAML (docs/formats.md §8.3)")->required();
   app.add_option("--program", program_path, "programmed path CSV x_mm,y_mm,z_mm,i,j,k (workpiece coordinates)")
       ->required();
-  app.add_option("--out", out_path, "counts CSV to write (docs/formats.md §8.1)")->required();
+  app.add_option("--out", out_path, "counts CSV to write (docs/formats.md §8.1); '-' = stdout")->required();
   app.add_option("--compensation", comp_path, "Siemens 840D sl table file (docs/formats.md §8.4) the controller applies");
   app.add_option("--temperature", temp_path, "temperature log t_s,axis,K0_mm,tan_beta,P0_mm");
   app.add_option("--feed-mm-min", feed_mm_min, "tool tip speed along the path [mm/min]")->capture_default_str();

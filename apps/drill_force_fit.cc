@@ -14,6 +14,7 @@
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/drilling/force_fit.h"
+#include "robomach/drilling/plausibility.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/drilling_files.h"
 #include "robomach/io/number_format.h"
@@ -95,7 +96,10 @@ int RunDrillForceFit(int argc, char** argv) {
   CLI::App app{"drill-force-fit: fit the twist-drill force model (oblique-cutting lips, dynamic "
                "rake, Kienzle size effect; seed 003) to a thrust/torque table"};
   AddVersionFlag(app, kTool);
-  app.footer(ExitCodeHelp());
+  app.footer(ExitCodeHelp() +
+             "\n3 here also: a torque/(thrust x diameter) ratio or fitted coefficient outside the range of "
+             "metals (a unit mistake, e.g. torque in N·mm). 65 also: a diameter or feed outside drilling practice "
+             "(docs/plausibility.md).");
   std::string table_path, drill_path, out_path, plot_path, predict_path, predictions_path;
   std::string chisel = "seed_scaling";
   bool verbose = false;
@@ -141,15 +145,21 @@ int RunDrillForceFit(int argc, char** argv) {
       throw InputError({table_path, table.lines.back(), 0},
                        "expected at least 2 rows to fit 3 coefficients to thrust and torque");
     }
-    const drilling::ForceFitResult fit = drilling::FitDrillingForces(drill.drill, table.rows, options);
+    const drilling::ForceFitResult fit = [&] {
+      try {
+        return drilling::FitDrillingForces(drill.drill, table.rows, options);
+      } catch (const drilling::ForceTableRowError& e) {
+        // Bad data (exit 65) at the row's line, not a bad command line.
+        throw InputError({table_path, table.lines.at(e.row()), 0}, e.what());
+      }
+    }();
     if (fit.status == drilling::FitStatus::kFailed) {
       std::cerr << kTool << ": the fit failed: " << fit.solver_message << "\n";
       return kExitSoftware;
     }
     // Everything computed: now write (each file atomically).
     const std::string yaml = io::MaterialYaml(fit, drill.drill, table);
-    if (out_path.empty() || out_path == "-") std::cout << yaml;
-    else io::WriteFileAtomically(out_path, yaml);
+    io::WriteFileAtomically(out_path.empty() ? "-" : out_path, yaml);
     if (!plot_path.empty()) Plot(plot_path, table, drill.drill, fit.material);
     if (predict) io::WriteFileAtomically(predictions_path, PredictionsCsv(*predict, drill.drill, fit.material));
 
@@ -164,10 +174,23 @@ int RunDrillForceFit(int argc, char** argv) {
       Warn(kTool, "the fit did not converge: " + fit.solver_message);
       rc = kExitFlagged;
     }
+    if (fit.kienzle_exponent_at_bound) {
+      Warn(kTool, "the Kienzle exponent ended on its bound (" + io::FormatDouble(fit.material.kienzle_exponent) +
+                      ", range 0..0.95): the forces do not grow with the feed as a size effect can; check the "
+                      "units of feed_mm_per_rev, thrust_N and torque_Nm");
+      rc = kExitFlagged;
+    }
     if (fit.max_rel_error_thrust > 0.10 || fit.max_rel_error_torque > 0.10) {
       Warn(kTool, "the model misses a row by more than 10 %; check the table and the drill geometry");
       rc = kExitFlagged;
     }
+    // Unit plausibility (drilling/plausibility.h): outputs stay written, exit 3.
+    std::vector<std::string> units = drilling::ForceTableFindings(table.rows);
+    for (const auto& more : {drilling::MaterialFindings(fit.material), drilling::ToolingFindings(drill.drill, nullptr)}) {
+      units.insert(units.end(), more.begin(), more.end());
+    }
+    for (const std::string& f : units) Warn(kTool, "implausible (unit mistake?): " + f);
+    if (!units.empty()) rc = kExitFlagged;
     return rc;
   });
 }

@@ -18,6 +18,7 @@
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/drilling/drilling_sim.h"
+#include "robomach/drilling/plausibility.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/drilling_files.h"
 #include "robomach/io/number_format.h"
@@ -31,7 +32,7 @@ constexpr char kTool[] = "drill-sim";
 
 // "run.csv" + "pd-tdc" -> "run_pd-tdc.csv" (several controllers: one file each).
 std::string WithSuffix(const std::string& path, const std::string& name, bool several) {
-  if (!several || path.empty()) return path;
+  if (!several || path.empty() || path == "-") return path;  // "-": stdout, one after the other
   const std::filesystem::path p(path);
   return (p.parent_path() / (p.stem().string() + "_" + name + p.extension().string())).string();
 }
@@ -157,7 +158,9 @@ int RunDrillSim(int argc, char** argv) {
   AddVersionFlag(app, kTool);
   app.footer("With several controllers each output gets the controller's name before its "
              "extension (run.csv -> run_pid.csv, run_pd-tdc.csv); the plot overlays them.\n" +
-             ExitCodeHelp());
+             ExitCodeHelp() +
+             "\n3 here also: a drill diameter, feed, spindle or cutting speed, or material coefficient outside "
+             "drilling practice (a unit mistake; docs/plausibility.md).");
   std::string robot_path, drill_path, material_path, out_path, summary_path, plot_path;
   std::string controllers = "pd-tdc";
   bool tune = false;
@@ -179,7 +182,7 @@ int RunDrillSim(int argc, char** argv) {
                  "K_P, K_D per joint from the effective inertia; THIRD is r of K_I = K_P OMEGA / r "
                  "(pid) or the Mbar ratio (pd-tdc); FILTER_S the low-pass time constant [s] on e' (pid, pd) "
                  "or q'' (pd-tdc), default 0.005; the starting point of --tune");
-  app.add_option("--out", out_path, "time series CSV (docs/formats.md 9.4)");
+  app.add_option("--out", out_path, "time series CSV (docs/formats.md 9.4); '-' = stdout");
   app.add_option("--summary", summary_path, "summary JSON (docs/formats.md 9.4); stdout if neither --out nor --summary");
   app.add_option("--plot", plot_path, "PNG: joint errors, drill offset, thrust, torque per controller")->check(PngFileName());
   try {
@@ -302,7 +305,7 @@ int RunDrillSim(int argc, char** argv) {
       if (!summary_path.empty()) {
         io::WriteFileAtomically(WithSuffix(summary_path, kind, several), report::DumpJson(j));
       } else if (out_path.empty()) {
-        std::cout << report::DumpJson(j);
+        io::WriteFileAtomically("-", report::DumpJson(j));
       }
     }
     if (!plot_path.empty()) Plot(plot_path, runs, n);
@@ -320,6 +323,11 @@ int RunDrillSim(int argc, char** argv) {
         rc = kExitFlagged;
       }
     }
+    // Unit plausibility (drilling/plausibility.h): outputs stay written, exit 3.
+    std::vector<std::string> units = drilling::ToolingFindings(drill.drill, &drill.process);
+    for (const std::string& f : drilling::MaterialFindings(material)) units.push_back(material_path + ": " + f);
+    for (const std::string& f : units) Warn(kTool, "implausible (unit mistake?): " + f);
+    if (!units.empty()) rc = kExitFlagged;
     return rc;
   });
 }

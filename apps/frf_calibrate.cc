@@ -77,8 +77,9 @@ int Run(int argc, char** argv) {
       "<pose>.png overlay per posture (measured, model before, model after), stabilisation_<pose>.png\n"
       "(the modal fits' stabilisation diagrams), summary.json."};
   AddVersionFlag(app, kTool);
-  app.footer(ExitCodeHelp() + " Exit 3 also when the fit did not converge or a parameter is weakly identified.");
-  std::string robot_path, postures_path, out_path, report_dir, objective = "modal-two-stage";
+  app.footer(ExitCodeHelp() + " Exit 3 also when the fit did not converge or a parameter is weakly identified, "
+                                "or a measured receptance is outside 1e-12..1e-3 m/N (a unit mistake).");
+  std::string robot_path, postures_path, out_path, report_dir, summary_path, objective = "modal-two-stage";
   std::vector<std::string> measured_files, pose_files, validate_files, validate_pose_files, frees, sets, adds;
   bool only_free = false;
   calibration::CalibrationOptions opt;
@@ -86,8 +87,9 @@ int Run(int argc, char** argv) {
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
   app.add_option("--measured", measured_files, "measured FRFs, CSV or UFF58 (.uff/.unv); repeatable");
   app.add_option("--pose", pose_files, "a UFF58 file of one posture whose records lack pose=ID: ID=file.uff; repeatable");
-  app.add_option("--out", out_path, "calibrated robot config YAML")->required();
+  app.add_option("--out", out_path, "calibrated robot config YAML; '-' = stdout")->required();
   app.add_option("--report", report_dir, "report folder (created)")->required();
+  app.add_option("--summary", summary_path, "also write the report's summary.json here ('-' = stdout)");
   app.add_option("--validate", validate_files, "held-out measured FRFs scored with the calibrated model; repeatable");
   app.add_option("--validate-pose", validate_pose_files, "held-out UFF58 file of one posture: ID=file.uff; repeatable");
   app.add_option("--free", frees, "also fit this parameter (any name of the model, e.g. kq2_Nm_per_rad); repeatable");
@@ -115,7 +117,7 @@ int Run(int argc, char** argv) {
                                                                  {"--postures", postures_path}};
       for (const auto& f : measured_files) inputs.emplace_back("--measured", f);
       for (const auto& f : validate_files) inputs.emplace_back("--validate", f);
-      CheckDistinctPaths(inputs, {{"--out", out_path}});
+      CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}});
     }
     if (measured_files.empty() && pose_files.empty()) {
       throw std::invalid_argument("no measured FRFs: give --measured FILE or --pose ID=file.uff");
@@ -228,8 +230,9 @@ int Run(int argc, char** argv) {
     report::WriteTable3Csv((dir / "table3.csv").string(), sets_out);
     report::WriteTable3Markdown((dir / "table3.md").string(), sets_out,
                                 "frf-calibrate: " + robot_path + " against the measured FRFs");
-    bool flagged = false;
-    std::vector<std::string> flags;
+    std::vector<std::string> flags = measured_read.unit_findings;  // implausible units, warned when read
+    flags.insert(flags.end(), holdout_read.unit_findings.begin(), holdout_read.unit_findings.end());
+    bool flagged = !flags.empty();
     double per_residual = NAN;
     if (result.status == calibration::FitStatus::kNotImproved) {
       Warn(kTool, "the calibration did not improve on the start values; " + out_path +
@@ -295,6 +298,7 @@ int Run(int argc, char** argv) {
         report::WriteStabilisationPng((dir / ("stabilisation_" + pose + ".png")).string(), pose, holdout_features);
       }
     }
+    if (!summary_path.empty()) io::WriteFileAtomically(summary_path, report::DumpJson(summary));
     // Matching and errors on stderr, briefly.
     for (const auto& s : sets_out) {
       std::ostringstream m;

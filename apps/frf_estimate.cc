@@ -135,7 +135,7 @@ int Run(int argc, char** argv) {
   calibration::FrfEstimateOptions o;
   int min_hits = 3;
   app.add_option("records", records, "hammer record CSV file(s)")->required();
-  app.add_option("--out", out_path, "output FRF CSV (docs/formats.md section 3)")->required();
+  app.add_option("--out", out_path, "output FRF CSV (docs/formats.md section 3); '-' = stdout")->required();
   app.add_option("--pose-id", pose_id, "pose id written in the FRF file")->capture_default_str();
   app.add_option("--excitation", excitation, "hammer direction at the tool tip: x, y or z")->capture_default_str();
   app.add_option("--direction", directions,
@@ -357,6 +357,7 @@ int Run(int argc, char** argv) {
     }
     if (r.status != calibration::FrfEstimateStatus::kOk) {
       std::cerr << kTool << ": every hit was rejected; no FRF written to " << out_path << '\n';
+      CommitOutputsNow();  // the summary says why (exit 65 otherwise writes nothing)
       return rc;
     }
     std::ostringstream msg;

@@ -84,7 +84,7 @@ int Run(int argc, char** argv) {
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
   app.add_option("--out", out_path, "predicted FRFs, CSV receptance [m/N]; stdout if omitted");
   app.add_option("--modes", modes_path, "modal table CSV: freq_hz, damping_ratio, modal_mass_kg, ux,uy,uz");
-  app.add_option("--details", details_path, "per-posture JSON: J, cond(J), M_q, K_q, C_q, Cartesian M, K, C, compliance, modes");
+  app.add_option("--summary,--details", details_path, "summary JSON per posture ('-' = stdout; --details is the old name): J, cond(J), M_q, K_q, C_q, Cartesian M, K, C, compliance, modes");
   app.add_option("--plot", plot_path, "one PNG sheet with all postures (magnitude and phase)")->check(PngFileName());
   app.add_option("--plot-dir", plot_dir, "folder for one PNG per posture (<pose_id>.png)");
   app.add_option("--fmin-hz", fmin_hz, "lowest frequency line [Hz]")->capture_default_str();
@@ -109,7 +109,7 @@ int Run(int argc, char** argv) {
     RequireReadableFile(postures_path, "posture file");
     if (!freq_file.empty()) RequireReadableFile(freq_file, "frequency file");
     CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}, {"--freq-file", freq_file}},
-                       {{"--out", out_path}, {"--modes", modes_path}, {"--details", details_path},
+                       {{"--out", out_path}, {"--modes", modes_path}, {"--summary", details_path},
                         {"--plot", plot_path}});
     const io::DirectionPairs pairs = io::ParseDirectionPairs(directions);
     Eigen::VectorXd freq_hz;
@@ -191,11 +191,7 @@ int Run(int argc, char** argv) {
     progress.Finish();
 
     // Every output is complete before it appears (docs/formats.md §4).
-    if (out_path.empty()) {
-      io::WritePredictedFrfCsv(std::cout, preds, pairs);
-    } else {
-      io::WritePredictedFrfCsv(out_path, preds, pairs);
-    }
+    io::WritePredictedFrfCsv(out_path.empty() ? "-" : out_path, preds, pairs);
     std::vector<std::string> ids;
     std::vector<std::vector<dynamics::Mode>> modes;
     for (size_t p = 0; p < postures.size(); ++p) {

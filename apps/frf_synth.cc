@@ -2,6 +2,7 @@
 // robot model (effects and parameters as asked) at the postures of a posture
 // file, on a hammer-test grid, with seeded noise, as CSV or UFF58.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cctype>
 
@@ -13,7 +14,9 @@
 #include "robomach/io/frf_files.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/prediction_files.h"
+#include "robomach/io/atomic_file.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/report/posture_json.h"
 
 namespace robomach::apps {
 namespace {
@@ -35,13 +38,15 @@ int Run(int argc, char** argv) {
       "gamma^2 = |H|^2 / (|H|^2 + (n-1) sigma^2), sigma^2 = (rel |H|)^2 + floor^2."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
-  std::string robot_path, postures_path, out_path, directions = "xx,yy", quantity = "receptance";
+  std::string robot_path, postures_path, out_path, summary_path, directions = "xx,yy", quantity = "receptance";
   std::vector<std::string> sets, adds;
   calibration::VirtualHammerOptions o;
   double fs_hz = NAN;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
-  app.add_option("--out", out_path, "output file: .csv (docs/formats.md §3) or .uff/.unv (UFF58 ASCII)")->required();
+  app.add_option("--out", out_path, "output file: .csv (docs/formats.md §3) or .uff/.unv (UFF58 ASCII); '-' = stdout (CSV)")->required();
+  app.add_option("--summary", summary_path,
+                 "summary JSON (docs/formats.md §4.1): inputs, grid, noise, per FRF its peak; '-' = stdout");
   app.add_option("--set", sets, "override a model parameter, NAME=VALUE in its unit (e.g. m6_kg=31.5)");
   app.add_option("--add", adds, "switch on an effect by name with its default parameters (e.g. tip_mass)");
   app.add_option("--directions", directions, "response/excitation pairs, e.g. xx,yy,xy")->capture_default_str();
@@ -76,7 +81,8 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--averages", o.averages, o.coherence ? 2 : 1, 100000);
     RequireReadableFile(robot_path, "robot config");
     RequireReadableFile(postures_path, "posture file");
-    CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}}, {{"--out", out_path}});
+    CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}},
+                       {{"--out", out_path}, {"--summary", summary_path}});
     o.directions.clear();
     for (const auto& [r, e] : io::ParseDirectionPairs(directions)) {
       o.directions.emplace_back(static_cast<Axis>(r), static_cast<Axis>(e));
@@ -107,6 +113,47 @@ int Run(int argc, char** argv) {
       io::WriteUff58(out_path, frfs, q);
     } else {
       io::WriteFrfCsv(out_path, frfs, q, o.coherence ? o.averages : 0);
+    }
+    if (!summary_path.empty()) {
+      nlohmann::json j;
+      j["tool"] = kTool;
+      j["robot"] = robot_path;
+      j["postures"] = postures_path;
+      j["sets"] = sets;
+      j["adds"] = adds;
+      j["out"] = out_path;
+      j["format"] = out_path != "-" && (ext == "uff" || ext == "unv" || ext == "uf") ? "uff58" : "csv";
+      j["quantity"] = quantity;
+      j["sample_rate_hz"] = o.sample_rate_hz;
+      j["block_samples"] = o.block_samples;
+      j["line_spacing_hz"] = o.sample_rate_hz / o.block_samples;
+      j["fmin_hz"] = o.fmin_hz;
+      j["fmax_hz"] = o.fmax_hz;
+      j["noise_rel"] = o.relative_noise;
+      j["noise_abs_m_per_N"] = o.absolute_noise_m_per_N;
+      j["noise_abs_m_per_s_per_N"] = o.absolute_noise_m_per_s_per_N;
+      j["noise_abs_m_per_s2_per_N"] = o.absolute_noise_m_per_s2_per_N;
+      j["hammer_cutoff_hz"] = o.hammer_cutoff_hz;
+      j["averages"] = o.averages;
+      j["coherence"] = o.coherence;
+      j["seed"] = o.seed;
+      j["frf_count"] = frfs.size();
+      // Per FRF: the line of largest |H| (receptance, with the noise, as written).
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& [key, frf] : frfs) {
+        Eigen::Index k = 0;
+        const double peak = frf.receptance().cwiseAbs().maxCoeff(&k);
+        list.push_back({{"pose_id", key.pose_id},
+                        {"response", std::string(1, AxisName(key.response))},
+                        {"excitation", std::string(1, AxisName(key.excitation))},
+                        {"lines", frf.size()},
+                        {"freq_min_hz", frf.freq_hz()(0)},
+                        {"freq_max_hz", frf.freq_hz()(frf.size() - 1)},
+                        {"peak_freq_hz", frf.freq_hz()(k)},
+                        {"peak_receptance_m_per_N", peak}});
+      }
+      j["frfs"] = list;
+      io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }
     std::ostringstream msg;
     msg << kTool << ": wrote " << frfs.size() << " FRFs of " << calibration::HammerTestGrid(o).size()

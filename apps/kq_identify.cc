@@ -178,11 +178,7 @@ int RunPlan(const io::RobotConfig& cfg, int num_postures, double noise_mm, unsig
     for (int a = 0; a < 3; ++a) csv << "," << io::FormatDouble(MToMm(l.p_pulley(a)));
     csv << "\n";
   }
-  if (out_path.empty()) {
-    std::cout << csv.str();
-  } else {
-    io::WriteFileAtomically(out_path, csv.str());
-  }
+  io::WriteFileAtomically(out_path.empty() ? "-" : out_path, csv.str());
   std::cerr << kTool << ": plan of " << num_postures << " postures x " << o.directions_per_posture
             << " rope directions x " << masses_kg.size() << " masses = " << plan.cases.size()
             << " load cases; expected standard deviations for a tracker noise of " << noise_mm << " mm:\n";
@@ -254,7 +250,7 @@ int Run(int argc, char** argv) {
                  "config; with --plan the plan CSV");
   app.add_option("--residuals", residuals_path, "residual of every case, CSV [mm]");
   app.add_option("--plot", plot_path, "residual plot, PNG")->check(PngFileName());
-  app.add_option("--json", json_path, "the full result as JSON (stiffness, covariance, residuals, advice)");
+  app.add_option("--summary,--json", json_path, "summary JSON ('-' = stdout; --json is the old name): the full result (stiffness, covariance, residuals, advice)");
   app.add_option("--robust", robust,
                  "robust loss against outlier cases: cauchy or huber (outliers are then left out)")
       ->check(CLI::IsMember({"cauchy", "huber"}))
@@ -290,7 +286,7 @@ int Run(int argc, char** argv) {
     RequireReadableFile(robot_path, "robot config");
     CheckDistinctPaths({{"--robot", robot_path}, {"--tracker", tracker_path}},
                        {{"--out", out_path}, {"--residuals", residuals_path}, {"--plot", plot_path},
-                        {"--json", json_path}});
+                        {"--summary", json_path}});
     const io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
     if (plan_n != 0) {
       if (plan_n < 1) throw std::invalid_argument("--plan: expected a number of postures >= 1");
@@ -345,8 +341,7 @@ int Run(int argc, char** argv) {
       ko.as_parameters = as_parameters;
       ko.header_comments = header;
       const std::string yaml = io::JointStiffnessYaml(r, ko);
-      if (out_path.empty()) std::cout << yaml;
-      else io::WriteFileAtomically(out_path, yaml);
+      io::WriteFileAtomically(out_path.empty() ? "-" : out_path, yaml);
     }
     if (!residuals_path.empty()) WriteResidualsCsv(residuals_path, r, cases);
     if (!plot_path.empty()) {

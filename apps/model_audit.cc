@@ -94,8 +94,9 @@ int Run(int argc, char** argv) {
   app.footer(ExitCodeHelp() +
              " Exit 3 when the failure is significant and not explained within the noise: unexplained, or mostly "
              "explained (the effect is named and effects.yaml written, but a misfit remains), or a fit failed (the "
-             "report is complete; candidates.csv says which and why).");
-  std::string robot_path, postures_path, report_dir, compare_dir, candidates_list;
+             "report is complete; candidates.csv says which and why), or a measured receptance is outside 1e-12..1e-3 "
+             "m/N (a unit mistake).");
+  std::string robot_path, postures_path, report_dir, compare_dir, candidates_list, summary_path;
   std::vector<std::string> measured_files, pose_files, adds;
   audit::AuditOptions opt;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
@@ -103,6 +104,7 @@ int Run(int argc, char** argv) {
   app.add_option("--measured", measured_files, "measured FRFs, CSV or UFF58 (.uff/.unv/.ufb); repeatable");
   app.add_option("--pose", pose_files, "a UFF58 file of one posture whose records lack pose=ID: ID=file.uff; repeatable");
   app.add_option("--report", report_dir, "report folder (created)")->required();
+  app.add_option("--summary", summary_path, "also write the report's summary.json here ('-' = stdout, after the effects YAML)");
   app.add_option("--add", adds, "switch on an effect before the audit (e.g. the winner of a previous one); its fittable parameters are calibrated too; repeatable");
   app.add_option("--compare", compare_dir, "a previous audit's report folder: its errors are shown next to these");
   app.add_option("--candidates", candidates_list, "comma-separated effects to try; default: every library effect not in the model");
@@ -140,7 +142,7 @@ int Run(int argc, char** argv) {
                                                                   {"--postures", postures_path}};
       for (const auto& f : measured_files) inputs.push_back({"--measured", f});
       for (const auto& f : pose_files) inputs.push_back({"--pose", f.substr(f.find('=') + 1)});
-      CheckDistinctPaths(inputs, {{"--report", report_dir}});
+      CheckDistinctPaths(inputs, {{"--report", report_dir}, {"--summary", summary_path}});
     }
     if (measured_files.empty() && pose_files.empty()) {
       throw std::invalid_argument("no measured FRFs: give --measured FILE or --pose ID=file.uff");
@@ -552,15 +554,20 @@ int Run(int argc, char** argv) {
     if (!pr.mode_error_map_png.empty()) write_png(names.mode_error_map_png, pr.mode_error_map_png);
     io::WriteFileAtomically((dir / "index.html").string(), h.str());
     io::WriteFileAtomically((dir / "summary.json").string(), report::DumpJson(j));
+    if (!summary_path.empty() && summary_path != "-") io::WriteFileAtomically(summary_path, report::DumpJson(j));
 
     std::cerr << kTool << ": " << r.verdict << '\n';
     for (const auto& w : r.warnings) Warn(kTool, w);
     bool failed_candidate = false;
     for (const auto& c : r.candidates) failed_candidate |= c.fit.status == calibration::FitStatus::kFailed;
     if (failed_candidate) Warn(kTool, "a candidate's fit failed; its row in candidates.csv says why");
-    std::cout << yaml;
-    return (r.significant_failure && !r.explained) || !r.warnings.empty() || failed_candidate ? kExitFlagged
-                                                                                              : kExitOk;
+    io::WriteFileAtomically("-", yaml);
+    if (summary_path == "-") io::WriteFileAtomically("-", report::DumpJson(j));
+    // measured_read.unit_findings: receptances outside the plausible range, warned when read.
+    return (r.significant_failure && !r.explained) || !r.warnings.empty() || failed_candidate ||
+                   !measured_read.unit_findings.empty()
+               ? kExitFlagged
+               : kExitOk;
   });
 }
 

@@ -123,8 +123,7 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
         << Short6(r.v_size_mm) << ',' << (r.trimmed ? 1 : 0) << ','
         << r.holes << ',' << (r.polishable ? 1 : 0) << ',' << CsvField(r.reason) << '\n';
   }
-  if (out.empty()) std::cout << csv.str();
-  else io::WriteFileAtomically(out, csv.str());
+  io::WriteFileAtomically(out.empty() ? "-" : out, csv.str());
   return kExitOk;
 }
 
@@ -540,8 +539,7 @@ int Run(int argc, char** argv) {
     robot.WriteJoints(e.path.rows);
     if (!plot_out.empty()) WritePictures(plot_out, grid, e.removal, e.path.rows, e.path.guide_lines_st, history, pattern, evaluated);
     const std::string text = summary.dump(2) + "\n";
-    if (!summary_out.empty()) io::WriteFileAtomically(summary_out, text);
-    else std::cout << text;
+    io::WriteFileAtomically(summary_out.empty() ? "-" : summary_out, text);
     return flagged ? kExitFlagged : kExitOk;
   });
 }

@@ -131,8 +131,7 @@ int Run(int argc, char** argv) {
     robot.WriteJoints(file.rows);
     if (!plot_out.empty()) WritePictures(plot_out, grid, removal, file.rows, {}, {}, "polish-sim");
     const std::string text = report::DumpJson(summary);
-    if (!summary_out.empty()) io::WriteFileAtomically(summary_out, text);
-    else std::cout << text;
+    io::WriteFileAtomically(summary_out.empty() ? "-" : summary_out, text);
     return flagged ? kExitFlagged : kExitOk;
   });
 }

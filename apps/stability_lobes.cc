@@ -2,6 +2,7 @@
 // semi-discretization) of a tool tip given by the robot model at a
 // posture, by a measured or predicted FRF file, or by a modal table.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <climits>
 #include <cstdio>
@@ -28,6 +29,7 @@
 #include "robomach/io/tip_dynamics_files.h"
 #include "robomach/report/modal_fit_plot.h"
 #include "robomach/report/plot.h"
+#include "robomach/report/posture_json.h"
 #include "robomach/stability/measured_tip_model.h"
 #include "robomach/stability/semi_discretization.h"
 #include "robomach/stability/tool_tip_model.h"
@@ -65,11 +67,17 @@ struct LobeRow {
   stability::LobePoint point;
 };
 
-// FRF files, CSV or UFF58 by extension; reader warnings go to stderr.
+// FRF files, CSV or UFF58 by extension; reader warnings go to stderr, and
+// so do receptances outside the plausible range (counted: exit 3).
+int g_implausible_frfs = 0;
 std::vector<io::FrfSetOfPose> ReadFrfFile(const std::string& path) {
   std::vector<std::string> warnings;
   auto sets = io::ReadTipFrfs(path, "", &warnings);
   for (const std::string& w : warnings) Warn(kTool, w);
+  for (const std::string& f : io::ReceptanceUnitFindings(sets)) {
+    Warn(kTool, "implausible (unit mistake?): " + f);
+    ++g_implausible_frfs;
+  }
   return sets;
 }
 
@@ -460,13 +468,14 @@ int Run(int argc, char** argv) {
       "FRF file (docs/formats.md §3) or a modal table (§4)."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
-             " Exit 3 when some speeds have no stability boundary, when a measured FRF's modal fit is poor "
+             " Exit 3 when some speeds have no stability boundary, when a measured receptance is outside "
+             "1e-12..1e-3 m/N (a unit mistake, e.g. a mobility read as receptance), when a measured FRF's modal fit is poor "
              "(misfit above 3 x the noise), finds no mode (then no SD lobes) or a mode at the edge of the usable "
              "band, when the FRF is not a passive driving point (Im H > 0 on more than 5 % of its usable lines), "
              "or when --method both finds the "
              "SD's and the ZOA's smallest depths more than 10 % apart at a radial immersion of 0.3 or more.");
   std::string robot_path, cut_path, postures_path, frf_path, frf_y_path, modal_path, out_path, plot_path,
-      fit_plot_path, modes_out_path, method = "zoa", tool_axis_text = "0,0,1";
+      fit_plot_path, modes_out_path, summary_path, method = "zoa", tool_axis_text = "0,0,1";
   std::vector<std::string> pose_ids;
   int speeds = 0, sd_speeds = 60, sd_steps = 0, sd_modes = 3, threads = 0, max_lobe = 30;
   double sd_max_depth_mm = 20.0;
@@ -494,6 +503,9 @@ int Run(int argc, char** argv) {
   app.add_option("--method", method, "zoa, sd or both")->check(CLI::IsMember({"zoa", "sd", "both"}))->capture_default_str();
   app.add_option("--out", out_path, "lobes CSV (spindle_speed_rpm, critical_depth_mm, chatter_freq_hz, lobe_index, method); stdout if omitted");
   app.add_option("--plot", plot_path, "lobe diagram PNG (speed [rpm] against depth [mm])")->check(PngFileName());
+  app.add_option("--summary", summary_path,
+                 "summary JSON (docs/formats.md §4.1): inputs, per posture and method the smallest and largest "
+                 "critical depth and their speeds, status; '-' = stdout");
   app.add_option("--speeds", speeds, "ZOA: number of spindle speeds in the cut's range (default: the cut file's spindle_speed_count)");
   app.add_option("--max-lobe", max_lobe, "ZOA: highest lobe index traced")->capture_default_str();
   app.add_option("--sd-speeds", sd_speeds, "SD: number of spindle speeds in the cut's range")->capture_default_str();
@@ -545,7 +557,7 @@ int Run(int argc, char** argv) {
     CheckDistinctPaths({{"--cut", cut_path}, {"--robot", robot_path}, {"--postures", postures_path},
                         {"--frf", frf_path}, {"--frf-y", frf_y_path}, {"--modal-table", modal_path}},
                        {{"--out", out_path}, {"--plot", plot_path}, {"--fit-plot", fit_plot_path},
-                        {"--modes-out", modes_out_path}});
+                        {"--modes-out", modes_out_path}, {"--summary", summary_path}});
     for (const auto& [p, what] : {std::pair{robot_path, "robot config"}, {postures_path, "posture file"},
                                   {frf_path, "FRF file"}, {frf_y_path, "FRF file (--frf-y)"},
                                   {modal_path, "modal table"}}) {
@@ -617,7 +629,7 @@ int Run(int argc, char** argv) {
       }
       if (tips.empty()) throw InputError({modal_path, 0, 0}, "none of the requested postures is in the file");
     }
-    bool flagged = false;
+    bool flagged = g_implausible_frfs > 0;
     for (const TipDynamics& t : tips) {
       for (const DirectionFit& d : t.fits) {
         if (d.fit.not_driving_point) {
@@ -726,11 +738,7 @@ int Run(int argc, char** argv) {
            << stability::ToString(p.status) << ',' << (p.sd_steps > 0 ? std::to_string(p.sd_steps) : "") << '\n';
       }
     };
-    if (out_path.empty()) {
-      write(std::cout);
-    } else {
-      io::WriteFileAtomically(out_path, write);
-    }
+    io::WriteFileAtomically(out_path.empty() ? "-" : out_path, write);
     if (!plot_path.empty()) {
       report::Figure fig(1, 1, 1000, 560);
       fig.title = "robomach stability-lobes: " + cut_path;
@@ -762,6 +770,66 @@ int Run(int argc, char** argv) {
     if (!fit_plot_path.empty()) PlotFits(fit_plot_path, frf_path, tips);
     if (no_boundary) Warn(kTool, "some speeds have no boundary (status column): widen the FRF band or the lobe range");
     flagged |= no_boundary;
+    if (!summary_path.empty()) {
+      nlohmann::json j;
+      j["tool"] = kTool;
+      j["cut"] = cut_path;
+      j["source"] = !robot_path.empty() ? "robot" : !frf_path.empty() ? "frf" : "modal_table";
+      if (!robot_path.empty()) {
+        j["robot"] = robot_path;
+        j["postures"] = postures_path;
+      }
+      if (!frf_path.empty()) j["frf"] = frf_path;
+      if (!frf_y_path.empty()) j["frf_y"] = frf_y_path;
+      if (!modal_path.empty()) j["modal_table"] = modal_path;
+      j["method"] = method;
+      j["teeth"] = cut.process.teeth;
+      j["radial_immersion"] = cut.process.radial_immersion;
+      j["lobes_csv"] = out_path.empty() ? "-" : out_path;
+      nlohmann::json results = nlohmann::json::array();
+      for (const TipDynamics& t : tips) {
+        for (const char* m : {"zoa", "sd"}) {
+          nlohmann::json r;
+          int points = 0, ok = 0;
+          double min_depth = INFINITY, max_depth = -INFINITY, min_speed = NAN, max_speed = NAN, min_freq = NAN;
+          for (const LobeRow& row : rows) {
+            if (row.id != t.id || row.method != m) continue;
+            ++points;
+            const auto& p = row.point;
+            if (!std::isfinite(p.critical_depth)) continue;
+            ++ok;
+            const double d = MToMm(p.critical_depth), rpm = RoundRpm(RadPerSecToRpm(p.spindle_speed_rad_s));
+            if (d < min_depth) {
+              min_depth = d;
+              min_speed = rpm;
+              min_freq = p.chatter_freq_hz;
+            }
+            if (d > max_depth) {
+              max_depth = d;
+              max_speed = rpm;
+            }
+          }
+          if (points == 0) continue;
+          r["pose_id"] = t.id;
+          r["method"] = m;
+          r["speeds"] = points;
+          r["speeds_with_boundary"] = ok;
+          if (ok > 0) {
+            r["min_critical_depth_mm"] = min_depth;
+            r["min_critical_depth_speed_rpm"] = min_speed;
+            if (std::isfinite(min_freq)) r["min_critical_depth_chatter_freq_hz"] = min_freq;
+            r["max_critical_depth_mm"] = max_depth;
+            r["max_critical_depth_speed_rpm"] = max_speed;
+          }
+          results.push_back(r);
+        }
+      }
+      j["lobes"] = results;
+      j["no_boundary_at_some_speeds"] = no_boundary;
+      j["flagged"] = flagged;
+      j["exit_code"] = flagged ? kExitFlagged : kExitOk;
+      io::WriteFileAtomically(summary_path, report::DumpJson(j));
+    }
     return flagged ? kExitFlagged : kExitOk;
   });
 }

@@ -1,6 +1,9 @@
 // stability-map: chatter limits (mode coupling and regenerative) over a
 // rectangle of the workspace or along a tool path, with IK per point.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <map>
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +19,7 @@
 #include "robomach/io/region_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/report/heat_map.h"
+#include "robomach/report/posture_json.h"
 #include "robomach/stability/stability_map.h"
 
 namespace robomach::apps {
@@ -38,7 +42,7 @@ int Run(int argc, char** argv) {
       "speed of its range); optionally the rotation about the tool axis that maximises the depth."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
-  std::string robot_path, cut_path, region_path, path_path, out_path, plot_path;
+  std::string robot_path, cut_path, region_path, path_path, out_path, plot_path, summary_path;
   int threads = 0, speeds = 0, rotation_evals = 20;
   double max_depth_mm = 50.0;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
@@ -47,6 +51,9 @@ int Run(int argc, char** argv) {
   app.add_option("--path", path_path, "tool-path CSV: x_mm,y_mm,z_mm,tool_i,tool_j,tool_k[,feed_i,feed_j,feed_k][,rotation_deg][,point_id]; the tool axis points from the tip to the spindle; rotation_deg is added to the region's rotation about the tool axis; the region file gives the seed posture");
   app.add_option("--out", out_path, "per-point CSV; stdout if omitted");
   app.add_option("--plot", plot_path, "heat map PNG of the critical depth [mm] (grid only)")->check(PngFileName());
+  app.add_option("--summary", summary_path,
+                 "summary JSON (docs/formats.md §4.1): inputs, point counts by status, the smallest and largest "
+                 "critical depth and where; '-' = stdout");
   app.add_option("--threads", threads, "worker threads, 0 = all cores")->capture_default_str();
   app.add_option("--speeds", speeds, "speeds scanned for the best one (default: the cut file's spindle_speed_count)");
   app.add_option("--max-depth-mm", max_depth_mm, "largest depth searched for mode coupling [mm]")->capture_default_str();
@@ -70,7 +77,7 @@ int Run(int argc, char** argv) {
     RequireReadableFile(cut_path, "cut file");
     RequireReadableFile(region_path, "region file");
     CheckDistinctPaths({{"--robot", robot_path}, {"--cut", cut_path}, {"--region", region_path}, {"--path", path_path}},
-                       {{"--out", out_path}, {"--plot", plot_path}});
+                       {{"--out", out_path}, {"--plot", plot_path}, {"--summary", summary_path}});
     if (!path_path.empty()) RequireReadableFile(path_path, "tool-path file");
     const auto model = io::LoadRobotConfig(robot_path).Build();
     const io::CutSpec cut = io::ReadCutFile(cut_path);
@@ -192,11 +199,7 @@ int Run(int argc, char** argv) {
       }
     };
     if (!plot_path.empty() && !grid) Warn(kTool, "--plot draws grids only; ignored with --path");
-    if (out_path.empty()) {
-      write(std::cout);
-    } else {
-      io::WriteFileAtomically(out_path, write);
-    }
+    io::WriteFileAtomically(out_path.empty() ? "-" : out_path, write);
     if (!plot_path.empty() && grid) {
       report::HeatMap hm;
       hm.title = "robomach stability-map: critical axial depth (" + cut_path + ")";
@@ -214,6 +217,63 @@ int Run(int argc, char** argv) {
         hm.marks.push_back(out ? 1 : 0);
       }
       report::SaveHeatMapPng(hm, plot_path);
+    }
+    if (!summary_path.empty()) {
+      nlohmann::json j;
+      j["tool"] = kTool;
+      j["robot"] = robot_path;
+      j["cut"] = cut_path;
+      if (!region_path.empty()) j["region"] = region_path;
+      if (!path_path.empty()) j["path"] = path_path;
+      j["mode"] = grid ? "grid" : "path";
+      j["points_csv"] = out_path.empty() ? "-" : out_path;
+      j["points"] = pts.size();
+      if (grid) {
+        j["grid_rows"] = rows;
+        j["grid_cols"] = cols;
+      }
+      j["points_reached"] = reached;
+      j["points_flagged"] = flagged;
+      std::map<std::string, int> by_status;
+      for (const auto& p : pts) ++by_status[stability::ToString(p.status)];
+      j["points_by_status"] = by_status;
+      // The extremes of critical_depth_mm over the points that have one, with
+      // the point as in the CSV (row,col or point_id).
+      auto where = [&](size_t i) {
+        nlohmann::json w;
+        if (grid) {
+          w["row"] = static_cast<int>(i) / cols;
+          w["col"] = static_cast<int>(i) % cols;
+        } else {
+          w["point_id"] = ids[i];
+        }
+        w["px_mm"] = MToMm(targets[i].p_BT.x());
+        w["py_mm"] = MToMm(targets[i].p_BT.y());
+        w["pz_mm"] = MToMm(targets[i].p_BT.z());
+        w["critical_depth_mm"] = MToMm(pts[i].stability.critical_depth);
+        w["limiting_mechanism"] = stability::ToString(pts[i].stability.limiting);
+        if (std::isfinite(pts[i].stability.chatter_freq_hz)) w["chatter_freq_hz"] = pts[i].stability.chatter_freq_hz;
+        w["status"] = stability::ToString(pts[i].status);
+        return w;
+      };
+      long with_depth = 0;
+      size_t lo = 0, hi = 0;
+      for (size_t i = 0; i < pts.size(); ++i) {
+        const double d = pts[i].stability.critical_depth;
+        if (!std::isfinite(d)) continue;
+        if (with_depth == 0 || d < pts[lo].stability.critical_depth) lo = i;
+        if (with_depth == 0 || d > pts[hi].stability.critical_depth) hi = i;
+        ++with_depth;
+      }
+      j["points_with_critical_depth"] = with_depth;
+      if (with_depth > 0) {
+        j["min_critical_depth_mm"] = MToMm(pts[lo].stability.critical_depth);
+        j["max_critical_depth_mm"] = MToMm(pts[hi].stability.critical_depth);
+        j["min_critical_depth_point"] = where(lo);
+        j["max_critical_depth_point"] = where(hi);
+      }
+      j["exit_code"] = flagged > 0 ? kExitFlagged : kExitOk;
+      io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }
     if (flagged > 0) {
       Warn(kTool, std::to_string(flagged) + " of " + std::to_string(pts.size()) +

@@ -2,7 +2,10 @@
 // config and writes it in the tracker format (docs/formats.md §2), to rehearse a
 // campaign or to test kq-identify.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <sstream>
 
@@ -14,7 +17,9 @@
 #include "robomach/io/number_format.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/io/atomic_file.h"
 #include "robomach/io/tracker_file.h"
+#include "robomach/report/posture_json.h"
 
 namespace robomach::apps {
 namespace {
@@ -29,14 +34,17 @@ int Run(int argc, char** argv) {
       "with Gaussian noise, optional gross outliers. Seeded: the same options give the same file."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
-  std::string robot_path, out_path, postures_path, plan_path, masses = "10,20,30", load_point = "150,0,100",
+  std::string robot_path, out_path, summary_path, postures_path, plan_path, masses = "10,20,30", load_point = "150,0,100",
                                                    target = "0,120,50", form = "rope";
   std::vector<std::string> pulleys{"1600,-1200,0", "1600,1200,0"}, sets;
   int num_postures = 12, outliers = 0;
   double noise_mm = 0.01, outlier_mm = 1.0, min_reach_mm = 1500.0;
   unsigned seed = 1;
   app.add_option("--robot", robot_path, "robot config YAML; its joint stiffness is the truth")->required();
-  app.add_option("--out", out_path, "tracker CSV to write (stdout if omitted)");
+  app.add_option("--out", out_path, "tracker CSV to write (stdout if omitted or '-')");
+  app.add_option("--summary", summary_path,
+                 "summary JSON (docs/formats.md §4.1): inputs, load cases, outliers, the true joint stiffness, "
+                 "deflections; '-' = stdout");
   app.add_option("--postures", postures_path, "posture file CSV (docs/formats.md §1); default: random postures");
   app.add_option("--plan-file", plan_path,
                  "a plan from kq-identify --plan: its postures and pulleys (and load point and target "
@@ -75,7 +83,7 @@ int Run(int argc, char** argv) {
     RequireReadableFile(robot_path, "robot config");
     if (!postures_path.empty()) RequireReadableFile(postures_path, "posture file");
     CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}, {"--plan-file", plan_path}},
-                       {{"--out", out_path}});
+                       {{"--out", out_path}, {"--summary", summary_path}});
     if (!plan_path.empty()) RequireReadableFile(plan_path, "plan file");
     if (!plan_path.empty() && !postures_path.empty()) {
       throw std::invalid_argument("--plan-file and --postures exclude each other");
@@ -171,10 +179,42 @@ int Run(int argc, char** argv) {
     std::string bad_ids;
     for (int c : bad) bad_ids += (bad_ids.empty() ? "" : " ") + ms[c].case_id;
     if (!bad.empty()) meta.emplace_back("outlier_cases", bad_ids);
-    if (out_path.empty()) {
-      io::WriteTrackerFile(std::cout, ms, meta);
-    } else {
-      io::WriteTrackerFile(out_path, ms, meta);
+    io::WriteTrackerFile(out_path.empty() ? "-" : out_path, ms, meta);
+    if (!summary_path.empty()) {
+      nlohmann::json j;
+      j["tool"] = kTool;
+      j["robot"] = robot_path;
+      j["postures_source"] = !plan_path.empty() ? "plan" : !postures_path.empty() ? "postures" : "random";
+      if (!plan_path.empty()) j["plan_file"] = plan_path;
+      if (!postures_path.empty()) j["postures"] = postures_path;
+      j["out"] = out_path.empty() ? "-" : out_path;
+      j["seed"] = seed;
+      j["tracker_noise_mm"] = noise_mm;
+      j["masses_kg"] = o.masses_kg;
+      j["form"] = form;
+      j["outliers_asked"] = outliers;
+      j["outlier_mm"] = outlier_mm;
+      j["load_cases"] = ms.size();
+      j["postures_count"] = ids.size();
+      j["pose_ids"] = ids;
+      std::vector<std::string> outlier_cases;
+      for (int c : bad) outlier_cases.push_back(ms[c].case_id);
+      j["outlier_cases"] = outlier_cases;
+      std::vector<double> kq(model->joint_stiffness().data(),
+                             model->joint_stiffness().data() + model->joint_stiffness().size());
+      j["truth_kq_Nm_per_rad"] = kq;
+      // Deflection of the target under load, |p1 - p0| with the tracker noise.
+      double dmin = INFINITY, dmax = 0.0;
+      for (const auto& m : ms) {
+        const double d = MToMm((m.p1 - m.p0).norm());
+        dmin = std::min(dmin, d);
+        dmax = std::max(dmax, d);
+      }
+      if (!ms.empty()) {
+        j["deflection_min_mm"] = dmin;
+        j["deflection_max_mm"] = dmax;
+      }
+      io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }
     std::cerr << kTool << ": " << ms.size() << " load cases (" << ids.size() << " postures x "
               << (plan_pulleys.empty() ? o.pulleys.size() : plan_pulleys[0].size()) << " rope directions x " << o.masses_kg.size() << " masses)"

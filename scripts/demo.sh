@@ -36,7 +36,7 @@ run() {
 
 echo "demo: 1. predicting the tool-tip FRFs of config/kr210.yaml at five postures" >&2
 run "$build/apps/frf-predict" --robot config/kr210.yaml --postures config/postures_demo.csv \
-  --out "$out/pred.csv" --modes "$out/modes.csv" --details "$out/details.json" \
+  --out "$out/pred.csv" --modes "$out/modes.csv" --summary "$out/details.json" \
   --plot "$out/frf.png" --plot-dir "$out/frf"
 
 echo "demo: 2. auditing the model against the hammer tests in config/demo/ (all library effects are candidates)" >&2

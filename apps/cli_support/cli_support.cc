@@ -12,6 +12,7 @@
 
 #include "robomach/common/errors.h"
 #include "robomach/common/version.h"
+#include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 
 namespace robomach::apps {
@@ -29,7 +30,12 @@ int RunGuarded(const std::string& tool, const std::function<int()>& body) {
   // words, so glog's lines below FATAL are silenced.
   FLAGS_minloglevel = google::GLOG_FATAL;
   try {
+    // Every output of the run is staged and appears only if the run ends
+    // with 0 or 3 (docs/conventions.md: all or nothing); an exception or an
+    // error exit destroys the run, which removes what it staged.
+    io::OutputRun outputs;
     const int rc = body();
+    if (rc == kExitOk || rc == kExitFlagged) outputs.Commit();
     // Results on stdout count as output: a full disk or closed pipe is an
     // error, not a silent success.
     std::cout.flush();
@@ -54,6 +60,10 @@ int RunGuarded(const std::string& tool, const std::function<int()>& body) {
     std::cerr << tool << ": internal error: " << e.what() << '\n';
     return kExitSoftware;
   }
+}
+
+void CommitOutputsNow() {
+  if (io::OutputRun* run = io::OutputRun::Active()) run->Commit();
 }
 
 void RequireReadableFile(const std::string& path, const std::string& what) {

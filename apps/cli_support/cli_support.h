@@ -35,7 +35,17 @@ std::string ExitCodeHelp();
 /// Runs `body` and maps exceptions to exit codes with one message on stderr
 /// prefixed by the tool name: InputError -> 65, OutputError -> 73,
 /// std::invalid_argument (bad option values) -> 64, anything else -> 70.
+/// The run is all or nothing: `body` runs inside an io::OutputRun, so every
+/// file written with io::WriteFileAtomically (and "-", stdout) is staged and
+/// put into place only when `body` returns 0 or 3; otherwise, or when it
+/// throws, nothing of the run appears. Write results to stdout with
+/// io::WriteFileAtomically("-", ...), never with std::cout directly.
 int RunGuarded(const std::string& tool, const std::function<int()>& body);
+
+/// Puts the outputs written so far into place now, for the rare tool whose
+/// error exit still leaves a diagnostic output (frf-estimate's --summary
+/// when every hit was rejected). Later writes go straight to their files.
+void CommitOutputsNow();
 
 /// @throws InputError "path: no such file" if `path` is not a readable file;
 /// RunGuarded maps it to 66.

@@ -20,6 +20,10 @@ MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::s
     const io::FrfReadResult r = io::ReadFrfFile(path, pose);
     for (const std::string& w : r.warnings) Warn(tool, w);
     for (const std::string& n : r.notes) Note(tool, n);
+    for (const std::string& f : dynamics::ReceptanceUnitFindings(r.frfs, path)) {
+      Warn(tool, "implausible (unit mistake?): " + f);
+      all.unit_findings.push_back(f);
+    }
     for (const auto& [key, frf] : r.frfs) {
       if (key.pose_id.empty()) {
         throw InputError({path, 0, 0}, "the FRFs of this file name no posture: give it as " + pose_option + " P1=" + path +
@@ -54,7 +58,7 @@ void AddNoiseOptions(CLI::App& app, NoiseCliOptions* o) {
       ->capture_default_str();
   app.add_option("--min-snr", o->min_snr,
                  "a line is used where |H| is at least this many times the additive noise floor (3: the "
-                 "log-magnitude and phase residuals are unbiased there; see README)")
+                 "log-magnitude and phase residuals are unbiased there; see docs/noise-model.md)")
       ->capture_default_str();
   app.add_flag("--drift-floor", o->drift_floor,
                "tap tests whose integrated accelerometer drifts at low frequency: the noise floor also from "

@@ -24,6 +24,10 @@ struct MeasuredData {
   dynamics::FrfSet frfs;
   std::map<dynamics::FrfKey, int> averages;
   std::map<dynamics::FrfKey, std::string> file;
+  /// FRFs whose receptance is outside the plausible range
+  /// (dynamics::ReceptanceUnitFindings; printed as warnings): a unit
+  /// mistake, which the tools flag (exit 3).
+  std::vector<std::string> unit_findings;
 };
 
 /// Reads `files` (CSV or UFF58) and `pose_files` ("ID=file.uff") into one

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -9,6 +11,7 @@
 #include <ceres/ceres.h>
 
 #include "robomach/calibration/frf_noise.h"
+#include "robomach/common/errors.h"
 #include "robomach/common/golden_section.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -260,6 +263,10 @@ struct ModelResidual {
   std::vector<Eigen::VectorXd> curve_weights;            // LogResidualWeights of each curve
   double freq_sigma{1.0}, peak_sigma{1.0};
   int num_residuals{0};
+  // The first exception other than a NumericalError raised in an evaluation
+  // (bad input, a bug). Ceres cannot carry it, so the evaluation fails and
+  // SolveStage rethrows it after the solve; shared by the copies.
+  std::shared_ptr<std::exception_ptr> error = std::make_shared<std::exception_ptr>();
 
   int CountResiduals() const {
     switch (kind) {
@@ -303,6 +310,7 @@ struct ModelResidual {
   }
 
   bool operator()(double const* const* parameters, double* residuals) const {
+    if (*error) return false;  // the solve ends; SolveStage rethrows
     try {
       const auto model = dynamics::RobotModel::Build(*description, Values(parameters[0]));
       const auto dyn = EvaluatePostures(model, *postures, pose_ids);
@@ -335,8 +343,11 @@ struct ModelResidual {
         }
       }
       return true;
-    } catch (const std::exception&) {
-      return false;  // e.g. a trial point the model rejects: Ceres shortens the step
+    } catch (const NumericalError&) {
+      return false;  // e.g. a mass matrix not positive definite at a trial point: Ceres shortens the step
+    } catch (...) {
+      *error = std::current_exception();
+      return false;
     }
   }
 };
@@ -402,14 +413,25 @@ StageOutcome SolveStage(const std::string& stage_name, ModelResidual residual, c
   so.line_search_interpolation_type = ceres::BISECTION;
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
+  if (*map.error) std::rethrow_exception(*map.error);
   out.termination = summary.termination_type;
   out.summary.termination = ceres::TerminationTypeToString(summary.termination_type);
   out.summary.message = summary.message;
   out.summary.iterations = static_cast<int>(summary.iterations.size());
   out.summary.initial_cost = summary.initial_cost;
   out.summary.final_cost = summary.final_cost;
-  for (int i = 0; i < n; ++i) out.values.push_back(std::clamp(map.ToValue(x[i], i), base.spec(names[i]).lower,
-                                                               base.spec(names[i]).upper));
+  for (int i = 0; i < n; ++i) {
+    double v = map.ToValue(x[i], i);
+    if (!std::isfinite(v)) {
+      // A numerical outcome (the status says so), not a parameter value to
+      // reject as bad input: the stage keeps the start value.
+      v = base.Get(names[i]);
+      out.termination = ceres::FAILURE;
+      out.summary.termination = "FAILURE";
+      out.summary.message = "the solver ended with a non-finite value of " + names[i] + "; " + out.summary.message;
+    }
+    out.values.push_back(std::clamp(v, base.spec(names[i]).lower, base.spec(names[i]).upper));
+  }
   out.std_dev.assign(n, NAN);
   // Covariance of the scaled parameters, from Jᵀ J at the solution, scaled by
   // the residual variance estimate 2 F / (m − n) (the residual weights are
@@ -433,7 +455,9 @@ StageOutcome SolveStage(const std::string& stage_name, ModelResidual residual, c
     problem.SetManifold(x.data(), new ceres::SubsetManifold(n, pinned));
   }
   std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
-  if (static_cast<int>(pinned.size()) < n && cov.Compute(blocks, &problem)) {
+  const bool cov_ok = static_cast<int>(pinned.size()) < n && cov.Compute(blocks, &problem);
+  if (*map.error) std::rethrow_exception(*map.error);
+  if (cov_ok) {
     std::vector<double> c(n * n);
     cov.GetCovarianceBlock(x.data(), x.data(), c.data());
     const double dof = std::max(1, m - n);
@@ -640,9 +664,10 @@ double WholeCurveMisfit(const dynamics::RobotDescription& description, const dyn
       }
     }
     return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
-  } catch (const std::invalid_argument&) {
-    throw;  // a posture missing from the posture file is the caller's error
-  } catch (const std::exception&) {
+  } catch (const NumericalError&) {
+    // The model cannot be evaluated at these values (a mass matrix not
+    // positive definite): infinitely far from the data. Anything else (a
+    // posture missing from the posture file, a bug) is the caller's.
     return std::numeric_limits<double>::infinity();
   }
 }

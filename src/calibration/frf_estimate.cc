@@ -394,17 +394,10 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
       const double w = 2.0 * M_PI * result.freq_hz(k);
       peak = std::max(peak, std::abs(result.channels[c].h1(k)) / std::pow(w, p));
     }
-    if (peak == 0.0) continue;
-    if (peak > kMaxPlausibleReceptance || peak < kMinPlausibleReceptance) {
+    const std::string finding = dynamics::ReceptancePeakFinding("response " + channels[c].name, peak);
+    if (!finding.empty()) {
       result.implausible = true;
-      result.warnings.push_back(
-          "response " + channels[c].name + ": the largest receptance on the coherent lines is " + Num(peak, 3) +
-          " m/N, outside the plausible " + Num(kMinPlausibleReceptance, 1) + " to " + Num(kMaxPlausibleReceptance, 1) +
-          " m/N of a machine structure: " +
-          (peak > kMaxPlausibleReceptance ? "the response was probably recorded in mm or um (or the force in kN) "
-                                            "under a column named in m (and N)"
-                                          : "the force was probably recorded in mN, or the response in km") +
-          "; check the units in the column names");
+      result.warnings.push_back(finding);
     }
   }
   // Roll-off of the force spectrum: 20 dB below its level at the lowest lines.

@@ -218,7 +218,12 @@ FlexibleJointRobot::FlexibleJointRobot(kinematics::SerialChain chain, std::vecto
   h_.resize(n_);
   tau_.resize(n_);
   rhs_.resize(n_);
-  llt_ = Eigen::LLT<Eigen::MatrixXd>(n_);
+  // Storage for the n×n factor, so that the first step does not allocate.
+  // Not `llt_ = Eigen::LLT<Eigen::MatrixXd>(n_)`: Eigen's size constructor
+  // leaves m_info uninitialised, and the assignment then reads it (UBSan:
+  // "not a valid value for type 'ComputationInfo'"). Factorising the identity
+  // sizes the storage and leaves a valid state.
+  llt_.compute(Eigen::MatrixXd::Identity(n_, n_));
 }
 
 FlexibleJointRobot::~FlexibleJointRobot() = default;

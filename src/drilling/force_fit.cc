@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include <ceres/ceres.h>
@@ -9,11 +10,23 @@
 namespace robomach::drilling {
 namespace {
 
-DrillingMaterial MaterialFromParameters(const DrillingMaterial& base, const double* x) {
+// The Kienzle exponent is fitted as y with m = kMaxKienzle / (1 + e^-y), so
+// that every value the solver tries, numeric-derivative steps included, is
+// one the force model accepts (CheckValid: 0 <= m < 1). The former linear m
+// with a guard at -0.5 let the solver step below 0, where the model threw
+// std::invalid_argument out of the solve (exit 64 for a table in the wrong
+// units). A fit that runs to either end is reported in the result.
+constexpr double kMaxKienzle = 0.95;
+constexpr double kKienzleAtBound = 1e-3;  // m within this of 0 or kMaxKienzle: on its bound
+
+double KienzleFromY(double y) { return kMaxKienzle / (1.0 + std::exp(-y)); }
+double YFromKienzle(double m) { return std::log(m / (kMaxKienzle - m)); }
+
+DrillingMaterial MaterialFromParameters(const DrillingMaterial& base, const double* x, bool fit_m) {
   DrillingMaterial m = base;
   m.shear_stress_thrust = std::exp(x[0]);
   m.shear_stress_torque = std::exp(x[1]);
-  m.kienzle_exponent = x[2];
+  if (fit_m) m.kienzle_exponent = KienzleFromY(x[2]);
   return m;
 }
 
@@ -23,9 +36,9 @@ struct RowResidual {
   const DrillingMaterial* base;
   ForceTableRow row;
   ForceModelOptions options;
+  bool fit_m;
   bool operator()(const double* x, double* r) const {
-    if (!(x[2] > -0.5 && x[2] < 0.95)) return false;  // keep m in a physical range
-    const DrillForces f = PredictRow(*drill, MaterialFromParameters(*base, x), row, options);
+    const DrillForces f = PredictRow(*drill, MaterialFromParameters(*base, x, fit_m), row, options);
     r[0] = (f.thrust - row.thrust) / row.thrust;
     r[1] = (f.torque - row.torque) / row.torque;
     return true;
@@ -53,20 +66,32 @@ ForceFitResult FitDrillingForces(const DrillGeometry& drill, const std::vector<F
     const ForceTableRow& r = rows[k];
     for (double v : {r.diameter, r.feed_per_rev, r.thrust, r.torque}) {
       if (!(std::isfinite(v) && v > 0.0)) {
-        throw std::invalid_argument("force table row " + std::to_string(k + 1) +
-                                    ": expected positive finite values");
+        throw ForceTableRowError(k, "force table row " + std::to_string(k + 1) +
+                                        ": expected positive finite values");
       }
     }
   }
   DrillingMaterial base;
   base.chisel = options.chisel;
-  base.kienzle_exponent = options.fit_kienzle_exponent ? 0.25 : base.kienzle_exponent;
+  const bool fit_m = options.fit_kienzle_exponent;
+  base.kienzle_exponent = fit_m ? 0.25 : base.kienzle_exponent;
   // Start: K = 1 Pa gives forces proportional to K; scale to the data.
-  double x[3] = {0.0, 0.0, base.kienzle_exponent};
+  double x[3] = {0.0, 0.0, fit_m ? YFromKienzle(base.kienzle_exponent) : 0.0};
   {
     double st = 0.0, sq = 0.0;
-    for (const ForceTableRow& r : rows) {
-      const DrillForces f = PredictRow(drill, MaterialFromParameters(base, x), r, options.model);
+    for (size_t k = 0; k < rows.size(); ++k) {
+      const ForceTableRow& r = rows[k];
+      const DrillForces f = PredictRow(drill, MaterialFromParameters(base, x, fit_m), r, options.model);
+      // The model's forces are proportional to K; where they are not
+      // positive at K = 1 Pa, no K fits the row (the dynamic rake of a feed
+      // of ~diameter per revolution turns the thrust negative).
+      if (!(std::isfinite(f.thrust) && f.thrust > 0.0 && std::isfinite(f.torque) && f.torque > 0.0)) {
+        std::ostringstream m;
+        m << "force table row " << k + 1 << ": feed_mm_per_rev " << r.feed_per_rev * 1e3 << " with diameter_mm "
+          << r.diameter * 1e3 << " is outside the force model's range (it gives a thrust of " << f.thrust
+          << " N per Pa of shear stress); is the feed in mm/min instead of mm/rev?";
+        throw ForceTableRowError(k, m.str());
+      }
       st += std::log(r.thrust / f.thrust);
       sq += std::log(r.torque / f.torque);
     }
@@ -76,7 +101,7 @@ ForceFitResult FitDrillingForces(const DrillGeometry& drill, const std::vector<F
   ceres::Problem problem;
   for (const ForceTableRow& r : rows) {
     auto* cost = new ceres::NumericDiffCostFunction<RowResidual, ceres::CENTRAL, 2, 3>(
-        new RowResidual{&drill, &base, r, options.model});
+        new RowResidual{&drill, &base, r, options.model, fit_m});
     problem.AddResidualBlock(cost, nullptr, x);
   }
   if (!options.fit_kienzle_exponent) {
@@ -92,7 +117,9 @@ ForceFitResult FitDrillingForces(const DrillGeometry& drill, const std::vector<F
   ceres::Solve(so, &problem, &summary);
 
   ForceFitResult out;
-  out.material = MaterialFromParameters(base, x);
+  out.material = MaterialFromParameters(base, x, fit_m);
+  out.kienzle_exponent_at_bound = fit_m && (out.material.kienzle_exponent < kKienzleAtBound ||
+                                            out.material.kienzle_exponent > kMaxKienzle - kKienzleAtBound);
   out.solver_message = summary.BriefReport();
   out.status = summary.termination_type == ceres::CONVERGENCE ? FitStatus::kConverged
                : summary.IsSolutionUsable()                   ? FitStatus::kNotConverged
@@ -124,7 +151,10 @@ ForceFitResult FitDrillingForces(const DrillGeometry& drill, const std::vector<F
     out.std_dev_shear_stress_thrust = out.material.shear_stress_thrust * std::sqrt(s2 * C[0]);
     out.std_dev_shear_stress_torque = out.material.shear_stress_torque * std::sqrt(s2 * C[4]);
     out.std_dev_kienzle_exponent =
-        options.fit_kienzle_exponent ? std::sqrt(std::max(0.0, s2 * C[8])) : 0.0;
+        // Delta method: dm/dy = m (1 - m / kMaxKienzle).
+        fit_m ? std::sqrt(std::max(0.0, s2 * C[8])) * out.material.kienzle_exponent *
+                    (1.0 - out.material.kienzle_exponent / kMaxKienzle)
+              : 0.0;
   }
   return out;
 }

@@ -1,6 +1,8 @@
 #include "robomach/dynamics/measured_frf.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -157,6 +159,54 @@ FrfSet FrfSet::ForPose(const std::string& pose_id) const {
 
 void FrfSet::Merge(const FrfSet& other) {
   for (const auto& [k, f] : other.frfs_) Insert(k, f);
+}
+
+std::string ReceptancePeakFinding(const std::string& what, double peak) {
+  if (!(peak > kMaxPlausibleReceptance || (peak > 0.0 && peak < kMinPlausibleReceptance))) return "";
+  char b[160];
+  std::snprintf(b, sizeof b, ": the largest receptance is %.3g m/N, outside the plausible %.0e to %.0e m/N of a machine structure: ",
+                peak, kMinPlausibleReceptance, kMaxPlausibleReceptance);
+  return what + b +
+         (peak > kMaxPlausibleReceptance
+              ? "the response was probably recorded in mm or um (or the force in kN) under a column named in m (and "
+                "N), or a mobility or accelerance was read as receptance (the file's quantity or unit labels)"
+              : "the force was probably recorded in mN, or the response in km") +
+         "; check the units in the column names";
+}
+
+namespace {
+
+// The largest median of three neighbouring values.
+double RobustPeak(const std::vector<double>& magnitude) {
+  const int n = static_cast<int>(magnitude.size());
+  if (n < 3) return n == 0 ? 0.0 : *std::min_element(magnitude.begin(), magnitude.end());
+  double peak = 0.0;
+  for (int k = 1; k + 1 < n; ++k) {
+    double a = magnitude[k - 1], b = magnitude[k], c = magnitude[k + 1];
+    peak = std::max(peak, std::max(std::min(a, b), std::min(std::max(a, b), c)));  // median of three
+  }
+  return peak;
+}
+
+}  // namespace
+
+double PeakReceptance(const Frf& frf) {
+  std::vector<double> m;
+  for (int k = 0; k < frf.size(); ++k) {
+    if (frf.freq_hz()(k) <= 0.0) continue;
+    if (frf.coherence() && (*frf.coherence())(k) < 0.5) continue;
+    m.push_back(std::abs(frf.receptance()(k)));
+  }
+  return RobustPeak(m);
+}
+
+std::vector<std::string> ReceptanceUnitFindings(const FrfSet& frfs, const std::string& source) {
+  std::vector<std::string> out;
+  for (const auto& [key, frf] : frfs) {
+    const std::string f = ReceptancePeakFinding(source + ": " + key.ToString(), PeakReceptance(frf));
+    if (!f.empty()) out.push_back(f);
+  }
+  return out;
 }
 
 }  // namespace robomach::dynamics

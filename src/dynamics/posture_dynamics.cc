@@ -9,6 +9,7 @@
 #include <Eigen/LU>
 
 #include "dynamics/internal/rigid_chain.h"
+#include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 
@@ -63,7 +64,7 @@ bool IsPositiveDiagonal(const Eigen::MatrixXd& K) {
 }
 
 [[noreturn]] void ThrowNotPositiveDefinite() {
-  throw std::runtime_error("modal analysis failed: the assembled mass matrix is not positive "
+  throw NumericalError("modal analysis failed: the assembled mass matrix is not positive "
                            "definite (check link and effect inertias)");
 }
 

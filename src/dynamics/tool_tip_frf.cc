@@ -7,6 +7,7 @@
 #include <Eigen/LU>
 
 #include "dynamics/internal/modal_sum.h"
+#include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 
 namespace robomach::dynamics {
@@ -85,7 +86,7 @@ namespace {
 // output matrix Cout (3×2N): H(s) = Cout (sI − A)⁻¹ Bin = Σ R_k / (s − λ_k).
 ComplexModalModel FromStateSpace(const Eigen::MatrixXd& A, const Eigen::MatrixXd& Bin, const Eigen::MatrixXd& Cout) {
   Eigen::EigenSolver<Eigen::MatrixXd> es(A);
-  if (es.info() != Eigen::Success) throw std::runtime_error("complex modal analysis failed");
+  if (es.info() != Eigen::Success) throw NumericalError("complex modal analysis failed");
   const Eigen::MatrixXcd V = es.eigenvectors();
   const Eigen::MatrixXcd W = V.inverse();
   ComplexModalModel out;

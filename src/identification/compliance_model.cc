@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "robomach/common/errors.h"
 #include "robomach/kinematics/serial_chain.h"
 
 namespace robomach::identification {
@@ -98,7 +99,7 @@ Eigen::Vector3d SolveStaticDeflection(const dynamics::RobotModel& model, const L
       return EvaluateAt(model, c.q + dq, p_L, p_T).p_BT - k0.p_BT;
     }
   }
-  throw std::runtime_error("SolveStaticDeflection: no equilibrium found for case " + c.case_id +
+  throw NumericalError("SolveStaticDeflection: no equilibrium found for case " + c.case_id +
                            " (load far beyond the linear range?)");
 }
 

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "robomach/common/units.h"
+#include "robomach/drilling/plausibility.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/robot_config.h"
@@ -14,10 +15,26 @@
 namespace robomach::io {
 namespace {
 
+std::string User(double v);
+
 double PositiveCell(const CsvTable& t, int row, const std::string& column) {
   const double v = t.Number(row, column);
   if (!(v > 0.0)) {
     throw t.ErrorAt(row, column, "expected a positive number, got " + t.Text(row, column));
+  }
+  return v;
+}
+
+// A table row is a measurement of twist drilling: a diameter or feed outside
+// the practice of drilling::plausibility.h cannot be one, and is almost
+// always a unit mistake (m or um in the mm column, mm/min in mm/rev).
+double PracticeCell(const CsvTable& t, int row, const std::string& column, double lo_mm, double hi_mm,
+                    const std::string& unit, const std::string& too_high, const std::string& too_low) {
+  const double v = PositiveCell(t, row, column);
+  if (v < lo_mm || v > hi_mm) {
+    throw t.ErrorAt(row, column, "expected " + User(lo_mm) + " to " + User(hi_mm) + " " + unit +
+                                     " (twist-drilling practice), got " + t.Text(row, column) + ": " +
+                                     (v > hi_mm ? too_high : too_low));
   }
   return v;
 }
@@ -78,8 +95,13 @@ ForceTableFile ReadForceTable(const std::string& path, bool require_forces) {
       t.UnknownColumns({"diameter_mm", "feed_mm_per_rev", "thrust_N", "torque_Nm", "speed_rpm"});
   for (int r = 0; r < t.num_rows(); ++r) {
     drilling::ForceTableRow row;
-    row.diameter = MmToM(PositiveCell(t, r, "diameter_mm"));
-    row.feed_per_rev = MmToM(PositiveCell(t, r, "feed_mm_per_rev"));
+    row.diameter = MmToM(PracticeCell(t, r, "diameter_mm", MToMm(drilling::kMinPlausibleDrillDiameter),
+                                      MToMm(drilling::kMaxPlausibleDrillDiameter), "mm",
+                                      "a diameter in um in the mm column?", "a diameter in m in the mm column?"));
+    row.feed_per_rev = MmToM(PracticeCell(t, r, "feed_mm_per_rev", MToMm(drilling::kMinPlausibleFeedPerRev),
+                                          MToMm(drilling::kMaxPlausibleFeedPerRev), "mm/rev",
+                                          "a feed in mm/min (feed per rev x rpm) in the mm/rev column?",
+                                          "a feed in m/rev in the mm/rev column?"));
     if (forces) {
       row.thrust = PositiveCell(t, r, "thrust_N");
       row.torque = PositiveCell(t, r, "torque_Nm");

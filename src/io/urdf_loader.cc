@@ -1,6 +1,7 @@
 #include "robomach/io/urdf_loader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -24,6 +25,54 @@ class CaptureConsoleBridge final : public console_bridge::OutputHandler {
   }
   std::vector<std::string> messages;
 };
+
+// Line and column (1-based) of the first whitespace-separated token inside a
+// quoted attribute value that equals `token` (or, with `token` empty, that
+// reads as NaN or inf: "nan", "-inf", "Infinity"...), and the token; line 0
+// if there is none.
+SourceLocation LocateAttributeToken(const std::string& xml, const std::string& path, const std::string& token,
+                                    std::string* found = nullptr) {
+  bool in_value = false;
+  char quote = 0;
+  int line = 1, col = 0;
+  for (size_t i = 0; i < xml.size(); ++i) {
+    const char c = xml[i];
+    ++col;
+    if (c == '\n') {
+      ++line;
+      col = 0;
+      continue;
+    }
+    if (!in_value) {
+      if ((c == '"' || c == '\'') && i > 0 && xml[i - 1] == '=') {
+        in_value = true;
+        quote = c;
+      }
+      continue;
+    }
+    if (c == quote) {
+      in_value = false;
+      continue;
+    }
+    const bool starts = xml[i - 1] == quote || xml[i - 1] == ' ' || xml[i - 1] == '\t';
+    if (!starts || c == ' ' || c == '\t') continue;
+    size_t e = i;
+    while (e < xml.size() && xml[e] != quote && xml[e] != ' ' && xml[e] != '\t' && xml[e] != '\n') ++e;
+    std::string t = xml.substr(i, e - i);
+    bool match = t == token;
+    if (token.empty()) {
+      std::string low = t;
+      for (char& ch : low) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+      if (!low.empty() && (low[0] == '+' || low[0] == '-')) low.erase(0, 1);
+      match = low.rfind("nan", 0) == 0 || low.rfind("inf", 0) == 0;
+    }
+    if (match) {
+      if (found) *found = t;
+      return {path, line, col};
+    }
+  }
+  return {path, 0, 0};
+}
 
 // 1-based line of the first `<tag ... name="name"`, 0 if not found.
 int FindElementLine(const std::string& xml, const std::string& tag, const std::string& name) {
@@ -53,6 +102,14 @@ kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string
   ss << in.rdbuf();
   const std::string xml = ss.str();
 
+  // NaN and inf: urdfdom reads some of them as numbers (an inertial origin
+  // of "nan" passes), so every attribute value is checked first.
+  {
+    std::string token;
+    const SourceLocation at = LocateAttributeToken(xml, path, "", &token);
+    if (at.line > 0) throw InputError(at, "expected a finite number, got \"" + token + "\"");
+  }
+
   urdf::ModelInterfaceSharedPtr model;
   {
     CaptureConsoleBridge capture;
@@ -61,7 +118,16 @@ kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string
       std::string reason;
       for (const auto& m : capture.messages) reason += (reason.empty() ? "" : "; ") + m;
       if (reason.empty()) reason = "urdfdom gave no reason";
-      throw InputError({path, 0, 0}, "not a valid URDF model: " + reason);
+      // urdfdom names a number it could not parse ("Unable to parse
+      // component [nan] to a double") but not where: the first attribute
+      // value holding that token gives the line and column.
+      SourceLocation at{path, 0, 0};
+      const std::string key = "Unable to parse component [";
+      if (const size_t k = reason.find(key); k != std::string::npos) {
+        const size_t e = reason.find(']', k + key.size());
+        if (e != std::string::npos) at = LocateAttributeToken(xml, path, reason.substr(k + key.size(), e - k - key.size()));
+      }
+      throw InputError(at, "not a valid URDF model: " + reason);
     }
   }
   auto link_error = [&](const std::string& role, const std::string& name) {

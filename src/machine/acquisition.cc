@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
+
+#include "robomach/common/units.h"
 
 namespace robomach::machine {
 
@@ -195,6 +198,41 @@ SeriesStats Stats(const std::vector<double>& v) {
   for (double x : v) var += (x - s.mean) * (x - s.mean);
   s.std_dev = v.size() > 1 ? std::sqrt(var / (v.size() - 1)) : 0.0;
   return s;
+}
+
+std::vector<std::string> ContourUnitFindings(const std::vector<ContourError>& contour, const ProgrammedPath& path) {
+  std::vector<std::string> out;
+  double d = 0.0, a = 0.0;
+  for (const ContourError& c : contour) {
+    d = std::max(d, c.distance);
+    a = std::max(a, c.axis_angle);
+  }
+  Eigen::Vector3d lo = path.tips().front(), hi = lo;
+  for (const Eigen::Vector3d& p : path.tips()) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double extent = (hi - lo).norm();
+  char b[500];
+  if (d > kMaxPlausibleContourError) {
+    std::snprintf(b, sizeof b,
+                  "contour error up to %.4g mm (%.3g %% of the %.4g mm extent of the programmed path), more than the "
+                  "%.4g mm a machine can be off its path: the count columns are probably swapped (their names in the "
+                  "counts header against the data), or a resolution_mm/_deg or origin in the machine file is in "
+                  "another unit, or the program is another one",
+                  d * 1e3, extent > 0 ? 100 * d / extent : 0.0, extent * 1e3, kMaxPlausibleContourError * 1e3);
+    out.push_back(b);
+  }
+  // With the tip far off its path the nearest point's programmed axis is
+  // another one too: the axis error then adds nothing.
+  if (a > kMaxPlausibleAxisError && out.empty()) {
+    std::snprintf(b, sizeof b,
+                  "tool axis error up to %.4g deg, more than the %.4g deg a machine's axis can be off: the rotary "
+                  "count columns are probably swapped, or a resolution_deg is in another unit (rad, arcsec)",
+                  a * 180.0 / kPi, kMaxPlausibleAxisError * 180.0 / kPi);
+    out.push_back(b);
+  }
+  return out;
 }
 
 }  // namespace robomach::machine

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "robomach/common/errors.h"
+
 namespace robomach::machine {
 namespace {
 
@@ -110,7 +112,7 @@ void Compensation::RealToMeasured(double t_s, const double* real, double* measur
       if (worst < 1e-15) return;
     }
   }
-  throw std::runtime_error("compensation: real-to-measured inversion did not converge (table slopes near 1?)");
+  throw NumericalError("compensation: real-to-measured inversion did not converge (table slopes near 1?)");
 }
 
 }  // namespace robomach::machine

@@ -103,3 +103,45 @@ Iso230Result EvaluateIso230(const std::vector<Iso230Approach>& approaches) {
 }
 
 }  // namespace robomach::machine
+
+namespace robomach::machine {
+
+std::vector<std::string> Iso230UnitFindings(const std::string& axis, const Iso230Result& r, bool rotary) {
+  std::vector<std::string> out;
+  if (r.targets.empty()) return out;
+  double dev = 0.0, target = 0.0;
+  for (const Iso230Target& t : r.targets) {
+    dev = std::max({dev, std::abs(t.mean_up) + 2 * t.s_up, std::abs(t.mean_down) + 2 * t.s_down});
+    target = std::max(target, std::abs(t.target));
+  }
+  const double travel = r.targets.back().target - r.targets.front().target;
+  const double magnitude = std::max(target, travel);
+  char b[400];
+  if (rotary) {
+    if (dev > kMaxPlausibleRotaryDeviationDeg) {
+      std::snprintf(b, sizeof b,
+                    "axis %s: deviations up to %.4g deg, more than the %.4g deg a rotary axis can be off: arcsec or "
+                    "another unit under the _deg headers?",
+                    axis.c_str(), dev, kMaxPlausibleRotaryDeviationDeg);
+      out.push_back(b);
+    }
+    return out;
+  }
+  if (magnitude > 0 && dev > kMaxPlausibleDeviationFraction * magnitude) {
+    std::snprintf(b, sizeof b,
+                  "axis %s: deviations up to %.4g mm are %.3g %% of the targets' magnitude (%.4g mm; more than "
+                  "%.3g %% is not a positioning error): measured values in um (or targets in m) under the _mm "
+                  "headers?",
+                  axis.c_str(), dev, 100 * dev / magnitude, magnitude, 100 * kMaxPlausibleDeviationFraction);
+    out.push_back(b);
+  } else if (dev > kMaxPlausibleLinearDeviationMm) {
+    std::snprintf(b, sizeof b,
+                  "axis %s: deviations up to %.4g mm, more than the %.4g mm a machine axis can be off: targets and "
+                  "measured values in um under the _mm headers?",
+                  axis.c_str(), dev, kMaxPlausibleLinearDeviationMm);
+    out.push_back(b);
+  }
+  return out;
+}
+
+}  // namespace robomach::machine

@@ -3,17 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <atomic>
 #include <cstdio>
 #include <chrono>
-#include <exception>
 #include <mutex>
 #include <random>
-#include <thread>
 
 #include <nlopt.hpp>
 
 #include "robomach/common/golden_section.h"
+#include "robomach/common/parallel.h"
 #include "robomach/common/units.h"
 #include "robomach/polishing/process.h"
 #include "robomach/polishing/removal.h"
@@ -44,6 +42,11 @@ struct Tracker {
   const OptimiseOptions* o;
   OptimiseResult* res;
   std::vector<double> best_x;
+  // An exception from the objective. NLopt's C++ wrapper would turn it into
+  // a generic failure ("nlopt failure"), so NloptThunk keeps it and stops
+  // the run, and RunNlopt rethrows it: an objective that throws is a bug or
+  // bad input, not an optimiser status.
+  std::exception_ptr error;
   double Eval(const std::vector<double>& x) {
     double v = (*f)(FromUnit(x, *base, *o));
     if (!std::isfinite(v)) v = 1e6;
@@ -58,7 +61,13 @@ struct Tracker {
 
 double NloptThunk(unsigned, const double* x, double*, void* data) {
   Tracker* t = static_cast<Tracker*>(data);
-  const double v = t->Eval(std::vector<double>(x, x + 3));
+  double v = 0.0;
+  try {
+    v = t->Eval(std::vector<double>(x, x + 3));
+  } catch (...) {
+    t->error = std::current_exception();
+    throw nlopt::forced_stop();
+  }
   t->res->history.push_back(t->res->best_value);
   if (t->o->progress) t->o->progress(t->res->evaluations, t->res->best_value);
   return v;
@@ -80,7 +89,12 @@ void RunNlopt(nlopt::algorithm alg, int budget, std::vector<double>* x, Tracker*
     *status = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : "converged";
   } catch (const nlopt::roundoff_limited&) {
     *status = "roundoff_limited";
+  } catch (const nlopt::forced_stop&) {
+    if (t->error) std::rethrow_exception(t->error);
+    *status = "forced_stop";
   } catch (const std::runtime_error& e) {
+    // NLopt's own failure (NLOPT_FAILURE); the objective's exceptions are
+    // rethrown above.
     *status = std::string("failed: ") + e.what();
   }
 }
@@ -244,26 +258,10 @@ class Book {
   }
   // Runs job(0..n-1) on o.threads threads; the first exception is rethrown.
   void RunParallel(int n, const std::function<void(int)>& job) {
-    std::atomic<int> next{0};
-    std::exception_ptr err;
-    std::mutex err_mu;
-    auto worker = [&]() {
-      for (int i = next++; i < n; i = next++) {
-        try {
-          job(i);
-        } catch (...) {
-          std::lock_guard<std::mutex> lock(err_mu);
-          if (!err) err = std::current_exception();
-          next = n;
-        }
-      }
-    };
-    const int nt = std::max(1, std::min(o_.threads, n));
-    std::vector<std::thread> pool;
-    for (int k = 1; k < nt; ++k) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
-    if (err) std::rethrow_exception(err);
+    ParallelForOptions po;
+    po.threads = std::max(1, o_.threads);
+    po.chunk_size = 1;  // one plan evaluation each (milliseconds to seconds)
+    ParallelFor(0, n, [&](long i, int) { job(static_cast<int>(i)); }, po);
   }
   PlanOptimiseResult& result() { return res_; }
   std::mutex& mutex() { return mu_; }

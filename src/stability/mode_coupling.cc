@@ -108,12 +108,47 @@ ModeCouplingResult SearchCriticalDepth(const Rightmost& rightmost, const ModeCou
   return out;
 }
 
-std::complex<double> RightmostOf(const Eigen::MatrixXd& A) {
-  Eigen::EigenSolver<Eigen::MatrixXd> es(A, false);
-  const Eigen::VectorXcd ev = es.eigenvalues();
-  Eigen::Index imax = 0;
-  ev.real().maxCoeff(&imax);
-  return ev(imax);
+// The rightmost eigenvalue of first-order system matrices of one size,
+// with the solver's storage kept between calls (the depth search calls it
+// 20-30 times per posture, a stability map 10^5 times per thread). Rows =
+// 2n at compile time where it is known (12 for a six-joint robot: Eigen
+// then keeps everything on the stack), Eigen::Dynamic otherwise.
+template <int Rows>
+class RightmostSolver {
+ public:
+  using Matrix = Eigen::Matrix<double, Rows, Rows>;
+  explicit RightmostSolver(Eigen::Index rows) : es_(rows) {}
+  std::complex<double> operator()(const Matrix& A) {
+    es_.compute(A, false);
+    const auto& ev = es_.eigenvalues();
+    Eigen::Index imax = 0;
+    for (Eigen::Index i = 1; i < ev.size(); ++i) {
+      if (ev(i).real() > ev(imax).real()) imax = i;  // the first of equal maxima, as maxCoeff
+    }
+    return ev(imax);
+  }
+
+ private:
+  Eigen::EigenSolver<Matrix> es_;
+};
+
+template <int Rows>
+ModeCouplingResult ModalSearch(const TipModalModel& modes, const Eigen::MatrixXd& Kc_q,
+                               const ModeCouplingOptions& options) {
+  const int n = modes.num_modes();
+  using Matrix = typename RightmostSolver<Rows>::Matrix;
+  Matrix A = Matrix::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomRightCorner(n, n).diagonal() = -2.0 * modes.zeta.cwiseProduct(modes.omega_rad_s);
+  const Eigen::VectorXd w2 = modes.omega_rad_s.array().square();
+  RightmostSolver<Rows> rightmost(2 * n);
+  return SearchCriticalDepth(
+      [&](double a) {
+        A.bottomLeftCorner(n, n) = -a * Kc_q;
+        A.bottomLeftCorner(n, n).diagonal() -= w2;
+        return rightmost(A);
+      },
+      options);
 }
 
 }  // namespace
@@ -133,10 +168,11 @@ ModeCouplingResult CriticalDepthModeCoupling(const Eigen::MatrixXd& M, const Eig
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
   A.topRightCorner(n, n).setIdentity();
   A.bottomRightCorner(n, n) = -MiC;
+  RightmostSolver<Eigen::Dynamic> rightmost(2 * n);
   return SearchCriticalDepth(
       [&](double a) {
         A.bottomLeftCorner(n, n) = -(MiK + a * MiKc);
-        return RightmostOf(A);
+        return rightmost(A);
       },
       options);
 }
@@ -146,17 +182,9 @@ ModeCouplingResult CriticalDepthModeCouplingModal(const TipModalModel& modes, co
   modes.Validate();
   const int n = modes.num_modes();
   const Eigen::MatrixXd Kc_q = modes.p.transpose() * Kc * modes.p;
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
-  A.topRightCorner(n, n).setIdentity();
-  A.bottomRightCorner(n, n).diagonal() = -2.0 * modes.zeta.cwiseProduct(modes.omega_rad_s);
-  const Eigen::VectorXd w2 = modes.omega_rad_s.array().square();
-  return SearchCriticalDepth(
-      [&](double a) {
-        A.bottomLeftCorner(n, n) = -a * Kc_q;
-        A.bottomLeftCorner(n, n).diagonal() -= w2;
-        return RightmostOf(A);
-      },
-      options);
+  // Six modes (a six-joint robot): fixed-size matrices, no heap at all.
+  if (n == 6) return ModalSearch<12>(modes, Kc_q, options);
+  return ModalSearch<Eigen::Dynamic>(modes, Kc_q, options);
 }
 
 double FlutterDepthClosedForm(const Eigen::Matrix2d& S, const Eigen::Matrix2d& Kc) {

@@ -26,14 +26,15 @@ PostureStability AnalysePosture(const dynamics::PostureDynamics& d, const Eigen:
   PostureStability out;
   const Eigen::Matrix3d Kc_C = CuttingStiffnessPerDepth(process);
   const Eigen::Matrix3d Kc_B = R_BC * Kc_C * R_BC.transpose();
+  // The posture's modes, once for both mechanisms and every speed.
+  const TipModalModel modes = ModalModelFromPosture(d);
   out.mode_coupling = d.proportional_damping && !d.modes.empty()
-                          ? CriticalDepthModeCouplingModal(ModalModelFromPosture(d), Kc_B, options.mode_coupling)
+                          ? CriticalDepthModeCouplingModal(modes, Kc_B, options.mode_coupling)
                           : CriticalDepthModeCoupling(d.system.M, d.system.C, d.system.K, d.system.B, Kc_B,
                                                       options.mode_coupling);
   out.closed_form = ModeCouplingClosedForm(R_BC.transpose() * d.static_compliance * R_BC,
                                            Kc_C.topLeftCorner<2, 2>());
 
-  const TipModalModel modes = ModalModelFromPosture(d);
   const Eigen::VectorXd f = LobeFrequencyGrid(modes, process.teeth,
                                               options.spindle_speed_rad_s.maxCoeff(), options.freq_lines);
   // With proportional damping the real modes are exact (tool_tip_frf.h

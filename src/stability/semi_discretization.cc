@@ -1,15 +1,13 @@
 #include "robomach/stability/semi_discretization.h"
 
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <stdexcept>
-#include <thread>
 
 #include <Eigen/Eigenvalues>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "robomach/common/parallel.h"
 #include "robomach/common/units.h"
 
 namespace robomach::stability {
@@ -231,37 +229,11 @@ std::vector<LobePoint> SdLobes(const TipModalModel& modes_C, const MillingProces
   modes_C.Validate();
   const long n = speeds.size();
   std::vector<LobePoint> out(n);
-  if (threads <= 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<int>(std::min<long>(threads, std::max(1L, n)));
-  std::atomic<long> next{0}, done{0};
-  std::exception_ptr error;
-  std::atomic<bool> failed{false};
-  auto worker = [&]() {
-    for (long i = next++; i < n && !failed; i = next++) {
-      try {
-        out[i] = SdCriticalDepth(modes_C, process, speeds(i), options);
-      } catch (...) {
-        if (!failed.exchange(true)) error = std::current_exception();
-      }
-      ++done;
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  if (threads == 1 || !progress) {
-    worker();
-  } else {
-    // The calling thread reports progress while the pool works.
-    std::thread last(worker);
-    while (done < n && !failed) {
-      progress(done, n);
-      std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    }
-    last.join();
-  }
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
-  if (progress) progress(n, n);
+  ParallelForOptions po;
+  po.threads = std::max(0, threads);  // <= 0: all cores, as documented
+  po.chunk_size = 1;                  // one speed is a whole depth search (milliseconds)
+  po.progress = progress;
+  ParallelFor(0, n, [&](long i, int) { out[i] = SdCriticalDepth(modes_C, process, speeds(i), options); }, po);
   return out;
 }
 

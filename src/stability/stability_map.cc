@@ -1,15 +1,14 @@
 #include "robomach/stability/stability_map.h"
 
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
+#include <exception>
 #include <stdexcept>
-#include <thread>
 
 #include <kdl/chainiksolverpos_lma.hpp>
 #include <nlopt.hpp>
 
+#include "robomach/common/parallel.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/kinematics/serial_chain.h"
 #include "robomach/stability/tool_tip_model.h"
@@ -77,33 +76,6 @@ class IkSolver {
   KDL::ChainIkSolverPos_LMA lma_;
 };
 
-// Runs f(i) for i in [0, n) on `threads` threads; progress from the caller.
-template <class F>
-void ParallelFor(long n, int threads, const ProgressCallback& progress, long progress_offset,
-                 long progress_total, F f) {
-  std::atomic<long> next{0}, done{0};
-  std::atomic<bool> failed{false};
-  std::exception_ptr error;
-  auto worker = [&](int t) {
-    for (long i = next++; i < n && !failed; i = next++) {
-      try {
-        f(t, i);
-      } catch (...) {
-        if (!failed.exchange(true)) error = std::current_exception();
-      }
-      ++done;
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) pool.emplace_back(worker, t);
-  while (done < n && !failed) {
-    if (progress) progress(progress_offset + done, progress_total);
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
-}
-
 // KDL::Joint caches its last pose in mutable members (kdl/joint.hpp,
 // `mutable Frame joint_pose; mutable double q_previous;`), so two threads
 // evaluating the same KDL::Chain race and can get each other's joint
@@ -141,8 +113,11 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
   if (options.optimise_rotation && !(options.rotation_max > options.rotation_min)) {
     throw std::invalid_argument("stability map: rotation_max must exceed rotation_min");
   }
-  int threads = options.threads > 0 ? options.threads
-                                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (options.threads < 0) {
+    throw std::invalid_argument("stability map: threads: expected >= 0 (0 = all cores), got " +
+                                std::to_string(options.threads));
+  }
+  const int threads = ResolveThreadCount(options.threads);
   const long total = static_cast<long>(targets.size());
   std::vector<MapPoint> out(total);
   const double rot0 = options.optimise_rotation
@@ -181,29 +156,30 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
     }
   }
   {
-    std::vector<std::unique_ptr<IkSolver>> solvers;
+    // Rows in parallel, each from its first point (one IK solver per thread,
+    // each on its own copy of the chain).
     const int t_ik = std::min(threads, rows);
     std::vector<std::shared_ptr<const dynamics::RobotModel>> copies;
+    std::vector<std::unique_ptr<IkSolver>> solvers;
     for (int t = 0; t < t_ik; ++t) {
       copies.push_back(PrivateCopy(*model));
       solvers.push_back(std::make_unique<IkSolver>(copies.back()->chain()));
     }
-    std::atomic<int> next_row{0};
-    std::vector<std::thread> pool;
-    for (int t = 0; t < t_ik; ++t) {
-      pool.emplace_back([&, t]() {
-        for (int r = next_row++; r < rows; r = next_row++) {
-          const long first = static_cast<long>(r) * cols;
+    ParallelForOptions po;
+    po.threads = t_ik;
+    po.chunk_size = 1;
+    ParallelFor(
+        0, rows,
+        [&](long r, int t) {
+          const long first = r * cols;
           Eigen::VectorXd seed = out[first].status == PointStatus::kOk ? out[first].q : options.seed_q;
           for (int c = 1; c < cols; ++c) {
             if (ik_point(*solvers[t], first + c, seed) && out[first + c].status == PointStatus::kOk) {
               seed = out[first + c].q;
             }
           }
-        }
-      });
-    }
-    for (auto& th : pool) th.join();
+        },
+        po);
   }
 
   // 2. Stability per point, one evaluator per thread.
@@ -264,11 +240,24 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
       opt.set_maxeval(std::max(1, options.rotation_evaluations - kScan));
       opt.set_xtol_abs(1e-3);
       opt.set_initial_step(0.25 * h);
+      // An exception in the objective is kept and rethrown after the run, as
+      // in the scan above: NLopt's wrapper would report it as a generic
+      // "nlopt failure" status.
+      struct Objective {
+        decltype(consider)* f;
+        std::exception_ptr error;
+      } objective{&consider, nullptr};
       opt.set_max_objective(
           [](unsigned, const double* x, double*, void* data) {
-            return (*static_cast<decltype(consider)*>(data))(x[0]);
+            auto* o = static_cast<Objective*>(data);
+            try {
+              return (*o->f)(x[0]);
+            } catch (...) {
+              o->error = std::current_exception();
+              throw nlopt::forced_stop();
+            }
           },
-          &consider);
+          &objective);
       std::vector<double> x{best_rot};
       double fx = 0.0;
       try {
@@ -276,17 +265,22 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
         p.optimiser_status = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : "converged";
       } catch (const nlopt::roundoff_limited&) {
         p.optimiser_status = "roundoff_limited";
+      } catch (const nlopt::forced_stop&) {
+        if (objective.error) std::rethrow_exception(objective.error);
+        p.optimiser_status = "forced_stop";
       } catch (const std::runtime_error& e) {
-        p.optimiser_status = std::string("failed: ") + e.what();
+        p.optimiser_status = std::string("failed: ") + e.what();  // NLopt's own failure
       }
       p.rotation = best_rot;
     }
     if (singular) p.status = PointStatus::kNearSingular;
   };
 
-  ParallelFor(total, threads, options.progress, 0, total,
-              [&](int t, long i) { analyse(*workers[t], i); });
-  if (options.progress) options.progress(total, total);
+  ParallelForOptions po;
+  po.threads = threads;
+  po.chunk_size = 1;  // a point costs 0.1-5 ms (more with optimise_rotation): no need to batch
+  po.progress = options.progress;
+  ParallelFor(0, total, [&](long i, int t) { analyse(*workers[t], i); }, po);
   return out;
 }
 

@@ -127,12 +127,31 @@ std::vector<LobePoint> ZoaLobes::At(const Eigen::VectorXd& speeds) const {
   if (n == 0) return out;
   const double s_lo = sorted.front(), s_hi = sorted.back();
 
+  // Lobe k at line i lies at Ω = num_i/(2θ_i + 2πk) with θ_i in (0, π], so
+  // within [num_i/(2π(k + 1)), num_i/(2πk)]; num_i = speed_numerator[i]
+  // grows with i. The lines of lobe k wholly below s_lo or above s_hi
+  // cannot give a point and are not visited (a relative margin of 1e-9
+  // covers the rounding of θ, of the sum and of the division, ~1e-16): the
+  // result is the same as visiting them (stability_map_test.cc checks it
+  // against a plain scan of every curve).
+  constexpr double kMargin = 1e-9;
   for (const Branch& br : branch_) {
     const size_t m = br.depth.size();
     for (int k = 0; k <= max_lobe_index_; ++k) {
       const double two_pi_k = 2.0 * kPi * k;
+      const double num_above = 2.0 * kPi * (k + 1) * s_hi * (1.0 + kMargin);  // beyond: Ω > s_hi
+      size_t i0 = 0;
+      if (k > 0) {
+        // The first segment whose upper line can reach s_lo.
+        const double num_below = two_pi_k * s_lo * (1.0 - kMargin);
+        const size_t j = static_cast<size_t>(
+            std::lower_bound(br.speed_numerator.begin(), br.speed_numerator.end(), num_below) -
+            br.speed_numerator.begin());
+        i0 = j > 0 ? j - 1 : 0;
+      }
       double sb = NAN;
-      for (size_t i = 0; i + 1 < m; ++i) {
+      for (size_t i = i0; i + 1 < m; ++i) {
+        if (br.speed_numerator[i] > num_above) break;
         const double sa = i == 0 || !std::isfinite(sb) ? br.speed_numerator[i] / (2.0 * br.theta[i] + two_pi_k) : sb;
         sb = br.speed_numerator[i + 1] / (2.0 * br.theta[i + 1] + two_pi_k);  // NaN where no boundary
         if (!std::isfinite(sa) || !std::isfinite(sb)) continue;

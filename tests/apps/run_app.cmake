@@ -2,6 +2,7 @@
 # files it leaves behind (style.md §2.14 app smoke tests).
 #   cmake -DEXPECT_RC=<code> [-DEXPECT_STDERR=<regex>] [-DEXPECT_STDOUT=<regex>]
 #         [-DEXPECT_FILES="a|b"] [-DEXPECT_NO_FILES="c|d"] [-DCLEAN_DIR=<dir>]
+#         [-DMAKE_DIRS="e|f"] (folders made after CLEAN_DIR, before the run)
 #         -P run_app.cmake <command> <args...>
 set(CMD "")
 set(after_script FALSE)
@@ -21,6 +22,10 @@ if(CLEAN_DIR)
   file(REMOVE_RECURSE ${CLEAN_DIR})
   file(MAKE_DIRECTORY ${CLEAN_DIR})
 endif()
+string(REPLACE "|" ";" MAKE_DIRS "${MAKE_DIRS}")
+foreach(d ${MAKE_DIRS})
+  file(MAKE_DIRECTORY ${d})
+endforeach()
 # Outputs left by an earlier run must not make this one pass.
 foreach(f ${EXPECT_FILES} ${EXPECT_NO_FILES})
   file(REMOVE ${f})

@@ -7,8 +7,14 @@ set -euo pipefail
 build=$1; src=$2; work=$3
 rm -rf "$work"; mkdir -p "$work"
 cmake --install "$build" --prefix "$work/prefix" >/dev/null
+# The consumers are compiled and linked with the build's own flags: in a
+# sanitizer build (scripts/check-sanitizers.sh) the installed libraries are
+# instrumented and link only into instrumented programs. Empty otherwise.
+cxx_flags=$(sed -n 's/^CMAKE_CXX_FLAGS:STRING=//p' "$build/CMakeCache.txt")
+ld_flags=$(sed -n 's/^CMAKE_EXE_LINKER_FLAGS:STRING=//p' "$build/CMakeCache.txt")
+flags=(-DCMAKE_CXX_FLAGS="$cxx_flags" -DCMAKE_EXE_LINKER_FLAGS="$ld_flags")
 cmake -S "$src/tests/cmake_consumer" -B "$work/consumer" -G Ninja \
-  -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
+  -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$work/prefix" "${flags[@]}" >/dev/null
 cmake --build "$work/consumer" >/dev/null
 out=$("$work/consumer/consumer" "$src/config/kr210.yaml")
 echo "consumer printed $out"
@@ -19,7 +25,7 @@ for p in Ceres NLopt yaml-cpp urdfdom nlohmann_json OpenCASCADE; do
   disabled+=("-DCMAKE_DISABLE_FIND_PACKAGE_$p=ON")
 done
 cmake -S "$src/tests/cmake_consumer/dynamics_only" -B "$work/dynamics_only" -G Ninja \
-  -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$work/prefix" "${disabled[@]}" >/dev/null
+  -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$work/prefix" "${disabled[@]}" "${flags[@]}" >/dev/null
 if grep -E '^ROBOMACH_(OPENCV|CLIPPER)' "$work/dynamics_only/CMakeCache.txt"; then
   echo "a dynamics-only consumer looked for OpenCV or Clipper"; exit 1
 fi

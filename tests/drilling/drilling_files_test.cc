@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "robomach/drilling/drilling_sim.h"
+#include "robomach/drilling/plausibility.h"
 #include "robomach/io/atomic_file.h"
 #include "drilling/drilling_test_models.h"
 #include "test_support.h"
@@ -45,6 +46,52 @@ TEST(DrillingFiles, ForceTableErrorsNameFileLineAndColumn) {
   const std::string rows = WriteText(dir + "/rows.csv", "diameter_mm,feed_mm_per_rev\n6,0.11\n");
   EXPECT_EQ(ReadForceTable(rows, false).rows.size(), 1u);
   EXPECT_THAT(CaptureError([&] { ReadForceTable(rows, true); }), HasSubstr("missing required column 'thrust_N'"));
+}
+
+// Unit plausibility (issue #22 item 1) on the shipped Q235/HSS table: its
+// median T / (F D) is row 3's 1.39 / (902 x 0.005) = 0.3082 (by hand, the
+// 7 ratios 0.299..0.314), inside 0.02..3; with the torque in N·mm (x1000)
+// it is 308.2 and named. A feed in mm/min (x rpm) is rejected by the reader
+// at its cell; a diameter in m is flagged with the cutting speed it implies.
+TEST(DrillingFiles, UnitMistakesInForceTablesAndDrillFilesAreNamed) {
+  ForceTableFile t = ReadForceTable(SourcePath("config/drilling/q235_hss.csv"));
+  EXPECT_TRUE(drilling::ForceTableFindings(t.rows).empty());
+  for (auto& r : t.rows) r.torque *= 1000.0;
+  const auto f = drilling::ForceTableFindings(t.rows);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_THAT(f[0], HasSubstr("median torque / (thrust x diameter) of the table is 308.2"));
+  EXPECT_THAT(f[0], HasSubstr("N·mm"));
+
+  const std::string dir = TempDir("drilling_files_units");
+  const std::string mm_min = WriteText(dir + "/mm_min.csv",
+                                       "diameter_mm,feed_mm_per_rev,thrust_N,torque_Nm,speed_rpm\n"
+                                       "5,0.08,676,1.010,1782.5\n5,152.79,794,1.200,1527.9\n");
+  EXPECT_THAT(CaptureError([&] { ReadForceTable(mm_min); }),
+              HasSubstr("mm_min.csv:3: column feed_mm_per_rev: expected 0.005 to 1 mm/rev (twist-drilling practice), "
+                        "got 152.79: a feed in mm/min"));
+  const std::string d_m = WriteText(dir + "/d_m.csv", "diameter_mm,feed_mm_per_rev,thrust_N,torque_Nm\n0.005,0.08,676,1\n");
+  EXPECT_THAT(CaptureError([&] { ReadForceTable(d_m); }),
+              HasSubstr("d_m.csv:2: column diameter_mm: expected 0.1 to 100 mm"));
+
+  DrillFile d = ReadDrillFile(SourcePath("config/drilling/drill_5mm.yaml"));
+  EXPECT_TRUE(drilling::ToolingFindings(d.drill, &d.process).empty());
+  d.drill.diameter *= 1e-3;  // 0.005 mm: metres typed in the mm field
+  const auto g = drilling::ToolingFindings(d.drill, &d.process);
+  ASSERT_EQ(g.size(), 2u);
+  EXPECT_THAT(g[0], HasSubstr("drill diameter_mm 0.005 mm is outside the 0.1 to 100 mm of twist drills: a diameter in m"));
+  // pi x 0.005 mm x 1500 rpm = 0.02356 m/min.
+  EXPECT_THAT(g[1], HasSubstr("the cutting speed pi D n = 0.02356 m/min"));
+  d = ReadDrillFile(SourcePath("config/drilling/drill_5mm.yaml"));
+  d.process.feed_per_rev *= 1500.0;  // mm/min
+  ASSERT_EQ(drilling::ToolingFindings(d.drill, &d.process).size(), 1u);
+  EXPECT_THAT(drilling::ToolingFindings(d.drill, &d.process)[0], HasSubstr("a feed in mm/min"));
+
+  const drilling::DrillingMaterial q235 = ReadMaterialFile(SourcePath("config/drilling/q235.yaml"));
+  EXPECT_TRUE(drilling::MaterialFindings(q235).empty());
+  drilling::DrillingMaterial gpa = q235;
+  gpa.shear_stress_torque = 600e9;
+  ASSERT_EQ(drilling::MaterialFindings(gpa).size(), 1u);
+  EXPECT_THAT(drilling::MaterialFindings(gpa)[0], HasSubstr("shear_stress_torque (K_TQ) = 6e+05 MPa"));
 }
 
 TEST(DrillingFiles, ReadsDrillFileAndRejectsUnknownKeys) {

@@ -1,6 +1,7 @@
 #include "robomach/drilling/force_fit.h"
 
 #include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -83,6 +84,39 @@ TEST(ForceFit, RejectsNonPositiveRow) {
   std::vector<ForceTableRow> rows = kTable1;
   rows[2].thrust = 0.0;
   EXPECT_THROW(FitDrillingForces(DrillGeometry{}, rows), std::invalid_argument);
+}
+
+// Issue #22: feed in mm/min under feed_mm_per_rev (Table 1's feeds times its
+// spindle speeds, 795..1783 rpm) is a row the model cannot use, named by
+// index so that a tool can report the file's line (exit 65); it used to
+// fail inside the solve as "shear_stress_thrust: expected > 0 Pa, got -nan".
+TEST(ForceFit, FeedInMillimetresPerMinuteIsARowError) {
+  const double rpm[] = {1782.5, 1527.9, 1336.9, 1209.6, 1034.5, 915.2, 795.8};
+  std::vector<ForceTableRow> rows = kTable1;
+  for (size_t k = 0; k < rows.size(); ++k) rows[k].feed_per_rev *= rpm[k];
+  try {
+    FitDrillingForces(DrillGeometry{}, rows);
+    ADD_FAILURE() << "no exception";
+  } catch (const ForceTableRowError& e) {
+    EXPECT_EQ(e.row(), 0u);
+    EXPECT_NE(std::string(e.what()).find("mm/min"), std::string::npos) << e.what();
+  }
+}
+
+// Forces that hardly grow with the feed (here thrust and torque +17 % for
+// feed +20 % at 1 mm/rev, far from Table 1's size effect) pull the Kienzle
+// exponent to 0: a flag in the result, not a material the force model
+// rejects (this threw std::invalid_argument, "kienzle_exponent: expected
+// 0 <= m < 1, got -0.12", from inside the solve: exit 64 in drill-force-fit).
+TEST(ForceFit, ExponentRunningToItsBoundIsAFlagNotAnException) {
+  const std::vector<ForceTableRow> rows = {{5e-3, 1.0e-3, 676, 1.0}, {5e-3, 1.2e-3, 794, 1.2}};
+  ForceFitResult fit;
+  ASSERT_NO_THROW(fit = FitDrillingForces(DrillGeometry{}, rows));
+  EXPECT_TRUE(fit.kienzle_exponent_at_bound);
+  EXPECT_GE(fit.material.kienzle_exponent, 0.0);
+  EXPECT_LT(fit.material.kienzle_exponent, 1e-3);
+  // Table 1 itself stays clear of both ends (m about 0.24).
+  EXPECT_FALSE(FitDrillingForces(DrillGeometry{}, kTable1).kienzle_exponent_at_bound);
 }
 
 }  // namespace

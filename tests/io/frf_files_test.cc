@@ -15,6 +15,7 @@
 #include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/io/frf_files.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/io/tip_dynamics_files.h"
 #include "test_support.h"
 
 namespace robomach::io {
@@ -177,6 +178,41 @@ TEST(FrfUff58, ReadsPyuffFileLikeTheShippedCsv) {
     EXPECT_LE((a.freq_hz() - b.freq_hz()).cwiseAbs().maxCoeff(), 1e-9);
     EXPECT_LE(MaxRelDiff(a, b), 1e-10) << k.ToString();
   }
+}
+
+// Unit plausibility (issue #22 item 1) on the pyuff file: its receptance
+// peaks (largest median of three neighbouring lines: 2.943e-6 m/N xx,
+// 2.0611e-5 m/N yy, by a Python scan of the CSV copy) are plausible; the
+// same values times i omega (a mobility read as receptance) peak at
+// 1.3312e-3 and 2.751e-3, above 1e-3 m/N: both FRFs are
+// flagged and the mistake is named; in mm (x1000) too. The tool-tip reader
+// (stability-lobes) gives one finding for the posture.
+TEST(FrfUff58, MobilityReadAsReceptanceIsFlagged) {
+  const FrfSet good = ReadUff58(SourcePath("tests/data/kr210_P1_receptance.uff")).frfs;
+  // Tolerances: 6 digits of the Python numbers (the file and its CSV copy
+  // agree to 1e-10 relative, FrfUff58.ReadsPyuffFileLikeTheShippedCsv).
+  EXPECT_NEAR(dynamics::PeakReceptance(good.at({"P1", Axis::kY, Axis::kY})), 2.06109e-5, 1e-10);
+  EXPECT_TRUE(dynamics::ReceptanceUnitFindings(good, "good.uff").empty());
+  FrfSet mobility, mm;
+  for (const auto& [k, frf] : good) {
+    Eigen::VectorXcd y = frf.receptance();
+    for (int i = 0; i < y.size(); ++i) y(i) *= std::complex<double>(0.0, 2.0 * M_PI * frf.freq_hz()(i));
+    mobility.Insert(k, Frf::FromSamples(frf.freq_hz(), y));
+    mm.Insert(k, Frf::FromSamples(frf.freq_hz(), frf.receptance() * 1000.0));
+  }
+  EXPECT_NEAR(dynamics::PeakReceptance(mobility.at({"P1", Axis::kX, Axis::kX})), 1.33123e-3, 1e-8);
+  const auto f = dynamics::ReceptanceUnitFindings(mobility, "m.uff");
+  ASSERT_EQ(f.size(), 2u);
+  EXPECT_THAT(f[0], HasSubstr("m.uff: pose P1, response x, excitation x: the largest receptance is 0.00133 m/N, "
+                              "outside the plausible 1e-12 to 1e-03 m/N"));
+  EXPECT_THAT(f[0], HasSubstr("a mobility or accelerance was read as receptance"));
+  EXPECT_EQ(dynamics::ReceptanceUnitFindings(mm, "mm.csv").size(), 2u);
+  const std::string dir = TempDir("frf_units");
+  WriteUff58(dir + "/mobility.uff", mobility);
+  const auto sets = ReadTipFrfs(dir + "/mobility.uff");
+  ASSERT_EQ(ReceptanceUnitFindings(sets).size(), 1u);
+  EXPECT_THAT(ReceptanceUnitFindings(sets)[0], HasSubstr("mobility.uff: posture P1: the largest receptance is 0.00275 m/N"));
+  EXPECT_TRUE(ReceptanceUnitFindings(ReadTipFrfs(SourcePath("tests/data/kr210_P1_receptance.uff"))).empty());
 }
 
 // The pyuff file was computed by an independent implementation of the

@@ -51,6 +51,26 @@ TEST(UrdfLoader, MalformedXmlKeepsUrdfdomsReason) {
               HasSubstr("link 'b' is not unique"));
 }
 
+// NaN or inf in a number (urdfdom rejects some without saying where, and
+// reads others, e.g. an inertial origin, as numbers): file, line and column
+// of the attribute value (line 11, column 22 of the two-link arm:
+// `    <origin xyz="0.5 nan 0"/>`; line 6, column 49 for the inertial origin of b).
+TEST(UrdfLoader, NanOrInfIsRejectedWithLineAndColumn) {
+  const std::string dir = TempDir("urdf_nan");
+  for (const std::string t : {"nan", "inf", "-inf", "NaN"}) {
+    std::string text = Urdf(kGoodInertia);
+    const std::string origin = "<origin xyz=\"0.5 0 0\"/>";
+    text.replace(text.find(origin), origin.size(), "<origin xyz=\"0.5 " + t + " 0\"/>");
+    const std::string path = WriteText(dir + "/r.urdf", text);
+    EXPECT_THAT(CaptureError([&] { LoadUrdfChain(path, "world", "b"); }),
+                HasSubstr("r.urdf:11:22: expected a finite number, got \"" + t + "\""));
+  }
+  std::string text = Urdf(std::string(R"(<origin xyz="0 0 inf"/>)") + kGoodInertia);
+  const std::string path = WriteText(dir + "/com.urdf", text);
+  EXPECT_THAT(CaptureError([&] { LoadUrdfChain(path, "world", "b"); }),
+              HasSubstr("com.urdf:6:49: expected a finite number, got \"inf\""));
+}
+
 TEST(UrdfLoader, MissingLinksAreNamedWithTheAvailableOnes) {
   const std::string dir = TempDir("urdf_link");
   const std::string path = WriteText(dir + "/r.urdf", Urdf(kGoodInertia));

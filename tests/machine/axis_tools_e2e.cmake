@@ -62,3 +62,20 @@ message(STATUS "without compensation: contour error max ${emax_off} um")
 if(NOT emax_off GREATER 2.0)
   message(FATAL_ERROR "without the tables the error should exceed 2 um, got ${emax_off}")
 endif()
+# Issue #22 item 1: the X and Y count columns swapped (data under each
+# other's header; a contour error of 253 mm came out with exit 0): exit 3,
+# the outputs written, the swap named. The counts are the decoded ones above
+# (no measured counts file is shipped).
+execute_process(COMMAND python3 ${SRC}/tests/apps/wrong_units.py swap ${TMP}/counts.csv ${TMP}/counts_swapped.csv
+                        X_count Y_count RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "wrong_units.py swap failed")
+endif()
+execute_process(COMMAND ${ACQUIRE} --machine ${TMP}/machine.yaml --counts ${TMP}/counts_swapped.csv --program ${P}
+                        --out ${TMP}/tcp_swapped.csv --summary ${TMP}/summary_swapped.json
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+message(STATUS "X and Y swapped: exit ${rc}\n${err}")
+if(NOT rc EQUAL 3 OR NOT err MATCHES "contour error up to [0-9.]+ mm .*the count columns are probably swapped"
+   OR NOT EXISTS ${TMP}/summary_swapped.json)
+  message(FATAL_ERROR "swapped X and Y counts: expected exit 3 naming swapped columns, with the summary written")
+endif()

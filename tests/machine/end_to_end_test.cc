@@ -9,6 +9,8 @@
 #include <cmath>
 #include <random>
 
+#include <Eigen/Geometry>
+
 #include "robomach/common/units.h"
 #include "robomach/machine/acquisition.h"
 #include "robomach/machine/nutating_head_rotary_table.h"
@@ -211,6 +213,46 @@ TEST(ContourTracker, FollowsAClosedPathLikeTheExhaustiveSearch) {
       ASSERT_LE(e.distance, full.distance + 1e-5) << "sample " << k;
     }
   }
+}
+
+// Unit plausibility of contour errors: the 45 mm circle in the xy plane
+// followed at a constant normal offset d (the tip moved radially, so the
+// contour error is d exactly and the axis error 0). 0.9 mm passes, 1.1 mm
+// is flagged (limit 1 mm); an axis tilted by 2° about the tangent is
+// flagged (limit 1°), by 0.5° not. X and Y of the machine swapped (the tip
+// mirrored about x = y on a circle centred at (20, 0) mm) is flagged.
+TEST(ContourUnitFindings, FlagsErrorsBeyondWhatAMachineCanBeOff) {
+  std::vector<Eigen::Vector3d> tips, axes;
+  for (int i = 0; i <= 360; ++i) {
+    const double a = DegToRad(i);
+    tips.emplace_back(0.02 + 0.045 * std::cos(a), 0.045 * std::sin(a), 0.02);
+    axes.emplace_back(0.0, 0.0, 1.0);
+  }
+  const ProgrammedPath path(tips, axes);
+  auto run = [&](double offset, double tilt, bool swap) {
+    ContourTracker tracker(path);
+    std::vector<ContourError> c;
+    for (int k = 0; k <= 720; ++k) {
+      ToolPose p = path.At(path.length() * k / 720.0);
+      const Eigen::Vector3d radial = Eigen::Vector3d(p.p_W.x() - 0.02, p.p_W.y(), 0.0).normalized();
+      p.p_W += offset * radial;
+      const Eigen::Vector3d tangent = Eigen::Vector3d::UnitZ().cross(radial);
+      p.k_W = Eigen::AngleAxisd(tilt, tangent) * p.k_W;
+      if (swap) std::swap(p.p_W.x(), p.p_W.y());
+      c.push_back(tracker.Next(p));
+    }
+    return ContourUnitFindings(c, path);
+  };
+  EXPECT_TRUE(run(0.0, 0.0, false).empty());
+  EXPECT_TRUE(run(0.9e-3, DegToRad(0.5), false).empty());
+  const auto f = run(1.1e-3, 0.0, false);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_NE(f[0].find("contour error up to 1.1 mm"), std::string::npos) << f[0];
+  EXPECT_NE(f[0].find("swapped"), std::string::npos);
+  const auto g = run(0.0, DegToRad(2.0), false);
+  ASSERT_EQ(g.size(), 1u);
+  EXPECT_NE(g[0].find("tool axis error up to 2 deg"), std::string::npos) << g[0];
+  EXPECT_EQ(run(0.0, 0.0, true).size(), 1u);
 }
 
 }  // namespace

@@ -58,6 +58,31 @@ TEST(Iso230, HandComputedExampleReproducedExactly) {
   EXPECT_EQ(r.B_mean, 3);
 }
 
+// Unit plausibility: the hand example's deviations are in µm. Given as mm
+// (÷1000) beside targets of 10 and 20 mm they are plausible; left in µm
+// under an _mm header the largest |mean| + 2 s (target 20 down: 2 + 2·2 = 6
+// by hand) is 30 % of the targets' magnitude (20 mm) and flagged; the same
+// runs with the targets in µm too (20000) pass the relative limit but not
+// the absolute 1 mm one.
+TEST(Iso230, DeviationsInMicrometresUnderMmAreFlagged) {
+  std::vector<Iso230Approach> mm = HandExample(), um_targets = HandExample();
+  for (auto& a : mm) a.deviation *= 1e-3;
+  for (auto& a : um_targets) a.target *= 1e3;
+  EXPECT_TRUE(Iso230UnitFindings("X", EvaluateIso230(mm), false).empty());
+  const auto f = Iso230UnitFindings("X", EvaluateIso230(HandExample()), false);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_NE(f[0].find("deviations up to 6 mm are 30 % of the targets' magnitude (20 mm"), std::string::npos) << f[0];
+  EXPECT_NE(f[0].find("in um"), std::string::npos);
+  const auto g = Iso230UnitFindings("X", EvaluateIso230(um_targets), false);
+  ASSERT_EQ(g.size(), 1u);
+  EXPECT_NE(g[0].find("more than the 1 mm"), std::string::npos) << g[0];
+  // Rotary: 6 "deg" is arcsec typed as deg; 6 arcsec (0.00167 deg) is not.
+  std::vector<Iso230Approach> arcsec = HandExample();
+  for (auto& a : arcsec) a.deviation /= 3600.0;
+  EXPECT_EQ(Iso230UnitFindings("C", EvaluateIso230(HandExample()), true).size(), 1u);
+  EXPECT_TRUE(Iso230UnitFindings("C", EvaluateIso230(arcsec), true).empty());
+}
+
 TEST(Iso230, ShiftingEveryDeviationLeavesSpreadFiguresUnchanged) {
   // Invariant: adding a constant to all deviations changes no figure except
   // the per-target means (all figures are differences or spreads).

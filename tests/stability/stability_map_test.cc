@@ -9,6 +9,9 @@
 #include "robomach/io/region_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/kinematics/serial_chain.h"
+#include "robomach/stability/mode_coupling.h"
+#include "robomach/stability/tool_tip_model.h"
+#include "robomach/stability/zoa_lobes.h"
 #include "test_support.h"
 
 namespace robomach::stability {
@@ -127,6 +130,120 @@ TEST(StabilityMap, ThreadCountDoesNotChangeResults) {
       ASSERT_EQ(a[i].stability.critical_depth, b[i].stability.critical_depth) << i;
     }
   }
+}
+
+}  // namespace
+}  // namespace robomach::stability
+
+namespace robomach::stability {
+namespace {
+
+// The map against a serial reference (issue #23 item 3): every analysed
+// point of a 2-thread map equals AnalysePosture at the map's own posture,
+// evaluated point after point on one thread with the plain calls (its own
+// model and PostureEvaluator, the speeds all at once). The same functions
+// of the same numbers in the same order: equal to rounding, and 1e-12
+// relative leaves room only for that.
+TEST(StabilityMap, PointsEqualASerialReferenceAnalysis) {
+  Fixture f;
+  f.region.size_u = 0.3;
+  f.region.size_v = 0.2;
+  f.region.grid_step = 0.05;
+  const auto targets = f.region.Targets(f.cut.feed_direction_B);
+  MapOptions o = f.Options();
+  o.analysis.spindle_speed_rad_s =
+      Eigen::VectorXd::LinSpaced(200, f.cut.spindle_speed_min_rad_s, f.cut.spindle_speed_max_rad_s);
+  const auto map = EvaluateStabilityMap(f.model, targets, f.region.num_v(), f.region.num_u(), f.cut.process, o);
+  dynamics::PostureEvaluator ev(dynamics::RobotModel::Build(f.model->description(), f.model->parameters()));
+  int analysed = 0;
+  for (size_t i = 0; i < map.size(); ++i) {
+    const MapPoint& p = map[i];
+    if (p.status != PointStatus::kOk && p.status != PointStatus::kNearSingular) continue;
+    ++analysed;
+    const dynamics::PostureDynamics d = ev.Evaluate(p.q, dynamics::PostureOptions{false, true});
+    const PostureStability ref = AnalysePosture(
+        d, CuttingFrameAtPosture(targets[i].Pose(p.rotation), targets[i].feed_B), f.cut.process, o.analysis);
+    const auto near = [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::abs(b); };
+    EXPECT_TRUE(near(p.stability.critical_depth, ref.critical_depth))
+        << i << ": " << p.stability.critical_depth << " vs " << ref.critical_depth;
+    EXPECT_TRUE(near(p.stability.mode_coupling.critical_depth, ref.mode_coupling.critical_depth)) << i;
+    EXPECT_TRUE(near(p.stability.regenerative.critical_depth, ref.regenerative.critical_depth)) << i;
+    EXPECT_TRUE(near(p.stability.regenerative.spindle_speed_rad_s, ref.regenerative.spindle_speed_rad_s)) << i;
+    EXPECT_TRUE(near(p.stability.closed_form.critical_depth, ref.closed_form.critical_depth)) << i;
+    EXPECT_EQ(p.stability.limiting, ref.limiting) << i;
+    EXPECT_TRUE(near(p.jacobian_condition, d.jacobian_condition)) << i;
+  }
+  EXPECT_GE(analysed, 20);  // 7 x 5 points, nearly all reachable from the demo seed
+}
+
+// ZoaLobes::At skips the lines of lobe k that cannot reach the speed range;
+// a plain interpolation over every segment of every curve (from curves(),
+// written here without the skipping) must give the same envelope. KR210
+// demo posture, 1200 lines, 200 speeds over 6000-24000 rpm (the map's
+// case) and a narrow range (where most lines are skipped).
+TEST(StabilityMap, LobeEnvelopeEqualsAPlainScanOfEveryCurve) {
+  Fixture f;
+  dynamics::PostureEvaluator ev(f.model);
+  const dynamics::PostureDynamics d = ev.Evaluate(f.region.seed_q, dynamics::PostureOptions{false, true});
+  const Eigen::Matrix3d R = CuttingFrameAtPosture(d.X_BT, f.cut.feed_direction_B);
+  const TipModalModel modes = ModalModelFromPosture(d);
+  for (const auto& [lo_rpm, hi_rpm] : {std::pair{6000.0, 24000.0}, std::pair{11000.0, 11500.0}}) {
+    const Eigen::VectorXd speeds = Eigen::VectorXd::LinSpaced(200, RpmToRadPerSec(lo_rpm), RpmToRadPerSec(hi_rpm));
+    const Eigen::VectorXd freq = LobeFrequencyGrid(modes, f.cut.process.teeth, speeds.maxCoeff(), 1200);
+    ZoaOptions zo;
+    zo.min_spindle_speed_rad_s = speeds.minCoeff();
+    const ZoaLobes lobes =
+        ComputeZoaLobes(freq, InPlaneModalReceptance(modes.Rotated(R), freq), f.cut.process, zo);
+    const std::vector<LobePoint> got = lobes.At(speeds);
+    int covered = 0;
+    for (Eigen::Index j = 0; j < speeds.size(); ++j) {
+      const double s = speeds(j);
+      double best = NAN;
+      for (const LobeCurve& c : lobes.curves()) {
+        for (size_t i = 0; i + 1 < c.spindle_speed_rad_s.size(); ++i) {
+          const double sa = c.spindle_speed_rad_s[i], sb = c.spindle_speed_rad_s[i + 1];
+          if (!std::isfinite(sa) || !std::isfinite(sb) || s < std::min(sa, sb) || s > std::max(sa, sb)) continue;
+          const double t = sb != sa ? (s - sa) / (sb - sa) : 0.0;
+          const double depth = c.critical_depth[i] + t * (c.critical_depth[i + 1] - c.critical_depth[i]);
+          if (!(depth >= best)) best = depth;
+        }
+      }
+      ASSERT_EQ(got[j].status == LobeStatus::kOk, std::isfinite(best)) << lo_rpm << " rpm range, speed " << j;
+      if (!std::isfinite(best)) continue;
+      ++covered;
+      // The same interpolation formula: equal to rounding.
+      EXPECT_NEAR(got[j].critical_depth, best, 1e-12 * best) << lo_rpm << " rpm range, speed " << j;
+    }
+    EXPECT_EQ(covered, 200) << lo_rpm;
+  }
+}
+
+// The modal mode-coupling search of six modes runs on fixed-size 12 x 12
+// matrices; the joint-space search (dynamic size) of the same structure
+// written as M = I, C = diag(2ζω), K = diag(ω²), B = P must give the same
+// depth. The bracket tolerance is set to 1e-10 so that both searches end
+// within 1e-10 relative of the same crossing; they differ only by rounding.
+TEST(StabilityMap, SixModeModalSearchEqualsTheGeneralSearch) {
+  Fixture f;
+  dynamics::PostureEvaluator ev(f.model);
+  const dynamics::PostureDynamics d = ev.Evaluate(f.region.seed_q, dynamics::PostureOptions{false, true});
+  const TipModalModel m = ModalModelFromPosture(d);
+  ASSERT_EQ(m.num_modes(), 6);
+  const Eigen::Matrix3d R = CuttingFrameAtPosture(d.X_BT, f.cut.feed_direction_B);
+  const Eigen::Matrix3d Kc_B = R * CuttingStiffnessPerDepth(f.cut.process) * R.transpose();
+  ModeCouplingOptions opt;
+  opt.depth_tolerance = 1e-10;
+  const ModeCouplingResult modal = CriticalDepthModeCouplingModal(m, Kc_B, opt);
+  const Eigen::VectorXd w = m.omega_rad_s;
+  const ModeCouplingResult general = CriticalDepthModeCoupling(
+      Eigen::MatrixXd::Identity(6, 6), (2.0 * m.zeta.cwiseProduct(w)).asDiagonal().toDenseMatrix(),
+      w.array().square().matrix().asDiagonal().toDenseMatrix(), m.p, Kc_B, opt);
+  ASSERT_EQ(modal.status, ModeCouplingStatus::kFound);
+  ASSERT_EQ(general.status, ModeCouplingStatus::kFound);
+  EXPECT_NEAR(modal.critical_depth, general.critical_depth, 2e-10 * general.critical_depth);
+  // The frequency of the eigenvalue at the upper end of each bracket (both
+  // within 1e-10 of the crossing, where Im λ varies smoothly): 1e-6 is loose.
+  EXPECT_NEAR(modal.chatter_freq_hz, general.chatter_freq_hz, 1e-6 * general.chatter_freq_hz);
 }
 
 }  // namespace

@@ -140,12 +140,10 @@ struct FrfEstimateResult {
   bool implausible{false};
 };
 
-/// Plausible peak receptance of a tool tip or a machine structure [m/N]:
-/// 1 mm/N would move a tool 10 cm under a 100 N tap; 1e-12 m/N is stiffer
-/// than any steel structure a hammer can excite (a 1 m cube of steel under
-/// a point load is ~1e-10 m/N).
-inline constexpr double kMaxPlausibleReceptance = 1e-3;
-inline constexpr double kMinPlausibleReceptance = 1e-12;
+/// Plausible peak receptance: dynamics::kMinPlausibleReceptance and
+/// kMaxPlausibleReceptance (measured_frf.h), the one check of every tool.
+using dynamics::kMaxPlausibleReceptance;
+using dynamics::kMinPlausibleReceptance;
 
 /// Estimates H1, H2 and the coherence of each response channel from the
 /// hits, after rejecting double hits and overloads (eq. (1)–(3)).

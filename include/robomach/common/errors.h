@@ -34,6 +34,17 @@ class OutputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A numerical method failed at the values it was given: a factorisation or
+/// an eigensolver did not succeed (a mass matrix that is not positive
+/// definite at an extreme parameter value), a result is not finite. Code that
+/// tries many values (a fit's trial points, an audit's candidates) catches
+/// this type, and only this type, and treats the value as infeasible; any
+/// other exception there is bad input or a bug and propagates.
+class NumericalError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace robomach
 
 /// Debug-only check of an internal invariant (a robomach bug, not bad input).

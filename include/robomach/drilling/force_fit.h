@@ -1,5 +1,6 @@
 #pragma once
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,21 @@ struct ForceTableRow {
 };
 
 enum class FitStatus { kConverged, kNotConverged, kFailed };
+
+/// A row of a force table that the fit cannot use: a value that is not
+/// positive and finite, or a row where the force model gives no positive
+/// thrust and torque (a feed far beyond the model's range for the diameter,
+/// typically a feed in mm/min under feed_mm_per_rev). Bad data, not a bad
+/// call: a tool maps `row()` to the file's line (exit 65).
+class ForceTableRowError : public std::invalid_argument {
+ public:
+  ForceTableRowError(size_t row, const std::string& message) : std::invalid_argument(message), row_(row) {}
+  /// 0-based index into the rows given to FitDrillingForces.
+  size_t row() const { return row_; }
+
+ private:
+  size_t row_;
+};
 
 struct ForceFitOptions {
   ChiselModel chisel{ChiselModel::kSeedScaling};
@@ -34,6 +50,10 @@ struct ForceFitResult {
   double max_rel_error_thrust{NAN};   // max |model - measured| / measured
   double max_rel_error_torque{NAN};
   double rms_rel_error{NAN};          // over all residuals
+  /// The fitted Kienzle exponent ended on its bound (0 or 0.95, within 1e-3): the forces
+  /// grow with the feed faster than linearly or hardly at all, which
+  /// usually means a unit mistake in the table.
+  bool kienzle_exponent_at_bound{false};
   FitStatus status{FitStatus::kFailed};
   std::string solver_message;         // ceres::Solver::Summary::BriefReport
 };
@@ -50,8 +70,9 @@ DrillForces PredictRow(const DrillGeometry& drill, const DrillingMaterial& mater
 /// m, so the shear stresses stay positive. Standard deviations come from the
 /// covariance at the solution scaled by the residual variance
 /// sigma^2 = sum r^2 / (2 n - p) (no measurement noise is given).
-/// @throws std::invalid_argument for fewer rows than parameters, or a
-///   non-positive or non-finite value in a row.
+/// @throws std::invalid_argument for fewer rows than parameters;
+///   ForceTableRowError for a non-positive or non-finite value in a row, or
+///   a row where the model gives no positive thrust and torque.
 ForceFitResult FitDrillingForces(const DrillGeometry& drill, const std::vector<ForceTableRow>& rows,
                                  const ForceFitOptions& options = {});
 

@@ -101,4 +101,35 @@ class FrfSet {
   std::map<FrfKey, Frf> frfs_;
 };
 
+// Unit plausibility of a receptance (issue #22 item 1). Plausible peak
+// receptance of a tool tip or a machine structure [m/N]: 1 mm/N would move
+// a tool 10 cm under a 100 N tap; 1e-12 m/N is stiffer than any steel
+// structure a hammer can excite (a 1 m cube of steel under a point load is
+// ~1e-10 m/N). Robot tool tips are 1e-7..1e-5 m/N (Cordes, Hintze, Altintas,
+// "Chatter stability in robotic milling", Robot. CIM 55 (2019) 11-18),
+// machine-tool tips 1e-8..1e-6 m/N (Altintas, Manufacturing Automation,
+// 2nd ed. (2012), Ch. 3 examples).
+inline constexpr double kMaxPlausibleReceptance = 1e-3;
+inline constexpr double kMinPlausibleReceptance = 1e-12;
+
+/// The one unit check of a peak receptance [m/N] against
+/// [kMinPlausibleReceptance, kMaxPlausibleReceptance]: "" if plausible, else
+/// a sentence starting with `what` that names the value, the range and the
+/// likely unit mistakes (mm or um under an _m column, kN under force_N, a
+/// mobility or accelerance read as receptance; or mN, km).
+std::string ReceptancePeakFinding(const std::string& what, double peak_m_per_N);
+
+/// The largest median of three neighbouring |H| (a resonance spans several
+/// lines; a lone line is noise) of `frf` on its lines above 0 Hz with
+/// coherence >= 0.5 (all lines above 0 Hz when it has no coherence) [m/N].
+/// The 0 Hz line and lone lines are left out: a hammer test does not measure
+/// the static compliance, and an integrated accelerometer's drift makes the
+/// lowest lines of a measured receptance large (tests/tap_test_synth.h:
+/// 1.2e-3 m/N at 0 Hz for a 6e-5 m/N tool tip).
+double PeakReceptance(const Frf& frf);
+
+/// ReceptancePeakFinding of every FRF of the set: one finding per FRF out of
+/// range, each starting with `source` and the FRF's key.
+std::vector<std::string> ReceptanceUnitFindings(const FrfSet& frfs, const std::string& source);
+
 }  // namespace robomach::dynamics

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "robomach/machine/axes.h"
@@ -96,6 +97,25 @@ class ContourTracker {
   int window_;
   int last_{-1};
 };
+
+// Unit plausibility of a contour error (issue #22 item 1). A five-axis
+// machine follows its programmed path to within micrometres to tens of
+// micrometres (servo lag and geometric errors; ISO 10791-6 circular and
+// cone tests accept 0.01-0.05 mm), and its tool axis to within hundredths
+// of a degree. A contour error past these limits (~100 times wider) is not
+// a machine error but a mismatch of the data: count columns swapped, a
+// resolution in the wrong unit, another program, or another reference
+// position.
+inline constexpr double kMaxPlausibleContourError = 1e-3;      // [m] = 1 mm
+inline constexpr double kMaxPlausibleAxisError = 0.0174532925;  // [rad] = 1 deg
+
+/// Findings of the plausibility check of a run's contour errors against the
+/// limits above and against the programmed path's extent (a contour error
+/// as large as 10 % of the path's bounding box means the tool was elsewhere);
+/// each a sentence naming the value, the limit and the likely mistake (the
+/// axis error only when the contour error is plausible: a tip far off its
+/// path is compared with another point's axis).
+std::vector<std::string> ContourUnitFindings(const std::vector<ContourError>& contour, const ProgrammedPath& path);
 
 /// Statistics of a series (max |v|, mean, rms, standard deviation).
 struct SeriesStats {

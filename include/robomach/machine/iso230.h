@@ -46,6 +46,29 @@ struct Iso230Result {
 ///   given twice, or if there are no targets.
 Iso230Result EvaluateIso230(const std::vector<Iso230Approach>& approaches);
 
+// Unit plausibility of positioning runs (issue #22 item 1). A machine-tool
+// axis positions to tens of micrometres over its travel: ISO 10791-2 and
+// ISO 10791-4 acceptance tolerances for A are 0.01-0.05 mm per 1000 mm of
+// travel, uncompensated axes of large machines reach ~0.1 mm per metre
+// (ISO/TR 230-9 examples); rotary axes are within 5-60 arcsec (ISO 10791-1
+// A tolerances for B/C tables: 10-20 arcsec). The limits below are ~100
+// times wider, so only a unit mistake exceeds them: micrometres under an
+// _mm header (deviations 1000 times too large), measured values in um with
+// targets in mm (deviations as large as the targets), arcsec under _deg.
+/// Largest plausible |deviation| of a linear axis as a fraction of the
+/// targets' magnitude (max(|target|, travel)): 1 % is 10 mm per metre.
+inline constexpr double kMaxPlausibleDeviationFraction = 0.01;
+/// Largest plausible |deviation| of a linear axis [mm].
+inline constexpr double kMaxPlausibleLinearDeviationMm = 1.0;
+/// Largest plausible |deviation| of a rotary axis [deg] (3600 arcsec).
+inline constexpr double kMaxPlausibleRotaryDeviationDeg = 1.0;
+
+/// Findings of the unit plausibility check of one axis's result (the mean
+/// deviations per direction and the ranges of the runs, mean ± 2 s, against
+/// the limits above), each a sentence naming the axis, the value, the limit
+/// and the likely unit mistake; empty if plausible. `unit` is "mm" or "deg".
+std::vector<std::string> Iso230UnitFindings(const std::string& axis, const Iso230Result& result, bool rotary);
+
 /// Wraps an angle deviation into (-180, 180] degrees.
 double WrapDeviationDeg(double deviation_deg);
 

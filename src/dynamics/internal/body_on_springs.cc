@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "robomach/common/errors.h"
 
 namespace robomach::dynamics::internal {
 namespace {
@@ -36,7 +37,7 @@ Eigen::MatrixXd ModalDampingMatrix(const Eigen::MatrixXd& M, const Eigen::Matrix
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ges(K, M, Eigen::ComputeEigenvectors |
                                                                           Eigen::Ax_lBx);
   if (ges.info() != Eigen::Success) {
-    throw std::runtime_error("modal damping: the mounted body's mass matrix is not positive definite");
+    throw NumericalError("modal damping: the mounted body's mass matrix is not positive definite");
   }
   const Eigen::VectorXd omega = ges.eigenvalues().cwiseMax(0.0).cwiseSqrt();
   const Eigen::MatrixXd MPhi = M * ges.eigenvectors();

@@ -1,0 +1,18 @@
+// libFuzzer target (issue #22 item 4): the robot config YAML reader
+// (docs/formats.md §1). Bad input must be an InputError with a location;
+// any other exception, crash, leak or UB report is a finding.
+#include <cstddef>
+#include <cstdint>
+
+#include "fuzz_input_file.h"
+#include "robomach/common/errors.h"
+#include "robomach/io/robot_config.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string path = robomach::fuzz::WriteInput(data, size, ".yaml");
+  try {
+    robomach::io::LoadRobotConfig(path);
+  } catch (const robomach::InputError&) {
+  }
+  return 0;
+}

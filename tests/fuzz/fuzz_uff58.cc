@@ -1,0 +1,18 @@
+// libFuzzer target (issue #22 item 4): the UFF dataset 58 reader, ASCII and
+// binary (docs/formats.md §3). Bad input must be an InputError with a
+// location; any other exception, crash, leak or UB report is a finding.
+#include <cstddef>
+#include <cstdint>
+
+#include "fuzz_input_file.h"
+#include "robomach/common/errors.h"
+#include "robomach/io/frf_files.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string path = robomach::fuzz::WriteInput(data, size, ".uff");
+  try {
+    robomach::io::ReadUff58(path, "P1");
+  } catch (const robomach::InputError&) {
+  }
+  return 0;
+}
