@@ -23,11 +23,24 @@ namespace {
 
 using cd = std::complex<double>;
 
+// The principal square root (Re ≥ 0, the branch of std::sqrt) by the
+// textbook formula t = √((|x| + |z|)/2), without the special-value handling
+// of libm's csqrt (which calls hypot: 7 % of a stability map). Falls back to
+// std::sqrt where x² + y² could overflow or underflow (|z| outside
+// 1e-150..1e150; ZOA's discriminants are near 1e-16..1e-4) or is not finite.
+cd PrincipalSqrt(const cd& z) {
+  const double x = z.real(), y = z.imag();
+  const double r2 = x * x + y * y;
+  if (!(r2 > 1e-300 && r2 < 1e300)) return std::sqrt(z);
+  const double t = std::sqrt(0.5 * (std::abs(x) + std::sqrt(r2)));
+  return x >= 0.0 ? cd(t, 0.5 * y / t) : cd(0.5 * std::abs(y) / t, std::copysign(t, y));
+}
+
 // Eigenvalues of a 2×2 complex matrix from its trace and determinant.
 std::pair<cd, cd> Eigenvalues2(const Eigen::Matrix2cd& A) {
   const cd half_tr = 0.5 * (A(0, 0) + A(1, 1));
   const cd det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-  const cd disc = std::sqrt(half_tr * half_tr - det);
+  const cd disc = PrincipalSqrt(half_tr * half_tr - det);
   cd l1 = half_tr + disc, l2 = half_tr - disc;
   // Avoid cancellation in the smaller root: l1 l2 = det.
   if (std::norm(l2) > std::norm(l1)) std::swap(l1, l2);
