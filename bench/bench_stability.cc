@@ -108,11 +108,20 @@ void BM_Map100x100(benchmark::State& state) {
   opt.rotation = region.rotation_fixed;
   opt.analysis.spindle_speed_rad_s =
       Eigen::VectorXd::LinSpaced(200, s.cut.spindle_speed_min_rad_s, s.cut.spindle_speed_max_rad_s);
+  double evals = 0.0, analysed = 0.0;
   for (auto _ : state) {
     const auto pts = stability::EvaluateStabilityMap(s.model, targets, region.num_v(), region.num_u(),
                                                      s.cut.process, opt);
     benchmark::DoNotOptimize(pts.data());
+    evals = analysed = 0.0;
+    for (const auto& p : pts) {
+      if (p.stability.mode_coupling.evaluations > 0) {
+        evals += p.stability.mode_coupling.evaluations;
+        analysed += 1.0;
+      }
+    }
   }
+  state.counters["mc_evals_per_point"] = analysed > 0.0 ? evals / analysed : 0.0;
   state.counters["points"] = static_cast<double>(targets.size());
   state.counters["threads"] = std::thread::hardware_concurrency();
 }

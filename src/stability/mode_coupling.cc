@@ -101,22 +101,36 @@ ModeCouplingResult SearchCriticalDepth(const Rightmost& rightmost, const ModeCou
     out.critical_depth = options.max_depth;
     return out;
   }
-  int side = 0;  // which end was kept last time (Illinois)
+  // Regula falsi with the Anderson-Björck weight: when the same end is kept
+  // twice, its value is scaled by m = 1 − g_new/g_old of the moved end (by
+  // 0.5 when m <= 0, Illinois) [Anderson & Björck 1973]. A trial point
+  // within half the tolerance of an end is moved to half the tolerance from
+  // it, so a good estimate closes the bracket in one step.
+  int side = 0;  // which end was moved last time
   while (hi - lo > options.depth_tolerance * hi) {
     const double w = hi - lo;
+    const double half_tol = 0.5 * options.depth_tolerance * hi;
     double x = (g_hi - g_lo) != 0.0 ? lo - g_lo * w / (g_hi - g_lo) : 0.5 * (lo + hi);
     x = std::clamp(x, lo + 0.05 * w, hi - 0.05 * w);
+    if (x - lo < half_tol) x = lo + half_tol;
+    if (hi - x < half_tol) x = hi - half_tol;
     const double g = growth(x, &lam);
     if (g > 0.0) {
+      if (side == -1) {
+        const double m = 1.0 - g / g_hi;
+        g_lo *= m > 0.0 ? m : 0.5;
+      }
       hi = x;
       g_hi = g;
       lam_hi = lam;
-      if (side == -1) g_lo *= 0.5;
       side = -1;
     } else {
+      if (side == 1) {
+        const double m = 1.0 - g / g_lo;
+        g_hi *= m > 0.0 ? m : 0.5;
+      }
       lo = x;
       g_lo = g;
-      if (side == 1) g_hi *= 0.5;
       side = 1;
     }
   }
