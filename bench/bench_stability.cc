@@ -67,8 +67,33 @@ void BM_AnalysePosture200Speeds(benchmark::State& state) {
     const Eigen::Matrix3d R = stability::CuttingFrameAtPosture(d.X_BT, s.cut.feed_direction_B);
     benchmark::DoNotOptimize(stability::AnalysePosture(d, R, s.cut.process, opt));
   }
+  // How many eigensolves the mode-coupling depth search took at this posture.
+  const dynamics::PostureDynamics d = ev.Evaluate(s.postures[0].q, dynamics::PostureOptions{false, true});
+  const stability::PostureStability ps = stability::AnalysePosture(
+      d, stability::CuttingFrameAtPosture(d.X_BT, s.cut.feed_direction_B), s.cut.process, opt);
+  state.counters["mc_evals"] = ps.mode_coupling.evaluations;
+  state.counters["mc_depth_mm"] = 1e3 * ps.mode_coupling.critical_depth;
 }
 BENCHMARK(BM_AnalysePosture200Speeds)->Unit(benchmark::kMicrosecond);
+
+// The mode-coupling depth search alone at one posture (the modal path a
+// map takes): its eigensolves are the largest part of a map point.
+void BM_ModeCouplingSearchOnePosture(benchmark::State& state) {
+  const Setup s;
+  dynamics::PostureEvaluator ev(s.model);
+  const dynamics::PostureDynamics d = ev.Evaluate(s.postures[0].q, dynamics::PostureOptions{false, true});
+  const Eigen::Matrix3d R = stability::CuttingFrameAtPosture(d.X_BT, s.cut.feed_direction_B);
+  const Eigen::Matrix3d Kc_B = R * stability::CuttingStiffnessPerDepth(s.cut.process) * R.transpose();
+  const stability::TipModalModel modes = stability::ModalModelFromPosture(d);
+  stability::ModeCouplingResult r;
+  for (auto _ : state) {
+    r = stability::CriticalDepthModeCouplingModal(modes, Kc_B, {});
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["evals"] = r.evaluations;
+  state.counters["depth_mm"] = 1e3 * r.critical_depth;
+}
+BENCHMARK(BM_ModeCouplingSearchOnePosture)->Unit(benchmark::kMicrosecond);
 
 // The 100 × 100 map over the demo region (500 mm × 500 mm, 5.05 mm
 // step), 200 speeds per point, all cores.
@@ -83,11 +108,20 @@ void BM_Map100x100(benchmark::State& state) {
   opt.rotation = region.rotation_fixed;
   opt.analysis.spindle_speed_rad_s =
       Eigen::VectorXd::LinSpaced(200, s.cut.spindle_speed_min_rad_s, s.cut.spindle_speed_max_rad_s);
+  double evals = 0.0, analysed = 0.0;
   for (auto _ : state) {
     const auto pts = stability::EvaluateStabilityMap(s.model, targets, region.num_v(), region.num_u(),
                                                      s.cut.process, opt);
     benchmark::DoNotOptimize(pts.data());
+    evals = analysed = 0.0;
+    for (const auto& p : pts) {
+      if (p.stability.mode_coupling.evaluations > 0) {
+        evals += p.stability.mode_coupling.evaluations;
+        analysed += 1.0;
+      }
+    }
   }
+  state.counters["mc_evals_per_point"] = analysed > 0.0 ? evals / analysed : 0.0;
   state.counters["points"] = static_cast<double>(targets.size());
   state.counters["threads"] = std::thread::hardware_concurrency();
 }

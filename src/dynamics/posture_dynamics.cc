@@ -7,38 +7,29 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-#include <Eigen/SVD>
-#include <kdl/chaindynparam.hpp>
-#include <kdl/chainfksolverpos_recursive.hpp>
-#include <kdl/chainjnttojacsolver.hpp>
 
-#include "kinematics/internal/kdl_status.h"
+#include "dynamics/internal/rigid_chain.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 
 namespace robomach::dynamics {
 
-// KDL::Joint::pose() caches its last result in mutable members, so two
-// threads must never evaluate the same KDL::Chain object. Each workspace owns
-// a private copy of the chain (a few hundred bytes) and binds its solvers to
-// it; that is what makes a shared RobotModel safe across threads.
+// One evaluator's reusable state. RigidChain reads the segments of a private
+// copy of the chain: KDL::Joint::pose() caches its last result in mutable
+// members, so two threads must never touch the same KDL::Chain object, and
+// a RobotModel is shared across threads.
 struct PostureEvaluator::Workspace {
-  explicit Workspace(const KDL::Chain& shared_chain)
-      : chain(shared_chain),
-        fk(chain),
-        jac(chain),
-        dyn(chain, KDL::Vector::Zero()),  // gravity does not enter M_q
-        q(shared_chain.getNrOfJoints()),
-        J(shared_chain.getNrOfJoints()),
-        H(shared_chain.getNrOfJoints()) {}
-  const KDL::Chain chain;  // declared first: the solvers below keep a reference to it
-  KDL::ChainFkSolverPos_recursive fk;
-  KDL::ChainJntToJacSolver jac;
-  KDL::ChainDynParam dyn;
-  KDL::JntArray q;
-  KDL::Jacobian J;
-  KDL::JntSpaceInertiaMatrix H;
+  explicit Workspace(const KDL::Chain& shared_chain) : rigid(KDL::Chain(shared_chain)) {}
+  internal::RigidChain rigid;
+  Eigen::SelfAdjointEigenSolver<Matrix6d> reduced6;  // A = K^{-1/2} M K^{-1/2}
+  Eigen::GeneralizedSelfAdjointEigenSolver<Matrix6d> general6;
+  Eigen::SelfAdjointEigenSolver<Matrix6d> gram6;     // JᵀJ, eigenvalues only
+  Eigen::LDLT<Eigen::MatrixXd> ldlt;                 // K, general path of H(0)
+  Eigen::MatrixXd k_inv_bt;                          // K⁻¹ Bᵀ (N × 3)
+  Eigen::VectorXd eigenvalues;                       // λ ascending
+  Eigen::MatrixXd eigenvectors;                      // M-normalised φ
+  Eigen::VectorXd c_phi;                             // C φ
 };
 
 PostureEvaluator::PostureEvaluator(std::shared_ptr<const RobotModel> model)
@@ -59,62 +50,43 @@ void NormaliseSign(Mode* m) {
   }
 }
 
-// K φ = λ M φ with M-normalised eigenvectors, ascending λ. A fixed-size
-// solver for the common 6-DOF case: about twice as fast as the dynamic one
-// (bench/bench_posture.cc), which matters in workspace maps.
-template <int Size>
-bool SolveGeneralizedFixed(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M,
-                           Eigen::VectorXd* values, Eigen::MatrixXd* vectors) {
-  using Mat = Eigen::Matrix<double, Size, Size>;
-  Eigen::GeneralizedSelfAdjointEigenSolver<Mat> ges(Mat(K), Mat(M),
-                                                    Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
-  if (ges.info() != Eigen::Success) return false;
-  *values = ges.eigenvalues();
-  *vectors = ges.eigenvectors();
-  return true;
-}
-
-bool SolveGeneralized(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M, Eigen::VectorXd* values,
-                      Eigen::MatrixXd* vectors) {
-  if (K.rows() == 6) return SolveGeneralizedFixed<6>(K, M, values, vectors);
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ges(K, M,
-                                                                Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
-  if (ges.info() != Eigen::Success) return false;
-  *values = ges.eigenvalues();
-  *vectors = ges.eigenvectors();
-  return true;
-}
-
-// Eigenvalues of JᵀJ (ascending), fixed-size for six joints.
-Eigen::VectorXd GramEigenvalues(const Matrix6Xd& J) {
-  if (J.cols() == 6) {
-    const Matrix6d JtJ = J.transpose() * J;
-    return Eigen::SelfAdjointEigenSolver<Matrix6d>(JtJ, Eigen::EigenvaluesOnly).eigenvalues();
+// True if K is diagonal with finite positive entries (joint stiffness only,
+// or effects whose springs act on single coordinates).
+bool IsPositiveDiagonal(const Eigen::MatrixXd& K) {
+  const Eigen::Index N = K.rows();
+  for (Eigen::Index c = 0; c < N; ++c) {
+    for (Eigen::Index r = 0; r < N; ++r) {
+      const double v = K(r, c);
+      if (r == c ? !(v > 0.0 && v < INFINITY) : v != 0.0) return false;
+    }
   }
-  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(J.transpose() * J, Eigen::EigenvaluesOnly)
-      .eigenvalues();
+  return true;
+}
+
+[[noreturn]] void ThrowNotPositiveDefinite() {
+  throw NumericalError("modal analysis failed: the assembled mass matrix is not positive "
+                           "definite (check link and effect inertias)");
 }
 
 }  // namespace
 
 PostureDynamics PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& options) {
+  PostureDynamics out;
+  Evaluate(q, options, &out);
+  return out;
+}
+
+void PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& options,
+                                PostureDynamics* out_ptr) {
+  PostureDynamics& out = *out_ptr;
   const RobotModel& model = *model_;
-  const kinematics::SerialChain& chain = model.chain();
-  kinematics::CheckJointVector(chain, q);
+  kinematics::CheckJointVector(model.chain(), q);
   const int n = model.num_joints();
   const int N = model.num_dofs();
   Workspace& w = *ws_;
-  w.q.data = q;
 
-  PostureDynamics out;
+  out.options = options;
   out.q = q;
-  KDL::Frame f;
-  kinematics::internal::ThrowIfKdlFailed(w.fk.JntToCart(w.q, f), w.fk, "forward kinematics");
-  out.X_BT = kinematics::ToEigen(f);
-  kinematics::internal::ThrowIfKdlFailed(w.jac.JntToJac(w.q, w.J), w.jac, "Jacobian");
-  out.J_BT = w.J.data;
-  kinematics::internal::ThrowIfKdlFailed(w.dyn.JntToMass(w.q, w.H), w.dyn, "joint-space inertia");
-
   AssembledSystem& sys = out.system;
   sys.num_joints = n;
   sys.M.setZero(N, N);
@@ -122,7 +94,9 @@ PostureDynamics PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const Postu
   sys.C_extra.setZero(N, N);
   sys.B.setZero(3, N);
   sys.V_T.setZero(6, N);
-  sys.M.topLeftCorner(n, n) = w.H.data;
+  out.J_BT.resize(6, n);
+  // Pose, J_BT and M_q in one pass (dynamics/internal/rigid_chain.h).
+  w.rigid.Compute(q.data(), &out.X_BT, out.J_BT, sys.M.topLeftCorner(n, n));
   sys.K.topLeftCorner(n, n).diagonal() = model.joint_stiffness();
   sys.B.leftCols(n) = out.J_BT.topRows<3>();
   sys.V_T.leftCols(n) = out.J_BT;
@@ -130,18 +104,35 @@ PostureDynamics PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const Postu
   for (const BoundEffect& be : model.effects()) {
     be.effect->Contribute(ctx, be.values, be.first_extra_dof, &sys);
   }
-  sys.C = model.alpha() * sys.K + model.beta() * sys.M + sys.C_extra;
+  sys.C.resize(N, N);
+  sys.C.noalias() = model.alpha() * sys.K + model.beta() * sys.M + sys.C_extra;
   out.proportional_damping = sys.C_extra.isZero(0.0);
+  const bool k_diagonal = IsPositiveDiagonal(sys.K);
 
-  // cond(J) = sqrt(λmax/λmin) of JᵀJ (n × n). Squaring loses the digits
-  // below eps·λmax, so condition numbers up to ≈ 1e7 are resolved, which is
-  // all the 1e5 threshold needs; beyond, the value is only "very large".
-  // (Three times cheaper than a Jacobi SVD of a 6×6 matrix.)
-  const Eigen::VectorXd gram = GramEigenvalues(out.J_BT);
-  const double lmin = gram(0), lmax = gram(n - 1);
-  out.jacobian_condition = lmin > 0.0 ? std::sqrt(lmax / lmin) : INFINITY;
-  if (!std::isfinite(out.jacobian_condition)) out.jacobian_condition = INFINITY;
-  out.near_singular = !(out.jacobian_condition <= kNearSingularCondition);
+  out.jacobian_condition = NAN;
+  out.near_singular = false;
+  if (options.jacobian_condition || options.cartesian) {
+    // cond(J) = sqrt(λmax/λmin) of JᵀJ (n × n). Squaring loses the digits
+    // below eps·λmax, so condition numbers up to ≈ 1e7 are resolved, which is
+    // all the 1e5 threshold needs; beyond, the value is only "very large".
+    // (Three times cheaper than a Jacobi SVD of a 6×6 matrix.)
+    double lmin = 0.0, lmax = 0.0;
+    if (n == 6) {
+      const Matrix6d JtJ = out.J_BT.transpose() * out.J_BT;
+      w.gram6.compute(JtJ, Eigen::EigenvaluesOnly);
+      lmin = w.gram6.eigenvalues()(0);
+      lmax = w.gram6.eigenvalues()(5);
+    } else {
+      const Eigen::VectorXd gram =
+          Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(out.J_BT.transpose() * out.J_BT, Eigen::EigenvaluesOnly)
+              .eigenvalues();
+      lmin = gram(0);
+      lmax = gram(n - 1);
+    }
+    out.jacobian_condition = lmin > 0.0 ? std::sqrt(lmax / lmin) : INFINITY;
+    if (!std::isfinite(out.jacobian_condition)) out.jacobian_condition = INFINITY;
+    out.near_singular = !(out.jacobian_condition <= kNearSingularCondition);
+  }
 
   out.M_X.setConstant(NAN);
   out.K_X.setConstant(NAN);
@@ -150,57 +141,114 @@ PostureDynamics PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const Postu
     // Congruence with J⁻¹: M_X = J⁻ᵀ M_q J⁻¹ [Khatib 1987], K_X = J⁻ᵀ K_q J⁻¹.
     const Matrix6d J = out.J_BT;
     const Matrix6d Jinv = J.partialPivLu().inverse();
-    out.M_X = Jinv.transpose() * sys.M.topLeftCorner(6, 6) * Jinv;
-    out.K_X = Jinv.transpose() * sys.K.topLeftCorner(6, 6) * Jinv;
-    out.C_X = Jinv.transpose() * sys.C.topLeftCorner(6, 6) * Jinv;
+    // Fixed-size blocks: no heap temporaries in the products.
+    out.M_X = Jinv.transpose() * sys.M.topLeftCorner<6, 6>() * Jinv;
+    out.K_X = Jinv.transpose() * sys.K.topLeftCorner<6, 6>() * Jinv;
+    out.C_X = Jinv.transpose() * sys.C.topLeftCorner<6, 6>() * Jinv;
   }
 
   // Static compliance H(0) = B K⁻¹ Bᵀ. K is SPD for positive joint stiffness.
-  Eigen::LDLT<Eigen::MatrixXd> ldlt(sys.K);
-  out.static_compliance = sys.B * ldlt.solve(sys.B.transpose());
+  if (!options.static_compliance) {
+    out.static_compliance.setConstant(NAN);
+  } else if (k_diagonal) {
+    Eigen::Matrix3d H0 = Eigen::Matrix3d::Zero();
+    for (int j = 0; j < N; ++j) H0.noalias() += sys.B.col(j) * (sys.B.col(j).transpose() / sys.K(j, j));
+    out.static_compliance = H0;
+  } else {
+    w.ldlt.compute(sys.K);
+    w.k_inv_bt = sys.B.transpose();
+    w.ldlt.solveInPlace(w.k_inv_bt);
+    out.static_compliance.noalias() = sys.B * w.k_inv_bt;
+  }
 
-  if (options.modes) {
-    Eigen::VectorXd eigenvalues;
-    Eigen::MatrixXd eigenvectors;
-    if (!SolveGeneralized(sys.K, sys.M, &eigenvalues, &eigenvectors)) {
-      throw NumericalError("modal analysis failed: the assembled mass matrix is not positive "
-                               "definite (check link and effect inertias)");
+  out.complex_modes.poles.resize(0);
+  out.complex_modes.residues.clear();
+  if (!options.modes) {
+    out.modes.clear();
+    return;
+  }
+  // K φ = λ M φ with M-normalised eigenvectors, ascending λ.
+  w.eigenvalues.resize(N);
+  w.eigenvectors.resize(N, N);
+  if (N == 6 && k_diagonal) {
+    // Reduced through diag K to one standard symmetric problem (header).
+    // Eigen's iterative solver, not computeDirect (closed-form 3×3 only and
+    // inaccurate beyond). μ ascending, so λ = 1/μ descending: mode k is μ's 5 − k.
+    const Vector6d k_diag = sys.K.diagonal();
+    const Vector6d d = k_diag.cwiseSqrt().cwiseInverse();
+    const Matrix6d M6 = sys.M;
+    w.reduced6.compute(d.asDiagonal() * M6 * d.asDiagonal(), Eigen::ComputeEigenvectors);
+    if (w.reduced6.info() != Eigen::Success || !(w.reduced6.eigenvalues()(0) > 0.0)) {
+      ThrowNotPositiveDefinite();
     }
-    out.modes.resize(N);
-    for (int k = 0; k < N; ++k) {
-      Mode& m = out.modes[k];
-      const double lambda = std::max(eigenvalues(k), 0.0);
-      const double omega = std::sqrt(lambda);
-      m.freq_hz = RadPerSecToHz(omega);
-      m.phi = eigenvectors.col(k);  // φᵀ M φ = 1 (Eigen's Ax_lBx normalisation)
-      m.p_T = sys.B * m.phi;
-      NormaliseSign(&m);
+    for (int k = 0; k < 6; ++k) {
+      // 1/μ and K^{-1/2}u/√μ carry the absolute error eps·μ_max of the
+      // smallest μ, i.e. eps·(ω_max/ω_min)² relative for the highest mode
+      // (≈ 1e-13 on the KR210). The Rayleigh quotient λ = vᵀKv / vᵀMv and the
+      // M-normalisation of v = K^{-1/2}u restore full precision: λ's error is
+      // quadratic in u's, which is ≈ eps·μ_max/gap.
+      const Vector6d v = d.cwiseProduct(w.reduced6.eigenvectors().col(5 - k));
+      const double vMv = v.dot(M6 * v);
+      w.eigenvalues(k) = v.cwiseAbs2().dot(k_diag) / vMv;
+      w.eigenvectors.col(k) = v / std::sqrt(vMv);
+    }
+  } else if (N == 6) {
+    w.general6.compute(Matrix6d(sys.K), Matrix6d(sys.M), Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+    if (w.general6.info() != Eigen::Success) ThrowNotPositiveDefinite();
+    w.eigenvalues = w.general6.eigenvalues();
+    w.eigenvectors = w.general6.eigenvectors();
+  } else {
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ges(sys.K, sys.M,
+                                                                  Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+    if (ges.info() != Eigen::Success) ThrowNotPositiveDefinite();
+    w.eigenvalues = ges.eigenvalues();
+    w.eigenvectors = ges.eigenvectors();
+  }
+
+  out.modes.resize(N);
+  w.c_phi.resize(N);
+  for (int k = 0; k < N; ++k) {
+    Mode& m = out.modes[k];
+    const double lambda = std::max(w.eigenvalues(k), 0.0);
+    const double omega = std::sqrt(lambda);
+    m.freq_hz = RadPerSecToHz(omega);
+    m.phi = w.eigenvectors.col(k);  // φᵀ M φ = 1
+    m.p_T.noalias() = sys.B * m.phi;
+    NormaliseSign(&m);
+    if (options.modal_masses) {
       const double p2 = m.p_T.squaredNorm();
       m.modal_mass_kg = p2 > 0.0 ? 1.0 / p2 : INFINITY;
       m.shape_T = p2 > 0.0 ? Eigen::Vector3d(m.p_T / std::sqrt(p2)) : Eigen::Vector3d::Zero();
-      // Proportional damping: φᵀ C φ = alpha ω² + beta = 2 ζ ω exactly.
-      m.damping_ratio = omega > 0.0 ? m.phi.dot(sys.C * m.phi) / (2.0 * omega) : 0.0;
+    } else {
+      m.modal_mass_kg = NAN;
+      m.shape_T.setConstant(NAN);
     }
-    if (!out.proportional_damping) {
-      // Non-proportional damping: the damping ratio of each mode is that of
-      // the complex pole nearest to its undamped frequency.
-      out.complex_modes = ComputeComplexModes(sys);
-      const ComplexModalModel& cm = out.complex_modes;
-      for (Mode& m : out.modes) {
-        double best = INFINITY;
-        for (int k = 0; k < cm.poles.size(); ++k) {
-          const std::complex<double> lam = cm.poles(k);
-          if (lam.imag() <= 0.0) continue;
-          const double d = std::abs(std::abs(lam) - HzToRadPerSec(m.freq_hz));
-          if (d < best) {
-            best = d;
-            m.damping_ratio = -lam.real() / std::abs(lam);
-          }
+    if (options.damping_ratios) {
+      // Proportional damping: φᵀ C φ = alpha ω² + beta = 2 ζ ω exactly.
+      w.c_phi.noalias() = sys.C * m.phi;
+      m.damping_ratio = omega > 0.0 ? m.phi.dot(w.c_phi) / (2.0 * omega) : 0.0;
+    } else {
+      m.damping_ratio = NAN;
+    }
+  }
+  if (options.damping_ratios && !out.proportional_damping) {
+    // Non-proportional damping: the damping ratio of each mode is that of
+    // the complex pole nearest to its undamped frequency.
+    out.complex_modes = ComputeComplexModes(sys);
+    const ComplexModalModel& cm = out.complex_modes;
+    for (Mode& m : out.modes) {
+      double best = INFINITY;
+      for (int k = 0; k < cm.poles.size(); ++k) {
+        const std::complex<double> lam = cm.poles(k);
+        if (lam.imag() <= 0.0) continue;
+        const double d = std::abs(std::abs(lam) - HzToRadPerSec(m.freq_hz));
+        if (d < best) {
+          best = d;
+          m.damping_ratio = -lam.real() / std::abs(lam);
         }
       }
     }
   }
-  return out;
 }
 
 PostureDynamics EvaluatePosture(std::shared_ptr<const RobotModel> model, const Eigen::VectorXd& q,

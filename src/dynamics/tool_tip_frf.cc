@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include "dynamics/internal/modal_sum.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 
@@ -31,44 +32,51 @@ std::vector<Eigen::Matrix3cd> ReceptanceDirect(const AssembledSystem& sys,
   return H;
 }
 
-std::vector<Eigen::Matrix3cd> ReceptanceModal(const PostureDynamics& d,
-                                              const Eigen::VectorXd& freq_hz) {
+void ReceptanceModal(const PostureDynamics& d, const Eigen::VectorXd& freq_hz, std::vector<Eigen::Matrix3cd>* H) {
   if (d.modes.empty()) throw std::invalid_argument("ReceptanceModal: the posture has no modes");
   if (!d.proportional_damping) {
     throw std::invalid_argument(
         "ReceptanceModal: damping is not proportional; use ReceptanceComplexModal");
   }
+  if (!d.options.damping_ratios) {
+    throw std::invalid_argument(
+        "ReceptanceModal: the posture was evaluated without damping ratios (PostureOptions::damping_ratios)");
+  }
   const int nm = static_cast<int>(d.modes.size());
-  // Per mode: ω_k², 2 ζ_k ω_k and the six distinct entries of p pᵀ.
-  Eigen::VectorXd w2(nm), c(nm);
-  Eigen::Matrix<double, 6, Eigen::Dynamic> P(6, nm);
+  // Per mode: ω_k², 2 ζ_k ω_k and the six distinct entries of p pᵀ. Fixed
+  // buffers for up to 32 modes (no allocation), a vector beyond.
+  constexpr int kFixed = 32;
+  double w2_fixed[kFixed], c_fixed[kFixed], P_fixed[6 * kFixed];
+  std::vector<double> heap;
+  double *w2 = w2_fixed, *c = c_fixed, *P = P_fixed;
+  if (nm > kFixed) {
+    heap.resize(8 * static_cast<size_t>(nm));
+    w2 = heap.data();
+    c = w2 + nm;
+    P = c + nm;
+  }
   for (int k = 0; k < nm; ++k) {
     const Mode& m = d.modes[k];
     const double w = HzToRadPerSec(m.freq_hz);
-    w2(k) = w * w;
-    c(k) = 2.0 * m.damping_ratio * w;
+    w2[k] = w * w;
+    c[k] = 2.0 * m.damping_ratio * w;
     const Eigen::Vector3d& p = m.p_T;
-    P.col(k) << p(0) * p(0), p(1) * p(1), p(2) * p(2), p(0) * p(1), p(0) * p(2), p(1) * p(2);
+    double* Pk = P + 6 * k;
+    Pk[0] = p(0) * p(0);
+    Pk[1] = p(1) * p(1);
+    Pk[2] = p(2) * p(2);
+    Pk[3] = p(0) * p(1);
+    Pk[4] = p(0) * p(2);
+    Pk[5] = p(1) * p(2);
   }
-  std::vector<Eigen::Matrix3cd> H(freq_hz.size());
-  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
-    const double w = HzToRadPerSec(freq_hz(i));
-    const double w_sq = w * w;
-    // 1/(a + ib) = (a − ib)/(a² + b²), accumulated in real arithmetic.
-    Eigen::Matrix<double, 6, 1> re = Eigen::Matrix<double, 6, 1>::Zero();
-    Eigen::Matrix<double, 6, 1> im = Eigen::Matrix<double, 6, 1>::Zero();
-    for (int k = 0; k < nm; ++k) {
-      const double a = w2(k) - w_sq, b = c(k) * w;
-      const double inv = 1.0 / (a * a + b * b);
-      re.noalias() += (a * inv) * P.col(k);
-      im.noalias() -= (b * inv) * P.col(k);
-    }
-    Eigen::Matrix3cd& h = H[i];
-    const int idx[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
-    for (int r = 0; r < 3; ++r) {
-      for (int col = 0; col < 3; ++col) h(r, col) = cd(re(idx[r][col]), im(idx[r][col]));
-    }
-  }
+  H->resize(freq_hz.size());
+  static_assert(sizeof(Eigen::Matrix3cd) == 9 * sizeof(cd), "Matrix3cd is nine packed complex numbers");
+  internal::RealModalSum(nm, w2, c, P, freq_hz.data(), freq_hz.size(), reinterpret_cast<cd*>(H->data()));
+}
+
+std::vector<Eigen::Matrix3cd> ReceptanceModal(const PostureDynamics& d, const Eigen::VectorXd& freq_hz) {
+  std::vector<Eigen::Matrix3cd> H;
+  ReceptanceModal(d, freq_hz, &H);
   return H;
 }
 
@@ -132,12 +140,23 @@ ComplexModalModel ComputeComplexModes(const AssembledSystem& sys) {
 
 std::vector<Eigen::Matrix3cd> ReceptanceComplexModal(const ComplexModalModel& m,
                                                      const Eigen::VectorXd& freq_hz) {
+  // R / (iω − λ) = R conj(d) / |d|², d = −Re λ + i (ω − Im λ): one real
+  // division per line and pole instead of nine complex ones.
   std::vector<Eigen::Matrix3cd> H(freq_hz.size());
+  const Eigen::Index np = m.poles.size();
   for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
-    const cd iw(0.0, HzToRadPerSec(freq_hz(i)));
-    Eigen::Matrix3cd h = Eigen::Matrix3cd::Zero();
-    for (int k = 0; k < m.poles.size(); ++k) h += m.residues[k] / (iw - m.poles(k));
-    H[i] = h;
+    const double w = HzToRadPerSec(freq_hz(i));
+    Eigen::Matrix3d re = Eigen::Matrix3d::Zero(), im = Eigen::Matrix3d::Zero();
+    for (Eigen::Index k = 0; k < np; ++k) {
+      const double dr = -m.poles(k).real(), di = w - m.poles(k).imag();
+      const double inv = 1.0 / (dr * dr + di * di);
+      const double gr = dr * inv, gi = -di * inv;  // 1/d
+      const Eigen::Matrix3cd& R = m.residues[k];
+      re.noalias() += gr * R.real() - gi * R.imag();
+      im.noalias() += gr * R.imag() + gi * R.real();
+    }
+    H[i].real() = re;
+    H[i].imag() = im;
   }
   return H;
 }

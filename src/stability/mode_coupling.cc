@@ -44,8 +44,14 @@ namespace {
 // into the right half-plane: a geometric scan brackets it, then a
 // safeguarded regula falsi (Illinois, each step kept at least 5 % of the
 // bracket from its ends) narrows the bracket to the tolerance.
+//
+// `stable_below` is a depth below which the system is known to be stable
+// (a small-gain certificate, ModalSearch): the scan points below it are not
+// evaluated, except the last one when the first unstable point follows it,
+// so the bracket and the result are those of the full scan.
 template <class Rightmost>
-ModeCouplingResult SearchCriticalDepth(const Rightmost& rightmost, const ModeCouplingOptions& options) {
+ModeCouplingResult SearchCriticalDepth(const Rightmost& rightmost, const ModeCouplingOptions& options,
+                                       double stable_below = 0.0) {
   if (!(options.max_depth > 0.0) || options.scan_points < 1 || !(options.depth_tolerance > 0.0)) {
     throw std::invalid_argument("mode coupling: need max_depth > 0, scan_points >= 1, tolerance > 0");
   }
@@ -59,7 +65,8 @@ ModeCouplingResult SearchCriticalDepth(const Rightmost& rightmost, const ModeCou
     return lambda->real() - 1e-9 * std::abs(*lambda);
   };
   std::complex<double> lam;
-  double lo = 0.0, hi = NAN, g_lo = growth(0.0, &lam), g_hi = 0.0;
+  // g_lo is NaN while lo is a certified point not evaluated.
+  double lo = 0.0, hi = NAN, g_lo = stable_below > 0.0 ? NAN : growth(0.0, &lam), g_hi = 0.0;
   if (g_lo > 0.0) {
     out.status = ModeCouplingStatus::kUnstableAtZero;
     return out;
@@ -67,6 +74,11 @@ ModeCouplingResult SearchCriticalDepth(const Rightmost& rightmost, const ModeCou
   std::complex<double> lam_hi;
   for (int j = 1; j <= options.scan_points; ++j) {
     const double a = options.max_depth * std::ldexp(1.0, j - options.scan_points);
+    if (a < stable_below) {
+      lo = a;
+      g_lo = NAN;
+      continue;
+    }
     const double g = growth(a, &lam);
     if (g > 0.0) {
       hi = a;
@@ -77,27 +89,48 @@ ModeCouplingResult SearchCriticalDepth(const Rightmost& rightmost, const ModeCou
     lo = a;
     g_lo = g;
   }
+  if (std::isfinite(hi) && std::isnan(g_lo)) {
+    g_lo = growth(lo, &lam);
+    if (g_lo > 0.0) {
+      // Not expected (the certificate says stable): the full scan decides.
+      return SearchCriticalDepth(rightmost, options, 0.0);
+    }
+  }
   if (!std::isfinite(hi)) {
     out.status = ModeCouplingStatus::kStableUpToMax;
     out.critical_depth = options.max_depth;
     return out;
   }
-  int side = 0;  // which end was kept last time (Illinois)
+  // Regula falsi with the Anderson-Björck weight: when the same end is kept
+  // twice, its value is scaled by m = 1 − g_new/g_old of the moved end (by
+  // 0.5 when m <= 0, Illinois) [Anderson & Björck 1973]. A trial point
+  // within half the tolerance of an end is moved to half the tolerance from
+  // it, so a good estimate closes the bracket in one step.
+  int side = 0;  // which end was moved last time
   while (hi - lo > options.depth_tolerance * hi) {
     const double w = hi - lo;
+    const double half_tol = 0.5 * options.depth_tolerance * hi;
     double x = (g_hi - g_lo) != 0.0 ? lo - g_lo * w / (g_hi - g_lo) : 0.5 * (lo + hi);
     x = std::clamp(x, lo + 0.05 * w, hi - 0.05 * w);
+    if (x - lo < half_tol) x = lo + half_tol;
+    if (hi - x < half_tol) x = hi - half_tol;
     const double g = growth(x, &lam);
     if (g > 0.0) {
+      if (side == -1) {
+        const double m = 1.0 - g / g_hi;
+        g_lo *= m > 0.0 ? m : 0.5;
+      }
       hi = x;
       g_hi = g;
       lam_hi = lam;
-      if (side == -1) g_lo *= 0.5;
       side = -1;
     } else {
+      if (side == 1) {
+        const double m = 1.0 - g / g_lo;
+        g_hi *= m > 0.0 ? m : 0.5;
+      }
       lo = x;
       g_lo = g;
-      if (side == 1) g_hi *= 0.5;
       side = 1;
     }
   }
@@ -132,23 +165,49 @@ class RightmostSolver {
   Eigen::EigenSolver<Matrix> es_;
 };
 
+// A depth below which the modal system is stable, by the small-gain
+// theorem. On s = iω the characteristic matrix factors as
+// Q(iω) + a K_q = Q(iω) (I + a Q⁻¹ pᵀ K_c p), Q = diag(ω_k² − ω² + 2iζ_kω_kω),
+// and det(I + a Q⁻¹ pᵀ K_c p) = det(I₃ + a K_c G(iω)) with the tip
+// receptance G = p Q⁻¹ pᵀ. While a‖K_c‖ ‖G(iω)‖ < 1 at every ω, or
+// a ‖Q⁻¹‖ ‖K_q‖ < 1, no eigenvalue lies on the imaginary axis, so none can
+// cross it between depth 0 (stable when every ζ_k > 0) and a. The peaks are
+// bounded mode by mode: 1/|ω_k² − ω² + 2iζ_kω_kω| ≤ 1/(2ζ_kω_k²√(1 − ζ_k²)).
+// Frobenius norms bound the 2-norms. Zero when a mode is undamped.
+double SmallGainStableDepth(const TipModalModel& modes, const Eigen::Matrix3d& Kc, const Eigen::MatrixXd& Kc_q) {
+  double sum_g = 0.0, max_q = 0.0;
+  for (int k = 0; k < modes.num_modes(); ++k) {
+    const double z = modes.zeta(k), w = modes.omega_rad_s(k);
+    if (!(z > 0.0)) return 0.0;
+    const double peak = 1.0 / (2.0 * z * w * w * std::sqrt(1.0 - z * z));
+    sum_g += modes.p.col(k).squaredNorm() * peak;
+    max_q = std::max(max_q, peak);
+  }
+  const double loop = std::min(Kc.norm() * sum_g, Kc_q.norm() * max_q);
+  return loop > 0.0 && std::isfinite(loop) ? 1.0 / loop : 0.0;
+}
+
 template <int Rows>
 ModeCouplingResult ModalSearch(const TipModalModel& modes, const Eigen::MatrixXd& Kc_q,
-                               const ModeCouplingOptions& options) {
+                               const ModeCouplingOptions& options, double stable_below) {
   const int n = modes.num_modes();
   using Matrix = typename RightmostSolver<Rows>::Matrix;
+  // State (η, η̇/ω): A = S A₀ S⁻¹ with S = diag(I, Ω⁻¹) has the same
+  // eigenvalues and entries of one scale (ω), which the QR iteration of the
+  // eigensolver needs fewer steps for than the unscaled [0 I; −Ω² −2ZΩ].
+  const Eigen::VectorXd& w = modes.omega_rad_s;
   Matrix A = Matrix::Zero(2 * n, 2 * n);
-  A.topRightCorner(n, n).setIdentity();
-  A.bottomRightCorner(n, n).diagonal() = -2.0 * modes.zeta.cwiseProduct(modes.omega_rad_s);
-  const Eigen::VectorXd w2 = modes.omega_rad_s.array().square();
+  A.topRightCorner(n, n).diagonal() = w;
+  A.bottomRightCorner(n, n).diagonal() = -2.0 * modes.zeta.cwiseProduct(w);
+  const Eigen::MatrixXd Kc_scaled = w.cwiseInverse().asDiagonal() * Kc_q;
   RightmostSolver<Rows> rightmost(2 * n);
   return SearchCriticalDepth(
       [&](double a) {
-        A.bottomLeftCorner(n, n) = -a * Kc_q;
-        A.bottomLeftCorner(n, n).diagonal() -= w2;
+        A.bottomLeftCorner(n, n) = -a * Kc_scaled;
+        A.bottomLeftCorner(n, n).diagonal() -= w;
         return rightmost(A);
       },
-      options);
+      options, stable_below);
 }
 
 }  // namespace
@@ -183,8 +242,9 @@ ModeCouplingResult CriticalDepthModeCouplingModal(const TipModalModel& modes, co
   const int n = modes.num_modes();
   const Eigen::MatrixXd Kc_q = modes.p.transpose() * Kc * modes.p;
   // Six modes (a six-joint robot): fixed-size matrices, no heap at all.
-  if (n == 6) return ModalSearch<12>(modes, Kc_q, options);
-  return ModalSearch<Eigen::Dynamic>(modes, Kc_q, options);
+  const double stable_below = SmallGainStableDepth(modes, Kc, Kc_q);
+  if (n == 6) return ModalSearch<12>(modes, Kc_q, options, stable_below);
+  return ModalSearch<Eigen::Dynamic>(modes, Kc_q, options, stable_below);
 }
 
 double FlutterDepthClosedForm(const Eigen::Matrix2d& S, const Eigen::Matrix2d& Kc) {

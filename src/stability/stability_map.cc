@@ -5,11 +5,11 @@
 #include <exception>
 #include <stdexcept>
 
-#include <kdl/chainiksolverpos_lma.hpp>
 #include <nlopt.hpp>
 
 #include "robomach/common/parallel.h"
 #include "robomach/dynamics/posture_dynamics.h"
+#include "robomach/kinematics/inverse_kinematics.h"
 #include "robomach/kinematics/serial_chain.h"
 #include "robomach/stability/tool_tip_model.h"
 
@@ -40,41 +40,10 @@ Eigen::Isometry3d ToolPoseTarget::Pose(double rotation) const {
 
 namespace {
 
-// Tolerances of an accepted IK solution. 1e-5 m and 1e-4 rad are well
-// below what matters for the dynamics (the stiffness changes on the scale
-// of centimetres and degrees) and well above LMA's convergence (eps 1e-5
-// on a weighted error norm, about 1e-6 m here).
-constexpr double kIkPositionTolerance = 1e-5;  // [m]
-constexpr double kIkRotationTolerance = 1e-4;  // [rad]
-
-class IkSolver {
- public:
-  explicit IkSolver(const kinematics::SerialChain& chain)
-      : chain_(chain), lma_(chain.kdl(), 1e-6, 500, 1e-15) {}
-
-  // Solves from `seed`; the result is wrapped to the 2π branch nearest the
-  // seed. Returns false if the pose was not reached.
-  bool Solve(const Eigen::Isometry3d& X, const Eigen::VectorXd& seed, Eigen::VectorXd* q) {
-    const int n = chain_.num_joints();
-    KDL::JntArray q0(n), q1(n);
-    for (int j = 0; j < n; ++j) q0(j) = seed(j);
-    lma_.CartToJnt(q0, kinematics::ToKdl(X), q1);
-    q->resize(n);
-    for (int j = 0; j < n; ++j) {
-      double v = q1(j);
-      v -= 2.0 * kPi * std::round((v - seed(j)) / (2.0 * kPi));
-      (*q)(j) = v;
-    }
-    const Eigen::Isometry3d X_got = kinematics::ForwardKinematics(chain_, *q);
-    const double dp = (X_got.translation() - X.translation()).norm();
-    const double dr = Eigen::AngleAxisd(X_got.linear().transpose() * X.linear()).angle();
-    return q->allFinite() && dp < kIkPositionTolerance && dr < kIkRotationTolerance;
-  }
-
- private:
-  const kinematics::SerialChain& chain_;
-  KDL::ChainIkSolverPos_LMA lma_;
-};
+// IK: kinematics::IkSolver with its default tolerances (1e-5 m and 1e-4
+// rad), well below what matters for the dynamics (the stiffness changes on
+// the scale of centimetres and degrees).
+using kinematics::IkSolver;
 
 // KDL::Joint caches its last pose in mutable members (kdl/joint.hpp,
 // `mutable Frame joint_pose; mutable double q_previous;`), so two threads

@@ -93,21 +93,39 @@ std::vector<Eigen::Matrix3cd> ModalReceptance(const TipModalModel& m, const Eige
 
 std::vector<Eigen::Matrix2cd> InPlaneModalReceptance(const TipModalModel& m,
                                                      const Eigen::VectorXd& freq_hz) {
-  std::vector<Eigen::Matrix2cd> H(freq_hz.size(), Eigen::Matrix2cd::Zero());
+  // Lines innermost, in plain arrays, so the compiler vectorises the loop;
+  // the 2×2 is symmetric (p pᵀ per mode), so three entries are summed. The
+  // sum over the modes runs in the same order as a per-line loop would.
+  const Eigen::Index L = freq_hz.size();
   const int n = m.num_modes();
-  std::vector<Eigen::Matrix2d> pp(n);
-  for (int k = 0; k < n; ++k) pp[k] = m.p.col(k).head<2>() * m.p.col(k).head<2>().transpose();
-  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
-    const double w = HzToRadPerSec(freq_hz(i));
-    Eigen::Matrix2d re = Eigen::Matrix2d::Zero(), im = Eigen::Matrix2d::Zero();
-    for (int k = 0; k < n; ++k) {
-      const double wk = m.omega_rad_s(k);
-      const double a = wk * wk - w * w, b = 2.0 * m.zeta(k) * wk * w, inv = 1.0 / (a * a + b * b);
-      re += (a * inv) * pp[k];   // 1/(a + ib) = (a − ib)/(a² + b²)
-      im -= (b * inv) * pp[k];
+  Eigen::ArrayXd w(L), w2(L);
+  for (Eigen::Index i = 0; i < L; ++i) w(i) = HzToRadPerSec(freq_hz(i));
+  w2 = w.square();
+  Eigen::ArrayXd re_xx = Eigen::ArrayXd::Zero(L), re_xy = Eigen::ArrayXd::Zero(L), re_yy = Eigen::ArrayXd::Zero(L);
+  Eigen::ArrayXd im_xx = Eigen::ArrayXd::Zero(L), im_xy = Eigen::ArrayXd::Zero(L), im_yy = Eigen::ArrayXd::Zero(L);
+  for (int k = 0; k < n; ++k) {
+    const double wk = m.omega_rad_s(k), wk2 = wk * wk, c = 2.0 * m.zeta(k) * wk;
+    const double pxx = m.p(0, k) * m.p(0, k), pxy = m.p(0, k) * m.p(1, k), pyy = m.p(1, k) * m.p(1, k);
+    const double* wp = w.data();
+    const double* w2p = w2.data();
+    double *rxx = re_xx.data(), *rxy = re_xy.data(), *ryy = re_yy.data();
+    double *ixx = im_xx.data(), *ixy = im_xy.data(), *iyy = im_yy.data();
+    for (Eigen::Index i = 0; i < L; ++i) {
+      const double a = wk2 - w2p[i], b = c * wp[i], inv = 1.0 / (a * a + b * b);
+      const double ra = a * inv, rb = b * inv;  // 1/(a + ib) = (a − ib)/(a² + b²)
+      rxx[i] += ra * pxx;
+      rxy[i] += ra * pxy;
+      ryy[i] += ra * pyy;
+      ixx[i] -= rb * pxx;
+      ixy[i] -= rb * pxy;
+      iyy[i] -= rb * pyy;
     }
-    H[i].real() = re;
-    H[i].imag() = im;
+  }
+  std::vector<Eigen::Matrix2cd> H(L);
+  for (Eigen::Index i = 0; i < L; ++i) {
+    H[i](0, 0) = {re_xx(i), im_xx(i)};
+    H[i](0, 1) = H[i](1, 0) = {re_xy(i), im_xy(i)};
+    H[i](1, 1) = {re_yy(i), im_yy(i)};
   }
   return H;
 }

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "robomach/common/units.h"
+#include "stability/internal/batch_atan2.h"
 
 namespace robomach::stability {
 
@@ -23,11 +24,26 @@ namespace {
 
 using cd = std::complex<double>;
 
+// The principal square root (Re ≥ 0, the branch of std::sqrt) by the
+// textbook formula t = √((|x| + |z|)/2), without the special-value handling
+// of libm's csqrt (which calls hypot: 7 % of a stability map). Falls back to
+// std::sqrt where x² + y² could overflow or underflow (|z| outside
+// 1e-150..1e150; ZOA's discriminants are near 1e-16..1e-4) or is not finite.
+cd PrincipalSqrt(const cd& z) {
+  const double x = z.real(), y = z.imag();
+  const double r2 = x * x + y * y;
+  if (!(r2 > 1e-300 && r2 < 1e300)) return std::sqrt(z);
+  const double t = std::sqrt(0.5 * (std::abs(x) + std::sqrt(r2)));
+  return x >= 0.0 ? cd(t, 0.5 * y / t) : cd(0.5 * std::abs(y) / t, std::copysign(t, y));
+}
+
+double Norm2(double re, double im) { return re * re + im * im; }
+
 // Eigenvalues of a 2×2 complex matrix from its trace and determinant.
 std::pair<cd, cd> Eigenvalues2(const Eigen::Matrix2cd& A) {
   const cd half_tr = 0.5 * (A(0, 0) + A(1, 1));
   const cd det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-  const cd disc = std::sqrt(half_tr * half_tr - det);
+  const cd disc = PrincipalSqrt(half_tr * half_tr - det);
   cd l1 = half_tr + disc, l2 = half_tr - disc;
   // Avoid cancellation in the smaller root: l1 l2 = det.
   if (std::norm(l2) > std::norm(l1)) std::swap(l1, l2);
@@ -64,31 +80,95 @@ ZoaLobes ComputeZoaLobes(const Eigen::VectorXd& freq_hz, const std::vector<Eigen
     br.theta.resize(freq_hz.size());
     br.speed_numerator.resize(freq_hz.size());
   }
-  cd prev1, prev2;
-  for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
-    auto [l1, l2] = Eigenvalues2(Phi_C[i] * H0);
-    // Follow each branch by continuity with the previous line.
-    if (i > 0 && std::norm(l1 - prev2) + std::norm(l2 - prev1) <
-                     std::norm(l1 - prev1) + std::norm(l2 - prev2)) {
-      std::swap(l1, l2);
+  // 1. The eigenvalues λ of Φ H₀ per line (H₀ real: 8 products per line),
+  //    each branch followed by continuity with the previous line.
+  const Eigen::Index L = freq_hz.size();
+  std::vector<double> re[2], im[2];
+  for (int b = 0; b < 2; ++b) {
+    re[b].resize(L);
+    im[b].resize(L);
+  }
+  // In plain doubles, line by line without branches (the compiler
+  // vectorises it); a line whose discriminant is outside the safe range of
+  // PrincipalSqrt is redone by Eigenvalues2 afterwards.
+  const double h00 = H0(0, 0).real(), h01 = H0(0, 1).real(), h10 = H0(1, 0).real(), h11 = H0(1, 1).real();
+  const double* P = reinterpret_cast<const double*>(Phi_C.data());  // column-major (re, im) pairs, 8 per line
+  std::vector<char> redo(L);
+  for (Eigen::Index i = 0; i < L; ++i) {
+    const double* p = P + 8 * i;
+    // Φ = [p00 p01; p10 p11] (column-major: p00, p10, p01, p11), A = Φ H₀.
+    const double p00r = p[0], p00i = p[1], p10r = p[2], p10i = p[3], p01r = p[4], p01i = p[5], p11r = p[6],
+                 p11i = p[7];
+    const double a00r = p00r * h00 + p01r * h10, a00i = p00i * h00 + p01i * h10;
+    const double a01r = p00r * h01 + p01r * h11, a01i = p00i * h01 + p01i * h11;
+    const double a10r = p10r * h00 + p11r * h10, a10i = p10i * h00 + p11i * h10;
+    const double a11r = p10r * h01 + p11r * h11, a11i = p10i * h01 + p11i * h11;
+    const double htr = 0.5 * (a00r + a11r), hti = 0.5 * (a00i + a11i);
+    const double detr = (a00r * a11r - a00i * a11i) - (a01r * a10r - a01i * a10i);
+    const double deti = (a00r * a11i + a00i * a11r) - (a01r * a10i + a01i * a10r);
+    const double zr = (htr * htr - hti * hti) - detr, zi = 2.0 * htr * hti - deti;
+    // PrincipalSqrt, branch-free.
+    const double r2 = zr * zr + zi * zi;
+    redo[i] = !(r2 > 1e-300 && r2 < 1e300);
+    const double t = std::sqrt(0.5 * (std::abs(zr) + std::sqrt(r2)));
+    const double t_safe = t > 0.0 ? t : 1.0;
+    const double dr = zr >= 0.0 ? t : 0.5 * std::abs(zi) / t_safe;
+    const double di = zr >= 0.0 ? 0.5 * zi / t_safe : std::copysign(t, zi);
+    double l1r = htr + dr, l1i = hti + di, l2r = htr - dr, l2i = hti - di;
+    const bool swap = l2r * l2r + l2i * l2i > l1r * l1r + l1i * l1i;
+    const double s1r = swap ? l2r : l1r, s1i = swap ? l2i : l1i;
+    l1r = s1r;
+    l1i = s1i;
+    // The smaller root as det/l1 (no cancellation): det·conj(l1)/|l1|².
+    const double n1 = l1r * l1r + l1i * l1i;
+    const double inv = n1 > 0.0 ? 1.0 / n1 : 0.0;
+    const double q2r = (detr * l1r + deti * l1i) * inv, q2i = (deti * l1r - detr * l1i) * inv;
+    re[0][i] = l1r;
+    im[0][i] = l1i;
+    re[1][i] = n1 > 0.0 ? q2r : (swap ? htr + dr : l2r);
+    im[1][i] = n1 > 0.0 ? q2i : (swap ? hti + di : l2i);
+  }
+  for (Eigen::Index i = 0; i < L; ++i) {
+    if (!redo[i]) continue;
+    Eigen::Matrix2cd A;
+    for (int r = 0; r < 2; ++r) {
+      for (int c = 0; c < 2; ++c) A(r, c) = Phi_C[i](r, 0) * H0(0, c).real() + Phi_C[i](r, 1) * H0(1, c).real();
     }
-    prev1 = l1;
-    prev2 = l2;
-    const double w = HzToRadPerSec(freq_hz(i));
-    const cd lam[2] = {l1, l2};
-    for (int b = 0; b < 2; ++b) {
-      double depth = NAN, theta = NAN;
-      const double n2 = std::norm(lam[b]);
-      if (n2 > 0.0) {
-        const cd L = -std::conj(lam[b]) / n2;  // −1/λ without a library complex division
-        if (L.real() > 0.0) {
-          depth = std::norm(L) / (2.0 * L.real());
-          theta = std::atan2(L.real(), L.imag());  // in (0, π)
-        }
-      }
-      out.branch_[b].depth[i] = depth;
-      out.branch_[b].theta[i] = theta;
-      out.branch_[b].speed_numerator[i] = 2.0 * kPi * w / N;  // Ω = this / (2θ + 2πk)
+    const auto [l1, l2] = Eigenvalues2(A);
+    re[0][i] = l1.real();
+    im[0][i] = l1.imag();
+    re[1][i] = l2.real();
+    im[1][i] = l2.imag();
+  }
+  // Each branch followed by continuity with the previous line.
+  for (Eigen::Index i = 1; i < L; ++i) {
+    const double d12 = Norm2(re[0][i] - re[1][i - 1], im[0][i] - im[1][i - 1]) +
+                       Norm2(re[1][i] - re[0][i - 1], im[1][i] - im[0][i - 1]);
+    const double d11 = Norm2(re[0][i] - re[0][i - 1], im[0][i] - im[0][i - 1]) +
+                       Norm2(re[1][i] - re[1][i - 1], im[1][i] - im[1][i - 1]);
+    if (d12 < d11) {
+      std::swap(re[0][i], re[1][i]);
+      std::swap(im[0][i], im[1][i]);
+    }
+  }
+  // 2. Per branch and line: with L = −1/λ, a_lim = |L|²/(2 Re L) and
+  //    θ = atan2(Re L, Im L) where Re L > 0. Since −1/λ = −λ̄/|λ|², Re L > 0
+  //    is Re λ < 0, a_lim = −1/(2 Re λ) and θ = atan2(−Re λ, Im λ) (a
+  //    positive factor does not change atan2). The phases in one batch
+  //    (BatchAtan2: glibc's vector atan2 where it is available).
+  for (int b = 0; b < 2; ++b) {
+    auto& br = out.branch_[b];
+    std::vector<double> y(L), x(L);
+    for (Eigen::Index i = 0; i < L; ++i) {
+      const bool ok = re[b][i] < 0.0;
+      br.depth[i] = ok ? -0.5 / re[b][i] : NAN;
+      y[i] = ok ? -re[b][i] : 1.0;  // a dummy where there is no boundary
+      x[i] = ok ? im[b][i] : 1.0;
+    }
+    internal::BatchAtan2(y.data(), x.data(), br.theta.data(), L);
+    for (Eigen::Index i = 0; i < L; ++i) {
+      if (!(re[b][i] < 0.0)) br.theta[i] = NAN;
+      br.speed_numerator[i] = 2.0 * kPi * HzToRadPerSec(freq_hz(i)) / N;  // Ω = this / (2θ + 2πk)
     }
   }
   return out;
@@ -119,12 +199,16 @@ std::vector<LobePoint> ZoaLobes::At(const Eigen::VectorXd& speeds) const {
   const Eigen::Index n = speeds.size();
   std::vector<LobePoint> out(n);
   for (Eigen::Index j = 0; j < n; ++j) out[j].spindle_speed_rad_s = speeds(j);
+  if (n == 0) return out;
+  // The speeds in ascending order (a map passes the same sorted grid at
+  // every point: no sort then).
   std::vector<Eigen::Index> order(n);
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](auto a, auto b) { return speeds(a) < speeds(b); });
+  if (!std::is_sorted(speeds.data(), speeds.data() + n)) {
+    std::sort(order.begin(), order.end(), [&](auto a, auto b) { return speeds(a) < speeds(b); });
+  }
   std::vector<double> sorted(n);
   for (Eigen::Index j = 0; j < n; ++j) sorted[j] = speeds(order[j]);
-  if (n == 0) return out;
   const double s_lo = sorted.front(), s_hi = sorted.back();
 
   // Lobe k at line i lies at Ω = num_i/(2θ_i + 2πk) with θ_i in (0, π], so
@@ -133,8 +217,10 @@ std::vector<LobePoint> ZoaLobes::At(const Eigen::VectorXd& speeds) const {
   // cannot give a point and are not visited (a relative margin of 1e-9
   // covers the rounding of θ, of the sum and of the division, ~1e-16): the
   // result is the same as visiting them (stability_map_test.cc checks it
-  // against a plain scan of every curve).
+  // against a plain scan of every curve). The speeds of one lobe's lines are
+  // computed in one loop (no branches: vectorised divisions), then scanned.
   constexpr double kMargin = 1e-9;
+  std::vector<double> speed;
   for (const Branch& br : branch_) {
     const size_t m = br.depth.size();
     for (int k = 0; k <= max_lobe_index_; ++k) {
@@ -149,11 +235,19 @@ std::vector<LobePoint> ZoaLobes::At(const Eigen::VectorXd& speeds) const {
             br.speed_numerator.begin());
         i0 = j > 0 ? j - 1 : 0;
       }
-      double sb = NAN;
-      for (size_t i = i0; i + 1 < m; ++i) {
-        if (br.speed_numerator[i] > num_above) break;
-        const double sa = i == 0 || !std::isfinite(sb) ? br.speed_numerator[i] / (2.0 * br.theta[i] + two_pi_k) : sb;
-        sb = br.speed_numerator[i + 1] / (2.0 * br.theta[i + 1] + two_pi_k);  // NaN where no boundary
+      // Segments (i, i + 1) for i < i_end: the first line beyond num_above
+      // starts no segment, as in a scan that stops there.
+      const size_t i_end = static_cast<size_t>(
+          std::upper_bound(br.speed_numerator.begin() + std::min(i0, m), br.speed_numerator.end(), num_above) -
+          br.speed_numerator.begin());
+      if (i_end <= i0 || i0 + 1 >= m) continue;
+      const size_t last = std::min(i_end, m - 1);  // the segments' upper lines reach `last`
+      speed.resize(last - i0 + 1);
+      const double* num = br.speed_numerator.data();
+      const double* th = br.theta.data();
+      for (size_t i = i0; i <= last; ++i) speed[i - i0] = num[i] / (2.0 * th[i] + two_pi_k);  // NaN: no boundary
+      for (size_t i = i0; i < last && i + 1 < m; ++i) {
+        const double sa = speed[i - i0], sb = speed[i + 1 - i0];
         if (!std::isfinite(sa) || !std::isfinite(sb)) continue;
         const double lo = std::min(sa, sb), hi = std::max(sa, sb);
         if (hi < s_lo || lo > s_hi) continue;

@@ -78,11 +78,7 @@ Outcome Audit(const std::string& name, const std::vector<Hidden>& hidden, unsign
   return out;
 }
 
-struct Case {
-  std::string name;
-  std::vector<Hidden> hidden;
-  unsigned seed;
-};
+using Case = testing::RealisticCase;
 void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 
 class HiddenEffectOnRealisticData : public ::testing::TestWithParam<Case> {};
@@ -116,43 +112,22 @@ TEST_P(HiddenEffectOnRealisticData, IsFlaggedRankedFirstAndExplained) {
 // situations); seeds 301.. not used in tuning.
 INSTANTIATE_TEST_SUITE_P(
     EveryDetectableLibraryEffect, HiddenEffectOnRealisticData,
-    ::testing::Values(
-        Case{"tip_mass", {{"tip_mass", {{"tip_mass.mass_kg", 0.5}}}}, 301},
-        Case{"flange_compliance", {{"flange_compliance", {{"flange_compliance.bending_stiffness_Nm_per_rad", 1e6}}}},
-             302},
-        Case{"joint_damping",
-             {{"joint_damping",
-               {{"joint_damping.c1_Nms_per_rad", 2550.0}, {"joint_damping.c2_Nms_per_rad", 4200.0},
-                {"joint_damping.c3_Nms_per_rad", 1950.0}, {"joint_damping.c4_Nms_per_rad", 60.0},
-                {"joint_damping.c5_Nms_per_rad", 120.0}, {"joint_damping.c6_Nms_per_rad", 10.5}}}},
-             303},
-        Case{"base_compliance",
-             {{"base_compliance",
-               {{"base_compliance.lateral_stiffness_N_per_m", 3e8},
-                {"base_compliance.rocking_stiffness_Nm_per_rad", 2e7}}}},
-             304},
-        Case{"tool_flexibility",
-             {{"tool_flexibility", {{"tool_flexibility.diameter_m", 0.012}, {"tool_flexibility.stick_out_m", 0.06}}}},
-             305},
-        Case{"spindle_interface",
-             {{"spindle_interface",
-               {{"spindle_interface.translational_scale", 1.5}, {"spindle_interface.tilting_scale", 10.0}}}},
-             306}),
+    ::testing::ValuesIn(testing::RealisticSingleEffectCases()),
     [](const ::testing::TestParamInfo<Case>& i) { return i.param.name; });
 
 // Nothing missing: no alarm (the issue found "12 of 12 FRFs fail
 // significantly" here before the noise model).
 TEST(NothingMissingOnRealisticData, RaisesNoAlarm) {
-  const Outcome o = Audit("none", {}, 307);
+  const Case k = testing::RealisticCaseNamed("none");
+  const Outcome o = Audit(k.name, k.hidden, k.seed);
   EXPECT_FALSE(o.result.significant_failure) << o.result.verdict;
   EXPECT_TRUE(o.result.missing_effects.empty());
   EXPECT_LT(o.result.errors_before.total_rms_log_mag, 1.3);
 }
 
 TEST(TwoHiddenEffectsOnRealisticData, AreBothFound) {
-  const Outcome o = Audit("two",
-                          testing::SoftFlangeOnSoftFoundation(),
-                          308);
+  const Case k = testing::RealisticCaseNamed("two");
+  const Outcome o = Audit(k.name, k.hidden, k.seed);
   const AuditResult& r = o.result;
   EXPECT_TRUE(r.significant_failure);
   ASSERT_GE(r.best, 0) << r.verdict;
@@ -167,7 +142,8 @@ TEST(TwoHiddenEffectsOnRealisticData, AreBothFound) {
 // damping) in every FRF alike, inside the usable band. Reported
 // unexplained, with the pattern: the same band fails at every posture.
 TEST(EffectOutsideTheLibraryOnRealisticData, IsReportedAsUnexplainedWithItsPattern) {
-  const Outcome o = Audit("outside", {}, 309, testing::ApplyMountingResonance);
+  const Case k = testing::RealisticCaseNamed("outside");
+  const Outcome o = Audit(k.name, k.hidden, k.seed, k.alter);
   const AuditResult& r = o.result;
   EXPECT_TRUE(r.significant_failure);
   EXPECT_FALSE(r.explained) << r.verdict;

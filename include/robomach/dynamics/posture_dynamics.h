@@ -39,9 +39,23 @@ struct ComplexModalModel {
   std::vector<Eigen::Matrix3cd> residues;
 };
 
+/// What PostureEvaluator::Evaluate computes. The defaults compute everything
+/// (what every caller got before these flags existed); a caller that needs
+/// less says so and does not pay for the rest. Always computed, because the
+/// assembly needs them and they come from the same pass: q, X_BT, J_BT,
+/// `system`, proportional_damping. An output not asked for is NaN (numbers),
+/// false (near_singular) or empty (modes, complex_modes).
+/// Fields are appended, never reordered: callers initialise the first two
+/// positionally (PostureOptions{false, true}).
 struct PostureOptions {
-  bool cartesian{true};  // form M_X, K_X, C_X (n == 6 and not near-singular)
-  bool modes{true};      // undamped modes and damping ratios
+  bool cartesian{true};           // M_X, K_X, C_X (n == 6 and not near-singular); implies jacobian_condition
+  bool modes{true};               // undamped modes: freq_hz, phi, p_T
+  bool jacobian_condition{true};  // jacobian_condition and near_singular
+  bool static_compliance{true};   // static_compliance
+  bool modal_masses{true};        // Mode::modal_mass_kg and shape_T (with modes)
+  /// Mode::damping_ratio (with modes), and complex_modes when the damping is
+  /// not proportional. ReceptanceModal needs them.
+  bool damping_ratios{true};
 };
 
 /// Everything that depends on the posture q. Plain data, cheap to copy.
@@ -61,6 +75,8 @@ struct PostureDynamics {
   /// proportional and modes were asked for (empty otherwise); computed once
   /// here because the damping ratios of `modes` need them anyway.
   ComplexModalModel complex_modes;
+  /// What was asked for when these data were computed.
+  PostureOptions options;
 
   /// Joint-space blocks of the assembled system (n × n).
   Eigen::MatrixXd M_q() const { return system.M.topLeftCorner(system.num_joints, system.num_joints); }
@@ -68,7 +84,7 @@ struct PostureDynamics {
   Eigen::MatrixXd C_q() const { return system.C.topLeftCorner(system.num_joints, system.num_joints); }
 };
 
-/// Evaluates postures of one model with reusable KDL solvers and buffers.
+/// Evaluates postures of one model with reusable buffers and solvers.
 /// Not thread-safe: use one evaluator per thread (they may share the model).
 class PostureEvaluator {
  public:
@@ -81,6 +97,21 @@ class PostureEvaluator {
   ///   std::runtime_error if the assembled mass matrix is not positive
   ///   definite (a bad model, not a bad posture).
   PostureDynamics Evaluate(const Eigen::VectorXd& q, const PostureOptions& options = {});
+
+  /// The same into `out`, reusing its storage: when `out` last held a posture
+  /// of this model, nothing is allocated (for the six-joint robot without
+  /// effect DOFs; effects and the general N-DOF path may allocate inside
+  /// Eigen). The fast path for loops over many postures.
+  ///
+  /// How it is computed: pose, J_BT and M_q in one pass over the segments
+  /// (composite-rigid-body algorithm in the base frame, Featherstone 2008
+  /// §6.2; KDL is the reference in tests/dynamics/rigid_chain_test.cc). With
+  /// six DOFs and K diagonal (joint stiffness only, the usual case) the
+  /// generalized problem K φ = λ M φ becomes one standard symmetric problem
+  /// A u = μ u, A = K^{-1/2} M K^{-1/2}, μ = 1/λ, φ = K^{-1/2} u / √μ, solved
+  /// with a fixed-size Eigen::SelfAdjointEigenSolver; otherwise Eigen's
+  /// GeneralizedSelfAdjointEigenSolver (Cholesky of M) as before.
+  void Evaluate(const Eigen::VectorXd& q, const PostureOptions& options, PostureDynamics* out);
 
   const RobotModel& model() const { return *model_; }
 

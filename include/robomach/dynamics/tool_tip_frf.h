@@ -26,13 +26,20 @@ std::vector<Eigen::Matrix3cd> ReceptanceDirect(const AssembledSystem& system,
 ///   H_ij(ω) = Σ_k p_ik p_jk / (ω_k² − ω² + 2i ζ_k ω_k ω),              (2)
 /// </pre>
 /// exact for proportional damping (2 ζ_k ω_k = alpha ω_k² + beta).
-/// @throws std::invalid_argument if `dynamics` has no modes or its damping is
-///   not proportional (use ReceptanceComplexModal then).
+/// Evaluated in real arithmetic, several lines at once in SIMD registers
+/// (dynamics/internal/modal_sum.h).
+/// @throws std::invalid_argument if `dynamics` has no modes, its damping is
+///   not proportional (use ReceptanceComplexModal then) or it was evaluated
+///   without damping ratios.
 ///
 /// - [Ewins 2000] D. J. Ewins, Modal Testing: Theory, Practice and
 ///   Application, 2nd ed., Research Studies Press, 2000.
 std::vector<Eigen::Matrix3cd> ReceptanceModal(const PostureDynamics& dynamics,
                                               const Eigen::VectorXd& freq_hz);
+/// The same into `H` (resized to the number of lines), reusing its storage:
+/// no allocation when it already has that size.
+void ReceptanceModal(const PostureDynamics& dynamics, const Eigen::VectorXd& freq_hz,
+                     std::vector<Eigen::Matrix3cd>* H);
 
 /// Poles and residues of the first-order (state-space) form of the
 /// assembled system; exact for non-proportional damping too.
