@@ -83,7 +83,8 @@ constexpr char kReceptanceDoc[] =
     "freq_hz: frequency lines [Hz], finite (0 gives the static compliance).\n"
     "method: 'modal' (superposition of real modes for proportional damping, of complex modes "
     "otherwise; frf-predict's default) or 'direct' (solve (K - w^2 M + i w C) per line).\n"
-    "'modal' needs the modes (evaluate(..., modes=True)). Releases the GIL.";
+    "Without the real modes (evaluate(..., modes=False)) 'modal' computes the complex modes here. "
+    "Releases the GIL.";
 
 }  // namespace
 

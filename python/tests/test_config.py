@@ -66,7 +66,8 @@ def test_missing_file_is_file_not_found():
 
 
 def test_bad_config_raises_input_error_with_the_tools_message(tmp):
-    text = open(KR210).read().replace('joint_stiffness_Nm_per_rad', 'joint_stifness_Nm_per_rad', 1)
+    text = open(KR210).read().replace('  alpha_s: 1.0e-4', '  alpha_s: fast', 1)
+    assert 'alpha_s: fast' in text
     bad = tmp / 'bad.yaml'
     bad.write_text(text)
     # Relative paths (the URDF) resolve from the config's folder: copy what it names.
