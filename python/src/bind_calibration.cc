@@ -118,7 +118,8 @@ void BindCalibration(py::module_& m) {
       .def_property_readonly("peak_error", &ModeMatch::peak_error, "model/measured - 1");
   py::class_<CalibrationResult>(m, "CalibrationResult", "What calibrate() found; never raises for a poor fit.")
       .def_property_readonly("status", [](const CalibrationResult& r) { return calibration::FitStatusName(r.status); },
-                             "'converged', 'not converged', 'failed' or 'not improved' (start kept)")
+                             "'converged', 'not_converged', 'failed' or 'not_improved' (no start fitted better: the start "
+                             "values are kept), as frf-calibrate's summary writes it")
       .def_readonly("message", &CalibrationResult::message)
       .def_property_readonly("parameters", [](const CalibrationResult& r) { return ParameterDict(r.parameters); },
                              "{name: value} of the full set with calibrated values (SI)")
@@ -223,7 +224,8 @@ void BindCalibration(py::module_& m) {
       .def_readonly("normalized", &CaseResidual::normalized, "|residual| / sigma_D [-]")
       .def_readonly("outlier", &CaseResidual::outlier);
   py::class_<JointStiffnessResult>(m, "JointStiffnessResult", "What identify_joint_stiffness() found.")
-      .def_property_readonly("status", [](const JointStiffnessResult& r) { return std::string(identification::ToString(r.status)); })
+      .def_property_readonly("status", [](const JointStiffnessResult& r) { return std::string(identification::ToString(r.status)); },
+                             "'converged', 'not converged' or 'failed', as kq-identify's summary writes it")
       .def_readonly("solver_message", &JointStiffnessResult::solver_message)
       .def_readonly("num_cases", &JointStiffnessResult::num_cases)
       .def_readonly("joint_stiffness", &JointStiffnessResult::joint_stiffness,
