@@ -158,3 +158,10 @@ def test_usable_data_attaches_sigma():
         assert len(u[key]) == n.usable_lines == len(lines)
         np.testing.assert_array_equal(u[key].freq_hz, s[key].freq_hz[lines])
         np.testing.assert_array_equal(u[key].noise_sigma, n.sigma_m_per_N[lines])
+
+
+def test_unwritable_output_is_an_output_error(tmp):
+    with pytest.raises(rm.OutputError) as e:
+        rm.write_frf_csv(str(tmp / 'no_such_folder' / 'h.csv'), synthetic_set())
+    assert isinstance(e.value, OSError) and 'no_such_folder' in str(e.value)
+    assert not (tmp / 'no_such_folder').exists()
