@@ -284,7 +284,11 @@ void BindDynamics(py::module_& m) {
           h = ReceptanceByMethod(d, freq_hz, method);
         }
         return ToArray(h);
-      }, py::arg("freq_hz"), py::arg("method") = "modal", kReceptanceDoc);
+      }, py::arg("freq_hz"), py::arg("method") = "modal", kReceptanceDoc)
+      .def("__repr__", [](const PostureDynamics& d) {
+        return "<PostureDynamics " + std::to_string(d.system.M.rows()) + " DOFs, " + std::to_string(d.modes.size()) +
+               " modes" + (d.near_singular ? ", near singular" : "") + ">";
+      });
 
   py::class_<PostureEvaluator>(
       m, "PostureEvaluator",
@@ -297,7 +301,8 @@ void BindDynamics(py::module_& m) {
       }, py::arg("q"), py::arg("cartesian") = true, py::arg("modes") = true,
          "PostureDynamics at joint angles q [rad] (length num_joints). cartesian: form M_X, K_X, "
          "C_X; modes: undamped modes and damping ratios. ValueError if q has the wrong size or is "
-         "not finite; NumericalError/RuntimeError if the mass matrix is not positive definite.");
+         "not finite; NumericalError if the assembled mass matrix is not positive definite (a bad model, not a bad "
+         "posture).");
 
   m.def("receptance", [](const PostureDynamics& d, const Eigen::VectorXd& freq_hz, const std::string& method) {
     CheckFrequencies(freq_hz);
