@@ -50,11 +50,13 @@ def test_calibrate_equals_frf_calibrate_and_finds_the_truth(hammer):
     assert [e.name for e in result.estimates] == FREE
     for e in result.estimates:
         assert e.value == pytest.approx(tool[e.name]['value'], rel=REL)
-        assert e.std_dev == pytest.approx(tool[e.name]['std_dev'], rel=1e-6)  # covariance: 1e-6, a
-        # second numeric-derivative product; still far below any physical meaning
+        # The covariance is a product of numeric derivatives (central
+        # differences): it repeats less tightly than the values, 1e-6.
+        assert e.std_dev == pytest.approx(tool[e.name]['std_dev'], rel=1e-6)
         assert e.unit == tool[e.name]['unit'] and e.stage == tool[e.name]['stage']
         # The truth within 3 sigma (0.3 % false alarm per parameter; the data's seed is fixed).
         assert abs(e.value - TRUTH[e.name]) < 3 * e.std_dev, e
+    # A sum over 8000 residual pairs at parameters equal to REL: 1e-9.
     assert result.misfit_final == pytest.approx(summary['misfit']['calibrated'], rel=1e-9)
     assert result.misfit_final < result.misfit_start
     assert result.parameters['m6_kg'] == result.estimates[1].value

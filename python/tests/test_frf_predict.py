@@ -60,6 +60,7 @@ def test_direct_and_modal_agree_and_the_static_limit():
     # proportional; direct solve per line): 1e-8 of the peak, the round-off
     # of the eigen-decomposition at the lightly damped peaks.
     assert np.abs(Hm - Hd).max() <= 1e-8 * np.abs(Hd).max()
+    # At 0 Hz the direct solve is K^-1: the static compliance to round-off.
     np.testing.assert_allclose(Hd[0].real, d.static_compliance, rtol=0,
                                atol=1e-12 * np.abs(d.static_compliance).max())
     with pytest.raises(ValueError, match="method 'exact'"):

@@ -84,7 +84,9 @@ def test_modes_solve_the_generalised_eigenproblem():
     # NumPy's own eigenvalues of M^-1 K; relative 1e-9 (conditioning of M^-1 K).
     ref = np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)
     np.testing.assert_allclose(w2, ref, rtol=1e-9)
-    # Static compliance B K^-1 B^T; Rayleigh damping C = alpha K + beta M.
+    # Static compliance B K^-1 B^T (NumPy's LU against the library's LDLT:
+    # 1e-9, the conditioning of K); Rayleigh damping C = alpha K + beta M
+    # (two products and a sum: 1e-12 of the largest entry).
     np.testing.assert_allclose(d.static_compliance, d.B @ np.linalg.solve(K, d.B.T), rtol=1e-9,
                                atol=1e-12 * np.abs(d.static_compliance).max())
     p = rm.RobotConfig(KR210).parameters
