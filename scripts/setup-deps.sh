@@ -14,6 +14,7 @@ packages=(
   libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev
   libocct-data-exchange-dev libpolyclipping-dev
   python3          # demo.sh (index.html), polishing and frf-estimate tests
+  pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module (docs/python.md) and its tests
 )
 
 missing=()

@@ -1,0 +1,285 @@
+// Calibration against measured FRFs (calibration/frf_calibration.h) and
+// joint-stiffness identification from load tests
+// (identification/joint_stiffness.h, io/tracker_file.h). Results are plain
+// objects with read-only attributes.
+#include <limits>
+
+#include "bindings.h"
+#include "robomach/calibration/frf_calibration.h"
+#include "robomach/calibration/modal_fit.h"
+#include "robomach/identification/joint_stiffness.h"
+#include "robomach/identification/load_case.h"
+#include "robomach/io/robot_config.h"
+#include "robomach/io/tracker_file.h"
+
+namespace robomach::python {
+namespace {
+
+using calibration::CalibrationOptions;
+using calibration::CalibrationResult;
+using calibration::MeasuredFeatures;
+using calibration::ModeMatch;
+using calibration::ParameterEstimate;
+using calibration::StageSummary;
+using identification::CaseResidual;
+using identification::JointStiffnessResult;
+using identification::LoadCase;
+
+std::map<std::string, double> ParameterDict(const dynamics::ParameterSet& p) {
+  std::map<std::string, double> out;
+  for (const auto& s : p.specs()) out[s.name] = p.Get(s.name);
+  return out;
+}
+
+std::tuple<std::string, std::string, std::string> KeyTuple(const dynamics::FrfKey& k) {
+  return {k.pose_id, AxisString(k.response), AxisString(k.excitation)};
+}
+
+calibration::PostureMap Postures(const std::map<std::string, Eigen::VectorXd>& p) {
+  return calibration::PostureMap(p.begin(), p.end());
+}
+
+MeasuredFeatures Features(const dynamics::FrfSet& measured, double fmin_hz, double fmax_hz) {
+  calibration::ModalFitOptions o;
+  o.fmin_hz = fmin_hz;
+  o.fmax_hz = fmax_hz;
+  return calibration::ExtractFeatures(measured, o);
+}
+
+}  // namespace
+
+void BindCalibration(py::module_& m) {
+  // ------------------------------------------------------ calibration --
+  py::class_<MeasuredFeatures>(m, "MeasuredFeatures",
+                               "Modal fits of every measured FRF (extract_features): the modes the "
+                               "modal objectives match.")
+      .def_property_readonly("modes", [](const MeasuredFeatures& f) {
+        std::vector<py::dict> out;
+        for (const auto& mm : f.modes) {
+          py::dict d;
+          d["key"] = KeyTuple(mm.key);
+          d["freq_hz"] = mm.fit.freq_hz;
+          d["damping_ratio"] = mm.fit.damping_ratio;
+          d["peak_freq_hz"] = mm.peak_freq_hz;
+          d["peak_magnitude_m_per_N"] = mm.peak_magnitude;
+          out.push_back(d);
+        }
+        return out;
+      }, "list of dicts: key (pose_id, response, excitation), freq_hz [Hz], damping_ratio [-], "
+         "peak_freq_hz [Hz], peak_magnitude_m_per_N [m/N]")
+      .def_property_readonly("fit_status", [](const MeasuredFeatures& f) {
+        std::map<std::tuple<std::string, std::string, std::string>, std::string> out;
+        for (const auto& [k, r] : f.fits) {
+          out[KeyTuple(k)] = r.status == calibration::ModalFitStatus::kOk            ? "ok"
+                             : r.status == calibration::ModalFitStatus::kNoStableModes ? "no stable modes"
+                                                                                       : "failed: " + r.message;
+        }
+        return out;
+      }, "{key: 'ok' | 'no stable modes' | 'failed: ...'} per FRF");
+  m.def("extract_features", [](const dynamics::FrfSet& measured, double fmin_hz, double fmax_hz) {
+    py::gil_scoped_release release;
+    return Features(measured, fmin_hz, fmax_hz);
+  }, py::arg("measured"), py::arg("fmin_hz") = 0.0, py::arg("fmax_hz") = std::numeric_limits<double>::infinity(),
+     "Fits the modes of every FRF in the band [fmin_hz, fmax_hz] [Hz] (LSCF with a stabilisation "
+     "diagram). Releases the GIL.");
+
+  py::class_<ParameterEstimate>(m, "ParameterEstimate", "One calibrated parameter, in its unit (SI).")
+      .def_readonly("name", &ParameterEstimate::name)
+      .def_readonly("unit", &ParameterEstimate::unit)
+      .def_readonly("initial", &ParameterEstimate::initial)
+      .def_readonly("value", &ParameterEstimate::value)
+      .def_readonly("std_dev", &ParameterEstimate::std_dev, "1 sigma from the covariance (NaN if none)")
+      .def_readonly("weakly_identified", &ParameterEstimate::weakly_identified)
+      .def_readonly("at_bound", &ParameterEstimate::at_bound)
+      .def_readonly("stage", &ParameterEstimate::stage)
+      .def("__repr__", [](const ParameterEstimate& e) {
+        return "<ParameterEstimate " + e.name + " = " + std::to_string(e.value) + " " + e.unit + ">";
+      });
+  py::class_<StageSummary>(m, "StageSummary", "One solver stage of a calibration.")
+      .def_readonly("name", &StageSummary::name)
+      .def_readonly("parameters", &StageSummary::parameters)
+      .def_readonly("termination", &StageSummary::termination)
+      .def_readonly("message", &StageSummary::message, "Ceres' summary message, verbatim")
+      .def_readonly("iterations", &StageSummary::iterations)
+      .def_readonly("num_residuals", &StageSummary::num_residuals)
+      .def_readonly("initial_cost", &StageSummary::initial_cost)
+      .def_readonly("final_cost", &StageSummary::final_cost)
+      .def_readonly("covariance_ok", &StageSummary::covariance_ok);
+  py::class_<ModeMatch>(m, "ModeMatch", "A measured mode paired with a model mode of the same posture.")
+      .def_property_readonly("key", [](const ModeMatch& x) { return KeyTuple(x.key); })
+      .def_readonly("model_mode", &ModeMatch::model_mode, "0-based index in PostureDynamics.modes")
+      .def_readonly("measured_freq_hz", &ModeMatch::measured_freq_hz)
+      .def_readonly("model_freq_hz", &ModeMatch::model_freq_hz)
+      .def_readonly("measured_peak", &ModeMatch::measured_peak, "[m/N]")
+      .def_readonly("model_peak", &ModeMatch::model_peak, "[m/N]")
+      .def_readonly("measured_damping", &ModeMatch::measured_damping)
+      .def_readonly("model_damping", &ModeMatch::model_damping)
+      .def_property_readonly("freq_error", &ModeMatch::freq_error, "model/measured - 1")
+      .def_property_readonly("peak_error", &ModeMatch::peak_error, "model/measured - 1");
+  py::class_<CalibrationResult>(m, "CalibrationResult", "What calibrate() found; never raises for a poor fit.")
+      .def_property_readonly("status", [](const CalibrationResult& r) { return calibration::FitStatusName(r.status); },
+                             "'converged', 'not_converged', 'failed' or 'not_improved' (no start fitted better: the start "
+                             "values are kept), as frf-calibrate's summary writes it")
+      .def_readonly("message", &CalibrationResult::message)
+      .def_property_readonly("parameters", [](const CalibrationResult& r) { return ParameterDict(r.parameters); },
+                             "{name: value} of the full set with calibrated values (SI)")
+      .def_readonly("estimates", &CalibrationResult::estimates)
+      .def_readonly("stages", &CalibrationResult::stages)
+      .def_readonly("weakly_identified", &CalibrationResult::weakly_identified)
+      .def_readonly("matches_before", &CalibrationResult::matches_before)
+      .def_readonly("matches_after", &CalibrationResult::matches_after)
+      .def_readonly("misfit_start", &CalibrationResult::misfit_start, "whole-curve chi^2 at the start values")
+      .def_readonly("misfit_final", &CalibrationResult::misfit_final, "whole-curve chi^2 of the result")
+      .def_readonly("start_used", &CalibrationResult::start_used)
+      .def_readonly("starts_tried", &CalibrationResult::starts_tried)
+      .def("__repr__", [](const CalibrationResult& r) {
+        return "<CalibrationResult " + calibration::FitStatusName(r.status) + ">";
+      });
+
+  m.def("calibrate", [](const io::RobotConfig& config, const std::map<std::string, Eigen::VectorXd>& postures,
+                        const dynamics::FrfSet& measured, const std::string& objective,
+                        const std::vector<std::string>& free_parameters, double fmin_hz, double fmax_hz,
+                        int max_iterations, bool extra_starts, const MeasuredFeatures* features) {
+    CalibrationOptions o;
+    o.objective = calibration::ParseObjective(objective);
+    o.free_parameters = free_parameters;
+    o.fmin_hz = fmin_hz;
+    o.fmax_hz = fmax_hz;
+    o.modal_fit.fmin_hz = fmin_hz;
+    o.modal_fit.fmax_hz = fmax_hz;
+    o.max_iterations = max_iterations;
+    o.extra_starts = extra_starts;
+    if (o.free_parameters.empty()) throw std::invalid_argument("free_parameters: expected at least one name");
+    if (max_iterations < 1) throw std::invalid_argument("max_iterations: expected >= 1");
+    py::gil_scoped_release release;
+    const MeasuredFeatures own = features ? MeasuredFeatures{} : calibration::ExtractFeatures(measured, o.modal_fit);
+    return calibration::Calibrate(config.description, config.parameters, Postures(postures), measured,
+                                  features ? *features : own, o);
+  }, py::arg("config"), py::arg("postures"), py::arg("measured"), py::arg("objective") = "modal-two-stage",
+     py::arg("free_parameters") = std::vector<std::string>{"m6_kg", "d6_m", "alpha_s", "beta_per_s"},
+     py::arg("fmin_hz") = 0.0, py::arg("fmax_hz") = std::numeric_limits<double>::infinity(),
+     py::arg("max_iterations") = 100, py::arg("extra_starts") = true, py::arg("features") = nullptr,
+     "Calibrates free_parameters of `config` (RobotConfig; its values are the start) against "
+     "`measured` (FrfSet, receptance [m/N]; usable_data(...) of it to fit with the noise model, as "
+     "frf-calibrate does) at `postures` ({pose_id: q [rad]}). objective: 'modal-two-stage', "
+     "'modal-joint' or 'whole-curve'; band [fmin_hz, fmax_hz] [Hz]. features: extract_features() "
+     "of measured (computed here if None). Returns a CalibrationResult; a poor fit is a status, not "
+     "an exception. ValueError for an unknown parameter or a measured posture missing from "
+     "postures. Releases the GIL (it can take seconds to minutes).");
+  m.def("whole_curve_misfit", [](const io::RobotConfig& config, const std::map<std::string, Eigen::VectorXd>& postures,
+                                 const dynamics::FrfSet& measured, double fmin_hz, double fmax_hz) {
+    py::gil_scoped_release release;
+    return calibration::WholeCurveMisfit(config.description, config.parameters, Postures(postures), measured,
+                                         fmin_hz, fmax_hz);
+  }, py::arg("config"), py::arg("postures"), py::arg("measured"), py::arg("fmin_hz") = 0.0,
+     py::arg("fmax_hz") = std::numeric_limits<double>::infinity(),
+     "Sum over lines of the squared log-magnitude and phase residuals (in units of the noise when "
+     "the FRFs carry sigma): the chi^2 a calibration lowers; inf if the model cannot be evaluated.");
+
+  // ------------------------------------------ joint stiffness (kq) --
+  py::class_<LoadCase>(m, "LoadCase",
+                       "One load case of a laser-tracker test: posture q [rad], force F in B [N], "
+                       "measured target displacement D in B [m]; load point and target in the tip "
+                       "frame [m] (None = the TCP).")
+      .def(py::init([](std::string case_id, Eigen::VectorXd q, Eigen::Vector3d force, Eigen::Vector3d displacement,
+                       std::optional<Eigen::Vector3d> p_load_tip, std::optional<Eigen::Vector3d> p_target_tip,
+                       std::string pose_id) {
+             LoadCase c;
+             c.case_id = std::move(case_id);
+             c.pose_id = std::move(pose_id);
+             c.q = std::move(q);
+             c.force = force;
+             c.displacement = displacement;
+             c.p_load_tip = p_load_tip;
+             c.p_target_tip = p_target_tip;
+             return c;
+           }),
+           py::arg("case_id"), py::arg("q"), py::arg("force_N"), py::arg("displacement_m"),
+           py::arg("p_load_tip_m") = py::none(), py::arg("p_target_tip_m") = py::none(), py::arg("pose_id") = "")
+      .def_readonly("case_id", &LoadCase::case_id)
+      .def_readonly("pose_id", &LoadCase::pose_id)
+      .def_property_readonly("q", [](const LoadCase& c) { return Eigen::VectorXd(c.q); }, "[rad]")
+      .def_property_readonly("force_N", [](const LoadCase& c) { return Eigen::Vector3d(c.force); })
+      .def_property_readonly("displacement_m", [](const LoadCase& c) { return Eigen::Vector3d(c.displacement); })
+      .def_readonly("p_load_tip_m", &LoadCase::p_load_tip)
+      .def_readonly("p_target_tip_m", &LoadCase::p_target_tip)
+      .def_readonly("line", &LoadCase::line);
+  m.def("read_tracker_file", [](const std::string& path, int num_joints) {
+    RequireReadableFile(path);
+    py::gil_scoped_release release;
+    const io::TrackerFile tf = io::ReadTrackerFile(path, num_joints);
+    std::vector<LoadCase> cases;
+    for (const auto& meas : tf.measurements) cases.push_back(identification::ToLoadCase(meas));
+    return cases;
+  }, py::arg("path"), py::arg("num_joints"),
+     "Reads a laser-tracker load-test file (docs/formats.md §2; force or rope form) into LoadCases "
+     "(SI, radians). InputError with file:line:col.");
+
+  py::class_<CaseResidual>(m, "CaseResidual", "The residual of one load case at the solution [m, in B].")
+      .def_readonly("case_id", &CaseResidual::case_id)
+      .def_property_readonly("measured", [](const CaseResidual& c) { return Eigen::Vector3d(c.measured); })
+      .def_property_readonly("predicted", [](const CaseResidual& c) { return Eigen::Vector3d(c.predicted); })
+      .def_property_readonly("residual", [](const CaseResidual& c) { return Eigen::Vector3d(c.residual); })
+      .def_readonly("norm", &CaseResidual::norm, "[m]")
+      .def_readonly("normalized", &CaseResidual::normalized, "|residual| / sigma_D [-]")
+      .def_readonly("outlier", &CaseResidual::outlier);
+  py::class_<JointStiffnessResult>(m, "JointStiffnessResult", "What identify_joint_stiffness() found.")
+      .def_property_readonly("status", [](const JointStiffnessResult& r) { return std::string(identification::ToString(r.status)); },
+                             "'converged', 'not converged' or 'failed', as kq-identify's summary writes it")
+      .def_readonly("solver_message", &JointStiffnessResult::solver_message)
+      .def_readonly("num_cases", &JointStiffnessResult::num_cases)
+      .def_readonly("joint_stiffness", &JointStiffnessResult::joint_stiffness,
+                    "[N·m/rad]; a not-determined joint keeps the prior")
+      .def_readonly("std_dev", &JointStiffnessResult::std_dev, "1 sigma [N·m/rad]; inf for a joint held at the prior")
+      .def_readonly("lower_95", &JointStiffnessResult::lower_95, "[N·m/rad]")
+      .def_readonly("upper_95", &JointStiffnessResult::upper_95, "[N·m/rad]")
+      .def_readonly("relative_std", &JointStiffnessResult::relative_std, "sigma(log k) [-]")
+      .def_readonly("correlation", &JointStiffnessResult::correlation)
+      .def_property_readonly("determination", [](const JointStiffnessResult& r) {
+        std::vector<std::string> out;
+        for (auto d : r.determination) out.emplace_back(identification::ToString(d));
+        return out;
+      }, "per joint: 'determined', 'weak' or 'not determined'")
+      .def_readonly("weakly_identified", &JointStiffnessResult::weakly_identified, "0-based joint indices")
+      .def_readonly("not_determined", &JointStiffnessResult::not_determined, "0-based joint indices")
+      .def_readonly("advice", &JointStiffnessResult::advice)
+      .def_readonly("residuals", &JointStiffnessResult::residuals)
+      .def_readonly("outliers", &JointStiffnessResult::outliers)
+      .def_readonly("rms_residual", &JointStiffnessResult::rms_residual, "over inliers [m]")
+      .def_readonly("reduced_chi2", &JointStiffnessResult::reduced_chi2)
+      .def_readonly("condition_number", &JointStiffnessResult::condition_number)
+      .def_readonly("linear_start", &JointStiffnessResult::linear_start, "[N·m/rad]")
+      .def_readonly("iterations", &JointStiffnessResult::iterations)
+      .def_property_readonly("flagged", &JointStiffnessResult::flagged);
+  m.def("identify_joint_stiffness", [](const std::shared_ptr<dynamics::RobotModel>& model,
+                                       const std::vector<LoadCase>& cases, double tracker_noise_m,
+                                       const std::string& loss, double loss_scale, double outlier_false_alarm,
+                                       double weak_relative_std, int max_iterations) {
+    identification::IdentificationOptions o;
+    o.tracker_noise = tracker_noise_m;
+    if (loss == "none" || loss.empty()) {
+      o.loss = identification::RobustLoss::kNone;
+    } else if (loss == "huber") {
+      o.loss = identification::RobustLoss::kHuber;
+    } else if (loss == "cauchy") {
+      o.loss = identification::RobustLoss::kCauchy;
+    } else {
+      throw std::invalid_argument("loss '" + loss + "': expected 'none', 'huber' or 'cauchy'");
+    }
+    o.loss_scale = loss_scale;
+    o.outlier_false_alarm = outlier_false_alarm;
+    o.weak_relative_std = weak_relative_std;
+    o.max_iterations = max_iterations;
+    identification::CheckValid(o);
+    py::gil_scoped_release release;
+    return identification::IdentifyJointStiffness(*model, cases, o);
+  }, py::arg("model"), py::arg("cases"), py::arg("tracker_noise_m") = 1e-5, py::arg("loss") = "none",
+     py::arg("loss_scale") = 3.0, py::arg("outlier_false_alarm") = 0.01, py::arg("weak_relative_std") = 0.1,
+     py::arg("max_iterations") = 100,
+     "Identifies the diagonal joint stiffness [N·m/rad] from load cases (kq-identify's library "
+     "call); the model's stiffness is the prior. tracker_noise_m: 1 sigma per measured coordinate "
+     "[m]; loss: 'none', 'huber', 'cauchy'. Numerical trouble is a status in the result. Releases "
+     "the GIL.");
+}
+
+}  // namespace robomach::python

@@ -1,0 +1,237 @@
+// Measured FRFs (dynamics/measured_frf.h), their files (io/frf_files.h: the
+// long CSV of docs/formats.md §3 and UFF58) and the noise model
+// (calibration/frf_noise.h).
+#include <optional>
+
+#include "bindings.h"
+#include "robomach/calibration/frf_noise.h"
+#include "robomach/dynamics/measured_frf.h"
+#include "robomach/io/frf_files.h"
+
+namespace robomach::python {
+namespace {
+
+using calibration::FrfNoise;
+using calibration::NoiseOptions;
+using dynamics::Frf;
+using dynamics::FrfKey;
+using dynamics::FrfSet;
+
+// Python spells an FRF key as a tuple (pose_id, response, excitation), e.g.
+// ("P1", "x", "x") for the direct FRF Hxx of posture P1.
+using KeyTuple = std::tuple<std::string, std::string, std::string>;
+FrfKey ToKey(const KeyTuple& t) {
+  return {std::get<0>(t), ParseAxis(std::get<1>(t)), ParseAxis(std::get<2>(t))};
+}
+KeyTuple FromKey(const FrfKey& k) { return {k.pose_id, AxisString(k.response), AxisString(k.excitation)}; }
+
+py::dict ReadResultDict(const io::FrfReadResult& r) {
+  py::dict d;
+  d["frfs"] = r.frfs;
+  d["quantity"] = io::QuantityName(r.file_quantity);
+  d["averages"] = r.averages;
+  d["warnings"] = r.warnings;
+  d["notes"] = r.notes;
+  return d;
+}
+
+constexpr char kReadResultDoc[] =
+    " Returns a dict: frfs (FrfSet, receptance [m/N]; mobility and accelerance are converted), "
+    "quantity (the file's: 'receptance', 'mobility', 'accelerance'), averages (from '# averages: "
+    "N', 0 if absent), warnings and notes (lists of 'path:line: ...' strings the tools print). "
+    "FileNotFoundError for a missing file, InputError (path:line:col) for bad content. Releases "
+    "the GIL.";
+
+NoiseOptions MakeNoiseOptions(double min_snr, int averages, bool use_coherence, double knots_per_octave,
+                              int max_gap_lines, int min_run_lines, bool refine_with_modal_fit, bool wide_floor) {
+  NoiseOptions o;
+  o.min_snr = min_snr;
+  o.averages = averages;
+  o.use_coherence = use_coherence;
+  o.knots_per_octave = knots_per_octave;
+  o.max_gap_lines = max_gap_lines;
+  o.min_run_lines = min_run_lines;
+  o.refine_with_modal_fit = refine_with_modal_fit;
+  o.wide_floor = wide_floor;
+  calibration::CheckValid(o);
+  return o;
+}
+
+}  // namespace
+
+void BindFrf(py::module_& m) {
+  py::class_<Frf>(m, "Frf",
+                  "One tool-tip FRF: receptance H(f) [m/N] in the base frame B on a strictly increasing "
+                  "frequency grid [Hz], with optional coherence [-] and noise sigma [m/N]. Immutable.")
+      .def(py::init([](Eigen::VectorXd f, Eigen::VectorXcd h, std::optional<Eigen::VectorXd> coherence) {
+             return Frf::FromSamples(std::move(f), std::move(h), std::move(coherence));
+           }),
+           py::arg("freq_hz"), py::arg("receptance"), py::arg("coherence") = py::none(),
+           "freq_hz [Hz] finite, >= 0, strictly increasing; receptance [m/N] complex, finite, same "
+           "length; coherence in [0, 1]. ValueError naming the first bad line.")
+      .def_property_readonly("freq_hz", [](const Frf& f) { return Eigen::VectorXd(f.freq_hz()); }, "[Hz]")
+      .def_property_readonly("receptance", [](const Frf& f) { return Eigen::VectorXcd(f.receptance()); }, "[m/N]")
+      .def_property_readonly("coherence", [](const Frf& f) { return f.coherence(); }, "[-] or None")
+      .def_property_readonly("noise_sigma", [](const Frf& f) { return f.noise_sigma(); },
+                             "per-line noise sigma [m/N] (E|H_measured - H_true|^2 = sigma^2) or None")
+      .def("with_noise", &Frf::WithNoise, py::arg("sigma_m_per_N"), "A copy with the per-line noise sigma [m/N].")
+      .def("band", &Frf::Band, py::arg("fmin_hz"), py::arg("fmax_hz"), "The lines with f in [fmin_hz, fmax_hz].")
+      .def("select", &Frf::Select, py::arg("lines"), "A copy of the given 0-based lines (strictly increasing).")
+      .def_property_readonly("evenly_spaced", &Frf::evenly_spaced)
+      .def("__len__", &Frf::size)
+      .def("__repr__", [](const Frf& f) { return "<Frf " + std::to_string(f.size()) + " lines>"; });
+
+  py::class_<FrfSet>(m, "FrfSet",
+                     "The FRFs of one test campaign, keyed by (pose_id, response, excitation), directions "
+                     "'x', 'y', 'z' in the base frame B; iterates over keys in order (posture id, "
+                     "response, excitation).")
+      .def(py::init<>())
+      .def("__len__", &FrfSet::size)
+      .def("__contains__", [](const FrfSet& s, const KeyTuple& k) { return s.contains(ToKey(k)); })
+      .def("__getitem__", [](const FrfSet& s, const KeyTuple& k) {
+        const FrfKey key = ToKey(k);
+        if (!s.contains(key)) throw py::key_error("no FRF for " + key.ToString());
+        return s.at(key);
+      })
+      .def("__setitem__", [](FrfSet& s, const KeyTuple& k, const Frf& f) { s.Insert(ToKey(k), f); },
+           "Inserts an FRF; ValueError if the key is already there.")
+      .def("keys", [](const FrfSet& s) {
+        std::vector<KeyTuple> k;
+        for (const auto& key : s.keys()) k.push_back(FromKey(key));
+        return k;
+      })
+      .def("items", [](const FrfSet& s) {
+        std::vector<std::pair<KeyTuple, Frf>> out;
+        for (const auto& [k, f] : s) out.emplace_back(FromKey(k), f);
+        return out;
+      })
+      .def("__iter__", [](const FrfSet& s) {
+        std::vector<KeyTuple> k;
+        for (const auto& key : s.keys()) k.push_back(FromKey(key));
+        return py::iter(py::cast(k));
+      })
+      .def("pose_ids", &FrfSet::pose_ids)
+      .def("for_pose", &FrfSet::ForPose, py::arg("pose_id"))
+      .def("merge", [](FrfSet& s, const FrfSet& o) { s.Merge(o); }, py::arg("other"),
+           "Adds all FRFs of other; ValueError on a duplicate key.")
+      .def("__repr__", [](const FrfSet& s) { return "<FrfSet " + std::to_string(s.size()) + " FRFs>"; });
+
+  m.def("read_frf_csv", [](const std::string& path) {
+    RequireReadableFile(path);
+    io::FrfReadResult r;
+    {
+      py::gil_scoped_release release;
+      r = io::ReadFrfCsv(path);
+    }
+    return ReadResultDict(r);
+  }, py::arg("path"), (std::string("Reads a measured-FRF CSV (docs/formats.md §3).") + kReadResultDoc).c_str());
+  m.def("read_uff58", [](const std::string& path, const std::string& default_pose_id) {
+    RequireReadableFile(path);
+    io::FrfReadResult r;
+    {
+      py::gil_scoped_release release;
+      r = io::ReadUff58(path, default_pose_id);
+    }
+    return ReadResultDict(r);
+  }, py::arg("path"), py::arg("default_pose_id") = "",
+     (std::string("Reads the FRFs of a Universal File Format file (dataset 58/58b; 164 units). "
+                  "default_pose_id is the posture of records without 'pose=ID' (the tools' --pose ID=file.uff).") +
+      kReadResultDoc).c_str());
+  m.def("read_frf_file", [](const std::string& path, const std::string& default_pose_id) {
+    RequireReadableFile(path);
+    io::FrfReadResult r;
+    {
+      py::gil_scoped_release release;
+      r = io::ReadFrfFile(path, default_pose_id);
+    }
+    return ReadResultDict(r);
+  }, py::arg("path"), py::arg("default_pose_id") = "",
+     (std::string("Reads a measured-FRF file: UFF58 by extension (.uff .unv .uf .ufb) or content, else CSV.") +
+      kReadResultDoc).c_str());
+  m.def("write_frf_csv", [](const std::string& path, const FrfSet& frfs, const std::string& quantity, int averages) {
+    const io::FrfQuantity q = io::ParseQuantity(quantity);
+    py::gil_scoped_release release;
+    io::WriteFrfCsv(path, frfs, q, averages);
+  }, py::arg("path"), py::arg("frfs"), py::arg("quantity") = "receptance", py::arg("averages") = 0,
+     "Writes FRFs (receptance [m/N] in the set) as the CSV of docs/formats.md §3 in `quantity` "
+     "('receptance' [m/N], 'mobility' [(m/s)/N], 'accelerance' [(m/s^2)/N]), with coherence if "
+     "every FRF has one and '# averages: N' if averages > 0. Numbers read back exactly. Atomic; "
+     "OutputError if it cannot be written.");
+  m.def("write_uff58", [](const std::string& path, const FrfSet& frfs, const std::string& quantity) {
+    const io::FrfQuantity q = io::ParseQuantity(quantity);
+    py::gil_scoped_release release;
+    io::WriteUff58(path, frfs, q);
+  }, py::arg("path"), py::arg("frfs"), py::arg("quantity") = "receptance",
+     "Writes one ASCII dataset 58 record per FRF (4E20.12, 13 significant digits; the abscissa in "
+     "E13.5 keeps 6 digits of f_min and df), 'pose=ID' in ID line 1, a coherence record where "
+     "present. Atomic.");
+  m.def("round_to_uff_precision", &io::RoundToUffPrecision, py::arg("value"),
+        "Rounds to 13 significant digits, the precision of UFF58's E20.12 field.");
+
+  py::class_<NoiseOptions>(m, "NoiseOptions", "Options of the FRF noise model (calibration/frf_noise.h).")
+      .def(py::init(&MakeNoiseOptions), py::arg("min_snr") = 3.0, py::arg("averages") = 0,
+           py::arg("use_coherence") = true, py::arg("knots_per_octave") = 1.0, py::arg("max_gap_lines") = 3,
+           py::arg("min_run_lines") = 8, py::arg("refine_with_modal_fit") = true, py::arg("wide_floor") = false,
+           "min_snr: a line is usable where |H|/floor reaches it; averages: number of averages "
+           "behind the coherence (0 = unknown: the scatter is used); wide_floor: also take the "
+           "floor from wide second differences (integrated-accelerometer drift). ValueError naming "
+           "the field for a bad value.")
+      .def_readonly("min_snr", &NoiseOptions::min_snr)
+      .def_readonly("averages", &NoiseOptions::averages)
+      .def_readonly("use_coherence", &NoiseOptions::use_coherence)
+      .def_readonly("knots_per_octave", &NoiseOptions::knots_per_octave)
+      .def_readonly("max_gap_lines", &NoiseOptions::max_gap_lines)
+      .def_readonly("min_run_lines", &NoiseOptions::min_run_lines)
+      .def_readonly("refine_with_modal_fit", &NoiseOptions::refine_with_modal_fit)
+      .def_readonly("wide_floor", &NoiseOptions::wide_floor);
+
+  py::class_<FrfNoise>(m, "FrfNoise",
+                       "The noise model of one FRF, sigma(f)^2 = (rel |H|)^2 + floor(f)^2 [m/N]^2, per line.")
+      .def_property_readonly("source", [](const FrfNoise& n) { return calibration::NoiseSourceName(n.source); },
+                             "'coherence' or 'scatter'")
+      .def_readonly("averages", &FrfNoise::averages)
+      .def_readonly("relative", &FrfNoise::relative, "rel [-]")
+      .def_readonly("floor_m_per_N", &FrfNoise::floor_m_per_N, "additive floor per line [m/N]")
+      .def_readonly("sigma_m_per_N", &FrfNoise::sigma_m_per_N, "sigma per line [m/N]")
+      .def_readonly("snr", &FrfNoise::snr, "|H| (5-line running median) / floor, per line [-]")
+      .def_property_readonly("usable", [](const FrfNoise& n) {
+        Eigen::Array<bool, Eigen::Dynamic, 1> u(n.usable.size());
+        for (size_t i = 0; i < n.usable.size(); ++i) u(i) = n.usable[i] != 0;
+        return u;
+      }, "bool per line")
+      .def_readonly("usable_bands", &FrfNoise::usable_bands, "list of (f_lo_hz, f_hi_hz)")
+      .def_readonly("usable_lines", &FrfNoise::usable_lines)
+      .def_readonly("iterations", &FrfNoise::iterations)
+      .def_readonly("converged", &FrfNoise::converged)
+      .def_readonly("modal_refined", &FrfNoise::modal_refined)
+      .def_readonly("description", &FrfNoise::description)
+      .def("describe_usable", [](const FrfNoise& n) { return calibration::DescribeUsable(n); })
+      .def("__repr__", [](const FrfNoise& n) { return "<FrfNoise " + n.description + ">"; });
+
+  m.def("estimate_frf_noise", [](const Frf& frf, const std::optional<NoiseOptions>& options) {
+    py::gil_scoped_release release;
+    return calibration::EstimateFrfNoise(frf, options.value_or(NoiseOptions{}));
+  }, py::arg("frf"), py::arg("options") = py::none(),
+     "The noise model of one FRF: from the coherence when it has one and options.averages is known, "
+     "else from the scatter of the data. ValueError for fewer than 8 lines. Releases the GIL.");
+  m.def("estimate_noise", [](const FrfSet& frfs, const std::optional<NoiseOptions>& options) {
+    calibration::NoiseModels n;
+    {
+      py::gil_scoped_release release;
+      n = calibration::EstimateNoise(frfs, options.value_or(NoiseOptions{}));
+    }
+    std::map<KeyTuple, FrfNoise> out;
+    for (auto& [k, v] : n) out.emplace(FromKey(k), std::move(v));
+    return out;
+  }, py::arg("frfs"), py::arg("options") = py::none(),
+     "estimate_frf_noise for every FRF: {(pose_id, response, excitation): FrfNoise}.");
+  m.def("usable_data", [](const FrfSet& frfs, const std::map<KeyTuple, FrfNoise>& noise) {
+    calibration::NoiseModels n;
+    for (const auto& [k, v] : noise) n.emplace(ToKey(k), v);
+    return calibration::UsableData(frfs, n);
+  }, py::arg("frfs"), py::arg("noise"),
+     "The usable lines of every FRF with their sigma attached: what the calibration fits. FRFs "
+     "with no usable line are left out; ValueError if an FRF has no noise model.");
+}
+
+}  // namespace robomach::python

@@ -1,0 +1,36 @@
+// Shared by the binding files of the Python module (python/CMakeLists.txt).
+#pragma once
+
+#include <complex>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <pybind11/complex.h>
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "robomach/common/frames.h"
+
+namespace robomach::python {
+
+namespace py = pybind11;
+
+void BindDynamics(py::module_& m);
+void BindFrf(py::module_& m);
+void BindCalibration(py::module_& m);
+
+/// Receptance matrices per line -> complex128 array of shape (lines, 3, 3).
+py::array_t<std::complex<double>> ToArray(const std::vector<Eigen::Matrix3cd>& h);
+
+/// 'x', 'y', 'z' <-> Axis; @throws std::invalid_argument for anything else.
+Axis ParseAxis(const std::string& name);
+std::string AxisString(Axis a);
+
+/// Raises FileNotFoundError ("path: no such file", as the tools' exit 66)
+/// unless `path` is a readable regular file.
+void RequireReadableFile(const std::string& path);
+
+}  // namespace robomach::python

@@ -1,0 +1,110 @@
+"""Calibration against hammer FRFs and joint-stiffness identification from a
+load test. References: the frf-calibrate and kq-identify tools' summary
+JSON on the same inputs (the C++ tools), and the true values behind the
+data, which other code made (frf-synth's hammer data from a model with m6
++10 % and d6 -5 %; tests/data/tracker_campaign.csv from tracker-synth, its
+truth in the header)."""
+import json
+import os
+import re
+
+import numpy as np
+import pytest
+
+import robomach as rm
+from conftest import DATA, KR210, run_tool
+
+POSTURES = os.path.join(DATA, 'calibration', 'postures_two.csv')
+TRUTH = {'m6_kg': 31.955, 'd6_m': 0.5225, 'kq3_Nm_per_rad': 4.2895e6}
+FREE = ['kq3_Nm_per_rad', 'm6_kg', 'd6_m']
+# The same library calls on the same data (Ceres single-threaded, central
+# numeric differences): the tool and Python agree to round-off; 1e-10 of the
+# value leaves room for a different instruction selection (FMA) only.
+REL = 1e-10
+
+
+@pytest.fixture(scope='module')
+def hammer(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp('calibration')
+    run_tool('frf-synth', '--robot', KR210, '--postures', POSTURES, '--out', tmp / 'hammer.csv',
+             '--set', f'm6_kg={TRUTH["m6_kg"]}', '--set', f'd6_m={TRUTH["d6_m"]}', '--noise-rel', '0.01',
+             '--seed', '5', '--coherence')
+    args = ['--robot', KR210, '--postures', POSTURES, '--measured', tmp / 'hammer.csv', '--only-free']
+    for f in FREE:
+        args += ['--free', f]
+    run_tool('frf-calibrate', *args, '--out', tmp / 'cal.yaml', '--report', tmp / 'report')
+    return tmp, json.loads((tmp / 'report' / 'summary.json').read_text())
+
+
+def test_calibrate_equals_frf_calibrate_and_finds_the_truth(hammer):
+    tmp, summary = hammer
+    cfg = rm.RobotConfig(KR210)
+    postures = {p.id: p.q for p in rm.read_posture_file(POSTURES, cfg.num_joints)}
+    read = rm.read_frf_csv(str(tmp / 'hammer.csv'))
+    noise = rm.estimate_noise(read['frfs'], rm.NoiseOptions(averages=read['averages']))
+    data = rm.usable_data(read['frfs'], noise)
+    result = rm.calibrate(cfg, postures, data, free_parameters=FREE)
+
+    assert result.status == summary['status'] == 'converged'
+    tool = {p['name']: p for p in summary['parameters']}
+    assert [e.name for e in result.estimates] == FREE
+    for e in result.estimates:
+        assert e.value == pytest.approx(tool[e.name]['value'], rel=REL)
+        # The covariance is a product of numeric derivatives (central
+        # differences): it repeats less tightly than the values, 1e-6.
+        assert e.std_dev == pytest.approx(tool[e.name]['std_dev'], rel=1e-6)
+        assert e.unit == tool[e.name]['unit'] and e.stage == tool[e.name]['stage']
+        # The truth within 3 sigma (0.3 % false alarm per parameter; the data's seed is fixed).
+        assert abs(e.value - TRUTH[e.name]) < 3 * e.std_dev, e
+    # A sum over 8000 residual pairs at parameters equal to REL: 1e-9.
+    assert result.misfit_final == pytest.approx(summary['misfit']['calibrated'], rel=1e-9)
+    assert result.misfit_final < result.misfit_start
+    assert result.parameters['m6_kg'] == result.estimates[1].value
+    # The calibrated config written by the tool reads back with the same values.
+    written = rm.RobotConfig(str(tmp / 'cal.yaml'))
+    for name in FREE:
+        assert written.get(name) == pytest.approx(result.parameters[name], rel=REL)
+
+
+def test_calibrate_rejects_unknown_parameters_and_postures(hammer):
+    tmp, _ = hammer
+    cfg = rm.RobotConfig(KR210)
+    frfs = rm.read_frf_csv(str(tmp / 'hammer.csv'))['frfs']
+    postures = {p.id: p.q for p in rm.read_posture_file(POSTURES, 6)}
+    with pytest.raises(ValueError, match='m7_kg'):
+        rm.calibrate(cfg, postures, frfs, free_parameters=['m7_kg'])
+    with pytest.raises(ValueError):
+        rm.calibrate(cfg, {'P1': postures['P1']}, frfs)  # P2 measured, not given
+    with pytest.raises(ValueError, match="objective"):
+        rm.calibrate(cfg, postures, frfs, objective='best')
+
+
+def test_identify_joint_stiffness_equals_kq_identify(tmp):
+    tracker = os.path.join(DATA, 'tracker_campaign.csv')
+    run_tool('kq-identify', '--robot', KR210, '--tracker', tracker, '--summary', tmp / 'kq.json',
+             '--out', tmp / 'kq.yaml', expect_rc=3)  # 3: joint 6 weakly determined
+    tool = json.loads((tmp / 'kq.json').read_text())
+
+    model = rm.RobotConfig(KR210).build()
+    cases = rm.read_tracker_file(tracker, model.num_joints)
+    r = rm.identify_joint_stiffness(model, cases, tracker_noise_m=1e-5)  # the tool's --noise-mm 0.01
+
+    assert r.status == tool['status'] == 'converged' and r.num_cases == tool['num_cases'] == len(cases)
+    np.testing.assert_allclose(r.joint_stiffness, tool['joint_stiffness_Nm_per_rad'], rtol=REL)
+    np.testing.assert_allclose(r.std_dev, tool['std_dev_Nm_per_rad'], rtol=1e-9)  # covariance: 1e-9
+    assert r.determination == tool['determination']
+    assert r.advice == tool['advice'] and r.flagged
+    # The truth of the synthetic campaign (its header, written by tracker-synth) within 3 sigma.
+    truth = [float(re.search(rf'truth_kq{j}_Nm_per_rad: ([0-9.e+]+)', open(tracker).read()).group(1))
+             for j in range(1, 7)]
+    assert np.all(np.abs(r.joint_stiffness - truth) < 3 * r.std_dev)
+
+
+def test_load_case_from_python_and_bad_options():
+    model = rm.RobotConfig(KR210).build()
+    c = rm.LoadCase('C1', np.radians([0, -90, 90, 0, 45, 0]), np.array([0, 0, -500.0]), np.zeros(3))
+    assert c.p_load_tip_m is None and c.force_N[2] == -500.0
+    with pytest.raises(ValueError, match="loss 'lts'"):
+        rm.identify_joint_stiffness(model, [c], loss='lts')
+    with pytest.raises(ValueError):
+        rm.identify_joint_stiffness(model, [])

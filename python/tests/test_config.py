@@ -1,0 +1,85 @@
+"""Robot configs: load, --add and --set equivalents, errors. Reference: the
+frf-predict tool's --summary JSON for the same config, adds and sets (the
+parameters it used), and its stderr for a bad config (the same message)."""
+import json
+import os
+
+import pytest
+
+import robomach as rm
+from conftest import KR210, run_tool
+
+
+def write_posture(path):
+    path.write_text('pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\nP1,0,-90,90,0,45,0\n')
+    return path
+
+
+def test_parameters_equal_the_tools_after_add_and_set(tmp):
+    cfg = rm.RobotConfig(KR210, add=['tip_mass'], set={'m6_kg': 31.5, 'tip_mass.mass_kg': 0.25})
+    postures = write_posture(tmp / 'p.csv')
+    run_tool('frf-predict', '--robot', KR210, '--postures', postures, '--out', tmp / 'h.csv',
+             '--summary', tmp / 's.json', '--add', 'tip_mass', '--set', 'm6_kg=31.5',
+             '--set', 'tip_mass.mass_kg=0.25', '--fmax-hz', '2')
+    tool = json.loads((tmp / 's.json').read_text())['parameters']
+    assert cfg.parameters == tool  # exact: both are the library's doubles, JSON keeps 17 digits
+    assert cfg.build().parameters == tool
+    assert 'tip_mass' in cfg.effects and 'tip_mass' in cfg.build().effects
+
+
+def test_add_effect_then_set_is_the_same_as_the_constructor():
+    a = rm.RobotConfig(KR210)
+    a.add_effect('tip_mass')
+    a.set('tip_mass.mass_kg', 0.25)
+    a.set('m6_kg', 31.5)
+    b = rm.load_robot_config(KR210, add=['tip_mass'], set={'m6_kg': 31.5, 'tip_mass.mass_kg': 0.25})
+    assert a.parameters == b.parameters
+    assert a.get('m6_kg') == 31.5
+
+
+def test_add_keeps_values_already_set():
+    cfg = rm.RobotConfig(KR210)
+    cfg.set('m6_kg', 30.0)
+    cfg.add_effect('tip_mass')
+    assert cfg.get('m6_kg') == 30.0
+    spec = {s.name: s for s in cfg.parameter_specs}['tip_mass.mass_kg']
+    assert cfg.get('tip_mass.mass_kg') == spec.default_value
+    assert spec.unit == 'kg'
+
+
+def test_unknown_effect_and_parameter_raise_value_error_with_the_librarys_message():
+    cfg = rm.RobotConfig(KR210)
+    before = cfg.parameters
+    with pytest.raises(ValueError, match="unknown effect 'no_such_effect'"):
+        cfg.add_effect('no_such_effect')
+    assert cfg.parameters == before and cfg.effects == rm.RobotConfig(KR210).effects  # unchanged
+    with pytest.raises(ValueError, match="unknown parameter 'm7_kg'"):
+        cfg.set('m7_kg', 1.0)
+    with pytest.raises(ValueError, match='m6_kg'):
+        cfg.set('m6_kg', -1.0)  # below the lower bound
+    assert set(rm.available_effects()) >= {'tip_mass'}
+
+
+def test_missing_file_is_file_not_found():
+    with pytest.raises(FileNotFoundError, match='no such file'):
+        rm.RobotConfig('/nonexistent/robot.yaml')
+
+
+def test_bad_config_raises_input_error_with_the_tools_message(tmp):
+    text = open(KR210).read().replace('  alpha_s: 1.0e-4', '  alpha_s: fast', 1)
+    assert 'alpha_s: fast' in text
+    bad = tmp / 'bad.yaml'
+    bad.write_text(text)
+    # Relative paths (the URDF) resolve from the config's folder: copy what it names.
+    src_dir = os.path.dirname(KR210)
+    for name in os.listdir(src_dir):
+        if name.endswith('.urdf'):
+            (tmp / name).write_text(open(os.path.join(src_dir, name)).read())
+    with pytest.raises(rm.InputError) as e:
+        rm.RobotConfig(str(bad))
+    err = e.value
+    assert isinstance(err, ValueError)
+    assert err.path == str(bad) and err.line > 0
+    assert str(err).startswith(f'{bad}:{err.line}')
+    r = run_tool('frf-predict', '--robot', bad, '--postures', write_posture(tmp / 'p.csv'), expect_rc=65)
+    assert str(err) in r.stderr

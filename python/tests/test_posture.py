@@ -1,0 +1,110 @@
+"""Posture evaluation: the matrices and modes returned as NumPy arrays.
+References: frf-predict's --summary JSON and --modes table at the same
+postures (the C++ tool's output), and analytic identities checked with
+NumPy's own linear algebra (generalised eigenproblem, static compliance)."""
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import robomach as rm
+from conftest import KR210, run_tool
+
+# Same library code on the same inputs (the postures are read by the same
+# reader); JSON and the CSV keep 17 significant digits, so agreement is
+# exact up to instruction selection (FMA contraction): 1e-12 relative.
+REL = 1e-12
+
+POSTURES = 'pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\nP1,0,-90,90,0,45,0\nP2,30,-60,100,20,-50,70\n'
+
+
+def close(a, b, rel=REL):
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    assert a.shape == b.shape
+    scale = np.max(np.abs(b))
+    np.testing.assert_allclose(a, b, rtol=0, atol=rel * scale)
+
+
+@pytest.fixture(scope='module')
+def tool_run(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp('posture')
+    (tmp / 'p.csv').write_text(POSTURES)
+    run_tool('frf-predict', '--robot', KR210, '--postures', tmp / 'p.csv', '--out', tmp / 'h.csv',
+             '--summary', tmp / 's.json', '--modes', tmp / 'modes.csv', '--fmax-hz', '2')
+    summary = json.loads((tmp / 's.json').read_text())
+    with open(tmp / 'modes.csv') as f:
+        modes = list(csv.DictReader(f))
+    return tmp, summary, modes
+
+
+def test_matrices_equal_the_tools_summary(tool_run):
+    tmp, summary, _ = tool_run
+    model = rm.RobotConfig(KR210).build()
+    ev = rm.PostureEvaluator(model)
+    for pose, ref in zip(rm.read_posture_file(str(tmp / 'p.csv'), model.num_joints), summary['postures']):
+        d = ev.evaluate(pose.q)
+        assert ref['pose_id'] == pose.id
+        for name in ('M_q', 'K_q', 'C_q'):
+            close(getattr(d, name), ref[name])
+        close(d.J, ref['J_BT'])
+        close(d.X_BT[:3, 3], ref['tcp_position_m'])
+        close(d.X_BT[:3, :3], ref['tcp_rotation'])
+        close(d.static_compliance, ref['static_compliance_m_per_N'])
+        for name in ('M_X', 'K_X', 'C_X'):
+            close(getattr(d, name), ref['cartesian'][name])
+        assert d.jacobian_condition == pytest.approx(ref['jacobian_condition'], rel=REL)
+        assert len(d.modes) == len(ref['modes'])
+        close(d.freq_hz, [m['freq_hz'] for m in ref['modes']])
+        close(d.damping_ratio, [m['damping_ratio'] for m in ref['modes']])
+        close(d.modal_mass_kg, [m['modal_mass_kg'] for m in ref['modes']])
+        close(d.shapes_T, [m['shape_T'] for m in ref['modes']])
+
+
+def test_modes_equal_the_tools_modal_table(tool_run):
+    tmp, _, rows = tool_run
+    model = rm.RobotConfig(KR210).build()
+    for pose in rm.read_posture_file(str(tmp / 'p.csv'), 6):
+        d = model.evaluate(pose.q)
+        mine = [r for r in rows if r['pose_id'] == pose.id]
+        close(d.freq_hz, [float(r['freq_hz']) for r in mine])
+        close(d.modal_mass_kg, [float(r['modal_mass_kg']) for r in mine])
+        close(d.shapes_T, [[float(r['ux']), float(r['uy']), float(r['uz'])] for r in mine])
+
+
+def test_modes_solve_the_generalised_eigenproblem():
+    d = rm.RobotConfig(KR210, add=['tip_mass']).build().evaluate(np.radians([10, -70, 95, 15, 40, -30]))
+    M, K, phi = d.M, d.K, d.phi
+    assert M.shape == (d.M.shape[0],) * 2 and phi.shape == (M.shape[0], len(d.modes))
+    w2 = (2 * np.pi * d.freq_hz) ** 2
+    # Mass normalisation and K phi = w^2 M phi; 1e-9: the eigensolver's
+    # residual on matrices whose entries span ~10 decades (kg·m² to N·m/rad).
+    np.testing.assert_allclose(phi.T @ M @ phi, np.eye(len(w2)), atol=1e-9)
+    np.testing.assert_allclose(phi.T @ K @ phi, np.diag(w2), rtol=0, atol=1e-9 * w2.max())
+    # NumPy's own eigenvalues of M^-1 K; relative 1e-9 (conditioning of M^-1 K).
+    ref = np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)
+    np.testing.assert_allclose(w2, ref, rtol=1e-9)
+    # Static compliance B K^-1 B^T (NumPy's LU against the library's LDLT:
+    # 1e-9, the conditioning of K); Rayleigh damping C = alpha K + beta M
+    # (two products and a sum: 1e-12 of the largest entry).
+    np.testing.assert_allclose(d.static_compliance, d.B @ np.linalg.solve(K, d.B.T), rtol=1e-9,
+                               atol=1e-12 * np.abs(d.static_compliance).max())
+    p = rm.RobotConfig(KR210).parameters
+    np.testing.assert_allclose(d.C - d.C_extra, p['alpha_s'] * K + p['beta_per_s'] * M, rtol=1e-12,
+                               atol=1e-12 * np.abs(d.C).max())
+
+
+def test_options_and_errors():
+    model = rm.RobotConfig(KR210).build()
+    ev = rm.PostureEvaluator(model)
+    d = ev.evaluate(np.zeros(6) + 0.3, cartesian=False, modes=False)
+    assert np.isnan(d.M_X).all() and d.modes == [] and d.freq_hz.shape == (0,)
+    with pytest.raises(ValueError):
+        ev.evaluate(np.zeros(5))
+    with pytest.raises(ValueError):
+        ev.evaluate(np.array([0, 0, np.nan, 0, 0, 0.0]))
+    # Without the real modes, 'modal' superposes the complex modes: the
+    # same receptance to round-off of the two decompositions (1e-9 of |H|).
+    f = np.array([5.0, 10.5, 40.0])
+    h0, h1 = d.receptance(f), ev.evaluate(d.q).receptance(f)
+    assert np.abs(h0 - h1).max() <= 1e-9 * np.abs(h1).max()
