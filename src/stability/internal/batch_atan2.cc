@@ -10,7 +10,7 @@ extern "C" __m128d _ZGVbN2vv_atan2(__m128d y, __m128d x);
 #if defined(__GNUC__) && defined(__x86_64__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"  // the AVX2 ABI is used only inside the target("avx2") function below
-extern "C" __m256d _ZGVdN4vv_atan2(__m256d y, __m256d x);
+extern "C" __attribute__((target("avx2"))) __m256d _ZGVdN4vv_atan2(__m256d y, __m256d x);
 #pragma GCC diagnostic pop
 #define ROBOMACH_ATAN2_AVX2 1
 #endif
