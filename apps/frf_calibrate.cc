@@ -109,6 +109,7 @@ int Run(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   return RunGuarded(kTool, [&]() -> int {
+    RequireFolderOption("--report", report_dir);
     RequireReadableFile(robot_path, "robot config");
     RequireReadableFile(postures_path, "posture file");
     CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
@@ -161,7 +162,6 @@ int Run(int argc, char** argv) {
         }
       }
     }
-    if (measured_read.frfs.empty()) throw std::invalid_argument("no measured FRFs were read");
     // The noise of every FRF, and the lines every fit uses (issue #10).
     const calibration::NoiseModels noise = EstimateNoiseModels(kTool, measured_read, noise_opt);
     const dynamics::FrfSet measured = FitData(measured_read, noise);

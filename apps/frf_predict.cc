@@ -105,6 +105,7 @@ int Run(int argc, char** argv) {
   }
 
   return RunGuarded(kTool, [&]() -> int {
+    RequireFolderOption("--plot-dir", plot_dir);
     RequireReadableFile(robot_path, "robot config");
     RequireReadableFile(postures_path, "posture file");
     if (!freq_file.empty()) RequireReadableFile(freq_file, "frequency file");

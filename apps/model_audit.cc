@@ -134,6 +134,8 @@ int Run(int argc, char** argv) {
         if (!seen.insert(a).second) throw std::invalid_argument("--add " + a + " is given twice");
       }
     }
+    RequireFolderOption("--report", report_dir);
+    RequireFolderOption("--compare", compare_dir);
     if (fs::exists(report_dir) && !fs::is_directory(report_dir)) {
       throw std::invalid_argument("--report " + report_dir + " exists and is not a folder");
     }
@@ -175,11 +177,15 @@ int Run(int argc, char** argv) {
                                                     " is not in this posture file");
       }
     }
-    if (measured_read.frfs.empty()) throw std::invalid_argument("no measured FRFs were read");
     // The noise of every FRF and the lines every fit and error uses (issue #10).
     const calibration::NoiseModels noise = EstimateNoiseModels(kTool, measured_read, noise_opt);
     const dynamics::FrfSet measured = FitData(measured_read, noise);
-    if (measured.empty()) throw std::invalid_argument("no measured FRFs were read");
+    if (measured.empty()) {
+      // Every FRF read, none with a usable line under the noise model.
+      const std::string first = measured_read.file.begin()->second;
+      throw InputError({first, 0, 0}, "no measured FRF has a usable line (the noise model found none above the "
+                                      "noise floor; see --min-snr and docs/noise-model.md)");
+    }
     {
       int lines = 0;
       for (const auto& [key, frf] : measured) lines += frf.Band(opt.fmin_hz, opt.fmax_hz).size();

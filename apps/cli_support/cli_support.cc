@@ -66,6 +66,12 @@ void CommitOutputsNow() {
   if (io::OutputRun* run = io::OutputRun::Active()) run->Commit();
 }
 
+void RequireFolderOption(const std::string& option, const std::string& path) {
+  if (path == "-") {
+    throw std::invalid_argument(option + " -: expected a folder; '-' (standard output) is for single-file outputs");
+  }
+}
+
 void RequireReadableFile(const std::string& path, const std::string& what) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -156,6 +162,25 @@ void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& 
       if (!outputs[j].second.empty() && key(outputs[j].second) == key(path)) {
         throw std::invalid_argument(opt + " and " + outputs[j].first + " name the same file " + path);
       }
+    }
+  }
+  // Writable before any work: the nearest existing ancestor of each output
+  // (its folder, or the first folder to be created) must be a folder we may
+  // write in. An existing output that is a folder is the output itself (a
+  // report folder), checked the same way.
+  for (const auto& [opt, path] : outputs) {
+    if (path.empty() || path == "-") continue;
+    std::error_code ec;
+    fs::path p = fs::absolute(fs::path(path), ec).lexically_normal();
+    if (ec) continue;
+    fs::path probe = fs::is_directory(p, ec) ? p : p.parent_path();
+    while (!probe.empty() && !fs::exists(probe, ec) && probe != probe.root_path()) probe = probe.parent_path();
+    if (probe.empty()) continue;
+    if (!fs::is_directory(probe, ec)) {
+      throw OutputError(opt + " " + path + ": cannot be written: " + probe.string() + " is not a folder");
+    }
+    if (::access(probe.c_str(), W_OK | X_OK) != 0) {
+      throw OutputError(opt + " " + path + ": cannot be written: the folder " + probe.string() + " is not writable");
     }
   }
 }

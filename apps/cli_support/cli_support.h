@@ -49,6 +49,10 @@ void CommitOutputsNow();
 
 /// @throws InputError "path: no such file" if `path` is not a readable file;
 /// RunGuarded maps it to 66.
+/// A folder option (--report, --plot-dir): "-" is standard output, which
+/// takes single files only. @throws std::invalid_argument (exit 64).
+void RequireFolderOption(const std::string& option, const std::string& path);
+
 void RequireReadableFile(const std::string& path, const std::string& what);
 
 /// A missing input file (exit 66).
@@ -97,6 +101,10 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
 /// Refuses an output path that is also an input or another output (a user
 /// typo that would silently destroy data). Empty paths are ignored; "-"
 /// means stdout. @throws std::invalid_argument naming both options.
+/// Then, before any work, checks that every output can be written: the
+/// nearest existing folder on its path must be a writable folder (a file in
+/// the way, a read-only folder). @throws OutputError (exit 73) naming the
+/// option, so a long run does not fail at its end.
 void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& inputs,
                         const std::vector<std::pair<std::string, std::string>>& outputs);
 

@@ -46,6 +46,23 @@ MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::s
     }
     add(a.substr(eq + 1), a.substr(0, eq));
   }
+  // Files were given and read, but none held an FRF (a UFF with only other
+  // datasets, a CSV with a header and no lines): bad input data, exit 65,
+  // not a command-line error.
+  if (all.frfs.empty() && !(files.empty() && pose_files.empty())) {
+    std::string names;
+    std::string first;
+    for (const std::string& f : files) {
+      names += (names.empty() ? "" : ", ") + f;
+      if (first.empty()) first = f;
+    }
+    for (const std::string& a : pose_files) {
+      const std::string f = a.substr(a.find('=') + 1);
+      names += (names.empty() ? "" : ", ") + f;
+      if (first.empty()) first = f;
+    }
+    throw InputError({first, 0, 0}, "no " + what + " holds an FRF (read: " + names + ")");
+  }
   return all;
 }
 

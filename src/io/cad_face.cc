@@ -461,9 +461,16 @@ std::vector<CadFaceRow> ListCadFaces(const std::string& path, const FaceCheck& c
       }
     } catch (const InputError& e) {
       row.reason = e.what();
-    } catch (const std::exception& e) {
+    } catch (const std::invalid_argument& e) {  // the surface's measures: a degenerate or non-finite face
       row.reason = e.what();
+    } catch (const std::domain_error& e) {
+      row.reason = e.what();
+    } catch (const NumericalError& e) {
+      row.reason = e.what();
+    } catch (const Standard_Failure& e) {
+      row.reason = std::string("OpenCASCADE: ") + e.GetMessageString();
     }
+    // Anything else (a bug, memory) propagates: it says nothing about the face.
     rows.push_back(row);
     if (progress) progress(i, n);
   }

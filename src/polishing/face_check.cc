@@ -1,5 +1,7 @@
 #include "robomach/polishing/face_check.h"
 
+#include "robomach/common/errors.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -109,9 +111,14 @@ Polishability CheckPolishable(const NurbsSurface& surface, const PolishingProces
       return p;
     }
     p.polishable = true;
-  } catch (const std::exception& e) {  // FaceTooNarrowError, a degenerate point, a size that is not finite
+  } catch (const std::invalid_argument& e) {  // FaceTooNarrowError, a size that is not finite
+    p.reason = e.what();
+  } catch (const std::domain_error& e) {  // a degenerate point (no normal, no tangent plane)
+    p.reason = e.what();
+  } catch (const NumericalError& e) {
     p.reason = e.what();
   }
+  // Anything else (a bug, memory) propagates: it says nothing about the face.
   return p;
 }
 
