@@ -199,7 +199,9 @@ ModeCouplingResult ModalSearch(const TipModalModel& modes, const Eigen::MatrixXd
   Matrix A = Matrix::Zero(2 * n, 2 * n);
   A.topRightCorner(n, n).diagonal() = w;
   A.bottomRightCorner(n, n).diagonal() = -2.0 * modes.zeta.cwiseProduct(w);
-  const Eigen::MatrixXd Kc_scaled = w.cwiseInverse().asDiagonal() * Kc_q;
+  using Half = Eigen::Matrix<double, Rows == Eigen::Dynamic ? Eigen::Dynamic : Rows / 2,
+                             Rows == Eigen::Dynamic ? Eigen::Dynamic : Rows / 2>;
+  const Half Kc_scaled = w.cwiseInverse().asDiagonal() * Kc_q;
   RightmostSolver<Rows> rightmost(2 * n);
   return SearchCriticalDepth(
       [&](double a) {
