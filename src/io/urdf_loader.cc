@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -130,6 +131,20 @@ kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string
       throw InputError(at, "not a valid URDF model: " + reason);
     }
   }
+  // urdfdom's links own their children (shared_ptr), and urdfdom accepts a
+  // joint cycle, which then owns itself and leaks (issue #22, fuzz_urdf).
+  // Everything needed is copied out of the model below, so the tree is taken
+  // apart on every way out of this function.
+  struct TreeBreaker {
+    const urdf::ModelInterfaceSharedPtr& model;
+    ~TreeBreaker() {
+      for (auto& [name, link] : model->links_) {
+        if (!link) continue;
+        link->child_links.clear();
+        link->child_joints.clear();
+      }
+    }
+  } tree_breaker{model};
   auto link_error = [&](const std::string& role, const std::string& name) {
     std::string names;
     for (const auto& [n, l] : model->links_) names += (names.empty() ? "" : ", ") + n;
@@ -141,7 +156,16 @@ kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string
 
   // Walk from the tip up to the base.
   std::vector<urdf::LinkConstSharedPtr> links;
+  std::set<std::string> seen;
   for (urdf::LinkConstSharedPtr l = model->getLink(tip_link); l; l = l->getParent()) {
+    // urdfdom accepts a joint whose parent is a descendant of its child (a
+    // cycle); walking up it never ended (issue #22, found by fuzz_urdf).
+    if (!seen.insert(l->name).second) {
+      const std::string joint = l->parent_joint ? l->parent_joint->name : "";
+      throw InputError({path, FindElementLine(xml, "joint", joint), 0},
+                       "link '" + l->name + "' is its own ancestor: the joints above tip link '" + tip_link +
+                           "' form a cycle (expected a tree; check the <parent link> of joint '" + joint + "')");
+    }
     links.push_back(l);
     if (l->name == base_link) break;
   }

@@ -13,7 +13,9 @@
 # sides agree on malloc/free).
 #
 # `run` fuzzes with -timeout=1 (an input slower than a second is a finding),
-# -rss_limit_mb=2048 and -max_total_time=<seconds>, under nice 19. The working
+# -rss_limit_mb=2048, -max_len=16384 (ROBOMACH_FUZZ_MAX_LEN; larger seeds are
+# used truncated: a 1 MB seed would make every mutation of it slow) and
+# -max_total_time=<seconds>, under nice 19. The working
 # corpus is $ROBOMACH_FUZZ_WORK/<name> (default /tmp/robomach-fuzz; outside
 # the repository); it starts from tests/fuzz/corpus/<name> and the target's
 # seeds (the project's own files, listed in build-fuzz/tests/fuzz/fuzz_<name>.seeds,
@@ -63,6 +65,7 @@ case "$1" in
     export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
     cd "$work"
     exec nice -n 19 "$exe" -max_total_time="$seconds" -timeout=1 -rss_limit_mb=2048 -print_final_stats=1 \
+      -max_len="${ROBOMACH_FUZZ_MAX_LEN:-16384}" \
       -artifact_prefix="$work/$name-artifacts/" "$@" "$work/$name" "$root/tests/fuzz/corpus/$name" "$work/$name-seeds"
     ;;
   *) usage ;;
