@@ -407,8 +407,10 @@ void ReadHeader(const std::string& path, const std::vector<std::pair<int, std::s
                                         std::to_string(v.size()) + " numbers");
   }
   for (int k = 0; k < 3; ++k) {
-    if (v[k] != std::floor(v[k])) {
-      throw InputError({path, l7, 0}, "record 7: field " + std::to_string(k + 1) + " must be an integer, got " +
+    // Bounded before any cast to an integer (1e121 here was UB; issue #22,
+    // found by fuzz_uff58).
+    if (v[k] != std::floor(v[k]) || std::abs(v[k]) > 2e9) {
+      throw InputError({path, l7, 0}, "record 7: field " + std::to_string(k + 1) + " must be an integer of at most 10 digits, got " +
                                           Trim(s7));
     }
   }

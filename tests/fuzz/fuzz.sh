@@ -63,6 +63,7 @@ case "$1" in
     while read -r seed; do [ -n "$seed" ] && cp "$seed" "$work/$name-seeds/"; done < "$build/tests/fuzz/fuzz_$name.seeds"
     export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:strict_string_checks=1}"
     export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+    export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$root/scripts/lsan.supp:print_suppressions=0}"
     cd "$work"
     exec nice -n 19 "$exe" -max_total_time="$seconds" -timeout=1 -rss_limit_mb=2048 -print_final_stats=1 \
       -max_len="${ROBOMACH_FUZZ_MAX_LEN:-16384}" \

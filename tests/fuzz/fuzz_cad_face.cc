@@ -42,7 +42,8 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
     robomach::io::ReadCadFace(robomach::fuzz::WriteInput(reinterpret_cast<const uint8_t*>(kNotIges),
                                                          sizeof(kNotIges) - 1, ".igs"),
                               0);
-  } catch (const robomach::InputError&) {
+  } catch (const robomach::InputError& e) {
+    robomach::fuzz::Rejected(e);
   }
 #if ROBOMACH_FUZZ_LSAN
   __lsan_enable();
@@ -58,7 +59,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     // Face 0 = the largest face: every face is converted once.
     robomach::io::ReadCadFace(path, 0);
-  } catch (const robomach::InputError&) {
+  } catch (const robomach::InputError& e) {
+    robomach::fuzz::Rejected(e);
   }
   return 0;
 }

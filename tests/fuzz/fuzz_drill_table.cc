@@ -15,7 +15,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (const bool require_forces : {true, false}) {
     try {
       robomach::io::ReadForceTable(path, require_forces);
-    } catch (const robomach::InputError&) {
+    } catch (const robomach::InputError& e) {
+      robomach::fuzz::Rejected(e);
     }
   }
   return 0;

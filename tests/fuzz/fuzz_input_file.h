@@ -9,6 +9,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -38,6 +40,14 @@ inline std::string WriteInput(const uint8_t* data, size_t size, const std::strin
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   return path;
+}
+
+/// Called with each rejected input's error: prints it when the environment
+/// has ROBOMACH_FUZZ_PRINT (to triage an input: the fuzzer or the replay
+/// executable with the input's path as argument).
+inline void Rejected(const std::exception& e) {
+  static const bool print = std::getenv("ROBOMACH_FUZZ_PRINT") != nullptr;
+  if (print) std::fprintf(stderr, "rejected: %s\n", e.what());
 }
 
 }  // namespace robomach::fuzz

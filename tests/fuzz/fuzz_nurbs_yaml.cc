@@ -23,7 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     // here; 5 mm spacing as in the shipped process files.
     const robomach::polishing::SurfaceSize z = robomach::polishing::MeasureSurface(surface, 20);
     robomach::polishing::EstimateGridPoints(z, 5e-3);
-  } catch (const robomach::InputError&) {
+  } catch (const robomach::InputError& e) {
+    robomach::fuzz::Rejected(e);
   }
   return 0;
 }

@@ -17,7 +17,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const robomach::io::CompensationTables t = robomach::io::ReadCompensationFile(path, mf);
     const robomach::machine::Compensation comp(static_cast<int>(mf.machine.axes.size()), t.encoder, t.cross_axis, {});
-  } catch (const robomach::InputError&) {
+  } catch (const robomach::InputError& e) {
+    robomach::fuzz::Rejected(e);
   }
   return 0;
 }
