@@ -23,8 +23,8 @@ std::vector<std::string> SplitLine(std::string_view line, const std::string& pat
   std::string cur;
   bool quoted = false, was_quoted = false;
   // Whether `cur` is blank so far: a quote opens a quoted cell only there.
-  // (Trimming `cur` at every quote made a long line of quotes quadratic, over
-  // a second for 10 KB; issue #22, found by fuzz_program_csv.)
+  // (Trimming `cur` at every quote made a line of quotes quadratic in its
+  // length; issue #22.)
   bool blank = true;
   for (size_t i = 0; i < line.size(); ++i) {
     const char c = line[i];
