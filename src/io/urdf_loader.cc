@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -102,6 +103,33 @@ kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string xml = ss.str();
+
+  // Valid UTF-8 only: TinyXML (urdfdom's parser) skips a multi-byte
+  // sequence by its lead byte's length, and a lead byte cut off at the end
+  // of the file made it read past the buffer (heap-buffer-overflow in
+  // TiXmlBase::ReadName; issue #22, found by fuzz_urdf).
+  {
+    int line = 1, column = 1;
+    for (size_t i = 0; i < xml.size();) {
+      const unsigned char c = static_cast<unsigned char>(xml[i]);
+      const int n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+      bool ok = n > 0 && i + n <= xml.size() && !(n == 2 && c < 0xC2);
+      for (int k = 1; ok && k < n; ++k) ok = (static_cast<unsigned char>(xml[i + k]) & 0xC0) == 0x80;
+      if (!ok) {
+        char hex[8];
+        std::snprintf(hex, sizeof(hex), "0x%02X", c);
+        throw InputError({path, line, column},
+                         std::string("not valid UTF-8 (byte ") + hex + "); a URDF is UTF-8 XML");
+      }
+      if (c == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+      i += n;
+    }
+  }
 
   // NaN and inf: urdfdom reads some of them as numbers (an inertial origin
   // of "nan" passes), so every attribute value is checked first.
