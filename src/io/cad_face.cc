@@ -31,7 +31,10 @@
 #include <IGESData_IGESModel.hxx>
 #include <TColStd_SequenceOfAsciiString.hxx>
 #include <TCollection_HAsciiString.hxx>
+#include <Interface_Check.hxx>
+#include <Interface_CheckIterator.hxx>
 #include <Interface_Static.hxx>
+#include <XSControl_WorkSession.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <Message_PrinterOStream.hxx>
@@ -122,6 +125,26 @@ ReadResult ReadShape(const std::string& path) {
       STEPControl_Reader r;
       status = r.ReadFile(path.c_str());
       if (status == IFSelect_RetDone) {
+        // Entities that failed to load (a damaged record, a reference to a
+        // missing entity) are refused before the translation: OpenCASCADE's
+        // translator dereferences their null references (a SEGV in
+        // StepToTopoDS_TranslateVertex; issue #22, found by fuzz_cad_face).
+        const Interface_CheckIterator checks = r.WS()->ModelCheckList(false);
+        if (!checks.IsEmpty(true)) {
+          int failed = 0;
+          std::string first;
+          for (checks.Start(); checks.More(); checks.Next()) {
+            const Handle(Interface_Check)& c = checks.Value();
+            if (c.IsNull() || !c->HasFailed()) continue;
+            if (failed++ == 0) {
+              first = "entity " + std::to_string(checks.Number()) + " in file order";
+              if (c->NbFails() > 0 && !c->Fail(1).IsNull()) first += ": " + std::string(c->Fail(1)->ToCString());
+            }
+          }
+          throw InputError({path, 0, 0}, "not a readable STEP file: " + std::to_string(failed) +
+                                             " damaged entit" + (failed == 1 ? "y" : "ies") + " (OpenCASCADE's check; first, " +
+                                             first + ")");
+        }
         r.TransferRoots();
         out.shape = r.OneShape();
         TColStd_SequenceOfAsciiString len, ang, solid;

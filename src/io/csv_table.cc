@@ -22,6 +22,10 @@ std::vector<std::string> SplitLine(std::string_view line, const std::string& pat
   std::vector<std::string> cells;
   std::string cur;
   bool quoted = false, was_quoted = false;
+  // Whether `cur` is blank so far: a quote opens a quoted cell only there.
+  // (Trimming `cur` at every quote made a line of quotes quadratic in its
+  // length; issue #22.)
+  bool blank = true;
   for (size_t i = 0; i < line.size(); ++i) {
     const char c = line[i];
     if (quoted) {
@@ -35,16 +39,19 @@ std::vector<std::string> SplitLine(std::string_view line, const std::string& pat
       } else {
         cur += c;
       }
-    } else if (c == '"' && Trim(cur).empty()) {
+    } else if (c == '"' && blank) {
       quoted = true;
       was_quoted = true;
+      blank = false;
       cur.clear();
     } else if (c == ',') {
       cells.push_back(was_quoted ? cur : Trim(cur));
       cur.clear();
       was_quoted = false;
+      blank = true;
     } else {
       cur += c;
+      if (!std::isspace(static_cast<unsigned char>(c))) blank = false;
     }
   }
   if (quoted) {
@@ -115,18 +122,17 @@ CsvTable CsvTable::Parse(std::string_view text, const std::string& path) {
     }
     std::vector<std::string> cells = SplitLine(line, path, line_no);
     if (t.header_.empty()) {
+      std::map<std::string_view, size_t> first;  // (not a pairwise check: quadratic in the columns)
       for (size_t c = 0; c < cells.size(); ++c) {
         if (cells[c].empty()) {
           throw InputError({path, line_no, 0},
                            "header: column " + std::to_string(c + 1) + " has no name");
         }
-        for (size_t d = 0; d < c; ++d) {
-          if (cells[d] == cells[c]) {
-            throw InputError({path, line_no, 0}, "header: column '" + cells[c] +
-                                                     "' appears twice (columns " +
-                                                     std::to_string(d + 1) + " and " +
-                                                     std::to_string(c + 1) + ")");
-          }
+        const auto [it, fresh] = first.emplace(cells[c], c);
+        if (!fresh) {
+          throw InputError({path, line_no, 0}, "header: column '" + cells[c] + "' appears twice (columns " +
+                                                   std::to_string(it->second + 1) + " and " +
+                                                   std::to_string(c + 1) + ")");
         }
       }
       t.header_ = std::move(cells);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -341,7 +342,15 @@ Direction RecordDirection(const std::string& path, int line, int column, int cod
   if (name_has_axis) {
     std::smatch n;
     const std::string head = m[1].str();
-    if (std::regex_search(head, n, node_re)) d.node = std::stoi(n[1].str());
+    // Not std::stoi: ten digits fit record 6's entity name and overflow an
+    // int (std::out_of_range; issue #22).
+    if (std::regex_search(head, n, node_re)) {
+      const std::string digits = n[1].str();
+      if (std::from_chars(digits.data(), digits.data() + digits.size(), d.node).ec != std::errc()) {
+        throw InputError({path, line, column}, "record 6: " + which + " entity name \"" + entity + "\": node number " +
+                                                   digits + " is out of range (at most 2147483647)");
+      }
+    }
   }
   const int a = std::abs(code);
   if (a >= 1 && a <= 3) {

@@ -1,5 +1,6 @@
 #include "robomach/io/posture_file.h"
 
+#include <charconv>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -18,9 +19,20 @@ std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints) {
   // Which joint columns exist, and in which unit.
   const std::regex qcol(R"(q(\d+)_(deg|rad))");
   int max_joint = 0;
-  for (const std::string& h : t.header()) {
+  for (size_t c = 0; c < t.header().size(); ++c) {
+    const std::string& h = t.header()[c];
     std::smatch m;
-    if (std::regex_match(h, m, qcol)) max_joint = std::max(max_joint, std::stoi(m[1]));
+    if (!std::regex_match(h, m, qcol)) continue;
+    // Not std::stoi: a number past int's range threw std::out_of_range (found
+    // by fuzz_posture_csv, issue #22).
+    int joint = 0;
+    const std::errc ec = std::from_chars(h.data() + m.position(1), h.data() + m.position(1) + m.length(1), joint).ec;
+    if (ec != std::errc()) {
+      throw InputError({path, t.header_line(), static_cast<int>(c) + 1},
+                       "column " + h + ": the robot has " + std::to_string(num_joints) + " joints, so there is no joint " +
+                           m[1].str());
+    }
+    max_joint = std::max(max_joint, joint);
   }
   if (max_joint > num_joints) {
     throw InputError({path, t.header_line(), 0},

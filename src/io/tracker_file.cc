@@ -1,5 +1,6 @@
 #include "robomach/io/tracker_file.h"
 
+#include <charconv>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -83,7 +84,12 @@ TrackerFile ReadTrackerFile(const std::string& path, int num_joints) {
   const std::regex qcol(R"(q(\d+)_(deg|rad))");
   for (const std::string& h : t.header()) {
     std::smatch m;
-    if (std::regex_match(h, m, qcol) && std::stoi(m[1]) > num_joints) {
+    if (!std::regex_match(h, m, qcol)) continue;
+    // Not std::stoi: a number past int's range threw std::out_of_range (found
+    // by fuzz_posture_csv in the posture reader's twin, issue #22).
+    int joint = 0;
+    const std::errc ec = std::from_chars(h.data() + m.position(1), h.data() + m.position(1) + m.length(1), joint).ec;
+    if (ec != std::errc() || joint > num_joints) {
       throw HeaderError(t, h, "the robot has " + std::to_string(num_joints) +
                                   " joints, so there is no joint " + std::string(m[1]));
     }

@@ -85,12 +85,25 @@ class UnitParser {
     a.time += sign * b.time;
     return a;
   }
-  static UnitDimension Pow(UnitDimension a, int n) {
+  // Exponents are bounded (issue #22, found by fuzz_uff58): a long one threw
+  // std::out_of_range from std::stoi, and nested powers ("((m^9)^9)^9...")
+  // overflowed the integer dimensions. No mechanical unit comes near these.
+  static constexpr int kMaxExponent = 12;
+  static constexpr int kMaxDimension = 64;
+  UnitDimension Pow(UnitDimension a, int n) const {
     UnitDimension r;
     r.factor = std::pow(a.factor, n);
-    r.length = a.length * n;
-    r.force = a.force * n;
-    r.time = a.time * n;
+    const auto power = [&](int e) {
+      const long long v = static_cast<long long>(e) * n;
+      if (v > kMaxDimension || v < -kMaxDimension) {
+        Fail("the unit's dimension exponent " + std::to_string(v) + " is out of range (|exponent| <= " +
+             std::to_string(kMaxDimension) + ")");
+      }
+      return static_cast<int>(v);
+    };
+    r.length = power(a.length);
+    r.force = power(a.force);
+    r.time = power(a.time);
     return r;
   }
   bool AtTermStart() const {
@@ -180,7 +193,10 @@ class UnitParser {
     size_t b = p_;
     while (p_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[p_]))) ++p_;
     if (b == p_) Fail("expected an integer exponent at position " + std::to_string(b + 1));
-    const int n = std::stoi(s_.substr(b, p_ - b));
+    int n = 0;
+    if (p_ - b > 2 || (n = std::stoi(s_.substr(b, p_ - b))) > kMaxExponent) {
+      Fail("exponent " + s_.substr(b, p_ - b) + " is out of range (at most " + std::to_string(kMaxExponent) + ")");
+    }
     if (paren) {
       if (p_ >= s_.size() || s_[p_] != ')') Fail("expected ')' after the exponent");
       ++p_;
@@ -391,8 +407,10 @@ void ReadHeader(const std::string& path, const std::vector<std::pair<int, std::s
                                         std::to_string(v.size()) + " numbers");
   }
   for (int k = 0; k < 3; ++k) {
-    if (v[k] != std::floor(v[k])) {
-      throw InputError({path, l7, 0}, "record 7: field " + std::to_string(k + 1) + " must be an integer, got " +
+    // Bounded before any cast to an integer (1e121 here was UB; issue #22,
+    // found by fuzz_uff58).
+    if (v[k] != std::floor(v[k]) || std::abs(v[k]) > 2e9) {
+      throw InputError({path, l7, 0}, "record 7: field " + std::to_string(k + 1) + " must be an integer of at most 10 digits, got " +
                                           Trim(s7));
     }
   }

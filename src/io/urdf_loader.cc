@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -102,6 +104,33 @@ kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string
   ss << in.rdbuf();
   const std::string xml = ss.str();
 
+  // Valid UTF-8 only: TinyXML (urdfdom's parser) skips a multi-byte
+  // sequence by its lead byte's length, and a lead byte cut off at the end
+  // of the file made it read past the buffer (heap-buffer-overflow in
+  // TiXmlBase::ReadName; issue #22, found by fuzz_urdf).
+  {
+    int line = 1, column = 1;
+    for (size_t i = 0; i < xml.size();) {
+      const unsigned char c = static_cast<unsigned char>(xml[i]);
+      const int n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+      bool ok = n > 0 && i + n <= xml.size() && !(n == 2 && c < 0xC2);
+      for (int k = 1; ok && k < n; ++k) ok = (static_cast<unsigned char>(xml[i + k]) & 0xC0) == 0x80;
+      if (!ok) {
+        char hex[8];
+        std::snprintf(hex, sizeof(hex), "0x%02X", c);
+        throw InputError({path, line, column},
+                         std::string("not valid UTF-8 (byte ") + hex + "); a URDF is UTF-8 XML");
+      }
+      if (c == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+      i += n;
+    }
+  }
+
   // NaN and inf: urdfdom reads some of them as numbers (an inertial origin
   // of "nan" passes), so every attribute value is checked first.
   {
@@ -130,6 +159,20 @@ kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string
       throw InputError(at, "not a valid URDF model: " + reason);
     }
   }
+  // urdfdom's links own their children (shared_ptr), and urdfdom accepts a
+  // joint cycle, which then owns itself and leaks (issue #22, fuzz_urdf).
+  // Everything needed is copied out of the model below, so the tree is taken
+  // apart on every way out of this function.
+  struct TreeBreaker {
+    const urdf::ModelInterfaceSharedPtr& model;
+    ~TreeBreaker() {
+      for (auto& [name, link] : model->links_) {
+        if (!link) continue;
+        link->child_links.clear();
+        link->child_joints.clear();
+      }
+    }
+  } tree_breaker{model};
   auto link_error = [&](const std::string& role, const std::string& name) {
     std::string names;
     for (const auto& [n, l] : model->links_) names += (names.empty() ? "" : ", ") + n;
@@ -141,7 +184,16 @@ kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string
 
   // Walk from the tip up to the base.
   std::vector<urdf::LinkConstSharedPtr> links;
+  std::set<std::string> seen;
   for (urdf::LinkConstSharedPtr l = model->getLink(tip_link); l; l = l->getParent()) {
+    // urdfdom accepts a joint whose parent is a descendant of its child (a
+    // cycle); walking up it never ended (issue #22, found by fuzz_urdf).
+    if (!seen.insert(l->name).second) {
+      const std::string joint = l->parent_joint ? l->parent_joint->name : "";
+      throw InputError({path, FindElementLine(xml, "joint", joint), 0},
+                       "link '" + l->name + "' is its own ancestor: the joints above tip link '" + tip_link +
+                           "' form a cycle (expected a tree; check the <parent link> of joint '" + joint + "')");
+    }
     links.push_back(l);
     if (l->name == base_link) break;
   }

@@ -27,10 +27,19 @@ namespace {
 
 // yaml-cpp keeps the first of two equal keys in a map and drops the other
 // without a word; a config edited by hand must not change meaning that way.
+// A key must be a plain name: a list, map or empty key ("? [a, b]: 1")
+// threw yaml-cpp's TypedBadConversion where the readers list the keys
+// (issue #22, found by fuzz_nurbs_yaml).
 void RejectDuplicateKeys(const YAML::Node& node, const std::string& path) {
   if (node.IsMap()) {
     std::map<std::string, YAML::Mark> seen;
     for (const auto& kv : node) {
+      if (!kv.first.IsScalar()) {
+        const YAML::Mark m = kv.first.Mark();
+        throw InputError({path, m.line + 1, m.column + 1},
+                         std::string("expected a key name, got ") +
+                             (kv.first.IsMap() ? "a map" : kv.first.IsSequence() ? "a list" : "an empty key"));
+      }
       if (kv.first.IsScalar()) {
         const std::string key = kv.first.Scalar();
         const auto [it, fresh] = seen.emplace(key, kv.first.Mark());

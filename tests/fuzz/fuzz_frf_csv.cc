@@ -12,7 +12,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = robomach::fuzz::WriteInput(data, size, ".csv");
   try {
     robomach::io::ReadFrfCsv(path);
-  } catch (const robomach::InputError&) {
+  } catch (const robomach::InputError& e) {
+    robomach::fuzz::Rejected(e);
   }
   return 0;
 }

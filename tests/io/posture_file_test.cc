@@ -38,6 +38,10 @@ TEST(PostureFile, BadInputGetsLocatedMessages) {
               HasSubstr("p.csv:1: missing column q3_deg (or q3_rad): the robot has 3 joints"));
   EXPECT_THAT(err("pose_id,q1_deg,q2_deg,q3_deg\nA,1,2,3\n", 2),
               HasSubstr("p.csv:1: the file has joint columns up to q3 but the robot has 2 joints"));
+  // A joint number past int's range (std::stoi threw std::out_of_range; found
+  // by fuzz_posture_csv, issue #22).
+  EXPECT_THAT(err("pose_id,q1_deg,q99999999999_deg\nA,1,2\n", 2),
+              HasSubstr("p.csv:1:3: column q99999999999_deg: the robot has 2 joints, so there is no joint 99999999999"));
   EXPECT_THAT(err("pose_id,q1_deg,q1_rad\nA,1,2\n", 1),
               HasSubstr("joint 1 is given twice, as q1_deg and q1_rad; keep one"));
   EXPECT_THAT(err("pose_id,q1_deg\nP2,1\nP2,3\n", 1),

@@ -119,6 +119,13 @@ TEST(TrackerFile, ErrorsNameFileLineAndColumn) {
                                 6);
               }),
               HasSubstr("comma.csv:3: column fy_N: expected a number, got \"12,5\" (decimal comma?)"));
+  // A joint number past int's range (std::stoi threw std::out_of_range; found
+  // by fuzz_tracker_csv, issue #22).
+  EXPECT_THAT(CaptureError([&] {
+                ReadTrackerFile(File(dir, "q_huge.csv", "q99999999999_deg," + kForceHeader + "0," + row), 6);
+              }),
+              HasSubstr("q_huge.csv:1:1: column q99999999999_deg: the robot has 6 joints, so there is no joint "
+                        "99999999999"));
   // Duplicate case id.
   EXPECT_THAT(CaptureError([&] { ReadTrackerFile(File(dir, "dup.csv", kForceHeader + row + row), 6); }),
               HasSubstr("dup.csv:3: column case_id: case \"C1\" appears twice (first on line 2)"));

@@ -71,6 +71,13 @@ TEST(UffUnits, ParsesTheLabelsExportsWrite) {
   EXPECT_THAT(CaptureError([] { ParseUnitLabel("V/N"); }), HasSubstr("unit 'V' (in \"V/N\")"));
   EXPECT_THAT(CaptureError([] { ParseUnitLabel("V/N"); }), HasSubstr("voltage"));
   EXPECT_THAT(CaptureError([] { ParseUnitLabel("m/(s"); }), HasSubstr("expected ')'"));
+  // Exponents are bounded (issue #22): a long one threw std::out_of_range
+  // from std::stoi, nested powers overflowed the integer dimensions.
+  EXPECT_THAT(CaptureError([] { ParseUnitLabel("m^99999999999/N"); }),
+              HasSubstr("exponent 99999999999 is out of range (at most 12)"));
+  EXPECT_THAT(CaptureError([] { ParseUnitLabel("((m^9)^9)/N"); }),
+              HasSubstr("dimension exponent 81 is out of range"));
+  EXPECT_EQ(ParseUnitLabel("(m^2)^3/N").length, 6);
 }
 
 // ------------------------------------------------------- files written here --

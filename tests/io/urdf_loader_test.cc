@@ -1,3 +1,7 @@
+#include <fstream>
+#include <iterator>
+#include <string>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -96,6 +100,21 @@ TEST(UrdfLoader, ShippedKr210HasSixJointsWithinLimits) {
   const auto chain = LoadUrdfChain(SourcePath("config/kr210_r2700_2.urdf"), "base_link", "tool0");
   EXPECT_EQ(chain.num_joints(), 6);
   EXPECT_NEAR(chain.limits()[1].lower, -2.443460952792061, 1e-15);
+}
+
+// A joint whose parent is its own child link: urdfdom accepts the cycle, and
+// walking up from the tip never ended (issue #22, found by fuzz_urdf; the
+// input is tests/fuzz/corpus/urdf/cycle_joint_parent_is_child.urdf).
+TEST(UrdfLoader, CycleInTheJointTreeIsRejectedWithTheJointsLine) {
+  std::ifstream in(SourcePath("config/kr210_r2700_2.urdf"));
+  std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "<parent link=\"link_4\"/>";
+  ASSERT_NE(xml.find(from), std::string::npos);
+  xml.replace(xml.find(from), from.size(), "<parent link=\"link_5\"/>");
+  const std::string path = WriteText(TempDir("urdf_cycle") + "/cycle.urdf", xml);
+  // Line 100 of the shipped file: <joint name="joint_5" type="revolute">.
+  EXPECT_THAT(CaptureError([&] { LoadUrdfChain(path, "base_link", "tool0"); }),
+              HasSubstr("cycle.urdf:100: link 'link_5' is its own ancestor"));
 }
 
 }  // namespace

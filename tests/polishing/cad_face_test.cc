@@ -6,6 +6,8 @@
 #include <functional>
 #include <fstream>
 #include <iostream>
+#include <iterator>
+#include <string>
 
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
@@ -295,6 +297,24 @@ TEST(CadFace, SeamTakesNoMarginOnADrilledCylinder) {
   }
   ASSERT_GT(seam_area, 0.0);
   EXPECT_GT(seam / seam_area, 0.8 * st.mean) << "mean at the seam " << seam / seam_area << ", overall " << st.mean;
+}
+
+// A face bound that refers to an entity the file does not have: OpenCASCADE
+// loads the file with a check failure, and its translator then crashed on
+// the null reference (SEGV; issue #22, found by fuzz_cad_face, input kept in
+// tests/fuzz/corpus/cad_face). Refused as damaged before the translation
+// (entity 17 is the ADVANCED_FACE; its second parameter, the face bounds).
+TEST(CadFace, UnresolvedReferenceIsRefusedBeforeTranslation) {
+  std::ifstream in(ROBOMACH_SOURCE_DIR "/tests/data/polishing/plate_hole.step");
+  std::string step((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "#17 = ADVANCED_FACE('',(#18,#89)";
+  ASSERT_NE(step.find(from), std::string::npos);
+  step.replace(step.find(from), from.size(), "#17 = ADVANCED_FACE('',(#18,#999)");
+  const std::string path = TmpPath("unresolved.step");
+  std::ofstream(path) << step;
+  const std::string e = ErrorOf([&] { ReadCadFace(path, 0); });
+  EXPECT_THAT(e, ::testing::HasSubstr("unresolved.step: not a readable STEP file: 1 damaged entity"));
+  EXPECT_THAT(e, ::testing::HasSubstr("first, entity 17 in file order: Parameter n0.2 (face_bound)"));
 }
 
 TEST(CadFace, CorruptAndEmptyFiles) {

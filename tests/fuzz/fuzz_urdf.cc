@@ -1,0 +1,19 @@
+// libFuzzer target (issue #22 item 4): the URDF reader (robot configs' urdf:)
+// (docs/formats.md §1). Bad input must be an InputError with a location; any other
+// exception, a crash, a leak, a UB report or a hang is a finding.
+#include <cstddef>
+#include <cstdint>
+
+#include "fuzz_input_file.h"
+#include "robomach/common/errors.h"
+#include "robomach/io/urdf_loader.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string path = robomach::fuzz::WriteInput(data, size, ".urdf");
+  try {
+    robomach::io::LoadUrdfChain(path, "base_link", "tool0");
+  } catch (const robomach::InputError& e) {
+    robomach::fuzz::Rejected(e);
+  }
+  return 0;
+}
