@@ -147,14 +147,7 @@ void BM_ModalFrf2000Lines_BaselineKernel(benchmark::State& state) {
   const Eigen::VectorXd f = Eigen::VectorXd::LinSpaced(2000, 0.5, 1000.0);
   const int nm = static_cast<int>(d.modes.size());
   std::vector<double> w2(nm), c(nm), P(6 * nm);
-  for (int k = 0; k < nm; ++k) {
-    const double w = HzToRadPerSec(d.modes[k].freq_hz);
-    w2[k] = w * w;
-    c[k] = 2.0 * d.modes[k].damping_ratio * w;
-    const Eigen::Vector3d& p = d.modes[k].p_T;
-    const double e[6] = {p(0) * p(0), p(1) * p(1), p(2) * p(2), p(0) * p(1), p(0) * p(2), p(1) * p(2)};
-    for (int j = 0; j < 6; ++j) P[6 * k + j] = e[j];
-  }
+  dynamics::internal::PackModes(d.modes, w2.data(), c.data(), P.data());
   std::vector<Eigen::Matrix3cd> H(f.size());
   for (auto _ : state) {
     dynamics::internal::RealModalSum(nm, w2.data(), c.data(), P.data(), f.data(), f.size(),

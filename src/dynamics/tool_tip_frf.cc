@@ -55,20 +55,7 @@ void ReceptanceModal(const PostureDynamics& d, const Eigen::VectorXd& freq_hz, s
     c = w2 + nm;
     P = c + nm;
   }
-  for (int k = 0; k < nm; ++k) {
-    const Mode& m = d.modes[k];
-    const double w = HzToRadPerSec(m.freq_hz);
-    w2[k] = w * w;
-    c[k] = 2.0 * m.damping_ratio * w;
-    const Eigen::Vector3d& p = m.p_T;
-    double* Pk = P + 6 * k;
-    Pk[0] = p(0) * p(0);
-    Pk[1] = p(1) * p(1);
-    Pk[2] = p(2) * p(2);
-    Pk[3] = p(0) * p(1);
-    Pk[4] = p(0) * p(2);
-    Pk[5] = p(1) * p(2);
-  }
+  internal::PackModes(d.modes, w2, c, P);
   H->resize(freq_hz.size());
   static_assert(sizeof(Eigen::Matrix3cd) == 9 * sizeof(cd), "Matrix3cd is nine packed complex numbers");
   internal::RealModalSum(nm, w2, c, P, freq_hz.data(), freq_hz.size(), reinterpret_cast<cd*>(H->data()));

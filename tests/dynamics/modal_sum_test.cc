@@ -100,14 +100,7 @@ TEST(ModalSum, EqualsOldFormulaOnEveryKernel) {
       // Each kernel explicitly.
       const int nm = static_cast<int>(d.modes.size());
       std::vector<double> w2(nm), c(nm), P(6 * nm);
-      for (int k = 0; k < nm; ++k) {
-        const double w = HzToRadPerSec(d.modes[k].freq_hz);
-        w2[k] = w * w;
-        c[k] = 2.0 * d.modes[k].damping_ratio * w;
-        const Eigen::Vector3d& p = d.modes[k].p_T;
-        const double e[6] = {p(0) * p(0), p(1) * p(1), p(2) * p(2), p(0) * p(1), p(0) * p(2), p(1) * p(2)};
-        for (int j = 0; j < 6; ++j) P[6 * k + j] = e[j];
-      }
+      internal::PackModes(d.modes, w2.data(), c.data(), P.data());
       for (auto level : {internal::SimdLevel::kBest, internal::SimdLevel::kBaseline, internal::SimdLevel::kScalar}) {
         std::vector<Eigen::Matrix3cd> H(f.size(), Eigen::Matrix3cd::Constant(cd(NAN, NAN)));
         internal::RealModalSum(nm, w2.data(), c.data(), P.data(), f.data(), f.size(),

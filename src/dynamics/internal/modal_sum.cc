@@ -10,6 +10,22 @@
 #endif
 
 namespace robomach::dynamics::internal {
+
+void PackModes(const std::vector<Mode>& modes, double* w2, double* c, double* P) {
+  for (size_t k = 0; k < modes.size(); ++k) {
+    const double w = HzToRadPerSec(modes[k].freq_hz);
+    w2[k] = w * w;
+    c[k] = 2.0 * modes[k].damping_ratio * w;
+    const Eigen::Vector3d& p = modes[k].p_T;
+    double* Pk = P + 6 * k;
+    Pk[0] = p(0) * p(0);
+    Pk[1] = p(1) * p(1);
+    Pk[2] = p(2) * p(2);
+    Pk[3] = p(0) * p(1);
+    Pk[4] = p(0) * p(2);
+    Pk[5] = p(1) * p(2);
+  }
+}
 namespace {
 
 // Column-major 3×3 position s → which of the six distinct entries.

@@ -12,8 +12,11 @@
 // library as a whole is built for the baseline (CMakeLists.txt: Debian's KDL
 // and Eigen's alignment settings). Elsewhere a plain loop.
 #include <complex>
+#include <vector>
 
 #include <Eigen/Core>
+
+#include "robomach/dynamics/posture_dynamics.h"
 
 namespace robomach::dynamics::internal {
 
@@ -25,6 +28,11 @@ enum class SimdLevel {
 
 /// True if kBest uses the AVX2+FMA kernel on this CPU.
 bool ModalSumUsesAvx2();
+
+/// The kernel's inputs from real modes: w2[k] = ω_k², c[k] = 2 ζ_k ω_k and
+/// P[6k .. 6k + 5] = the six distinct entries of p_k p_kᵀ (xx yy zz xy xz yz).
+/// The arrays hold modes.size() (w2, c) and 6 · modes.size() (P) values.
+void PackModes(const std::vector<Mode>& modes, double* w2, double* c, double* P);
 
 /// out[9 i .. 9 i + 8] = H at freq_hz[i] as a column-major 3×3 (the storage
 /// of Eigen::Matrix3cd), for i in [0, num_lines).
