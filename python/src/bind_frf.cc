@@ -35,6 +35,19 @@ py::dict ReadResultDict(const io::FrfReadResult& r) {
   return d;
 }
 
+// One of the io readers, the file checked first (FileNotFoundError) and the
+// GIL released while it reads.
+template <class Reader>
+py::dict ReadFrfs(const std::string& path, Reader&& read) {
+  RequireReadableFile(path);
+  io::FrfReadResult r;
+  {
+    py::gil_scoped_release release;
+    r = read();
+  }
+  return ReadResultDict(r);
+}
+
 constexpr char kReadResultDoc[] =
     " Returns a dict: frfs (FrfSet, receptance [m/N]; mobility and accelerance are converted), "
     "quantity (the file's: 'receptance', 'mobility', 'accelerance'), averages (from '# averages: "
@@ -117,34 +130,16 @@ void BindFrf(py::module_& m) {
       .def("__repr__", [](const FrfSet& s) { return "<FrfSet " + std::to_string(s.size()) + " FRFs>"; });
 
   m.def("read_frf_csv", [](const std::string& path) {
-    RequireReadableFile(path);
-    io::FrfReadResult r;
-    {
-      py::gil_scoped_release release;
-      r = io::ReadFrfCsv(path);
-    }
-    return ReadResultDict(r);
+    return ReadFrfs(path, [&] { return io::ReadFrfCsv(path); });
   }, py::arg("path"), (std::string("Reads a measured-FRF CSV (docs/formats.md §3).") + kReadResultDoc).c_str());
   m.def("read_uff58", [](const std::string& path, const std::string& default_pose_id) {
-    RequireReadableFile(path);
-    io::FrfReadResult r;
-    {
-      py::gil_scoped_release release;
-      r = io::ReadUff58(path, default_pose_id);
-    }
-    return ReadResultDict(r);
+    return ReadFrfs(path, [&] { return io::ReadUff58(path, default_pose_id); });
   }, py::arg("path"), py::arg("default_pose_id") = "",
      (std::string("Reads the FRFs of a Universal File Format file (dataset 58/58b; 164 units). "
                   "default_pose_id is the posture of records without 'pose=ID' (the tools' --pose ID=file.uff).") +
       kReadResultDoc).c_str());
   m.def("read_frf_file", [](const std::string& path, const std::string& default_pose_id) {
-    RequireReadableFile(path);
-    io::FrfReadResult r;
-    {
-      py::gil_scoped_release release;
-      r = io::ReadFrfFile(path, default_pose_id);
-    }
-    return ReadResultDict(r);
+    return ReadFrfs(path, [&] { return io::ReadFrfFile(path, default_pose_id); });
   }, py::arg("path"), py::arg("default_pose_id") = "",
      (std::string("Reads a measured-FRF file: UFF58 by extension (.uff .unv .uf .ufb) or content, else CSV.") +
       kReadResultDoc).c_str());
