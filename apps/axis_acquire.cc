@@ -68,7 +68,7 @@ int Run(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   return RunGuarded(kTool, [&]() -> int {
-    if (!plot_path.empty() && program_path.empty()) throw std::invalid_argument("--plot needs --program");
+    if (!plot_path.empty() && program_path.empty()) throw UsageError("--plot needs --program");
     RequireReadableFile(machine_path, "machine file");
     RequireReadableFile(counts_path, "counts file");
     if (!comp_path.empty()) RequireReadableFile(comp_path, "compensation file");

@@ -47,9 +47,9 @@ int Run(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   return RunGuarded(kTool, [&]() -> int {
-    if (!(rate_hz > 0.0) || !std::isfinite(rate_hz)) throw std::invalid_argument("--sample-rate-hz: expected a rate > 0 Hz");
-    if (every < 1) throw std::invalid_argument("--every: expected N >= 1");
-    if (filter < 0 || filter > 1000000) throw std::invalid_argument("--glitch-filter: expected 0..1000000 samples");
+    if (!(rate_hz > 0.0) || !std::isfinite(rate_hz)) throw UsageError("--sample-rate-hz: expected a rate > 0 Hz");
+    if (every < 1) throw UsageError("--every: expected N >= 1");
+    if (filter < 0 || filter > 1000000) throw UsageError("--glitch-filter: expected 0..1000000 samples");
     RequireReadableFile(machine_path, "machine file");
     RequireReadableFile(capture_path, "capture");
     CheckDistinctPaths({{"--machine", machine_path}, {"--capture", capture_path}},

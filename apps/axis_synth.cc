@@ -68,8 +68,8 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--dwell-s", dwell_s, 0.0, 1e5);
     CheckOptionRange("--start-b-deg", start_b_deg, -720.0, 720.0);
     CheckOptionRange("--glitch-probability", glitch_p, 0.0, 1.0);
-    if (capture_every < 1 || capture_every > 100000) throw std::invalid_argument("--capture-every: expected 1..100000");
-    if (settle < 0 || settle >= capture_every) throw std::invalid_argument("--capture-settle: expected 0 <= settle < --capture-every");
+    if (capture_every < 1 || capture_every > 100000) throw UsageError("--capture-every: expected 1..100000");
+    if (settle < 0 || settle >= capture_every) throw UsageError("--capture-settle: expected 0 <= settle < --capture-every");
     RequireReadableFile(machine_path, "machine file");
     RequireReadableFile(program_path, "programmed path");
     if (!comp_path.empty()) RequireReadableFile(comp_path, "compensation file");
@@ -138,7 +138,7 @@ int Run(int argc, char** argv) {
           try {
             cap.Next(rec.counts.data() + r * n, &words);
           } catch (const std::invalid_argument& e) {
-            throw std::invalid_argument(std::string("--capture-every ") + std::to_string(capture_every) + ": " + e.what() +
+            throw UsageError(std::string("--capture-every ") + std::to_string(capture_every) + ": " + e.what() +
                                         "; raise --capture-every or lower --feed-mm-min");
           }
           if (words.size() > (1u << 16)) flush();

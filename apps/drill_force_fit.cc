@@ -122,7 +122,7 @@ int RunDrillForceFit(int argc, char** argv) {
   }
   return RunGuarded(kTool, [&]() -> int {
     if (predict_path.empty() != predictions_path.empty()) {
-      throw std::invalid_argument("--predict and --predictions go together");
+      throw UsageError("--predict and --predictions go together");
     }
     CheckDistinctPaths({{"--table", table_path}, {"--drill", drill_path}, {"--predict", predict_path}},
                        {{"--out", out_path}, {"--plot", plot_path}, {"--predictions", predictions_path}});

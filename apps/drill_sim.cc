@@ -197,15 +197,15 @@ int RunDrillSim(int argc, char** argv) {
       std::string k;
       while (std::getline(ss, k, ',')) {
         if (k != "pid" && k != "pd" && k != "pd-tdc") {
-          throw std::invalid_argument("--controller: expected pid, pd or pd-tdc, got \"" + k + "\"");
+          throw UsageError("--controller: expected pid, pd or pd-tdc, got \"" + k + "\"");
         }
         if (std::find(kinds.begin(), kinds.end(), k) != kinds.end()) {
-          throw std::invalid_argument("--controller: \"" + k + "\" given twice");
+          throw UsageError("--controller: \"" + k + "\" given twice");
         }
         kinds.push_back(k);
       }
     }
-    if (kinds.empty()) throw std::invalid_argument("--controller: expected at least one controller");
+    if (kinds.empty()) throw UsageError("--controller: expected at least one controller");
     const bool several = kinds.size() > 1;
     std::vector<std::pair<std::string, std::string>> outs;
     for (const auto& k : kinds) {
@@ -252,13 +252,13 @@ int RunDrillSim(int argc, char** argv) {
       const auto eq = text.find('=');
       const std::string kind = text.substr(0, eq);
       if (eq == std::string::npos || (kind != "pid" && kind != "pd" && kind != "pd-tdc")) {
-        throw std::invalid_argument("--gains: expected KIND=OMEGA,ZETA[,THIRD] with KIND pid, pd or pd-tdc, got \"" +
+        throw UsageError("--gains: expected KIND=OMEGA,ZETA[,THIRD] with KIND pid, pd or pd-tdc, got \"" +
                                     text + "\"");
       }
       const std::vector<double> v = ParseNumberList("--gains", text.substr(eq + 1));
       if (v.size() < 2 || v.size() > 4 || v[0] <= 0 || v[1] <= 0 || (v.size() >= 3 && v[2] <= 0) ||
           (v.size() == 4 && v[3] < 0)) {
-        throw std::invalid_argument("--gains: expected 2 to 4 positive numbers after " + kind + "=");
+        throw UsageError("--gains: expected 2 to 4 positive numbers after " + kind + "=");
       }
       drilling::ControllerParameters p = drilling::DefaultParameters(kind);
       p.omega = v[0];

@@ -121,7 +121,7 @@ int Run(int argc, char** argv) {
       CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}});
     }
     if (measured_files.empty() && pose_files.empty()) {
-      throw std::invalid_argument("no measured FRFs: give --measured FILE or --pose ID=file.uff");
+      throw UsageError("no measured FRFs: give --measured FILE or --pose ID=file.uff");
     }
     opt.objective = calibration::ParseObjective(objective);
     if (only_free) opt.free_parameters.clear();
@@ -130,7 +130,7 @@ int Run(int argc, char** argv) {
         opt.free_parameters.push_back(f);
       }
     }
-    if (opt.free_parameters.empty()) throw std::invalid_argument("no free parameters (--only-free without --free)");
+    if (opt.free_parameters.empty()) throw UsageError("no free parameters (--only-free without --free)");
     opt.modal_fit.fmin_hz = opt.fmin_hz;
     opt.modal_fit.fmax_hz = opt.fmax_hz;
 
@@ -138,7 +138,7 @@ int Run(int argc, char** argv) {
     ApplyAddsAndSets(adds, sets, &cfg);
     for (const std::string& name : opt.free_parameters) {
       if (!cfg.parameters.Has(name)) {
-        throw std::invalid_argument("--free " + name + ": unknown parameter; known: " + cfg.parameters.NameList());
+        throw UsageError("--free " + name + ": unknown parameter; known: " + cfg.parameters.NameList());
       }
     }
     const auto model_before = cfg.Build();

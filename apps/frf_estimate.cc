@@ -44,7 +44,7 @@ Axis ParseAxisOption(const std::string& option, const std::string& text) {
   if (text == "x") return Axis::kX;
   if (text == "y") return Axis::kY;
   if (text == "z") return Axis::kZ;
-  throw std::invalid_argument(option + ": expected x, y or z, got '" + text + "'");
+  throw UsageError(option + ": expected x, y or z, got '" + text + "'");
 }
 
 // A channel's direction: --direction NAME=AXIS, else a name that is x, y or
@@ -54,7 +54,7 @@ Axis ChannelDirection(const std::string& name, const std::map<std::string, std::
   const char last = name.empty() ? '\0' : name.back();
   const bool suffix = name.size() == 1 || (name.size() >= 2 && name[name.size() - 2] == '_');
   if (suffix && (last == 'x' || last == 'y' || last == 'z')) return static_cast<Axis>(last - 'x');
-  throw std::invalid_argument("response channel '" + name +
+  throw UsageError("response channel '" + name +
                               "': its direction is not in its name (…_x, …_y, …_z); give --direction " + name +
                               "=x (or y, z)");
 }
@@ -191,7 +191,7 @@ int Run(int argc, char** argv) {
     for (const std::string& d : directions) {
       const size_t eq = d.find('=');
       if (eq == std::string::npos || eq == 0) {
-        throw std::invalid_argument("--direction: expected NAME=AXIS, got '" + d + "'");
+        throw UsageError("--direction: expected NAME=AXIS, got '" + d + "'");
       }
       dir_given[d.substr(0, eq)] = d.substr(eq + 1);
     }
@@ -208,13 +208,13 @@ int Run(int argc, char** argv) {
     for (const auto& [name, v] : dir_given) {
       bool known = false;
       for (const auto& c : rec.channels) known = known || c.name == name;
-      if (!known) throw std::invalid_argument("--direction " + name + "=" + v + ": no response channel '" + name + "'");
+      if (!known) throw UsageError("--direction " + name + "=" + v + ": no response channel '" + name + "'");
     }
     for (const auto& ch : rec.channels) {
       dynamics::FrfKey key{pose_id, ChannelDirection(ch.name, dir_given), exc};
       for (size_t k = 0; k < keys.size(); ++k) {
         if (keys[k] == key) {
-          throw std::invalid_argument("response channels '" + rec.channels[k].name + "' and '" + ch.name +
+          throw UsageError("response channels '" + rec.channels[k].name + "' and '" + ch.name +
                                       "' both give " + key.ToString() + "; give --direction for one of them");
         }
       }
@@ -227,7 +227,7 @@ int Run(int argc, char** argv) {
         size_t c = 0;
         while (c < rec.channels.size() && rec.channels[c].name != name) ++c;
         if (c == rec.channels.size()) {
-          throw std::invalid_argument("--response-range " + text + ": no response channel '" + name + "'");
+          throw UsageError("--response-range " + text + ": no response channel '" + name + "'");
         }
         CheckOptionRange("--response-range " + name, value, 0.0, 1e300);
         o.response_range[c] = value;
@@ -268,7 +268,7 @@ int Run(int argc, char** argv) {
     if (!flags.empty()) rc = kExitFlagged;
 
     // The FRFs, in receptance inside; written in --quantity.
-    const io::FrfQuantity out_q = io::ParseQuantity(quantity);
+    const io::FrfQuantity out_q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
     dynamics::FrfSet frfs;
     std::vector<std::string> labels;
     std::vector<int> channel_of;

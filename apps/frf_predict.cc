@@ -112,18 +112,18 @@ int Run(int argc, char** argv) {
     CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}, {"--freq-file", freq_file}},
                        {{"--out", out_path}, {"--modes", modes_path}, {"--summary", details_path},
                         {"--plot", plot_path}});
-    const io::DirectionPairs pairs = io::ParseDirectionPairs(directions);
+    const io::DirectionPairs pairs = FromOption("--directions", [&] { return io::ParseDirectionPairs(directions); });
     Eigen::VectorXd freq_hz;
     if (!freq_file.empty()) {
       freq_hz = ReadFrequencyFile(freq_file);
     } else {
       if (!(fmin_hz >= 0.0) || !(fmax_hz > fmin_hz) || !(df_hz > 0.0) || !std::isfinite(fmax_hz) ||
           !std::isfinite(df_hz)) {
-        throw std::invalid_argument("expected finite 0 <= --fmin-hz < --fmax-hz and --df-hz > 0");
+        throw UsageError("expected finite 0 <= --fmin-hz < --fmax-hz and --df-hz > 0");
       }
       // Count in double first: a tiny step would overflow the integer.
       const double lines = std::floor((fmax_hz - fmin_hz) / df_hz + 1e-9) + 1.0;
-      if (lines > 1e6) throw std::invalid_argument("more than 1e6 frequency lines: raise --df-hz");
+      if (lines > 1e6) throw UsageError("more than 1e6 frequency lines: raise --df-hz");
       const long n = static_cast<long>(lines);
       freq_hz = Eigen::VectorXd::LinSpaced(n, fmin_hz, fmin_hz + (n - 1) * df_hz);
     }
@@ -143,7 +143,7 @@ int Run(int argc, char** argv) {
     // outputs), so bound the memory: 3×3 complex values per line and posture.
     const double values = static_cast<double>(postures.size()) * static_cast<double>(freq_hz.size());
     if (values > 2e7) {
-      throw std::invalid_argument(std::to_string(postures.size()) + " postures × " +
+      throw UsageError(std::to_string(postures.size()) + " postures × " +
                                   std::to_string(freq_hz.size()) +
                                   " frequency lines is more than 2e7 FRF lines (~3 GB): split the "
                                   "posture file or coarsen the grid");

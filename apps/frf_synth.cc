@@ -84,7 +84,7 @@ int Run(int argc, char** argv) {
     CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}},
                        {{"--out", out_path}, {"--summary", summary_path}});
     o.directions.clear();
-    for (const auto& [r, e] : io::ParseDirectionPairs(directions)) {
+    for (const auto& [r, e] : FromOption("--directions", [&] { return io::ParseDirectionPairs(directions); })) {
       o.directions.emplace_back(static_cast<Axis>(r), static_cast<Axis>(e));
     }
     io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
@@ -102,7 +102,7 @@ int Run(int argc, char** argv) {
       postures.push_back({p.id, p.q});
     }
     const dynamics::FrfSet frfs = calibration::SynthesizeHammerTest(model, postures, o);
-    const io::FrfQuantity q = io::ParseQuantity(quantity);
+    const io::FrfQuantity q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
     std::string ext = out_path.substr(out_path.find_last_of('.') + 1);
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (ext == "uff" || ext == "unv" || ext == "uf") {

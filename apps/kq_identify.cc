@@ -218,7 +218,7 @@ std::vector<double> ParsePositiveList(const std::string& option, const std::stri
   const std::vector<double> v = ParseNumberList(option, text);
   for (double x : v) {
     if (!(x > 0.0)) {
-      throw std::invalid_argument(option + ": expected positive numbers separated by commas, got \"" + text + "\"");
+      throw UsageError(option + ": expected positive numbers separated by commas, got \"" + text + "\"");
     }
   }
   return v;
@@ -280,7 +280,7 @@ int Run(int argc, char** argv) {
 
   return RunGuarded(kTool, [&]() -> int {
     if (!(noise_mm > 0.0) || !std::isfinite(noise_mm)) {
-      throw std::invalid_argument("--noise-mm: expected a finite noise > 0 mm");
+      throw UsageError("--noise-mm: expected a finite noise > 0 mm");
     }
     CheckOptionRange("--plan", plan_n, 0, 500);  // 500 postures: ~15 s of planning
     RequireReadableFile(robot_path, "robot config");
@@ -289,14 +289,14 @@ int Run(int argc, char** argv) {
                         {"--summary", json_path}});
     const io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
     if (plan_n != 0) {
-      if (plan_n < 1) throw std::invalid_argument("--plan: expected a number of postures >= 1");
-      if (merge) throw std::invalid_argument("--merge cannot be combined with --plan");
+      if (plan_n < 1) throw UsageError("--plan: expected a number of postures >= 1");
+      if (merge) throw UsageError("--merge cannot be combined with --plan");
       return RunPlan(cfg, plan_n, noise_mm, seed, ParsePointMm("--load-point-mm", load_point),
                      ParsePointMm("--target-mm", target), ParsePositiveList("--masses-kg", masses), rope_angle_deg,
                      out_path);
     }
-    if (tracker_path.empty()) throw std::invalid_argument("--tracker is required (or --plan N)");
-    if (merge && out_path.empty()) throw std::invalid_argument("--merge needs --out for the merged config");
+    if (tracker_path.empty()) throw UsageError("--tracker is required (or --plan N)");
+    if (merge && out_path.empty()) throw UsageError("--merge needs --out for the merged config");
     RequireReadableFile(tracker_path, "tracker file");
     const auto model = cfg.Build();
     if (!model->effects().empty()) {

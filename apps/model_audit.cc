@@ -14,6 +14,7 @@
 #include "robomach/audit/error_patterns.h"
 #include "robomach/audit/model_audit.h"
 #include "robomach/common/errors.h"
+#include "robomach/dynamics/effect.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/frf_files.h"
@@ -124,20 +125,20 @@ int Run(int argc, char** argv) {
     // Option values, with the options' names (before minutes of fitting).
     CheckOptionRange("--fmin-hz", opt.fmin_hz, 0.0, 1e9);
     if (!(opt.fmax_hz > opt.fmin_hz)) {
-      throw std::invalid_argument("--fmax-hz must be above --fmin-hz (" + Num(opt.fmin_hz) + " Hz), got " +
+      throw UsageError("--fmax-hz must be above --fmin-hz (" + Num(opt.fmin_hz) + " Hz), got " +
                                   Num(opt.fmax_hz));
     }
     CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
     {
       std::set<std::string> seen;
       for (const std::string& a : adds) {
-        if (!seen.insert(a).second) throw std::invalid_argument("--add " + a + " is given twice");
+        if (!seen.insert(a).second) throw UsageError("--add " + a + " is given twice");
       }
     }
     RequireFolderOption("--report", report_dir);
     RequireFolderOption("--compare", compare_dir);
     if (fs::exists(report_dir) && !fs::is_directory(report_dir)) {
-      throw std::invalid_argument("--report " + report_dir + " exists and is not a folder");
+      throw UsageError("--report " + report_dir + " exists and is not a folder");
     }
     {
       std::vector<std::pair<std::string, std::string>> inputs = {{"--robot", robot_path},
@@ -147,11 +148,13 @@ int Run(int argc, char** argv) {
       CheckDistinctPaths(inputs, {{"--report", report_dir}, {"--summary", summary_path}});
     }
     if (measured_files.empty() && pose_files.empty()) {
-      throw std::invalid_argument("no measured FRFs: give --measured FILE or --pose ID=file.uff");
+      throw UsageError("no measured FRFs: give --measured FILE or --pose ID=file.uff");
     }
     std::stringstream cl(candidates_list);
     for (std::string n; std::getline(cl, n, ',');) {
-      if (!n.empty()) opt.candidates.push_back(n);
+      if (n.empty()) continue;
+      FromOption("--candidates", [&] { dynamics::EffectRegistry::Instance().Create(n); });
+      opt.candidates.push_back(n);
     }
     opt.progress = [](const std::string& s) { std::cerr << kTool << ": " << s << '\n'; };
     json previous;
@@ -159,7 +162,8 @@ int Run(int argc, char** argv) {
 
     io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
     for (const std::string& name : adds) {
-      std::tie(cfg.description, cfg.parameters) = audit::WithEffect(cfg.description, cfg.parameters, name);
+      std::tie(cfg.description, cfg.parameters) =
+          FromOption("--add " + name, [&] { return audit::WithEffect(cfg.description, cfg.parameters, name); });
       // An effect switched on here starts at its defaults, so its fittable
       // parameters are calibrated with the others.
       for (const auto& spec : cfg.parameters.specs()) {

@@ -87,10 +87,10 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
               const SurfaceChoice& choice, const std::string& pattern, double radius_mm, double sample_mm,
               double offset_mm, double pitch_mm, double row_step_mm) {
   if (!io::IsCadFile(surface_path)) {
-    throw std::invalid_argument("--list-faces: " + surface_path + " is a NURBS YAML (one patch); --list-faces lists "
+    throw UsageError("--list-faces: " + surface_path + " is a NURBS YAML (one patch); --list-faces lists "
                                 "the faces of a STEP/IGES file");
   }
-  if (choice.face_given) throw std::invalid_argument("--list-faces lists every face; drop --face");
+  if (choice.face_given) throw UsageError("--list-faces lists every face; drop --face");
   const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
   polishing::PathParameters params;
   params.pattern = pattern == "cycloid" ? polishing::Pattern::kCycloid : polishing::Pattern::kParallel;
@@ -245,7 +245,7 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--max-time-s", max_time_s, 1.0, 86400.0);
     CheckOptionRange("--threads", threads, 1, 64);
     if (optimise != "none" && pattern == "parallel" && optimise == "pso") {
-      throw std::invalid_argument("--optimise pso applies to the cycloid; the parallel pattern is optimised with --optimise nlopt");
+      throw UsageError("--optimise pso applies to the cycloid; the parallel pattern is optimised with --optimise nlopt");
     }
     RequireReadableFile(surface_path, "surface");
     RequireReadableFile(process_path, "process file");
@@ -259,7 +259,7 @@ int Run(int argc, char** argv) {
 
     if (list_faces) return ListFaces(surface_path, process_path, list_out, choice, pattern, radius_mm, sample_mm, offset_mm,
                                      pitch_mm, row_step_mm);
-    if (!list_out.empty()) throw std::invalid_argument("--out goes with --list-faces");
+    if (!list_out.empty()) throw UsageError("--out goes with --list-faces");
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
     const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
     {
@@ -305,7 +305,8 @@ int Run(int argc, char** argv) {
     params.stagger = stagger_loops;
     params.edge_overrun = MmToM(edge_overrun_mm);
     params.line_angle = line_angle_deg * kPi / 180.0;
-    polishing::CheckValid(params);  // std::invalid_argument -> exit 64, naming the limit
+    // Every parameter comes from an option: a value out of its limits is exit 64.
+    FromOption("path parameters", [&] { polishing::CheckValid(params); });
     if (optimise == "none" && params.pattern == polishing::Pattern::kCycloid) {
       // A face too narrow for the circle is an error in the input (exit 65),
       // never rows clamped onto its edges (PlanPath checks it again).

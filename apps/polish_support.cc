@@ -22,11 +22,11 @@ namespace robomach::apps {
 polishing::NurbsSurface LoadSurface(const std::string& tool, const std::string& path, const SurfaceChoice& choice) {
   if (!io::IsCadFile(path)) {
     if (choice.face_given) {
-      throw std::invalid_argument("--face " + std::to_string(choice.face) + ": " + path +
+      throw UsageError("--face " + std::to_string(choice.face) + ": " + path +
                                   " is a NURBS YAML (one patch); --face picks a face of a STEP/IGES file");
     }
     if (choice.cad_unit_scale != 1.0) {
-      throw std::invalid_argument("--cad-unit-scale: " + path + " is a NURBS YAML (lengths in mm by docs/formats.md §5); "
+      throw UsageError("--cad-unit-scale: " + path + " is a NURBS YAML (lengths in mm by docs/formats.md §5); "
                                   "the option applies to STEP/IGES files");
     }
     return io::ReadNurbsYaml(path);
@@ -372,15 +372,15 @@ void RobotOptions::Add(CLI::App* app) {
 
 void RobotOptions::Prepare(std::vector<std::pair<std::string, std::string>>* outs) {
   outs->push_back({"--joints", joints_out_});
-  if (!joints_out_.empty() && robot_path_.empty()) throw std::invalid_argument("--joints needs --robot");
+  if (!joints_out_.empty() && robot_path_.empty()) throw UsageError("--joints needs --robot");
   part_ = ParseNumberList("--part-frame-mm-deg", part_frame_text_);
   seed_deg_ = ParseNumberList("--robot-seed-deg", seed_text_);
-  if (part_.size() != 6) throw std::invalid_argument("--part-frame-mm-deg: expected x,y,z,rx,ry,rz (6 numbers)");
+  if (part_.size() != 6) throw UsageError("--part-frame-mm-deg: expected x,y,z,rx,ry,rz (6 numbers)");
   if (robot_path_.empty()) return;
   RequireReadableFile(robot_path_, "robot config");
   robot_ = io::LoadRobotConfig(robot_path_).Build();
   if (static_cast<int>(seed_deg_.size()) != robot_->num_joints()) {
-    throw std::invalid_argument("--robot-seed-deg: expected " + std::to_string(robot_->num_joints()) + " angles");
+    throw UsageError("--robot-seed-deg: expected " + std::to_string(robot_->num_joints()) + " angles");
   }
 }
 

@@ -34,7 +34,7 @@ struct SurfaceChoice {
 /// note on stderr) of a STEP/IGES file (formats.md §5), by the file's
 /// extension. Warns under `tool` when the CAD part is under 1 mm or over
 /// 10 m (units plausibility).
-/// @throws std::invalid_argument (exit 64) for --face or --cad-unit-scale
+/// @throws UsageError (exit 64) for --face or --cad-unit-scale
 /// with a YAML surface.
 polishing::NurbsSurface LoadSurface(const std::string& tool, const std::string& path, const SurfaceChoice& choice);
 
@@ -111,7 +111,7 @@ class RobotOptions {
   void Add(CLI::App* app);
   /// Checks the options and loads the robot (before any output is written);
   /// adds --joints to `outs` for the distinct-path check.
-  /// @throws std::invalid_argument (bad command line), InputError (robot config).
+  /// @throws UsageError (bad command line), InputError (robot config).
   void Prepare(std::vector<std::pair<std::string, std::string>>* outs);
   bool enabled() const { return robot_ != nullptr; }
   const std::string& robot_path() const { return robot_path_; }

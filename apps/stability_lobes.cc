@@ -91,7 +91,7 @@ Eigen::Vector3d ParseVector(const std::string& option, const std::string& text) 
     v.push_back(x);
   }
   if (v.size() != 3 || Eigen::Vector3d(v[0], v[1], v[2]).norm() == 0.0) {
-    throw std::invalid_argument(option + " " + text + ": expected a non-zero vector x,y,z");
+    throw UsageError(option + " " + text + ": expected a non-zero vector x,y,z");
   }
   return {v[0], v[1], v[2]};
 }
@@ -530,18 +530,18 @@ int Run(int argc, char** argv) {
   return RunGuarded(kTool, [&]() -> int {
     const int sources = (!robot_path.empty()) + (!frf_path.empty()) + (!modal_path.empty());
     if (sources != 1) {
-      throw std::invalid_argument("give exactly one tool-tip source: --robot (with --postures), --frf or --modal-table");
+      throw UsageError("give exactly one tool-tip source: --robot (with --postures), --frf or --modal-table");
     }
-    if (!robot_path.empty() && postures_path.empty()) throw std::invalid_argument("--robot needs --postures");
+    if (!robot_path.empty() && postures_path.empty()) throw UsageError("--robot needs --postures");
     if (frf_path.empty()) {
       for (const auto& [o, v] : {std::pair{"--frf-y", &frf_y_path}, {"--fit-plot", &fit_plot_path},
                                  {"--modes-out", &modes_out_path}}) {
-        if (!v->empty()) throw std::invalid_argument(std::string(o) + " needs --frf");
+        if (!v->empty()) throw UsageError(std::string(o) + " needs --frf");
       }
     }
     if ((sd_steps != 0 && sd_steps < 2) || sd_speeds < 1 || sd_modes < 1 || !(sd_max_depth_mm > 0.0) || speeds < 0 ||
         max_lobe < 0) {
-      throw std::invalid_argument(
+      throw UsageError(
           "expected --sd-steps 0 (automatic) or >= 2, --sd-speeds >= 1, --sd-modes >= 1, --sd-max-depth-mm > 0");
     }
     // Bounds that keep a typo from hours of work or an allocation failure.

@@ -65,10 +65,10 @@ int Run(int argc, char** argv) {
   }
   return RunGuarded(kTool, [&]() -> int {
     if (region_path.empty()) {
-      throw std::invalid_argument("--region is required (with --path it gives the seed posture and rotation)");
+      throw UsageError("--region is required (with --path it gives the seed posture and rotation)");
     }
     if (!(max_depth_mm > 0.0) || speeds < 0 || rotation_evals < 8) {
-      throw std::invalid_argument("expected --max-depth-mm > 0, --speeds >= 0, --rotation-evals >= 8");
+      throw UsageError("expected --max-depth-mm > 0, --speeds >= 0, --rotation-evals >= 8");
     }
     // Bounds that keep a typo from spawning 1e5 threads or hours of work.
     CheckOptionRange("--threads", threads, 0, 256);

@@ -75,9 +75,9 @@ int Run(int argc, char** argv) {
   }
 
   return RunGuarded(kTool, [&]() -> int {
-    if (!(noise_mm >= 0.0)) throw std::invalid_argument("--noise-mm: expected a noise >= 0 mm");
-    if (outliers < 0) throw std::invalid_argument("--outliers: expected a count >= 0");
-    if (num_postures < 1) throw std::invalid_argument("--num-postures: expected at least 1");
+    if (!(noise_mm >= 0.0)) throw UsageError("--noise-mm: expected a noise >= 0 mm");
+    if (outliers < 0) throw UsageError("--outliers: expected a count >= 0");
+    if (num_postures < 1) throw UsageError("--num-postures: expected at least 1");
     CheckOptionRange("--noise-mm", noise_mm, 0.0, 1e3);
     CheckOptionRange("--outlier-mm", outlier_mm, 0.0, 1e4);
     RequireReadableFile(robot_path, "robot config");
@@ -86,7 +86,7 @@ int Run(int argc, char** argv) {
                        {{"--out", out_path}, {"--summary", summary_path}});
     if (!plan_path.empty()) RequireReadableFile(plan_path, "plan file");
     if (!plan_path.empty() && !postures_path.empty()) {
-      throw std::invalid_argument("--plan-file and --postures exclude each other");
+      throw UsageError("--plan-file and --postures exclude each other");
     }
     io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
     for (const std::string& s : sets) {
@@ -101,18 +101,18 @@ int Run(int argc, char** argv) {
     // the static equilibrium of the simulation are meaningless.
     for (double m : o.masses_kg) CheckOptionRange("--masses-kg", m, 1e-3, 1e3);
     for (double m : o.masses_kg) {
-      if (!(m > 0.0)) throw std::invalid_argument("--masses-kg: expected masses > 0 kg");
+      if (!(m > 0.0)) throw UsageError("--masses-kg: expected masses > 0 kg");
     }
     o.pulleys.clear();
     for (const auto& p : pulleys) {
       const auto v = ParsePointMm("--pulley-mm", p);
-      if (!v) throw std::invalid_argument("--pulley-mm: expected x,y,z in mm");
+      if (!v) throw UsageError("--pulley-mm: expected x,y,z in mm");
       o.pulleys.push_back(*v);
     }
     o.p_load_tip = ParsePointMm("--load-point-mm", load_point);
     o.p_target_tip = ParsePointMm("--target-mm", target);
     for (const auto& [opt, p] : {std::pair{"--load-point-mm", o.p_load_tip}, {"--target-mm", o.p_target_tip}}) {
-      if (p && p->norm() > 2.0) throw std::invalid_argument(std::string(opt) + ": expected a point within 2000 mm of the flange");
+      if (p && p->norm() > 2.0) throw UsageError(std::string(opt) + ": expected a point within 2000 mm of the flange");
     }
     o.tracker_noise = MmToM(noise_mm);
     o.seed = seed;

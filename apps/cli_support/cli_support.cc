@@ -53,9 +53,14 @@ int RunGuarded(const std::string& tool, const std::function<int()>& body) {
   } catch (const OutputError& e) {
     std::cerr << tool << ": " << e.what() << '\n';
     return kExitCantCreate;
-  } catch (const std::invalid_argument& e) {
+  } catch (const UsageError& e) {
     std::cerr << tool << ": " << e.what() << '\n';
     return kExitUsage;
+  } catch (const std::invalid_argument& e) {
+    // The library refused a value the app passed on unchecked: every option
+    // is checked by the app (UsageError), so this value came from the input.
+    std::cerr << tool << ": bad input: " << e.what() << '\n';
+    return kExitDataError;
   } catch (const std::exception& e) {
     std::cerr << tool << ": internal error: " << e.what() << '\n';
     return kExitSoftware;
@@ -68,7 +73,7 @@ void CommitOutputsNow() {
 
 void RequireFolderOption(const std::string& option, const std::string& path) {
   if (path == "-") {
-    throw std::invalid_argument(option + " -: expected a folder; '-' (standard output) is for single-file outputs");
+    throw UsageError(option + " -: expected a folder; '-' (standard output) is for single-file outputs");
   }
 }
 
@@ -136,7 +141,7 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
   const size_t eq = text.find('=');
   double v = 0.0;
   if (eq == std::string::npos || eq == 0 || !io::ParseFiniteNumber(text.substr(eq + 1), &v)) {
-    throw std::invalid_argument(option + " " + text + ": expected NAME=VALUE with a number, e.g. m6_kg=30");
+    throw UsageError(option + " " + text + ": expected NAME=VALUE with a number, e.g. m6_kg=30");
   }
   return {text.substr(0, eq), v};
 }
@@ -154,13 +159,13 @@ void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& 
     if (path.empty() || path == "-") continue;
     for (const auto& [in_opt, in_path] : inputs) {
       if (!in_path.empty() && key(in_path) == key(path)) {
-        throw std::invalid_argument(opt + " " + path + " is also the input of " + in_opt +
+        throw UsageError(opt + " " + path + " is also the input of " + in_opt +
                                     "; writing it would destroy the input");
       }
     }
     for (size_t j = 0; j < i; ++j) {
       if (!outputs[j].second.empty() && key(outputs[j].second) == key(path)) {
-        throw std::invalid_argument(opt + " and " + outputs[j].first + " name the same file " + path);
+        throw UsageError(opt + " and " + outputs[j].first + " name the same file " + path);
       }
     }
   }
@@ -189,7 +194,7 @@ void CheckOptionRange(const std::string& option, double value, double lo, double
   if (!(value >= lo && value <= hi)) {
     std::ostringstream s;
     s << option << ": expected a value in [" << lo << ", " << hi << "], got " << value;
-    throw std::invalid_argument(s.str());
+    throw UsageError(s.str());
   }
 }
 
@@ -201,7 +206,7 @@ std::vector<double> ParseNumberList(const std::string& option, const std::string
     if (comma == std::string::npos) comma = text.size();
     double x = 0.0;
     if (!io::ParseFiniteNumber(text.substr(pos, comma - pos), &x)) {
-      throw std::invalid_argument(option + ": expected numbers separated by commas, got \"" + text + "\"");
+      throw UsageError(option + ": expected numbers separated by commas, got \"" + text + "\"");
     }
     v.push_back(x);
     pos = comma + 1;
@@ -218,7 +223,7 @@ std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std
     v.clear();
   }
   if (v.size() != 3) {
-    throw std::invalid_argument(option + ": expected x,y,z in mm or 'tcp', got \"" + text + "\"");
+    throw UsageError(option + ": expected x,y,z in mm or 'tcp', got \"" + text + "\"");
   }
   return Eigen::Vector3d(v[0] * 1e-3, v[1] * 1e-3, v[2] * 1e-3);
 }
@@ -228,12 +233,12 @@ void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<st
   for (const std::string& name : adds) cfg->description.effects.push_back({name, {}});
   if (!adds.empty()) {
     const dynamics::ParameterSet old = cfg->parameters;
-    cfg->parameters = dynamics::DefaultParameters(cfg->description);
+    cfg->parameters = FromOption("--add", [&] { return dynamics::DefaultParameters(cfg->description); });
     for (const auto& s : old.specs()) cfg->parameters.Set(s.name, old.Get(s.name));
   }
   for (const std::string& s : sets) {
     const auto [name, value] = ParseAssignment("--set", s);
-    cfg->parameters.Set(name, value);
+    FromOption("--set " + s, [&] { cfg->parameters.Set(name, value); });
   }
 }
 

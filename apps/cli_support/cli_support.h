@@ -16,6 +16,7 @@ namespace CLI {
 class App;
 }  // namespace CLI
 #include <iostream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -32,9 +33,32 @@ inline constexpr int kExitCantCreate = 73; // EX_CANTCREAT
 /// The exit-code table for --help footers.
 std::string ExitCodeHelp();
 
+/// A bad command line: an option's value, a missing option, options that
+/// exclude each other. The only exception RunGuarded maps to exit 64.
+class UsageError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// Runs `parse` on an option's value (a library parser or check): its
+/// std::invalid_argument becomes a UsageError naming the option (exit 64).
+template <class F>
+auto FromOption(const std::string& option, F&& parse) -> decltype(parse()) {
+  try {
+    return parse();
+  } catch (const UsageError&) {
+    throw;
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(option + ": " + e.what());
+  }
+}
+
 /// Runs `body` and maps exceptions to exit codes with one message on stderr
-/// prefixed by the tool name: InputError -> 65, OutputError -> 73,
-/// std::invalid_argument (bad option values) -> 64, anything else -> 70.
+/// prefixed by the tool name: UsageError -> 64, NoInputError -> 66,
+/// InputError -> 65, OutputError -> 73, anything else -> 70. A library's
+/// std::invalid_argument that reaches it is not a command-line error (the
+/// apps check their options and throw UsageError): it came from input data,
+/// 65. Exit 64 means the command line and nothing else.
 /// The run is all or nothing: `body` runs inside an io::OutputRun, so every
 /// file written with io::WriteFileAtomically (and "-", stdout) is staged and
 /// put into place only when `body` returns 0 or 3; otherwise, or when it
@@ -50,7 +74,7 @@ void CommitOutputsNow();
 /// @throws InputError "path: no such file" if `path` is not a readable file;
 /// RunGuarded maps it to 66.
 /// A folder option (--report, --plot-dir): "-" is standard output, which
-/// takes single files only. @throws std::invalid_argument (exit 64).
+/// takes single files only. @throws UsageError (exit 64).
 void RequireFolderOption(const std::string& option, const std::string& path);
 
 void RequireReadableFile(const std::string& path, const std::string& what);
@@ -95,12 +119,12 @@ void AddVersionFlag(CLI::App& app, const std::string& tool);
 /// Use as app.add_option("--plot", path, "...")->check(PngFileName()).
 std::function<std::string(const std::string&)> PngFileName();
 
-/// Splits "NAME=VALUE"; @throws std::invalid_argument naming the option.
+/// Splits "NAME=VALUE"; @throws UsageError naming the option.
 std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text);
 
 /// Refuses an output path that is also an input or another output (a user
 /// typo that would silently destroy data). Empty paths are ignored; "-"
-/// means stdout. @throws std::invalid_argument naming both options.
+/// means stdout. @throws UsageError naming both options.
 /// Then, before any work, checks that every output can be written: the
 /// nearest existing folder on its path must be a writable folder (a file in
 /// the way, a read-only folder). @throws OutputError (exit 73) naming the
@@ -108,17 +132,17 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
 void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& inputs,
                         const std::vector<std::pair<std::string, std::string>>& outputs);
 
-/// @throws std::invalid_argument unless lo <= value <= hi (and finite).
+/// @throws UsageError unless lo <= value <= hi (and finite).
 void CheckOptionRange(const std::string& option, double value, double lo, double hi);
 
-/// "1,2.5,3" -> numbers; @throws std::invalid_argument naming the option.
+/// "1,2.5,3" -> numbers; @throws UsageError naming the option.
 std::vector<double> ParseNumberList(const std::string& option, const std::string& text);
 /// "x,y,z" in millimetres -> metres, or nullopt for "tcp" (or empty).
 std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std::string& text);
 
 /// Applies `--add EFFECT` (with its default parameters; values already set
 /// are kept) and then `--set NAME=VALUE` to a loaded robot config.
-/// @throws std::invalid_argument for an unknown effect or parameter, or a
+/// @throws UsageError for an unknown effect or parameter, or a
 ///   value outside its bounds.
 void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<std::string>& sets,
                       io::RobotConfig* config);

@@ -42,7 +42,7 @@ MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::s
   for (const std::string& a : pose_files) {
     const auto eq = a.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == a.size()) {
-      throw std::invalid_argument(pose_option + " '" + a + "': expected ID=file.uff, e.g. " + pose_option + " P1=p1.uff");
+      throw UsageError(pose_option + " '" + a + "': expected ID=file.uff, e.g. " + pose_option + " P1=p1.uff");
     }
     add(a.substr(eq + 1), a.substr(0, eq));
   }
@@ -102,11 +102,11 @@ calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const Meas
     no.wide_floor = o.drift_floor;
     if (o.model == "coherence") {
       if (!frf.coherence()) {
-        throw std::invalid_argument("--noise-model coherence: " + key.ToString() + " (" + data.file.at(key) +
+        throw UsageError("--noise-model coherence: " + key.ToString() + " (" + data.file.at(key) +
                                     ") has no coherence; use --noise-model scatter or auto");
       }
       if (no.averages == 0) {
-        throw std::invalid_argument("--noise-model coherence: " + data.file.at(key) +
+        throw UsageError("--noise-model coherence: " + data.file.at(key) +
                                     " does not say how many averages are behind its coherence ('# averages: N'); "
                                     "give --averages N");
       }

@@ -34,7 +34,7 @@ struct MeasuredData {
 /// set; warnings and notes go to stderr under `tool`. @throws InputError for
 /// an FRF read twice or one without a posture (the message suggests
 /// --pose, so every tool that calls this has that option),
-/// std::invalid_argument for a malformed ID=file.
+/// UsageError for a malformed ID=file.
 MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::string>& files,
                                const std::vector<std::string>& pose_files, const std::string& what,
                                const std::string& pose_option = "--pose");
@@ -55,7 +55,7 @@ void AddNoiseOptions(CLI::App& app, NoiseCliOptions* options);
 
 /// The noise model of every FRF (empty for --noise-model none), one line per
 /// FRF on stderr (source, rel, floor, usable band), warnings for FRFs with
-/// no usable line. @throws std::invalid_argument for inconsistent options
+/// no usable line. @throws UsageError for inconsistent options
 ///   (coherence asked for an FRF without coherence or without a number of
 ///   averages), naming the FRF and what to give.
 calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const MeasuredData& data,
