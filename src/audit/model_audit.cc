@@ -584,7 +584,11 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
   CandidateResult c;
   c.effects = base_effects_added;
   c.effects.push_back(effect);
-  auto [desc, params] = WithEffect(base_desc, start, effect);
+  // Named references, not a structured binding: the lambdas below capture
+  // them (clang before 16 cannot capture a structured binding).
+  const auto with_effect = WithEffect(base_desc, start, effect);
+  const dynamics::RobotDescription& desc = with_effect.first;
+  const dynamics::ParameterSet& params = with_effect.second;
   const std::vector<std::string> added = FittableOf(effect);
   const auto finish = [&](CandidateResult& cand, const std::vector<std::string>& free) {
     cand.errors = ComputeErrors(dynamics::RobotModel::Build(desc, cand.fit.parameters), x.postures, x.measured,
@@ -1241,7 +1245,7 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   const CandidateResult& top = singles.front();
   const bool top_usable = top.bic_change < 0.0 && top.fit.status != calibration::FitStatus::kFailed;
   if ((r.best < 0 || !explains(singles[r.best])) && top_usable && o.greedy_second_round && singles.size() > 1) {
-    auto [desc1, params1] = WithEffect(description, top.fit.parameters, top.effects[0]);
+    const dynamics::RobotDescription desc1 = WithEffect(description, top.fit.parameters, top.effects[0]).first;
     // The first effect's parameters that its single fit pinned at a bound
     // were standing in for what is still missing: they restart from their
     // defaults (seen: a tool's damping ratio at 0.3 that kept the pair with
