@@ -25,12 +25,6 @@ namespace {
 
 constexpr char kTool[] = "frf-estimate";
 
-std::string Num(double v, int digits = 4) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
-
 io::FrfQuantity QuantityOf(calibration::ResponseQuantity q) {
   switch (q) {
     case calibration::ResponseQuantity::kDisplacement: return io::FrfQuantity::kReceptance;
@@ -65,7 +59,7 @@ void SavePlot(const std::string& path, const calibration::FrfEstimateResult& r, 
   report::Figure fig(2, 1, 1000, 400);
   fig.title = "frf-estimate: " + estimator + " of " + std::to_string(r.averages) + " hits";
   if (r.exponential_tau_s > 0.0) {
-    fig.title += ", exponential window tau = " + Num(r.exponential_tau_s, 3) + " s (adds damping)";
+    fig.title += ", exponential window tau = " + FormatNumber(r.exponential_tau_s, 3) + " s (adds damping)";
   }
   report::Axes& mag = fig.at(0, 0);
   report::Axes& coh = fig.at(1, 0);
@@ -233,7 +227,7 @@ int Run(int argc, char** argv) {
         o.response_range[c] = value;
       }
     }
-    std::cerr << kTool << ": " << rec.hits.size() << " hit(s) at " << Num(rec.hits.front().sample_rate_hz, 7)
+    std::cerr << kTool << ": " << rec.hits.size() << " hit(s) at " << FormatNumber(rec.hits.front().sample_rate_hz, 7)
               << " Hz; pose " << pose_id << ", excitation " << AxisName(exc) << ", responses";
     for (size_t c = 0; c < keys.size(); ++c) {
       std::cerr << (c ? ", " : " ") << rec.channel_columns[c] << " -> " << AxisName(keys[c].response);
@@ -246,7 +240,7 @@ int Run(int argc, char** argv) {
       if (h.status == calibration::HitStatus::kAccepted) continue;
       rejected.push_back(h.id + " (" + calibration::HitStatusName(h.status) + ")");
       for (const std::string& note : h.notes) {
-        std::cerr << kTool << ": hit " << h.id << " (" << h.source << ", hit at t = " << Num(h.hit_time_s, 6)
+        std::cerr << kTool << ": hit " << h.id << " (" << h.source << ", hit at t = " << FormatNumber(h.hit_time_s, 6)
                   << " s) rejected: " << note << '\n';
       }
     }
@@ -367,8 +361,8 @@ int Run(int argc, char** argv) {
       for (size_t i = 0; i < rejected.size(); ++i) msg << (i ? ", " : "") << rejected[i];
       msg << ")";
     }
-    msg << "; " << frfs.size() << " FRF(s) of " << r.freq_hz.size() << " lines, " << Num(r.freq_hz(0)) << " to "
-        << Num(r.freq_hz(r.freq_hz.size() - 1), 6) << " Hz, written to " << out_path << '\n';
+    msg << "; " << frfs.size() << " FRF(s) of " << r.freq_hz.size() << " lines, " << FormatNumber(r.freq_hz(0)) << " to "
+        << FormatNumber(r.freq_hz(r.freq_hz.size() - 1), 6) << " Hz, written to " << out_path << '\n';
     std::cerr << msg.str();
     return rc;
   });

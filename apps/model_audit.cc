@@ -14,6 +14,7 @@
 #include "robomach/audit/error_patterns.h"
 #include "robomach/audit/model_audit.h"
 #include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
 #include "robomach/dynamics/effect.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/io/atomic_file.h"
@@ -22,6 +23,7 @@
 #include "robomach/io/robot_config.h"
 #include "robomach/report/audit_patterns_report.h"
 #include "robomach/report/calibration_report.h"
+#include "robomach/report/html.h"
 #include "robomach/report/posture_json.h"
 
 namespace robomach::apps {
@@ -41,24 +43,6 @@ std::map<std::string, double> PerPosture(const audit::ModelErrors& e, const std:
   std::map<std::string, double> out;
   for (size_t i = 0; i < ids.size(); ++i) out[ids[i]] = v(static_cast<Eigen::Index>(i));
   return out;
-}
-
-std::string Html(const std::string& s) {
-  std::string o;
-  for (char ch : s) {
-    if (ch == '<') o += "&lt;";
-    else if (ch == '>') o += "&gt;";
-    else if (ch == '&') o += "&amp;";
-    else o += ch;
-  }
-  return o;
-}
-
-std::string Num(double v, int precision = 4) {
-  std::ostringstream s;
-  s.precision(precision);
-  s << v;
-  return s.str();
 }
 
 json ReadPreviousSummary(const std::string& dir) {
@@ -125,8 +109,8 @@ int Run(int argc, char** argv) {
     // Option values, with the options' names (before minutes of fitting).
     CheckOptionRange("--fmin-hz", opt.fmin_hz, 0.0, 1e9);
     if (!(opt.fmax_hz > opt.fmin_hz)) {
-      throw UsageError("--fmax-hz must be above --fmin-hz (" + Num(opt.fmin_hz) + " Hz), got " +
-                                  Num(opt.fmax_hz));
+      throw UsageError("--fmax-hz must be above --fmin-hz (" + FormatNumber(opt.fmin_hz) + " Hz), got " +
+                                  FormatNumber(opt.fmax_hz));
     }
     CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
     {
@@ -196,7 +180,7 @@ int Run(int argc, char** argv) {
       if (lines < 3) {
         throw InputError({measured_read.file.begin()->second, 0, 0},
                          "the measured FRFs have " + std::to_string(lines) + " lines in the band " +
-                             Num(opt.fmin_hz) + ".." + Num(opt.fmax_hz) + " Hz (--fmin-hz, --fmax-hz); need at least 3");
+                             FormatNumber(opt.fmin_hz) + ".." + FormatNumber(opt.fmax_hz) + " Hz (--fmin-hz, --fmax-hz); need at least 3");
       }
     }
 
@@ -308,10 +292,10 @@ int Run(int argc, char** argv) {
     for (size_t i = 0; i < r.errors_before.curves.size(); ++i) {
       const auto& c = r.errors_before.curves[i];
       ecsv << c.key.pose_id << ',' << AxisName(c.key.response) << ',' << AxisName(c.key.excitation) << ','
-           << c.lines << ',' << Num(c.rms_log_mag, 6) << ',' << Num(after.curves[i].rms_log_mag, 6);
+           << c.lines << ',' << FormatNumber(c.rms_log_mag, 6) << ',' << FormatNumber(after.curves[i].rms_log_mag, 6);
       if (!c.bands.empty()) {
-        ecsv << ',' << Num(c.bands[0].fmin_hz, 6) << ',' << Num(c.bands[0].fmax_hz, 6) << ','
-             << Num(c.bands[0].rms_log_mag, 6);
+        ecsv << ',' << FormatNumber(c.bands[0].fmin_hz, 6) << ',' << FormatNumber(c.bands[0].fmax_hz, 6) << ','
+             << FormatNumber(c.bands[0].rms_log_mag, 6);
       } else {
         ecsv << ",,,";
       }
@@ -324,7 +308,7 @@ int Run(int argc, char** argv) {
       std::string note = c.note;
       std::replace(note.begin(), note.end(), ',', ';');
       std::replace(note.begin(), note.end(), '\n', ' ');
-      ccsv << i + 1 << ',' << c.name() << ',' << Num(c.bic_change, 8) << ',' << Num(c.errors.total_rms_log_mag, 6)
+      ccsv << i + 1 << ',' << c.name() << ',' << FormatNumber(c.bic_change, 8) << ',' << FormatNumber(c.errors.total_rms_log_mag, 6)
            << ',' << (c.plausible ? "yes" : "no") << ',' << note << '\n';
     }
 
@@ -357,10 +341,10 @@ int Run(int argc, char** argv) {
           : r.grade == audit::AuditGrade::kMostlyExplained ? "#e67e22"
                                                             : "#27ae60")
       << ";background:#f6f6f6}img{max-width:100%}"
-         "</style></head><body><h1>model-audit: " << Html(robot_path) << "</h1>\n";
+         "</style></head><body><h1>model-audit: " << report::HtmlEscape(robot_path) << "</h1>\n";
     {
       // The library's plain-text arrows and times signs, typeset.
-      std::string line = Html(r.headline);
+      std::string line = report::HtmlEscape(r.headline);
       for (const auto& [from, to] : {std::pair<std::string, std::string>{" -&gt; ", " → "}, {" x the noise", " × the noise"}}) {
         for (size_t at = line.find(from); at != std::string::npos; at = line.find(from, at + to.size())) {
           line.replace(at, from.size(), to);
@@ -374,14 +358,14 @@ int Run(int argc, char** argv) {
       const bool has_after = shown && worst < shown->errors.curves.size();
       h << "<p><img src=\"worst_frf.png\" alt=\"worst FRF before and after\"><br>The FRF the current model fits "
            "worst, "
-        << Html(KeyLabel(wc.key)) << " (error " << Num(wc.rms_log_mag / r.noise_floor, 3) << " × the noise floor";
+        << report::HtmlEscape(KeyLabel(wc.key)) << " (error " << FormatNumber(wc.rms_log_mag / r.noise_floor, 3) << " × the noise floor";
       if (has_after) {
-        h << "; " << Num(shown->errors.curves[worst].rms_log_mag / r.noise_floor, 3) << " with "
-          << Html(shown->name());
+        h << "; " << FormatNumber(shown->errors.curves[worst].rms_log_mag / r.noise_floor, 3) << " with "
+          << report::HtmlEscape(shown->name());
       }
       h << "): measured (wide, with its noise where known), the calibrated current model (dashed)";
       if (shown) {
-        h << " and the model with " << Html(shown->name()) << " (" << (best ? "" : "not accepted; ") << "thin line)";
+        h << " and the model with " << report::HtmlEscape(shown->name()) << " (" << (best ? "" : "not accepted; ") << "thin line)";
       }
       h << ".</p>\n";
     }
@@ -390,29 +374,29 @@ int Run(int argc, char** argv) {
       // The verdict's parts one by one (summary.json's verdict.text has them
       // in one sentence).
       h << "<p>Likely reasons for the remainder:</p><ul>";
-      for (const auto& reason : r.reasons) h << "<li>" << Html(reason) << "</li>";
-      h << "</ul>\n<p>Pattern of the remainder: " << Html(r.pattern) << ".</p>\n";
+      for (const auto& reason : r.reasons) h << "<li>" << report::HtmlEscape(reason) << "</li>";
+      h << "</ul>\n<p>Pattern of the remainder: " << report::HtmlEscape(r.pattern) << ".</p>\n";
     } else {
-      h << "<p>" << Html(r.verdict) << "</p>\n";
+      h << "<p>" << report::HtmlEscape(r.verdict) << "</p>\n";
     }
     if (r.graded >= 0) {
-      h << "<p>Graded on " << Html(r.candidates[r.graded].name()) << ": error " << Num(r.error_before_noise_units, 3)
-        << " → " << Num(r.remainder_noise_units, 3) << " × the noise floor, "
-        << Num(100.0 * r.fraction_removed, 3) << " % of the excess misfit (error/noise − 1) removed; BIC "
-        << Num(r.bic_gap, 4) << " below the runner-up, " << Html(r.runner_up) << ". \"Mostly explained\" takes "
-        << Num(100.0 * opt.mostly_explained_fraction, 3) << " % or more and a BIC gap above "
-        << Num(opt.clear_bic_gap, 3) << " (very strong evidence, Kass &amp; Raftery 1995).</p>\n";
+      h << "<p>Graded on " << report::HtmlEscape(r.candidates[r.graded].name()) << ": error " << FormatNumber(r.error_before_noise_units, 3)
+        << " → " << FormatNumber(r.remainder_noise_units, 3) << " × the noise floor, "
+        << FormatNumber(100.0 * r.fraction_removed, 3) << " % of the excess misfit (error/noise − 1) removed; BIC "
+        << FormatNumber(r.bic_gap, 4) << " below the runner-up, " << report::HtmlEscape(r.runner_up) << ". \"Mostly explained\" takes "
+        << FormatNumber(100.0 * opt.mostly_explained_fraction, 3) << " % or more and a BIC gap above "
+        << FormatNumber(opt.clear_bic_gap, 3) << " (very strong evidence, Kass &amp; Raftery 1995).</p>\n";
     }
     h << "<p>Whole-curve error (rms of ln|H<sub>model</sub>| − "
       << "ln|H<sub>measured</sub>|" << (noise.empty() ? "" : ", each line in units of its noise: 1 is a model that is right")
-      << "): before " << Num(r.errors_before.total_rms_log_mag) << ", after "
-      << Num(after.total_rms_log_mag) << "; noise floor " << Num(r.noise_floor) << " ("
+      << "): before " << FormatNumber(r.errors_before.total_rms_log_mag) << ", after "
+      << FormatNumber(after.total_rms_log_mag) << "; noise floor " << FormatNumber(r.noise_floor) << " ("
       << (r.significant_failure ? "significant failure" : "consistent with the noise") << ").</p>\n";
     if (!noise.empty()) {
-      h << "<h2>Noise model and usable band per FRF</h2><p>Lines used where |H| ≥ " << Num(noise_opt.min_snr)
+      h << "<h2>Noise model and usable band per FRF</h2><p>Lines used where |H| ≥ " << FormatNumber(noise_opt.min_snr)
         << " × the additive noise floor (--min-snr).</p><table><tr><th>FRF</th><th>noise model</th></tr>\n";
       for (const auto& [key, n] : noise) {
-        h << "<tr><td>" << Html(KeyLabel(key)) << "</td><td style=\"text-align:left\">" << Html(n.description)
+        h << "<tr><td>" << report::HtmlEscape(KeyLabel(key)) << "</td><td style=\"text-align:left\">" << report::HtmlEscape(n.description)
           << "</td></tr>\n";
       }
       h << "</table>\n";
@@ -421,29 +405,29 @@ int Run(int argc, char** argv) {
     if (!previous.is_null()) h << "<th>previous before</th><th>previous after</th>";
     h << "</tr>\n";
     for (const auto& [id, e] : pb) {
-      h << "<tr><td>" << Html(id) << "</td><td>" << Num(e) << "</td><td>" << Num(pa.at(id)) << "</td>";
+      h << "<tr><td>" << report::HtmlEscape(id) << "</td><td>" << FormatNumber(e) << "</td><td>" << FormatNumber(pa.at(id)) << "</td>";
       if (!previous.is_null()) {
         const bool has = previous["postures"].contains(id);
-        h << "<td>" << (has ? Num(previous["postures"][id]["error_before"].get<double>()) : "–") << "</td><td>"
-          << (has ? Num(previous["postures"][id]["error_after"].get<double>()) : "–") << "</td>";
+        h << "<td>" << (has ? FormatNumber(previous["postures"][id]["error_before"].get<double>()) : "–") << "</td><td>"
+          << (has ? FormatNumber(previous["postures"][id]["error_after"].get<double>()) : "–") << "</td>";
       }
       h << "</tr>\n";
     }
-    h << "<tr><th>total</th><th>" << Num(r.errors_before.total_rms_log_mag) << "</th><th>"
-      << Num(after.total_rms_log_mag) << "</th>";
+    h << "<tr><th>total</th><th>" << FormatNumber(r.errors_before.total_rms_log_mag) << "</th><th>"
+      << FormatNumber(after.total_rms_log_mag) << "</th>";
     if (!previous.is_null()) {
-      h << "<th>" << Num(previous["error_before"].get<double>()) << "</th><th>"
-        << Num(previous["error_after"].get<double>()) << "</th>";
+      h << "<th>" << FormatNumber(previous["error_before"].get<double>()) << "</th><th>"
+        << FormatNumber(previous["error_after"].get<double>()) << "</th>";
     }
     h << "</tr></table>\n<h2>Error per posture and direction, worst band</h2><table><tr><th>FRF</th><th>before</th>"
          "<th>after</th><th>worst band [Hz]</th><th>its error</th></tr>\n";
     for (size_t i = 0; i < r.errors_before.curves.size(); ++i) {
       const auto& c = r.errors_before.curves[i];
-      h << "<tr><td>" << Html(KeyLabel(c.key)) << "</td><td>" << Num(c.rms_log_mag) << "</td><td>"
-        << Num(after.curves[i].rms_log_mag) << "</td>";
+      h << "<tr><td>" << report::HtmlEscape(KeyLabel(c.key)) << "</td><td>" << FormatNumber(c.rms_log_mag) << "</td><td>"
+        << FormatNumber(after.curves[i].rms_log_mag) << "</td>";
       if (!c.bands.empty()) {
-        h << "<td>" << Num(c.bands[0].fmin_hz, 3) << "–" << Num(c.bands[0].fmax_hz, 3) << "</td><td>"
-          << Num(c.bands[0].rms_log_mag) << "</td>";
+        h << "<td>" << FormatNumber(c.bands[0].fmin_hz, 3) << "–" << FormatNumber(c.bands[0].fmax_hz, 3) << "</td><td>"
+          << FormatNumber(c.bands[0].rms_log_mag) << "</td>";
       } else {
         h << "<td></td><td></td>";
       }
@@ -452,9 +436,9 @@ int Run(int argc, char** argv) {
     h << "</table>\n<h2>Modes (current model, calibrated)</h2><table><tr><th>FRF</th><th>measured [Hz]</th>"
          "<th>frequency error</th><th>damping meas.</th><th>damping model</th><th>peak error</th></tr>\n";
     for (const auto& m : r.modes_before.matches) {
-      h << "<tr><td>" << Html(KeyLabel(m.key)) << "</td><td>" << Num(m.measured_freq_hz) << "</td><td>"
-        << Num(100 * m.freq_error(), 3) << " %</td><td>" << Num(m.measured_damping, 3) << "</td><td>"
-        << Num(m.model_damping, 3) << "</td><td>" << Num(100 * m.peak_error(), 3) << " %</td></tr>\n";
+      h << "<tr><td>" << report::HtmlEscape(KeyLabel(m.key)) << "</td><td>" << FormatNumber(m.measured_freq_hz) << "</td><td>"
+        << FormatNumber(100 * m.freq_error(), 3) << " %</td><td>" << FormatNumber(m.measured_damping, 3) << "</td><td>"
+        << FormatNumber(m.model_damping, 3) << "</td><td>" << FormatNumber(100 * m.peak_error(), 3) << " %</td></tr>\n";
     }
     h << "</table>\n" << pr.html << "<h2>Candidate effects (best first)</h2>";
     if (r.candidates.empty()) h << "<p>None tried.</p>";
@@ -462,11 +446,11 @@ int Run(int argc, char** argv) {
          "<th>fitted parameters (±1σ)</th></tr>\n";
     for (size_t i = 0; i < r.candidates.size(); ++i) {
       const auto& c = r.candidates[i];
-      h << "<tr><td>" << i + 1 << "</td><td>" << Html(c.name()) << "</td><td>" << Num(c.bic_change, 6)
-        << "</td><td>" << Num(c.errors.total_rms_log_mag) << "</td><td>" << (c.plausible ? "yes" : "no: " + Html(c.note))
+      h << "<tr><td>" << i + 1 << "</td><td>" << report::HtmlEscape(c.name()) << "</td><td>" << FormatNumber(c.bic_change, 6)
+        << "</td><td>" << FormatNumber(c.errors.total_rms_log_mag) << "</td><td>" << (c.plausible ? "yes" : "no: " + report::HtmlEscape(c.note))
         << "</td><td style=\"text-align:left\">";
       for (const auto& e : c.fit.estimates) {
-        if (e.name.find('.') != std::string::npos) h << Html(e.name) << " = " << Num(e.value) << " ± " << Num(e.std_dev, 2) << "<br>";
+        if (e.name.find('.') != std::string::npos) h << report::HtmlEscape(e.name) << " = " << FormatNumber(e.value) << " ± " << FormatNumber(e.std_dev, 2) << "<br>";
       }
       h << "</td></tr>\n";
     }
@@ -474,13 +458,13 @@ int Run(int argc, char** argv) {
     if (!yaml.empty()) {
       h << "<h2>" << (best ? "Add the effect" : "The added effects, calibrated")
         << "</h2><p>Append to the robot config (merge into its <code>effects:</code> list if it has one):</p><pre>"
-        << Html(yaml) << "</pre>\n";
+        << report::HtmlEscape(yaml) << "</pre>\n";
     }
     h << "<h2>Overlays per posture</h2><p>Measured FRFs (wide band), the calibrated current model (dashed)"
-      << (shown ? " and the model " + Html(after_label) + " (thin line)" : std::string())
+      << (shown ? " and the model " + report::HtmlEscape(after_label) + " (thin line)" : std::string())
       << "; vertical lines: the natural frequencies of the " << (shown ? "latter" : "model") << ".</p>\n";
     for (const auto& id : measured.pose_ids()) {
-      h << "<p><img src=\"overlay_" << Html(id) << ".png\" alt=\"overlay " << Html(id) << "\"></p>\n";
+      h << "<p><img src=\"overlay_" << report::HtmlEscape(id) << ".png\" alt=\"overlay " << report::HtmlEscape(id) << "\"></p>\n";
     }
     h << "</body></html>\n";
 

@@ -31,8 +31,6 @@ double RoundRpm(double rpm) { return std::round(rpm * 1e9) / 1e9; }
 
 constexpr char kTool[] = "stability-map";
 
-std::string Num(double v, double scale = 1.0) { return std::isfinite(v) ? io::FormatDouble(v * scale) : ""; }
-
 int Run(int argc, char** argv) {
   CLI::App app{
       "stability-map: critical axial depth of cut over a work region (grid of tool poses from a\n"
@@ -177,24 +175,24 @@ int Run(int argc, char** argv) {
         if (grid) {
           const int r = static_cast<int>(i) / cols, c = static_cast<int>(i) % cols;
           const Eigen::Vector2d uv = region.PlaneCoordinates(r, c);
-          os << r << ',' << c << ',' << Num(uv(0), 1e3) << ',' << Num(uv(1), 1e3) << ',';
+          os << r << ',' << c << ',' << FormatCell(uv(0) * 1e3) << ',' << FormatCell(uv(1) * 1e3) << ',';
         } else {
           os << ids[i] << ',';
         }
-        os << Num(targets[i].p_BT.x(), 1e3) << ',' << Num(targets[i].p_BT.y(), 1e3) << ','
-           << Num(targets[i].p_BT.z(), 1e3) << ','
-           << Num(RadToDeg(p.rotation + (grid ? 0.0 : path_rotation[i])));
-        for (int j = 0; j < n; ++j) os << ',' << (p.q.size() == n ? Num(RadToDeg(p.q(j))) : "");
+        os << FormatCell(targets[i].p_BT.x() * 1e3) << ',' << FormatCell(targets[i].p_BT.y() * 1e3) << ','
+           << FormatCell(targets[i].p_BT.z() * 1e3) << ','
+           << FormatCell(RadToDeg(p.rotation + (grid ? 0.0 : path_rotation[i])));
+        for (int j = 0; j < n; ++j) os << ',' << (p.q.size() == n ? FormatCell(RadToDeg(p.q(j))) : "");
         const bool mc = analysed && s.mode_coupling.status == stability::ModeCouplingStatus::kFound;
         const bool rg = analysed && s.regenerative.status == stability::LobeStatus::kOk;
-        os << ',' << (mc ? Num(s.mode_coupling.critical_depth, 1e3) : "") << ','
-           << (analysed ? Num(s.closed_form.critical_depth, 1e3) : "") << ','
-           << (analysed ? Num(s.closed_form.deformation_ratio) : "") << ','
-           << (rg ? Num(s.regenerative.critical_depth, 1e3) : "") << ','
-           << (rg ? Num(RoundRpm(RadPerSecToRpm(s.regenerative.spindle_speed_rad_s))) : "") << ','
-           << (analysed ? Num(s.critical_depth, 1e3) : "") << ','
+        os << ',' << (mc ? FormatCell(s.mode_coupling.critical_depth * 1e3) : "") << ','
+           << (analysed ? FormatCell(s.closed_form.critical_depth * 1e3) : "") << ','
+           << (analysed ? FormatCell(s.closed_form.deformation_ratio) : "") << ','
+           << (rg ? FormatCell(s.regenerative.critical_depth * 1e3) : "") << ','
+           << (rg ? FormatCell(RoundRpm(RadPerSecToRpm(s.regenerative.spindle_speed_rad_s))) : "") << ','
+           << (analysed ? FormatCell(s.critical_depth * 1e3) : "") << ','
            << (analysed ? stability::ToString(s.limiting) : "") << ','
-           << (analysed ? Num(s.chatter_freq_hz) : "") << ',' << Num(p.jacobian_condition) << ','
+           << (analysed ? FormatCell(s.chatter_freq_hz) : "") << ',' << FormatCell(p.jacobian_condition) << ','
            << stability::ToString(p.status) << '\n';
       }
     };

@@ -237,8 +237,8 @@ void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<st
     for (const auto& s : old.specs()) cfg->parameters.Set(s.name, old.Get(s.name));
   }
   for (const std::string& s : sets) {
-    const auto [name, value] = ParseAssignment("--set", s);
-    FromOption("--set " + s, [&] { cfg->parameters.Set(name, value); });
+    const std::pair<std::string, double> assignment = ParseAssignment("--set", s);
+    FromOption("--set " + s, [&] { cfg->parameters.Set(assignment.first, assignment.second); });
   }
 }
 

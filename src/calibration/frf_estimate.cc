@@ -11,20 +11,15 @@
 // libeigen3-dev): see third_party_notes.md for why this one.
 #include <unsupported/Eigen/FFT>
 
+#include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 
 namespace robomach::calibration {
 namespace {
 
-std::string Num(double v, int digits = 4) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
-
 void Require(bool ok, const std::string& field, double value, const std::string& rule) {
   if (!ok) {
-    throw std::invalid_argument("FrfEstimateOptions::" + field + " = " + Num(value, 6) + ": expected " + rule);
+    throw std::invalid_argument("FrfEstimateOptions::" + field + " = " + FormatNumber(value, 6) + ": expected " + rule);
   }
 }
 
@@ -174,8 +169,8 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
   int n_max = 0;
   for (const ImpactRecord& h : hits) {
     if (!(h.sample_rate_hz > 0.0) || std::abs(h.sample_rate_hz - fs) > 1e-4 * fs) {
-      throw std::invalid_argument("hit " + h.id + " (" + h.source + "): sample rate " + Num(h.sample_rate_hz, 9) +
-                                  " Hz differs from hit " + hits.front().id + "'s " + Num(fs, 9) + " Hz");
+      throw std::invalid_argument("hit " + h.id + " (" + h.source + "): sample rate " + FormatNumber(h.sample_rate_hz, 9) +
+                                  " Hz differs from hit " + hits.front().id + "'s " + FormatNumber(fs, 9) + " Hz");
     }
     if (h.response.cols() != nc || h.response.rows() != h.force_N.size()) {
       throw std::invalid_argument("hit " + h.id + " (" + h.source + "): expected " + std::to_string(nc) +
@@ -210,7 +205,7 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
   const double df = fs / n;
   const double fmax = o.fmax_hz > 0.0 ? o.fmax_hz : fs / 2.56;
   const int lines = std::min(n / 2, static_cast<int>(std::floor(fmax / df + 1e-9)));
-  if (lines < 1) throw std::invalid_argument("EstimateFrf: fmax_hz " + Num(fmax) + " is below the line spacing " + Num(df) + " Hz");
+  if (lines < 1) throw std::invalid_argument("EstimateFrf: fmax_hz " + FormatNumber(fmax) + " is below the line spacing " + FormatNumber(df) + " Hz");
 
   // Pass 1: pulses, double hits and overloads.
   std::vector<Pulse> pulses(hits.size());
@@ -229,7 +224,7 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
     rep.peak_force_N = f(p.peak);
     rep.hit_time_s = rec.start_time_s + p.start / fs;
     rep.pulse_duration_s = (p.end - p.start + 1) / fs;
-    const auto time_of = [&](int i) { return Num(rec.start_time_s + i / fs, 5); };
+    const auto time_of = [&](int i) { return FormatNumber(rec.start_time_s + i / fs, 5); };
     // Double hit: a second pulse before or after the main one.
     const double dbl = o.double_hit_fraction * p.peak_N;
     int second = -1;
@@ -250,7 +245,7 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
       rep.status = HitStatus::kDoubleHit;
       rep.notes.push_back(std::string("double hit: ") + (best > p.end ? "a second" : "an earlier") +
                           " force pulse at t = " + time_of(best) + " s, " +
-                          Num(100.0 * std::abs(f(best)) / p.peak_N, 3) + " % of the main pulse's peak (at t = " +
+                          FormatNumber(100.0 * std::abs(f(best)) / p.peak_N, 3) + " % of the main pulse's peak (at t = " +
                           time_of(p.peak) + " s)");
     }
     // Overload: flat tops or samples at a given range.
@@ -259,7 +254,7 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
       const int flat = DetectFlatTop(x, o.flat_top_samples);
       if (flat >= 0) {
         rep.status = rep.status == HitStatus::kAccepted ? HitStatus::kOverload : rep.status;
-        rep.notes.push_back("overload: " + name + " is clipped (flat top at " + Num(x(flat), 5) + " " + unit +
+        rep.notes.push_back("overload: " + name + " is clipped (flat top at " + FormatNumber(x(flat), 5) + " " + unit +
                             " from t = " + time_of(flat) + " s)");
         return;
       }
@@ -268,8 +263,8 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
         const double m = x.cwiseAbs().maxCoeff(&i);
         if (m >= range) {
           rep.status = rep.status == HitStatus::kAccepted ? HitStatus::kOverload : rep.status;
-          rep.notes.push_back("overload: " + name + " reaches " + Num(x(i), 5) + " " + unit + " at t = " +
-                              time_of(static_cast<int>(i)) + " s, at or beyond the range " + Num(range, 5) +
+          rep.notes.push_back("overload: " + name + " reaches " + FormatNumber(x(i), 5) + " " + unit + " at t = " +
+                              time_of(static_cast<int>(i)) + " s, at or beyond the range " + FormatNumber(range, 5) +
                               " " + unit);
         }
       }
@@ -353,12 +348,12 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
     result.leakage = true;
     result.warnings.push_back("response " + channels[c].name + ": has not decayed by the end of the record in " +
                               std::to_string(leaky_hits[c]) + " of " + std::to_string(result.averages) +
-                              " accepted hits (rms of the last 5 % up to " + Num(100.0 * worst_tail[c], 3) +
+                              " accepted hits (rms of the last 5 % up to " + FormatNumber(100.0 * worst_tail[c], 3) +
                               " % of the peak): leakage widens the peaks and overstates the damping; use longer "
-                              "records or an exponential window (tau = " + Num(shortest_decay_s / 6.0, 3) +
+                              "records or an exponential window (tau = " + FormatNumber(shortest_decay_s / 6.0, 3) +
                               " s, a sixth of the shortest time from a hit to its record's end, leaves e^-6 = "
                               "0.25 %" + (o.exponential_tau_s > 0.0 ? "; the window now has tau = " +
-                                          Num(o.exponential_tau_s, 3) + " s" : std::string()) + ")");
+                                          FormatNumber(o.exponential_tau_s, 3) + " s" : std::string()) + ")");
   }
   result.freq_hz = Eigen::VectorXd::LinSpaced(lines, df, lines * df);
   if (result.averages == 0) {
@@ -406,7 +401,7 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
   for (int k = 0; k < lines; ++k) {
     if (result.force_autospectrum(k) < 0.01 * ref) {
       result.warnings.push_back("the force spectrum is 20 dB below its low-frequency level from " +
-                                Num(result.freq_hz(k), 5) +
+                                FormatNumber(result.freq_hz(k), 5) +
                                 " Hz up: the FRF there rests on little excitation (a harder hammer tip "
                                 "excites higher)");
       break;
@@ -418,8 +413,8 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
 std::pair<double, double> CorrectExponentialWindowDamping(double freq_hz, double damping_ratio, double tau_s) {
   if (!(tau_s > 0.0) || !(freq_hz > 0.0) || !(damping_ratio >= 0.0 && damping_ratio < 1.0)) {
     throw std::invalid_argument("CorrectExponentialWindowDamping: expected tau_s > 0, freq_hz > 0 and 0 <= "
-                                "damping_ratio < 1, got " + Num(tau_s) + ", " + Num(freq_hz) + ", " +
-                                Num(damping_ratio));
+                                "damping_ratio < 1, got " + FormatNumber(tau_s) + ", " + FormatNumber(freq_hz) + ", " +
+                                FormatNumber(damping_ratio));
   }
   const double wm = HzToRadPerSec(freq_hz);
   const double sigma = damping_ratio * wm - 1.0 / tau_s;

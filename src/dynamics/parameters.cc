@@ -4,22 +4,15 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace robomach::dynamics {
-namespace {
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
-}  // namespace
+#include "robomach/common/number_format.h"
 
+namespace robomach::dynamics {
 void ParameterSet::Add(ParameterSpec spec) {
   if (Has(spec.name)) throw std::invalid_argument("parameter '" + spec.name + "' defined twice");
   if (!(spec.lower <= spec.default_value && spec.default_value <= spec.upper)) {
     throw std::invalid_argument("parameter '" + spec.name + "': default " +
-                                Num(spec.default_value) + " " + spec.unit + " is outside [" +
-                                Num(spec.lower) + ", " + Num(spec.upper) + "]");
+                                FormatNumber(spec.default_value, 10) + " " + spec.unit + " is outside [" +
+                                FormatNumber(spec.lower, 10) + ", " + FormatNumber(spec.upper, 10) + "]");
   }
   specs_.push_back(std::move(spec));
   values_.conservativeResize(specs_.size());
@@ -56,8 +49,8 @@ double ParameterSet::Get(std::string_view name) const {
 void ParameterSet::Set(std::string_view name, double value) {
   const ParameterSpec& s = spec(name);
   if (!std::isfinite(value) || value < s.lower || value > s.upper) {
-    throw std::invalid_argument("parameter '" + s.name + "': " + Num(value) + " " + s.unit +
-                                " is outside its bounds [" + Num(s.lower) + ", " + Num(s.upper) +
+    throw std::invalid_argument("parameter '" + s.name + "': " + FormatNumber(value, 10) + " " + s.unit +
+                                " is outside its bounds [" + FormatNumber(s.lower, 10) + ", " + FormatNumber(s.upper, 10) +
                                 "]");
   }
   values_(IndexOf(name)) = value;
@@ -66,7 +59,7 @@ void ParameterSet::Set(std::string_view name, double value) {
 void ParameterSet::SetClamped(std::string_view name, double value) {
   const ParameterSpec& s = spec(name);
   if (!std::isfinite(value)) {
-    throw std::invalid_argument("parameter '" + s.name + "': " + Num(value) + " is not a finite number");
+    throw std::invalid_argument("parameter '" + s.name + "': " + FormatNumber(value, 10) + " is not a finite number");
   }
   values_(IndexOf(name)) = std::min(std::max(value, s.lower), s.upper);
 }

@@ -3,20 +3,11 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "robomach/common/eigen_types.h"
 #include "robomach/common/errors.h"
 #include "robomach/kinematics/serial_chain.h"
 
 namespace robomach::identification {
-namespace {
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
-
-}  // namespace
-
 Matrix6Xd ShiftJacobian(const Matrix6Xd& J_BT, const Eigen::Vector3d& r_TP_B) {
   Matrix6Xd J = J_BT;
   // v_P = v_T + ω × r = v_T − r × ω = v_T − [r]× ω.

@@ -57,8 +57,6 @@ std::string Quoted(const std::string& s) {
   return out + "\"";
 }
 
-std::string Num(double v) { return FormatDouble(v); }
-
 // A value converted back to the user's unit (mm, deg): 12 significant digits
 // hide the conversion's last-bit residue (0.12000000000000001).
 std::string User(double v) {
@@ -191,13 +189,13 @@ std::string MaterialYaml(const drilling::ForceFitResult& fit, const drilling::Dr
     << "# Model: oblique-cutting lip elements with the dynamic rake angle (seed 003,\n"
     << "# Minukhin 2013); shear stress tau = K (h / h_ref)^(-m) on the uncut chip thickness h.\n"
     << "material:\n"
-    << "  shear_stress_thrust_MPa: " << Num(m.shear_stress_thrust * 1e-6) << "   # K_TH at h_ref\n"
-    << "  shear_stress_torque_MPa: " << Num(m.shear_stress_torque * 1e-6) << "   # K_TQ at h_ref\n"
-    << "  kienzle_exponent: " << Num(m.kienzle_exponent) << "   # m: forces go as f^(1 - m)\n"
+    << "  shear_stress_thrust_MPa: " << FormatDouble(m.shear_stress_thrust * 1e-6) << "   # K_TH at h_ref\n"
+    << "  shear_stress_torque_MPa: " << FormatDouble(m.shear_stress_torque * 1e-6) << "   # K_TQ at h_ref\n"
+    << "  kienzle_exponent: " << FormatDouble(m.kienzle_exponent) << "   # m: forces go as f^(1 - m)\n"
     << "  reference_chip_thickness_mm: " << User(MToMm(m.reference_chip_thickness)) << "\n"
     << "  chisel: " << ChiselName(m.chisel) << "   # seed_scaling | orthogonal | none\n"
-    << "  chisel_thrust_factor: " << Num(m.chisel_thrust_factor) << "\n"
-    << "  chisel_torque_factor: " << Num(m.chisel_torque_factor) << "\n"
+    << "  chisel_thrust_factor: " << FormatDouble(m.chisel_thrust_factor) << "\n"
+    << "  chisel_torque_factor: " << FormatDouble(m.chisel_torque_factor) << "\n"
     << "  chisel_rake_deg: " << User(RadToDeg(m.chisel_rake_angle)) << "\n"
     << "std_dev:   # 1 sigma from the covariance, scaled by the residual variance\n"
     << "  shear_stress_thrust_MPa: " << Sig(fit.std_dev_shear_stress_thrust * 1e-6, 3) << "\n"
@@ -217,7 +215,7 @@ std::string MaterialYaml(const drilling::ForceFitResult& fit, const drilling::Dr
     << "    lips: " << drill.lips << "\n"
     << "    point_angle_deg: " << User(RadToDeg(drill.point_angle)) << "\n"
     << "    helix_angle_deg: " << User(RadToDeg(drill.helix_angle)) << "\n"
-    << "    web_thickness_ratio: " << Num(drill.web_thickness_ratio) << "\n"
+    << "    web_thickness_ratio: " << FormatDouble(drill.web_thickness_ratio) << "\n"
     << "    chisel_edge_angle_deg: " << User(RadToDeg(drill.chisel_edge_angle)) << "\n"
     << "  table:\n"
     << "    path: " << Quoted(table.path) << "\n"
@@ -226,8 +224,8 @@ std::string MaterialYaml(const drilling::ForceFitResult& fit, const drilling::Dr
   for (size_t k = 0; k < table.rows.size(); ++k) {
     const auto& r = table.rows[k];
     s << "      - {diameter_mm: " << User(MToMm(r.diameter))
-      << ", feed_mm_per_rev: " << User(MToMm(r.feed_per_rev)) << ", thrust_N: " << Num(r.thrust)
-      << ", torque_Nm: " << Num(r.torque);
+      << ", feed_mm_per_rev: " << User(MToMm(r.feed_per_rev)) << ", thrust_N: " << FormatDouble(r.thrust)
+      << ", torque_Nm: " << FormatDouble(r.torque);
     if (k < fit.thrust_model.size()) {
       s << ", thrust_model_N: " << Sig(fit.thrust_model[k], 5)
         << ", torque_model_Nm: " << Sig(fit.torque_model[k], 5);

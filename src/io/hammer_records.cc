@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include "robomach/common/number_format.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 
@@ -18,12 +19,6 @@ using calibration::ResponseQuantity;
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
   return s.size() > suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-std::string Num(double v) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
 }
 
 // A number of a required column, with the column's position in the error.
@@ -118,8 +113,8 @@ FileHits ReadOne(const std::string& path, bool prefix_ids) {
       const int r = b.first + i;
       time(i) = NumberAt(t, r, c_time);
       if (i > 0 && !(time(i) > time(i - 1))) {
-        throw ErrorAtCell(t, r, c_time, "expected a time > " + Num(time(i - 1)) + " (the previous row), got " +
-                                            Num(time(i)) + "; time must increase within a hit");
+        throw ErrorAtCell(t, r, c_time, "expected a time > " + FormatNumber(time(i - 1), 10) + " (the previous row), got " +
+                                            FormatNumber(time(i), 10) + "; time must increase within a hit");
       }
       rec.force_N(i) = NumberAt(t, r, c_force);
       for (size_t k = 0; k < c_resp.size(); ++k) rec.response(i, static_cast<int>(k)) = NumberAt(t, r, c_resp[k]);
@@ -139,8 +134,8 @@ FileHits ReadOne(const std::string& path, bool prefix_ids) {
       const double step = time(i) - time(i - 1);
       if (std::abs(step - median) > 0.01 * median) {
         throw ErrorAtCell(t, b.first + i, c_time,
-                          "uneven sampling: step " + Num(step) + " s from the previous row, the hit's usual "
-                          "step is " + Num(median) + " s (more than 1 % apart; a missing or repeated sample?)");
+                          "uneven sampling: step " + FormatNumber(step, 10) + " s from the previous row, the hit's usual "
+                          "step is " + FormatNumber(median, 10) + " s (more than 1 % apart; a missing or repeated sample?)");
       }
     }
     const double dt = (time(n - 1) - time(0)) / (n - 1);
@@ -219,8 +214,8 @@ HammerRecords ReadHammerRecords(const std::vector<std::string>& paths) {
         const double fs0 = out.hits.front().sample_rate_hz;
         if (std::abs(rec.sample_rate_hz - fs0) > 1e-4 * fs0) {
           throw InputError({paths[f], 0, 0}, "hit '" + rec.id + "' (" + rec.source + ") is sampled at " +
-                                                 Num(rec.sample_rate_hz) + " Hz, hit '" + out.hits.front().id +
-                                                 "' at " + Num(fs0) + " Hz; all hits need one sample rate");
+                                                 FormatNumber(rec.sample_rate_hz, 10) + " Hz, hit '" + out.hits.front().id +
+                                                 "' at " + FormatNumber(fs0, 10) + " Hz; all hits need one sample rate");
         }
       }
       out.hits.push_back(std::move(rec));

@@ -9,14 +9,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "robomach/common/number_format.h"
+
 namespace robomach::machine {
 namespace {
-
-std::string Num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.10g", v);
-  return b;
-}
 
 void MeanAndS(const std::vector<double>& x, double* mean, double* s) {
   double sum = 0.0;
@@ -44,7 +40,7 @@ Iso230Result EvaluateIso230(const std::vector<Iso230Approach>& approaches) {
       throw std::invalid_argument("ISO 230-2: non-finite target or deviation");
     }
     if (!seen.insert({a.target, a.run, a.up}).second) {
-      throw std::invalid_argument("ISO 230-2: target " + Num(a.target) + ", run " + std::to_string(a.run) +
+      throw std::invalid_argument("ISO 230-2: target " + FormatNumber(a.target, 10) + ", run " + std::to_string(a.run) +
                                   ", direction " + (a.up ? "+" : "-") + " is given twice");
     }
     auto& d = by_target[a.target];
@@ -53,7 +49,7 @@ Iso230Result EvaluateIso230(const std::vector<Iso230Approach>& approaches) {
   Iso230Result r;
   for (const auto& [target, d] : by_target) {
     if (d.first.size() < 2 || d.second.size() < 2) {
-      throw std::invalid_argument("ISO 230-2: target " + Num(target) + " has " + std::to_string(d.first.size()) +
+      throw std::invalid_argument("ISO 230-2: target " + FormatNumber(target, 10) + " has " + std::to_string(d.first.size()) +
                                   " runs in + and " + std::to_string(d.second.size()) +
                                   " in - direction; at least 2 each are needed (ISO asks for 5)");
     }

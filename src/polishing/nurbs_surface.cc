@@ -8,14 +8,10 @@
 
 #include <Eigen/Dense>
 
+#include "robomach/common/number_format.h"
+
 namespace robomach::polishing {
 namespace {
-
-std::string Num(double x) {
-  std::ostringstream s;
-  s << x;
-  return s.str();
-}
 
 void CheckKnots(const char* name, const std::vector<double>& knots, int n, int degree) {
   const int expected = n + degree + 1;
@@ -28,7 +24,7 @@ void CheckKnots(const char* name, const std::vector<double>& knots, int n, int d
     if (!std::isfinite(knots[i])) throw std::invalid_argument(std::string(name) + ": knot " + std::to_string(i) + " is not finite");
     if (i > 0 && knots[i] < knots[i - 1]) {
       throw std::invalid_argument(std::string(name) + ": knots must be non-decreasing, knot " + std::to_string(i) +
-                                  " = " + Num(knots[i]) + " < " + Num(knots[i - 1]));
+                                  " = " + FormatNumber(knots[i], 6) + " < " + FormatNumber(knots[i - 1], 6));
     }
   }
   for (int i = 1; i <= degree; ++i) {
@@ -160,7 +156,7 @@ NurbsSurface NurbsSurface::Create(int degree_u, int degree_v, std::vector<double
       for (int j = 0; j < n_v; ++j) {
         if (!(weights[i][j] > 0.0) || !std::isfinite(weights[i][j])) {
           throw std::invalid_argument("weights: row " + std::to_string(i + 1) + ", entry " + std::to_string(j + 1) +
-                                      ": expected a weight > 0, got " + Num(weights[i][j]));
+                                      ": expected a weight > 0, got " + FormatNumber(weights[i][j], 6));
         }
         s.weights_.push_back(weights[i][j]);
       }

@@ -8,14 +8,13 @@
 #include "robomach/common/units.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/heat_map.h"
+#include "robomach/report/html.h"
 #include "robomach/report/plot.h"
 
 namespace robomach::report {
 namespace {
 
 using nlohmann::json;
-
-std::string Num(double v) { return std::isfinite(v) ? io::FormatDouble(v) : ""; }
 
 std::string Fixed(double v, int digits) {
   if (!std::isfinite(v)) return "–";
@@ -27,17 +26,6 @@ std::string Fixed(double v, int digits) {
 json JsonNumber(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 std::string Dir(const dynamics::FrfKey& k) { return std::string(1, AxisName(k.response)) + AxisName(k.excitation); }
-
-std::string Html(const std::string& s) {
-  std::string o;
-  for (char ch : s) {
-    if (ch == '<') o += "&lt;";
-    else if (ch == '>') o += "&gt;";
-    else if (ch == '&') o += "&amp;";
-    else o += ch;
-  }
-  return o;
-}
 
 // A descriptor as shown: joint angles in degrees, the rest in SI.
 struct Shown {
@@ -160,9 +148,9 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
                           {"critical_correlation", JsonNumber(t.critical_correlation)},
                           {"correlation_after", JsonNumber(tr.correlation_after)},
                           {"significant_after", has_after ? json(tr.significant_after) : json(nullptr)}});
-    tcsv << tr.descriptor << ',' << s.unit << ',' << t.n << ',' << Num(t.critical_correlation) << ','
-         << Num(tr.correlation_before) << ',' << (tr.significant_before ? "yes" : "no") << ','
-         << Num(tr.correlation_after) << ',' << (has_after ? (tr.significant_after ? "yes" : "no") : "") << '\n';
+    tcsv << tr.descriptor << ',' << s.unit << ',' << t.n << ',' << FormatCell(t.critical_correlation) << ','
+         << FormatCell(tr.correlation_before) << ',' << (tr.significant_before ? "yes" : "no") << ','
+         << FormatCell(tr.correlation_after) << ',' << (has_after ? (tr.significant_after ? "yes" : "no") : "") << '\n';
   }
   out.trends_csv = tcsv.str();
 
@@ -174,11 +162,11 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
   out.posture_descriptors = json::object();
   for (int k = 0; k < t.n; ++k) {
     const std::string& id = t.pose_ids[k];
-    dcsv << id << ',' << Num(t.error_before(k)) << ',' << (has_after ? Num(t.error_after(k)) : "");
+    dcsv << id << ',' << FormatCell(t.error_before(k)) << ',' << (has_after ? FormatCell(t.error_after(k)) : "");
     json d = json::object();
     for (const audit::Trend& tr : t.trends) {
       const Shown s = Display(tr.descriptor, tr.unit);
-      dcsv << ',' << Num(s.scale * tr.values(k));
+      dcsv << ',' << FormatCell(s.scale * tr.values(k));
       d[s.key()] = JsonNumber(s.scale * tr.values(k));
     }
     dcsv << '\n';
@@ -205,9 +193,9 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
         continue;
       }
       const calibration::ModeMatch& mm = m.matches[k];
-      mcsv << AxisName(mm.key.response) << ',' << AxisName(mm.key.excitation) << ',' << Num(mm.model_freq_hz) << ','
-           << Num(mm.measured_freq_hz) << ',' << Num(mm.freq_error()) << ',' << Num(mm.model_peak) << ','
-           << Num(mm.measured_peak) << ',' << Num(mm.peak_error()) << '\n';
+      mcsv << AxisName(mm.key.response) << ',' << AxisName(mm.key.excitation) << ',' << FormatCell(mm.model_freq_hz) << ','
+           << FormatCell(mm.measured_freq_hz) << ',' << FormatCell(mm.freq_error()) << ',' << FormatCell(mm.model_peak) << ','
+           << FormatCell(mm.measured_peak) << ',' << FormatCell(mm.peak_error()) << '\n';
     }
     fe.push_back(fr);
     pe.push_back(pr);
@@ -228,8 +216,8 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
                                          {"damping_ratio", u.damping_ratio},
                                          {"relative_visibility", JsonNumber(u.relative_visibility)}});
     ucsv << "model," << u.key.pose_id << ',' << AxisName(u.key.response) << ',' << AxisName(u.key.excitation) << ','
-         << u.model_mode + 1 << ',' << Num(u.freq_hz) << ',' << Num(u.damping_ratio) << ','
-         << Num(u.relative_visibility) << '\n';
+         << u.model_mode + 1 << ',' << FormatCell(u.freq_hz) << ',' << FormatCell(u.damping_ratio) << ','
+         << FormatCell(u.relative_visibility) << '\n';
   }
   for (const audit::UnmatchedMode& u : p.unmatched_measured) {
     out.unmatched_measured_modes.push_back({{"pose", u.key.pose_id},
@@ -238,7 +226,7 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
                                             {"damping_ratio", u.damping_ratio},
                                             {"relative_visibility", JsonNumber(u.relative_visibility)}});
     ucsv << "measured," << u.key.pose_id << ',' << AxisName(u.key.response) << ',' << AxisName(u.key.excitation)
-         << ",," << Num(u.freq_hz) << ',' << Num(u.damping_ratio) << ',' << Num(u.relative_visibility) << '\n';
+         << ",," << FormatCell(u.freq_hz) << ',' << FormatCell(u.damping_ratio) << ',' << FormatCell(u.relative_visibility) << '\n';
   }
   out.unmatched_modes_csv = ucsv.str();
 
@@ -274,19 +262,19 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
     h << " After the best candidate the errors are at the noise floor everywhere: the correlations after it "
          "describe noise and are never flagged.";
   }
-  h << " Data: <a href=\"" << Html(files.trends_csv) << "\">" << Html(files.trends_csv) << "</a>, <a href=\""
-    << Html(files.posture_descriptors_csv) << "\">" << Html(files.posture_descriptors_csv) << "</a>.</p>\n";
+  h << " Data: <a href=\"" << HtmlEscape(files.trends_csv) << "\">" << HtmlEscape(files.trends_csv) << "</a>, <a href=\""
+    << HtmlEscape(files.posture_descriptors_csv) << "\">" << HtmlEscape(files.posture_descriptors_csv) << "</a>.</p>\n";
   h << "<table><tr><th>descriptor</th><th>unit</th><th>r before</th>" << (has_after ? "<th>r after</th>" : "")
     << "<th>significant</th></tr>\n";
   for (const audit::Trend& tr : t.trends) {
-    h << "<tr><td>" << Html(tr.descriptor) << "</td><td>" << Html(Display(tr.descriptor, tr.unit).unit)
+    h << "<tr><td>" << HtmlEscape(tr.descriptor) << "</td><td>" << HtmlEscape(Display(tr.descriptor, tr.unit).unit)
       << "</td><td>" << Fixed(tr.correlation_before, 3) << "</td>";
     if (has_after) h << "<td>" << Fixed(tr.correlation_after, 3) << "</td>";
     h << "<td>" << (tr.significant_before ? "<b>yes</b>" : "no")
       << (has_after ? std::string(" / ") + (tr.significant_after ? "<b>yes</b>" : "no") + " after" : "")
       << "</td></tr>\n";
   }
-  h << "</table>\n<p><img src=\"" << Html(files.trends_png) << "\" alt=\"error against posture descriptors\"></p>\n";
+  h << "</table>\n<p><img src=\"" << HtmlEscape(files.trends_png) << "\" alt=\"error against posture descriptors\"></p>\n";
 
   h << "<h2>Error map: postures against model modes</h2>\n";
   if (out.mode_error_map_png.empty()) {
@@ -295,8 +283,8 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
     h << "<p>Relative error of the calibrated current model per posture and model mode (numbered in ascending "
          "frequency), where a measured mode matched it; where it matched in several FRFs, the one with the largest "
          "measured peak. Table: <a href=\""
-      << Html(files.mode_errors_csv) << "\">" << Html(files.mode_errors_csv) << "</a>.</p>\n<p><img src=\""
-      << Html(files.mode_error_map_png) << "\" alt=\"error map postures x modes\"></p>\n";
+      << HtmlEscape(files.mode_errors_csv) << "\">" << HtmlEscape(files.mode_errors_csv) << "</a>.</p>\n<p><img src=\""
+      << HtmlEscape(files.mode_error_map_png) << "\" alt=\"error map postures x modes\"></p>\n";
   }
 
   h << "<h2>Modes without a counterpart</h2>\n<p>Per FRF: measured modes with no model mode near them (the model "
@@ -305,15 +293,15 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
        "\"Near\" is the matching's rule (frequency within its window, cost |ln f ratio| + w |ln visibility "
        "ratio|, one to one); modes too weak for the matching to try are paired by the same rule without the "
        "visibility threshold ("
-    << p.weak_pairs << " such weak pairs, not listed). Table: <a href=\"" << Html(files.unmatched_modes_csv) << "\">"
-    << Html(files.unmatched_modes_csv) << "</a>.</p>\n";
+    << p.weak_pairs << " such weak pairs, not listed). Table: <a href=\"" << HtmlEscape(files.unmatched_modes_csv) << "\">"
+    << HtmlEscape(files.unmatched_modes_csv) << "</a>.</p>\n";
   auto table = [&](const std::vector<audit::UnmatchedMode>& list, const std::string& what, bool model) {
     h << "<h3>" << what << ": " << list.size() << "</h3>\n";
     if (list.empty()) return;
     h << "<table><tr><th>posture</th><th>FRF</th>" << (model ? "<th>model mode</th>" : "")
       << "<th>frequency [Hz]</th><th>damping ratio</th><th>relative visibility</th></tr>\n";
     for (const audit::UnmatchedMode& u : list) {
-      h << "<tr><td>" << Html(u.key.pose_id) << "</td><td>H" << Dir(u.key) << "</td>";
+      h << "<tr><td>" << HtmlEscape(u.key.pose_id) << "</td><td>H" << Dir(u.key) << "</td>";
       if (model) h << "<td>" << u.model_mode + 1 << "</td>";
       h << "<td>" << Fixed(u.freq_hz, 2) << "</td><td>" << Fixed(u.damping_ratio, 4) << "</td><td>"
         << Fixed(u.relative_visibility, 2) << "</td></tr>\n";
@@ -324,7 +312,7 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
   table(p.unmatched_model, "Model modes without a measured mode", true);
   if (!p.frfs_without_modal_fit.empty()) {
     h << "<p>The modal fit found no mode in";
-    for (const auto& k : p.frfs_without_modal_fit) h << ' ' << Html(k.pose_id) << " H" << Dir(k);
+    for (const auto& k : p.frfs_without_modal_fit) h << ' ' << HtmlEscape(k.pose_id) << " H" << Dir(k);
     h << "; model modes are not checked there.</p>\n";
   }
   out.html = h.str();

@@ -23,8 +23,6 @@ const ModeMatch* FindBefore(const calibration::Comparison& before, const ModeMat
   return nullptr;
 }
 
-std::string Num(double v) { return std::isfinite(v) ? io::FormatDouble(v) : ""; }
-
 std::string Fixed(double v, int digits) {
   if (!std::isfinite(v)) return "–";
   char buf[64];
@@ -53,13 +51,13 @@ void WriteTable3Csv(const std::string& path, const std::vector<TableSet>& sets) 
       for (const ModeMatch& m : s.after.matches) {
         const ModeMatch* b = FindBefore(s.before, m);
         os << m.key.pose_id << ',' << AxisName(m.key.response) << ',' << AxisName(m.key.excitation) << ','
-           << s.label << ',' << m.model_mode + 1 << ',' << Num(m.measured_freq_hz) << ','
-           << (b ? Num(b->model_freq_hz) : "") << ',' << (b ? Num(100 * b->freq_error()) : "") << ','
-           << Num(m.model_freq_hz) << ',' << Num(100 * m.freq_error()) << ',' << Num(m.measured_peak) << ','
-           << (b ? Num(b->model_peak) : "") << ',' << (b ? Num(100 * b->peak_error()) : "") << ','
-           << Num(m.model_peak) << ',' << Num(100 * m.peak_error()) << ',' << Num(m.measured_damping) << ','
-           << Num(m.model_damping) << ',' << Num(m.model_shape_T(0)) << ',' << Num(m.model_shape_T(1)) << ','
-           << Num(m.model_shape_T(2)) << '\n';
+           << s.label << ',' << m.model_mode + 1 << ',' << FormatCell(m.measured_freq_hz) << ','
+           << (b ? FormatCell(b->model_freq_hz) : "") << ',' << (b ? FormatCell(100 * b->freq_error()) : "") << ','
+           << FormatCell(m.model_freq_hz) << ',' << FormatCell(100 * m.freq_error()) << ',' << FormatCell(m.measured_peak) << ','
+           << (b ? FormatCell(b->model_peak) : "") << ',' << (b ? FormatCell(100 * b->peak_error()) : "") << ','
+           << FormatCell(m.model_peak) << ',' << FormatCell(100 * m.peak_error()) << ',' << FormatCell(m.measured_damping) << ','
+           << FormatCell(m.model_damping) << ',' << FormatCell(m.model_shape_T(0)) << ',' << FormatCell(m.model_shape_T(1)) << ','
+           << FormatCell(m.model_shape_T(2)) << '\n';
       }
     }
   });

@@ -1,10 +1,12 @@
 #pragma once
 
-#include <string>
+// The number formatter lives in common (robomach/common/number_format.h), so
+// that every module can use it; io's name for it stays.
+
+#include "robomach/common/number_format.h"
 
 namespace robomach::io {
 
-/// Shortest text that reads back to exactly the same double.
-std::string FormatDouble(double v);
+using robomach::FormatDouble;
 
 }  // namespace robomach::io

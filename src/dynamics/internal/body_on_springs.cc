@@ -6,19 +6,10 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "robomach/common/eigen_types.h"
 #include "robomach/common/errors.h"
 
 namespace robomach::dynamics::internal {
-namespace {
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
-
-}  // namespace
-
 Matrix6d ShiftTwist(const Eigen::Vector3d& r) {
   Matrix6d X = Matrix6d::Identity();
   X.topRightCorner<3, 3>() = -Skew(r);

@@ -3,14 +3,10 @@
 #include <Eigen/Geometry>
 #include <kdl/frames.hpp>
 
+#include "robomach/common/eigen_types.h"
+
 namespace robomach::dynamics::internal {
 namespace {
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
 
 Eigen::Vector3d ToEigen(const KDL::Vector& v) { return Eigen::Vector3d(v.x(), v.y(), v.z()); }
 
