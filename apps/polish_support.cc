@@ -252,95 +252,22 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
 
 }  // namespace robomach::apps
 
-#include <kdl/chainiksolverpos_lma.hpp>
-
-#include <Eigen/SVD>
-
 #include "robomach/common/units.h"
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/number_format.h"
-#include "robomach/kinematics/serial_chain.h"
+#include "robomach/kinematics/pose_path.h"
 
 namespace robomach::apps {
 
 RobotCheck CheckOnRobot(const dynamics::RobotModel& model, const Eigen::Isometry3d& X_BP,
                         const Eigen::Isometry3d& X_FC, const std::vector<polishing::PathRow>& rows,
                         const Eigen::VectorXd& seed) {
-  const kinematics::SerialChain& arm = model.description().arm;
-  const int n = arm.num_joints();
-  KDL::ChainIkSolverPos_LMA lma(arm.kdl(), 1e-6, 500, 1e-15);
-  // Tolerances as in stability-map: far below what matters for polishing.
-  constexpr double kPos = 1e-5, kRot = 1e-4;
-  constexpr double kMaxJointStep = 0.5;  // [rad] between consecutive rows
-  auto solve = [&](const Eigen::Isometry3d& X, const Eigen::VectorXd& from, Eigen::VectorXd* q) {
-    KDL::JntArray q0(n), q1(n);
-    for (int j = 0; j < n; ++j) q0(j) = from(j);
-    lma.CartToJnt(q0, kinematics::ToKdl(X), q1);
-    q->resize(n);
-    for (int j = 0; j < n; ++j) (*q)(j) = q1(j) - 2.0 * kPi * std::round((q1(j) - from(j)) / (2.0 * kPi));
-    const Eigen::Isometry3d got = kinematics::ForwardKinematics(arm, *q);
-    return (got.translation() - X.translation()).norm() < kPos &&
-           Eigen::AngleAxisd(got.linear().transpose() * X.linear()).angle() < kRot;
-  };
-  RobotCheck c;
-  const size_t N = rows.size();
-  c.q.resize(N);
-  c.reachable.assign(N, 0);
-  c.limit_margin.assign(N, std::nan(""));
-  c.condition.assign(N, std::nan(""));
-  Eigen::VectorXd prev = seed;
   const Eigen::Isometry3d X_CF = X_FC.inverse();
-  for (size_t r = 0; r < N; ++r) {
-    Eigen::Isometry3d X_PC = Eigen::Isometry3d::Identity();
-    X_PC.linear().col(0) = rows[r].tx;
-    X_PC.linear().col(1) = rows[r].n.cross(rows[r].tx);
-    X_PC.linear().col(2) = rows[r].n;
-    X_PC.translation() = rows[r].p;
-    const Eigen::Isometry3d X_BF = X_BP * X_PC * X_CF;
-    Eigen::VectorXd q;
-    bool ok = solve(X_BF, prev, &q);
-    if (!ok) ok = solve(X_BF, seed, &q);
-    if (!ok) {
-      ++c.num_unreachable;
-      if (c.first_bad_row < 0) c.first_bad_row = static_cast<int>(r);
-      continue;
-    }
-    // Of the 2 pi branches of each joint, one inside its limits if there is one.
-    for (int j = 0; j < n; ++j) {
-      const auto& lim = arm.limits()[j];
-      if (!lim.bounded) continue;
-      for (int k = -2; k <= 2 && (q(j) < lim.lower || q(j) > lim.upper); ++k) {
-        const double alt = q(j) + 2.0 * kPi * k;
-        if (alt >= lim.lower && alt <= lim.upper) q(j) = alt;
-      }
-    }
-    // A jump between consecutive rows (a 2 pi branch change to stay inside
-    // the limits, or another IK branch) cannot be executed continuously.
-    if (r > 0 && c.reachable[r - 1] && (q - c.q[r - 1]).cwiseAbs().maxCoeff() > kMaxJointStep) {
-      ++c.num_jumps;
-      if (c.first_bad_row < 0) c.first_bad_row = static_cast<int>(r);
-    }
-    c.reachable[r] = 1;
-    c.q[r] = q;
-    prev = q;
-    double margin = 1e300;
-    for (int j = 0; j < n; ++j) {
-      const auto& lim = arm.limits()[j];
-      if (lim.bounded) margin = std::min({margin, q(j) - lim.lower, lim.upper - q(j)});
-    }
-    c.limit_margin[r] = margin;
-    c.min_limit_margin = std::min(c.min_limit_margin, margin);
-    if (margin < 0) {
-      ++c.num_outside_limits;
-      if (c.first_bad_row < 0) c.first_bad_row = static_cast<int>(r);
-    }
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(kinematics::Jacobian(arm, q));
-    const auto& s = svd.singularValues();
-    c.condition[r] = s(s.size() - 1) > 0 ? s(0) / s(s.size() - 1) : 1e300;
-    c.max_condition = std::max(c.max_condition, c.condition[r]);
-  }
-  return c;
+  std::vector<Eigen::Isometry3d> X_BF;
+  X_BF.reserve(rows.size());
+  for (const polishing::PathRow& row : rows) X_BF.push_back(X_BP * polishing::ContactFrame(row) * X_CF);
+  return kinematics::CheckPosePath(model.description().arm, X_BF, seed);
 }
 
 void WriteJointTrajectory(const std::string& path, const std::vector<polishing::PathRow>& rows,

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "robomach/kinematics/pose_path.h"
 #include "robomach/polishing/nurbs_surface.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/process.h"
@@ -84,16 +85,9 @@ namespace robomach::apps {
 /// frame P placed in the robot base B, each row's contact frame C (z = the
 /// surface normal towards the tool, x = tool x) in B, the flange pose
 /// X_BF = X_BP X_PC X_FC^-1 with the process's contact frame in the flange,
-/// and the inverse kinematics of the arm (KDL LMA, seeded from the previous
-/// row, the first row from `seed`).
-struct RobotCheck {
-  std::vector<Eigen::VectorXd> q;       // [rad]; empty where unreachable
-  std::vector<char> reachable;
-  std::vector<double> limit_margin;     // smallest distance to a joint limit [rad] (< 0: outside)
-  std::vector<double> condition;        // condition number of the 6 x n Jacobian
-  int num_unreachable{0}, num_outside_limits{0}, num_jumps{0}, first_bad_row{-1};
-  double min_limit_margin{1e300}, max_condition{0.0};
-};
+/// followed by the arm (kinematics::CheckPosePath: IK seeded from the
+/// previous row, the first row from `seed`).
+using RobotCheck = kinematics::PosePathCheck;
 RobotCheck CheckOnRobot(const dynamics::RobotModel& model, const Eigen::Isometry3d& X_BP,
                         const Eigen::Isometry3d& X_FC, const std::vector<polishing::PathRow>& rows,
                         const Eigen::VectorXd& seed);

@@ -260,4 +260,13 @@ RemovalStats ComputeRemovalStats(const std::vector<double>& removal, const std::
   return s;
 }
 
+Eigen::Isometry3d ContactFrame(const PathRow& row) {
+  Eigen::Isometry3d X_PC = Eigen::Isometry3d::Identity();
+  X_PC.linear().col(0) = row.tx;
+  X_PC.linear().col(1) = row.n.cross(row.tx);
+  X_PC.linear().col(2) = row.n;
+  X_PC.translation() = row.p;
+  return X_PC;
+}
+
 }  // namespace robomach::polishing

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "robomach/polishing/nurbs_surface.h"
 #include "robomach/polishing/process.h"
@@ -27,6 +28,10 @@ struct PathRow {
   double force{-1.0};          // [N]; < 0: the process force; 0: the tool is lifted
                                // (a segment starting or ending at 0 removes nothing)
 };
+
+/// The row's contact frame C in the part frame P: origin p, z = n (towards
+/// the tool), x = tx, y = n × tx.
+Eigen::Isometry3d ContactFrame(const PathRow& row);
 
 /// The contact at one path row, in 3-D: ellipse centre p, semi-axes a (along
 /// e_a, the axis nearer tool x) and b (along e_b), peak pressure p0.
