@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "robomach/common/errors.h"
 #include "robomach/common/version.h"
@@ -230,11 +231,9 @@ std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std
 
 void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<std::string>& sets,
                       io::RobotConfig* cfg) {
-  for (const std::string& name : adds) cfg->description.effects.push_back({name, {}});
-  if (!adds.empty()) {
-    const dynamics::ParameterSet old = cfg->parameters;
-    cfg->parameters = FromOption("--add", [&] { return dynamics::DefaultParameters(cfg->description); });
-    for (const auto& s : old.specs()) cfg->parameters.Set(s.name, old.Get(s.name));
+  for (const std::string& name : adds) {
+    std::tie(cfg->description, cfg->parameters) =
+        FromOption("--add " + name, [&] { return dynamics::WithEffect(cfg->description, cfg->parameters, name); });
   }
   for (const std::string& s : sets) {
     const std::pair<std::string, double> assignment = ParseAssignment("--set", s);

@@ -3,6 +3,7 @@
 // io/posture_file.h, io/prediction_files.h).
 #include <map>
 #include <memory>
+#include <tuple>
 
 #include "bindings.h"
 #include "robomach/dynamics/effect.h"
@@ -36,16 +37,10 @@ std::map<std::string, double> ParameterDict(const ParameterSet& p) {
   return out;
 }
 
-// The equivalent of the tools' `--add EFFECT` (apps/cli_support
-// ApplyAddsAndSets): the effect with its default parameters, values already
-// set kept. On a copy, so that an unknown effect leaves the config as it was.
+// The equivalent of the tools' `--add EFFECT`: dynamics::WithEffect, which
+// leaves the config as it was when it throws (an unknown effect).
 void AddEffect(RobotConfig* cfg, const std::string& name) {
-  RobotConfig c = *cfg;
-  c.description.effects.push_back({name, {}});
-  ParameterSet fresh = dynamics::DefaultParameters(c.description);
-  for (const auto& s : c.parameters.specs()) fresh.Set(s.name, c.parameters.Get(s.name));
-  c.parameters = std::move(fresh);
-  *cfg = std::move(c);
+  std::tie(cfg->description, cfg->parameters) = dynamics::WithEffect(cfg->description, cfg->parameters, name);
 }
 
 // `--add` for each of `add`, then `--set` for each of `set`, as the tools do.

@@ -164,15 +164,6 @@ std::string CandidateResult::name() const {
   return s;
 }
 
-std::pair<dynamics::RobotDescription, dynamics::ParameterSet> WithEffect(
-    const dynamics::RobotDescription& description, const dynamics::ParameterSet& base, const std::string& effect) {
-  dynamics::RobotDescription d = description;
-  d.effects.push_back({effect, {}});
-  dynamics::ParameterSet p = dynamics::DefaultParameters(d);
-  for (const auto& s : base.specs()) p.Set(s.name, base.Get(s.name));
-  return {d, p};
-}
-
 std::string EffectYaml(const CandidateResult& c) {
   std::ostringstream out;
   out.precision(6);

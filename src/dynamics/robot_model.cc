@@ -100,6 +100,15 @@ ParameterSet DefaultParameters(const RobotDescription& d) {
   return p;
 }
 
+std::pair<RobotDescription, ParameterSet> WithEffect(const RobotDescription& description, const ParameterSet& base,
+                                                     const std::string& effect) {
+  RobotDescription d = description;
+  d.effects.push_back({effect, {}});
+  ParameterSet p = DefaultParameters(d);
+  for (const auto& s : base.specs()) p.Set(s.name, base.Get(s.name));
+  return {std::move(d), std::move(p)};
+}
+
 std::shared_ptr<const RobotModel> RobotModel::Build(const RobotDescription& d,
                                                     const ParameterSet& parameters) {
   const ParameterSet defaults = DefaultParameters(d);

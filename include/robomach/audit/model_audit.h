@@ -261,10 +261,8 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
                      const calibration::PostureMap& postures, const dynamics::FrfSet& measured,
                      const AuditOptions& options = {});
 
-/// The description with `effect` appended and parameters for it: `base`'s
-/// values kept, the new effect's at their defaults.
-std::pair<dynamics::RobotDescription, dynamics::ParameterSet> WithEffect(
-    const dynamics::RobotDescription& description, const dynamics::ParameterSet& base, const std::string& effect);
+/// dynamics::WithEffect, by its old name here.
+using dynamics::WithEffect;
 
 /// Words for the pattern of a model's errors: how many FRFs fail
 /// significantly, the band that is worst in most FRFs and whether it is the

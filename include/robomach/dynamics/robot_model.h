@@ -3,6 +3,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -80,6 +81,13 @@ Eigen::Vector3d ToolAxisInTip(const RobotDescription& d);
 /// each enabled effect's parameters as "effect.param" (config values applied).
 /// @throws std::invalid_argument for an unknown effect or effect parameter.
 ParameterSet DefaultParameters(const RobotDescription& d);
+
+/// The description with `effect` switched on and parameters for it: the
+/// values of `base` kept, the new effect's at their defaults (the tools'
+/// `--add`, the audit's candidates, Python's `add`).
+/// @throws std::invalid_argument for an unknown effect.
+std::pair<RobotDescription, ParameterSet> WithEffect(const RobotDescription& description, const ParameterSet& base,
+                                                     const std::string& effect);
 
 /// An effect bound to its parameter values and to its extra degrees of
 /// freedom in the assembled system.
