@@ -17,6 +17,7 @@
 #include "cli_support.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
+#include "robomach/drilling/controller_kinds.h"
 #include "robomach/drilling/drilling_sim.h"
 #include "robomach/drilling/plausibility.h"
 #include "robomach/io/atomic_file.h"
@@ -80,8 +81,8 @@ nlohmann::json Summary(const Run& run, const drilling::DrillingScenario& sc,
   for (const auto& [name, v] : r.gains) gains[name] = std::vector<double>(v.data(), v.data() + v.size());
   j["gains"] = gains;
   nlohmann::json par{{"omega_rad_s", run.parameters.omega}, {"zeta", run.parameters.zeta}};
-  if (run.parameters.kind == "pid") par["integral_ratio"] = run.parameters.third;
-  if (run.parameters.kind == "pd-tdc") par["mbar_ratio"] = run.parameters.third;
+  const drilling::ControllerKind& kind = drilling::FindControllerKind(run.parameters.kind);
+  if (!kind.third_parameter().empty()) par[kind.third_parameter()] = run.parameters.third;
   par["filter_time_constant_s"] = run.parameters.filter_time_constant;
   j["gain_parameters"] = par;
   j["gains_source"] = run.tuned ? "tuned" : "defaults";
@@ -107,7 +108,7 @@ nlohmann::json Summary(const Run& run, const drilling::DrillingScenario& sc,
   j["cost_rad_s2"] = r.cost;
   j["diverged"] = r.diverged;
   j["plant_substeps_per_period"] = r.substeps;
-  if (run.parameters.kind == "pd-tdc") j["tde_stability_measure"] = run.tde_measure;
+  if (kind.uses_time_delay_estimation()) j["tde_stability_measure"] = run.tde_measure;
   return j;
 }
 
@@ -196,9 +197,7 @@ int RunDrillSim(int argc, char** argv) {
       std::stringstream ss(controllers);
       std::string k;
       while (std::getline(ss, k, ',')) {
-        if (k != "pid" && k != "pd" && k != "pd-tdc") {
-          throw UsageError("--controller: expected pid, pd or pd-tdc, got \"" + k + "\"");
-        }
+        FromOption("--controller", [&] { drilling::FindControllerKind(k); });
         if (std::find(kinds.begin(), kinds.end(), k) != kinds.end()) {
           throw UsageError("--controller: \"" + k + "\" given twice");
         }
@@ -251,10 +250,11 @@ int RunDrillSim(int argc, char** argv) {
     for (const std::string& text : gain_texts) {
       const auto eq = text.find('=');
       const std::string kind = text.substr(0, eq);
-      if (eq == std::string::npos || (kind != "pid" && kind != "pd" && kind != "pd-tdc")) {
-        throw UsageError("--gains: expected KIND=OMEGA,ZETA[,THIRD] with KIND pid, pd or pd-tdc, got \"" +
-                                    text + "\"");
+      if (eq == std::string::npos) {
+        throw UsageError("--gains: expected KIND=OMEGA,ZETA[,THIRD] with KIND " + drilling::ControllerKindList() +
+                         ", got \"" + text + "\"");
       }
+      FromOption("--gains " + text, [&] { drilling::FindControllerKind(kind); });
       const std::vector<double> v = ParseNumberList("--gains", text.substr(eq + 1));
       if (v.size() < 2 || v.size() > 4 || v[0] <= 0 || v[1] <= 0 || (v.size() >= 3 && v[2] <= 0) ||
           (v.size() == 4 && v[3] < 0)) {
@@ -285,7 +285,7 @@ int RunDrillSim(int argc, char** argv) {
       o.progress = [&](long done, long) { progress.Update(done); };
       run.result = sc->Run(*ctl, o);
       progress.Finish();
-      if (kind == "pd-tdc") {
+      if (drilling::FindControllerKind(kind).uses_time_delay_estimation()) {
         const Eigen::VectorXd mbar = sc->effective_inertia().diagonal() * run.parameters.third;
         run.tde_measure = drilling::TdeStabilityMeasure(sc->effective_inertia(), mbar);
         if (!(run.tde_measure < 1.0)) {

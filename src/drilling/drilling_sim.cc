@@ -10,6 +10,7 @@
 #include <nlopt.hpp>
 
 #include "robomach/common/units.h"
+#include "robomach/drilling/controller_kinds.h"
 
 namespace robomach::drilling {
 namespace {
@@ -236,54 +237,25 @@ SimResult DrillingScenario::Run(JointController& controller, const SimOptions& o
 std::unique_ptr<JointController> MakeController(const ControllerParameters& p,
                                                 const DrillingScenario& sc,
                                                 const Eigen::VectorXd& limit) {
-  const Eigen::VectorXd m = sc.effective_inertia().diagonal();
-  const double L = sc.process().control_period;
-  const int n = static_cast<int>(m.size());
-  if (p.kind == "pid" || p.kind == "pd") {
-    PidGains g;
-    g.kp = m * p.omega * p.omega;
-    g.kd = m * 2.0 * p.zeta * p.omega;
-    g.ki = p.kind == "pid" ? Eigen::VectorXd(g.kp * p.omega / p.third) : Eigen::VectorXd::Zero(n);
-    g.derivative_filter_time_constant = p.filter_time_constant;
-    return std::make_unique<PidController>(g, limit, L);
-  }
-  if (p.kind == "pd-tdc") {
-    PdTdcGains g;
-    g.kp = Eigen::VectorXd::Constant(n, p.omega * p.omega);
-    g.kd = Eigen::VectorXd::Constant(n, 2.0 * p.zeta * p.omega);
-    g.mbar = m * p.third;
-    g.accel_filter_time_constant = p.filter_time_constant;
-    return std::make_unique<PdTdcController>(g, limit, L);
-  }
-  throw std::invalid_argument("controller: expected pid, pd or pd-tdc, got \"" + p.kind + "\"");
+  return FindControllerKind(p.kind).Make(p, sc.effective_inertia().diagonal(), sc.process().control_period, limit);
 }
 
-ControllerParameters DefaultParameters(const std::string& kind) {
-  // drill-sim --tune (30 simulations each) on config/drilling/ (planar3r,
-  // drill_5mm, q235), rounded to 3 digits; pd takes pid's w and zeta.
-  if (kind == "pid") return {"pid", 70.6, 1.06, 3.91, 0.005};
-  if (kind == "pd") return {"pd", 70.6, 1.06, 0.0, 0.005};
-  if (kind == "pd-tdc") return {"pd-tdc", 37.0, 0.506, 0.438, 0.005};
-  throw std::invalid_argument("controller: expected pid, pd or pd-tdc, got \"" + kind + "\"");
-}
+ControllerParameters DefaultParameters(const std::string& kind) { return FindControllerKind(kind).defaults(); }
 
 TuneResult TuneController(const ControllerParameters& start, DrillingScenario& scenario,
                           const SimOptions& options, int max_evaluations) {
   ControllerParameters p = start;
-  const std::string kind = p.kind;
-  const bool third = kind != "pd";
+  const ControllerKind& kind = FindControllerKind(p.kind);
+  const bool third = !kind.third_parameter().empty();
   const int dim = third ? 3 : 2;
   // Bounds: w from a slow 2 rad/s to 1/4 of the control rate (the sampled
-  // loop needs w L well below 1); zeta 0.2..3; r 1..100 (pid); alpha
-  // 0.01..1.95 (the TDE condition needs alpha < 2 for a diagonal Mbar).
+  // loop needs w L well below 1); zeta 0.2..3; the third parameter's from
+  // its ControllerKind (pid: r 1..100; pd-tdc: alpha 0.01..1.95).
   const double wmax = 0.25 / scenario.process().control_period;
   std::vector<double> lo = {std::log(2.0), std::log(0.2)}, hi = {std::log(wmax), std::log(3.0)};
-  if (kind == "pid") {
-    lo.push_back(std::log(1.0));
-    hi.push_back(std::log(100.0));
-  } else if (kind == "pd-tdc") {
-    lo.push_back(std::log(0.01));
-    hi.push_back(std::log(1.95));
+  if (third) {
+    lo.push_back(std::log(kind.third_bounds().first));
+    hi.push_back(std::log(kind.third_bounds().second));
   }
   std::vector<double> x = {std::log(p.omega), std::log(p.zeta)};
   if (third) x.push_back(std::log(p.third));
