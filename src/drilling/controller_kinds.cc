@@ -77,7 +77,7 @@ const ControllerKind& FindControllerKind(const std::string& name) {
   for (const ControllerKind* k : ControllerKinds()) {
     if (k->name() == name) return *k;
   }
-  throw std::invalid_argument("controller: expected " + ControllerKindList() + ", got \"" + name + "\"");
+  throw std::invalid_argument("unknown controller kind \"" + name + "\"; expected " + ControllerKindList());
 }
 
 }  // namespace robomach::drilling
