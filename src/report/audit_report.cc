@@ -1,0 +1,411 @@
+#include "robomach/report/audit_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+
+#include "robomach/audit/error_patterns.h"
+#include "robomach/common/number_format.h"
+#include "robomach/dynamics/tool_tip_frf.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/report/audit_patterns_report.h"
+#include "robomach/report/calibration_report.h"
+#include "robomach/report/html.h"
+#include "robomach/report/posture_json.h"
+
+namespace robomach::report {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string KeyLabel(const dynamics::FrfKey& k) {
+  return k.pose_id + " " + AxisName(k.response) + AxisName(k.excitation);
+}
+
+// rms log-magnitude error per posture (audit::ErrorPerPosture), by id.
+std::map<std::string, double> PerPosture(const audit::ModelErrors& e, const std::vector<std::string>& ids) {
+  const Eigen::VectorXd v = audit::ErrorPerPosture(e, ids);
+  std::map<std::string, double> out;
+  for (size_t i = 0; i < ids.size(); ++i) out[ids[i]] = v(static_cast<Eigen::Index>(i));
+  return out;
+}
+
+}  // namespace
+
+AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResult& r,
+                             const dynamics::RobotDescription& description, const calibration::PostureMap& postures,
+                             const dynamics::FrfSet& measured_fit, const dynamics::FrfSet& measured_all,
+                             const calibration::NoiseModels& noise, const AuditReportOptions& ro) {
+  // The candidate the report shows as the model after: the named one
+  // (explained or mostly explained), else the accepted one.
+  const bool named = r.grade == audit::AuditGrade::kExplained || r.grade == audit::AuditGrade::kMostlyExplained;
+  const audit::CandidateResult* best =
+      named ? &r.candidates[r.graded] : (r.best >= 0 ? &r.candidates[r.best] : nullptr);
+  const audit::ModelErrors& after = best ? best->errors : r.errors_before;
+
+  // ---- where it fails: trends, error map, modes without a counterpart.
+  if (ro.progress) ro.progress("error patterns: trends against posture descriptors, mode error map, unmatched modes");
+  const auto base_model = dynamics::RobotModel::Build(description, r.baseline_fit.parameters);
+  const calibration::MeasuredFeatures& features = r.features;
+  audit::ErrorPatternOptions popt;
+  popt.fmin_hz = ro.fmin_hz;
+  popt.fmax_hz = ro.fmax_hz;
+  const audit::ErrorPatterns patterns = audit::AnalyzeErrorPatterns(r, base_model, postures, measured_fit, features, popt);
+  const AuditPatternsReport pr = MakeAuditPatternsReport(patterns, r.noise_floor, "model-audit");
+
+  // ---- summary.json (stable keys; see README)
+  json j;
+  j["robot"] = ro.robot_path;
+  j["effects_in_model"] = json::array();
+  for (const auto& e : description.effects) j["effects_in_model"].push_back(e.name);
+  j["error_before"] = r.errors_before.total_rms_log_mag;
+  j["error_after"] = after.total_rms_log_mag;
+  j["noise_floor"] = r.noise_floor;
+  // With a noise model every error is in units of the noise (1: a model
+  // that is right); with --noise-model none, an rms of ln|H| differences.
+  j["error_units"] = noise.empty() ? "log_magnitude" : "noise_sigma";
+  j["noise"] = NoiseSummaryJson(noise, ro.noise_model, ro.min_snr);
+  j["warnings"] = r.warnings;
+  j["significant_failure"] = r.significant_failure;
+  j["baseline_calibration"] = {{"status", calibration::FitStatusName(r.baseline_fit.status)},
+                               {"message", r.baseline_fit.message},
+                               {"parameters", json::object()}};
+  for (const auto& e : r.baseline_fit.estimates) {
+    j["baseline_calibration"]["parameters"][e.name] = {{"value", e.value}, {"std", e.std_dev}};
+  }
+  const auto pb = PerPosture(r.errors_before, measured_fit.pose_ids()), pa = PerPosture(after, measured_fit.pose_ids());
+  for (const auto& [id, e] : pb) {
+    j["postures"][id] = {{"error_before", e}, {"error_after", pa.at(id)}};
+    if (pr.posture_descriptors.contains(id)) j["postures"][id]["descriptors"] = pr.posture_descriptors[id];
+  }
+  if (!ro.previous.is_null()) {
+    // The previous audit's errors next to these, per posture and in total.
+    j["compare"] = {{"report", ro.compare_dir},
+                    {"error_before", ro.previous["error_before"]},
+                    {"error_after", ro.previous["error_after"]},
+                    {"postures", json::object()}};
+    for (const auto& [id, e] : pb) {
+      if (ro.previous["postures"].contains(id)) {
+        j["compare"]["postures"][id] = {{"error_before", ro.previous["postures"][id]["error_before"]},
+                                        {"error_after", ro.previous["postures"][id]["error_after"]}};
+      }
+    }
+  }
+  j["trends"] = pr.trends;
+  j["mode_error_map"] = pr.mode_error_map;
+  j["unmatched_model_modes"] = pr.unmatched_model_modes;
+  j["unmatched_measured_modes"] = pr.unmatched_measured_modes;
+  j["candidates"] = json::array();
+  for (const auto& c : r.candidates) {
+    json cj{{"name", c.name()}, {"bic_change", c.bic_change}, {"error_after", c.errors.total_rms_log_mag},
+            {"plausible", c.plausible}, {"note", c.note}, {"parameters", json::object()},
+            {"not_identifiable", c.not_identifiable}, {"held_calibration", c.held_calibration},
+            {"start", c.start}};
+    for (const auto& e : c.fit.estimates) cj["parameters"][e.name] = {{"value", e.value}, {"std", e.std_dev}};
+    j["candidates"].push_back(cj);
+  }
+  // Numbers that are undefined (no candidate) are null.
+  const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  j["verdict"] = {{"grade", audit::AuditGradeName(r.grade)},
+                  {"missing_effects", r.missing_effects},
+                  {"explained", r.explained},
+                  {"headline", r.headline},
+                  {"text", r.verdict},
+                  {"pattern", r.pattern},
+                  {"candidate", r.graded >= 0 ? json(r.candidates[r.graded].name()) : json(nullptr)},
+                  {"error_before_noise_units", number(r.error_before_noise_units)},
+                  {"remainder_noise_units", number(r.remainder_noise_units)},
+                  {"fraction_removed", number(r.fraction_removed)},
+                  {"bic_gap", number(r.bic_gap)},
+                  {"runner_up", r.runner_up},
+                  {"reasons", r.reasons}};
+  // The YAML to paste: the accepted candidate's effects, or else the
+  // effects switched on with --add, with their calibrated values.
+  std::string yaml;
+  if (best) {
+    yaml = audit::EffectYaml(*best);
+  } else if (!ro.added_effects.empty()) {
+    audit::CandidateResult added;
+    added.effects = ro.added_effects;
+    added.fit = r.baseline_fit;
+    yaml = audit::EffectYaml(added);
+  }
+  j["yaml"] = yaml;
+
+  // ---- errors.csv, candidates.csv
+  std::ostringstream ecsv;
+  ecsv << "pose_id,response,excitation,lines,error_before,error_after,worst_band_fmin_hz,worst_band_fmax_hz,"
+          "worst_band_error\n";
+  for (size_t i = 0; i < r.errors_before.curves.size(); ++i) {
+    const auto& c = r.errors_before.curves[i];
+    ecsv << c.key.pose_id << ',' << AxisName(c.key.response) << ',' << AxisName(c.key.excitation) << ','
+         << c.lines << ',' << FormatNumber(c.rms_log_mag, 6) << ',' << FormatNumber(after.curves[i].rms_log_mag, 6);
+    if (!c.bands.empty()) {
+      ecsv << ',' << FormatNumber(c.bands[0].fmin_hz, 6) << ',' << FormatNumber(c.bands[0].fmax_hz, 6) << ','
+           << FormatNumber(c.bands[0].rms_log_mag, 6);
+    } else {
+      ecsv << ",,,";
+    }
+    ecsv << '\n';
+  }
+  std::ostringstream ccsv;
+  ccsv << "rank,candidate,bic_change,error_after,plausible,note\n";
+  for (size_t i = 0; i < r.candidates.size(); ++i) {
+    const auto& c = r.candidates[i];
+    std::string note = c.note;
+    std::replace(note.begin(), note.end(), ',', ';');
+    std::replace(note.begin(), note.end(), '\n', ' ');
+    ccsv << i + 1 << ',' << c.name() << ',' << FormatNumber(c.bic_change, 8) << ',' << FormatNumber(c.errors.total_rms_log_mag, 6)
+         << ',' << (c.plausible ? "yes" : "no") << ',' << note << '\n';
+  }
+
+  // Overlays: the calibrated current model against the named or accepted
+  // candidate; without one, against the best-ranked candidate, labelled
+  // as not accepted, so that the unexplained pattern can be seen; with no
+  // candidate fitted, the current model alone.
+  const audit::CandidateResult* shown = best ? best : (r.candidates.empty() ? nullptr : &r.candidates[0]);
+  const std::string before_label = "current model (calibrated)";
+  const std::string after_label =
+      shown ? "with " + shown->name() +
+                  (!best ? " (not accepted)"
+                         : r.grade == audit::AuditGrade::kMostlyExplained ? " (mostly explains)" : "")
+            : "";
+  // The FRF the current model fits worst (whole-curve error before).
+  size_t worst = 0;
+  for (size_t i = 1; i < r.errors_before.curves.size(); ++i) {
+    if (r.errors_before.curves[i].rms_log_mag > r.errors_before.curves[worst].rms_log_mag) worst = i;
+  }
+  const bool has_worst = !r.errors_before.curves.empty();
+
+  // ---- index.html (self-contained; PNGs by relative path): the verdict in
+  // one sentence and the worst FRF before and after first, the tables after.
+  std::ostringstream h;
+  h << "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>model-audit</title><style>"
+       "body{font-family:sans-serif;max-width:70em;margin:auto}table{border-collapse:collapse}"
+       "td,th{border:1px solid #999;padding:2px 6px;text-align:right}pre{background:#eee;padding:6px}"
+       ".headline{font-size:1.3em;padding:8px;border-left:6px solid "
+    << (r.grade == audit::AuditGrade::kUnexplained         ? "#c0392b"
+        : r.grade == audit::AuditGrade::kMostlyExplained ? "#e67e22"
+                                                          : "#27ae60")
+    << ";background:#f6f6f6}img{max-width:100%}"
+       "</style></head><body><h1>model-audit: " << HtmlEscape(ro.robot_path) << "</h1>\n";
+  {
+    // The library's plain-text arrows and times signs, typeset.
+    std::string line = HtmlEscape(r.headline);
+    for (const auto& [from, to] : {std::pair<std::string, std::string>{" -&gt; ", " → "}, {" x the noise", " × the noise"}}) {
+      for (size_t at = line.find(from); at != std::string::npos; at = line.find(from, at + to.size())) {
+        line.replace(at, from.size(), to);
+      }
+    }
+    h << "<p class=\"headline\">" << line << "</p>\n";
+  }
+  if (has_worst) {
+    const auto& wc = r.errors_before.curves[worst];
+    // The error of the curve drawn thin (the shown candidate's), if any.
+    const bool has_after = shown && worst < shown->errors.curves.size();
+    h << "<p><img src=\"worst_frf.png\" alt=\"worst FRF before and after\"><br>The FRF the current model fits "
+         "worst, "
+      << HtmlEscape(KeyLabel(wc.key)) << " (error " << FormatNumber(wc.rms_log_mag / r.noise_floor, 3) << " × the noise floor";
+    if (has_after) {
+      h << "; " << FormatNumber(shown->errors.curves[worst].rms_log_mag / r.noise_floor, 3) << " with "
+        << HtmlEscape(shown->name());
+    }
+    h << "): measured (wide, with its noise where known), the calibrated current model (dashed)";
+    if (shown) {
+      h << " and the model with " << HtmlEscape(shown->name()) << " (" << (best ? "" : "not accepted; ") << "thin line)";
+    }
+    h << ".</p>\n";
+  }
+  h << "<h2>Verdict</h2>\n";
+  if (r.grade == audit::AuditGrade::kMostlyExplained) {
+    // The verdict's parts one by one (summary.json's verdict.text has them
+    // in one sentence).
+    h << "<p>Likely reasons for the remainder:</p><ul>";
+    for (const auto& reason : r.reasons) h << "<li>" << HtmlEscape(reason) << "</li>";
+    h << "</ul>\n<p>Pattern of the remainder: " << HtmlEscape(r.pattern) << ".</p>\n";
+  } else {
+    h << "<p>" << HtmlEscape(r.verdict) << "</p>\n";
+  }
+  if (r.graded >= 0) {
+    h << "<p>Graded on " << HtmlEscape(r.candidates[r.graded].name()) << ": error " << FormatNumber(r.error_before_noise_units, 3)
+      << " → " << FormatNumber(r.remainder_noise_units, 3) << " × the noise floor, "
+      << FormatNumber(100.0 * r.fraction_removed, 3) << " % of the excess misfit (error/noise − 1) removed; BIC "
+      << FormatNumber(r.bic_gap, 4) << " below the runner-up, " << HtmlEscape(r.runner_up) << ". \"Mostly explained\" takes "
+      << FormatNumber(100.0 * ro.mostly_explained_fraction, 3) << " % or more and a BIC gap above "
+      << FormatNumber(ro.clear_bic_gap, 3) << " (very strong evidence, Kass &amp; Raftery 1995).</p>\n";
+  }
+  h << "<p>Whole-curve error (rms of ln|H<sub>model</sub>| − "
+    << "ln|H<sub>measured</sub>|" << (noise.empty() ? "" : ", each line in units of its noise: 1 is a model that is right")
+    << "): before " << FormatNumber(r.errors_before.total_rms_log_mag) << ", after "
+    << FormatNumber(after.total_rms_log_mag) << "; noise floor " << FormatNumber(r.noise_floor) << " ("
+    << (r.significant_failure ? "significant failure" : "consistent with the noise") << ").</p>\n";
+  if (!noise.empty()) {
+    h << "<h2>Noise model and usable band per FRF</h2><p>Lines used where |H| ≥ " << FormatNumber(ro.min_snr)
+      << " × the additive noise floor (--min-snr).</p><table><tr><th>FRF</th><th>noise model</th></tr>\n";
+    for (const auto& [key, n] : noise) {
+      h << "<tr><td>" << HtmlEscape(KeyLabel(key)) << "</td><td style=\"text-align:left\">" << HtmlEscape(n.description)
+        << "</td></tr>\n";
+    }
+    h << "</table>\n";
+  }
+  h << "<h2>Error per posture</h2><table><tr><th>posture</th><th>before</th><th>after</th>";
+  if (!ro.previous.is_null()) h << "<th>previous before</th><th>previous after</th>";
+  h << "</tr>\n";
+  for (const auto& [id, e] : pb) {
+    h << "<tr><td>" << HtmlEscape(id) << "</td><td>" << FormatNumber(e) << "</td><td>" << FormatNumber(pa.at(id)) << "</td>";
+    if (!ro.previous.is_null()) {
+      const bool has = ro.previous["postures"].contains(id);
+      h << "<td>" << (has ? FormatNumber(ro.previous["postures"][id]["error_before"].get<double>()) : "–") << "</td><td>"
+        << (has ? FormatNumber(ro.previous["postures"][id]["error_after"].get<double>()) : "–") << "</td>";
+    }
+    h << "</tr>\n";
+  }
+  h << "<tr><th>total</th><th>" << FormatNumber(r.errors_before.total_rms_log_mag) << "</th><th>"
+    << FormatNumber(after.total_rms_log_mag) << "</th>";
+  if (!ro.previous.is_null()) {
+    h << "<th>" << FormatNumber(ro.previous["error_before"].get<double>()) << "</th><th>"
+      << FormatNumber(ro.previous["error_after"].get<double>()) << "</th>";
+  }
+  h << "</tr></table>\n<h2>Error per posture and direction, worst band</h2><table><tr><th>FRF</th><th>before</th>"
+       "<th>after</th><th>worst band [Hz]</th><th>its error</th></tr>\n";
+  for (size_t i = 0; i < r.errors_before.curves.size(); ++i) {
+    const auto& c = r.errors_before.curves[i];
+    h << "<tr><td>" << HtmlEscape(KeyLabel(c.key)) << "</td><td>" << FormatNumber(c.rms_log_mag) << "</td><td>"
+      << FormatNumber(after.curves[i].rms_log_mag) << "</td>";
+    if (!c.bands.empty()) {
+      h << "<td>" << FormatNumber(c.bands[0].fmin_hz, 3) << "–" << FormatNumber(c.bands[0].fmax_hz, 3) << "</td><td>"
+        << FormatNumber(c.bands[0].rms_log_mag) << "</td>";
+    } else {
+      h << "<td></td><td></td>";
+    }
+    h << "</tr>\n";
+  }
+  h << "</table>\n<h2>Modes (current model, calibrated)</h2><table><tr><th>FRF</th><th>measured [Hz]</th>"
+       "<th>frequency error</th><th>damping meas.</th><th>damping model</th><th>peak error</th></tr>\n";
+  for (const auto& m : r.modes_before.matches) {
+    h << "<tr><td>" << HtmlEscape(KeyLabel(m.key)) << "</td><td>" << FormatNumber(m.measured_freq_hz) << "</td><td>"
+      << FormatNumber(100 * m.freq_error(), 3) << " %</td><td>" << FormatNumber(m.measured_damping, 3) << "</td><td>"
+      << FormatNumber(m.model_damping, 3) << "</td><td>" << FormatNumber(100 * m.peak_error(), 3) << " %</td></tr>\n";
+  }
+  h << "</table>\n" << pr.html << "<h2>Candidate effects (best first)</h2>";
+  if (r.candidates.empty()) h << "<p>None tried.</p>";
+  h << "<table><tr><th>rank</th><th>candidate</th><th>ΔBIC</th><th>error after</th><th>plausible</th>"
+       "<th>fitted parameters (±1σ)</th></tr>\n";
+  for (size_t i = 0; i < r.candidates.size(); ++i) {
+    const auto& c = r.candidates[i];
+    h << "<tr><td>" << i + 1 << "</td><td>" << HtmlEscape(c.name()) << "</td><td>" << FormatNumber(c.bic_change, 6)
+      << "</td><td>" << FormatNumber(c.errors.total_rms_log_mag) << "</td><td>" << (c.plausible ? "yes" : "no: " + HtmlEscape(c.note))
+      << "</td><td style=\"text-align:left\">";
+    for (const auto& e : c.fit.estimates) {
+      if (e.name.find('.') != std::string::npos) h << HtmlEscape(e.name) << " = " << FormatNumber(e.value) << " ± " << FormatNumber(e.std_dev, 2) << "<br>";
+    }
+    h << "</td></tr>\n";
+  }
+  h << "</table>\n";
+  if (!yaml.empty()) {
+    h << "<h2>" << (best ? "Add the effect" : "The added effects, calibrated")
+      << "</h2><p>Append to the robot config (merge into its <code>effects:</code> list if it has one):</p><pre>"
+      << HtmlEscape(yaml) << "</pre>\n";
+  }
+  h << "<h2>Overlays per posture</h2><p>Measured FRFs (wide band), the calibrated current model (dashed)"
+    << (shown ? " and the model " + HtmlEscape(after_label) + " (thin line)" : std::string())
+    << "; vertical lines: the natural frequencies of the " << (shown ? "latter" : "model") << ".</p>\n";
+  for (const auto& id : measured_fit.pose_ids()) {
+    h << "<p><img src=\"overlay_" << HtmlEscape(id) << ".png\" alt=\"overlay " << HtmlEscape(id) << "\"></p>\n";
+  }
+  h << "</body></html>\n";
+
+  // ---- write (each file complete or absent)
+  io::EnsureDirectory(dir_path);
+  const fs::path dir(dir_path);
+  const AuditPatternFiles names;
+  {
+    dynamics::PostureEvaluator eb(base_model);
+    std::unique_ptr<dynamics::PostureEvaluator> ea;
+    if (shown) {
+      dynamics::RobotDescription desc = description;
+      for (const auto& e : shown->effects) desc.effects.push_back({e, {}});
+      ea = std::make_unique<dynamics::PostureEvaluator>(dynamics::RobotModel::Build(desc, shown->fit.parameters));
+    }
+    for (const std::string& pose : measured_fit.pose_ids()) {
+      const auto db = eb.Evaluate(postures.at(pose));
+      // Every measured line with its noise, not only the usable ones.
+      PostureOverlay o = ea ? MakePostureOverlay(pose, measured_all, db,
+                                                                 ea->Evaluate(postures.at(pose)))
+                                    : MakePostureOverlay(pose, measured_all, db);
+      AddNoise(noise, &o);
+      if (has_worst && pose == r.errors_before.curves[worst].key.pose_id) {
+        // The worst FRF alone: its row of the posture's overlay.
+        const dynamics::FrfKey& wk = r.errors_before.curves[worst].key;
+        PostureOverlay w = o;
+        w.keys.clear(), w.freq_hz.clear(), w.measured.clear(), w.before.clear(), w.after.clear();
+        w.noise_sigma.clear(), w.usable.clear();
+        for (size_t k = 0; k < o.keys.size(); ++k) {
+          if (!(o.keys[k] == wk)) continue;
+          w.keys.push_back(o.keys[k]);
+          w.freq_hz.push_back(o.freq_hz[k]);
+          w.measured.push_back(o.measured[k]);
+          w.before.push_back(o.before[k]);
+          if (k < o.after.size()) w.after.push_back(o.after[k]);
+          if (k < o.noise_sigma.size()) w.noise_sigma.push_back(o.noise_sigma[k]);
+          if (k < o.usable.size()) w.usable.push_back(o.usable[k]);
+        }
+        WriteOverlayPng((dir / "worst_frf.png").string(), w,
+                                "model-audit: worst FRF " + KeyLabel(wk) + ", measured vs " + before_label +
+                                    (shown ? " and " + after_label : std::string()),
+                                before_label, after_label);
+      }
+      WriteOverlayPng((dir / ("overlay_" + pose + ".png")).string(), o,
+                              "model-audit: posture " + pose + ", measured vs " + before_label +
+                                  (shown ? " and " + after_label : std::string()),
+                              before_label, after_label);
+    }
+  }
+  // Files of an earlier run in this folder that this run does not
+  // rewrite would be taken for its results: remove them.
+  {
+    std::vector<fs::path> stale;
+    const std::vector<std::string> ids = measured_fit.pose_ids();
+    const std::set<std::string> poses(ids.begin(), ids.end());
+    if (yaml.empty()) stale.push_back(dir / "effects.yaml");
+    if (pr.mode_error_map_png.empty()) stale.push_back(dir / names.mode_error_map_png);
+    for (const auto& entry : fs::directory_iterator(dir)) {
+      const std::string n = entry.path().filename().string();
+      if (n.rfind("overlay_", 0) == 0 && entry.path().extension() == ".png" &&
+          !poses.count(n.substr(8, n.size() - 12))) {
+        stale.push_back(entry.path());
+      }
+    }
+    for (const auto& f : stale) fs::remove(f);
+  }
+  if (!yaml.empty()) {
+    io::WriteFileAtomically((dir / "effects.yaml").string(), "# model-audit: add to the robot config\n" + yaml);
+  }
+  io::WriteFileAtomically((dir / "errors.csv").string(), ecsv.str());
+  io::WriteFileAtomically((dir / "candidates.csv").string(), ccsv.str());
+  io::WriteFileAtomically((dir / names.trends_csv).string(), pr.trends_csv);
+  io::WriteFileAtomically((dir / names.posture_descriptors_csv).string(), pr.posture_descriptors_csv);
+  io::WriteFileAtomically((dir / names.mode_errors_csv).string(), pr.mode_errors_csv);
+  io::WriteFileAtomically((dir / names.unmatched_modes_csv).string(), pr.unmatched_modes_csv);
+  auto write_png = [&](const std::string& name, const std::vector<unsigned char>& png) {
+    io::WriteFileAtomically((dir / name).string(),
+                            std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+  };
+  write_png(names.trends_png, pr.trends_png);
+  if (!pr.mode_error_map_png.empty()) write_png(names.mode_error_map_png, pr.mode_error_map_png);
+  io::WriteFileAtomically((dir / "index.html").string(), h.str());
+  io::WriteFileAtomically((dir / "summary.json").string(), DumpJson(j));
+
+  AuditReport out;
+  out.summary = std::move(j);
+  out.effects_yaml = yaml;
+  for (const auto& c : r.candidates) out.failed_candidate |= c.fit.status == calibration::FitStatus::kFailed;
+  return out;
+}
+
+}  // namespace robomach::report
