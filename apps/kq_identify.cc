@@ -192,10 +192,10 @@ int RunPlan(const io::RobotConfig& cfg, int num_postures, double noise_mm, unsig
     }
     std::cerr << kTool << ":   joint " << j + 1 << ": k = " << Sci(model->joint_stiffness()(j)) << " N·m/rad, std dev "
               << Sci(plan.expected_std_dev(j), 2) << " N·m/rad (" << rel.str() << ")\n";
-    // The identification's rule: not determined only where the plan's
-    // information is numerically rank-deficient (an infinite std); a finite
-    // std above the weak bound is a weakly determined joint.
-    if (!std::isfinite(plan.expected_relative_std(j))) {
+    // The identification's rule (identification::DeterminationFromRelativeStd).
+    const identification::Determination d =
+        identification::DeterminationFromRelativeStd(plan.expected_relative_std(j), weak);
+    if (d == identification::Determination::kNotDetermined) {
       flagged = true;
       std::cerr << kTool << ": warning: joint " << j + 1
                 << " cannot be determined with this set-up"
@@ -203,7 +203,7 @@ int RunPlan(const io::RobotConfig& cfg, int num_postures, double noise_mm, unsig
                         ? ": put the load point and the target off the tool axis (--load-point-mm, --target-mm)"
                         : ": allow more postures or rope directions")
                 << "\n";
-    } else if (plan.expected_relative_std(j) > weak) {
+    } else if (d == identification::Determination::kWeak) {
       std::cerr << kTool << ": warning: joint " << j + 1 << " would be weakly determined (±"
                 << std::fixed << std::setprecision(0) << 100 * plan.expected_relative_std(j)
                 << " % at 1 sigma): plan more postures (--plan N)"

@@ -68,6 +68,11 @@ const char* ToString(FitStatus s) {
   return "?";
 }
 
+Determination DeterminationFromRelativeStd(double relative_std, double weak_relative_std) {
+  if (!std::isfinite(relative_std)) return Determination::kNotDetermined;
+  return relative_std > weak_relative_std ? Determination::kWeak : Determination::kDetermined;
+}
+
 const char* ToString(Determination d) {
   switch (d) {
     case Determination::kDetermined: return "determined";
@@ -387,8 +392,8 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
   std::vector<int> cov_failed;
   for (int j : free) {
     const double s = std::sqrt(std::max(cov_theta(j, j), 0.0));
-    if (!std::isfinite(s)) {
-      res.determination[j] = Determination::kNotDetermined;
+    res.determination[j] = DeterminationFromRelativeStd(s, options.weak_relative_std);
+    if (res.determination[j] == Determination::kNotDetermined) {
       cov_failed.push_back(j);
       continue;
     }
@@ -405,7 +410,6 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     const double x = std::exp(-theta(j)), sx = x * s;
     res.lower_95(j) = k0(j) / (x + kZ95 * sx);
     res.upper_95(j) = x - kZ95 * sx > 0.0 ? k0(j) / (x - kZ95 * sx) : kInf;
-    if (s > options.weak_relative_std) res.determination[j] = Determination::kWeak;
   }
   for (int a : free) {
     for (int b : free) {

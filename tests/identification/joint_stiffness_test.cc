@@ -1,6 +1,7 @@
 #include "robomach/identification/joint_stiffness.h"
 
 #include <cmath>
+#include <limits>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -429,6 +430,19 @@ TEST(IdentifyJointStiffness, InvalidOptionsNameTheField) {
   IdentificationOptions o;
   o.tracker_noise = -1.0;
   EXPECT_THAT(testing::CaptureError([&] { CheckValid(o); }), HasSubstr("tracker_noise"));
+}
+
+// One rule for a fit's and a plan's joints: rank-deficient (inf, NaN) is
+// not determined, above the bound weak, else determined (the bound itself
+// is still determined).
+TEST(DeterminationFromRelativeStd, ClassifiesAtTheBound) {
+  const double weak = IdentificationOptions{}.weak_relative_std;
+  EXPECT_EQ(DeterminationFromRelativeStd(0.01, weak), Determination::kDetermined);
+  EXPECT_EQ(DeterminationFromRelativeStd(weak, weak), Determination::kDetermined);
+  EXPECT_EQ(DeterminationFromRelativeStd(std::nextafter(weak, 1.0), weak), Determination::kWeak);
+  EXPECT_EQ(DeterminationFromRelativeStd(1e6, weak), Determination::kWeak);
+  EXPECT_EQ(DeterminationFromRelativeStd(std::numeric_limits<double>::infinity(), weak), Determination::kNotDetermined);
+  EXPECT_EQ(DeterminationFromRelativeStd(std::numeric_limits<double>::quiet_NaN(), weak), Determination::kNotDetermined);
 }
 
 }  // namespace

@@ -50,6 +50,12 @@ enum class Determination { kDetermined, kWeak, kNotDetermined };
 const char* ToString(FitStatus s);
 const char* ToString(Determination d);
 
+/// The rule from a joint's relative standard deviation σ_k/k (of a fit, or
+/// expected by a test plan): not determined where it is infinite or NaN
+/// (the information is rank-deficient), weakly determined above
+/// `weak_relative_std`, else determined.
+Determination DeterminationFromRelativeStd(double relative_std, double weak_relative_std);
+
 /// The residual of one load case at the solution.
 struct CaseResidual {
   std::string case_id;
