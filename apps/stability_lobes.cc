@@ -16,6 +16,7 @@
 
 #include "cli_support.h"
 #include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -120,12 +121,6 @@ dynamics::Frf DirectFrf(const io::FrfSetOfPose& s, int a) {
   return dynamics::Frf::FromSamples(s.freq_hz, h);
 }
 
-std::string Sig4(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.4g", v);
-  return buf;
-}
-
 // Noise model and modal fit of one direct FRF, reported on stderr.
 DirectionFit FitOne(const std::string& label, const dynamics::Frf& frf) {
   DirectionFit d{label, stability::FitDirectFrf(frf)};
@@ -135,7 +130,7 @@ DirectionFit FitOne(const std::string& label, const dynamics::Frf& frf) {
   for (const calibration::FittedMode& fm : d.fit.fit.modes) {
     m << "\n  " << io::FormatDouble(std::round(fm.freq_hz * 10.0) / 10.0) << " Hz, damping ratio "
       << io::FormatDouble(std::round(fm.damping_ratio * 1e4) / 1e4) << ", modal mass "
-      << (fm.modal_constant.real() > 0.0 ? Sig4(1.0 / fm.modal_constant.real()) + " kg"
+      << (fm.modal_constant.real() > 0.0 ? FormatNumber(1.0 / fm.modal_constant.real()) + " kg"
                                           : std::string("none (Re A <= 0: not a driving-point mode, left out)"));
   }
   if (std::isfinite(d.fit.noise_rms)) {
@@ -398,7 +393,7 @@ void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
     }
     const double diff = std::abs(sd - zoa) / std::min(sd, zoa);
     std::ostringstream m;
-    m << t.id << ": smallest critical depth SD " << Sig4(MToMm(sd)) << " mm, ZOA " << Sig4(MToMm(zoa)) << " mm";
+    m << t.id << ": smallest critical depth SD " << FormatNumber(MToMm(sd)) << " mm, ZOA " << FormatNumber(MToMm(zoa)) << " mm";
     if (diff > 0.10) {
       Warn(kTool, m.str() + ": they differ by " + io::FormatDouble(std::round(diff * 1000.0) / 10.0) +
                       " % (more than 10 % at a radial immersion of " + io::FormatDouble(cut.process.radial_immersion) +

@@ -11,6 +11,7 @@
 #include <nlopt.hpp>
 
 #include "robomach/common/golden_section.h"
+#include "robomach/common/number_format.h"
 #include "robomach/common/parallel.h"
 #include "robomach/common/units.h"
 #include "robomach/polishing/process.h"
@@ -104,7 +105,7 @@ void RunNlopt(nlopt::algorithm alg, int budget, std::vector<double>* x, Tracker*
 OptimiseResult OptimiseCycloid(const std::function<double(const PathParameters&)>& objective,
                                const PathParameters& start, const OptimiseOptions& o) {
   OptimiseResult res;
-  Tracker t{&objective, &start, &o, &res, {}};
+  Tracker t{&objective, &start, &o, &res, {}, {}};
   if (o.method == Optimiser::kNlopt) {
     res.method = "NLopt GN_DIRECT_L (" + std::to_string(o.global_evaluations) + " evaluations) then LN_SBPLX (" +
                  std::to_string(o.local_evaluations) + ")";
@@ -204,11 +205,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string io_ftol(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", x);
-  return buf;
-}
+std::string io_ftol(double x) { return FormatNumber(x, 6); }
 
 // Ranks evaluations: feasible before infeasible; feasible by cv; infeasible
 // by how far they miss the target (mean), invalid last.

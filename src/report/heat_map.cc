@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/report/plot.h"
 
@@ -20,11 +21,7 @@ namespace {
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 const cv::Scalar kBlack(0, 0, 0);
 
-std::string Label(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", std::abs(v) < 1e-12 ? 0.0 : v);
-  return buf;
-}
+std::string Label(double v) { return FormatNumber(std::abs(v) < 1e-12 ? 0.0 : v, 6); }
 
 void Text(cv::Mat& img, const std::string& s, cv::Point p, double scale = 0.45, int align = 0) {
   int base = 0;
@@ -112,8 +109,7 @@ cv::Mat Render(const HeatMap& m) {
                  cv::LINE_AA);
       }
       if (m.annotate && std::isfinite(v)) {
-        char buf[32];
-        std::snprintf(buf, sizeof(buf), "%.3g", v);
+        const std::string buf = FormatNumber(v, 3);
         // Dark text on the light (yellow) end of viridis, light text on the dark end.
         const bool light = (v - vmin) / (vmax - vmin) > 0.6;
         int base = 0;
