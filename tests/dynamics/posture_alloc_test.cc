@@ -12,7 +12,14 @@
 #include "robomach/dynamics/tool_tip_frf.h"
 #include "test_models.h"
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || defined(__SANITIZE_MEMORY__)
+// GCC says so with __SANITIZE_*__; clang before 17 only through __has_feature.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define ROBOMACH_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || defined(__SANITIZE_MEMORY__) || \
+    defined(ROBOMACH_SANITIZED)
 #define ROBOMACH_COUNT_MALLOC 0  // the sanitizer owns malloc
 #elif defined(__GLIBC__) && defined(__GNUC__)
 #define ROBOMACH_COUNT_MALLOC 1
