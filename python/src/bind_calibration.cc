@@ -31,9 +31,6 @@ std::map<std::string, double> ParameterDict(const dynamics::ParameterSet& p) {
   return out;
 }
 
-std::tuple<std::string, std::string, std::string> KeyTuple(const dynamics::FrfKey& k) {
-  return {k.pose_id, AxisString(k.response), AxisString(k.excitation)};
-}
 
 calibration::PostureMap Postures(const std::map<std::string, Eigen::VectorXd>& p) {
   return calibration::PostureMap(p.begin(), p.end());
@@ -57,7 +54,7 @@ void BindCalibration(py::module_& m) {
         std::vector<py::dict> out;
         for (const auto& mm : f.modes) {
           py::dict d;
-          d["key"] = KeyTuple(mm.key);
+          d["key"] = FromKey(mm.key);
           d["freq_hz"] = mm.fit.freq_hz;
           d["damping_ratio"] = mm.fit.damping_ratio;
           d["peak_freq_hz"] = mm.peak_freq_hz;
@@ -70,7 +67,7 @@ void BindCalibration(py::module_& m) {
       .def_property_readonly("fit_status", [](const MeasuredFeatures& f) {
         std::map<std::tuple<std::string, std::string, std::string>, std::string> out;
         for (const auto& [k, r] : f.fits) {
-          out[KeyTuple(k)] = r.status == calibration::ModalFitStatus::kOk            ? "ok"
+          out[FromKey(k)] = r.status == calibration::ModalFitStatus::kOk            ? "ok"
                              : r.status == calibration::ModalFitStatus::kNoStableModes ? "no stable modes"
                                                                                        : "failed: " + r.message;
         }
@@ -106,7 +103,7 @@ void BindCalibration(py::module_& m) {
       .def_readonly("final_cost", &StageSummary::final_cost)
       .def_readonly("covariance_ok", &StageSummary::covariance_ok);
   py::class_<ModeMatch>(m, "ModeMatch", "A measured mode paired with a model mode of the same posture.")
-      .def_property_readonly("key", [](const ModeMatch& x) { return KeyTuple(x.key); })
+      .def_property_readonly("key", [](const ModeMatch& x) { return FromKey(x.key); })
       .def_readonly("model_mode", &ModeMatch::model_mode, "0-based index in PostureDynamics.modes")
       .def_readonly("measured_freq_hz", &ModeMatch::measured_freq_hz)
       .def_readonly("model_freq_hz", &ModeMatch::model_freq_hz)

@@ -17,14 +17,6 @@ using dynamics::Frf;
 using dynamics::FrfKey;
 using dynamics::FrfSet;
 
-// Python spells an FRF key as a tuple (pose_id, response, excitation), e.g.
-// ("P1", "x", "x") for the direct FRF Hxx of posture P1.
-using KeyTuple = std::tuple<std::string, std::string, std::string>;
-FrfKey ToKey(const KeyTuple& t) {
-  return {std::get<0>(t), ParseAxis(std::get<1>(t)), ParseAxis(std::get<2>(t))};
-}
-KeyTuple FromKey(const FrfKey& k) { return {k.pose_id, AxisString(k.response), AxisString(k.excitation)}; }
-
 py::dict ReadResultDict(const io::FrfReadResult& r) {
   py::dict d;
   d["frfs"] = r.frfs;

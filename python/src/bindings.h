@@ -3,6 +3,7 @@
 
 #include <complex>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <Eigen/Core>
@@ -13,6 +14,7 @@
 #include <pybind11/stl.h>
 
 #include "robomach/common/frames.h"
+#include "robomach/dynamics/measured_frf.h"
 
 namespace robomach::python {
 
@@ -21,6 +23,7 @@ namespace py = pybind11;
 void BindDynamics(py::module_& m);
 void BindFrf(py::module_& m);
 void BindCalibration(py::module_& m);
+void BindAudit(py::module_& m);
 
 /// Receptance matrices per line -> complex128 array of shape (lines, 3, 3).
 py::array_t<std::complex<double>> ToArray(const std::vector<Eigen::Matrix3cd>& h);
@@ -28,6 +31,12 @@ py::array_t<std::complex<double>> ToArray(const std::vector<Eigen::Matrix3cd>& h
 /// 'x', 'y', 'z' <-> Axis; @throws std::invalid_argument for anything else.
 Axis ParseAxis(const std::string& name);
 std::string AxisString(Axis a);
+
+/// Python spells an FRF key as a tuple (pose_id, response, excitation), e.g.
+/// ("P1", "x", "x") for the direct FRF Hxx of posture P1.
+using KeyTuple = std::tuple<std::string, std::string, std::string>;
+dynamics::FrfKey ToKey(const KeyTuple& t);
+KeyTuple FromKey(const dynamics::FrfKey& k);
 
 /// Raises FileNotFoundError ("path: no such file", as the tools' exit 66)
 /// unless `path` is a readable regular file.

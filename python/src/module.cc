@@ -30,6 +30,12 @@ Axis ParseAxis(const std::string& name) {
 
 std::string AxisString(Axis a) { return std::string(1, AxisName(a)); }
 
+dynamics::FrfKey ToKey(const KeyTuple& t) {
+  return {std::get<0>(t), ParseAxis(std::get<1>(t)), ParseAxis(std::get<2>(t))};
+}
+
+KeyTuple FromKey(const dynamics::FrfKey& k) { return {k.pose_id, AxisString(k.response), AxisString(k.excitation)}; }
+
 void RequireReadableFile(const std::string& path) {
   std::error_code ec;
   const bool regular = std::filesystem::is_regular_file(path, ec);
@@ -87,4 +93,5 @@ PYBIND11_MODULE(robomach, m) {
   BindDynamics(m);
   BindFrf(m);
   BindCalibration(m);
+  BindAudit(m);
 }

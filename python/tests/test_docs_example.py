@@ -33,6 +33,16 @@ def test_worked_example_runs_and_recovers_the_truth(tmp_path, monkeypatch):
     printed = out.getvalue()
     assert 'natural frequencies [Hz]' in printed
     before, after, residuals = ns['before'], ns['after'], ns['residuals']
+    # The audit names the effect the data were made with, and writes
+    # model-audit's report folder with the same verdict.
+    audit = ns['audit']
+    assert audit['grade'] == 'explained' and audit['candidate'] == 'spindle_interface', audit['headline']
+    assert audit['candidates'][0]['name'] == 'spindle_interface'
+    assert all(audit['candidates'][i]['bic_change'] <= audit['candidates'][i + 1]['bic_change']
+               for i in range(len(audit['candidates']) - 1))
+    assert (tmp_path / 'audit_report' / 'index.html').stat().st_size > 0
+    assert audit['summary']['verdict']['grade'] == 'explained'
+    assert audit['summary']['verdict']['candidate'] == 'spindle_interface'
     assert after.status == 'converged'
     for e in after.estimates:
         # Within 3 standard deviations of the value the data were made with.

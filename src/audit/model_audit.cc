@@ -164,6 +164,12 @@ std::string CandidateResult::name() const {
   return s;
 }
 
+const CandidateResult* AcceptedCandidate(const AuditResult& r) {
+  const bool named = r.grade == AuditGrade::kExplained || r.grade == AuditGrade::kMostlyExplained;
+  if (named && r.graded >= 0) return &r.candidates[r.graded];
+  return r.best >= 0 ? &r.candidates[r.best] : nullptr;
+}
+
 std::string EffectYaml(const CandidateResult& c) {
   std::ostringstream out;
   out.precision(6);

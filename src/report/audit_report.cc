@@ -43,9 +43,7 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
                              const calibration::NoiseModels& noise, const AuditReportOptions& ro) {
   // The candidate the report shows as the model after: the named one
   // (explained or mostly explained), else the accepted one.
-  const bool named = r.grade == audit::AuditGrade::kExplained || r.grade == audit::AuditGrade::kMostlyExplained;
-  const audit::CandidateResult* best =
-      named ? &r.candidates[r.graded] : (r.best >= 0 ? &r.candidates[r.best] : nullptr);
+  const audit::CandidateResult* best = audit::AcceptedCandidate(r);
   const audit::ModelErrors& after = best ? best->errors : r.errors_before;
 
   // ---- where it fails: trends, error map, modes without a counterpart.

@@ -250,6 +250,11 @@ struct AuditResult {
   std::vector<std::string> warnings;
 };
 
+/// The candidate that stands for "the model after": the named one when the
+/// grade is explained or mostly explained, else the accepted one (r.best),
+/// else none (nullptr). model-audit's report and YAML show this one.
+const CandidateResult* AcceptedCandidate(const AuditResult& r);
+
 /// BIC of a Gaussian least-squares fit: n ln(RSS/n) + k ln n.
 double Bic(double rss, int n, int k);
 

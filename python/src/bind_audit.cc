@@ -1,0 +1,122 @@
+// Python bindings of the model audit (model-audit's call) and of its report
+// folder (docs/python.md).
+#include <cmath>
+#include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "robomach/audit/model_audit.h"
+#include "robomach/io/robot_config.h"
+#include "robomach/report/audit_report.h"
+#include "robomach/report/posture_json.h"
+
+namespace robomach::python {
+
+namespace {
+
+// A result as plain Python objects: numbers, strings, lists and dicts.
+py::dict ResultDict(const audit::AuditResult& r) {
+  auto number = [](double v) -> py::object { return std::isfinite(v) ? py::object(py::float_(v)) : py::none(); };
+  py::dict d;
+  d["grade"] = audit::AuditGradeName(r.grade);
+  d["headline"] = r.headline;
+  d["verdict"] = r.verdict;
+  d["pattern"] = r.pattern;
+  d["explained"] = r.explained;
+  d["significant_failure"] = r.significant_failure;
+  d["missing_effects"] = r.missing_effects;
+  d["candidate"] = r.graded >= 0 ? py::object(py::str(r.candidates[r.graded].name())) : py::none();
+  d["error_before"] = r.errors_before.total_rms_log_mag;
+  d["noise_floor"] = r.noise_floor;
+  d["error_before_noise_units"] = number(r.error_before_noise_units);
+  d["remainder_noise_units"] = number(r.remainder_noise_units);
+  d["fraction_removed"] = number(r.fraction_removed);
+  d["bic_gap"] = number(r.bic_gap);
+  d["runner_up"] = r.runner_up;
+  d["reasons"] = r.reasons;
+  d["warnings"] = r.warnings;
+  py::list cands;
+  for (const auto& c : r.candidates) {
+    py::dict cd;
+    cd["name"] = c.name();
+    cd["effects"] = c.effects;
+    cd["bic_change"] = c.bic_change;
+    cd["error_after"] = c.errors.total_rms_log_mag;
+    cd["plausible"] = c.plausible;
+    cd["note"] = c.note;
+    py::dict params;
+    for (const auto& e : c.fit.estimates) params[py::str(e.name)] = py::make_tuple(e.value, e.std_dev);
+    cd["parameters"] = params;
+    cands.append(cd);
+  }
+  d["candidates"] = cands;
+  const audit::CandidateResult* best = audit::AcceptedCandidate(r);
+  d["effects_yaml"] = best ? audit::EffectYaml(*best) : std::string();
+  return d;
+}
+
+}  // namespace
+
+void BindAudit(py::module_& m) {
+  m.def("audit", [](const io::RobotConfig& config, const std::map<std::string, Eigen::VectorXd>& postures,
+                    const dynamics::FrfSet& measured, const std::map<KeyTuple, calibration::FrfNoise>& noise,
+                    const std::optional<std::string>& report_dir, const std::vector<std::string>& candidates,
+                    const std::vector<std::string>& calibration_parameters, double fmin_hz, double fmax_hz,
+                    int max_iterations, const std::optional<dynamics::FrfSet>& measured_all) {
+    audit::AuditOptions o;
+    o.candidates = candidates;
+    o.calibration_parameters = calibration_parameters;
+    o.fmin_hz = fmin_hz;
+    o.fmax_hz = fmax_hz;
+    o.max_iterations = max_iterations;
+    calibration::NoiseModels n;
+    for (const auto& [k, v] : noise) n.emplace(ToKey(k), v);
+    const calibration::PostureMap q(postures.begin(), postures.end());
+    for (const auto& [key, frf] : measured) {
+      if (!q.count(key.pose_id)) throw std::invalid_argument("posture " + key.pose_id + " of a measured FRF is not in postures");
+    }
+    audit::AuditResult r;
+    report::AuditReport rep;
+    {
+      py::gil_scoped_release release;
+      r = audit::RunAudit(config.description, config.parameters, q, measured, o);
+      if (report_dir) {
+        report::AuditReportOptions ro;
+        ro.robot_path = config.path;
+        ro.noise_model = n.empty() ? "none" : "given";
+        ro.min_snr = calibration::NoiseOptions{}.min_snr;
+        ro.fmin_hz = fmin_hz;
+        ro.fmax_hz = fmax_hz;
+        ro.mostly_explained_fraction = o.mostly_explained_fraction;
+        ro.clear_bic_gap = o.clear_bic_gap;
+        rep = report::WriteAuditReport(*report_dir, r, config.description, q, measured,
+                                       measured_all ? *measured_all : measured, n, ro);
+      }
+    }
+    py::dict d = ResultDict(r);
+    if (report_dir) {
+      d["report"] = *report_dir;
+      d["summary"] = py::module_::import("json").attr("loads")(report::DumpJson(rep.summary));
+    }
+    return d;
+  }, py::arg("config"), py::arg("postures"), py::arg("measured"),
+     py::arg("noise") = std::map<KeyTuple, calibration::FrfNoise>{}, py::arg("report_dir") = py::none(),
+     py::arg("candidates") = std::vector<std::string>{},
+     py::arg("calibration_parameters") = audit::AuditOptions{}.calibration_parameters, py::arg("fmin_hz") = 0.0,
+     py::arg("fmax_hz") = std::numeric_limits<double>::infinity(), py::arg("max_iterations") = 100,
+     py::arg("measured_all") = py::none(),
+     "model-audit's call: calibrates `config` (RobotConfig) against `measured` (FrfSet, receptance "
+     "[m/N]; usable_data(...) of it, as the tool fits) at `postures` ({pose_id: q [rad]}), tries each "
+     "library effect not in the model (or `candidates`) and grades the best. Returns a dict of plain "
+     "Python objects: grade, headline, verdict, explained, missing_effects, candidate, errors "
+     "(rms of ln|H| differences; in units of the noise when the FRFs carry sigma), candidates (name, "
+     "bic_change, error_after, plausible, note, parameters {name: (value, std)}) and effects_yaml. "
+     "With report_dir it also writes model-audit's report folder there (noise: the noise models of "
+     "estimate_noise; measured_all: every measured line for the overlays) and adds 'report' and "
+     "'summary' (summary.json as a dict). Releases the GIL (seconds to minutes).");
+}
+
+}  // namespace robomach::python
