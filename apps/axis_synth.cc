@@ -139,7 +139,7 @@ int Run(int argc, char** argv) {
             cap.Next(rec.counts.data() + r * n, &words);
           } catch (const std::invalid_argument& e) {
             throw UsageError(std::string("--capture-every ") + std::to_string(capture_every) + ": " + e.what() +
-                                        "; raise --capture-every or lower --feed-mm-min");
+                             "; raise --capture-every or lower --feed-mm-min");
           }
           if (words.size() > (1u << 16)) flush();
         }

@@ -49,8 +49,8 @@ Axis ChannelDirection(const std::string& name, const std::map<std::string, std::
   const bool suffix = name.size() == 1 || (name.size() >= 2 && name[name.size() - 2] == '_');
   if (suffix && (last == 'x' || last == 'y' || last == 'z')) return static_cast<Axis>(last - 'x');
   throw UsageError("response channel '" + name +
-                              "': its direction is not in its name (…_x, …_y, …_z); give --direction " + name +
-                              "=x (or y, z)");
+                   "': its direction is not in its name (…_x, …_y, …_z); give --direction " + name +
+                   "=x (or y, z)");
 }
 
 void SavePlot(const std::string& path, const calibration::FrfEstimateResult& r, const dynamics::FrfSet& frfs,
@@ -209,7 +209,7 @@ int Run(int argc, char** argv) {
       for (size_t k = 0; k < keys.size(); ++k) {
         if (keys[k] == key) {
           throw UsageError("response channels '" + rec.channels[k].name + "' and '" + ch.name +
-                                      "' both give " + key.ToString() + "; give --direction for one of them");
+                           "' both give " + key.ToString() + "; give --direction for one of them");
         }
       }
       keys.push_back(key);

@@ -144,9 +144,9 @@ int Run(int argc, char** argv) {
     const double values = static_cast<double>(postures.size()) * static_cast<double>(freq_hz.size());
     if (values > 2e7) {
       throw UsageError(std::to_string(postures.size()) + " postures × " +
-                                  std::to_string(freq_hz.size()) +
-                                  " frequency lines is more than 2e7 FRF lines (~3 GB): split the "
-                                  "posture file or coarsen the grid");
+                       std::to_string(freq_hz.size()) +
+                       " frequency lines is more than 2e7 FRF lines (~3 GB): split the "
+                       "posture file or coarsen the grid");
     }
 
     bool flagged = false;

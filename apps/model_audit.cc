@@ -92,7 +92,7 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--fmin-hz", opt.fmin_hz, 0.0, 1e9);
     if (!(opt.fmax_hz > opt.fmin_hz)) {
       throw UsageError("--fmax-hz must be above --fmin-hz (" + FormatNumber(opt.fmin_hz) + " Hz), got " +
-                                  FormatNumber(opt.fmax_hz));
+                       FormatNumber(opt.fmax_hz));
     }
     CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
     {

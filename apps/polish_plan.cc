@@ -88,7 +88,7 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
               double offset_mm, double pitch_mm, double row_step_mm) {
   if (!io::IsCadFile(surface_path)) {
     throw UsageError("--list-faces: " + surface_path + " is a NURBS YAML (one patch); --list-faces lists "
-                                "the faces of a STEP/IGES file");
+                     "the faces of a STEP/IGES file");
   }
   if (choice.face_given) throw UsageError("--list-faces lists every face; drop --face");
   const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);

@@ -23,11 +23,11 @@ polishing::NurbsSurface LoadSurface(const std::string& tool, const std::string& 
   if (!io::IsCadFile(path)) {
     if (choice.face_given) {
       throw UsageError("--face " + std::to_string(choice.face) + ": " + path +
-                                  " is a NURBS YAML (one patch); --face picks a face of a STEP/IGES file");
+                       " is a NURBS YAML (one patch); --face picks a face of a STEP/IGES file");
     }
     if (choice.cad_unit_scale != 1.0) {
       throw UsageError("--cad-unit-scale: " + path + " is a NURBS YAML (lengths in mm by docs/formats.md §5); "
-                                  "the option applies to STEP/IGES files");
+                       "the option applies to STEP/IGES files");
     }
     return io::ReadNurbsYaml(path);
   }

@@ -161,7 +161,7 @@ void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& 
     for (const auto& [in_opt, in_path] : inputs) {
       if (!in_path.empty() && key(in_path) == key(path)) {
         throw UsageError(opt + " " + path + " is also the input of " + in_opt +
-                                    "; writing it would destroy the input");
+                         "; writing it would destroy the input");
       }
     }
     for (size_t j = 0; j < i; ++j) {

@@ -103,12 +103,12 @@ calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const Meas
     if (o.model == "coherence") {
       if (!frf.coherence()) {
         throw UsageError("--noise-model coherence: " + key.ToString() + " (" + data.file.at(key) +
-                                    ") has no coherence; use --noise-model scatter or auto");
+                         ") has no coherence; use --noise-model scatter or auto");
       }
       if (no.averages == 0) {
         throw UsageError("--noise-model coherence: " + data.file.at(key) +
-                                    " does not say how many averages are behind its coherence ('# averages: N'); "
-                                    "give --averages N");
+                         " does not say how many averages are behind its coherence ('# averages: N'); "
+                         "give --averages N");
       }
     }
     if (o.model == "auto" && frf.coherence() && no.averages == 0) {
