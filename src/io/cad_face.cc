@@ -101,30 +101,6 @@ bool IsIges(const std::string& path) {
 
 // OpenCASCADE prints its reader's complaints on stdout by default, which
 // would mix with a summary written to stdout: keep it quiet, we report.
-// Once per process, before any OpenCASCADE exchange: its messages off
-// stdout, and its STEP and IGES controllers set up. That set-up keeps about
-// 3 KB that no pointer LeakSanitizer can see still refers to (the same for
-// one read or a thousand; every stack of it goes through
-// STEPControl_Controller::Init, seen with fast_unwind_on_malloc=0). Under
-// LeakSanitizer it runs with the leak check off, so that a leak check
-// (scripts/check-sanitizers.sh, tests/fuzz) reports robomach's leaks only.
-void SilenceOcct() {
-  static const bool done = [] {
-    const Handle(Message_Messenger)& m = Message::DefaultMessenger();
-    m->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
-#if ROBOMACH_LSAN
-    __lsan_disable();
-#endif
-    STEPControl_Controller::Init();
-    IGESControl_Controller::Init();
-#if ROBOMACH_LSAN
-    __lsan_enable();
-#endif
-    return true;
-  }();
-  (void)done;
-}
-
 std::string OcctWhat(const Standard_Failure& e) {
   const char* s = e.GetMessageString();
   return std::string(e.DynamicType()->Name()) + (s && *s ? std::string(": ") + s : std::string());
@@ -136,7 +112,7 @@ struct ReadResult {
 };
 
 ReadResult ReadShape(const std::string& path) {
-  SilenceOcct();
+  SetUpOpenCascadeExchange();
   const bool iges = IsIges(path);
   const char* kind = iges ? "IGES" : "STEP";
   try {
@@ -534,7 +510,7 @@ std::vector<CadFaceRow> ListCadFaces(const std::string& path, const FaceCheck& c
 }
 
 void WriteStepFace(const polishing::NurbsSurface& s, const std::string& path, const std::string& comment) {
-  SilenceOcct();
+  SetUpOpenCascadeExchange();
   const int nu = s.num_u(), nv = s.num_v();
   TColgp_Array2OfPnt poles(1, nu, 1, nv);
   TColStd_Array2OfReal weights(1, nu, 1, nv);
@@ -599,5 +575,29 @@ void WriteStepFace(const polishing::NurbsSurface& s, const std::string& path, co
     throw OutputError(path + ": cannot rename " + tmp + " into place: " + ec.message());
   }
 }
+
+// The controllers' set-up keeps about 3 KB that no pointer LeakSanitizer
+// can see still refers to (the same for one read or a thousand; every stack
+// of it goes through STEPControl_Controller::Init, seen with
+// fast_unwind_on_malloc=0). Under LeakSanitizer it runs with the leak check
+// off, so that a leak check (scripts/check-sanitizers.sh, tests/fuzz)
+// reports robomach's leaks only.
+void SetUpOpenCascadeExchange() {
+  static const bool done = [] {
+    const Handle(Message_Messenger)& m = Message::DefaultMessenger();
+    m->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
+#if ROBOMACH_LSAN
+    __lsan_disable();
+#endif
+    STEPControl_Controller::Init();
+    IGESControl_Controller::Init();
+#if ROBOMACH_LSAN
+    __lsan_enable();
+#endif
+    return true;
+  }();
+  (void)done;
+}
+
 
 }  // namespace robomach::io

@@ -16,9 +16,6 @@
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRep_Builder.hxx>
-#include <Message.hxx>
-#include <Message_PrinterOStream.hxx>
-#include <IGESControl_Controller.hxx>
 #include <IGESControl_Writer.hxx>
 #include <STEPControl_Writer.hxx>
 #include <TopoDS_Compound.hxx>
@@ -62,7 +59,7 @@ TopoDS_Face PlateWithHole(double Lx, double Ly, double cx, double cy, double r) 
 }
 
 void WriteStep(const TopoDS_Shape& shape, const std::string& path) {
-  Message::DefaultMessenger()->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
+  SetUpOpenCascadeExchange();  // as the reader does (messages off, controllers set up once)
   STEPControl_Writer w;
   ASSERT_EQ(w.Transfer(shape, STEPControl_AsIs), IFSelect_RetDone);
   ASSERT_EQ(w.Write(path.c_str()), IFSelect_RetDone);
@@ -159,7 +156,7 @@ TEST(CadFace, FaceNumbersAndMissingFace) {
 // (trimmed surface entities) reads back with its hole.
 TEST(CadFace, IgesPlateWithHole) {
   const std::string file = TmpPath("plate_hole.igs");
-  IGESControl_Controller::Init();
+  SetUpOpenCascadeExchange();
   IGESControl_Writer w("MM", 0);
   ASSERT_TRUE(w.AddShape(PlateWithHole(100, 60, 50, 30, 10)));
   w.ComputeModel();
