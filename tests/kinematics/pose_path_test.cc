@@ -10,34 +10,14 @@
 #include <Eigen/SVD>
 
 #include "robomach/common/units.h"
-#include "robomach/kinematics/modified_dh.h"
 #include "robomach/kinematics/pose_path.h"
+#include "kr210_chain.h"
 
 namespace robomach::kinematics {
 namespace {
 
-// Craig's modified DH of a 6R industrial arm with a spherical wrist (the
-// KR 210 R2700 geometry of config/kr210_dh.yaml, without the tool offset).
-SerialChain Arm() {
-  const double d2r = kPi / 180.0;
-  const double rows[6][6] = {{0, 0, -0.645, 0, -185, 185},    {90, 0.33, 0, 0, -140, -5},
-                             {0, 1.15, 0, -90, -120, 168},     {90, 0.115, -1.22, 0, -350, 350},
-                             {-90, 0, 0, 0, -125, 125},        {90, 0, 0, 0, -350, 350}};
-  std::vector<ModifiedDhRow> table;
-  for (int i = 0; i < 6; ++i) {
-    ModifiedDhRow r;
-    r.joint_name = "joint_" + std::to_string(i + 1);
-    r.alpha_prev = rows[i][0] * d2r;
-    r.a_prev = rows[i][1];
-    r.d = rows[i][2];
-    r.theta_offset = rows[i][3] * d2r;
-    r.limits = {rows[i][4] * d2r, rows[i][5] * d2r, true};
-    r.inertial.mass = 10.0;
-    r.inertial.inertia_com = Eigen::Matrix3d::Identity();
-    table.push_back(r);
-  }
-  return BuildModifiedDhChain(table, Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity());
-}
+// The KR 210 R2700 arm of config/kr210_dh.yaml (kr210_chain.h).
+SerialChain Arm() { return testing::Kr210(); }
 
 // A smooth joint path well inside the limits and away from the wrist
 // singularity (q5 = 0).
