@@ -17,13 +17,26 @@ using dynamics::Frf;
 using dynamics::FrfKey;
 using dynamics::FrfSet;
 
+// Lines that may quote a file's own text, which need not be UTF-8 (a
+// Latin-1 UFF header): undecodable bytes become U+FFFD instead of a
+// UnicodeDecodeError that would lose the whole result.
+py::list TextLines(const std::vector<std::string>& lines) {
+  py::list out;
+  for (const std::string& s : lines) {
+    PyObject* u = PyUnicode_DecodeUTF8(s.data(), static_cast<Py_ssize_t>(s.size()), "replace");
+    if (u == nullptr) throw py::error_already_set();
+    out.append(py::reinterpret_steal<py::str>(u));
+  }
+  return out;
+}
+
 py::dict ReadResultDict(const io::FrfReadResult& r) {
   py::dict d;
   d["frfs"] = r.frfs;
   d["quantity"] = io::QuantityName(r.file_quantity);
   d["averages"] = r.averages;
-  d["warnings"] = r.warnings;
-  d["notes"] = r.notes;
+  d["warnings"] = TextLines(r.warnings);
+  d["notes"] = TextLines(r.notes);
   return d;
 }
 

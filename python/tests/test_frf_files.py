@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import robomach as rm
-from conftest import DATA
+from conftest import DATA, SOURCE_DIR
 
 
 def parse_csv(path):
@@ -165,3 +165,17 @@ def test_unwritable_output_is_an_output_error(tmp):
         rm.write_frf_csv(str(tmp / 'no_such_folder' / 'h.csv'), synthetic_set())
     assert isinstance(e.value, OSError) and 'no_such_folder' in str(e.value)
     assert not (tmp / 'no_such_folder').exists()
+
+
+def test_non_utf8_header_of_another_programs_uff_is_read():
+    """pyuff's non_ascii_header.uff (../shared/external, not in the project):
+    a Latin-1 unit string, (1/N)*(m/s²), that the reader quotes in a note.
+    The FRF is read as accelerance, and the note keeps the text with the
+    undecodable byte replaced (a UnicodeDecodeError lost the result before)."""
+    path = os.path.join(SOURCE_DIR, '..', 'shared', 'external', 'frf_uff58', 'pyuff', 'non_ascii_header.uff')
+    if not os.path.exists(path):
+        pytest.skip('../shared/external is absent')
+    r = rm.read_frf_file(path, "P1")
+    assert r['quantity'] == 'accelerance'
+    assert len(r['frfs']) == 1
+    assert any('\ufffd' in n and 'accelerance' in n for n in r['notes'])
