@@ -1,126 +1,22 @@
 #pragma once
 
 // Measured FRF files: the long CSV of formats.md §3 and Universal File Format
-// dataset 58 (ASCII). Readers convert mobility and accelerance to receptance
-// once, here, so the library sees one quantity (style.md §2.5).
+// dataset 58 (formats.md §4), one format per header (frf_csv.h, frf_uff58.h,
+// the quantities they share in frf_quantity.h). Readers convert mobility and
+// accelerance to receptance once, here, so the library sees one quantity
+// (style.md §2.5). This header includes them all and picks the reader.
 
-#include <map>
-#include <optional>
-#include <ostream>
 #include <string>
-#include <vector>
 
-#include "robomach/dynamics/measured_frf.h"
+#include "robomach/io/frf_csv.h"
+#include "robomach/io/frf_quantity.h"
+#include "robomach/io/frf_uff58.h"
 
 namespace robomach::io {
-
-/// The physical quantity stored in a file. With H the receptance [m/N] and
-/// the e^{iωt} convention: mobility Y = iω H [(m/s)/N], accelerance
-/// A = −ω² H [(m/s²)/N].
-enum class FrfQuantity { kReceptance, kMobility, kAccelerance };
-
-/// "receptance", "mobility", "accelerance".
-std::string QuantityName(FrfQuantity q);
-/// @throws std::invalid_argument for anything else.
-FrfQuantity ParseQuantity(const std::string& name);
-
-/// Converts one line of `quantity` to receptance and back.
-/// ω = 2π f must be > 0 for mobility and accelerance.
-std::complex<double> ToReceptance(FrfQuantity quantity, double freq_hz, std::complex<double> value);
-std::complex<double> FromReceptance(FrfQuantity quantity, double freq_hz, std::complex<double> h);
-
-/// What a reader found, plus warnings for the caller to print (the library
-/// never prints).
-struct FrfReadResult {
-  dynamics::FrfSet frfs;                 // receptance [m/N]
-  FrfQuantity file_quantity{FrfQuantity::kReceptance};
-  /// Number of averages behind the coherence (`# averages: N`); 0 if not given.
-  int averages{0};
-  /// Something the caller should hear about: a reading that may be wrong
-  /// (a quantity assumed, nonzero values past the announced count).
-  std::vector<std::string> warnings;     // "path:line: ..." each
-  /// What the reader inferred or skipped, for the record: directions from
-  /// entity names, a quantity from unit labels, padding, datasets and
-  /// records that are not FRFs. Tools print them as notes, not warnings.
-  std::vector<std::string> notes;
-};
-
-/// Reads the long CSV format of formats.md §3: columns pose_id, response,
-/// excitation, freq_hz, re, im, optional coherence; `# quantity:` metadata.
-/// Rows of one FRF must be contiguous, with strictly increasing frequencies
-/// on one grid. Lines at 0 Hz of mobility or accelerance files (where the
-/// conversion to receptance is undefined) are dropped with a warning.
-/// A warning is also given when a file declared as receptance rises like f²
-/// (accelerance) or like f (mobility) at its lowest lines, below the first
-/// resonance, where a receptance tends to the static compliance.
-/// @throws InputError "file:line: column X: expected ..., got ..." for bad
-///   cells, a non-increasing frequency, mixed grids inside one FRF (the rows
-///   of one FRF split into blocks, or an even grid whose step changes),
-///   a duplicate FRF, an unknown quantity.
-FrfReadResult ReadFrfCsv(const std::string& path);
-
-/// Writes `frfs` in the format of formats.md §3 as `quantity`, with a
-/// coherence column if every FRF has coherence, and `# averages: N` if
-/// `averages` > 0. Numbers are written so that they read back exactly.
-/// Atomic (formats.md §4).
-void WriteFrfCsv(const std::string& path, const dynamics::FrfSet& frfs,
-                 FrfQuantity quantity = FrfQuantity::kReceptance, int averages = 0);
-void WriteFrfCsv(std::ostream& os, const dynamics::FrfSet& frfs,
-                 FrfQuantity quantity = FrfQuantity::kReceptance, int averages = 0);
-
-/// Reads the FRFs of a Universal File Format file as modal-analysis
-/// software and acquisition systems export it (io/uff58.h reads the
-/// records: ASCII 58 and binary 58b, dataset 164 units; other datasets are
-/// skipped and named in a note).
-///
-/// - Function type 4 records are FRFs (complex ordinates); function type 6
-///   (coherence, real) is attached to the FRF with the same response and
-///   reference node and direction. Every other function (time response,
-///   spectrum, ...) is skipped with a note naming it; a file with no FRF at
-///   all is an error that says what it holds.
-/// - Directions: record 6 codes 1/-1 = x, 2/-2 = y, 3/-3 = z; a negative
-///   code (or a '-' in the entity name) means the transducer points along
-///   -axis, so the value is negated once per negative end. Code 0 (scalar):
-///   the direction is read from the entity name (".1.Z-", "12:+X"); with
-///   none, the FRF is read as a direct FRF xx with a warning (a symmetric
-///   tool, as a tap test on one axis gives). Rotational codes are errors.
-/// - Quantity and units: the ordinate's specific data type (record 9: 8
-///   displacement, 11 velocity, 12 acceleration), else the unit labels of
-///   records 9 and 10 ("(m/s)/N", "g/lbf", "mm/s^2" over "N" ...; see
-///   ParseUnitLabel), else the axis label's word ("Mobility", "Inertance"
-///   ...) with a warning, else receptance with a warning. A code and a label
-///   that disagree are an error. Values are converted to SI by the labels'
-///   factors, or, for unlabelled axes, by dataset 164's factors with the
-///   records' length and force exponents; labels that disagree with 164
-///   are an error. Mobility and accelerance are converted to receptance
-///   (the 0 Hz line, which has no receptance, is dropped).
-/// - The abscissa is frequency in Hz (a label "rad/s" or "kHz" is converted);
-///   time, rpm and order abscissae are errors for an FRF.
-/// - The posture is `pose=ID` in ID line 1 of the record; otherwise
-///   `default_pose_id` (from `--pose ID=file.uff`); otherwise the FRF has no
-///   posture (empty pose id): a tool that needs one says so.
-/// - Two FRF records of the same posture and directions (other nodes) are
-///   an error: a file holds the FRFs of one tool-tip point per posture.
-/// @throws InputError "file:line[:col]: ..." naming the record and field.
-FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose_id = "");
-
-/// Writes one dataset 58 record per FRF (complex double, format 4E20.12;
-/// even spacing when the grid is even, else E13.5,2E20.12), `pose=ID` in
-/// ID line 1, and a coherence record (function type 6) per FRF that has
-/// coherence. Atomic. The abscissa is written in E13.5 as the format
-/// prescribes; this keeps 6 significant digits of f_min and Δf.
-void WriteUff58(const std::string& path, const dynamics::FrfSet& frfs,
-                FrfQuantity quantity = FrfQuantity::kReceptance);
-void WriteUff58(std::ostream& os, const dynamics::FrfSet& frfs,
-                FrfQuantity quantity = FrfQuantity::kReceptance);
 
 /// Reads a measured-FRF file: UFF for the extensions `.uff`, `.unv`, `.uf`,
 /// `.ufb` or a file that starts with the UFF delimiter "-1", else CSV.
 /// `default_pose_id` applies to UFF only.
 FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_pose_id = "");
-
-/// Rounds to 13 significant digits, the precision of UFF58's E20.12 field.
-/// Data rounded so carry identical values in a CSV and a UFF58 copy.
-double RoundToUffPrecision(double v);
 
 }  // namespace robomach::io

@@ -1,0 +1,176 @@
+#include "robomach/io/frf_csv.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include "robomach/common/errors.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/csv_table.h"
+#include "robomach/io/number_format.h"
+#include "frf_text.h"
+
+namespace robomach::io {
+
+using dynamics::Frf;
+using dynamics::FrfKey;
+using dynamics::FrfSet;
+using frf_text::CheckLowFrequencyTrend;
+using frf_text::Fmt;
+using frf_text::ParseAxis;
+
+FrfReadResult ReadFrfCsv(const std::string& path) {
+  const CsvTable t = CsvTable::ReadFile(path);
+  FrfReadResult out;
+  if (auto it = t.metadata().find("quantity"); it != t.metadata().end()) {
+    try {
+      out.file_quantity = ParseQuantity(it->second);
+    } catch (const std::invalid_argument&) {
+      throw InputError({path, 0, 0}, "metadata '# quantity: " + it->second +
+                                         "': expected receptance, mobility or accelerance");
+    }
+  }
+  if (auto it = t.metadata().find("averages"); it != t.metadata().end()) {
+    char* end = nullptr;
+    const long n = std::strtol(it->second.c_str(), &end, 10);
+    if (end == it->second.c_str() || *end != '\0' || n < 1 || n > 1000000) {
+      throw InputError({path, 0, 0}, "metadata '# averages: " + it->second + "': expected a whole number >= 1");
+    }
+    out.averages = static_cast<int>(n);
+  }
+  for (const char* c : {"pose_id", "response", "excitation", "freq_hz", "re", "im"}) t.RequireColumn(c);
+  const bool has_coherence = t.HasColumn("coherence");
+  if (t.num_rows() == 0) throw InputError({path, t.header_line(), 0}, "no FRF lines after the header");
+
+  struct Block {
+    FrfKey key;
+    int first_row{0}, last_row{0};
+    std::vector<double> f;
+    std::vector<std::complex<double>> h;
+    std::vector<double> coh;
+    double step{NAN};      // the step of an even grid, once established
+    int step_from_row{0};
+  };
+  std::map<FrfKey, std::pair<int, int>> seen;  // key -> first and last line of its block
+  Block cur;
+  bool open = false;
+  auto finish = [&]() {
+    if (!open) return;
+    seen[cur.key] = {t.line(cur.first_row), t.line(cur.last_row)};
+    if (cur.f.empty()) {
+      open = false;
+      return;
+    }
+    Eigen::VectorXd f = Eigen::Map<Eigen::VectorXd>(cur.f.data(), cur.f.size());
+    Eigen::VectorXcd h = Eigen::Map<Eigen::VectorXcd>(cur.h.data(), cur.h.size());
+    std::optional<Eigen::VectorXd> coh;
+    if (has_coherence) coh = Eigen::Map<Eigen::VectorXd>(cur.coh.data(), cur.coh.size());
+    try {
+      Frf frf = Frf::FromSamples(f, h, coh);
+      if (out.file_quantity == FrfQuantity::kReceptance) {
+        CheckLowFrequencyTrend(cur.key, frf, path + ":" + std::to_string(t.line(cur.first_row)),
+                               &out.warnings);
+      }
+      out.frfs.Insert(cur.key, std::move(frf));
+    } catch (const std::invalid_argument& e) {
+      throw InputError({path, t.line(cur.first_row), 0},
+                       "FRF " + cur.key.ToString() + ": " + e.what());
+    }
+    open = false;
+  };
+
+  for (int r = 0; r < t.num_rows(); ++r) {
+    FrfKey key;
+    key.pose_id = t.Text(r, "pose_id");
+    if (!ParseAxis(t.Text(r, "response"), &key.response)) {
+      throw t.ErrorAt(r, "response", "expected x, y or z, got \"" + t.Text(r, "response") + "\"");
+    }
+    if (!ParseAxis(t.Text(r, "excitation"), &key.excitation)) {
+      throw t.ErrorAt(r, "excitation", "expected x, y or z, got \"" + t.Text(r, "excitation") + "\"");
+    }
+    if (!open || !(key == cur.key)) {
+      finish();
+      if (auto it = seen.find(key); it != seen.end()) {
+        throw t.ErrorAtRow(
+            r, "mixed frequency grids: the lines of FRF " + key.ToString() + " resume here after "
+                   "another FRF (its first block is lines " + std::to_string(it->second.first) +
+                   "-" + std::to_string(it->second.second) +
+                   "); a duplicate FRF, or one FRF split into blocks: the lines of one FRF must be contiguous, "
+                   "on one strictly increasing grid");
+      }
+      cur = Block{};
+      cur.key = key;
+      cur.first_row = r;
+      open = true;
+    }
+    cur.last_row = r;
+    const double f = t.Number(r, "freq_hz");
+    if (f < 0.0) throw t.ErrorAt(r, "freq_hz", "expected a frequency >= 0, got " + t.Text(r, "freq_hz"));
+    if (!cur.f.empty()) {
+      const double prev = cur.f.back();
+      if (!(f > prev)) {
+        throw t.ErrorAt(r, "freq_hz",
+                        "expected a frequency above the previous line's " + Fmt(prev) +
+                            " Hz (the lines of one FRF must be strictly increasing), got " +
+                            t.Text(r, "freq_hz"));
+      }
+      const double step = f - prev;
+      const double tol = 1e-6 * std::max(f, 1.0);
+      if (cur.f.size() == 2) {
+        const double s0 = cur.f[1] - cur.f[0];
+        if (std::abs(step - s0) <= tol) {
+          cur.step = s0;
+          cur.step_from_row = cur.first_row;
+        }
+      } else if (std::isfinite(cur.step) && std::abs(step - cur.step) > tol) {
+        throw t.ErrorAt(r, "freq_hz",
+                        "mixed frequency grids in FRF " + cur.key.ToString() + ": step " +
+                            Fmt(cur.step) + " Hz from line " + std::to_string(t.line(cur.step_from_row)) +
+                            ", then " + Fmt(step) + " Hz here; one FRF must be on one grid");
+      }
+    }
+    const std::complex<double> v(t.Number(r, "re"), t.Number(r, "im"));
+    double coh = NAN;
+    if (has_coherence) {
+      coh = t.Number(r, "coherence");
+      if (coh < 0.0 || coh > 1.0) throw t.ErrorAt(r, "coherence", "expected a value in [0, 1], got " + t.Text(r, "coherence"));
+    }
+    if (f == 0.0 && out.file_quantity != FrfQuantity::kReceptance) {
+      out.warnings.push_back(path + ":" + std::to_string(t.line(r)) + ": the 0 Hz line of a " +
+                             QuantityName(out.file_quantity) +
+                             " FRF has no receptance equivalent; it is skipped");
+      continue;
+    }
+    cur.f.push_back(f);
+    cur.h.push_back(ToReceptance(out.file_quantity, f, v));
+    if (has_coherence) cur.coh.push_back(coh);
+  }
+  finish();
+  return out;
+}
+
+void WriteFrfCsv(std::ostream& os, const FrfSet& frfs, FrfQuantity quantity, int averages) {
+  bool coherence = !frfs.empty();
+  for (const auto& [k, f] : frfs) coherence = coherence && f.coherence().has_value();
+  os << "# quantity: " << QuantityName(quantity) << '\n';
+  if (averages > 0) os << "# averages: " << averages << '\n';
+  os << "# written by robomach; tool-tip FRFs in the robot base frame B, SI units\n";
+  os << "pose_id,response,excitation,freq_hz,re,im" << (coherence ? ",coherence" : "") << '\n';
+  for (const auto& [k, frf] : frfs) {
+    for (int i = 0; i < frf.size(); ++i) {
+      const double f = frf.freq_hz()(i);
+      if (f == 0.0 && quantity != FrfQuantity::kReceptance) continue;  // undefined there
+      const std::complex<double> v = FromReceptance(quantity, f, frf.receptance()(i));
+      os << k.pose_id << ',' << AxisName(k.response) << ',' << AxisName(k.excitation) << ','
+         << FormatDouble(f) << ',' << FormatDouble(v.real()) << ',' << FormatDouble(v.imag());
+      if (coherence) os << ',' << FormatDouble((*frf.coherence())(i));
+      os << '\n';
+    }
+  }
+}
+
+void WriteFrfCsv(const std::string& path, const FrfSet& frfs, FrfQuantity quantity, int averages) {
+  WriteFileAtomically(path, [&](std::ostream& os) { WriteFrfCsv(os, frfs, quantity, averages); });
+}
+
+}  // namespace robomach::io
