@@ -27,6 +27,7 @@
 #include "robomach/io/posture_file.h"
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/io/lobes_file.h"
 #include "robomach/io/tip_dynamics_files.h"
 #include "robomach/report/modal_fit_plot.h"
 #include "robomach/report/plot.h"
@@ -34,44 +35,19 @@
 #include "robomach/stability/measured_tip_model.h"
 #include "robomach/stability/semi_discretization.h"
 #include "robomach/stability/tool_tip_model.h"
+#include "robomach/stability/lobes_workflow.h"
+#include "robomach/stability/tip_dynamics.h"
 #include "robomach/stability/zoa_lobes.h"
 
 namespace robomach::apps {
 namespace {
 
-// Speeds went rpm -> rad/s -> rpm; 1e-9 rpm is far below any meaningful
-// speed and hides the last-bit residue (6000.000000000001).
-double RoundRpm(double rpm) { return std::round(rpm * 1e9) / 1e9; }
-
 constexpr char kTool[] = "stability-lobes";
-
-// The modal fit of one direct FRF of a measured file.
-struct DirectionFit {
-  std::string label;  // "P1 Hxx", for messages and the plot
-  stability::DirectFrfFit fit;
-};
-
-// The tool-tip dynamics of one source, oriented into the cutting frame.
-struct TipDynamics {
-  std::string id;
-  Eigen::VectorXd freq_hz;                  // grid of the FRF
-  std::vector<Eigen::Matrix2cd> Phi_C;      // in-plane oriented FRF [m/N]
-  stability::TipModalModel modes_C;         // for the semi-discretization
-  bool modes_fitted{false};                 // fitted to an FRF (not given)
-  bool no_modes{false};                     // fitted, but no mode: no SD
-  std::vector<DirectionFit> fits;           // measured FRFs: one per direct FRF fitted
-  Eigen::Matrix3d R_BC{Eigen::Matrix3d::Identity()};  // frame of the modal table written
-};
-
-struct LobeRow {
-  std::string id, method;
-  stability::LobePoint point;
-};
 
 // FRF files, CSV or UFF58 by extension; reader warnings go to stderr, and
 // so do receptances outside the plausible range (counted: exit 3).
 int g_implausible_frfs = 0;
-std::vector<io::FrfSetOfPose> ReadFrfFile(const std::string& path) {
+std::vector<stability::TipFrfs> ReadFrfFile(const std::string& path) {
   std::vector<std::string> warnings;
   auto sets = io::ReadTipFrfs(path, "", &warnings);
   for (const std::string& w : warnings) Warn(kTool, w);
@@ -97,350 +73,37 @@ Eigen::Vector3d ParseVector(const std::string& option, const std::string& text) 
   return {v[0], v[1], v[2]};
 }
 
-// The shown id of a posture of an FRF file: an FRF without a posture
-// (pose_id "") is shown as the file's stem.
-std::string ShownId(const std::string& pose_id, const std::string& path) {
-  return pose_id.empty() ? std::filesystem::path(path).stem().string() : pose_id;
-}
-
-// The direct FRFs a file's posture gives, and how many FRFs it gives.
-std::vector<int> DirectFrfs(const io::FrfSetOfPose& s, int* total) {
-  std::vector<int> d;
-  *total = 0;
-  for (int a = 0; a < 3; ++a) {
-    for (int b = 0; b < 3; ++b) *total += s.present[a][b];
-    if (s.present[a][a]) d.push_back(a);
-  }
-  return d;
-}
-
-// One direct FRF of a posture as an Frf (all lines, 0 Hz included).
-dynamics::Frf DirectFrf(const io::FrfSetOfPose& s, int a) {
-  Eigen::VectorXcd h(s.freq_hz.size());
-  for (Eigen::Index k = 0; k < h.size(); ++k) h(k) = s.H[k](a, a);
-  return dynamics::Frf::FromSamples(s.freq_hz, h);
-}
-
-// Noise model and modal fit of one direct FRF, reported on stderr.
-DirectionFit FitOne(const std::string& label, const dynamics::Frf& frf) {
-  DirectionFit d{label, stability::FitDirectFrf(frf)};
-  std::ostringstream m;
-  m << kTool << ": " << label << ": noise " << d.fit.noise.description << "\n" << kTool << ": " << label
-    << ": modal fit: " << d.fit.fit.message;
-  for (const calibration::FittedMode& fm : d.fit.fit.modes) {
-    m << "\n  " << io::FormatDouble(std::round(fm.freq_hz * 10.0) / 10.0) << " Hz, damping ratio "
-      << io::FormatDouble(std::round(fm.damping_ratio * 1e4) / 1e4) << ", modal mass "
-      << (fm.modal_constant.real() > 0.0 ? FormatNumber(1.0 / fm.modal_constant.real()) + " kg"
-                                          : std::string("none (Re A <= 0: not a driving-point mode, left out)"));
-  }
-  if (std::isfinite(d.fit.noise_rms)) {
-    m << "\n  rms misfit " << io::FormatDouble(std::round(d.fit.noise_rms * 100.0) / 100.0) << " x the noise";
-  }
-  std::cerr << m.str() << "\n";
-  return d;
-}
-
-// The tool tips of a measured FRF file (and of --frf-y): the in-plane FRF
-// for the ZOA, and (if `fit`) the modal model of the direct FRFs for the SD.
-std::vector<TipDynamics> FrfTips(const std::string& frf_path, const std::string& frf_y_path,
-                                 const std::vector<std::string>& pose_ids, const std::string& tool_axis_text,
-                                 const io::CutSpec& cut, const std::string& cut_path, bool fit, int sd_modes) {
-  std::vector<io::FrfSetOfPose> sets = ReadFrfFile(frf_path);
-  std::vector<io::FrfSetOfPose> ysets;
-  if (!frf_y_path.empty()) ysets = ReadFrfFile(frf_y_path);
-  // The cutting frame, needed only when the file's FRFs are oriented.
-  auto frame = [&]() {
-    const Eigen::Vector3d axis = ParseVector("--tool-axis", tool_axis_text);
-    try {
-      return stability::CuttingFrame(axis, cut.feed_direction_B);
-    } catch (const std::invalid_argument& e) {
-      throw InputError({cut_path, cut.feed_line, cut.feed_column},
-                       std::string("feed_direction: ") + e.what() + " (--tool-axis " + tool_axis_text + ")");
-    }
-  };
-  auto only_direct = [](const io::FrfSetOfPose& s, const std::string& path, const std::string& id,
-                        const std::string& option) {
-    int total = 0;
-    const std::vector<int> d = DirectFrfs(s, &total);
-    if (d.size() != 1 || total != 1) {
-      throw InputError({path, 0, 0}, "posture " + id + ": with --frf-y, " + option + " must give exactly one direct FRF; it gives " +
-                                         std::to_string(total) + " FRFs, " + std::to_string(d.size()) + " of them direct");
-    }
-    return d[0];
-  };
-  std::vector<TipDynamics> tips;
-  bool noted = false;
-  for (io::FrfSetOfPose& s : sets) {
-    const std::string id = ShownId(s.pose_id, frf_path);
-    if (!pose_ids.empty() && std::find(pose_ids.begin(), pose_ids.end(), id) == pose_ids.end()) continue;
-    int total = 0;
-    const std::vector<int> direct = DirectFrfs(s, &total);
-    TipDynamics t;
-    t.id = id;
-    // Drop a 0 Hz line (the ZOA needs ω > 0); the fit keeps every line.
-    const Eigen::Index first = s.freq_hz.size() > 0 && s.freq_hz(0) == 0.0 ? 1 : 0;
-    t.freq_hz = s.freq_hz.tail(s.freq_hz.size() - first);
-    auto diagonal = [&](const Eigen::VectorXcd& hx, const Eigen::VectorXcd& hy) {
-      t.Phi_C.assign(t.freq_hz.size(), Eigen::Matrix2cd::Zero());
-      for (Eigen::Index k = 0; k < t.freq_hz.size(); ++k) {
-        t.Phi_C[k](0, 0) = hx(k + first);
-        t.Phi_C[k](1, 1) = hy(k + first);
+// What the library says while it builds the tool tips and the lobes, on
+// stderr: fit reports and information prefixed by the tool's name (their
+// continuation lines are indented), notes, warnings.
+void Tell(const stability::TipMessage& m) {
+  switch (m.kind) {
+    case stability::TipMessage::Kind::kWarning:
+      Warn(kTool, m.text);
+      return;
+    case stability::TipMessage::Kind::kNote:
+      std::cerr << kTool << ": note: " << m.text << "\n";
+      return;
+    case stability::TipMessage::Kind::kFit: {
+      std::istringstream lines(m.text);
+      for (std::string line; std::getline(lines, line);) {
+        std::cerr << (line.rfind("  ", 0) == 0 ? "" : std::string(kTool) + ": ") << line << "\n";
       }
-    };
-    const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY();
-    if (!ysets.empty()) {
-      // Two files, one direct FRF each: along the feed (x_C) and normal to it (y_C).
-      const int a = only_direct(s, frf_path, id, "--frf");
-      const io::FrfSetOfPose* y = nullptr;
-      for (const io::FrfSetOfPose& c : ysets) {
-        if (ShownId(c.pose_id, frf_y_path) == id || (c.pose_id == s.pose_id)) y = &c;
-      }
-      if (!y && sets.size() == 1 && ysets.size() == 1) y = &ysets.front();
-      if (!y) throw InputError({frf_y_path, 0, 0}, "no posture " + id + " in the file (--frf-y)");
-      const int b = only_direct(*y, frf_y_path, id, "--frf-y");
-      if (y->freq_hz.size() != s.freq_hz.size() || y->freq_hz != s.freq_hz) {
-        throw InputError({frf_y_path, 0, 0}, "posture " + id + ": the FRF of --frf-y uses another frequency grid than "
-                                                 "the one of --frf; both must use the same lines");
-      }
-      const dynamics::Frf hx = DirectFrf(s, a), hy = DirectFrf(*y, b);
-      diagonal(hx.receptance(), hy.receptance());
-      if (fit) {
-        t.fits.push_back(FitOne(id + " H" + std::string(2, "xyz"[a]) + " (feed, x of the cut)", hx));
-        t.fits.push_back(FitOne(id + " H" + std::string(2, "xyz"[b]) + " (normal to the feed, y of the cut)", hy));
-        t.modes_C = stability::Concatenate(
-            {stability::DominantModes(stability::ModesAlong(t.fits[0].fit.fit, ex), sd_modes),
-             stability::DominantModes(stability::ModesAlong(t.fits[1].fit.fit, ey), sd_modes)});
-      }
-      t.R_BC = frame();
-    } else if (direct.size() == 1 && total == 1) {
-      // One direct FRF: a symmetric tool (issue #18).
-      const int a = direct[0];
-      const dynamics::Frf h = DirectFrf(s, a);
-      diagonal(h.receptance(), h.receptance());
-      if (!noted) {
-        std::cerr << kTool << ": note: " << id << " has one direct FRF (H" << "xyz"[a] << "xyz"[a]
-                  << "): the tool is taken as symmetric, this FRF in both in-plane directions of the cut and no "
-                     "cross terms; --tool-axis does not apply\n";
-        noted = true;
-      }
-      if (fit) {
-        t.fits.push_back(FitOne(id + " H" + std::string(2, "xyz"[a]), h));
-        const stability::TipModalModel mx = stability::DominantModes(stability::ModesAlong(t.fits[0].fit.fit, ex), sd_modes);
-        const stability::TipModalModel my = stability::DominantModes(stability::ModesAlong(t.fits[0].fit.fit, ey), sd_modes);
-        t.modes_C = stability::Concatenate({mx, my});
-      }
-      // The modal table is written for the default tool axis (z) unless one is given.
-      try {
-        t.R_BC = frame();
-      } catch (const InputError&) {
-        t.R_BC = Eigen::Matrix3d::Identity();
-      }
-    } else {
-      // Several FRFs in the base frame: oriented by --tool-axis.
-      const Eigen::Matrix3d R = frame();
-      t.R_BC = R;
-      std::vector<int> dirs;
-      for (int a = 0; a < 3; ++a) {
-        if (R.col(0).cwiseAbs()(a) > 1e-9 || R.col(1).cwiseAbs()(a) > 1e-9) dirs.push_back(a);
-      }
-      for (int a : dirs) {
-        for (int b : dirs) {
-          if (!s.present[a][b]) {
-            if (a == b) {
-              throw InputError({frf_path, 0, 0}, "posture " + id + ": the cutting plane (--tool-axis " + tool_axis_text +
-                                                     ") needs FRF " + "xyz"[a] + "xyz"[b] +
-                                                     ", which the file does not give; give a --tool-axis whose "
-                                                     "cutting plane the file's directions span, or the second "
-                                                     "direction with --frf-y from a file of one direct FRF");
-            }
-            Warn(kTool, frf_path + ": posture " + id + ": no cross FRF " + "xyz"[a] + "xyz"[b] + "; taken as zero");
-          }
-        }
-      }
-      std::vector<Eigen::Matrix3cd> H(s.H.begin() + first, s.H.end());
-      t.Phi_C = stability::OrientInCuttingPlane(H, R);
-      if (fit) {
-        std::vector<stability::TipModalModel> parts;
-        for (int a : dirs) {
-          t.fits.push_back(FitOne(id + " H" + std::string(2, "xyz"[a]), DirectFrf(s, a)));
-          parts.push_back(stability::DominantModes(
-              stability::ModesAlong(t.fits.back().fit.fit, Eigen::Vector3d::Unit(a)).Rotated(R), sd_modes));
-        }
-        t.modes_C = stability::Concatenate(parts);
-        bool cross = false;
-        for (int a : dirs) {
-          for (int b : dirs) cross |= a != b && s.present[a][b];
-        }
-        if (cross && dirs.size() == 2) {
-          // Two base directions span the cutting plane: a mode seen in both
-          // direct FRFs is one mode whose shape's sign the cross FRF gives.
-          const int a = dirs[0], b = dirs[1];
-          const int r = s.present[a][b] ? a : b, c = s.present[a][b] ? b : a;
-          double lo = -INFINITY, hi = INFINITY;
-          for (const DirectionFit& d : t.fits) {
-            if (d.fit.noise.usable_bands.empty()) continue;
-            lo = std::max(lo, d.fit.noise.usable_bands.front().first);
-            hi = std::min(hi, d.fit.noise.usable_bands.back().second);
-          }
-          std::vector<int> lines;
-          for (Eigen::Index k = 0; k < s.freq_hz.size(); ++k) {
-            if (s.freq_hz(k) >= lo && s.freq_hz(k) <= hi) lines.push_back(static_cast<int>(k));
-          }
-          if (lines.size() >= 8) {
-            Eigen::VectorXcd h(s.freq_hz.size());
-            for (Eigen::Index k = 0; k < h.size(); ++k) h(k) = s.H[k](r, c);
-            const dynamics::Frf cross_frf = dynamics::Frf::FromSamples(s.freq_hz, h).Select(lines);
-            t.modes_C = stability::DominantModes(
-                stability::ModesOfTwoDirections(t.fits[0].fit.fit, Eigen::Vector3d::Unit(a), t.fits[1].fit.fit,
-                                                Eigen::Vector3d::Unit(b), cross_frf)
-                    .Rotated(R),
-                2 * sd_modes);
-            std::cerr << kTool << ": note: " << id << ": a mode found in both H" << "xyz"[a] << "xyz"[a] << " and H"
-                      << "xyz"[b] << "xyz"[b] << " is one mode of the SD's model, its shape's sign from the cross FRF H"
-                      << "xyz"[r] << "xyz"[c] << "\n";
-          }
-        } else if (cross) {
-          std::cerr << kTool << ": note: " << id << ": the SD's modal model is fitted to the direct FRFs; the "
-                    "cross FRFs of the file are used by the ZOA only\n";
-        }
-      }
-    }
-    if (fit) {
-      t.modes_fitted = true;
-      t.no_modes = t.modes_C.num_modes() == 0;
-      // The ZOA uses the measured FRF where the noise model finds it usable
-      // in every fitted direction: below that (the drift of an integrated
-      // accelerometer signal) and above it (the floor) a line says nothing
-      // of the structure, and a drift 5x the resonance makes spurious
-      // lobes of a few hertz.
-      double lo = -INFINITY, hi = INFINITY;
-      for (const DirectionFit& d : t.fits) {
-        if (d.fit.noise.usable_bands.empty()) continue;
-        lo = std::max(lo, d.fit.noise.usable_bands.front().first);
-        hi = std::min(hi, d.fit.noise.usable_bands.back().second);
-      }
-      if (std::isfinite(lo) && std::isfinite(hi) && hi > lo) {
-        std::vector<Eigen::Matrix2cd> phi;
-        std::vector<double> f;
-        for (Eigen::Index k = 0; k < t.freq_hz.size(); ++k) {
-          if (t.freq_hz(k) >= lo && t.freq_hz(k) <= hi) {
-            f.push_back(t.freq_hz(k));
-            phi.push_back(t.Phi_C[k]);
-          }
-        }
-        if (f.size() >= 3 && static_cast<Eigen::Index>(f.size()) < t.freq_hz.size()) {
-          std::cerr << kTool << ": " << id << ": the ZOA uses the measured FRF in its usable band, "
-                    << io::FormatDouble(lo) << " to " << io::FormatDouble(hi) << " Hz\n";
-          t.freq_hz = Eigen::Map<Eigen::VectorXd>(f.data(), static_cast<Eigen::Index>(f.size()));
-          t.Phi_C = std::move(phi);
-        }
-      }
-    }
-    tips.push_back(std::move(t));
-  }
-  if (tips.empty()) throw InputError({frf_path, 0, 0}, "none of the requested postures is in the file");
-  return tips;
-}
-
-// The smallest critical depth [m] of one method over its ok points.
-double MinDepth(const std::vector<LobeRow>& rows, const std::string& id, const std::string& method) {
-  double m = INFINITY;
-  for (const LobeRow& r : rows) {
-    if (r.id == id && r.method == method && r.point.status == stability::LobeStatus::kOk) {
-      m = std::min(m, r.point.critical_depth);
+      return;
     }
   }
-  return m;
-}
-
-// --method both: the ZOA and the SD should agree on the smallest critical
-// depth at radial immersions of 0.3 and more, where the ZOA's averaged
-// directional factors are accurate (Altintas & Budak 1995; the SD is exact
-// up to its discretisation). The SD's speed grid is coarse and its lobes
-// lie a little apart from the ZOA's, so its minimum is also searched on 7
-// speeds within ±4 % of the bottom of each of the (at most 4) lowest ZOA
-// lobes (`sd_at`); the ZOA's lobe bottoms are all about equally deep, the
-// SD's are not (on issue #18's tap test, 0.886 mm at lobe 0 and 0.971 mm
-// at lobe 2 against the ZOA's 0.896 mm).
-using SdAt = std::function<std::vector<stability::LobePoint>(const TipDynamics&, const Eigen::VectorXd&)>;
-void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<LobeRow>& rows,
-                     const io::CutSpec& cut, const SdAt& sd_at, bool* flagged) {
-  if (cut.process.radial_immersion < 0.3) return;
-  for (const TipDynamics& t : tips) {
-    double sd = MinDepth(rows, t.id, "sd");
-    const double zoa = MinDepth(rows, t.id, "zoa");
-    if (!std::isfinite(sd) || !std::isfinite(zoa)) continue;
-    std::map<int, const LobeRow*> bottom;  // lowest ZOA point of each lobe
-    for (const LobeRow& r : rows) {
-      if (r.id != t.id || r.method != "zoa" || r.point.status != stability::LobeStatus::kOk) continue;
-      const LobeRow*& b = bottom[r.point.lobe_index];
-      if (!b || r.point.critical_depth < b->point.critical_depth) b = &r;
-    }
-    std::vector<const LobeRow*> lows;
-    for (const auto& [k, r] : bottom) {
-      if (r->point.critical_depth <= 1.2 * zoa) lows.push_back(r);
-    }
-    std::sort(lows.begin(), lows.end(),
-              [](const LobeRow* a, const LobeRow* b) { return a->point.critical_depth < b->point.critical_depth; });
-    if (lows.size() > 4) lows.resize(4);
-    for (const LobeRow* r : lows) {
-      const double lo = std::max(cut.spindle_speed_min_rad_s, 0.96 * r->point.spindle_speed_rad_s);
-      const double hi = std::min(cut.spindle_speed_max_rad_s, 1.04 * r->point.spindle_speed_rad_s);
-      if (!(hi > lo)) continue;
-      for (const stability::LobePoint& p : sd_at(t, Eigen::VectorXd::LinSpaced(7, lo, hi))) {
-        if (p.status == stability::LobeStatus::kOk) sd = std::min(sd, p.critical_depth);
-      }
-    }
-    const double diff = std::abs(sd - zoa) / std::min(sd, zoa);
-    std::ostringstream m;
-    m << t.id << ": smallest critical depth SD " << FormatNumber(MToMm(sd)) << " mm, ZOA " << FormatNumber(MToMm(zoa)) << " mm";
-    if (diff > 0.10) {
-      Warn(kTool, m.str() + ": they differ by " + io::FormatDouble(std::round(diff * 1000.0) / 10.0) +
-                      " % (more than 10 % at a radial immersion of " + io::FormatDouble(cut.process.radial_immersion) +
-                      ", where they should agree): check " +
-                      (t.fits.empty() ? std::string("") : "the modal fit (--fit-plot), ") +
-                      "the modes the SD keeps (--sd-modes) and its steps per tooth period (--sd-steps)");
-      *flagged = true;
-    } else {
-      std::cerr << kTool << ": " << m.str() << " (they agree within 10 %)\n";
-    }
-  }
-}
-
-// --modes-out: the modes the SD used, in the frame of the file's FRFs
-// (p_B = R_BC p_C), as docs/formats.md §4's modal table.
-void WriteFittedModes(const std::string& path, const std::vector<TipDynamics>& tips) {
-  std::vector<std::string> ids;
-  std::vector<std::vector<dynamics::Mode>> modes;
-  for (const TipDynamics& t : tips) {
-    ids.push_back(t.id);
-    modes.emplace_back();
-    for (int k = 0; k < t.modes_C.num_modes(); ++k) {
-      dynamics::Mode m;
-      m.freq_hz = RadPerSecToHz(t.modes_C.omega_rad_s(k));
-      m.damping_ratio = t.modes_C.zeta(k);
-      m.p_T = t.R_BC * t.modes_C.p.col(k);
-      m.modal_mass_kg = 1.0 / m.p_T.squaredNorm();
-      Eigen::Index big = 0;
-      m.p_T.cwiseAbs().maxCoeff(&big);
-      m.shape_T = m.p_T.normalized() * (m.p_T(big) < 0.0 ? -1.0 : 1.0);
-      for (int i = 0; i < 3; ++i) m.shape_T(i) = m.shape_T(i) == 0.0 ? 0.0 : m.shape_T(i);  // no "-0"
-      modes.back().push_back(m);
-    }
-  }
-  io::WriteModalTableCsv(path, ids, modes);
 }
 
 // --fit-plot: each fitted direct FRF with its modal fit, magnitude and phase.
-void PlotFits(const std::string& path, const std::string& frf_path, const std::vector<TipDynamics>& tips) {
+void PlotFits(const std::string& path, const std::string& frf_path, const std::vector<stability::TipDynamics>& tips) {
   int n = 0;
-  for (const TipDynamics& t : tips) n += static_cast<int>(t.fits.size());
+  for (const stability::TipDynamics& t : tips) n += static_cast<int>(t.fits.size());
   if (n == 0) return;
   report::Figure fig(2 * n, 1, 1000, 330);
   fig.title = "robomach stability-lobes: modal fits of " + std::filesystem::path(frf_path).filename().string();
   int row = 0;
-  for (const TipDynamics& t : tips) {
-    for (const DirectionFit& d : t.fits) {
+  for (const stability::TipDynamics& t : tips) {
+    for (const stability::DirectionFit& d : t.fits) {
       std::ostringstream title;
       title << d.label << ": " << d.fit.fit.modes.size() << " modes";
       if (std::isfinite(d.fit.noise_rms)) {
@@ -559,14 +222,8 @@ int Run(int argc, char** argv) {
       if (!p.empty()) RequireReadableFile(p, what);
     }
     const io::CutSpec cut = io::ReadCutFile(cut_path);
-    const bool do_zoa = method != "sd", do_sd = method != "zoa";
-    const Eigen::VectorXd zoa_speeds = Eigen::VectorXd::LinSpaced(
-        speeds > 0 ? speeds : cut.spindle_speed_count, cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
-    const Eigen::VectorXd sd_speed_grid =
-        Eigen::VectorXd::LinSpaced(sd_speeds, cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
-    constexpr int kLines = 4000;  // log grid: ~ln(100)/4000 ≈ 1e-3 relative spacing, < ζ/10 for ζ ≥ 1 %
 
-    std::vector<TipDynamics> tips;
+    std::vector<stability::TipDynamics> tips;
     if (!robot_path.empty()) {
       const auto model = io::LoadRobotConfig(robot_path).Build();
       const auto postures = io::ReadPostureFile(postures_path, model->num_joints());
@@ -588,152 +245,81 @@ int Run(int argc, char** argv) {
           Warn(kTool, postures_path + ":" + std::to_string(p->line) + ": posture " + p->id +
                           " is near a singularity; the tool-tip FRF (joint space) stays valid");
         }
-        TipDynamics t;
-        t.id = p->id;
-        Eigen::Matrix3d R;
         try {
-          R = stability::CuttingFrameAtPosture(d.X_BT, cut.feed_direction_B);
+          tips.push_back(stability::TipFromPosture(p->id, d, cut.feed_direction_B, cut.process.teeth,
+                                                   cut.spindle_speed_max_rad_s));
         } catch (const std::invalid_argument& e) {
-          throw InputError({cut_path, cut.feed_line, cut.feed_column}, std::string("feed_direction: ") + e.what() + " at posture " + p->id);
+          throw InputError({cut_path, cut.feed_line, cut.feed_column},
+                           std::string("feed_direction: ") + e.what() + " at posture " + p->id);
         }
-        const stability::TipModalModel modes = stability::ModalModelFromPosture(d);
-        t.freq_hz = stability::LobeFrequencyGrid(modes, cut.process.teeth, cut.spindle_speed_max_rad_s, kLines);
-        t.Phi_C = stability::OrientInCuttingPlane(dynamics::Receptance(d, t.freq_hz), R);
-        t.modes_C = modes.Rotated(R);
-        tips.push_back(std::move(t));
       }
-    } else if (!frf_path.empty()) {
-      // Always fitted: the noise model's usable band serves the ZOA too.
-      tips = FrfTips(frf_path, frf_y_path, pose_ids, tool_axis_text, cut, cut_path, true, sd_modes);
     } else {
-      const Eigen::Vector3d axis = ParseVector("--tool-axis", tool_axis_text);
-      Eigen::Matrix3d R;
-      try {
-        R = stability::CuttingFrame(axis, cut.feed_direction_B);
-      } catch (const std::invalid_argument& e) {
-        throw InputError({cut_path, cut.feed_line, cut.feed_column}, std::string("feed_direction: ") + e.what() + " (--tool-axis " + tool_axis_text + ")");
-      }
-      for (const io::ModalTableEntry& e : io::ReadModalTable(modal_path)) {
-        if (!pose_ids.empty() && std::find(pose_ids.begin(), pose_ids.end(), e.pose_id) == pose_ids.end()) continue;
-        TipDynamics t;
-        t.id = e.pose_id;
-        t.freq_hz = stability::LobeFrequencyGrid(e.modes, cut.process.teeth, cut.spindle_speed_max_rad_s, kLines);
-        t.Phi_C = stability::OrientInCuttingPlane(stability::ModalReceptance(e.modes, t.freq_hz), R);
-        t.modes_C = e.modes.Rotated(R);
-        tips.push_back(std::move(t));
-      }
-      if (tips.empty()) throw InputError({modal_path, 0, 0}, "none of the requested postures is in the file");
-    }
-    bool flagged = g_implausible_frfs > 0;
-    for (const TipDynamics& t : tips) {
-      for (const DirectionFit& d : t.fits) {
-        if (d.fit.not_driving_point) {
-          Warn(kTool, d.label + ": Im H > 0 (beyond twice the noise) on " +
-                          io::FormatDouble(std::round(d.fit.active_fraction * 1000.0) / 10.0) +
-                          " % of the usable lines: this is not the driving-point receptance of a passive structure "
-                          "(response and excitation at different points, e.g. a transfer FRF, or in opposite "
-                          "directions, or another sign convention), so the lobes from it do not describe a tool tip");
-          flagged = true;
+      // The cutting frame of --tool-axis and the cut's feed, when needed.
+      auto frame = [&]() {
+        const Eigen::Vector3d axis = ParseVector("--tool-axis", tool_axis_text);
+        try {
+          return stability::CuttingFrame(axis, cut.feed_direction_B);
+        } catch (const std::invalid_argument& e) {
+          throw InputError({cut_path, cut.feed_line, cut.feed_column},
+                           std::string("feed_direction: ") + e.what() + " (--tool-axis " + tool_axis_text + ")");
         }
-        for (double f : d.fit.edge_modes_hz) {
-          Warn(kTool, d.label + ": the mode at " + io::FormatDouble(std::round(f * 10.0) / 10.0) +
-                          " Hz reaches past the edge of the usable band (" + calibration::DescribeUsable(d.fit.noise) +
-                          "): the fit saw one flank only, and it may model the drift or the noise floor beyond "
-                          "the band rather than the tool (see --fit-plot)");
-          flagged = true;
+      };
+      if (!frf_path.empty()) {
+        stability::MeasuredTipOptions mo;
+        mo.frf_path = frf_path;
+        mo.frf_y_path = frf_y_path;
+        mo.pose_ids = pose_ids;
+        mo.cutting_frame = frame;
+        mo.tool_axis_source = "--tool-axis " + tool_axis_text;
+        mo.fit = true;  // always: the noise model's usable band serves the ZOA too
+        mo.sd_modes = sd_modes;
+        const std::vector<stability::TipFrfs> sets = ReadFrfFile(frf_path);
+        std::vector<stability::TipFrfs> ysets;
+        if (!frf_y_path.empty()) ysets = ReadFrfFile(frf_y_path);
+        tips = stability::TipsFromMeasuredFrfs(sets, ysets, mo, Tell);
+      } else {
+        const Eigen::Matrix3d R = frame();
+        for (const io::ModalTableEntry& e : io::ReadModalTable(modal_path)) {
+          if (!pose_ids.empty() && std::find(pose_ids.begin(), pose_ids.end(), e.pose_id) == pose_ids.end()) continue;
+          tips.push_back(stability::TipFromModes(e.pose_id, e.modes, R, cut.process.teeth, cut.spindle_speed_max_rad_s));
         }
-        if (d.fit.poor) {
-          Warn(kTool, d.label + ": " + d.fit.problem +
-                          (d.fit.fit.modes.empty() ? "" : "; the SD uses these modes all the same (see --fit-plot)"));
-          flagged = true;
-        }
-      }
-      if (do_sd && t.no_modes) {
-        Warn(kTool, t.id + ": no mode was fitted, so no SD lobes (the ZOA uses the measured FRF)");
-        flagged = true;
+        if (tips.empty()) throw InputError({modal_path, 0, 0}, "none of the requested postures is in the file");
       }
     }
 
-    stability::SdOptions so;
-    so.steps_per_period = sd_steps;
-    so.steps_per_mode_period = sd_steps_per_mode;
-    so.max_depth = MmToM(sd_max_depth_mm);
-    const SdAt sd_at = [&](const TipDynamics& t, const Eigen::VectorXd& speeds) {
-      const stability::TipModalModel m = t.modes_fitted ? t.modes_C : stability::DominantModes(t.modes_C, sd_modes);
-      return stability::SdLobes(m, cut.process, speeds, so, threads, nullptr);
-    };
-    std::vector<LobeRow> rows;
-    bool no_boundary = false;
-    for (const TipDynamics& t : tips) {
-      if (do_zoa) {
-        stability::ZoaOptions zo;
-        zo.max_lobe_index = max_lobe;
-        zo.min_spindle_speed_rad_s = cut.spindle_speed_min_rad_s;
-        const auto lobes = stability::ComputeZoaLobes(t.freq_hz, t.Phi_C, cut.process, zo);
-        for (const auto& p : lobes.At(zoa_speeds)) {
-          rows.push_back({t.id, "zoa", p});
-          no_boundary |= p.status != stability::LobeStatus::kOk;
-        }
-      }
-      if (do_sd && t.modes_C.num_modes() > 0) {
-        // Fitted models keep --sd-modes per direct FRF already (FrfTips).
-        const stability::TipModalModel m = t.modes_fitted ? t.modes_C : stability::DominantModes(t.modes_C, sd_modes);
-        // Say what discretisation is used, before the (possibly long) work.
-        int k_lo = INT_MAX, k_hi = 0;
-        bool capped = false;
-        for (Eigen::Index i = 0; i < sd_speed_grid.size(); ++i) {
-          bool c = false;
-          const int k = stability::SdStepsPerPeriod(m, cut.process, sd_speed_grid(i), so, &c);
-          k_lo = std::min(k_lo, k);
-          k_hi = std::max(k_hi, k);
-          capped |= c;
-        }
-        {
-          std::ostringstream msg;
-          msg << kTool << ": SD of " << t.id << ": " << m.num_modes() << " mode" << (m.num_modes() > 1 ? "s" : "")
-              << " kept (highest " << io::FormatDouble(std::round(10.0 * RadPerSecToHz(m.omega_rad_s.maxCoeff())) / 10.0)
-              << " Hz); steps per tooth period " << k_lo;
-          if (k_hi != k_lo) msg << " to " << k_hi;
-          if (sd_steps > 0) {
-            msg << " (--sd-steps)";
-          } else {
-            msg << " (automatic: " << io::FormatDouble(sd_steps_per_mode) << " per period of the highest mode, at least "
-                << so.min_steps_per_period << ")";
+    stability::LobesOptions lo;
+    lo.method = method == "zoa" ? stability::LobeMethod::kZoa
+                : method == "sd" ? stability::LobeMethod::kSd
+                                 : stability::LobeMethod::kBoth;
+    lo.process = cut.process;
+    lo.min_speed_rad_s = cut.spindle_speed_min_rad_s;
+    lo.max_speed_rad_s = cut.spindle_speed_max_rad_s;
+    lo.zoa_speeds_rad_s = Eigen::VectorXd::LinSpaced(speeds > 0 ? speeds : cut.spindle_speed_count,
+                                                     cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
+    lo.sd_speeds_rad_s = Eigen::VectorXd::LinSpaced(sd_speeds, cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
+    lo.max_lobe_index = max_lobe;
+    lo.sd.steps_per_period = sd_steps;
+    lo.sd.steps_per_mode_period = sd_steps_per_mode;
+    lo.sd.max_depth = MmToM(sd_max_depth_mm);
+    lo.sd_modes = sd_modes;
+    lo.threads = threads;
+    std::optional<ProgressLine> progress;
+    const stability::LobesResult lobes =
+        stability::ComputeLobes(tips, lo, Tell, [&](const stability::SdProgress& p) {
+          if (p.done == 0 && !p.finished) progress.emplace(kTool, "SD speeds of " + p.id, p.total >= 20 ? 1000 : 0);
+          if (!progress) return;
+          if (p.finished) {
+            progress->Finish();
+            progress.reset();
+          } else if (p.total > 0) {
+            progress->Update(p.done * 1000 / p.total);
           }
-          std::cerr << msg.str() << "\n";
-        }
-        if (capped) {
-          Warn(kTool, "SD of " + t.id + ": at the lowest speeds the automatic steps per tooth period were capped "
-                          "at " + std::to_string(k_hi) + " (monodromy matrix of " +
-                          std::to_string(so.max_monodromy_dimension) + " rows), fewer than " +
-                          io::FormatDouble(sd_steps_per_mode) + " per period of the highest mode: the lobes there "
-                          "are less accurate (fewer modes, --sd-modes, or --sd-steps to force more steps)");
-        }
-        ProgressLine progress(kTool, "SD speeds of " + t.id, sd_speed_grid.size() >= 20 ? 1000 : 0);
-        const auto pts = stability::SdLobes(m, cut.process, sd_speed_grid, so, threads,
-                                            [&](long done, long total) { progress.Update(done * 1000 / total); });
-        progress.Finish();
-        for (const auto& p : pts) {
-          rows.push_back({t.id, "sd", p});
-          no_boundary |= p.status == stability::LobeStatus::kUnstableAtZero;
-        }
-      }
-    }
+        });
+    const std::vector<stability::LobeRow>& rows = lobes.rows;
+    const bool no_boundary = lobes.no_boundary;
+    bool flagged = g_implausible_frfs > 0 || lobes.flagged;
 
-    if (do_zoa && do_sd) CompareZoaAndSd(tips, rows, cut, sd_at, &flagged);
-
-    auto write = [&](std::ostream& os) {
-      os << "pose_id,spindle_speed_rpm,critical_depth_mm,chatter_freq_hz,lobe_index,method,status,sd_steps\n";
-      for (const LobeRow& r : rows) {
-        const auto& p = r.point;
-        os << r.id << ',' << io::FormatDouble(RoundRpm(RadPerSecToRpm(p.spindle_speed_rad_s))) << ','
-           << (std::isfinite(p.critical_depth) ? io::FormatDouble(MToMm(p.critical_depth)) : "") << ','
-           << (std::isfinite(p.chatter_freq_hz) ? io::FormatDouble(p.chatter_freq_hz) : "") << ','
-           << (p.lobe_index >= 0 ? std::to_string(p.lobe_index) : "") << ',' << r.method << ','
-           << stability::ToString(p.status) << ',' << (p.sd_steps > 0 ? std::to_string(p.sd_steps) : "") << '\n';
-      }
-    };
-    io::WriteFileAtomically(out_path.empty() ? "-" : out_path, write);
+    io::WriteLobesCsv(out_path.empty() ? "-" : out_path, rows);
     if (!plot_path.empty()) {
       report::Figure fig(1, 1, 1000, 560);
       fig.title = "robomach stability-lobes: " + cut_path;
@@ -744,10 +330,10 @@ int Run(int argc, char** argv) {
       ax.y_label = "critical axial depth [mm]";
       ax.y_min = 0.0;
       int color = 0;
-      for (const TipDynamics& t : tips) {
+      for (const stability::TipDynamics& t : tips) {
         for (const char* m : {"zoa", "sd"}) {
           report::Series s;
-          for (const LobeRow& r : rows) {
+          for (const stability::LobeRow& r : rows) {
             if (r.id != t.id || r.method != m) continue;
             s.x.push_back(RadPerSecToRpm(r.point.spindle_speed_rad_s));
             s.y.push_back(r.point.status == stability::LobeStatus::kOk ? MToMm(r.point.critical_depth) : NAN);
@@ -761,7 +347,15 @@ int Run(int argc, char** argv) {
       }
       fig.SavePng(plot_path);
     }
-    if (!modes_out_path.empty()) WriteFittedModes(modes_out_path, tips);
+    if (!modes_out_path.empty()) {
+      std::vector<std::string> ids;
+      std::vector<std::vector<dynamics::Mode>> modes;
+      for (const stability::TipDynamics& t : tips) {
+        ids.push_back(t.id);
+        modes.push_back(stability::ModesInSourceFrame(t));
+      }
+      io::WriteModalTableCsv(modes_out_path, ids, modes);
+    }
     if (!fit_plot_path.empty()) PlotFits(fit_plot_path, frf_path, tips);
     if (no_boundary) Warn(kTool, "some speeds have no boundary (status column): widen the FRF band or the lobe range");
     flagged |= no_boundary;
@@ -782,18 +376,18 @@ int Run(int argc, char** argv) {
       j["radial_immersion"] = cut.process.radial_immersion;
       j["lobes_csv"] = out_path.empty() ? "-" : out_path;
       nlohmann::json results = nlohmann::json::array();
-      for (const TipDynamics& t : tips) {
+      for (const stability::TipDynamics& t : tips) {
         for (const char* m : {"zoa", "sd"}) {
           nlohmann::json r;
           int points = 0, ok = 0;
           double min_depth = INFINITY, max_depth = -INFINITY, min_speed = NAN, max_speed = NAN, min_freq = NAN;
-          for (const LobeRow& row : rows) {
+          for (const stability::LobeRow& row : rows) {
             if (row.id != t.id || row.method != m) continue;
             ++points;
             const auto& p = row.point;
             if (!std::isfinite(p.critical_depth)) continue;
             ++ok;
-            const double d = MToMm(p.critical_depth), rpm = RoundRpm(RadPerSecToRpm(p.spindle_speed_rad_s));
+            const double d = MToMm(p.critical_depth), rpm = io::LobeSpeedRpm(p.spindle_speed_rad_s);
             if (d < min_depth) {
               min_depth = d;
               min_speed = rpm;

@@ -6,19 +6,14 @@
 
 #include <Eigen/Core>
 
+#include "robomach/stability/tip_dynamics.h"
 #include "robomach/stability/tool_tip_model.h"
 
 namespace robomach::io {
 
-/// The tool-tip FRFs of one posture from a file, as receptance [m/N] in B.
-/// Directions that the file does not give are zero and flagged absent.
-struct FrfSetOfPose {
-  std::string pose_id;
-  Eigen::VectorXd freq_hz;            // one grid shared by all pairs of the pose
-  std::vector<Eigen::Matrix3cd> H;    // per line [m/N]
-  std::array<std::array<bool, 3>, 3> present{};  // [response][excitation]
-  std::string source;                 // file, for messages
-};
+/// The tool-tip FRFs of one posture from a file, as receptance [m/N] in B
+/// (stability/tip_dynamics.h's TipFrfs, which turns them into tool tips).
+using FrfSetOfPose = stability::TipFrfs;
 
 /// Reads measured or predicted tool-tip FRFs (formats.md §3: the long CSV,
 /// or UFF58 by extension; io/frf_files.h validates them and converts
@@ -50,5 +45,6 @@ struct ModalTableEntry {
 /// tool-tip shape `ux,uy,uz` (normalised on reading). p = u/√m.
 /// @throws InputError naming file, line and column.
 std::vector<ModalTableEntry> ReadModalTable(const std::string& path);
+
 
 }  // namespace robomach::io

@@ -1,0 +1,76 @@
+#pragma once
+// stability-lobes' workflow as one library call (issue #21): the ZOA and/or
+// the semi-discretization lobes of a set of tool tips (tip_dynamics.h), the
+// checks of the tips' modal fits, and the comparison of the two methods.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/stability/milling.h"
+#include "robomach/stability/semi_discretization.h"
+#include "robomach/stability/tip_dynamics.h"
+#include "robomach/stability/zoa_lobes.h"
+
+namespace robomach::stability {
+
+enum class LobeMethod { kZoa, kSd, kBoth };
+
+/// One point of the lobes of one tool tip by one method.
+struct LobeRow {
+  std::string id;      // the tool tip's id
+  std::string method;  // "zoa" or "sd"
+  LobePoint point;
+};
+
+struct LobesOptions {
+  LobeMethod method{LobeMethod::kZoa};
+  MillingProcess process;
+  double min_speed_rad_s{0.0};  // the cut's speed range: the ZOA's lowest lobe, the
+  double max_speed_rad_s{0.0};  // ZOA-SD comparison's search window
+  Eigen::VectorXd zoa_speeds_rad_s;  // where the ZOA lobes are sampled
+  Eigen::VectorXd sd_speeds_rad_s;   // where the SD is solved
+  int max_lobe_index{30};            // ZoaOptions::max_lobe_index
+  SdOptions sd;
+  int sd_modes{4};  // dominant modes of a model (not fitted) tip the SD keeps
+  int threads{0};   // SD threads (0 = all cores)
+};
+
+/// What the run has to say as it goes (kFit is information here: the SD's
+/// discretisation), and the SD's progress per tool tip: `done` of `total`
+/// speeds; `finished` once, after the last.
+struct SdProgress {
+  std::string id;
+  long done{0}, total{0};
+  bool finished{false};
+};
+using SdProgressSink = std::function<void(const SdProgress&)>;
+
+struct LobesResult {
+  std::vector<LobeRow> rows;  // per tip: the ZOA's rows, then the SD's
+  /// Some speeds have no boundary (a ZOA point that is not ok, an SD point
+  /// unstable at depth zero).
+  bool no_boundary{false};
+  /// A modal fit that does not describe a tool tip (not a driving point,
+  /// a mode at the edge of the usable band, a poor fit, no mode for the
+  /// SD), or the ZOA and the SD more than 10 % apart where they should agree.
+  bool flagged{false};
+};
+
+/// The warnings about one tip's modal fits (empty for a model tip): one per
+/// problem, each naming the FRF. `sd` adds "no mode, no SD lobes".
+std::vector<std::string> TipFitWarnings(const TipDynamics& tip, bool sd);
+
+/// The lobes of every tip: the ZOA on its FRF (ComputeZoaLobes sampled at
+/// zoa_speeds_rad_s), the SD on its modes (SdLobes at sd_speeds_rad_s; a
+/// model tip keeps its sd_modes dominant modes, a fitted one what the fit
+/// kept). With both methods at a radial immersion of 0.3 or more the
+/// smallest critical depths must agree within 10 %: the SD's minimum is
+/// also searched on 7 speeds within ±4 % of the bottom of each of the (at
+/// most 4) lowest ZOA lobes.
+LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOptions& options,
+                         const TipMessageSink& on_message = {}, const SdProgressSink& on_progress = {});
+
+}  // namespace robomach::stability

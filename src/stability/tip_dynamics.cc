@@ -1,0 +1,297 @@
+#include "robomach/stability/tip_dynamics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
+#include "robomach/common/units.h"
+#include "robomach/dynamics/tool_tip_frf.h"
+
+namespace robomach::stability {
+namespace {
+
+// The shown id of a posture of an FRF file: an FRF without a posture
+// (pose_id "") is shown as the file's stem.
+std::string ShownId(const std::string& pose_id, const std::string& path) {
+  return pose_id.empty() ? std::filesystem::path(path).stem().string() : pose_id;
+}
+
+// The direct FRFs a file's posture gives, and how many FRFs it gives.
+std::vector<int> DirectFrfs(const TipFrfs& s, int* total) {
+  std::vector<int> d;
+  *total = 0;
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) *total += s.present[a][b];
+    if (s.present[a][a]) d.push_back(a);
+  }
+  return d;
+}
+
+// One direct FRF of a posture as an Frf (all lines, 0 Hz included).
+dynamics::Frf DirectFrf(const TipFrfs& s, int a) {
+  Eigen::VectorXcd h(s.freq_hz.size());
+  for (Eigen::Index k = 0; k < h.size(); ++k) h(k) = s.H[k](a, a);
+  return dynamics::Frf::FromSamples(s.freq_hz, h);
+}
+
+std::string Hname(int a, int b) { return std::string("H") + "xyz"[a] + "xyz"[b]; }
+
+// Noise model and modal fit of one direct FRF, told to `on_message`.
+DirectionFit FitOne(const std::string& label, const dynamics::Frf& frf, const TipMessageSink& on_message) {
+  DirectionFit d{label, FitDirectFrf(frf)};
+  std::ostringstream m;
+  m << label << ": noise " << d.fit.noise.description << "\n" << label << ": modal fit: " << d.fit.fit.message;
+  for (const calibration::FittedMode& fm : d.fit.fit.modes) {
+    m << "\n  " << FormatDouble(std::round(fm.freq_hz * 10.0) / 10.0) << " Hz, damping ratio "
+      << FormatDouble(std::round(fm.damping_ratio * 1e4) / 1e4) << ", modal mass "
+      << (fm.modal_constant.real() > 0.0 ? FormatNumber(1.0 / fm.modal_constant.real()) + " kg"
+                                          : std::string("none (Re A <= 0: not a driving-point mode, left out)"));
+  }
+  if (std::isfinite(d.fit.noise_rms)) {
+    m << "\n  rms misfit " << FormatDouble(std::round(d.fit.noise_rms * 100.0) / 100.0) << " x the noise";
+  }
+  if (on_message) on_message({TipMessage::Kind::kFit, m.str()});
+  return d;
+}
+
+// The band [lo, hi] usable in every fitted direction (±inf where none says).
+std::pair<double, double> CommonUsableBand(const std::vector<DirectionFit>& fits) {
+  double lo = -INFINITY, hi = INFINITY;
+  for (const DirectionFit& d : fits) {
+    if (d.fit.noise.usable_bands.empty()) continue;
+    lo = std::max(lo, d.fit.noise.usable_bands.front().first);
+    hi = std::min(hi, d.fit.noise.usable_bands.back().second);
+  }
+  return {lo, hi};
+}
+
+}  // namespace
+
+TipDynamics TipFromPosture(const std::string& id, const dynamics::PostureDynamics& d, const Eigen::Vector3d& feed_B,
+                           int teeth, double max_speed_rad_s, int lines) {
+  const Eigen::Matrix3d R = CuttingFrameAtPosture(d.X_BT, feed_B);
+  TipDynamics t;
+  t.id = id;
+  const TipModalModel modes = ModalModelFromPosture(d);
+  t.freq_hz = LobeFrequencyGrid(modes, teeth, max_speed_rad_s, lines);
+  t.Phi_C = OrientInCuttingPlane(dynamics::Receptance(d, t.freq_hz), R);
+  t.modes_C = modes.Rotated(R);
+  t.R_BC = R;
+  return t;
+}
+
+TipDynamics TipFromModes(const std::string& id, const TipModalModel& modes_B, const Eigen::Matrix3d& R_BC, int teeth,
+                         double max_speed_rad_s, int lines) {
+  TipDynamics t;
+  t.id = id;
+  t.freq_hz = LobeFrequencyGrid(modes_B, teeth, max_speed_rad_s, lines);
+  t.Phi_C = OrientInCuttingPlane(ModalReceptance(modes_B, t.freq_hz), R_BC);
+  t.modes_C = modes_B.Rotated(R_BC);
+  t.R_BC = R_BC;
+  return t;
+}
+
+std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, const std::vector<TipFrfs>& ysets,
+                                              const MeasuredTipOptions& o, const TipMessageSink& on_message) {
+  auto tell = [&](TipMessage::Kind kind, const std::string& text) {
+    if (on_message) on_message({kind, text});
+  };
+  auto frame = [&]() -> Eigen::Matrix3d {
+    if (!o.cutting_frame) throw std::invalid_argument("TipsFromMeasuredFrfs: the FRFs need a cutting frame, and none was given");
+    return o.cutting_frame();
+  };
+  auto only_direct = [](const TipFrfs& s, const std::string& path, const std::string& id, const std::string& option) {
+    int total = 0;
+    const std::vector<int> d = DirectFrfs(s, &total);
+    if (d.size() != 1 || total != 1) {
+      throw InputError({path, 0, 0}, "posture " + id + ": with --frf-y, " + option + " must give exactly one direct FRF; it gives " +
+                                         std::to_string(total) + " FRFs, " + std::to_string(d.size()) + " of them direct");
+    }
+    return d[0];
+  };
+  std::vector<TipDynamics> tips;
+  bool noted = false;
+  for (const TipFrfs& s : sets) {
+    const std::string id = ShownId(s.pose_id, o.frf_path);
+    if (!o.pose_ids.empty() && std::find(o.pose_ids.begin(), o.pose_ids.end(), id) == o.pose_ids.end()) continue;
+    int total = 0;
+    const std::vector<int> direct = DirectFrfs(s, &total);
+    TipDynamics t;
+    t.id = id;
+    // Drop a 0 Hz line (the ZOA needs ω > 0); the fit keeps every line.
+    const Eigen::Index first = s.freq_hz.size() > 0 && s.freq_hz(0) == 0.0 ? 1 : 0;
+    t.freq_hz = s.freq_hz.tail(s.freq_hz.size() - first);
+    auto diagonal = [&](const Eigen::VectorXcd& hx, const Eigen::VectorXcd& hy) {
+      t.Phi_C.assign(t.freq_hz.size(), Eigen::Matrix2cd::Zero());
+      for (Eigen::Index k = 0; k < t.freq_hz.size(); ++k) {
+        t.Phi_C[k](0, 0) = hx(k + first);
+        t.Phi_C[k](1, 1) = hy(k + first);
+      }
+    };
+    const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY();
+    if (!ysets.empty()) {
+      // Two files, one direct FRF each: along the feed (x_C) and normal to it (y_C).
+      const int a = only_direct(s, o.frf_path, id, "--frf");
+      const TipFrfs* y = nullptr;
+      for (const TipFrfs& c : ysets) {
+        if (ShownId(c.pose_id, o.frf_y_path) == id || (c.pose_id == s.pose_id)) y = &c;
+      }
+      if (!y && sets.size() == 1 && ysets.size() == 1) y = &ysets.front();
+      if (!y) throw InputError({o.frf_y_path, 0, 0}, "no posture " + id + " in the file (--frf-y)");
+      const int b = only_direct(*y, o.frf_y_path, id, "--frf-y");
+      if (y->freq_hz.size() != s.freq_hz.size() || y->freq_hz != s.freq_hz) {
+        throw InputError({o.frf_y_path, 0, 0}, "posture " + id + ": the FRF of --frf-y uses another frequency grid than "
+                                                   "the one of --frf; both must use the same lines");
+      }
+      const dynamics::Frf hx = DirectFrf(s, a), hy = DirectFrf(*y, b);
+      diagonal(hx.receptance(), hy.receptance());
+      if (o.fit) {
+        t.fits.push_back(FitOne(id + " " + Hname(a, a) + " (feed, x of the cut)", hx, on_message));
+        t.fits.push_back(FitOne(id + " " + Hname(b, b) + " (normal to the feed, y of the cut)", hy, on_message));
+        t.modes_C = Concatenate({DominantModes(ModesAlong(t.fits[0].fit.fit, ex), o.sd_modes),
+                                 DominantModes(ModesAlong(t.fits[1].fit.fit, ey), o.sd_modes)});
+      }
+      t.R_BC = frame();
+    } else if (direct.size() == 1 && total == 1) {
+      // One direct FRF: a symmetric tool (issue #18).
+      const int a = direct[0];
+      const dynamics::Frf h = DirectFrf(s, a);
+      diagonal(h.receptance(), h.receptance());
+      if (!noted) {
+        tell(TipMessage::Kind::kNote, id + " has one direct FRF (" + Hname(a, a) +
+                                          "): the tool is taken as symmetric, this FRF in both in-plane directions of "
+                                          "the cut and no cross terms; --tool-axis does not apply");
+        noted = true;
+      }
+      if (o.fit) {
+        t.fits.push_back(FitOne(id + " " + Hname(a, a), h, on_message));
+        const TipModalModel mx = DominantModes(ModesAlong(t.fits[0].fit.fit, ex), o.sd_modes);
+        const TipModalModel my = DominantModes(ModesAlong(t.fits[0].fit.fit, ey), o.sd_modes);
+        t.modes_C = Concatenate({mx, my});
+      }
+      // The modal table is written for the default tool axis (z) unless one is given.
+      if (o.cutting_frame) {
+        try {
+          t.R_BC = o.cutting_frame();
+        } catch (const InputError&) {
+          t.R_BC = Eigen::Matrix3d::Identity();
+        }
+      }
+    } else {
+      // Several FRFs in the base frame: oriented by the tool axis.
+      const Eigen::Matrix3d R = frame();
+      t.R_BC = R;
+      std::vector<int> dirs;
+      for (int a = 0; a < 3; ++a) {
+        if (R.col(0).cwiseAbs()(a) > 1e-9 || R.col(1).cwiseAbs()(a) > 1e-9) dirs.push_back(a);
+      }
+      for (int a : dirs) {
+        for (int b : dirs) {
+          if (!s.present[a][b]) {
+            if (a == b) {
+              throw InputError({o.frf_path, 0, 0}, "posture " + id + ": the cutting plane (" + o.tool_axis_source +
+                                                       ") needs FRF " + "xyz"[a] + "xyz"[b] +
+                                                       ", which the file does not give; give a --tool-axis whose "
+                                                       "cutting plane the file's directions span, or the second "
+                                                       "direction with --frf-y from a file of one direct FRF");
+            }
+            tell(TipMessage::Kind::kWarning, o.frf_path + ": posture " + id + ": no cross FRF " + "xyz"[a] + "xyz"[b] +
+                                                 "; taken as zero");
+          }
+        }
+      }
+      std::vector<Eigen::Matrix3cd> H(s.H.begin() + first, s.H.end());
+      t.Phi_C = OrientInCuttingPlane(H, R);
+      if (o.fit) {
+        std::vector<TipModalModel> parts;
+        for (int a : dirs) {
+          t.fits.push_back(FitOne(id + " " + Hname(a, a), DirectFrf(s, a), on_message));
+          parts.push_back(
+              DominantModes(ModesAlong(t.fits.back().fit.fit, Eigen::Vector3d::Unit(a)).Rotated(R), o.sd_modes));
+        }
+        t.modes_C = Concatenate(parts);
+        bool cross = false;
+        for (int a : dirs) {
+          for (int b : dirs) cross |= a != b && s.present[a][b];
+        }
+        if (cross && dirs.size() == 2) {
+          // Two base directions span the cutting plane: a mode seen in both
+          // direct FRFs is one mode whose shape's sign the cross FRF gives.
+          const int a = dirs[0], b = dirs[1];
+          const int r = s.present[a][b] ? a : b, c = s.present[a][b] ? b : a;
+          const auto [lo, hi] = CommonUsableBand(t.fits);
+          std::vector<int> lines;
+          for (Eigen::Index k = 0; k < s.freq_hz.size(); ++k) {
+            if (s.freq_hz(k) >= lo && s.freq_hz(k) <= hi) lines.push_back(static_cast<int>(k));
+          }
+          if (lines.size() >= 8) {
+            Eigen::VectorXcd h(s.freq_hz.size());
+            for (Eigen::Index k = 0; k < h.size(); ++k) h(k) = s.H[k](r, c);
+            const dynamics::Frf cross_frf = dynamics::Frf::FromSamples(s.freq_hz, h).Select(lines);
+            t.modes_C = DominantModes(ModesOfTwoDirections(t.fits[0].fit.fit, Eigen::Vector3d::Unit(a),
+                                                           t.fits[1].fit.fit, Eigen::Vector3d::Unit(b), cross_frf)
+                                          .Rotated(R),
+                                      2 * o.sd_modes);
+            tell(TipMessage::Kind::kNote, id + ": a mode found in both " + Hname(a, a) + " and " + Hname(b, b) +
+                                              " is one mode of the SD's model, its shape's sign from the cross FRF " +
+                                              Hname(r, c));
+          }
+        } else if (cross) {
+          tell(TipMessage::Kind::kNote, id + ": the SD's modal model is fitted to the direct FRFs; the cross FRFs "
+                                             "of the file are used by the ZOA only");
+        }
+      }
+    }
+    if (o.fit) {
+      t.modes_fitted = true;
+      t.no_modes = t.modes_C.num_modes() == 0;
+      // The ZOA uses the measured FRF where the noise model finds it usable
+      // in every fitted direction: below that (the drift of an integrated
+      // accelerometer signal) and above it (the floor) a line says nothing
+      // of the structure, and a drift 5x the resonance makes spurious
+      // lobes of a few hertz.
+      const auto [lo, hi] = CommonUsableBand(t.fits);
+      if (std::isfinite(lo) && std::isfinite(hi) && hi > lo) {
+        std::vector<Eigen::Matrix2cd> phi;
+        std::vector<double> f;
+        for (Eigen::Index k = 0; k < t.freq_hz.size(); ++k) {
+          if (t.freq_hz(k) >= lo && t.freq_hz(k) <= hi) {
+            f.push_back(t.freq_hz(k));
+            phi.push_back(t.Phi_C[k]);
+          }
+        }
+        if (f.size() >= 3 && static_cast<Eigen::Index>(f.size()) < t.freq_hz.size()) {
+          tell(TipMessage::Kind::kFit, id + ": the ZOA uses the measured FRF in its usable band, " + FormatDouble(lo) +
+                                           " to " + FormatDouble(hi) + " Hz");
+          t.freq_hz = Eigen::Map<Eigen::VectorXd>(f.data(), static_cast<Eigen::Index>(f.size()));
+          t.Phi_C = std::move(phi);
+        }
+      }
+    }
+    tips.push_back(std::move(t));
+  }
+  if (tips.empty()) throw InputError({o.frf_path, 0, 0}, "none of the requested postures is in the file");
+  return tips;
+}
+
+std::vector<dynamics::Mode> ModesInSourceFrame(const TipDynamics& tip) {
+  std::vector<dynamics::Mode> modes;
+  for (int k = 0; k < tip.modes_C.num_modes(); ++k) {
+    dynamics::Mode m;
+    m.freq_hz = RadPerSecToHz(tip.modes_C.omega_rad_s(k));
+    m.damping_ratio = tip.modes_C.zeta(k);
+    m.p_T = tip.R_BC * tip.modes_C.p.col(k);
+    m.modal_mass_kg = 1.0 / m.p_T.squaredNorm();
+    Eigen::Index big = 0;
+    m.p_T.cwiseAbs().maxCoeff(&big);
+    m.shape_T = m.p_T.normalized() * (m.p_T(big) < 0.0 ? -1.0 : 1.0);
+    for (int i = 0; i < 3; ++i) m.shape_T(i) = m.shape_T(i) == 0.0 ? 0.0 : m.shape_T(i);  // no "-0"
+    modes.push_back(m);
+  }
+  return modes;
+}
+
+}  // namespace robomach::stability

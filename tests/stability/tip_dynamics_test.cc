@@ -1,0 +1,218 @@
+#include "robomach/stability/tip_dynamics.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "robomach/common/errors.h"
+#include "robomach/common/units.h"
+#include "robomach/io/csv_table.h"
+#include "robomach/io/cut_file.h"
+#include "robomach/io/lobes_file.h"
+#include "robomach/stability/lobes_workflow.h"
+#include "tap_test_synth.h"
+#include "test_support.h"
+
+namespace robomach::stability {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Two modes in B with shapes along no axis of the cutting frame.
+TipModalModel TwoModesInB() {
+  TipModalModel m;
+  m.omega_rad_s = Eigen::Vector2d(HzToRadPerSec(410.0), HzToRadPerSec(1230.0));
+  m.zeta = Eigen::Vector2d(0.04, 0.02);
+  m.p = Eigen::Matrix3Xd(3, 2);
+  m.p.col(0) = Eigen::Vector3d(0.6, -0.3, 0.2) / std::sqrt(12.0);
+  m.p.col(1) = Eigen::Vector3d(-0.1, 0.8, 0.5) / std::sqrt(3.5);
+  return m;
+}
+
+// A modal table's modes oriented into the cutting frame and back to the
+// frame of the source: frequency, damping and p (up to the sign of the
+// shape) are the table's, the modal mass is 1/|p|².
+TEST(TipFromModes, ModesRoundTripThroughTheSourceFrame) {
+  const TipModalModel mB = TwoModesInB();
+  const Eigen::Matrix3d R = CuttingFrame(Eigen::Vector3d(0.2, -0.1, 1.0), Eigen::Vector3d(1.0, 0.3, 0.0));
+  const TipDynamics tip = TipFromModes("T", mB, R, 4, RpmToRadPerSec(12000.0));
+  const std::vector<dynamics::Mode> back = ModesInSourceFrame(tip);
+  ASSERT_EQ(back.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_NEAR(back[k].freq_hz, RadPerSecToHz(mB.omega_rad_s(k)), 1e-9);
+    EXPECT_DOUBLE_EQ(back[k].damping_ratio, mB.zeta(k));
+    const double sign = back[k].p_T.dot(mB.p.col(k)) > 0.0 ? 1.0 : -1.0;
+    EXPECT_LT((sign * back[k].p_T - mB.p.col(k)).norm(), 1e-14 * mB.p.col(k).norm());
+    EXPECT_NEAR(back[k].modal_mass_kg, 1.0 / mB.p.col(k).squaredNorm(), 1e-12 * back[k].modal_mass_kg);
+    EXPECT_NEAR(back[k].shape_T.norm(), 1.0, 1e-14);
+  }
+}
+
+// One mode along the feed (x_B, tool axis z_B: the cutting frame is B): the
+// in-plane FRF is the single-DOF receptance 1/(m (ω_n² − ω² + 2iζω_nω)) in
+// xx and nothing else, on a grid that covers the mode.
+TEST(TipFromModes, InPlaneFrfOfOneModeIsTheSingleDofReceptance) {
+  TipModalModel m;
+  const double wn = HzToRadPerSec(922.0), zeta = 0.011, mass = 0.03993;
+  m.omega_rad_s = Eigen::VectorXd::Constant(1, wn);
+  m.zeta = Eigen::VectorXd::Constant(1, zeta);
+  m.p = Eigen::Matrix3Xd::Zero(3, 1);
+  m.p(0, 0) = 1.0 / std::sqrt(mass);
+  const Eigen::Matrix3d R = CuttingFrame(Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX());
+  ASSERT_LT((R - Eigen::Matrix3d::Identity()).norm(), 1e-15);
+  const TipDynamics tip = TipFromModes("IS", m, R, 2, RpmToRadPerSec(20000.0), 500);
+  ASSERT_EQ(tip.freq_hz.size(), 500);
+  ASSERT_EQ(tip.Phi_C.size(), 500u);
+  EXPECT_LT(tip.freq_hz(0), 922.0);
+  EXPECT_GT(tip.freq_hz(499), 922.0);
+  for (Eigen::Index k = 0; k < tip.freq_hz.size(); k += 37) {
+    const double w = HzToRadPerSec(tip.freq_hz(k));
+    const std::complex<double> h = 1.0 / (mass * std::complex<double>(wn * wn - w * w, 2.0 * zeta * wn * w));
+    EXPECT_LT(std::abs(tip.Phi_C[k](0, 0) - h), 1e-12 * std::abs(h)) << tip.freq_hz(k);
+    EXPECT_EQ(tip.Phi_C[k](1, 1), 0.0);
+    EXPECT_EQ(tip.Phi_C[k](0, 1), 0.0);
+  }
+}
+
+TipFrfs TapTestFrfs(const testing::TapTest& t, int direction) {
+  TipFrfs s;
+  s.pose_id = "P1";
+  s.freq_hz = t.freq_hz;
+  s.H.assign(t.freq_hz.size(), Eigen::Matrix3cd::Zero());
+  for (Eigen::Index k = 0; k < t.freq_hz.size(); ++k) s.H[k](direction, direction) = t.measured(k);
+  s.present[direction][direction] = true;
+  s.source = "tap.csv";
+  return s;
+}
+
+// One direct FRF is a symmetric tool: the same FRF in xx and yy of the cut
+// (inside the usable band the noise model finds; the 0 Hz line and the
+// drift below the band are dropped), a note that says so, one modal fit
+// whose modes appear once per in-plane direction, and without a cutting
+// frame the identity as R_BC.
+TEST(TipsFromMeasuredFrfs, OneDirectFrfIsASymmetricTool) {
+  const testing::TapTest t = testing::MakeTapTest(testing::TapTestOptions{});
+  MeasuredTipOptions o;
+  o.frf_path = "tap.csv";
+  o.sd_modes = 3;
+  std::vector<TipMessage> said;
+  const std::vector<TipDynamics> tips =
+      TipsFromMeasuredFrfs({TapTestFrfs(t, 2)}, {}, o, [&](const TipMessage& m) { said.push_back(m); });
+  ASSERT_EQ(tips.size(), 1u);
+  const TipDynamics& tip = tips[0];
+  EXPECT_EQ(tip.id, "P1");
+  ASSERT_EQ(tip.fits.size(), 1u);
+  EXPECT_EQ(tip.fits[0].fit.fit.modes.size(), 3u) << tip.fits[0].fit.fit.message;
+  EXPECT_EQ(tip.modes_C.num_modes(), 6);
+  EXPECT_TRUE(tip.modes_fitted);
+  EXPECT_TRUE(tip.R_BC.isIdentity(0.0));
+  const auto& band = tip.fits[0].fit.noise.usable_bands;
+  ASSERT_FALSE(band.empty());
+  EXPECT_GE(tip.freq_hz(0), band.front().first);
+  EXPECT_LE(tip.freq_hz(tip.freq_hz.size() - 1), band.back().second);
+  EXPECT_GT(tip.freq_hz(0), 0.0);
+  for (Eigen::Index k = 0; k < tip.freq_hz.size(); k += 101) {
+    const Eigen::Index line = static_cast<Eigen::Index>(std::lround(tip.freq_hz(k) / 1.0));  // df = 1 Hz from 0 Hz
+    ASSERT_DOUBLE_EQ(t.freq_hz(line), tip.freq_hz(k));
+    EXPECT_EQ(tip.Phi_C[k](0, 0), t.measured(line));
+    EXPECT_EQ(tip.Phi_C[k](1, 1), t.measured(line));
+    EXPECT_EQ(tip.Phi_C[k](0, 1), 0.0);
+  }
+  bool noted = false, fitted = false;
+  for (const TipMessage& m : said) {
+    noted |= m.kind == TipMessage::Kind::kNote && m.text.find("symmetric") != std::string::npos;
+    fitted |= m.kind == TipMessage::Kind::kFit && m.text.find("P1 Hzz: modal fit") != std::string::npos;
+  }
+  EXPECT_TRUE(noted);
+  EXPECT_TRUE(fitted);
+}
+
+// FRFs in B whose directions do not span the cutting plane: the error names
+// the file, the posture and the FRF missing.
+TEST(TipsFromMeasuredFrfs, CuttingPlaneTheFileDoesNotSpanNamesTheFrfMissing) {
+  testing::TapTestOptions to;
+  const testing::TapTest t = testing::MakeTapTest(to);
+  TipFrfs s = TapTestFrfs(t, 0);
+  for (Eigen::Index k = 0; k < t.freq_hz.size(); ++k) s.H[k](2, 2) = t.measured(k);
+  s.present[2][2] = true;  // Hxx and Hzz: no Hyy for a tool along z
+  MeasuredTipOptions o;
+  o.frf_path = "tap.csv";
+  o.tool_axis_source = "tool axis 0,0,1";
+  o.cutting_frame = [] { return CuttingFrame(Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()); };
+  o.fit = false;
+  const std::string what = testing::CaptureError([&] { TipsFromMeasuredFrfs({s}, {}, o, {}); });
+  EXPECT_THAT(what, HasSubstr("tap.csv"));
+  EXPECT_THAT(what, HasSubstr("posture P1: the cutting plane (tool axis 0,0,1) needs FRF yy"));
+}
+
+// Two files (--frf and --frf-y) must share one frequency grid.
+TEST(TipsFromMeasuredFrfs, TwoFilesOnDifferentGridsAreRefused) {
+  const testing::TapTest t = testing::MakeTapTest(testing::TapTestOptions{});
+  TipFrfs y = TapTestFrfs(t, 1);
+  y.freq_hz *= 1.001;
+  MeasuredTipOptions o;
+  o.frf_path = "x.csv";
+  o.frf_y_path = "y.csv";
+  o.fit = false;
+  o.cutting_frame = [] { return Eigen::Matrix3d::Identity().eval(); };
+  const std::string what = testing::CaptureError([&] { TipsFromMeasuredFrfs({TapTestFrfs(t, 0)}, {y}, o, {}); });
+  EXPECT_THAT(what, HasSubstr("y.csv"));
+  EXPECT_THAT(what, HasSubstr("another frequency grid"));
+}
+
+// The workflow on issue #18's tap test at a radial immersion of 0.5: the
+// ZOA (on the measured FRF) and the SD (on the fitted modes) are two
+// methods that must agree within 10 % on the smallest critical depth; the
+// run is not flagged, every row is the tip's, the ZOA's and the SD's rows
+// count as asked, and the lobes CSV written holds them (read back with the
+// CSV reader, depths in mm).
+TEST(ComputeLobes, TapTestZoaAndSdAgreeAndTheCsvHoldsTheRows) {
+  const testing::TapTest t = testing::MakeTapTest(testing::TapTestOptions{});
+  const io::CutSpec cut = io::ReadCutFile(testing::SourcePath("tests/data/stability/cut_tap_lobe0.yaml"));
+  ASSERT_GE(cut.process.radial_immersion, 0.3);
+  MeasuredTipOptions mo;
+  mo.frf_path = "tap.csv";
+  mo.sd_modes = 3;
+  const std::vector<TipDynamics> tips = TipsFromMeasuredFrfs({TapTestFrfs(t, 2)}, {}, mo, {});
+  LobesOptions o;
+  o.method = LobeMethod::kBoth;
+  o.process = cut.process;
+  o.min_speed_rad_s = cut.spindle_speed_min_rad_s;
+  o.max_speed_rad_s = cut.spindle_speed_max_rad_s;
+  o.zoa_speeds_rad_s = Eigen::VectorXd::LinSpaced(50, o.min_speed_rad_s, o.max_speed_rad_s);
+  o.sd_speeds_rad_s = Eigen::VectorXd::LinSpaced(3, o.min_speed_rad_s, o.max_speed_rad_s);
+  std::vector<TipMessage> said;
+  long progress_ends = 0;
+  const LobesResult r = ComputeLobes(tips, o, [&](const TipMessage& m) { said.push_back(m); },
+                                     [&](const SdProgress& p) { progress_ends += p.finished; });
+  EXPECT_FALSE(r.flagged);
+  EXPECT_EQ(progress_ends, 1);
+  int zoa = 0, sd = 0;
+  for (const LobeRow& row : r.rows) {
+    EXPECT_EQ(row.id, "P1");
+    zoa += row.method == "zoa";
+    sd += row.method == "sd";
+  }
+  EXPECT_EQ(zoa, 50);
+  EXPECT_EQ(sd, 3);
+  bool agree = false;
+  for (const TipMessage& m : said) agree |= m.text.find("(they agree within 10 %)") != std::string::npos;
+  EXPECT_TRUE(agree);
+
+  std::ostringstream csv;
+  io::WriteLobesCsv(csv, r.rows);
+  const io::CsvTable table = io::CsvTable::Parse(csv.str(), "lobes.csv");
+  ASSERT_EQ(table.num_rows(), static_cast<int>(r.rows.size()));
+  for (int i = 0; i < table.num_rows(); ++i) {
+    const LobePoint& p = r.rows[i].point;
+    EXPECT_NEAR(table.Number(i, "spindle_speed_rpm"), RadPerSecToRpm(p.spindle_speed_rad_s), 1e-8);
+    if (std::isfinite(p.critical_depth)) {
+      EXPECT_NEAR(table.Number(i, "critical_depth_mm"), MToMm(p.critical_depth), 1e-12 * MToMm(p.critical_depth));
+    }
+  }
+}
+
+}  // namespace
+}  // namespace robomach::stability
