@@ -94,4 +94,5 @@ PYBIND11_MODULE(robomach, m) {
   BindFrf(m);
   BindCalibration(m);
   BindAudit(m);
+  BindStability(m);
 }

@@ -1,0 +1,361 @@
+// Python bindings of chatter stability (docs/python.md): the cut file, the
+// tool tips of stability-lobes' three sources, its lobes (ComputeLobes, the
+// call the tool makes) and the lobes CSV; stability-map's per-point analysis
+// (EvaluateStabilityMap) on targets the caller gives or a region file makes.
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
+#include "robomach/common/units.h"
+#include "robomach/dynamics/posture_dynamics.h"
+#include "robomach/io/cut_file.h"
+#include "robomach/io/lobes_file.h"
+#include "robomach/io/region_file.h"
+#include "robomach/io/tip_dynamics_files.h"
+#include "robomach/stability/lobes_workflow.h"
+#include "robomach/stability/stability_map.h"
+#include "robomach/stability/tip_dynamics.h"
+
+namespace robomach::python {
+namespace {
+
+using stability::TipDynamics;
+
+// The cutting frame of a tool axis and the cut's feed, as stability-lobes
+// makes it (an InputError naming the cut file's feed_direction).
+Eigen::Matrix3d FrameOf(const io::CutSpec& cut, const Eigen::Vector3d& tool_axis) {
+  if (!(tool_axis.norm() > 0.0)) throw std::invalid_argument("tool_axis: expected a non-zero vector");
+  try {
+    return stability::CuttingFrame(tool_axis, cut.feed_direction_B);
+  } catch (const std::invalid_argument& e) {
+    throw InputError({cut.path, cut.feed_line, cut.feed_column}, std::string("feed_direction: ") + e.what());
+  }
+}
+
+std::string AxisText(const Eigen::Vector3d& a) {
+  return "tool_axis " + FormatDouble(a(0)) + "," + FormatDouble(a(1)) + "," + FormatDouble(a(2));
+}
+
+py::dict MessageDict(const stability::TipMessage& m) {
+  py::dict d;
+  d["kind"] = m.kind == stability::TipMessage::Kind::kWarning ? "warning"
+              : m.kind == stability::TipMessage::Kind::kNote  ? "note"
+                                                               : "info";
+  d["text"] = m.text;
+  return d;
+}
+
+// Messages gathered while the GIL is released, handed to Python afterwards.
+struct Collected {
+  std::vector<stability::TipMessage> messages;
+  stability::TipMessageSink Sink() {
+    return [this](const stability::TipMessage& m) { messages.push_back(m); };
+  }
+  py::list List() const {
+    py::list l;
+    for (const auto& m : messages) l.append(MessageDict(m));
+    return l;
+  }
+};
+
+py::array_t<std::complex<double>> ToArray2(const std::vector<Eigen::Matrix2cd>& phi) {
+  py::array_t<std::complex<double>> a({static_cast<py::ssize_t>(phi.size()), py::ssize_t{2}, py::ssize_t{2}});
+  auto r = a.mutable_unchecked<3>();
+  for (size_t k = 0; k < phi.size(); ++k) {
+    for (int i = 0; i < 2; ++i) {
+      for (int j = 0; j < 2; ++j) r(static_cast<py::ssize_t>(k), i, j) = phi[k](i, j);
+    }
+  }
+  return a;
+}
+
+}  // namespace
+
+void BindStability(py::module_& m) {
+  py::class_<io::CutSpec>(m, "Cut",
+                          "A cut file (docs/formats.md, config/cut_demo.yaml): the milling process, the tool, the "
+                          "feed direction and the spindle speed range. Read one with read_cut_file().")
+      .def_property_readonly("path", [](const io::CutSpec& c) { return c.path; })
+      .def_property_readonly("teeth", [](const io::CutSpec& c) { return c.process.teeth; })
+      .def_property_readonly("radial_immersion", [](const io::CutSpec& c) { return c.process.radial_immersion; },
+                             "a_e/D")
+      .def_property_readonly("down_milling",
+                             [](const io::CutSpec& c) { return c.process.direction == stability::MillingDirection::kDown; })
+      .def_property_readonly("tool_diameter_m", [](const io::CutSpec& c) { return c.tool_diameter; })
+      .def_property_readonly("feed_direction", [](const io::CutSpec& c) { return c.feed_direction_B; },
+                             "unit vector in the base frame")
+      .def_property_readonly("spindle_speed_min_rpm",
+                             [](const io::CutSpec& c) { return RadPerSecToRpm(c.spindle_speed_min_rad_s); })
+      .def_property_readonly("spindle_speed_max_rpm",
+                             [](const io::CutSpec& c) { return RadPerSecToRpm(c.spindle_speed_max_rad_s); })
+      .def_property_readonly("spindle_speed_count", [](const io::CutSpec& c) { return c.spindle_speed_count; })
+      .def("__repr__", [](const io::CutSpec& c) {
+        return "<Cut " + c.path + ": " + std::to_string(c.process.teeth) + " teeth, a_e/D " +
+               FormatDouble(c.process.radial_immersion) + ">";
+      });
+  m.def("read_cut_file", [](const std::string& path) {
+    RequireReadableFile(path);
+    return io::ReadCutFile(path);
+  }, py::arg("path"), "Reads a cut file (YAML). Raises InputError naming file, line and column.");
+
+  py::class_<TipDynamics>(m, "TipDynamics",
+                          "The tool tip of one source, oriented into the cutting frame C (x along the feed, z "
+                          "along the tool axis): what the lobes are computed from.")
+      .def_readonly("id", &TipDynamics::id)
+      .def_property_readonly("freq_hz", [](const TipDynamics& t) { return Eigen::VectorXd(t.freq_hz); },
+                             "the lines of the in-plane FRF [Hz]")
+      .def_property_readonly("phi_c", [](const TipDynamics& t) { return ToArray2(t.Phi_C); },
+                             "in-plane oriented receptance, complex (lines, 2, 2) [m/N]")
+      .def_property_readonly("num_modes", [](const TipDynamics& t) { return t.modes_C.num_modes(); })
+      .def_property_readonly("mode_freq_hz",
+                             [](const TipDynamics& t) { return Eigen::VectorXd(t.modes_C.omega_rad_s / (2.0 * kPi)); })
+      .def_property_readonly("mode_damping_ratio", [](const TipDynamics& t) { return Eigen::VectorXd(t.modes_C.zeta); })
+      .def_readonly("modes_fitted", &TipDynamics::modes_fitted)
+      .def_property_readonly("R_BC", [](const TipDynamics& t) { return Eigen::Matrix3d(t.R_BC); },
+                             "the cutting frame in the source's frame")
+      .def_property_readonly("fit_labels", [](const TipDynamics& t) {
+        std::vector<std::string> l;
+        for (const auto& f : t.fits) l.push_back(f.label);
+        return l;
+      }, "the direct FRFs fitted (measured sources)")
+      .def("__repr__", [](const TipDynamics& t) {
+        return "<TipDynamics " + t.id + ": " + std::to_string(t.freq_hz.size()) + " lines, " +
+               std::to_string(t.modes_C.num_modes()) + " modes>";
+      });
+
+  m.def("tip_from_posture", [](const std::shared_ptr<dynamics::RobotModel>& model, const Eigen::VectorXd& q, const io::CutSpec& cut,
+                               const std::string& id) {
+    py::gil_scoped_release release;
+    const dynamics::PostureDynamics d = dynamics::EvaluatePosture(model, q, {.cartesian = true, .modes = true});
+    try {
+      return stability::TipFromPosture(id, d, cut.feed_direction_B, cut.process.teeth, cut.spindle_speed_max_rad_s);
+    } catch (const std::invalid_argument& e) {
+      throw InputError({cut.path, cut.feed_line, cut.feed_column}, std::string("feed_direction: ") + e.what());
+    }
+  }, py::arg("model"), py::arg("q"), py::arg("cut"), py::arg("id") = "P",
+     "The tool tip of the robot model at posture q [rad], as stability-lobes --robot makes it.");
+
+  m.def("tips_from_modal_table", [](const std::string& path, const io::CutSpec& cut, const Eigen::Vector3d& tool_axis,
+                                    const std::vector<std::string>& poses) {
+    RequireReadableFile(path);
+    const Eigen::Matrix3d R = FrameOf(cut, tool_axis);
+    std::vector<TipDynamics> tips;
+    for (const io::ModalTableEntry& e : io::ReadModalTable(path)) {
+      if (!poses.empty() && std::find(poses.begin(), poses.end(), e.pose_id) == poses.end()) continue;
+      tips.push_back(stability::TipFromModes(e.pose_id, e.modes, R, cut.process.teeth, cut.spindle_speed_max_rad_s));
+    }
+    if (tips.empty()) throw InputError({path, 0, 0}, "none of the requested postures is in the file");
+    return tips;
+  }, py::arg("path"), py::arg("cut"), py::arg("tool_axis") = Eigen::Vector3d::UnitZ(),
+     py::arg("poses") = std::vector<std::string>{},
+     "The tool tips of a modal table (docs/formats.md §4), as stability-lobes --modal-table makes them.");
+
+  m.def("tips_from_frf_file", [](const std::string& path, const io::CutSpec& cut, const Eigen::Vector3d& tool_axis,
+                                 const std::optional<std::string>& frf_y, const std::vector<std::string>& poses,
+                                 int sd_modes) {
+    RequireReadableFile(path);
+    if (frf_y) RequireReadableFile(*frf_y);
+    if (sd_modes < 1) throw std::invalid_argument("sd_modes: expected >= 1");
+    stability::MeasuredTipOptions o;
+    o.frf_path = path;
+    o.frf_y_path = frf_y.value_or("");
+    o.pose_ids = poses;
+    o.cutting_frame = [&cut, tool_axis] { return FrameOf(cut, tool_axis); };
+    o.tool_axis_source = AxisText(tool_axis);
+    o.sd_modes = sd_modes;
+    Collected said;
+    std::vector<TipDynamics> tips;
+    {
+      py::gil_scoped_release release;
+      std::vector<std::string> warnings;
+      const auto sets = io::ReadTipFrfs(path, "", &warnings);
+      std::vector<io::FrfSetOfPose> ysets;
+      if (frf_y) ysets = io::ReadTipFrfs(*frf_y, "", &warnings);
+      for (const std::string& w : warnings) said.messages.push_back({stability::TipMessage::Kind::kWarning, w});
+      for (const std::string& f : io::ReceptanceUnitFindings(sets)) {
+        said.messages.push_back({stability::TipMessage::Kind::kWarning, "implausible (unit mistake?): " + f});
+      }
+      tips = stability::TipsFromMeasuredFrfs(sets, ysets, o, said.Sink());
+    }
+    return py::make_tuple(tips, said.List());
+  }, py::arg("path"), py::arg("cut"), py::arg("tool_axis") = Eigen::Vector3d::UnitZ(), py::arg("frf_y") = py::none(),
+     py::arg("poses") = std::vector<std::string>{}, py::arg("sd_modes") = 3,
+     "The tool tips of a measured FRF file (CSV or UFF58), each direct FRF with a noise model and a modal fit, "
+     "as stability-lobes --frf makes them. Returns (tips, messages): messages are dicts {kind: 'info' | 'note' | "
+     "'warning', text} (the reader's warnings, receptances outside the plausible range, the fits).");
+
+  m.def("stability_lobes", [](const std::vector<TipDynamics>& tips, const io::CutSpec& cut, const std::string& method,
+                              int speeds, int sd_speeds, int sd_steps, double sd_steps_per_mode_period, int sd_modes,
+                              double sd_max_depth_mm, int max_lobe, int threads) {
+    if (method != "zoa" && method != "sd" && method != "both") {
+      throw std::invalid_argument("method: expected zoa, sd or both, got " + method);
+    }
+    if (speeds < 0 || sd_speeds < 1 || (sd_steps != 0 && sd_steps < 2) || sd_modes < 1 || !(sd_max_depth_mm > 0.0) ||
+        max_lobe < 0 || threads < 0 || !(sd_steps_per_mode_period >= 4.0)) {
+      throw std::invalid_argument(
+          "expected speeds >= 0, sd_speeds >= 1, sd_steps 0 or >= 2, sd_steps_per_mode_period >= 4, sd_modes >= 1, "
+          "sd_max_depth_mm > 0, max_lobe >= 0, threads >= 0");
+    }
+    stability::LobesOptions o;
+    o.method = method == "zoa" ? stability::LobeMethod::kZoa
+               : method == "sd" ? stability::LobeMethod::kSd
+                                : stability::LobeMethod::kBoth;
+    o.process = cut.process;
+    o.min_speed_rad_s = cut.spindle_speed_min_rad_s;
+    o.max_speed_rad_s = cut.spindle_speed_max_rad_s;
+    o.zoa_speeds_rad_s = Eigen::VectorXd::LinSpaced(speeds > 0 ? speeds : cut.spindle_speed_count,
+                                                    cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
+    o.sd_speeds_rad_s = Eigen::VectorXd::LinSpaced(sd_speeds, cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
+    o.max_lobe_index = max_lobe;
+    o.sd.steps_per_period = sd_steps;
+    o.sd.steps_per_mode_period = sd_steps_per_mode_period;
+    o.sd.max_depth = MmToM(sd_max_depth_mm);
+    o.sd_modes = sd_modes;
+    o.threads = threads;
+    Collected said;
+    stability::LobesResult r;
+    {
+      py::gil_scoped_release release;
+      r = stability::ComputeLobes(tips, o, said.Sink());
+    }
+    return py::make_tuple(r, said.List());
+  }, py::arg("tips"), py::arg("cut"), py::arg("method") = "zoa", py::arg("speeds") = 0, py::arg("sd_speeds") = 60,
+     py::arg("sd_steps") = 0, py::arg("sd_steps_per_mode_period") = stability::SdOptions{}.steps_per_mode_period,
+     py::arg("sd_modes") = 3, py::arg("sd_max_depth_mm") = 20.0, py::arg("max_lobe") = 30, py::arg("threads") = 0,
+     "Stability lobes of the tool tips, as stability-lobes computes them (the same options, the same defaults): "
+     "method 'zoa', 'sd' or 'both'; speeds = ZOA speeds in the cut's range (0: the cut's count). Returns "
+     "(Lobes, messages). The GIL is released while it runs.");
+
+  py::class_<stability::LobesResult>(m, "Lobes", "The lobes of every tool tip: one row per speed, tip and method.")
+      .def_readonly("flagged", &stability::LobesResult::flagged,
+                    "a modal fit that does not describe a tool tip, or ZOA and SD more than 10 % apart")
+      .def_readonly("no_boundary", &stability::LobesResult::no_boundary, "some speeds have no stability boundary")
+      .def_property_readonly("pose_id", [](const stability::LobesResult& r) {
+        std::vector<std::string> v;
+        for (const auto& row : r.rows) v.push_back(row.id);
+        return v;
+      })
+      .def_property_readonly("method", [](const stability::LobesResult& r) {
+        std::vector<std::string> v;
+        for (const auto& row : r.rows) v.push_back(row.method);
+        return v;
+      })
+      .def_property_readonly("status", [](const stability::LobesResult& r) {
+        std::vector<std::string> v;
+        for (const auto& row : r.rows) v.push_back(stability::ToString(row.point.status));
+        return v;
+      })
+      .def_property_readonly("spindle_speed_rpm", [](const stability::LobesResult& r) {
+        Eigen::VectorXd v(r.rows.size());
+        for (size_t i = 0; i < r.rows.size(); ++i) v(i) = io::LobeSpeedRpm(r.rows[i].point.spindle_speed_rad_s);
+        return v;
+      })
+      .def_property_readonly("critical_depth_mm", [](const stability::LobesResult& r) {
+        Eigen::VectorXd v(r.rows.size());
+        for (size_t i = 0; i < r.rows.size(); ++i) v(i) = MToMm(r.rows[i].point.critical_depth);
+        return v;
+      }, "NaN where a speed has no boundary")
+      .def_property_readonly("chatter_freq_hz", [](const stability::LobesResult& r) {
+        Eigen::VectorXd v(r.rows.size());
+        for (size_t i = 0; i < r.rows.size(); ++i) v(i) = r.rows[i].point.chatter_freq_hz;
+        return v;
+      })
+      .def_property_readonly("lobe_index", [](const stability::LobesResult& r) {
+        std::vector<int> v;
+        for (const auto& row : r.rows) v.push_back(row.point.lobe_index);
+        return v;
+      }, "-1 where none")
+      .def("__len__", [](const stability::LobesResult& r) { return r.rows.size(); })
+      .def("__repr__", [](const stability::LobesResult& r) {
+        return "<Lobes " + std::to_string(r.rows.size()) + " rows" + (r.flagged ? ", flagged" : "") + ">";
+      });
+  m.def("write_lobes_csv", [](const std::string& path, const stability::LobesResult& r) {
+    io::WriteLobesCsv(path, r.rows);
+  }, py::arg("path"), py::arg("lobes"), "Writes the lobes CSV of stability-lobes --out (atomic).");
+
+  // ---- stability maps
+  py::class_<stability::ToolPoseTarget>(m, "ToolPoseTarget",
+                                        "A tool pose of a stability map: TCP position p_BT [m], tool axis z_T "
+                                        "(spindle to tip), reference x_ref normal to it, feed direction (all in B).")
+      .def(py::init([](const Eigen::Vector3d& p, const Eigen::Vector3d& z, const Eigen::Vector3d& x,
+                       const Eigen::Vector3d& feed) {
+             return stability::ToolPoseTarget{p, z, x, feed};
+           }),
+           py::arg("p_BT"), py::arg("z_T") = Eigen::Vector3d::UnitZ(), py::arg("x_ref") = Eigen::Vector3d::UnitX(),
+           py::arg("feed") = Eigen::Vector3d::UnitX())
+      .def_readwrite("p_BT", &stability::ToolPoseTarget::p_BT)
+      .def_readwrite("z_T", &stability::ToolPoseTarget::z_T)
+      .def_readwrite("x_ref", &stability::ToolPoseTarget::x_ref)
+      .def_readwrite("feed", &stability::ToolPoseTarget::feed_B);
+
+  m.def("region_targets", [](const std::string& path, int num_joints, const io::CutSpec& cut) {
+    RequireReadableFile(path);
+    const io::RegionSpec region = io::ReadRegionFile(path, num_joints);
+    py::dict d;
+    d["targets"] = region.Targets(cut.feed_direction_B);
+    d["rows"] = region.num_v();
+    d["cols"] = region.num_u();
+    d["seed_q"] = region.seed_q;
+    d["rotation"] = region.rotation_fixed;
+    d["rotation_free"] = region.rotation_free;
+    d["rotation_min"] = region.rotation_min;
+    d["rotation_max"] = region.rotation_max;
+    return d;
+  }, py::arg("path"), py::arg("num_joints"), py::arg("cut"),
+     "A region file's grid of tool poses (stability-map --region): dict with targets (row-major), rows, cols, "
+     "seed_q [rad], rotation [rad], rotation_free, rotation_min, rotation_max [rad].");
+
+  m.def("stability_map", [](const std::shared_ptr<dynamics::RobotModel>& model, const std::vector<stability::ToolPoseTarget>& targets,
+                            int rows, int cols, const io::CutSpec& cut, const Eigen::VectorXd& seed_q, double rotation,
+                            bool optimise_rotation, double rotation_min, double rotation_max, int rotation_evaluations,
+                            int speeds, double max_depth_mm, int threads) {
+    stability::MapOptions o;
+    o.seed_q = seed_q;
+    o.rotation = rotation;
+    o.optimise_rotation = optimise_rotation;
+    o.rotation_min = rotation_min;
+    o.rotation_max = rotation_max;
+    o.rotation_evaluations = rotation_evaluations;
+    o.threads = threads;
+    o.analysis.spindle_speed_rad_s =
+        cut.spindle_speed_rad_s ? cut.SpeedGrid()
+                                : Eigen::VectorXd::LinSpaced(speeds > 0 ? speeds : cut.spindle_speed_count,
+                                                             cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
+    o.analysis.mode_coupling.max_depth = MmToM(max_depth_mm);
+    std::vector<stability::MapPoint> pts;
+    {
+      py::gil_scoped_release release;
+      pts = stability::EvaluateStabilityMap(model, targets, rows, cols, cut.process, o);
+    }
+    py::list out;
+    for (const auto& p : pts) {
+      py::dict d;
+      d["status"] = stability::ToString(p.status);
+      d["q"] = p.q;
+      d["rotation"] = p.rotation;
+      d["jacobian_condition"] = p.jacobian_condition;
+      d["critical_depth_mm"] = MToMm(p.stability.critical_depth);
+      d["limiting_mechanism"] = stability::ToString(p.stability.limiting);
+      d["chatter_freq_hz"] = p.stability.chatter_freq_hz;
+      d["regenerative_depth_mm"] = MToMm(p.stability.regenerative.critical_depth);
+      d["mode_coupling_depth_mm"] = MToMm(p.stability.mode_coupling.critical_depth);
+      d["optimiser_status"] = p.optimiser_status;
+      out.append(d);
+    }
+    return out;
+  }, py::arg("model"), py::arg("targets"), py::arg("rows"), py::arg("cols"), py::arg("cut"), py::arg("seed_q"),
+     py::arg("rotation") = 0.0, py::arg("optimise_rotation") = false, py::arg("rotation_min") = -0.5 * kPi,
+     py::arg("rotation_max") = 0.5 * kPi, py::arg("rotation_evaluations") = 20, py::arg("speeds") = 0,
+     py::arg("max_depth_mm") = 50.0, py::arg("threads") = 0,
+     "stability-map's analysis of rows × cols tool poses (row-major; rows = 1: a path): IK from seed_q [rad] "
+     "along the grid, then mode coupling and the regenerative ZOA at each point, as EvaluateStabilityMap. "
+     "Returns one dict per point (status, q [rad], critical_depth_mm, limiting_mechanism, ...). Defaults as "
+     "stability-map's (max_depth_mm: the mode coupling's search range). The GIL is "
+     "released while it runs.");
+}
+
+}  // namespace robomach::python

@@ -1,0 +1,108 @@
+"""Chatter stability through Python: stability-lobes' three tool-tip sources
+and its lobes reproduce the tool's --out file byte for byte (the same
+library call, ComputeLobes), and stability-map's points from a region file
+reproduce the tool's map CSV to 1e-12. Then bad input."""
+import csv
+import math
+import os
+
+import numpy as np
+import pytest
+
+import robomach as rm
+from conftest import DATA, KR210, SOURCE_DIR, run_tool
+
+CUT = os.path.join(SOURCE_DIR, 'config', 'cut_demo.yaml')
+MODAL = os.path.join(DATA, 'stability', 'modal_benchmark.csv')
+FRF = os.path.join(DATA, 'kr210_P1_receptance.csv')
+REGION = os.path.join(SOURCE_DIR, 'config', 'region_demo.yaml')
+
+
+def read_lobes(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def test_modal_table_lobes_equal_stability_lobes(tmp):
+    run_tool('stability-lobes', '--modal-table', MODAL, '--cut', CUT, '--method', 'both', '--sd-speeds', 3,
+             '--out', tmp / 'tool.csv')
+    cut = rm.read_cut_file(CUT)
+    tips = rm.tips_from_modal_table(MODAL, cut)
+    lobes, messages = rm.stability_lobes(tips, cut, method='both', sd_speeds=3)
+    rm.write_lobes_csv(str(tmp / 'py.csv'), lobes)
+    assert (tmp / 'py.csv').read_text() == (tmp / 'tool.csv').read_text()
+    rows = read_lobes(tmp / 'tool.csv')
+    assert len(lobes) == len(rows)
+    depth = np.array([float(r['critical_depth_mm']) if r['critical_depth_mm'] else math.nan for r in rows])
+    ok = np.isfinite(depth)
+    assert np.all(np.abs(lobes.critical_depth_mm[ok] - depth[ok]) <= 1e-12 * depth[ok])
+    assert lobes.method == [r['method'] for r in rows]
+    assert any(m['kind'] == 'info' and 'SD of' in m['text'] for m in messages)
+
+
+def test_measured_frf_lobes_equal_stability_lobes(tmp):
+    r = run_tool('stability-lobes', '--frf', FRF, '--cut', CUT, '--out', tmp / 'tool.csv')
+    cut = rm.read_cut_file(CUT)
+    tips, messages = rm.tips_from_frf_file(FRF, cut)
+    assert len(tips) == 1 and tips[0].modes_fitted
+    assert tips[0].phi_c.shape == (tips[0].freq_hz.size, 2, 2)
+    lobes, more = rm.stability_lobes(tips, cut)
+    rm.write_lobes_csv(str(tmp / 'py.csv'), lobes)
+    assert (tmp / 'py.csv').read_text() == (tmp / 'tool.csv').read_text()
+    # The tool prints what the library said: every fit report is on its stderr.
+    for m in messages + more:
+        if m['kind'] == 'info':
+            assert m['text'].splitlines()[0] in r.stderr
+
+
+def test_robot_posture_lobes_equal_stability_lobes(tmp):
+    run_tool('stability-lobes', '--robot', KR210, '--postures', os.path.join(SOURCE_DIR, 'config', 'postures_demo.csv'),
+             '--posture', 'P1', '--cut', CUT, '--out', tmp / 'tool.csv', expect_rc=None)
+    model = rm.RobotConfig(KR210).build()
+    pose = [p for p in rm.read_posture_file(os.path.join(SOURCE_DIR, 'config', 'postures_demo.csv'),
+                                            model.num_joints) if p.id == 'P1'][0]
+    cut = rm.read_cut_file(CUT)
+    tip = rm.tip_from_posture(model, pose.q, cut, id='P1')
+    # The cutting frame is orthonormal, with x along the feed's part normal to the tool axis.
+    R = tip.R_BC
+    np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-14)
+    lobes, _ = rm.stability_lobes([tip], cut)
+    rm.write_lobes_csv(str(tmp / 'py.csv'), lobes)
+    assert (tmp / 'py.csv').read_text() == (tmp / 'tool.csv').read_text()
+
+
+def test_region_map_equals_stability_map(tmp):
+    run_tool('stability-map', '--robot', KR210, '--cut', CUT, '--region', REGION, '--out', tmp / 'map.csv')
+    model = rm.RobotConfig(KR210).build()
+    cut = rm.read_cut_file(CUT)
+    region = rm.region_targets(REGION, model.num_joints, cut)
+    points = rm.stability_map(model, region['targets'], region['rows'], region['cols'], cut, region['seed_q'],
+                              rotation=region['rotation'], optimise_rotation=region['rotation_free'],
+                              rotation_min=region['rotation_min'], rotation_max=region['rotation_max'])
+    rows = read_lobes(tmp / 'map.csv')
+    assert len(points) == len(rows) == region['rows'] * region['cols']
+    for p, r in zip(points, rows):
+        assert p['status'] == r['status']
+        if r['critical_depth_mm']:
+            d = float(r['critical_depth_mm'])
+            assert abs(p['critical_depth_mm'] - d) <= 1e-12 * d
+            assert p['limiting_mechanism'] == r['limiting_mechanism']
+        q_deg = np.array([float(r[f'q{j}_deg']) for j in range(1, 7)])
+        assert np.all(np.abs(np.degrees(p['q']) - q_deg) <= 1e-12 * np.maximum(1.0, np.abs(q_deg)))
+
+
+def test_bad_input():
+    cut = rm.read_cut_file(CUT)
+    with pytest.raises(FileNotFoundError):
+        rm.read_cut_file('/nonexistent/cut.yaml')
+    tips = rm.tips_from_modal_table(MODAL, cut)
+    with pytest.raises(ValueError, match='method'):
+        rm.stability_lobes(tips, cut, method='fast')
+    with pytest.raises(ValueError, match='sd_speeds >= 1'):
+        rm.stability_lobes(tips, cut, sd_speeds=0)
+    with pytest.raises(rm.InputError, match='none of the requested postures'):
+        rm.tips_from_modal_table(MODAL, cut, poses=['nope'])
+    # The feed along the tool axis has no cutting plane: the error names the cut file.
+    with pytest.raises(rm.InputError) as e:
+        rm.tips_from_modal_table(MODAL, cut, tool_axis=np.array(cut.feed_direction))
+    assert e.value.path == CUT and 'feed_direction' in e.value.message
