@@ -27,6 +27,7 @@
 #include "robomach/io/cad_face.h"
 #include "robomach/polishing/face_check.h"
 #include "robomach/polishing/optimise.h"
+#include "robomach/polishing/path_patterns.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/removal.h"
 
@@ -93,7 +94,7 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
   if (choice.face_given) throw UsageError("--list-faces lists every face; drop --face");
   const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
   polishing::PathParameters params;
-  params.pattern = pattern == "cycloid" ? polishing::Pattern::kCycloid : polishing::Pattern::kParallel;
+  params.pattern = polishing::FindPathPattern(pattern).id();
   params.radius = MmToM(radius_mm);
   params.offset = MmToM(offset_mm);
   params.pitch = MmToM(pitch_mm);
@@ -185,7 +186,15 @@ int Run(int argc, char** argv) {
                "trimmed, holes, polishable, reason; polishable with --process, --pattern and --radius-mm) and stop");
   app.add_option("--out", list_out, "with --list-faces: write the CSV here instead of stdout");
   app.add_option("--process", process_path, "process YAML (docs/formats.md §7), e.g. config/polishing/belt_2N.yaml")->required();
-  app.add_option("--pattern", pattern, "cycloid or parallel")->check(CLI::IsMember({"cycloid", "parallel"}))->capture_default_str();
+  {
+    std::string help;
+    std::vector<std::string> names;
+    for (const polishing::PathPattern* p : polishing::PathPatterns()) {
+      help += (help.empty() ? "" : "; ") + p->description();
+      names.push_back(p->name());
+    }
+    app.add_option("--pattern", pattern, help)->check(CLI::IsMember(names))->capture_default_str();
+  }
   app.add_option("--guides", guides, "cycloid guide lines: offsets (of the region boundary, closed loops) or parallel")
       ->check(CLI::IsMember({"offsets", "parallel"}))->capture_default_str();
   app.add_option("--optimise", optimise, "none, nlopt (grid, then COBYLA multi-start with the target as a constraint; "
@@ -264,7 +273,7 @@ int Run(int argc, char** argv) {
     const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
     {
       polishing::PathParameters p;
-      p.pattern = pattern == "cycloid" ? polishing::Pattern::kCycloid : polishing::Pattern::kParallel;
+      p.pattern = polishing::FindPathPattern(pattern).id();
       p.offset = MmToM(offset_mm);
       p.radius = MmToM(radius_mm);
       p.pitch = MmToM(pitch_mm);
@@ -295,7 +304,7 @@ int Run(int argc, char** argv) {
     const polishing::RemovalSimulator sim(surface, process, grid.points(), grid.normals(), cell);
 
     polishing::PathParameters params;
-    params.pattern = pattern == "cycloid" ? polishing::Pattern::kCycloid : polishing::Pattern::kParallel;
+    params.pattern = polishing::FindPathPattern(pattern).id();
     params.guides = guides == "offsets" ? polishing::GuideLines::kBoundaryOffsets : polishing::GuideLines::kParallelLines;
     params.offset = params.pattern == polishing::Pattern::kParallel && !offset_given ? contact_width : MmToM(offset_mm);
     params.radius = MmToM(radius_mm);
@@ -383,7 +392,7 @@ int Run(int argc, char** argv) {
       }
       auto family_json = [&](const polishing::PlanEvaluation& ev) {
         const bool c = ev.params.pattern == polishing::Pattern::kCycloid;
-        nlohmann::json j = {{"pattern", c ? "cycloid" : "parallel"},
+        nlohmann::json j = {{"pattern", polishing::PathPatternOf(ev.params.pattern).name()},
                             {"guides", c ? polishing::FamilyName({ev.params.guides, ev.params.line_angle})
                                          : polishing::FamilyName({polishing::GuideLines::kParallelLines, ev.params.line_angle})},
                             {"offset_mm", 1e3 * ev.params.offset},

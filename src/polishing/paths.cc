@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <sstream>
 
 #include "robomach/common/units.h"
 #include "robomach/polishing/face_check.h"
+#include "robomach/polishing/path_patterns.h"
 #include "robomach/polishing/region_outline.h"
 
 namespace robomach::polishing {
@@ -85,32 +87,26 @@ void StraightMove(const Mapper& m, const Vec2& a, const Vec2& b, const Vec2& tan
 
 }  // namespace
 
+namespace {
+
+std::string Mm(double x) {
+  std::ostringstream s;
+  s << x * 1e3;
+  return s.str();
+}
+
+}  // namespace
+
 double MaxEdgeOverrun(const PathParameters& p, const PolishingProcess& process) {
-  return p.pattern == Pattern::kCycloid ? std::max(0.0, process.margin - p.radius) : process.margin;
+  return PathPatternOf(p.pattern).MaxEdgeOverrun(p, process);
 }
 
 void CheckValid(const PathParameters& p) {
   auto fail = [](const std::string& m) { throw std::invalid_argument(m); };
-  auto mm = [](double x) {
-    std::ostringstream s;
-    s << x * 1e3;
-    return s.str();
-  };
-  if (!(p.offset > 0) || !std::isfinite(p.offset)) fail("offset_mm: expected > 0, got " + mm(p.offset));
+  if (!(p.offset > 0) || !std::isfinite(p.offset)) fail("offset_mm: expected > 0, got " + Mm(p.offset));
   if (!(p.row_step > 0)) fail("row step must be > 0");
   if (!std::isfinite(p.line_angle)) fail("line angle: expected a finite number of radians");
-  if (p.pattern == Pattern::kParallel) return;
-  if (!(p.stagger >= 0.0 && p.stagger <= 1.0)) fail("stagger: expected in [0, 1] loops, got " + std::to_string(p.stagger));
-  if (!(p.radius > 0)) fail("radius_mm: expected > 0, got " + mm(p.radius));
-  if (!(p.pitch > 0)) fail("pitch_mm: expected > 0, got " + mm(p.pitch));
-  if (p.offset > 2 * p.radius * (1 + 1e-12)) {
-    fail("offset_mm " + mm(p.offset) + " > 2 x radius_mm " + mm(p.radius) +
-         ": adjacent cycloid rows would leave an unpolished strip (seed 004 §3.1, d <= 2r)");
-  }
-  if (p.pitch >= 2 * kPi * p.radius) {
-    fail("pitch_mm " + mm(p.pitch) + " >= 2 pi radius_mm: the centre outruns the rolling point and the cycloid "
-         "no longer loops (seed 004 §3.2, v < omega r)");
-  }
+  PathPatternOf(p.pattern).CheckValid(p);
 }
 
 namespace {
@@ -378,16 +374,177 @@ bool Link(const Mapper& m, const NurbsSurface& surface, const Vec2& from, const 
 
 }  // namespace
 
+namespace internal {
+
+// PlanPath's state along one guide line: what a pattern's Follow reads and
+// appends to (path_patterns.h).
+struct GuideWalk {
+  const Mapper& m;
+  const std::vector<GuideSpec>& guides;
+  size_t g;                      // the guide line being walked
+  const Guide& guide;            // guides[g].guide
+  const PathParameters& params;
+  bool parallel_lines;           // the guides are parallel lines (not boundary offsets)
+  Vec2 e_dir, nrm;               // along and across the parallel lines
+  const std::function<Vec2(const Vec2&)>& tool_dir;    // tool x for a guide tangent
+  const std::function<void(const Vec2&, const Vec2&)>& link;  // from last_st to a point, lifting if needed
+  double vmax;                   // process.max_speed [m/s]
+  double omega0;                 // the pattern's NominalRate [rad/s]
+  PlannedPath& out;
+  std::vector<double>& t;        // time stamps of out.rows
+  Vec2& last_st;                 // where the previous guide ended, (s, t)
+};
+
+}  // namespace internal
+
+namespace {
+
+// The cycloid (seed 004 eq. 11): the tool circles with radius r around a
+// centre that advances `pitch` per loop along the guide line.
+class CycloidPattern final : public PathPattern {
+ public:
+  Pattern id() const override { return Pattern::kCycloid; }
+  std::string name() const override { return "cycloid"; }
+  std::string description() const override {
+    return "cycloid: the tool circles (radius_mm) around a centre that advances pitch_mm per loop along guide lines "
+           "offset_mm apart (seed 004)";
+  }
+  double circle_radius(const PathParameters& p) const override { return p.radius; }
+  void CheckValid(const PathParameters& p) const override {
+    auto fail = [](const std::string& m) { throw std::invalid_argument(m); };
+    if (!(p.stagger >= 0.0 && p.stagger <= 1.0)) fail("stagger: expected in [0, 1] loops, got " + std::to_string(p.stagger));
+    if (!(p.radius > 0)) fail("radius_mm: expected > 0, got " + Mm(p.radius));
+    if (!(p.pitch > 0)) fail("pitch_mm: expected > 0, got " + Mm(p.pitch));
+    if (p.offset > 2 * p.radius * (1 + 1e-12)) {
+      fail("offset_mm " + Mm(p.offset) + " > 2 x radius_mm " + Mm(p.radius) +
+           ": adjacent cycloid rows would leave an unpolished strip (seed 004 §3.1, d <= 2r)");
+    }
+    if (p.pitch >= 2 * kPi * p.radius) {
+      fail("pitch_mm " + Mm(p.pitch) + " >= 2 pi radius_mm: the centre outruns the rolling point and the cycloid "
+           "no longer loops (seed 004 §3.2, v < omega r)");
+    }
+  }
+  double MaxEdgeOverrun(const PathParameters& p, const PolishingProcess& process) const override {
+    return std::max(0.0, process.margin - p.radius);
+  }
+  double NominalRate(const PathParameters& p, double max_speed) const override {
+    return max_speed / (p.radius + p.pitch / (2 * kPi));
+  }
+  double CentreSpeed(const PathParameters& p, double rate) const override { return p.pitch * rate / (2 * kPi); }
+  void Follow(internal::GuideWalk& w) const override {
+    const double r = w.params.radius, pitch = w.params.pitch;
+    // Cycloid (seed eq. 11): x = xc + r cos(omega t + theta), y = yc + r sin(...),
+    // the centre advancing `pitch` per loop; adjacent rows staggered by
+    // params.stagger loops. On parallel lines the phase is tied to the
+    // position along e_dir (paths.h), so that the stagger between
+    // neighbours does not depend on the lines' lengths or run direction.
+    double theta = 2 * kPi * w.params.stagger * static_cast<double>(w.g);
+    if (w.parallel_lines) {
+      const Vec2& a = w.guide.pts.front();
+      const double k = std::round((a - w.guides[0].guide.pts.front()).dot(w.nrm) / w.params.offset);
+      theta = 2 * kPi * (a.dot(w.e_dir) / pitch + w.params.stagger * k);
+    }
+    const double L = w.guide.length();
+    // On a closed guide a whole number of loops (the pitch adjusted by at
+    // most half a loop over the guide's length) closes the cycloid on
+    // itself: no dense head and tail where it starts and ends.
+    const double loops = w.guides[w.g].closed ? std::max(1.0, std::round(L / pitch)) : std::max(1.0, L / pitch);
+    const double pitch_g = L > 0 ? L / loops : pitch;
+    const double phi_end = 2 * kPi * loops;
+    const double dphi = std::min(0.5, w.params.row_step / (r + pitch / (2 * kPi)));
+    const int n = std::max(1, static_cast<int>(std::ceil(phi_end / dphi)));
+    const int sense = w.guides[w.g].sense;
+    auto point = [&](double phi) {
+      const double sigma = pitch_g * phi / (2 * kPi);
+      const double ang = sense * phi + theta;
+      return Vec2(w.guide.At(sigma) + r * Vec2(std::cos(ang), std::sin(ang)));
+    };
+    for (int i = 0; i <= n; ++i) {
+      const double phi = phi_end * i / n;
+      const Vec2 st = point(phi);
+      const Vec2 tan = w.tool_dir(w.guide.Tangent(pitch_g * phi / (2 * kPi)));
+      if (i == 0) {
+        if (w.out.rows.empty()) {
+          w.out.rows.push_back(w.m.Row(st, tan));
+          w.t.push_back(0.0);
+        } else {
+          // Transition from the end of the previous row, on the surface.
+          w.link(st, tan);
+        }
+      } else {
+        w.out.rows.push_back(w.m.Row(st, tan));
+        w.t.push_back(w.t.back() + (phi_end / n) / w.omega0);
+      }
+      w.last_st = st;
+    }
+  }
+};
+
+// The direction-parallel (zig-zag) pattern: the tool follows each guide
+// line (row) straight, linked to the next.
+class ParallelPattern final : public PathPattern {
+ public:
+  Pattern id() const override { return Pattern::kParallel; }
+  std::string name() const override { return "parallel"; }
+  std::string description() const override {
+    return "parallel: the direction-parallel zig-zag, rows offset_mm apart (default: the contact width)";
+  }
+  double circle_radius(const PathParameters&) const override { return 0.0; }
+  void CheckValid(const PathParameters&) const override {}
+  double MaxEdgeOverrun(const PathParameters&, const PolishingProcess& process) const override { return process.margin; }
+  double NominalRate(const PathParameters&, double) const override { return 0.0; }
+  double CentreSpeed(const PathParameters&, double) const override { return 0.0; }
+  void Follow(internal::GuideWalk& w) const override {
+    const Vec2 dir = w.tool_dir(w.guide.Tangent(0.0));
+    if (!w.out.rows.empty()) w.link(w.guide.pts.front(), dir);
+    StraightMove(w.m, w.guide.pts.front(), w.guide.pts.back(), dir, w.vmax, w.params.row_step, w.out.rows.empty(), &w.out.rows, &w.t);
+    w.last_st = w.guide.pts.back();
+  }
+};
+
+}  // namespace
+
+const std::vector<const PathPattern*>& PathPatterns() {
+  static const CycloidPattern cycloid;
+  static const ParallelPattern parallel;
+  static const std::vector<const PathPattern*> all{&cycloid, &parallel};
+  return all;
+}
+
+std::string PathPatternList() {
+  std::string s;
+  const auto& all = PathPatterns();
+  for (size_t i = 0; i < all.size(); ++i) s += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + all[i]->name();
+  return s;
+}
+
+const PathPattern& FindPathPattern(const std::string& name) {
+  for (const PathPattern* p : PathPatterns()) {
+    if (p->name() == name) return *p;
+  }
+  throw std::invalid_argument("unknown path pattern '" + name + "': expected " + PathPatternList());
+}
+
+const PathPattern& PathPatternOf(Pattern id) {
+  for (const PathPattern* p : PathPatterns()) {
+    if (p->id() == id) return *p;
+  }
+  throw std::invalid_argument("PathPatternOf: no pattern has this id");
+}
+
 PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const PathParameters& params,
                      const PolishingProcess& process) {
   CheckValid(params);
+  const PathPattern& pattern = PathPatternOf(params.pattern);
   const Mapper m(surface, grid, process.flip_normal);
   if (!(grid.s_hi() >= grid.s_lo()) || !(grid.t_hi() >= grid.t_lo())) {
     throw std::invalid_argument("the polished region is empty (margin too large for the patch)");
   }
-  const double r = params.radius, pitch = params.pitch;
+  const double r = pattern.circle_radius(params);
   const double vmax = process.max_speed;
-  const bool cyc = params.pattern == Pattern::kCycloid;
+  // A pattern whose tool circles around its guide lines needs room for the
+  // circle at the region's edge; its guides can be the boundary's offsets.
+  const bool cyc = r > 0.0;
   const bool parallel_lines = !(cyc && params.guides == GuideLines::kBoundaryOffsets);
 
   // Guide lines, in order, with the direction sense of the cycloid.
@@ -438,7 +595,7 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   // Tool x along the guide line (seed eq. 16) with one sign for all the
   // parallel lines: the belt keeps running the same way and the wrist does
   // not turn half a revolution at every row end.
-  auto tool_dir = [&](const Vec2& tangent) {
+  const std::function<Vec2(const Vec2&)> tool_dir = [&](const Vec2& tangent) {
     return (parallel_lines && tangent.dot(e_dir) < 0) ? Vec2(-tangent) : tangent;
   };
 
@@ -448,68 +605,20 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   // The rectangle's links are short by construction (the next loop, the
   // next line, the centre line); the general layouts lift on long ones.
   const double max_link = region.rectangle() ? std::numeric_limits<double>::infinity()
-                                             : 2.0 * (params.offset + (cyc ? r : 0.0));
-  auto link = [&](const Vec2& to, const Vec2& tangent) {
+                                             : 2.0 * (params.offset + r);
+  const std::function<void(const Vec2&, const Vec2&)> link = [&](const Vec2& to, const Vec2& tangent) {
     out.lifts += Link(m, surface, last_st, to, tangent, vmax, params.row_step, max_link, &out.rows, &t);
   };
-  const double omega0 = cyc ? vmax / (r + pitch / (2 * kPi)) : 0.0;  // nominal rolling rate
+  const double omega0 = pattern.NominalRate(params, vmax);
   for (size_t g = 0; g < guides.size(); ++g) {
     const Guide& guide = guides[g].guide;
     std::vector<Eigen::Vector3d> line;
     for (const Vec2& p : guide.pts) line.push_back(m.Point(p));
     out.guide_lines.push_back(line);
     out.guide_lines_st.push_back(guide.pts);
-    if (!cyc) {
-      const Vec2 dir = tool_dir(guide.Tangent(0.0));
-      if (!out.rows.empty()) link(guide.pts.front(), dir);
-      StraightMove(m, guide.pts.front(), guide.pts.back(), dir, vmax, params.row_step, out.rows.empty(), &out.rows, &t);
-      last_st = guide.pts.back();
-      continue;
-    }
-    // Cycloid (seed eq. 11): x = xc + r cos(omega t + theta), y = yc + r sin(...),
-    // the centre advancing `pitch` per loop; adjacent rows staggered by
-    // params.stagger loops. On parallel lines the phase is tied to the
-    // position along e_dir (paths.h), so that the stagger between
-    // neighbours does not depend on the lines' lengths or run direction.
-    double theta = 2 * kPi * params.stagger * static_cast<double>(g);
-    if (parallel_lines) {
-      const Vec2& a = guide.pts.front();
-      const double k = std::round((a - guides[0].guide.pts.front()).dot(nrm) / params.offset);
-      theta = 2 * kPi * (a.dot(e_dir) / pitch + params.stagger * k);
-    }
-    const double L = guide.length();
-    // On a closed guide a whole number of loops (the pitch adjusted by at
-    // most half a loop over the guide's length) closes the cycloid on
-    // itself: no dense head and tail where it starts and ends.
-    const double loops = guides[g].closed ? std::max(1.0, std::round(L / pitch)) : std::max(1.0, L / pitch);
-    const double pitch_g = L > 0 ? L / loops : pitch;
-    const double phi_end = 2 * kPi * loops;
-    const double dphi = std::min(0.5, params.row_step / (r + pitch / (2 * kPi)));
-    const int n = std::max(1, static_cast<int>(std::ceil(phi_end / dphi)));
-    const int sense = guides[g].sense;
-    auto point = [&](double phi) {
-      const double sigma = pitch_g * phi / (2 * kPi);
-      const double ang = sense * phi + theta;
-      return Vec2(guide.At(sigma) + r * Vec2(std::cos(ang), std::sin(ang)));
-    };
-    for (int i = 0; i <= n; ++i) {
-      const double phi = phi_end * i / n;
-      const Vec2 st = point(phi);
-      const Vec2 tan = tool_dir(guide.Tangent(pitch_g * phi / (2 * kPi)));
-      if (i == 0) {
-        if (out.rows.empty()) {
-          out.rows.push_back(m.Row(st, tan));
-          t.push_back(0.0);
-        } else {
-          // Transition from the end of the previous row, on the surface.
-          link(st, tan);
-        }
-      } else {
-        out.rows.push_back(m.Row(st, tan));
-        t.push_back(t.back() + (phi_end / n) / omega0);
-      }
-      last_st = st;
-    }
+    internal::GuideWalk w{m, guides, g, guide, params, parallel_lines, e_dir, nrm, tool_dir, link,
+                          vmax, omega0, out, t, last_st};
+    pattern.Follow(w);
   }
   // With lifts every row says its force (the file's force_N column).
   if (out.lifts > 0) {
@@ -520,7 +629,7 @@ PlannedPath PlanPath(const NurbsSurface& surface, const SampleGrid& grid, const 
   // distorts lengths on doubly curved patches).
   for (size_t i = 0; i < out.rows.size(); ++i) out.rows[i].t = t[i];
   out.omega_rad_per_s = omega0;
-  out.centre_speed = cyc ? pitch * omega0 / (2 * kPi) : 0.0;
+  out.centre_speed = pattern.CentreSpeed(params, omega0);
   const double vm = MaxSpeed(out.rows);
   if (vm > vmax) ScaleTime(&out, vm / vmax);
   out.length = ContactLength(out.rows);
