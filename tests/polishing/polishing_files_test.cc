@@ -71,7 +71,7 @@ TEST(PolishingFiles, PathRoundTripsAndBadRowsAreLocated) {
 // force_N (formats.md §6): written when the path sets it (a planned path
 // with lifts), read back; 0 is a lifted row, a negative force an error.
 TEST(PolishingFiles, ForceColumnRoundTripsWithLiftedRows) {
-  const std::string dir = robomach::testing::TempDir("polishing_files");
+  const std::string dir = robomach::testing::TempDir("polishing_files_force");
   std::vector<polishing::PathRow> rows(3);
   for (int i = 0; i < 3; ++i) {
     rows[i].t = 0.1 * i;
