@@ -12,15 +12,18 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "cli_support.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/drilling/controller_kinds.h"
+#include "robomach/drilling/controller_runs.h"
 #include "robomach/drilling/drilling_sim.h"
 #include "robomach/drilling/plausibility.h"
 #include "robomach/io/atomic_file.h"
+#include "robomach/io/drill_series_file.h"
 #include "robomach/io/drilling_files.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
@@ -38,39 +41,13 @@ std::string WithSuffix(const std::string& path, const std::string& name, bool se
   return (p.parent_path() / (p.stem().string() + "_" + name + p.extension().string())).string();
 }
 
-std::string SeriesCsv(const drilling::SimResult& r) {
-  const drilling::SimSeries& s = r.series;
-  const int n = static_cast<int>(s.q.rows());
-  std::ostringstream o;
-  o << "t_s";
-  for (int i = 1; i <= n; ++i) o << ",q" << i << "_deg";
-  for (int i = 1; i <= n; ++i) o << ",e" << i << "_deg";
-  for (int i = 1; i <= n; ++i) o << ",tau_m" << i << "_Nm";
-  o << ",thrust_N,torque_Nm,offset_deg\n";
-  for (size_t k = 0; k < s.t.size(); ++k) {
-    o << io::FormatDouble(s.t[k]);
-    for (int i = 0; i < n; ++i) o << "," << io::FormatDouble(RadToDeg(s.q(i, k)));
-    for (int i = 0; i < n; ++i) o << "," << io::FormatDouble(RadToDeg(s.e(i, k)));
-    for (int i = 0; i < n; ++i) o << "," << io::FormatDouble(s.tau_m(i, k));
-    o << "," << io::FormatDouble(s.thrust[k]) << "," << io::FormatDouble(s.torque[k]) << ","
-      << io::FormatDouble(RadToDeg(s.offset[k])) << "\n";
-  }
-  return o.str();
-}
-
 std::vector<double> Deg(const Eigen::VectorXd& v) {
   std::vector<double> out;
   for (int i = 0; i < v.size(); ++i) out.push_back(RadToDeg(v(i)));
   return out;
 }
 
-struct Run {
-  drilling::ControllerParameters parameters;
-  bool tuned{false};
-  drilling::TuneResult tune;
-  drilling::SimResult result;
-  double tde_measure{NAN};
-};
+using Run = drilling::ControllerRun;
 
 nlohmann::json Summary(const Run& run, const drilling::DrillingScenario& sc,
                        const Eigen::VectorXd& limit) {
@@ -267,33 +244,31 @@ int RunDrillSim(int argc, char** argv) {
       if (v.size() == 4) p.filter_time_constant = v[3];
       given[kind] = p;
     }
-    std::vector<Run> runs;
-    drilling::SimOptions options;
-    options.motor_torque_limit = limit;
-    for (const std::string& kind : kinds) {
-      Run run;
-      run.parameters = given.count(kind) ? given[kind] : drilling::DefaultParameters(kind);
-      if (tune) {
-        std::cerr << kTool << ": tuning " << kind << " (" << tune_evaluations << " simulations)\n";
-        run.tune = drilling::TuneController(run.parameters, *sc, options, tune_evaluations);
-        run.parameters = run.tune.parameters;
-        run.tuned = true;
+    drilling::ControllerRunOptions ro;
+    ro.kinds = kinds;
+    ro.given = given;
+    ro.tune = tune;
+    ro.tune_evaluations = tune_evaluations;
+    ro.motor_torque_limit = limit;
+    std::optional<ProgressLine> progress;
+    const std::vector<Run> runs = drilling::RunControllers(*sc, ro, [&](const drilling::ControllerRunProgress& p) {
+      if (p.tuning) {
+        std::cerr << kTool << ": tuning " << p.kind << " (" << p.total << " simulations)\n";
+        return;
       }
-      auto ctl = drilling::MakeController(run.parameters, *sc, limit);
-      ProgressLine progress(kTool, "simulating " + kind, sc->num_samples());
-      drilling::SimOptions o = options;
-      o.progress = [&](long done, long) { progress.Update(done); };
-      run.result = sc->Run(*ctl, o);
-      progress.Finish();
-      if (drilling::FindControllerKind(kind).uses_time_delay_estimation()) {
-        const Eigen::VectorXd mbar = sc->effective_inertia().diagonal() * run.parameters.third;
-        run.tde_measure = drilling::TdeStabilityMeasure(sc->effective_inertia(), mbar);
-        if (!(run.tde_measure < 1.0)) {
-          Warn(kTool, "pd-tdc: the TDE stability condition ||I - M^-1 Mbar|| < 1 fails (" +
-                          io::FormatDouble(run.tde_measure) + "); lower the Mbar ratio");
-        }
+      if (p.finished) {
+        if (progress) progress->Finish();
+        progress.reset();
+        return;
       }
-      runs.push_back(std::move(run));
+      if (!progress) progress.emplace(kTool, "simulating " + p.kind, p.total);
+      progress->Update(p.done);
+    });
+    for (const Run& run : runs) {
+      if (run.tde_condition_fails()) {
+        Warn(kTool, "pd-tdc: the TDE stability condition ||I - M^-1 Mbar|| < 1 fails (" +
+                        io::FormatDouble(run.tde_measure) + "); lower the Mbar ratio");
+      }
     }
 
     // All runs done: write every output (each atomically).
@@ -301,7 +276,7 @@ int RunDrillSim(int argc, char** argv) {
     for (const Run& run : runs) {
       const std::string kind = run.parameters.kind;
       const nlohmann::json j = Summary(run, *sc, limit);
-      if (!out_path.empty()) io::WriteFileAtomically(WithSuffix(out_path, kind, several), SeriesCsv(run.result));
+      if (!out_path.empty()) io::WriteFileAtomically(WithSuffix(out_path, kind, several), io::DrillSeriesCsv(run.result));
       if (!summary_path.empty()) {
         io::WriteFileAtomically(WithSuffix(summary_path, kind, several), report::DumpJson(j));
       } else if (out_path.empty()) {

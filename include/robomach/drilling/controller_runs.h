@@ -1,0 +1,58 @@
+#pragma once
+
+// drill-sim's workflow as one library call (issue #21): each controller kind
+// asked for, with its given or default gains (or tuned first), simulated on
+// one drilling scenario, with the time-delay estimation condition of the
+// kinds that use it.
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/drilling/drilling_sim.h"
+
+namespace robomach::drilling {
+
+struct ControllerRunOptions {
+  /// Controller kinds (ControllerKinds() names), simulated in this order.
+  std::vector<std::string> kinds;
+  /// Gains per kind; a kind not listed runs on DefaultParameters(kind).
+  std::map<std::string, ControllerParameters> given;
+  /// Tune each kind first (TuneController from its gains) with at most
+  /// tune_evaluations simulations.
+  bool tune{false};
+  int tune_evaluations{60};
+  /// Per joint [N·m].
+  Eigen::VectorXd motor_torque_limit;
+};
+
+/// One controller's run.
+struct ControllerRun {
+  ControllerParameters parameters;  // what was simulated (tuned, given or default)
+  bool tuned{false};
+  TuneResult tune;                  // when tuned
+  SimResult result;
+  /// ||I - M^-1 Mbar|| (TdeStabilityMeasure) for kinds with time-delay
+  /// estimation; NaN otherwise. The condition holds when < 1.
+  double tde_measure{NAN};
+  bool tde_condition_fails() const { return tde_measure >= 1.0; }
+};
+
+/// What the runs tell as they go: `kind` is being tuned (`tuning`) or
+/// simulated, `done` of `total` samples.
+struct ControllerRunProgress {
+  std::string kind;
+  bool tuning{false};
+  long done{0}, total{0};
+  bool finished{false};
+};
+
+/// Runs every kind of `options` on `scenario`.
+/// @throws std::invalid_argument for an unknown kind or a torque limit of
+///   the wrong size.
+std::vector<ControllerRun> RunControllers(DrillingScenario& scenario, const ControllerRunOptions& options,
+                                          const std::function<void(const ControllerRunProgress&)>& progress = {});
+
+}  // namespace robomach::drilling

@@ -1,0 +1,49 @@
+#include "robomach/drilling/controller_runs.h"
+
+#include <stdexcept>
+
+#include "robomach/drilling/controller_kinds.h"
+#include "robomach/drilling/controllers.h"
+
+namespace robomach::drilling {
+
+std::vector<ControllerRun> RunControllers(DrillingScenario& scenario, const ControllerRunOptions& o,
+                                          const std::function<void(const ControllerRunProgress&)>& progress) {
+  const Eigen::Index n = scenario.effective_inertia().rows();
+  if (o.motor_torque_limit.size() != n) {
+    throw std::invalid_argument("RunControllers: expected one motor torque limit per joint (" +
+                                std::to_string(n) + "), got " +
+                                std::to_string(o.motor_torque_limit.size()));
+  }
+  for (const std::string& kind : o.kinds) FindControllerKind(kind);  // all names checked before any work
+  SimOptions options;
+  options.motor_torque_limit = o.motor_torque_limit;
+  std::vector<ControllerRun> runs;
+  for (const std::string& kind : o.kinds) {
+    ControllerRun run;
+    const auto given = o.given.find(kind);
+    run.parameters = given != o.given.end() ? given->second : DefaultParameters(kind);
+    if (o.tune) {
+      if (progress) progress({kind, true, 0, o.tune_evaluations, false});
+      run.tune = TuneController(run.parameters, scenario, options, o.tune_evaluations);
+      run.parameters = run.tune.parameters;
+      run.tuned = true;
+    }
+    auto ctl = MakeController(run.parameters, scenario, o.motor_torque_limit);
+    SimOptions sim = options;
+    const long total = scenario.num_samples();
+    if (progress) {
+      sim.progress = [&](long done, long) { progress({kind, false, done, total, false}); };
+    }
+    run.result = scenario.Run(*ctl, sim);
+    if (progress) progress({kind, false, total, total, true});
+    if (FindControllerKind(kind).uses_time_delay_estimation()) {
+      const Eigen::VectorXd mbar = scenario.effective_inertia().diagonal() * run.parameters.third;
+      run.tde_measure = TdeStabilityMeasure(scenario.effective_inertia(), mbar);
+    }
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
+}  // namespace robomach::drilling

@@ -1,0 +1,98 @@
+#include "robomach/drilling/controller_runs.h"
+
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "drilling/drilling_test_models.h"
+#include "robomach/drilling/controllers.h"
+#include "test_support.h"
+
+namespace robomach::drilling {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::PlanarRodArm;
+using testing::SeedDrives;
+using testing::SeedPosture;
+
+DrillingMaterial Q235Like() {
+  DrillingMaterial m;
+  m.shear_stress_thrust = 930e6;
+  m.shear_stress_torque = 600e6;
+  m.kienzle_exponent = 0.24;
+  return m;
+}
+
+DrillingProcess ShortProcess() {
+  DrillingProcess p;
+  p.initial_posture = SeedPosture();
+  p.duration = 0.2;
+  return p;
+}
+
+// drill-sim's runs: every kind in order with its given gains (else the
+// defaults), the same series as building the controller and running the
+// scenario by hand, and the TDE condition only for pd-tdc, where it is
+// ||I - M^-1 Mbar|| with Mbar = alpha diag(M_eff) (computed here from the
+// definition).
+TEST(RunControllers, EachKindAsGivenOrDefaultWithTheTdeConditionForPdTdc) {
+  FlexibleJointRobot robot(PlanarRodArm(true), SeedDrives(5.0));
+  DrillingScenario sc(&robot, DrillGeometry{}, Q235Like(), ShortProcess());
+  ControllerRunOptions o;
+  o.kinds = {"pid", "pd-tdc"};
+  ControllerParameters pid = DefaultParameters("pid");
+  pid.omega *= 0.8;
+  o.given["pid"] = pid;
+  o.motor_torque_limit = Eigen::VectorXd::Constant(3, 10.0);
+  long ends = 0, last_done = -1;
+  const std::vector<ControllerRun> runs = RunControllers(sc, o, [&](const ControllerRunProgress& p) {
+    EXPECT_FALSE(p.tuning);
+    ends += p.finished;
+    last_done = p.done;
+  });
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(ends, 2);
+  EXPECT_EQ(last_done, sc.num_samples());
+  EXPECT_EQ(runs[0].parameters.kind, "pid");
+  EXPECT_EQ(runs[0].parameters.omega, pid.omega);
+  EXPECT_EQ(runs[1].parameters.omega, DefaultParameters("pd-tdc").omega);
+  EXPECT_FALSE(runs[0].tuned);
+  EXPECT_TRUE(std::isnan(runs[0].tde_measure));
+  EXPECT_FALSE(runs[0].tde_condition_fails());
+
+  const Eigen::MatrixXd M = sc.effective_inertia();
+  const Eigen::MatrixXd Mbar = (M.diagonal() * runs[1].parameters.third).asDiagonal();
+  const double tde = (Eigen::MatrixXd::Identity(3, 3) - M.inverse() * Mbar).operatorNorm();
+  EXPECT_NEAR(runs[1].tde_measure, tde, 1e-12 * tde);
+
+  auto ctl = MakeController(pid, sc, o.motor_torque_limit);
+  SimOptions so;
+  so.motor_torque_limit = o.motor_torque_limit;
+  const SimResult by_hand = sc.Run(*ctl, so);
+  ASSERT_EQ(by_hand.series.q.cols(), runs[0].result.series.q.cols());
+  EXPECT_EQ((by_hand.series.q - runs[0].result.series.q).cwiseAbs().maxCoeff(), 0.0);
+}
+
+// Every name is checked before any work, and the torque limit needs one
+// value per joint.
+TEST(RunControllers, RefusesAnUnknownKindAndAWrongTorqueLimit) {
+  FlexibleJointRobot robot(PlanarRodArm(true), SeedDrives(5.0));
+  DrillingScenario sc(&robot, DrillGeometry{}, Q235Like(), ShortProcess());
+  ControllerRunOptions o;
+  o.kinds = {"pid", "lqr"};
+  o.motor_torque_limit = Eigen::VectorXd::Constant(3, 10.0);
+  bool worked = false;
+  EXPECT_THAT(robomach::testing::CaptureError([&] { RunControllers(sc, o, [&](const ControllerRunProgress&) { worked = true; }); }),
+              HasSubstr("lqr"));
+  EXPECT_FALSE(worked);
+  o.kinds = {"pd"};
+  o.motor_torque_limit = Eigen::VectorXd::Constant(2, 10.0);
+  EXPECT_THAT(robomach::testing::CaptureError([&] { RunControllers(sc, o); }), HasSubstr("one motor torque limit per joint (3)"));
+}
+
+}  // namespace
+}  // namespace robomach::drilling
