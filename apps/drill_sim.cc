@@ -25,6 +25,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/drill_series_file.h"
 #include "robomach/io/drilling_files.h"
+#include "robomach/io/drilling_setup.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/posture_json.h"
@@ -194,34 +195,13 @@ int RunDrillSim(int argc, char** argv) {
     RequireReadableFile(robot_path, "robot file");
     RequireReadableFile(drill_path, "drill file");
     RequireReadableFile(material_path, "material file");
-    const io::FlexibleRobotFile robot_file = io::ReadFlexibleRobotFile(robot_path);
-    for (const auto& s : robot_file.unused_sections) {
-      Warn(kTool, robot_path + ": section '" + s + "' is not used by drill-sim");
+    const io::DrillingSetup setup = io::LoadDrillingSetup(robot_path, drill_path, material_path, limit_Nm);
+    for (const auto& u : setup.robot_file.unused_sections) {
+      Warn(kTool, robot_path + ": section '" + u + "' is not used by drill-sim");
     }
-    const io::DrillFile drill = io::ReadDrillFile(drill_path);
-    if (!drill.has_process) {
-      throw InputError({drill_path, 0, 0}, "expected a 'process:' section (feed, speed, posture, hole axis)");
-    }
-    const drilling::DrillingMaterial material = io::ReadMaterialFile(material_path);
-    drilling::FlexibleJointRobot robot(robot_file.chain, robot_file.drives);
-    const int n = robot.num_joints();
-    if (drill.process.initial_posture.size() != n) {
-      throw InputError(drill.initial_posture_at,
-                       "initial_posture_deg: expected " + std::to_string(n) + " angles (one per joint), got " +
-                           std::to_string(drill.process.initial_posture.size()));
-    }
-    std::unique_ptr<drilling::DrillingScenario> sc;
-    try {
-      sc = std::make_unique<drilling::DrillingScenario>(&robot, drill.drill, material, drill.process);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(drill.hole_axis_at, std::string("hole_axis: ") + e.what());
-    }
-    const Eigen::VectorXd limit = Eigen::VectorXd::Constant(n, limit_Nm);
-    if ((sc->holding_torque().cwiseAbs().array() > limit.array()).any()) {
-      throw InputError(drill.initial_posture_at,
-                       "the motors cannot hold the robot at the initial posture within the torque limit "
-                       "(--motor-torque-limit-Nm)");
-    }
+    drilling::DrillingScenario* sc = setup.scenario.get();
+    const int n = setup.robot->num_joints();
+    const Eigen::VectorXd& limit = setup.motor_torque_limit;
 
     std::map<std::string, drilling::ControllerParameters> given;
     for (const std::string& text : gain_texts) {
@@ -299,10 +279,8 @@ int RunDrillSim(int argc, char** argv) {
       }
     }
     // Unit plausibility (drilling/plausibility.h): outputs stay written, exit 3.
-    std::vector<std::string> units = drilling::ToolingFindings(drill.drill, &drill.process);
-    for (const std::string& f : drilling::MaterialFindings(material)) units.push_back(material_path + ": " + f);
-    for (const std::string& f : units) Warn(kTool, "implausible (unit mistake?): " + f);
-    if (!units.empty()) rc = kExitFlagged;
+    for (const std::string& f : setup.unit_findings) Warn(kTool, "implausible (unit mistake?): " + f);
+    if (!setup.unit_findings.empty()) rc = kExitFlagged;
     return rc;
   });
 }

@@ -1,0 +1,39 @@
+#pragma once
+// drill-sim's set-up from its three files (docs/formats.md §9): the
+// flexible-joint robot, the drill with its process, the material; checked
+// against each other (one initial angle per joint, a hole axis the robot
+// can feed along, motors that hold the robot at the start), with errors
+// located in the file that is wrong.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/drilling/drilling_sim.h"
+#include "robomach/drilling/flexible_joint_robot.h"
+#include "robomach/io/drilling_files.h"
+
+namespace robomach::io {
+
+struct DrillingSetup {
+  FlexibleRobotFile robot_file;
+  DrillFile drill;
+  drilling::DrillingMaterial material;
+  std::unique_ptr<drilling::FlexibleJointRobot> robot;
+  std::unique_ptr<drilling::DrillingScenario> scenario;  // on *robot
+  Eigen::VectorXd motor_torque_limit;                    // per joint [N·m]
+  /// Unit plausibility of the drill, process and material
+  /// (drilling/plausibility.h), each naming its file where it is not the
+  /// drill file's own value: a run on them is flagged (exit 3).
+  std::vector<std::string> unit_findings;
+};
+
+/// @throws InputError naming the file (and line) for a drill file without a
+///   process, an initial posture of the wrong size, a hole axis the robot
+///   cannot feed along, a holding torque above the limit.
+DrillingSetup LoadDrillingSetup(const std::string& robot_path, const std::string& drill_path,
+                                const std::string& material_path, double motor_torque_limit_Nm);
+
+}  // namespace robomach::io

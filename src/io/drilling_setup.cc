@@ -1,0 +1,40 @@
+#include "robomach/io/drilling_setup.h"
+
+#include "robomach/common/errors.h"
+#include "robomach/drilling/plausibility.h"
+
+namespace robomach::io {
+
+DrillingSetup LoadDrillingSetup(const std::string& robot_path, const std::string& drill_path,
+                                const std::string& material_path, double motor_torque_limit_Nm) {
+  DrillingSetup s;
+  s.robot_file = ReadFlexibleRobotFile(robot_path);
+  s.drill = ReadDrillFile(drill_path);
+  if (!s.drill.has_process) {
+    throw InputError({drill_path, 0, 0}, "expected a 'process:' section (feed, speed, posture, hole axis)");
+  }
+  s.material = ReadMaterialFile(material_path);
+  s.robot = std::make_unique<drilling::FlexibleJointRobot>(s.robot_file.chain, s.robot_file.drives);
+  const int n = s.robot->num_joints();
+  if (s.drill.process.initial_posture.size() != n) {
+    throw InputError(s.drill.initial_posture_at,
+                     "initial_posture_deg: expected " + std::to_string(n) + " angles (one per joint), got " +
+                         std::to_string(s.drill.process.initial_posture.size()));
+  }
+  try {
+    s.scenario = std::make_unique<drilling::DrillingScenario>(s.robot.get(), s.drill.drill, s.material, s.drill.process);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(s.drill.hole_axis_at, std::string("hole_axis: ") + e.what());
+  }
+  s.motor_torque_limit = Eigen::VectorXd::Constant(n, motor_torque_limit_Nm);
+  if ((s.scenario->holding_torque().cwiseAbs().array() > s.motor_torque_limit.array()).any()) {
+    throw InputError(s.drill.initial_posture_at,
+                     "the motors cannot hold the robot at the initial posture within the torque limit "
+                     "(--motor-torque-limit-Nm)");
+  }
+  s.unit_findings = drilling::ToolingFindings(s.drill.drill, &s.drill.process);
+  for (const std::string& f : drilling::MaterialFindings(s.material)) s.unit_findings.push_back(material_path + ": " + f);
+  return s;
+}
+
+}  // namespace robomach::io
