@@ -95,4 +95,5 @@ PYBIND11_MODULE(robomach, m) {
   BindCalibration(m);
   BindAudit(m);
   BindStability(m);
+  BindDrilling(m);
 }

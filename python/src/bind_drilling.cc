@@ -1,0 +1,103 @@
+// Python bindings of the drilling robot (docs/python.md): drill-sim's call
+// (io::LoadDrillingSetup, then drilling::RunControllers) and its series CSV.
+#include <map>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "robomach/drilling/controller_kinds.h"
+#include "robomach/drilling/controller_runs.h"
+#include "robomach/io/drill_series_file.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/drilling_setup.h"
+
+namespace robomach::python {
+
+void BindDrilling(py::module_& m) {
+  using drilling::ControllerRun;
+  py::class_<ControllerRun>(m, "ControllerRun", "One controller's drilling run (drill-sim).")
+      .def_property_readonly("controller", [](const ControllerRun& r) { return r.parameters.kind; })
+      .def_property_readonly("parameters", [](const ControllerRun& r) {
+        py::dict d;
+        d["omega_rad_s"] = r.parameters.omega;
+        d["zeta"] = r.parameters.zeta;
+        d["third"] = r.parameters.third;
+        d["filter_time_constant_s"] = r.parameters.filter_time_constant;
+        return d;
+      }, "the gain parameters simulated (given, default or tuned); `third` is r (pid) or the Mbar ratio (pd-tdc)")
+      .def_readonly("tuned", &ControllerRun::tuned)
+      .def_property_readonly("tuning_status", [](const ControllerRun& r) { return r.tune.message; })
+      .def_property_readonly("settling_time_s", [](const ControllerRun& r) { return r.result.settling_time; },
+                             "NaN: still outside the band at the end")
+      .def_property_readonly("max_abs_error_rad", [](const ControllerRun& r) { return r.result.max_abs_error; })
+      .def_property_readonly("max_abs_error_last_10pc_rad",
+                             [](const ControllerRun& r) { return r.result.max_abs_error_last_10pc; })
+      .def_property_readonly("cost_rad_s2", [](const ControllerRun& r) { return r.result.cost; })
+      .def_property_readonly("diverged", [](const ControllerRun& r) { return r.result.diverged; })
+      .def_readonly("tde_measure", &ControllerRun::tde_measure,
+                    "||I - M^-1 Mbar|| for pd-tdc (the condition holds below 1); NaN for the others")
+      .def_property_readonly("t_s", [](const ControllerRun& r) { return r.result.series.t; })
+      .def_property_readonly("q_rad", [](const ControllerRun& r) { return r.result.series.q; }, "(joints, samples)")
+      .def_property_readonly("e_rad", [](const ControllerRun& r) { return r.result.series.e; }, "q_d - q (joints, samples)")
+      .def_property_readonly("tau_m_Nm", [](const ControllerRun& r) { return r.result.series.tau_m; })
+      .def_property_readonly("thrust_N", [](const ControllerRun& r) { return r.result.series.thrust; })
+      .def_property_readonly("torque_Nm", [](const ControllerRun& r) { return r.result.series.torque; })
+      .def_property_readonly("offset_rad", [](const ControllerRun& r) { return r.result.series.offset; },
+                             "angle between the drill axis and the hole axis")
+      .def("__repr__", [](const ControllerRun& r) {
+        return "<ControllerRun " + r.parameters.kind + (r.result.diverged ? ", diverged" : "") + ">";
+      });
+
+  m.def("controller_kinds", [] {
+    std::vector<std::string> n;
+    for (const auto* k : drilling::ControllerKinds()) n.push_back(k->name());
+    return n;
+  }, "The drilling controller kinds: names drill_sim accepts.");
+
+  m.def("drill_sim", [](const std::string& robot, const std::string& drill, const std::string& material,
+                        const std::vector<std::string>& controllers, bool tune, int tune_evaluations,
+                        double motor_torque_limit_Nm, const std::map<std::string, std::vector<double>>& gains) {
+    for (const std::string& p : {robot, drill, material}) RequireReadableFile(p);
+    if (!(motor_torque_limit_Nm > 0.0)) throw std::invalid_argument("motor_torque_limit_Nm: expected > 0");
+    if (tune_evaluations < 5 || tune_evaluations > 1000) throw std::invalid_argument("tune_evaluations: expected 5 to 1000");
+    drilling::ControllerRunOptions o;
+    o.kinds = controllers;
+    o.tune = tune;
+    o.tune_evaluations = tune_evaluations;
+    for (const auto& [kind, v] : gains) {
+      drilling::FindControllerKind(kind);
+      if (v.size() < 2 || v.size() > 4 || v[0] <= 0 || v[1] <= 0 || (v.size() >= 3 && v[2] <= 0) ||
+          (v.size() == 4 && v[3] < 0)) {
+        throw std::invalid_argument("gains[" + kind + "]: expected (omega_rad_s, zeta[, third[, filter_s]]), positive");
+      }
+      drilling::ControllerParameters p = drilling::DefaultParameters(kind);
+      p.omega = v[0];
+      p.zeta = v[1];
+      if (v.size() >= 3) p.third = v[2];
+      if (v.size() == 4) p.filter_time_constant = v[3];
+      o.given[kind] = p;
+    }
+    std::vector<ControllerRun> runs;
+    std::vector<std::string> findings;
+    {
+      py::gil_scoped_release release;
+      io::DrillingSetup setup = io::LoadDrillingSetup(robot, drill, material, motor_torque_limit_Nm);
+      o.motor_torque_limit = setup.motor_torque_limit;
+      runs = drilling::RunControllers(*setup.scenario, o);
+      findings = setup.unit_findings;
+    }
+    return py::make_tuple(runs, findings);
+  }, py::arg("robot"), py::arg("drill"), py::arg("material"), py::arg("controllers") = std::vector<std::string>{"pd-tdc"},
+     py::arg("tune") = false, py::arg("tune_evaluations") = 30, py::arg("motor_torque_limit_Nm") = 10.0,
+     py::arg("gains") = std::map<std::string, std::vector<double>>{},
+     "drill-sim's call with its defaults: the robot, drill-and-process and material files (docs/formats.md §9), "
+     "each controller kind simulated (tuned first with tune=True). gains: {kind: (omega_rad_s, zeta[, third[, "
+     "filter_s]])}. Returns (runs, unit_findings): a list of ControllerRun, and the unit plausibility findings "
+     "(drill-sim exits 3 on any). The GIL is released while it runs.");
+
+  m.def("write_drill_series_csv", [](const std::string& path, const ControllerRun& run) {
+    io::WriteFileAtomically(path, io::DrillSeriesCsv(run.result));
+  }, py::arg("path"), py::arg("run"), "drill-sim's --out time series of one run (atomic).");
+}
+
+}  // namespace robomach::python
