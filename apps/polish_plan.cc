@@ -28,6 +28,7 @@
 #include "robomach/polishing/face_check.h"
 #include "robomach/polishing/optimise.h"
 #include "robomach/polishing/path_patterns.h"
+#include "robomach/polishing/plan_workflow.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/removal.h"
 
@@ -35,32 +36,6 @@ namespace robomach::apps {
 namespace {
 
 constexpr char kTool[] = "polish-plan";
-
-struct Evaluated {
-  polishing::PlannedPath path;
-  std::vector<double> removal;
-  polishing::RemovalStats stats;
-};
-
-// Plans and simulates; a contact that fails at a row becomes an InputError
-// on the surface file naming the row and its position.
-Evaluated Evaluate(const polishing::NurbsSurface& surface, const polishing::SampleGrid& grid,
-                   const polishing::RemovalSimulator& sim, const polishing::PathParameters& params,
-                   const polishing::PolishingProcess& process, const std::string& surface_path) {
-  Evaluated e;
-  e.path = polishing::PlanPath(surface, grid, params, process);
-  try {
-    e.removal = sim.Simulate(e.path.rows);
-  } catch (const polishing::PathRowError& err) {
-    const auto& r = e.path.rows[err.row()];
-    std::ostringstream m;
-    m << "planned path row " << err.row() + 1 << " at (" << 1e3 * r.p.x() << ", " << 1e3 * r.p.y() << ", "
-      << 1e3 * r.p.z() << ") mm (u " << r.u << ", v " << r.v << "): " << err.what();
-    throw InputError({surface_path, 0, 0}, m.str());
-  }
-  e.stats = polishing::ComputeRemovalStats(e.removal, grid.areas(), grid.in_region());
-  return e;
-}
 
 std::string Short(double x) {
   std::ostringstream o;
@@ -280,28 +255,10 @@ int Run(int argc, char** argv) {
       p.row_step = MmToM(row_step_mm);
       CheckFaceSize(surface, surface_path, sample_mm, p);
     }
-    auto build_grid = [&](double spacing) {
-      try {
-        return polishing::SampleGrid::Build(surface, MmToM(spacing), process.margin, process.flip_normal);
-      } catch (const std::domain_error& e) {
-        throw InputError({surface_path, 0, 0}, e.what());
-      }
-    };
-    const polishing::SampleGrid grid = build_grid(sample_mm);
-    if (grid.num_in_region() == 0) {
-      throw InputError({process_path, 0, 0}, "process.margin_mm " + io::FormatDouble(1e3 * process.margin) +
-                                                 " leaves no polished region on " + polishing::SurfaceName(surface) +
-                                                 " (" + Short(1e3 * grid.length_s()) + " x " +
-                                                 Short(1e3 * grid.length_t()) + " mm, mean arc lengths along u and v)");
-    }
-    double contact_width = 0;
-    try {
-      contact_width = polishing::ContactWidthAtCentre(surface, grid, process);
-    } catch (const std::domain_error& e) {
-      throw InputError({surface_path, 0, 0}, std::string("at the centre of the region: ") + e.what());
-    }
-    const double cell = 0.5 * contact_width;  // index cell ~ the contact semi-axis
-    const polishing::RemovalSimulator sim(surface, process, grid.points(), grid.normals(), cell);
+    const polishing::PlanningContext ctx =
+        polishing::PreparePlanning(surface, process, MmToM(sample_mm), surface_path, process_path);
+    const polishing::SampleGrid& grid = *ctx.grid;
+    const double contact_width = ctx.contact_width;
 
     polishing::PathParameters params;
     params.pattern = polishing::FindPathPattern(pattern).id();
@@ -316,80 +273,37 @@ int Run(int argc, char** argv) {
     params.line_angle = line_angle_deg * kPi / 180.0;
     // Every parameter comes from an option: a value out of its limits is exit 64.
     FromOption("path parameters", [&] { polishing::CheckValid(params); });
-    if (optimise == "none" && params.pattern == polishing::Pattern::kCycloid) {
-      // A face too narrow for the circle is an error in the input (exit 65),
-      // never rows clamped onto its edges (PlanPath checks it again).
-      try {
-        polishing::CheckCircleFits(surface, grid, polishing::DevelopedRegion::Build(surface, grid, process.margin), params,
-                                   process);
-      } catch (const polishing::FaceTooNarrowError& e) {
-        throw InputError({surface_path, 0, 0}, e.what());
-      }
-    }
 
-    nlohmann::json opt_json;
-    std::vector<double> history, evaluated;
-    bool flagged = false;
-    polishing::PlanOptimiseResult opt;
-    if (optimise != "none") {
-      const polishing::SampleGrid coarse = build_grid(opt_sample_mm);
-      const polishing::RemovalSimulator coarse_sim(surface, process, coarse.points(), coarse.normals(), cell);
-      polishing::PathParameters base = params;
-      base.row_step = std::max(params.row_step, MmToM(opt_sample_mm));
-      polishing::PlanProblem pb;
-      pb.surface = &surface;
-      pb.grid = &coarse;
-      pb.sim = &coarse_sim;
-      pb.process = &process;
-      pb.target = MmToM(1e-3 * target_um);
-      pb.contact_width = contact_width;
-      polishing::PlanOptimiseOptions oo;
-      oo.method = optimise == "nlopt" ? polishing::Optimiser::kNlopt : polishing::Optimiser::kPso;
-      oo.pattern = params.pattern;
-      if (guides_given) {
-        // The user chose the family: offsets, or parallel lines (both directions).
-        if (params.guides == polishing::GuideLines::kBoundaryOffsets) oo.families = {{params.guides, 0.0}};
-        else oo.families = {{params.guides, 0.0}, {params.guides, kPi / 2}};
-      }
-      oo.offset_min = std::max(opt_offset_min_cw * contact_width, MmToM(0.5));
-      oo.offset_max = std::max(oo.offset_min * 1.5, MmToM(opt_offset_max_mm));
-      oo.max_time_s = max_time_s;
-      oo.threads = threads;
-      oo.seed = static_cast<unsigned>(seed);
-      // The progress line counts per mille of the time budget (the optimiser
-      // stops on convergence, usually before it).
-      ProgressLine progress(kTool, "optimiser, per mille of --max-time-s", 1000);
-      oo.progress = [&](int n, double best, double elapsed) {
+    polishing::PlanRequest req;
+    req.params = params;
+    req.target_removal = target_um * 1e-6;  // [um] -> [m]
+    if (optimise != "none") req.optimise = optimise == "nlopt" ? polishing::Optimiser::kNlopt : polishing::Optimiser::kPso;
+    req.guides_given = guides_given;
+    req.opt_sample_spacing = MmToM(opt_sample_mm);
+    req.opt_offset_min_contact_widths = opt_offset_min_cw;
+    req.opt_offset_max = MmToM(opt_offset_max_mm);
+    req.max_time_s = max_time_s;
+    req.threads = threads;
+    req.seed = static_cast<unsigned>(seed);
+    // The progress line counts per mille of the time budget (the optimiser
+    // stops on convergence, usually before it).
+    std::optional<ProgressLine> progress;
+    if (req.optimise) {
+      progress.emplace(kTool, "optimiser, per mille of --max-time-s", 1000);
+      req.progress = [&](int n, double best, double elapsed) {
         std::ostringstream d;
         d << n << " evaluations, best feasible cv " << (std::isfinite(best) ? io::FormatDouble(best) : "none yet");
-        progress.Update(std::min(1000L, static_cast<long>(1000 * elapsed / max_time_s)), d.str());
+        progress->Update(std::min(1000L, static_cast<long>(1000 * elapsed / max_time_s)), d.str());
       };
-      if (params.offset < oo.offset_min || params.offset > oo.offset_max) {
-        base.offset = std::clamp(base.offset, oo.offset_min, oo.offset_max);
-        base.radius = std::clamp(base.radius, 0.5 * base.offset, base.offset);
-      }
-      try {
-        opt = polishing::OptimisePlan(pb, base, oo);
-      } catch (const polishing::PathRowError& err) {
-        throw InputError({surface_path, 0, 0}, std::string("while optimising: ") + err.what());
-      }
-      progress.Finish();
-      if (!opt.best.valid) {
-        throw std::runtime_error("the optimiser found no plan that fits the region: " + opt.best.error);
-      }
-      params = opt.best.params;
-      params.row_step = MmToM(row_step_mm);
-      // The convergence plot: the optimised pattern's evaluations only (the
-      // zig-zag's, made for the comparison, are in the summary's counts).
-      double best_so_far = std::numeric_limits<double>::quiet_NaN();
-      for (size_t i = 0; i < opt.cv_history.size(); ++i) {
-        const bool par = opt.history_parallel[i] != 0;
-        if (par != (params.pattern == polishing::Pattern::kParallel)) continue;
-        const double cv = opt.cv_history[i];
-        if (std::isfinite(cv) && !(cv >= best_so_far)) best_so_far = cv;
-        evaluated.push_back(cv);
-        history.push_back(best_so_far);
-      }
+    }
+    polishing::PlanOutcome outcome = polishing::PlanPolishing(ctx, req);
+    if (progress) progress->Finish();
+    params = outcome.params;
+    const polishing::EvaluatedPlan& e = outcome.plan;
+    bool flagged = false;
+    nlohmann::json opt_json;
+    if (outcome.optimisation) {
+      const polishing::PlanOptimiseResult& opt = *outcome.optimisation;
       auto family_json = [&](const polishing::PlanEvaluation& ev) {
         const bool c = ev.params.pattern == polishing::Pattern::kCycloid;
         nlohmann::json j = {{"pattern", polishing::PathPatternOf(ev.params.pattern).name()},
@@ -420,10 +334,10 @@ int Run(int argc, char** argv) {
                   {"best_cv", opt.best.cv},
                   {"feasible", opt.best.feasible},
                   {"best", family_json(opt.best)}};
-      opt_json["history"] = history;      // best feasible cv so far (null before the first)
-      opt_json["history_cv"] = evaluated; // each evaluation's cv (null: infeasible)
+      opt_json["history"] = outcome.history_best;     // best feasible cv so far (null before the first)
+      opt_json["history_cv"] = outcome.history_cv;    // each evaluation's cv (null: infeasible)
       if (params.pattern == polishing::Pattern::kCycloid) {
-        opt_json["bounds"] = {{"offset_mm", {1e3 * oo.offset_min, 1e3 * oo.offset_max}},
+        opt_json["bounds"] = {{"offset_mm", {1e3 * outcome.opt_offset_min, 1e3 * outcome.opt_offset_max}},
                               {"radius_over_offset", {0.5, 1.0}},
                               {"pitch_over_radius", {0.5, kPi}},
                               {"stagger_loops", {0.0, 1.0}},
@@ -433,68 +347,49 @@ int Run(int argc, char** argv) {
         opt_json["families"] = fams;
         if (opt.best_parallel.valid) opt_json["parallel"] = family_json(opt.best_parallel);
       }
-      if (!opt.best.feasible) {
+      if (!outcome.infeasible_message.empty()) {
         flagged = true;
-        const std::string m = target_um > 0
-            ? "no plan the optimiser saw reaches the target removal " + io::FormatDouble(target_um) +
-                  " um within max_speed_mm_per_s and covers the region: every covering one removes more at the "
-                  "limit (written: the least infeasible, " + io::FormatDouble(1e6 * opt.best.mean) +
-                  " um at the limit, coverage " + io::FormatDouble(opt.best.coverage) + ")"
-            : "the optimiser found no feasible plan";
-        opt_json["message"] = m;
-        Warn(kTool, m);
+        opt_json["message"] = outcome.infeasible_message;
+        Warn(kTool, outcome.infeasible_message);
       }
       if (opt.status == "max_time") {
         Note(kTool, "the optimiser stopped at --max-time-s " + io::FormatDouble(max_time_s) +
                         " before its local searches converged; the best plan so far is written");
       }
     }
-
-    Evaluated e = Evaluate(surface, grid, sim, params, process, surface_path);
     nlohmann::json target_json;
-    if (target_um > 0) {
-      const polishing::TargetResult t =
-          polishing::ScaleToTargetRemoval(sim, grid, target_um * 1e-6, process.max_speed, &e.path);
-      e.removal = t.removal;
-      e.stats = polishing::ComputeRemovalStats(e.removal, grid.areas(), grid.in_region());
-      target_json = {{"removal_um", target_um}, {"reached", t.reached}};
-      if (!t.reached) {
+    if (outcome.target_given) {
+      target_json = {{"removal_um", target_um}, {"reached", outcome.target.reached}};
+      if (!outcome.target.reached) {
         flagged = true;
-        target_json["message"] = t.message;
-        Warn(kTool, t.message);
+        target_json["message"] = outcome.target.message;
+        Warn(kTool, outcome.target.message);
       }
     }
     const bool cyc = params.pattern == polishing::Pattern::kCycloid;
     nlohmann::json summary;
-    if (cyc && optimise != "none" && opt.best_parallel.valid) {
-      // The cycloid against the optimised zig-zag, both on the final grid
-      // and timed for the target as the written path is (issue 19).
-      polishing::PathParameters pp = opt.best_parallel.params;
-      pp.row_step = MmToM(row_step_mm);
-      Evaluated z = Evaluate(surface, grid, sim, pp, process, surface_path);
-      bool z_reached = true;
-      if (target_um > 0) {
-        const polishing::TargetResult t = polishing::ScaleToTargetRemoval(sim, grid, target_um * 1e-6, process.max_speed, &z.path);
-        z.stats = polishing::ComputeRemovalStats(t.removal, grid.areas(), grid.in_region());
-        z_reached = t.reached;
-      }
-      const bool cycloid_ok = target_um <= 0 || target_json.value("reached", true);
-      const bool zigzag_better = (z_reached && !cycloid_ok) || (z_reached == cycloid_ok && z.stats.cv < e.stats.cv);
+    if (outcome.comparison) {
+      const polishing::PlanOutcome::Comparison& cmp = *outcome.comparison;
+      const polishing::PathParameters& pp = cmp.parallel;
+      const bool cycloid_ok = !outcome.target_given || outcome.target.reached;
       summary["comparison"] = {{"cycloid_cv", e.stats.cv},
-                               {"parallel_cv", z.stats.cv},
+                               {"parallel_cv", cmp.parallel_stats.cv},
                                {"parallel_offset_mm", 1e3 * pp.offset},
                                {"parallel_line_angle_deg", pp.line_angle * 180.0 / kPi},
-                               {"parallel_reaches_target", z_reached},
-                               {"better", zigzag_better ? "parallel" : "cycloid"}};
-      if (zigzag_better) {
+                               {"parallel_reaches_target", cmp.parallel_reaches_target},
+                               {"better", cmp.zigzag_better ? "parallel" : "cycloid"}};
+      if (cmp.zigzag_better) {
         flagged = true;
-        Warn(kTool, "the optimised zig-zag is better than the optimised cycloid: cv " + io::FormatDouble(z.stats.cv) +
-                        (z_reached ? "" : " (target not reached)") + " against " + io::FormatDouble(e.stats.cv) +
-                        (cycloid_ok ? "" : " (target not reached)") + "; plan it with --pattern parallel --offset-mm " +
-                        io::FormatDouble(1e3 * pp.offset) + " --line-angle-deg " + io::FormatDouble(pp.line_angle * 180.0 / kPi) +
-                        " --edge-overrun-mm " + io::FormatDouble(1e3 * pp.edge_overrun));
+        Warn(kTool, "the optimised zig-zag is better than the optimised cycloid: cv " +
+                        io::FormatDouble(cmp.parallel_stats.cv) + (cmp.parallel_reaches_target ? "" : " (target not reached)") +
+                        " against " + io::FormatDouble(e.stats.cv) + (cycloid_ok ? "" : " (target not reached)") +
+                        "; plan it with --pattern parallel --offset-mm " + io::FormatDouble(1e3 * pp.offset) +
+                        " --line-angle-deg " + io::FormatDouble(pp.line_angle * 180.0 / kPi) + " --edge-overrun-mm " +
+                        io::FormatDouble(1e3 * pp.edge_overrun));
       }
     }
+    const std::vector<double>& history = outcome.history_best;
+    const std::vector<double>& evaluated = outcome.history_cv;
     summary["removal_um"] = RemovalJson(e.stats);
     summary["path"] = PathJson(e.path.rows);
     const std::string guides_used = !cyc ? "parallel"
@@ -516,7 +411,7 @@ int Run(int argc, char** argv) {
       // that would cross a hole are lifted; a row in contact off the face
       // would be a planner bug, or the developed plane's distortion on a
       // strongly doubly curved face (README "CAD faces").
-      const int off = RowsOffFace(surface, e.path.rows);
+      const int off = outcome.rows_off_face;
       summary["region"]["face"] = surface.trim()->source;
       summary["region"]["rows_off_face"] = off;
       if (off > 0) {

@@ -56,12 +56,6 @@ void AddSurfaceChoiceOptions(CLI::App* app, SurfaceChoice* choice) {
       ->capture_default_str();
 }
 
-int RowsOffFace(const polishing::NurbsSurface& surface, const std::vector<polishing::PathRow>& rows) {
-  int n = 0;
-  for (const auto& r : rows) n += r.force != 0.0 && !surface.OnFace(r.u, r.v);  // lifted rows may cross holes
-  return n;
-}
-
 void ReportUnpolished(const std::string& tool, const polishing::RemovalStats& stats,
                       const polishing::SampleGrid& grid, nlohmann::json* region) {
   double area = 0.0;

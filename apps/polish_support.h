@@ -42,9 +42,6 @@ polishing::NurbsSurface LoadSurface(const std::string& tool, const std::string& 
 /// Registers --face and --cad-unit-scale on `app` (polish-plan, polish-sim).
 void AddSurfaceChoiceOptions(CLI::App* app, SurfaceChoice* choice);
 
-/// Number of rows whose (u, v) lie off the surface's trimmed face.
-int RowsOffFace(const polishing::NurbsSurface& surface, const std::vector<polishing::PathRow>& rows);
-
 /// formats.md §7 "removal_um" block (area-weighted over the region).
 nlohmann::json RemovalJson(const polishing::RemovalStats& stats_m);
 nlohmann::json PathJson(const std::vector<polishing::PathRow>& rows);

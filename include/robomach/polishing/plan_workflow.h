@@ -1,0 +1,118 @@
+#pragma once
+// polish-plan's workflow as library calls (issue #21): the sampled region
+// and the contact on a surface (PreparePlanning), then a path planned,
+// optionally optimised for uniform removal, simulated and timed for a
+// target removal (PlanPolishing); the optimised cycloid is compared with the
+// optimised zig-zag. The tool reads the files, resolves its options into
+// PathParameters (an invalid one is a command-line error) and writes what
+// comes back.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "robomach/polishing/nurbs_surface.h"
+#include "robomach/polishing/optimise.h"
+#include "robomach/polishing/paths.h"
+#include "robomach/polishing/process.h"
+#include "robomach/polishing/removal.h"
+#include "robomach/polishing/surface_grid.h"
+
+namespace robomach::polishing {
+
+/// The sampled region of a surface and what the contact makes of it.
+struct PlanningContext {
+  const NurbsSurface* surface{nullptr};  // not owned; outlives the context
+  PolishingProcess process;
+  double sample_spacing{0.5e-3};  // [m]
+  std::shared_ptr<const SampleGrid> grid;
+  double contact_width{0.0};  // across the path at the region's centre [m]
+  std::shared_ptr<const RemovalSimulator> simulator;
+  /// Where the surface and the process came from, for errors.
+  std::string surface_source, process_source;
+};
+
+/// Samples the region (arc-length spacing `sample_spacing` [m], the
+/// process's margin), computes the contact width at its centre and builds
+/// the removal simulator.
+/// @throws InputError naming the surface file for a surface that cannot be
+///   sampled or a contact that fails at the centre, and the process file
+///   for a margin that leaves no region.
+PlanningContext PreparePlanning(const NurbsSurface& surface, const PolishingProcess& process, double sample_spacing,
+                                const std::string& surface_source, const std::string& process_source);
+
+/// How to plan: the path's parameters, and optionally the optimisation and
+/// the target removal.
+struct PlanRequest {
+  PathParameters params;  // as given (CheckValid passed)
+  /// Mean removal over the region to time the path for [m]; 0: at the
+  /// speed limit.
+  double target_removal{0.0};
+  /// Optimise (OptimisePlan) with this method, on a coarser grid.
+  std::optional<Optimiser> optimise;
+  bool guides_given{false};  // the optimiser keeps params.guides (else it chooses the family)
+  double opt_sample_spacing{1e-3};             // [m]
+  double opt_offset_min_contact_widths{0.3};   // smallest spacing tried, in contact widths
+  double opt_offset_max{0.030};                // largest spacing tried [m]
+  double max_time_s{50.0};
+  int threads{2};
+  unsigned seed{20240404};
+  /// OptimisePlan's progress: evaluations, best feasible cv, elapsed [s].
+  std::function<void(int, double, double)> progress;
+};
+
+/// A planned, simulated path.
+struct EvaluatedPlan {
+  PlannedPath path;
+  std::vector<double> removal;  // at every grid point [m]
+  RemovalStats stats;
+};
+
+struct PlanOutcome {
+  PathParameters params;  // what was planned (the optimum with optimise)
+  EvaluatedPlan plan;
+  /// With optimise: the optimiser's result, the bounds it searched, and
+  /// for the optimised pattern's evaluations only, each one's cv (NaN:
+  /// infeasible) and the best feasible so far.
+  std::optional<PlanOptimiseResult> optimisation;
+  double opt_offset_min{0.0}, opt_offset_max{0.0};
+  std::vector<double> history_cv, history_best;
+  /// The optimiser found no plan that reaches the target and covers the
+  /// region (the least infeasible is planned): why, for the user.
+  std::string infeasible_message;
+  /// With a target: whether the speed limit allows it, and why not.
+  bool target_given{false};
+  TargetResult target;
+  /// The optimised cycloid against the optimised zig-zag, both on the final
+  /// grid and timed for the target.
+  struct Comparison {
+    PathParameters parallel;
+    RemovalStats parallel_stats;
+    bool parallel_reaches_target{true};
+    bool zigzag_better{false};
+  };
+  std::optional<Comparison> comparison;
+  /// Rows in contact off a trimmed face (a planner bug, or the developed
+  /// plane's distortion on a strongly doubly curved face); 0 on a patch.
+  int rows_off_face{0};
+  /// Something the user should act on: a target out of reach, no feasible
+  /// plan, a better zig-zag, rows off the face (exit 3 in the tool).
+  bool flagged{false};
+};
+
+/// Plans `request.params` (or the optimum) on the context's region.
+/// @throws InputError naming the surface file for a contact that fails at a
+///   row (with its position) or a cycloid too wide for the face;
+///   std::runtime_error when the optimiser finds no plan that fits.
+PlanOutcome PlanPolishing(const PlanningContext& context, const PlanRequest& request);
+
+/// Plans and simulates `params` on the context's grid.
+/// @throws InputError naming the surface file and the row for a contact
+///   that fails.
+EvaluatedPlan EvaluatePlanOnGrid(const PlanningContext& context, const PathParameters& params);
+
+/// Path rows in contact (force != 0) whose (u, v) lie off a trimmed face.
+int RowsOffFace(const NurbsSurface& surface, const std::vector<PathRow>& rows);
+
+}  // namespace robomach::polishing

@@ -1,0 +1,204 @@
+#include "robomach/polishing/plan_workflow.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
+#include "robomach/common/units.h"
+#include "robomach/polishing/face_check.h"
+#include "robomach/polishing/path_patterns.h"
+#include "robomach/polishing/region_outline.h"
+
+namespace robomach::polishing {
+namespace {
+
+std::string Short(double x) {
+  std::ostringstream o;
+  o.precision(4);
+  o << x;
+  return o.str();
+}
+
+std::shared_ptr<const SampleGrid> BuildGrid(const NurbsSurface& surface, const PolishingProcess& process,
+                                            double spacing, const std::string& surface_source) {
+  try {
+    return std::make_shared<const SampleGrid>(SampleGrid::Build(surface, spacing, process.margin, process.flip_normal));
+  } catch (const std::domain_error& e) {
+    throw InputError({surface_source, 0, 0}, e.what());
+  }
+}
+
+// The pattern runs its tool around a circle (the cycloid): it needs room
+// at the face's edge, and it is the one compared with the zig-zag.
+bool PathPatternCircles(const PathParameters& p) { return PathPatternOf(p.pattern).circle_radius(p) > 0.0; }
+
+}  // namespace
+
+int RowsOffFace(const NurbsSurface& surface, const std::vector<PathRow>& rows) {
+  int n = 0;
+  for (const auto& r : rows) n += r.force != 0.0 && !surface.OnFace(r.u, r.v);  // lifted rows may cross holes
+  return n;
+}
+
+PlanningContext PreparePlanning(const NurbsSurface& surface, const PolishingProcess& process, double sample_spacing,
+                                const std::string& surface_source, const std::string& process_source) {
+  PlanningContext c;
+  c.surface = &surface;
+  c.process = process;
+  c.sample_spacing = sample_spacing;
+  c.surface_source = surface_source;
+  c.process_source = process_source;
+  c.grid = BuildGrid(surface, process, sample_spacing, surface_source);
+  if (c.grid->num_in_region() == 0) {
+    throw InputError({process_source, 0, 0}, "process.margin_mm " + FormatDouble(1e3 * process.margin) +
+                                                 " leaves no polished region on " + SurfaceName(surface) + " (" +
+                                                 Short(1e3 * c.grid->length_s()) + " x " +
+                                                 Short(1e3 * c.grid->length_t()) + " mm, mean arc lengths along u and v)");
+  }
+  try {
+    c.contact_width = ContactWidthAtCentre(surface, *c.grid, process);
+  } catch (const std::domain_error& e) {
+    throw InputError({surface_source, 0, 0}, std::string("at the centre of the region: ") + e.what());
+  }
+  const double cell = 0.5 * c.contact_width;  // index cell ~ the contact semi-axis
+  c.simulator = std::make_shared<const RemovalSimulator>(surface, process, c.grid->points(), c.grid->normals(), cell);
+  return c;
+}
+
+EvaluatedPlan EvaluatePlanOnGrid(const PlanningContext& c, const PathParameters& params) {
+  EvaluatedPlan e;
+  e.path = PlanPath(*c.surface, *c.grid, params, c.process);
+  try {
+    e.removal = c.simulator->Simulate(e.path.rows);
+  } catch (const PathRowError& err) {
+    const auto& r = e.path.rows[err.row()];
+    std::ostringstream m;
+    m << "planned path row " << err.row() + 1 << " at (" << 1e3 * r.p.x() << ", " << 1e3 * r.p.y() << ", "
+      << 1e3 * r.p.z() << ") mm (u " << r.u << ", v " << r.v << "): " << err.what();
+    throw InputError({c.surface_source, 0, 0}, m.str());
+  }
+  e.stats = ComputeRemovalStats(e.removal, c.grid->areas(), c.grid->in_region());
+  return e;
+}
+
+PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
+  const NurbsSurface& surface = *c.surface;
+  const SampleGrid& grid = *c.grid;
+  PlanOutcome out;
+  PathParameters params = req.params;
+  if (!req.optimise && PathPatternCircles(params)) {
+    // A face too narrow for the circle is an error in the input, never
+    // rows clamped onto its edges (PlanPath checks it again).
+    try {
+      CheckCircleFits(surface, grid, DevelopedRegion::Build(surface, grid, c.process.margin), params, c.process);
+    } catch (const FaceTooNarrowError& e) {
+      throw InputError({c.surface_source, 0, 0}, e.what());
+    }
+  }
+
+  if (req.optimise) {
+    const std::shared_ptr<const SampleGrid> coarse = BuildGrid(surface, c.process, req.opt_sample_spacing, c.surface_source);
+    const RemovalSimulator coarse_sim(surface, c.process, coarse->points(), coarse->normals(), 0.5 * c.contact_width);
+    PathParameters base = params;
+    base.row_step = std::max(params.row_step, req.opt_sample_spacing);
+    PlanProblem pb;
+    pb.surface = &surface;
+    pb.grid = coarse.get();
+    pb.sim = &coarse_sim;
+    pb.process = &c.process;
+    pb.target = req.target_removal;
+    pb.contact_width = c.contact_width;
+    PlanOptimiseOptions oo;
+    oo.method = *req.optimise;
+    oo.pattern = params.pattern;
+    if (req.guides_given) {
+      // The user chose the family: offsets, or parallel lines (both directions).
+      if (params.guides == GuideLines::kBoundaryOffsets) oo.families = {{params.guides, 0.0}};
+      else oo.families = {{params.guides, 0.0}, {params.guides, kPi / 2}};
+    }
+    oo.offset_min = std::max(req.opt_offset_min_contact_widths * c.contact_width, MmToM(0.5));
+    oo.offset_max = std::max(oo.offset_min * 1.5, req.opt_offset_max);
+    oo.max_time_s = req.max_time_s;
+    oo.threads = req.threads;
+    oo.seed = req.seed;
+    oo.progress = req.progress;
+    if (params.offset < oo.offset_min || params.offset > oo.offset_max) {
+      base.offset = std::clamp(base.offset, oo.offset_min, oo.offset_max);
+      base.radius = std::clamp(base.radius, 0.5 * base.offset, base.offset);
+    }
+    out.opt_offset_min = oo.offset_min;
+    out.opt_offset_max = oo.offset_max;
+    PlanOptimiseResult opt;
+    try {
+      opt = OptimisePlan(pb, base, oo);
+    } catch (const PathRowError& err) {
+      throw InputError({c.surface_source, 0, 0}, std::string("while optimising: ") + err.what());
+    }
+    if (!opt.best.valid) throw std::runtime_error("the optimiser found no plan that fits the region: " + opt.best.error);
+    const double row_step = params.row_step;
+    params = opt.best.params;
+    params.row_step = row_step;
+    // The convergence history: the optimised pattern's evaluations only (the
+    // zig-zag's, made for the comparison, are in the counts).
+    double best_so_far = std::numeric_limits<double>::quiet_NaN();
+    for (size_t i = 0; i < opt.cv_history.size(); ++i) {
+      const bool par = opt.history_parallel[i] != 0;
+      if (par != (params.pattern == Pattern::kParallel)) continue;
+      const double cv = opt.cv_history[i];
+      if (std::isfinite(cv) && !(cv >= best_so_far)) best_so_far = cv;
+      out.history_cv.push_back(cv);
+      out.history_best.push_back(best_so_far);
+    }
+    if (!opt.best.feasible) {
+      out.flagged = true;
+      out.infeasible_message =
+          req.target_removal > 0
+              ? "no plan the optimiser saw reaches the target removal " + FormatDouble(1e6 * req.target_removal) +
+                    " um within max_speed_mm_per_s and covers the region: every covering one removes more at the "
+                    "limit (written: the least infeasible, " + FormatDouble(1e6 * opt.best.mean) +
+                    " um at the limit, coverage " + FormatDouble(opt.best.coverage) + ")"
+              : "the optimiser found no feasible plan";
+    }
+    out.optimisation = std::move(opt);
+  }
+
+  out.params = params;
+  out.plan = EvaluatePlanOnGrid(c, params);
+  if (req.target_removal > 0) {
+    out.target_given = true;
+    out.target = ScaleToTargetRemoval(*c.simulator, grid, req.target_removal, c.process.max_speed, &out.plan.path);
+    out.plan.removal = out.target.removal;
+    out.plan.stats = ComputeRemovalStats(out.plan.removal, grid.areas(), grid.in_region());
+    if (!out.target.reached) out.flagged = true;
+  }
+  if (PathPatternCircles(params) && out.optimisation && out.optimisation->best_parallel.valid) {
+    // The cycloid against the optimised zig-zag, both on the final grid
+    // and timed for the target as the written path is (issue 19).
+    PlanOutcome::Comparison cmp;
+    cmp.parallel = out.optimisation->best_parallel.params;
+    cmp.parallel.row_step = params.row_step;
+    EvaluatedPlan z = EvaluatePlanOnGrid(c, cmp.parallel);
+    cmp.parallel_stats = z.stats;
+    if (req.target_removal > 0) {
+      const TargetResult t = ScaleToTargetRemoval(*c.simulator, grid, req.target_removal, c.process.max_speed, &z.path);
+      cmp.parallel_stats = ComputeRemovalStats(t.removal, grid.areas(), grid.in_region());
+      cmp.parallel_reaches_target = t.reached;
+    }
+    const bool cycloid_ok = !out.target_given || out.target.reached;
+    cmp.zigzag_better = (cmp.parallel_reaches_target && !cycloid_ok) ||
+                        (cmp.parallel_reaches_target == cycloid_ok && cmp.parallel_stats.cv < out.plan.stats.cv);
+    if (cmp.zigzag_better) out.flagged = true;
+    out.comparison = cmp;
+  }
+  if (surface.trim()) {
+    out.rows_off_face = RowsOffFace(surface, out.plan.path.rows);
+    if (out.rows_off_face > 0) out.flagged = true;
+  }
+  return out;
+}
+
+}  // namespace robomach::polishing
