@@ -427,18 +427,7 @@ int Run(int argc, char** argv) {
     }
 
     if (robot.Check(kTool, process, e.path.rows, &summary)) flagged = true;
-    std::vector<std::pair<std::string, std::string>> meta = {{"pattern", pattern}};
-    meta.push_back({"offset_mm", io::FormatDouble(1e3 * params.offset)});
-    meta.push_back({"edge_overrun_mm", io::FormatDouble(1e3 * std::min(params.edge_overrun, polishing::MaxEdgeOverrun(params, process)))});
-    if (cyc) {
-      meta.push_back({"guides", guides_used});
-      meta.push_back({"radius_mm", io::FormatDouble(1e3 * params.radius)});
-      meta.push_back({"pitch_mm", io::FormatDouble(1e3 * params.pitch)});
-      meta.push_back({"stagger_loops", io::FormatDouble(params.stagger)});
-    }
-    if (!cyc || params.guides == polishing::GuideLines::kParallelLines) {
-      meta.push_back({"line_angle_deg", io::FormatDouble(params.line_angle * 180.0 / kPi)});
-    }
+    const auto meta = io::PlannedPathMetadata(params, process);
     if (!path_out.empty()) io::WritePolishPath(path_out, e.path.rows, meta);
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, e.removal);
     robot.WriteJoints(e.path.rows);

@@ -96,4 +96,5 @@ PYBIND11_MODULE(robomach, m) {
   BindAudit(m);
   BindStability(m);
   BindDrilling(m);
+  BindPolishing(m);
 }

@@ -10,6 +10,7 @@
 #include "robomach/io/csv_table.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/yaml_doc.h"
+#include "robomach/polishing/path_patterns.h"
 
 namespace robomach::io {
 namespace {
@@ -236,6 +237,27 @@ void WriteRemovalMap(const std::string& path, const polishing::SampleGrid& grid,
       }
     }
   });
+}
+
+std::vector<std::pair<std::string, std::string>> PlannedPathMetadata(const polishing::PathParameters& params,
+                                                                     const polishing::PolishingProcess& process) {
+  const bool cyc = params.pattern == polishing::Pattern::kCycloid;
+  const std::string guides_used =
+      !cyc ? "parallel" : params.guides == polishing::GuideLines::kBoundaryOffsets ? "offsets" : "parallel";
+  std::vector<std::pair<std::string, std::string>> meta = {{"pattern", polishing::PathPatternOf(params.pattern).name()}};
+  meta.push_back({"offset_mm", FormatDouble(1e3 * params.offset)});
+  meta.push_back(
+      {"edge_overrun_mm", FormatDouble(1e3 * std::min(params.edge_overrun, polishing::MaxEdgeOverrun(params, process)))});
+  if (cyc) {
+    meta.push_back({"guides", guides_used});
+    meta.push_back({"radius_mm", FormatDouble(1e3 * params.radius)});
+    meta.push_back({"pitch_mm", FormatDouble(1e3 * params.pitch)});
+    meta.push_back({"stagger_loops", FormatDouble(params.stagger)});
+  }
+  if (!cyc || params.guides == polishing::GuideLines::kParallelLines) {
+    meta.push_back({"line_angle_deg", FormatDouble(params.line_angle * 180.0 / kPi)});
+  }
+  return meta;
 }
 
 }  // namespace robomach::io

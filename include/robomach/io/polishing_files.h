@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "robomach/polishing/nurbs_surface.h"
+#include "robomach/polishing/paths.h"
 #include "robomach/polishing/process.h"
 #include "robomach/polishing/removal.h"
 #include "robomach/polishing/surface_grid.h"
@@ -40,6 +41,13 @@ PolishPathFile ReadPolishPath(const std::string& path);
 /// t_s,x_mm,y_mm,z_mm,nx,ny,nz,tx,ty,tz,u,v. Atomic.
 void WritePolishPath(const std::string& path, const std::vector<polishing::PathRow>& rows,
                      const std::vector<std::pair<std::string, std::string>>& metadata);
+
+/// The `# key: value` lines polish-plan writes at the top of a planned path
+/// (formats.md §6): pattern, offset_mm, edge_overrun_mm (the one used); for
+/// the cycloid guides, radius_mm, pitch_mm, stagger_loops; line_angle_deg
+/// where guide lines are parallel.
+std::vector<std::pair<std::string, std::string>> PlannedPathMetadata(const polishing::PathParameters& params,
+                                                                     const polishing::PolishingProcess& process);
 
 /// Removal map CSV x_mm,y_mm,z_mm,u,v,removal_um of the region's points. Atomic.
 void WriteRemovalMap(const std::string& path, const polishing::SampleGrid& grid, const std::vector<double>& removal_m);

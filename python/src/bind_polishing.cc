@@ -1,0 +1,221 @@
+// Python bindings of polishing (docs/python.md): surfaces (NURBS YAML or a
+// STEP/IGES face), the process, polish-plan's call (PreparePlanning and
+// PlanPolishing) and its path and removal files.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "robomach/common/units.h"
+#include "robomach/io/cad_face.h"
+#include "robomach/io/polishing_files.h"
+#include "robomach/polishing/path_patterns.h"
+#include "robomach/polishing/plan_workflow.h"
+
+namespace robomach::python {
+namespace {
+
+using polishing::NurbsSurface;
+using polishing::PolishingProcess;
+using SurfacePtr = std::shared_ptr<NurbsSurface>;  // pybind11 holders are not const
+
+// A plan with what it was planned on (the context points at the surface).
+struct PyPlan {
+  SurfacePtr surface;
+  polishing::PlanningContext context;
+  polishing::PlanOutcome outcome;
+};
+
+py::dict StatsDict(const polishing::RemovalStats& s) {
+  py::dict d;
+  d["mean_um"] = 1e6 * s.mean;
+  d["std_um"] = 1e6 * s.std;
+  d["cv"] = s.cv;
+  d["min_um"] = 1e6 * s.min;
+  d["max_um"] = 1e6 * s.max;
+  d["peak_to_valley_um"] = 1e6 * s.peak_to_valley;
+  d["coverage"] = s.coverage;
+  d["unpolished_area_mm2"] = 1e6 * s.unpolished_area;
+  return d;
+}
+
+py::dict ParamsDict(const polishing::PathParameters& p) {
+  py::dict d;
+  d["pattern"] = polishing::PathPatternOf(p.pattern).name();
+  d["guides"] = p.guides == polishing::GuideLines::kBoundaryOffsets ? "offsets" : "parallel";
+  d["offset_mm"] = 1e3 * p.offset;
+  d["radius_mm"] = 1e3 * p.radius;
+  d["pitch_mm"] = 1e3 * p.pitch;
+  d["stagger_loops"] = p.stagger;
+  d["line_angle_deg"] = p.line_angle * 180.0 / kPi;
+  d["edge_overrun_mm"] = 1e3 * p.edge_overrun;
+  return d;
+}
+
+}  // namespace
+
+void BindPolishing(py::module_& m) {
+  py::class_<NurbsSurface, SurfacePtr>(m, "Surface",
+                                       "A NURBS patch, possibly trimmed (a CAD face): what polishing plans on.")
+      .def_property_readonly("name", [](const NurbsSurface& s) { return polishing::SurfaceName(s); })
+      .def_property_readonly("trimmed", [](const NurbsSurface& s) { return static_cast<bool>(s.trim()); })
+      .def("__repr__", [](const NurbsSurface& s) { return "<Surface " + polishing::SurfaceName(s) + ">"; });
+  m.def("load_surface", [](const std::string& path, int face, double cad_unit_scale) -> SurfacePtr {
+    RequireReadableFile(path);
+    if (!io::IsCadFile(path)) {
+      if (face != 0 || cad_unit_scale != 1.0) {
+        throw std::invalid_argument(path + " is a NURBS YAML (one patch, lengths in mm): face and cad_unit_scale "
+                                           "apply to STEP/IGES files");
+      }
+      return std::make_shared<NurbsSurface>(io::ReadNurbsYaml(path));
+    }
+    io::SetUpOpenCascadeExchange();
+    io::CadReadOptions o;
+    o.unit_scale = cad_unit_scale;
+    py::gil_scoped_release release;
+    return std::make_shared<NurbsSurface>(io::ReadCadFace(path, face, o));
+  }, py::arg("path"), py::arg("face") = 0, py::arg("cad_unit_scale") = 1.0,
+     "A surface: NURBS YAML (docs/formats.md §5) or a face of a STEP/IGES file (1-based; 0: the largest by area), "
+     "as polish-plan --surface/--face/--cad-unit-scale.");
+
+  py::class_<PolishingProcess>(m, "PolishingProcess", "The belt-grinding process (docs/formats.md §7).")
+      .def_property_readonly("force_N", [](const PolishingProcess& p) { return p.force; })
+      .def_property_readonly("margin_mm", [](const PolishingProcess& p) { return 1e3 * p.margin; })
+      .def_property_readonly("max_speed_mm_per_s", [](const PolishingProcess& p) { return 1e3 * p.max_speed; })
+      .def_property_readonly("belt_speed_m_per_s", [](const PolishingProcess& p) { return p.belt_speed; });
+  m.def("read_polishing_process", [](const std::string& path) {
+    RequireReadableFile(path);
+    return io::ReadPolishingProcess(path);
+  }, py::arg("path"), "Reads a process YAML. Raises InputError naming file, line and column.");
+
+  m.def("path_patterns", [] {
+    std::vector<std::string> n;
+    for (const auto* p : polishing::PathPatterns()) n.push_back(p->name());
+    return n;
+  }, "The path patterns plan_polishing accepts.");
+
+  py::class_<PyPlan>(m, "PolishPlan", "A planned, simulated polishing path (polish-plan's result).")
+      .def_property_readonly("parameters", [](const PyPlan& p) { return ParamsDict(p.outcome.params); },
+                             "what was planned (the optimum with optimise)")
+      .def_property_readonly("contact_width_mm", [](const PyPlan& p) { return 1e3 * p.context.contact_width; })
+      .def_property_readonly("t_s", [](const PyPlan& p) {
+        std::vector<double> t;
+        for (const auto& r : p.outcome.plan.path.rows) t.push_back(r.t);
+        return t;
+      })
+      .def_property_readonly("p_m", [](const PyPlan& p) {
+        Eigen::MatrixX3d x(p.outcome.plan.path.rows.size(), 3);
+        for (size_t i = 0; i < p.outcome.plan.path.rows.size(); ++i) x.row(i) = p.outcome.plan.path.rows[i].p;
+        return x;
+      }, "contact points (rows, 3) [m] in the part frame")
+      .def_property_readonly("length_m", [](const PyPlan& p) { return p.outcome.plan.path.length; })
+      .def_property_readonly("removal_m", [](const PyPlan& p) { return p.outcome.plan.removal; },
+                             "removal at every grid point [m]")
+      .def_property_readonly("stats", [](const PyPlan& p) { return StatsDict(p.outcome.plan.stats); },
+                             "area-weighted over the region")
+      .def_property_readonly("target_reached", [](const PyPlan& p) -> py::object {
+        return p.outcome.target_given ? py::object(py::bool_(p.outcome.target.reached)) : py::none();
+      }, "None without a target")
+      .def_property_readonly("target_message", [](const PyPlan& p) { return p.outcome.target.message; })
+      .def_property_readonly("infeasible_message", [](const PyPlan& p) { return p.outcome.infeasible_message; })
+      .def_property_readonly("rows_off_face", [](const PyPlan& p) { return p.outcome.rows_off_face; })
+      .def_property_readonly("flagged", [](const PyPlan& p) { return p.outcome.flagged; },
+                             "polish-plan exits 3: a target out of reach, no feasible plan, a better zig-zag, rows off the face")
+      .def_property_readonly("optimisation", [](const PyPlan& p) -> py::object {
+        if (!p.outcome.optimisation) return py::none();
+        const auto& o = *p.outcome.optimisation;
+        py::dict d;
+        d["method"] = o.method;
+        d["status"] = o.status;
+        d["evaluations"] = o.evaluations;
+        d["best_cv"] = o.best.cv;
+        d["feasible"] = o.best.feasible;
+        d["history_cv"] = p.outcome.history_cv;
+        return d;
+      })
+      .def_property_readonly("comparison", [](const PyPlan& p) -> py::object {
+        if (!p.outcome.comparison) return py::none();
+        const auto& c = *p.outcome.comparison;
+        py::dict d;
+        d["parallel"] = ParamsDict(c.parallel);
+        d["parallel_cv"] = c.parallel_stats.cv;
+        d["parallel_reaches_target"] = c.parallel_reaches_target;
+        d["zigzag_better"] = c.zigzag_better;
+        return d;
+      }, "the optimised cycloid against the optimised zig-zag (None unless both were optimised)")
+      .def("__repr__", [](const PyPlan& p) {
+        return "<PolishPlan " + polishing::PathPatternOf(p.outcome.params.pattern).name() + ", " +
+               std::to_string(p.outcome.plan.path.rows.size()) + " rows>";
+      });
+
+  m.def("plan_polishing", [](const SurfacePtr& surface, const PolishingProcess& process, const std::string& pattern,
+                             const std::string& guides, std::optional<double> offset_mm, double radius_mm, double pitch_mm,
+                             double row_step_mm, double sample_mm, double edge_inset_mm, double stagger_loops,
+                             double edge_overrun_mm, double line_angle_deg, double target_removal_um,
+                             const std::string& optimise, bool guides_given, double opt_sample_mm,
+                             double opt_offset_max_mm, double opt_offset_min_contact_widths, double max_time_s,
+                             int threads, unsigned seed, const std::string& surface_source,
+                             const std::string& process_source) {
+    if (guides != "offsets" && guides != "parallel") throw std::invalid_argument("guides: expected offsets or parallel");
+    if (optimise != "none" && optimise != "nlopt" && optimise != "pso") {
+      throw std::invalid_argument("optimise: expected none, nlopt or pso");
+    }
+    if (!(sample_mm > 0.0 && sample_mm <= 0.5)) throw std::invalid_argument("sample_mm: expected in (0, 0.5]");
+    if (!(target_removal_um >= 0.0)) throw std::invalid_argument("target_removal_um: expected >= 0");
+    auto plan = std::make_unique<PyPlan>();
+    plan->surface = surface;
+    polishing::PathParameters params;
+    params.pattern = polishing::FindPathPattern(pattern).id();
+    params.guides = guides == "offsets" ? polishing::GuideLines::kBoundaryOffsets : polishing::GuideLines::kParallelLines;
+    params.radius = MmToM(radius_mm);
+    params.pitch = MmToM(pitch_mm);
+    params.row_step = MmToM(row_step_mm);
+    params.edge_inset = edge_inset_mm < 0 ? -1.0 : MmToM(edge_inset_mm);
+    params.stagger = stagger_loops;
+    params.edge_overrun = MmToM(edge_overrun_mm);
+    params.line_angle = line_angle_deg * kPi / 180.0;
+    polishing::PlanRequest req;
+    req.target_removal = target_removal_um * 1e-6;
+    if (optimise != "none") req.optimise = optimise == "nlopt" ? polishing::Optimiser::kNlopt : polishing::Optimiser::kPso;
+    req.guides_given = guides_given;
+    req.opt_sample_spacing = MmToM(opt_sample_mm);
+    req.opt_offset_min_contact_widths = opt_offset_min_contact_widths;
+    req.opt_offset_max = MmToM(opt_offset_max_mm);
+    req.max_time_s = max_time_s;
+    req.threads = threads;
+    req.seed = seed;
+    {
+      py::gil_scoped_release release;
+      plan->context = polishing::PreparePlanning(*surface, process, MmToM(sample_mm), surface_source, process_source);
+      // The zig-zag's rows are one contact width apart unless told otherwise (polish-plan's default).
+      params.offset = offset_mm ? MmToM(*offset_mm)
+                                : params.pattern == polishing::Pattern::kParallel ? plan->context.contact_width
+                                                                                  : 0.008;
+      polishing::CheckValid(params);
+      req.params = params;
+      plan->outcome = polishing::PlanPolishing(plan->context, req);
+    }
+    return plan;
+  }, py::arg("surface"), py::arg("process"), py::arg("pattern") = "cycloid", py::arg("guides") = "offsets",
+     py::arg("offset_mm") = py::none(), py::arg("radius_mm") = 6.0, py::arg("pitch_mm") = 3.0,
+     py::arg("row_step_mm") = 0.5, py::arg("sample_mm") = 0.5, py::arg("edge_inset_mm") = -1.0,
+     py::arg("stagger_loops") = 0.5, py::arg("edge_overrun_mm") = 0.0, py::arg("line_angle_deg") = 0.0,
+     py::arg("target_removal_um") = 0.0, py::arg("optimise") = "none", py::arg("guides_given") = false,
+     py::arg("opt_sample_mm") = 1.0, py::arg("opt_offset_max_mm") = 30.0, py::arg("opt_offset_min_contact_widths") = 0.3,
+     py::arg("max_time_s") = 50.0, py::arg("threads") = 2, py::arg("seed") = 20240404u,
+     py::arg("surface_source") = "surface", py::arg("process_source") = "process",
+     "polish-plan's call with its defaults (the same names, units in them): the region sampled, the path planned "
+     "(optimised with optimise='nlopt' or 'pso'), simulated and timed for target_removal_um. offset_mm None: 8 mm "
+     "for the cycloid, one contact width for the zig-zag. surface_source and process_source name the files in "
+     "errors. The GIL is released while it runs.");
+
+  m.def("write_polish_path", [](const std::string& path, const PyPlan& plan) {
+    io::WritePolishPath(path, plan.outcome.plan.path.rows, io::PlannedPathMetadata(plan.outcome.params, plan.context.process));
+  }, py::arg("path"), py::arg("plan"), "polish-plan's --path (docs/formats.md §6), atomic.");
+  m.def("write_removal_map", [](const std::string& path, const PyPlan& plan) {
+    io::WriteRemovalMap(path, *plan.context.grid, plan.outcome.plan.removal);
+  }, py::arg("path"), py::arg("plan"), "polish-plan's --removal, atomic.");
+}
+
+}  // namespace robomach::python

@@ -1,0 +1,63 @@
+"""Polishing through Python: plan_polishing reproduces polish-plan's path
+and removal files byte for byte (the same library calls) on a cycloid timed
+for a target and on the zig-zag, its statistics equal the tool's summary,
+and bad input raises with the file named."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+import robomach as rm
+from conftest import SOURCE_DIR, run_tool
+
+P = os.path.join(SOURCE_DIR, 'config', 'polishing')
+DOME, CYLINDER, BELT = (os.path.join(P, f) for f in ('dome.yaml', 'cylinder_r60.yaml', 'belt_2N.yaml'))
+
+
+@pytest.mark.parametrize('surface, options, tool_args', [
+    (DOME, dict(target_removal_um=2.0), ['--target-removal-um', 2]),
+    (CYLINDER, dict(pattern='parallel', line_angle_deg=90.0), ['--pattern', 'parallel', '--line-angle-deg', 90]),
+])
+def test_plan_equals_polish_plan(tmp, surface, options, tool_args):
+    r = run_tool('polish-plan', '--surface', surface, '--process', BELT, *tool_args, '--path', tmp / 'tool_path.csv',
+                 '--removal', tmp / 'tool_removal.csv', '--summary', tmp / 'tool.json', expect_rc=None)
+    plan = rm.plan_polishing(rm.load_surface(surface), rm.read_polishing_process(BELT), **options)
+    rm.write_polish_path(str(tmp / 'py_path.csv'), plan)
+    rm.write_removal_map(str(tmp / 'py_removal.csv'), plan)
+    assert (tmp / 'py_path.csv').read_text() == (tmp / 'tool_path.csv').read_text()
+    assert (tmp / 'py_removal.csv').read_text() == (tmp / 'tool_removal.csv').read_text()
+    s = json.loads((tmp / 'tool.json').read_text())
+    assert plan.stats['cv'] == pytest.approx(s['removal_um']['cv'], rel=1e-12)
+    assert plan.stats['mean_um'] == pytest.approx(s['removal_um']['mean'], rel=1e-12)
+    assert plan.flagged == (r.returncode == 3)
+    # With a target: reached, the mean is the target; out of reach within the
+    # speed limit, the path runs at the limit and removes more (flagged).
+    if 'target_removal_um' in options:
+        target = options['target_removal_um']
+        assert plan.target_reached == s['target']['reached']
+        if plan.target_reached:
+            assert plan.stats['mean_um'] == pytest.approx(target, rel=1e-6)
+        else:
+            assert plan.flagged and plan.target_message and plan.stats['mean_um'] > target
+    else:
+        assert plan.target_reached is None
+    assert np.all(np.diff(plan.t_s) >= 0)
+    assert plan.p_m.shape == (len(plan.t_s), 3)
+
+
+def test_bad_input(tmp):
+    surface = rm.load_surface(DOME)
+    process = rm.read_polishing_process(BELT)
+    with pytest.raises(ValueError, match='unknown path pattern'):
+        rm.plan_polishing(surface, process, pattern='spiral')
+    with pytest.raises(ValueError, match='d <= 2r'):
+        rm.plan_polishing(surface, process, offset_mm=20.0)
+    with pytest.raises(ValueError, match='STEP/IGES'):
+        rm.load_surface(DOME, face=2)
+    bad = tmp / 'belt.yaml'
+    bad.write_text(open(BELT).read().replace('margin_mm', 'margin_cm'))
+    with pytest.raises(rm.InputError) as e:
+        rm.read_polishing_process(str(bad))
+    assert e.value.path == str(bad)
+    assert set(rm.path_patterns()) == {'cycloid', 'parallel'}
