@@ -97,4 +97,5 @@ PYBIND11_MODULE(robomach, m) {
   BindStability(m);
   BindDrilling(m);
   BindPolishing(m);
+  BindMachine(m);
 }

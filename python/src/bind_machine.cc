@@ -1,0 +1,150 @@
+// Python bindings of the five-axis machine tools (docs/python.md): the
+// acquisition of axis-acquire (counts -> compensated axes -> tool pose, the
+// contour error against a programmed path) and the ISO 230-2 evaluation of
+// axis-accuracy.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "robomach/common/errors.h"
+#include "robomach/io/acquired_path_file.h"
+#include "robomach/io/atomic_file.h"
+#include "robomach/io/compensation_file.h"
+#include "robomach/io/counts_file.h"
+#include "robomach/io/iso_runs_file.h"
+#include "robomach/io/machine_file.h"
+#include "robomach/io/program_file.h"
+#include "robomach/io/temperature_log.h"
+#include "robomach/machine/iso230.h"
+
+namespace robomach::python {
+
+void BindMachine(py::module_& m) {
+  m.def("acquire", [](const std::string& machine_path, const std::string& counts_path,
+                      const std::optional<std::string>& compensation, const std::optional<std::string>& temperature,
+                      const std::optional<std::string>& program, const std::optional<std::string>& out) {
+    for (const auto& p : {std::optional<std::string>(machine_path), std::optional<std::string>(counts_path), compensation,
+                          temperature, program}) {
+      if (p) RequireReadableFile(*p);
+    }
+    const io::MachineFile mf = io::ReadMachineFile(machine_path);
+    io::CompensationTables tables;
+    if (compensation) tables = io::ReadCompensationFile(*compensation, mf);
+    std::vector<machine::TemperatureCompensation> temps;
+    if (temperature) temps = io::ReadTemperatureLog(*temperature, mf);
+    const machine::Compensation comp(static_cast<int>(mf.machine.axes.size()), tables.encoder, tables.cross_axis, temps);
+    std::optional<machine::ProgrammedPath> path;
+    if (program) path = io::ReadProgramFile(*program);
+    const machine::CountsRecord rec = io::ReadCountsFile(counts_path, mf);
+    const long rows = rec.rows();
+    const int n = rec.num_axes;
+    Eigen::MatrixXd axes(rows, n), tip(rows, 3), tool_axis(rows, 3);
+    std::vector<machine::ContourError> contour;
+    {
+      py::gil_scoped_release release;
+      machine::Acquisition acq(mf.machine, comp.empty() ? nullptr : &comp);
+      std::optional<machine::ContourTracker> tracker;
+      if (path) tracker.emplace(*path);
+      for (long r = 0; r < rows; ++r) {
+        const machine::AcquiredSample& s = acq.Process(rec.t_s[r], rec.counts.data() + r * n);
+        for (int a = 0; a < n; ++a) axes(r, a) = s.real[a];
+        tip.row(r) = s.pose.p_W.transpose();
+        tool_axis.row(r) = s.pose.k_W.transpose();
+        if (tracker) contour.push_back(tracker->Next(s.pose));
+      }
+      if (out) {
+        // axis-acquire's --out: the same rows through the file's writer.
+        machine::Acquisition again(mf.machine, comp.empty() ? nullptr : &comp);
+        std::optional<machine::ContourTracker> t2;
+        if (path) t2.emplace(*path);
+        io::WriteFileAtomically(*out, [&](std::ostream& os) {
+          io::WriteAcquiredPath(os, rec, mf.machine.axes, &again, t2 ? &*t2 : nullptr);
+        });
+      }
+    }
+    py::dict d;
+    std::vector<std::string> names;
+    for (const auto& a : mf.machine.axes) names.push_back(a.name);
+    d["axis_names"] = names;
+    d["t_s"] = rec.t_s;
+    d["axes"] = axes;
+    d["tip_m"] = tip;
+    d["tool_axis"] = tool_axis;
+    if (path) {
+      Eigen::VectorXd dist(rows), ang(rows), s(rows);
+      for (long r = 0; r < rows; ++r) {
+        dist(r) = contour[r].distance;
+        ang(r) = contour[r].axis_angle;
+        s(r) = contour[r].s;
+      }
+      d["contour_error_m"] = dist;
+      d["axis_error_rad"] = ang;
+      d["path_s_m"] = s;
+      d["unit_findings"] = machine::ContourUnitFindings(contour, *path);
+    }
+    return d;
+  }, py::arg("machine"), py::arg("counts"), py::arg("compensation") = py::none(), py::arg("temperature") = py::none(),
+     py::arg("program") = py::none(), py::arg("out") = py::none(),
+     "axis-acquire's call: encoder counts (docs/formats.md §8.1) through the machine file's scales, the controller's "
+     "compensation tables and temperature log, to compensated axis positions [m, rad] and the tool tip and axis in "
+     "workpiece coordinates; with a programmed path, the contour error of every sample (and axis-acquire's unit "
+     "findings). out: also write axis-acquire's --out file. Returns a dict of arrays (rows first). The GIL is "
+     "released while it runs.");
+
+  m.def("iso230_evaluate", [](const std::string& runs_path) {
+    RequireReadableFile(runs_path);
+    const io::IsoRuns runs = io::ReadIsoRuns(runs_path);
+    py::dict axes;
+    std::vector<std::string> findings;
+    for (const std::string& axis : runs.axis_order) {
+      machine::Iso230Result r;
+      try {
+        r = machine::EvaluateIso230(runs.approaches.at(axis));
+      } catch (const std::invalid_argument& e) {
+        throw InputError({runs_path, 0, 0}, "axis " + axis + ": " + e.what());
+      }
+      py::dict a;
+      a["A"] = r.A;
+      a["A_up"] = r.A_up;
+      a["A_down"] = r.A_down;
+      a["E"] = r.E;
+      a["E_up"] = r.E_up;
+      a["E_down"] = r.E_down;
+      a["M"] = r.M;
+      a["R"] = r.R;
+      a["R_up"] = r.R_up;
+      a["R_down"] = r.R_down;
+      a["B"] = r.B;
+      a["B_mean"] = r.B_mean;
+      py::list targets;
+      for (const auto& t : r.targets) {
+        py::dict td;
+        td["target"] = t.target;
+        td["runs_up"] = t.runs_up;
+        td["runs_down"] = t.runs_down;
+        td["mean_up"] = t.mean_up;
+        td["mean_down"] = t.mean_down;
+        td["s_up"] = t.s_up;
+        td["s_down"] = t.s_down;
+        td["mean"] = t.mean;
+        td["B"] = t.reversal;
+        td["R"] = t.R;
+        targets.append(td);
+      }
+      a["targets"] = targets;
+      axes[py::str(axis)] = a;
+      for (const std::string& f : machine::Iso230UnitFindings(axis, r, runs.rotary)) findings.push_back(f);
+    }
+    py::dict d;
+    d["unit"] = runs.rotary ? "deg" : "mm";
+    d["axes"] = axes;
+    d["unit_findings"] = findings;
+    return d;
+  }, py::arg("runs"),
+     "axis-accuracy's evaluation: ISO 230-2 accuracy A, systematic error E, mean error M, repeatability R, "
+     "reversal B per axis of a runs file (docs/formats.md §8.6), in the file's unit (mm or deg), with the "
+     "per-target statistics and the unit plausibility findings.");
+}
+
+}  // namespace robomach::python

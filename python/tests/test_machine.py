@@ -1,0 +1,62 @@
+"""The five-axis machine tools through Python: acquire reproduces
+axis-acquire's acquired path byte for byte (on counts axis-synth made, with
+the controller's compensation and temperature log) and its contour error
+statistics, and iso230_evaluate equals axis-accuracy's JSON to 1e-12. Then
+bad input."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+import robomach as rm
+from conftest import DATA, SOURCE_DIR, run_tool
+
+M = os.path.join(SOURCE_DIR, 'config', 'machine')
+MACHINE, PROGRAM, COMP, TEMP = (os.path.join(M, f) for f in
+                                ('dmu80p.yaml', 'cone_frustum.csv', 'dmu80p_comp.mpf', 'dmu80p_temperature.csv'))
+
+
+def test_acquire_equals_axis_acquire(tmp):
+    run_tool('axis-synth', '--machine', MACHINE, '--program', PROGRAM, '--compensation', COMP, '--temperature', TEMP,
+             '--feed-mm-min', 20000, '--sample-rate-hz', 2000, '--out', tmp / 'counts.csv',
+             '--machine-out', tmp / 'machine.yaml')
+    run_tool('axis-acquire', '--machine', tmp / 'machine.yaml', '--counts', tmp / 'counts.csv', '--compensation', COMP,
+             '--temperature', TEMP, '--program', PROGRAM, '--out', tmp / 'tool.csv', '--summary', tmp / 'tool.json',
+             expect_rc=None)
+    a = rm.acquire(str(tmp / 'machine.yaml'), str(tmp / 'counts.csv'), compensation=COMP, temperature=TEMP,
+                   program=PROGRAM, out=str(tmp / 'py.csv'))
+    assert (tmp / 'py.csv').read_text() == (tmp / 'tool.csv').read_text()
+    s = json.loads((tmp / 'tool.json').read_text())
+    d_um = a['contour_error_m'] * 1e6
+    assert d_um.max() == pytest.approx(s['contour_error_um']['max'], rel=1e-12)
+    assert np.sqrt(np.mean(d_um ** 2)) == pytest.approx(s['contour_error_um']['rms'], rel=1e-9)
+    assert a['axes'].shape == (len(a['t_s']), 5) and a['tip_m'].shape == (len(a['t_s']), 3)
+    # The tool axis is a unit vector; the synthesised machine follows the path to well under a millimetre.
+    np.testing.assert_allclose(np.linalg.norm(a['tool_axis'], axis=1), 1.0, atol=1e-12)
+    assert d_um.max() < 1000.0
+    assert a['unit_findings'] == []
+
+
+def test_iso230_equals_axis_accuracy(tmp):
+    runs = os.path.join(DATA, 'machine', 'x_runs_hand.csv')
+    run_tool('axis-accuracy', '--runs', runs, '--out', tmp / 'tool.json', expect_rc=None)
+    tool = json.loads((tmp / 'tool.json').read_text())
+    r = rm.iso230_evaluate(runs)
+    assert r['unit'] == tool['unit']
+    for axis, t in tool['axes'].items():
+        for k in ('A', 'A_up', 'A_down', 'E', 'M', 'R', 'R_up', 'R_down', 'B', 'B_mean'):
+            assert r['axes'][axis][k] == pytest.approx(t[k], rel=1e-12, abs=1e-15)
+        # ISO 230-2: A is at least the systematic error E and the repeatability R of each direction.
+        a = r['axes'][axis]
+        assert a['A'] >= a['E'] - 1e-12 and a['A'] >= max(a['R_up'], a['R_down']) - 1e-12
+
+
+def test_bad_input(tmp):
+    with pytest.raises(FileNotFoundError):
+        rm.acquire(MACHINE, str(tmp / 'none.csv'))
+    with pytest.raises(rm.InputError) as e:
+        rm.acquire(MACHINE, os.path.join(DATA, 'machine', 'counts_first_row_nonzero.csv'))
+    assert e.value.path.endswith('counts_first_row_nonzero.csv') and e.value.line == 3
+    with pytest.raises(rm.InputError, match='axis'):
+        rm.iso230_evaluate(os.path.join(DATA, 'machine', 'x_runs_no_down.csv'))
