@@ -10,7 +10,8 @@
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/io/atomic_file.h"
-#include "robomach/io/machine_files.h"
+#include "robomach/io/acquired_path_file.h"
+#include "robomach/io/acquisition_inputs.h"
 #include "robomach/machine/acquisition.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/posture_json.h"
@@ -78,18 +79,16 @@ int Run(int argc, char** argv) {
                         {"--temperature", temp_path}, {"--program", program_path}},
                        {{"--out", out_path}, {"--summary", summary_path}, {"--plot", plot_path}});
     // Read and check every input before writing anything.
-    const io::MachineFile mf = io::ReadMachineFile(machine_path);
-    io::CompensationTables tables;
-    if (!comp_path.empty()) tables = io::ReadCompensationFile(comp_path, mf);
-    std::vector<machine::TemperatureCompensation> temps;
-    if (!temp_path.empty()) temps = io::ReadTemperatureLog(temp_path, mf);
-    const machine::Compensation comp(static_cast<int>(mf.machine.axes.size()), tables.encoder, tables.cross_axis, temps);
-    std::optional<machine::ProgrammedPath> path;
-    if (!program_path.empty()) path = io::ReadProgramFile(program_path);
-    const machine::CountsRecord rec = io::ReadCountsFile(counts_path, mf);
+    const io::AcquisitionInputs in =
+        io::ReadAcquisitionInputs(machine_path, counts_path, comp_path, temp_path, program_path);
+    const io::MachineFile& mf = in.machine;
+    const io::CompensationTables& tables = in.tables;
+    const std::vector<machine::TemperatureCompensation>& temps = in.temperatures;
+    const std::optional<machine::ProgrammedPath>& path = in.program;
+    const machine::CountsRecord& rec = in.counts;
     const size_t n = mf.machine.axes.size();
 
-    machine::Acquisition acq(mf.machine, comp.empty() ? nullptr : &comp);
+    machine::Acquisition acq(mf.machine, in.applied());
     std::optional<machine::ContourTracker> tracker;
     if (path) tracker.emplace(*path);
     // Rows are computed in order (the contour tracker follows the path)

@@ -9,13 +9,9 @@
 #include "bindings.h"
 #include "robomach/common/errors.h"
 #include "robomach/io/acquired_path_file.h"
+#include "robomach/io/acquisition_inputs.h"
 #include "robomach/io/atomic_file.h"
-#include "robomach/io/compensation_file.h"
-#include "robomach/io/counts_file.h"
 #include "robomach/io/iso_runs_file.h"
-#include "robomach/io/machine_file.h"
-#include "robomach/io/program_file.h"
-#include "robomach/io/temperature_log.h"
 #include "robomach/machine/iso230.h"
 
 namespace robomach::python {
@@ -28,22 +24,18 @@ void BindMachine(py::module_& m) {
                           temperature, program}) {
       if (p) RequireReadableFile(*p);
     }
-    const io::MachineFile mf = io::ReadMachineFile(machine_path);
-    io::CompensationTables tables;
-    if (compensation) tables = io::ReadCompensationFile(*compensation, mf);
-    std::vector<machine::TemperatureCompensation> temps;
-    if (temperature) temps = io::ReadTemperatureLog(*temperature, mf);
-    const machine::Compensation comp(static_cast<int>(mf.machine.axes.size()), tables.encoder, tables.cross_axis, temps);
-    std::optional<machine::ProgrammedPath> path;
-    if (program) path = io::ReadProgramFile(*program);
-    const machine::CountsRecord rec = io::ReadCountsFile(counts_path, mf);
+    const io::AcquisitionInputs in = io::ReadAcquisitionInputs(machine_path, counts_path, compensation.value_or(""),
+                                                                temperature.value_or(""), program.value_or(""));
+    const io::MachineFile& mf = in.machine;
+    const std::optional<machine::ProgrammedPath>& path = in.program;
+    const machine::CountsRecord& rec = in.counts;
     const long rows = rec.rows();
     const int n = rec.num_axes;
     Eigen::MatrixXd axes(rows, n), tip(rows, 3), tool_axis(rows, 3);
     std::vector<machine::ContourError> contour;
     {
       py::gil_scoped_release release;
-      machine::Acquisition acq(mf.machine, comp.empty() ? nullptr : &comp);
+      machine::Acquisition acq(mf.machine, in.applied());
       std::optional<machine::ContourTracker> tracker;
       if (path) tracker.emplace(*path);
       for (long r = 0; r < rows; ++r) {
@@ -55,7 +47,7 @@ void BindMachine(py::module_& m) {
       }
       if (out) {
         // axis-acquire's --out: the same rows through the file's writer.
-        machine::Acquisition again(mf.machine, comp.empty() ? nullptr : &comp);
+        machine::Acquisition again(mf.machine, in.applied());
         std::optional<machine::ContourTracker> t2;
         if (path) t2.emplace(*path);
         io::WriteFileAtomically(*out, [&](std::ostream& os) {

@@ -1,0 +1,37 @@
+#pragma once
+// axis-acquire's inputs read and checked together (docs/formats.md §8): the
+// machine file, the encoder counts, and optionally the controller's
+// compensation tables, its temperature log and the programmed path.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "robomach/io/compensation_file.h"
+#include "robomach/io/machine_file.h"
+#include "robomach/machine/acquisition.h"
+#include "robomach/machine/compensation.h"
+#include "robomach/machine/synthesis.h"
+
+namespace robomach::io {
+
+struct AcquisitionInputs {
+  MachineFile machine;
+  CompensationTables tables;                                 // empty without a compensation file
+  std::vector<machine::TemperatureCompensation> temperatures;  // empty without a temperature log
+  std::unique_ptr<machine::Compensation> compensation;       // all of them; empty() when none
+  std::optional<machine::ProgrammedPath> program;
+  machine::CountsRecord counts;
+  /// The compensation the acquisition applies (null when there is none).
+  const machine::Compensation* applied() const { return compensation->empty() ? nullptr : compensation.get(); }
+};
+
+/// Reads every input before any work (an empty path: not given).
+/// @throws InputError naming the file, line and column of the first problem.
+AcquisitionInputs ReadAcquisitionInputs(const std::string& machine_path, const std::string& counts_path,
+                                        const std::string& compensation_path = "",
+                                        const std::string& temperature_path = "",
+                                        const std::string& program_path = "");
+
+}  // namespace robomach::io

@@ -1,0 +1,23 @@
+#include "robomach/io/acquisition_inputs.h"
+
+#include "robomach/io/counts_file.h"
+#include "robomach/io/program_file.h"
+#include "robomach/io/temperature_log.h"
+
+namespace robomach::io {
+
+AcquisitionInputs ReadAcquisitionInputs(const std::string& machine_path, const std::string& counts_path,
+                                        const std::string& compensation_path, const std::string& temperature_path,
+                                        const std::string& program_path) {
+  AcquisitionInputs in;
+  in.machine = ReadMachineFile(machine_path);
+  if (!compensation_path.empty()) in.tables = ReadCompensationFile(compensation_path, in.machine);
+  if (!temperature_path.empty()) in.temperatures = ReadTemperatureLog(temperature_path, in.machine);
+  in.compensation = std::make_unique<machine::Compensation>(static_cast<int>(in.machine.machine.axes.size()),
+                                                            in.tables.encoder, in.tables.cross_axis, in.temperatures);
+  if (!program_path.empty()) in.program = ReadProgramFile(program_path);
+  in.counts = ReadCountsFile(counts_path, in.machine);
+  return in;
+}
+
+}  // namespace robomach::io
