@@ -294,9 +294,8 @@ int Run(int argc, char** argv) {
     lo.process = cut.process;
     lo.min_speed_rad_s = cut.spindle_speed_min_rad_s;
     lo.max_speed_rad_s = cut.spindle_speed_max_rad_s;
-    lo.zoa_speeds_rad_s = Eigen::VectorXd::LinSpaced(speeds > 0 ? speeds : cut.spindle_speed_count,
-                                                     cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
-    lo.sd_speeds_rad_s = Eigen::VectorXd::LinSpaced(sd_speeds, cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
+    lo.zoa_speeds_rad_s = cut.SpeedRange(speeds);
+    lo.sd_speeds_rad_s = cut.SpeedRange(sd_speeds);
     lo.max_lobe_index = max_lobe;
     lo.sd.steps_per_period = sd_steps;
     lo.sd.steps_per_mode_period = sd_steps_per_mode;

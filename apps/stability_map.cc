@@ -90,9 +90,7 @@ int Run(int argc, char** argv) {
     opt.rotation_evaluations = rotation_evals;
     opt.threads = threads;
     opt.analysis.spindle_speed_rad_s =
-        cut.spindle_speed_rad_s ? cut.SpeedGrid()
-                                : Eigen::VectorXd::LinSpaced(speeds > 0 ? speeds : cut.spindle_speed_count,
-                                                             cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
+        cut.spindle_speed_rad_s ? cut.SpeedGrid() : cut.SpeedRange(speeds);
     opt.analysis.mode_coupling.max_depth = MmToM(max_depth_mm);
 
     std::vector<stability::ToolPoseTarget> targets;

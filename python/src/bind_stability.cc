@@ -207,9 +207,8 @@ void BindStability(py::module_& m) {
     o.process = cut.process;
     o.min_speed_rad_s = cut.spindle_speed_min_rad_s;
     o.max_speed_rad_s = cut.spindle_speed_max_rad_s;
-    o.zoa_speeds_rad_s = Eigen::VectorXd::LinSpaced(speeds > 0 ? speeds : cut.spindle_speed_count,
-                                                    cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
-    o.sd_speeds_rad_s = Eigen::VectorXd::LinSpaced(sd_speeds, cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
+    o.zoa_speeds_rad_s = cut.SpeedRange(speeds);
+    o.sd_speeds_rad_s = cut.SpeedRange(sd_speeds);
     o.max_lobe_index = max_lobe;
     o.sd.steps_per_period = sd_steps;
     o.sd.steps_per_mode_period = sd_steps_per_mode_period;
@@ -322,9 +321,7 @@ void BindStability(py::module_& m) {
     o.rotation_evaluations = rotation_evaluations;
     o.threads = threads;
     o.analysis.spindle_speed_rad_s =
-        cut.spindle_speed_rad_s ? cut.SpeedGrid()
-                                : Eigen::VectorXd::LinSpaced(speeds > 0 ? speeds : cut.spindle_speed_count,
-                                                             cut.spindle_speed_min_rad_s, cut.spindle_speed_max_rad_s);
+        cut.spindle_speed_rad_s ? cut.SpeedGrid() : cut.SpeedRange(speeds);
     o.analysis.mode_coupling.max_depth = MmToM(max_depth_mm);
     std::vector<stability::MapPoint> pts;
     {

@@ -12,6 +12,11 @@ Eigen::VectorXd CutSpec::SpeedGrid() const {
   return Eigen::VectorXd::LinSpaced(spindle_speed_count, spindle_speed_min_rad_s, spindle_speed_max_rad_s);
 }
 
+Eigen::VectorXd CutSpec::SpeedRange(int count) const {
+  return Eigen::VectorXd::LinSpaced(count > 0 ? count : spindle_speed_count, spindle_speed_min_rad_s,
+                                    spindle_speed_max_rad_s);
+}
+
 namespace {
 
 Eigen::Vector3d UnitVector(const YamlDoc& node) {

@@ -17,22 +17,8 @@ namespace {
 using ::testing::HasSubstr;
 using testing::PlanarRodArm;
 using testing::SeedDrives;
-using testing::SeedPosture;
-
-DrillingMaterial Q235Like() {
-  DrillingMaterial m;
-  m.shear_stress_thrust = 930e6;
-  m.shear_stress_torque = 600e6;
-  m.kienzle_exponent = 0.24;
-  return m;
-}
-
-DrillingProcess ShortProcess() {
-  DrillingProcess p;
-  p.initial_posture = SeedPosture();
-  p.duration = 0.2;
-  return p;
-}
+using testing::Q235Like;
+using testing::SeedProcess;
 
 // drill-sim's runs: every kind in order with its given gains (else the
 // defaults), the same series as building the controller and running the
@@ -41,7 +27,7 @@ DrillingProcess ShortProcess() {
 // definition).
 TEST(RunControllers, EachKindAsGivenOrDefaultWithTheTdeConditionForPdTdc) {
   FlexibleJointRobot robot(PlanarRodArm(true), SeedDrives(5.0));
-  DrillingScenario sc(&robot, DrillGeometry{}, Q235Like(), ShortProcess());
+  DrillingScenario sc(&robot, DrillGeometry{}, Q235Like(), SeedProcess(0.2));
   ControllerRunOptions o;
   o.kinds = {"pid", "pd-tdc"};
   ControllerParameters pid = DefaultParameters("pid");
@@ -81,7 +67,7 @@ TEST(RunControllers, EachKindAsGivenOrDefaultWithTheTdeConditionForPdTdc) {
 // value per joint.
 TEST(RunControllers, RefusesAnUnknownKindAndAWrongTorqueLimit) {
   FlexibleJointRobot robot(PlanarRodArm(true), SeedDrives(5.0));
-  DrillingScenario sc(&robot, DrillGeometry{}, Q235Like(), ShortProcess());
+  DrillingScenario sc(&robot, DrillGeometry{}, Q235Like(), SeedProcess(0.2));
   ControllerRunOptions o;
   o.kinds = {"pid", "lqr"};
   o.motor_torque_limit = Eigen::VectorXd::Constant(3, 10.0);

@@ -11,22 +11,9 @@ namespace {
 
 using testing::PlanarRodArm;
 using testing::SeedDrives;
+using testing::Q235Like;
 using testing::SeedPosture;
-
-DrillingMaterial Q235Like() {
-  DrillingMaterial m;
-  m.shear_stress_thrust = 930e6;
-  m.shear_stress_torque = 600e6;
-  m.kienzle_exponent = 0.24;
-  return m;
-}
-
-DrillingProcess SeedProcess(double duration) {
-  DrillingProcess p;
-  p.initial_posture = SeedPosture();
-  p.duration = duration;
-  return p;
-}
+using testing::SeedProcess;
 
 TEST(DrillingScenario, DesiredPathFeedsTheTipAlongTheHoleAxis) {
   FlexibleJointRobot robot(PlanarRodArm(true), SeedDrives(5.0));

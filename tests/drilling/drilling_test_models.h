@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include "robomach/common/units.h"
+#include "robomach/drilling/drilling_sim.h"
 #include "robomach/drilling/flexible_joint_robot.h"
 #include "robomach/kinematics/modified_dh.h"
 
@@ -42,6 +43,23 @@ inline std::vector<JointDrive> SeedDrives(double damping) {
 
 inline Eigen::VectorXd SeedPosture() {
   return Eigen::Vector3d(DegToRad(-90.0), DegToRad(90.0), DegToRad(90.0));
+}
+
+/// Q235 steel's shear stresses and Kienzle exponent, rounded (config/drilling/q235.yaml).
+inline DrillingMaterial Q235Like() {
+  DrillingMaterial m;
+  m.shear_stress_thrust = 930e6;
+  m.shear_stress_torque = 600e6;
+  m.kienzle_exponent = 0.24;
+  return m;
+}
+
+/// The seed's process at SeedPosture, `duration` [s] long.
+inline DrillingProcess SeedProcess(double duration) {
+  DrillingProcess p;
+  p.initial_posture = SeedPosture();
+  p.duration = duration;
+  return p;
 }
 
 /// Largest difference between the link accelerations of Derivative() (its

@@ -25,6 +25,9 @@ struct CutSpec {
 
   /// `spindle_speed_count` speeds evenly spaced in [min, max] (or the fixed one).
   Eigen::VectorXd SpeedGrid() const;
+  /// `count` speeds evenly spaced in [min, max] (0: spindle_speed_count),
+  /// the fixed speed ignored: stability-lobes' grids.
+  Eigen::VectorXd SpeedRange(int count) const;
 };
 
 /// Reads a cut file. Keys: `diameter_mm`, `teeth` (>= 1), `radial_immersion`
