@@ -144,15 +144,21 @@ int Run(int argc, char** argv) {
              "speed limit (the path runs at the limit), or --optimise found no plan that reaches it; the optimised zig-zag "
              "is more uniform than the optimised cycloid (the message names it); path rows in contact lie off a trimmed face; with --robot, "
              "rows are unreachable, outside the joint limits or after a joint jump > 0.5 rad.");
-  std::string surface_path, process_path, pattern = "cycloid", guides = "offsets", optimise = "none", path_out,
-                                          removal_out, summary_out, plot_out;
+  std::string surface_path, process_path, path_out, removal_out, summary_out, plot_out;
   SurfaceChoice choice;
   bool list_faces = false;
   std::string list_out;
-  double target_um = 0.0, offset_mm = 8.0, radius_mm = 6.0, pitch_mm = 3.0, sample_mm = 0.5, row_step_mm = 0.5;
-  double opt_sample_mm = 1.0, opt_offset_max_mm = 30.0, opt_offset_min_cw = 0.3, edge_inset_mm = -1.0;
-  int seed = 20240404, threads = 2;
-  double max_time_s = 50.0, stagger_loops = 0.5, line_angle_deg = 0.0, edge_overrun_mm = 0.0;
+  // The planning options with the library's defaults (polishing::PlanOptions).
+  polishing::PlanOptions po;
+  std::string &pattern = po.pattern, &guides = po.guides, &optimise = po.optimise;
+  double offset_mm = 8.0, sample_mm = 0.5;
+  double &target_um = po.target_removal_um, &radius_mm = po.radius_mm, &pitch_mm = po.pitch_mm,
+         &row_step_mm = po.row_step_mm, &opt_sample_mm = po.opt_sample_mm, &opt_offset_max_mm = po.opt_offset_max_mm,
+         &opt_offset_min_cw = po.opt_offset_min_contact_widths, &edge_inset_mm = po.edge_inset_mm,
+         &max_time_s = po.max_time_s, &stagger_loops = po.stagger_loops, &line_angle_deg = po.line_angle_deg,
+         &edge_overrun_mm = po.edge_overrun_mm;
+  int& threads = po.threads;
+  int seed = static_cast<int>(po.seed);
   RobotOptions robot;
   app.add_option("--surface", surface_path, "NURBS patch YAML, or STEP (.step/.stp) / IGES (.iges/.igs) file (docs/formats.md §5)")->required();
   AddSurfaceChoiceOptions(&app, &choice);
@@ -260,31 +266,13 @@ int Run(int argc, char** argv) {
     const polishing::SampleGrid& grid = *ctx.grid;
     const double contact_width = ctx.contact_width;
 
-    polishing::PathParameters params;
-    params.pattern = polishing::FindPathPattern(pattern).id();
-    params.guides = guides == "offsets" ? polishing::GuideLines::kBoundaryOffsets : polishing::GuideLines::kParallelLines;
-    params.offset = params.pattern == polishing::Pattern::kParallel && !offset_given ? contact_width : MmToM(offset_mm);
-    params.radius = MmToM(radius_mm);
-    params.pitch = MmToM(pitch_mm);
-    params.row_step = MmToM(row_step_mm);
-    params.edge_inset = edge_inset_mm < 0 ? -1.0 : MmToM(edge_inset_mm);
-    params.stagger = stagger_loops;
-    params.edge_overrun = MmToM(edge_overrun_mm);
-    params.line_angle = line_angle_deg * kPi / 180.0;
+    if (offset_given) po.offset_mm = offset_mm;
+    po.guides_given = guides_given;
+    po.seed = static_cast<unsigned>(seed);
     // Every parameter comes from an option: a value out of its limits is exit 64.
-    FromOption("path parameters", [&] { polishing::CheckValid(params); });
-
     polishing::PlanRequest req;
-    req.params = params;
-    req.target_removal = target_um * 1e-6;  // [um] -> [m]
-    if (optimise != "none") req.optimise = optimise == "nlopt" ? polishing::Optimiser::kNlopt : polishing::Optimiser::kPso;
-    req.guides_given = guides_given;
-    req.opt_sample_spacing = MmToM(opt_sample_mm);
-    req.opt_offset_min_contact_widths = opt_offset_min_cw;
-    req.opt_offset_max = MmToM(opt_offset_max_mm);
-    req.max_time_s = max_time_s;
-    req.threads = threads;
-    req.seed = static_cast<unsigned>(seed);
+    FromOption("path parameters", [&] { req = polishing::ToPlanRequest(po, ctx); });
+    polishing::PathParameters params = req.params;
     // The progress line counts per mille of the time budget (the optimiser
     // stops on convergence, usually before it).
     std::optional<ProgressLine> progress;

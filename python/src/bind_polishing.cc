@@ -149,6 +149,7 @@ void BindPolishing(py::module_& m) {
                std::to_string(p.outcome.plan.path.rows.size()) + " rows>";
       });
 
+  const polishing::PlanOptions kDefaults;
   m.def("plan_polishing", [](const SurfacePtr& surface, const PolishingProcess& process, const std::string& pattern,
                              const std::string& guides, std::optional<double> offset_mm, double radius_mm, double pitch_mm,
                              double row_step_mm, double sample_mm, double edge_inset_mm, double stagger_loops,
@@ -157,53 +158,46 @@ void BindPolishing(py::module_& m) {
                              double opt_offset_max_mm, double opt_offset_min_contact_widths, double max_time_s,
                              int threads, unsigned seed, const std::string& surface_source,
                              const std::string& process_source) {
-    if (guides != "offsets" && guides != "parallel") throw std::invalid_argument("guides: expected offsets or parallel");
-    if (optimise != "none" && optimise != "nlopt" && optimise != "pso") {
-      throw std::invalid_argument("optimise: expected none, nlopt or pso");
-    }
     if (!(sample_mm > 0.0 && sample_mm <= 0.5)) throw std::invalid_argument("sample_mm: expected in (0, 0.5]");
     if (!(target_removal_um >= 0.0)) throw std::invalid_argument("target_removal_um: expected >= 0");
+    polishing::PlanOptions o;
+    o.pattern = pattern;
+    o.guides = guides;
+    o.offset_mm = offset_mm;
+    o.radius_mm = radius_mm;
+    o.pitch_mm = pitch_mm;
+    o.row_step_mm = row_step_mm;
+    o.edge_inset_mm = edge_inset_mm;
+    o.stagger_loops = stagger_loops;
+    o.edge_overrun_mm = edge_overrun_mm;
+    o.line_angle_deg = line_angle_deg;
+    o.target_removal_um = target_removal_um;
+    o.optimise = optimise;
+    o.guides_given = guides_given;
+    o.opt_sample_mm = opt_sample_mm;
+    o.opt_offset_max_mm = opt_offset_max_mm;
+    o.opt_offset_min_contact_widths = opt_offset_min_contact_widths;
+    o.max_time_s = max_time_s;
+    o.threads = threads;
+    o.seed = seed;
     auto plan = std::make_unique<PyPlan>();
     plan->surface = surface;
-    polishing::PathParameters params;
-    params.pattern = polishing::FindPathPattern(pattern).id();
-    params.guides = guides == "offsets" ? polishing::GuideLines::kBoundaryOffsets : polishing::GuideLines::kParallelLines;
-    params.radius = MmToM(radius_mm);
-    params.pitch = MmToM(pitch_mm);
-    params.row_step = MmToM(row_step_mm);
-    params.edge_inset = edge_inset_mm < 0 ? -1.0 : MmToM(edge_inset_mm);
-    params.stagger = stagger_loops;
-    params.edge_overrun = MmToM(edge_overrun_mm);
-    params.line_angle = line_angle_deg * kPi / 180.0;
-    polishing::PlanRequest req;
-    req.target_removal = target_removal_um * 1e-6;
-    if (optimise != "none") req.optimise = optimise == "nlopt" ? polishing::Optimiser::kNlopt : polishing::Optimiser::kPso;
-    req.guides_given = guides_given;
-    req.opt_sample_spacing = MmToM(opt_sample_mm);
-    req.opt_offset_min_contact_widths = opt_offset_min_contact_widths;
-    req.opt_offset_max = MmToM(opt_offset_max_mm);
-    req.max_time_s = max_time_s;
-    req.threads = threads;
-    req.seed = seed;
     {
       py::gil_scoped_release release;
       plan->context = polishing::PreparePlanning(*surface, process, MmToM(sample_mm), surface_source, process_source);
-      // The zig-zag's rows are one contact width apart unless told otherwise (polish-plan's default).
-      params.offset = offset_mm ? MmToM(*offset_mm)
-                                : params.pattern == polishing::Pattern::kParallel ? plan->context.contact_width
-                                                                                  : 0.008;
-      polishing::CheckValid(params);
-      req.params = params;
-      plan->outcome = polishing::PlanPolishing(plan->context, req);
+      plan->outcome = polishing::PlanPolishing(plan->context, polishing::ToPlanRequest(o, plan->context));
     }
     return plan;
   }, py::arg("surface"), py::arg("process"), py::arg("pattern") = "cycloid", py::arg("guides") = "offsets",
-     py::arg("offset_mm") = py::none(), py::arg("radius_mm") = 6.0, py::arg("pitch_mm") = 3.0,
-     py::arg("row_step_mm") = 0.5, py::arg("sample_mm") = 0.5, py::arg("edge_inset_mm") = -1.0,
-     py::arg("stagger_loops") = 0.5, py::arg("edge_overrun_mm") = 0.0, py::arg("line_angle_deg") = 0.0,
-     py::arg("target_removal_um") = 0.0, py::arg("optimise") = "none", py::arg("guides_given") = false,
-     py::arg("opt_sample_mm") = 1.0, py::arg("opt_offset_max_mm") = 30.0, py::arg("opt_offset_min_contact_widths") = 0.3,
-     py::arg("max_time_s") = 50.0, py::arg("threads") = 2, py::arg("seed") = 20240404u,
+     py::arg("offset_mm") = py::none(), py::arg("radius_mm") = kDefaults.radius_mm,
+     py::arg("pitch_mm") = kDefaults.pitch_mm, py::arg("row_step_mm") = kDefaults.row_step_mm, py::arg("sample_mm") = 0.5,
+     py::arg("edge_inset_mm") = kDefaults.edge_inset_mm, py::arg("stagger_loops") = kDefaults.stagger_loops,
+     py::arg("edge_overrun_mm") = kDefaults.edge_overrun_mm, py::arg("line_angle_deg") = kDefaults.line_angle_deg,
+     py::arg("target_removal_um") = kDefaults.target_removal_um, py::arg("optimise") = kDefaults.optimise,
+     py::arg("guides_given") = false, py::arg("opt_sample_mm") = kDefaults.opt_sample_mm,
+     py::arg("opt_offset_max_mm") = kDefaults.opt_offset_max_mm,
+     py::arg("opt_offset_min_contact_widths") = kDefaults.opt_offset_min_contact_widths,
+     py::arg("max_time_s") = kDefaults.max_time_s, py::arg("threads") = kDefaults.threads, py::arg("seed") = kDefaults.seed,
      py::arg("surface_source") = "surface", py::arg("process_source") = "process",
      "polish-plan's call with its defaults (the same names, units in them): the region sampled, the path planned "
      "(optimised with optimise='nlopt' or 'pso'), simulated and timed for target_removal_um. offset_mm None: 8 mm "

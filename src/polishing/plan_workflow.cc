@@ -85,6 +85,38 @@ EvaluatedPlan EvaluatePlanOnGrid(const PlanningContext& c, const PathParameters&
   return e;
 }
 
+PlanRequest ToPlanRequest(const PlanOptions& o, const PlanningContext& c) {
+  if (o.guides != "offsets" && o.guides != "parallel") {
+    throw std::invalid_argument("guides: expected offsets or parallel, got " + o.guides);
+  }
+  if (o.optimise != "none" && o.optimise != "nlopt" && o.optimise != "pso") {
+    throw std::invalid_argument("optimise: expected none, nlopt or pso, got " + o.optimise);
+  }
+  PlanRequest req;
+  PathParameters& params = req.params;
+  params.pattern = FindPathPattern(o.pattern).id();
+  params.guides = o.guides == "offsets" ? GuideLines::kBoundaryOffsets : GuideLines::kParallelLines;
+  params.offset = o.offset_mm ? MmToM(*o.offset_mm) : params.pattern == Pattern::kParallel ? c.contact_width : MmToM(8.0);
+  params.radius = MmToM(o.radius_mm);
+  params.pitch = MmToM(o.pitch_mm);
+  params.row_step = MmToM(o.row_step_mm);
+  params.edge_inset = o.edge_inset_mm < 0 ? -1.0 : MmToM(o.edge_inset_mm);
+  params.stagger = o.stagger_loops;
+  params.edge_overrun = MmToM(o.edge_overrun_mm);
+  params.line_angle = o.line_angle_deg * kPi / 180.0;
+  CheckValid(params);
+  req.target_removal = o.target_removal_um * 1e-6;  // [um] -> [m]
+  if (o.optimise != "none") req.optimise = o.optimise == "nlopt" ? Optimiser::kNlopt : Optimiser::kPso;
+  req.guides_given = o.guides_given;
+  req.opt_sample_spacing = MmToM(o.opt_sample_mm);
+  req.opt_offset_min_contact_widths = o.opt_offset_min_contact_widths;
+  req.opt_offset_max = MmToM(o.opt_offset_max_mm);
+  req.max_time_s = o.max_time_s;
+  req.threads = o.threads;
+  req.seed = o.seed;
+  return req;
+}
+
 PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
   const NurbsSurface& surface = *c.surface;
   const SampleGrid& grid = *c.grid;

@@ -62,6 +62,32 @@ struct PlanRequest {
   std::function<void(int, double, double)> progress;
 };
 
+/// polish-plan's options as a user gives them: the names and units of its
+/// command line and of Python's plan_polishing, with their defaults.
+struct PlanOptions {
+  std::string pattern{"cycloid"};  // a PathPatterns() name
+  std::string guides{"offsets"};   // cycloid guide lines: offsets (of the boundary) or parallel
+  /// Guide-line / row spacing; none: 8 mm for the cycloid, one contact
+  /// width for the zig-zag.
+  std::optional<double> offset_mm;
+  double radius_mm{6.0}, pitch_mm{3.0}, row_step_mm{0.5};
+  double edge_inset_mm{-1.0};  // < 0: on the boundary, or r - margin inside
+  double stagger_loops{0.5}, edge_overrun_mm{0.0}, line_angle_deg{0.0};
+  double target_removal_um{0.0};  // 0: at the speed limit
+  std::string optimise{"none"};   // none, nlopt or pso
+  bool guides_given{false};       // the optimiser keeps `guides`
+  double opt_sample_mm{1.0}, opt_offset_max_mm{30.0}, opt_offset_min_contact_widths{0.3}, max_time_s{50.0};
+  int threads{2};
+  unsigned seed{20240404};
+};
+
+/// The request `options` make on `context` (the zig-zag's default spacing
+/// is its contact width); `progress` is not set.
+/// @throws std::invalid_argument for an unknown pattern, guides or
+///   optimiser and for path parameters outside their limits (CheckValid):
+///   all of them mistakes in the options.
+PlanRequest ToPlanRequest(const PlanOptions& options, const PlanningContext& context);
+
 /// A planned, simulated path.
 struct EvaluatedPlan {
   PlannedPath path;
