@@ -16,6 +16,7 @@
 #include "robomach/identification/test_plan.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
+#include "robomach/io/kq_files.h"
 #include "robomach/io/kq_yaml.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/robot_config.h"
@@ -52,23 +53,6 @@ void PrintReport(const identification::JointStiffnessResult& r, std::ostream& os
      << " mm per coordinate), chi2/dof " << std::setprecision(2) << r.reduced_chi2
      << ", condition number of the scaled problem " << std::setprecision(1) << r.condition_number << "\n";
   for (const auto& a : r.advice) os << kTool << ": NOTE: " << a << "\n";
-}
-
-void WriteResidualsCsv(const std::string& path, const identification::JointStiffnessResult& r,
-                       const std::vector<identification::LoadCase>& cases) {
-  io::WriteFileAtomically(path, [&](std::ostream& os) {
-    os << "case_id,pose_id,dx_mm,dy_mm,dz_mm,pred_dx_mm,pred_dy_mm,pred_dz_mm,rx_mm,ry_mm,rz_mm,r_mm,"
-          "r_over_sigma,outlier\n";
-    for (size_t c = 0; c < r.residuals.size(); ++c) {
-      const auto& x = r.residuals[c];
-      os << x.case_id << "," << cases[c].pose_id;
-      for (const Eigen::Vector3d* v : {&x.measured, &x.predicted, &x.residual}) {
-        for (int a = 0; a < 3; ++a) os << "," << io::FormatDouble(MToMm((*v)(a)));
-      }
-      os << "," << io::FormatDouble(MToMm(x.norm)) << "," << io::FormatDouble(x.normalized) << ","
-         << (x.outlier ? 1 : 0) << "\n";
-    }
-  });
 }
 
 void PlotResiduals(const std::string& path, const identification::JointStiffnessResult& r,
@@ -148,37 +132,14 @@ int RunPlan(const io::RobotConfig& cfg, int num_postures, double noise_mm, unsig
   o.num_candidate_postures = std::max(400, 4 * num_postures);
   const identification::TestPlan plan = identification::PlanLoadTests(*model, o);
   const double weak = identification::IdentificationOptions{}.weak_relative_std;
-  std::ostringstream csv;
-  csv << "# kq-identify --plan " << num_postures << ": D-optimal load tests for " << cfg.path << "\n";
-  csv << "# log_det_information: " << io::FormatDouble(plan.log_det_information) << "\n";
-  csv << "# tracker_noise_mm: " << io::FormatDouble(noise_mm) << "\n";
-  csv << "# masses_kg:";
-  for (double m : masses_kg) csv << " " << io::FormatDouble(m);
-  csv << "\n";
-  auto point = [&](const char* key, const std::optional<Eigen::Vector3d>& p) {
-    csv << "# " << key << ": ";
-    if (!p) csv << "tcp";
-    else csv << io::FormatDouble(MToMm(p->x())) << "," << io::FormatDouble(MToMm(p->y())) << ","
-             << io::FormatDouble(MToMm(p->z()));
-    csv << "\n";
-  };
-  point("load_point_mm", load_point);
-  point("target_mm", target);
-  for (int j = 0; j < model->num_joints(); ++j) {
-    csv << "# expected_std_kq" << j + 1 << "_Nm_per_rad: " << io::FormatDouble(plan.expected_std_dev(j)) << "\n";
-  }
-  csv << "pose_id";
-  for (int j = 0; j < model->num_joints(); ++j) csv << ",q" << j + 1 << "_deg";
-  csv << ",rope_ux,rope_uy,rope_uz,load_x_mm,load_y_mm,load_z_mm,pulley_x_mm,pulley_y_mm,pulley_z_mm\n";
-  for (const auto& l : plan.loads) {
-    csv << l.pose_id;
-    for (int j = 0; j < l.q.size(); ++j) csv << "," << io::FormatDouble(RadToDeg(l.q(j)));
-    for (int a = 0; a < 3; ++a) csv << "," << io::FormatDouble(l.rope_direction(a));
-    for (int a = 0; a < 3; ++a) csv << "," << io::FormatDouble(MToMm(l.p_load(a)));
-    for (int a = 0; a < 3; ++a) csv << "," << io::FormatDouble(MToMm(l.p_pulley(a)));
-    csv << "\n";
-  }
-  io::WriteFileAtomically(out_path.empty() ? "-" : out_path, csv.str());
+  io::LoadTestPlanHeader header;
+  header.num_postures = num_postures;
+  header.robot_config = cfg.path;
+  header.tracker_noise_mm = noise_mm;
+  header.masses_kg = masses_kg;
+  header.load_point = load_point;
+  header.target = target;
+  io::WriteLoadTestPlanCsv(out_path, plan, header);
   std::cerr << kTool << ": plan of " << num_postures << " postures x " << o.directions_per_posture
             << " rope directions x " << masses_kg.size() << " masses = " << plan.cases.size()
             << " load cases; expected standard deviations for a tracker noise of " << noise_mm << " mm:\n";
@@ -343,7 +304,7 @@ int Run(int argc, char** argv) {
       const std::string yaml = io::JointStiffnessYaml(r, ko);
       io::WriteFileAtomically(out_path.empty() ? "-" : out_path, yaml);
     }
-    if (!residuals_path.empty()) WriteResidualsCsv(residuals_path, r, cases);
+    if (!residuals_path.empty()) io::WriteKqResidualsCsv(residuals_path, r, cases);
     if (!plot_path.empty()) {
       PlotResiduals(plot_path, r, r.outlier_threshold, "kq-identify: " + tracker_path);
     }
