@@ -375,42 +375,20 @@ int Run(int argc, char** argv) {
       j["radial_immersion"] = cut.process.radial_immersion;
       j["lobes_csv"] = out_path.empty() ? "-" : out_path;
       nlohmann::json results = nlohmann::json::array();
-      for (const stability::TipDynamics& t : tips) {
-        for (const char* m : {"zoa", "sd"}) {
-          nlohmann::json r;
-          int points = 0, ok = 0;
-          double min_depth = INFINITY, max_depth = -INFINITY, min_speed = NAN, max_speed = NAN, min_freq = NAN;
-          for (const stability::LobeRow& row : rows) {
-            if (row.id != t.id || row.method != m) continue;
-            ++points;
-            const auto& p = row.point;
-            if (!std::isfinite(p.critical_depth)) continue;
-            ++ok;
-            const double d = MToMm(p.critical_depth), rpm = io::LobeSpeedRpm(p.spindle_speed_rad_s);
-            if (d < min_depth) {
-              min_depth = d;
-              min_speed = rpm;
-              min_freq = p.chatter_freq_hz;
-            }
-            if (d > max_depth) {
-              max_depth = d;
-              max_speed = rpm;
-            }
-          }
-          if (points == 0) continue;
-          r["pose_id"] = t.id;
-          r["method"] = m;
-          r["speeds"] = points;
-          r["speeds_with_boundary"] = ok;
-          if (ok > 0) {
-            r["min_critical_depth_mm"] = min_depth;
-            r["min_critical_depth_speed_rpm"] = min_speed;
-            if (std::isfinite(min_freq)) r["min_critical_depth_chatter_freq_hz"] = min_freq;
-            r["max_critical_depth_mm"] = max_depth;
-            r["max_critical_depth_speed_rpm"] = max_speed;
-          }
-          results.push_back(r);
+      for (const stability::LobeSummary& l : stability::SummarizeLobes(tips, rows)) {
+        nlohmann::json r;
+        r["pose_id"] = l.id;
+        r["method"] = l.method;
+        r["speeds"] = l.speeds;
+        r["speeds_with_boundary"] = l.speeds_with_boundary;
+        if (l.speeds_with_boundary > 0) {
+          r["min_critical_depth_mm"] = MToMm(l.min_depth);
+          r["min_critical_depth_speed_rpm"] = io::LobeSpeedRpm(l.min_depth_speed_rad_s);
+          if (std::isfinite(l.min_depth_chatter_freq_hz)) r["min_critical_depth_chatter_freq_hz"] = l.min_depth_chatter_freq_hz;
+          r["max_critical_depth_mm"] = MToMm(l.max_depth);
+          r["max_critical_depth_speed_rpm"] = io::LobeSpeedRpm(l.max_depth_speed_rad_s);
         }
+        results.push_back(r);
       }
       j["lobes"] = results;
       j["no_boundary_at_some_speeds"] = no_boundary;

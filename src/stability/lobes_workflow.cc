@@ -189,4 +189,33 @@ LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOption
   return result;
 }
 
+std::vector<LobeSummary> SummarizeLobes(const std::vector<TipDynamics>& tips, const std::vector<LobeRow>& rows) {
+  std::vector<LobeSummary> out;
+  for (const TipDynamics& t : tips) {
+    for (const char* m : {"zoa", "sd"}) {
+      LobeSummary s;
+      s.id = t.id;
+      s.method = m;
+      for (const LobeRow& row : rows) {
+        if (row.id != t.id || row.method != m) continue;
+        ++s.speeds;
+        const LobePoint& p = row.point;
+        if (!std::isfinite(p.critical_depth)) continue;
+        ++s.speeds_with_boundary;
+        if (!(p.critical_depth >= s.min_depth)) {
+          s.min_depth = p.critical_depth;
+          s.min_depth_speed_rad_s = p.spindle_speed_rad_s;
+          s.min_depth_chatter_freq_hz = p.chatter_freq_hz;
+        }
+        if (!(p.critical_depth <= s.max_depth)) {
+          s.max_depth = p.critical_depth;
+          s.max_depth_speed_rad_s = p.spindle_speed_rad_s;
+        }
+      }
+      if (s.speeds > 0) out.push_back(s);
+    }
+  }
+  return out;
+}
+
 }  // namespace robomach::stability

@@ -214,5 +214,38 @@ TEST(ComputeLobes, TapTestZoaAndSdAgreeAndTheCsvHoldsTheRows) {
   }
 }
 
+// The summary of hand-made rows: the speeds per tip and method, those with
+// a boundary (a NaN depth has none), the smallest and largest depth with
+// their speeds; a method without rows has no summary.
+TEST(SummarizeLobes, MinimumAndMaximumOverThePointsWithABoundary) {
+  TipDynamics a, b;
+  a.id = "A";
+  b.id = "B";
+  auto row = [](const std::string& id, const std::string& m, double speed, double depth, double f) {
+    LobePoint p;
+    p.spindle_speed_rad_s = speed;
+    p.critical_depth = depth;
+    p.chatter_freq_hz = f;
+    return LobeRow{id, m, p};
+  };
+  const std::vector<LobeRow> rows = {row("A", "zoa", 100, 2e-3, 900), row("A", "zoa", 200, NAN, NAN),
+                                     row("A", "zoa", 300, 1e-3, 950), row("A", "zoa", 400, 3e-3, 800),
+                                     row("B", "sd", 100, 5e-4, 1200)};
+  const std::vector<LobeSummary> s = SummarizeLobes({a, b}, rows);
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s[0].id, "A");
+  EXPECT_EQ(s[0].method, "zoa");
+  EXPECT_EQ(s[0].speeds, 4);
+  EXPECT_EQ(s[0].speeds_with_boundary, 3);
+  EXPECT_EQ(s[0].min_depth, 1e-3);
+  EXPECT_EQ(s[0].min_depth_speed_rad_s, 300);
+  EXPECT_EQ(s[0].min_depth_chatter_freq_hz, 950);
+  EXPECT_EQ(s[0].max_depth, 3e-3);
+  EXPECT_EQ(s[0].max_depth_speed_rad_s, 400);
+  EXPECT_EQ(s[1].id, "B");
+  EXPECT_EQ(s[1].method, "sd");
+  EXPECT_EQ(s[1].min_depth, s[1].max_depth);
+}
+
 }  // namespace
 }  // namespace robomach::stability

@@ -73,4 +73,18 @@ std::vector<std::string> TipFitWarnings(const TipDynamics& tip, bool sd);
 LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOptions& options,
                          const TipMessageSink& on_message = {}, const SdProgressSink& on_progress = {});
 
+/// The lobes of one tip by one method in a few numbers (stability-lobes'
+/// summary): the speeds, those with a boundary, and the smallest and
+/// largest critical depth with their speeds.
+struct LobeSummary {
+  std::string id, method;
+  int speeds{0}, speeds_with_boundary{0};
+  double min_depth{NAN}, min_depth_speed_rad_s{NAN}, min_depth_chatter_freq_hz{NAN};  // [m], [rad/s], [Hz]
+  double max_depth{NAN}, max_depth_speed_rad_s{NAN};
+};
+
+/// One summary per tip and method that has rows, in the tips' order, the
+/// ZOA before the SD.
+std::vector<LobeSummary> SummarizeLobes(const std::vector<TipDynamics>& tips, const std::vector<LobeRow>& rows);
+
 }  // namespace robomach::stability
