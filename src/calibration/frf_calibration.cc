@@ -227,15 +227,7 @@ Objective ParseObjective(const std::string& name) {
   throw std::invalid_argument("objective '" + name + "': expected modal-two-stage, modal-joint or whole-curve");
 }
 
-std::string FitStatusName(FitStatus s) {
-  switch (s) {
-    case FitStatus::kConverged: return "converged";
-    case FitStatus::kNotConverged: return "not_converged";
-    case FitStatus::kFailed: return "failed";
-    case FitStatus::kNotImproved: return "not_improved";
-  }
-  return "?";
-}
+std::string FitStatusName(FitStatus s) { return SolverStatusName(s); }
 
 namespace {
 

@@ -59,14 +59,7 @@ std::string MomentAdvice(int j, int n) {
 
 }  // namespace
 
-const char* ToString(FitStatus s) {
-  switch (s) {
-    case FitStatus::kConverged: return "converged";
-    case FitStatus::kNotConverged: return "not converged";
-    case FitStatus::kFailed: return "failed";
-  }
-  return "?";
-}
+const char* ToString(FitStatus s) { return SolverStatusName(s); }
 
 Determination DeterminationFromRelativeStd(double relative_std, double weak_relative_std) {
   if (!std::isfinite(relative_std)) return Determination::kNotDetermined;

@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "robomach/common/solver_status.h"
 #include "robomach/common/units.h"
 #include "robomach/drilling/plausibility.h"
 #include "robomach/io/csv_table.h"
@@ -203,9 +204,7 @@ std::string MaterialYaml(const drilling::ForceFitResult& fit, const drilling::Dr
     << "  kienzle_exponent: " << Sig(fit.std_dev_kienzle_exponent, 3) << "\n"
     << "fit:\n"
     << "  status: "
-    << (fit.status == drilling::FitStatus::kConverged      ? "converged"
-        : fit.status == drilling::FitStatus::kNotConverged ? "not_converged"
-                                                            : "failed")
+    << SolverStatusName(fit.status)
     << "\n"
     << "  solver: " << Quoted(fit.solver_message) << "\n"
     << "  max_rel_error_thrust: " << Sig(fit.max_rel_error_thrust) << "\n"

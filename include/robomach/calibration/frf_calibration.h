@@ -18,6 +18,7 @@
 
 #include "robomach/calibration/modal_fit.h"
 #include "robomach/calibration/virtual_hammer_test.h"
+#include "robomach/common/solver_status.h"
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/dynamics/parameters.h"
 #include "robomach/dynamics/posture_dynamics.h"
@@ -192,7 +193,8 @@ struct CalibrationOptions {
 
 /// kNotImproved: no start lowered the whole-curve misfit below that of the
 /// start values, which the result keeps.
-enum class FitStatus { kConverged, kNotConverged, kFailed, kNotImproved };
+using FitStatus = SolverStatus;  // the library's one solver status
+/// SolverStatusName.
 std::string FitStatusName(FitStatus s);
 
 struct ParameterEstimate {

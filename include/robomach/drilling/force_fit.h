@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "robomach/common/solver_status.h"
 #include "robomach/drilling/drill_forces.h"
 
 namespace robomach::drilling {
@@ -16,7 +17,8 @@ struct ForceTableRow {
   double torque{0.0};        // [N·m]
 };
 
-enum class FitStatus { kConverged, kNotConverged, kFailed };
+/// The library's one solver status (kNotImproved does not occur here).
+using FitStatus = SolverStatus;
 
 /// A row of a force table that the fit cannot use: a value that is not
 /// positive and finite, or a row where the force model gives no positive

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "robomach/common/progress.h"
+#include "robomach/common/solver_status.h"
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/identification/load_case.h"
 
@@ -42,11 +43,13 @@ struct IdentificationOptions {
 /// @throws std::invalid_argument naming the field and the violated bound.
 void CheckValid(const IdentificationOptions& options);
 
-/// Outcome of the solver (style §2.9).
-enum class FitStatus { kConverged, kNotConverged, kFailed };
+/// Outcome of the solver (style §2.9): the library's one solver status
+/// (kNotImproved does not occur here).
+using FitStatus = SolverStatus;
 /// How well the data determine one joint's stiffness.
 enum class Determination { kDetermined, kWeak, kNotDetermined };
 
+/// SolverStatusName.
 const char* ToString(FitStatus s);
 const char* ToString(Determination d);
 

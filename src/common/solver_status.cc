@@ -1,0 +1,15 @@
+#include "robomach/common/solver_status.h"
+
+namespace robomach {
+
+const char* SolverStatusName(SolverStatus s) {
+  switch (s) {
+    case SolverStatus::kConverged: return "converged";
+    case SolverStatus::kNotConverged: return "not_converged";
+    case SolverStatus::kFailed: return "failed";
+    case SolverStatus::kNotImproved: return "not_improved";
+  }
+  return "?";
+}
+
+}  // namespace robomach
