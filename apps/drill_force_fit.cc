@@ -17,6 +17,7 @@
 #include "robomach/drilling/plausibility.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/drilling_files.h"
+#include "robomach/io/drilling_setup.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
 
@@ -129,37 +130,25 @@ int RunDrillForceFit(int argc, char** argv) {
     RequireReadableFile(table_path, "force table");
     RequireReadableFile(drill_path, "drill file");
     if (!predict_path.empty()) RequireReadableFile(predict_path, "rows to predict");
-    const io::ForceTableFile table = io::ReadForceTable(table_path);
-    const io::DrillFile drill = io::ReadDrillFile(drill_path);
+    drilling::ForceFitOptions options;
+    options.chisel = chisel == "orthogonal" ? drilling::ChiselModel::kOrthogonal
+                     : chisel == "none"     ? drilling::ChiselModel::kNone
+                                            : drilling::ChiselModel::kSeedScaling;
+    const io::ForceFitRun run = io::FitForceTableFiles(table_path, drill_path, options);
+    const io::ForceTableFile& table = run.table;
+    const io::DrillFile& drill = run.drill;
+    const drilling::ForceFitResult& fit = run.fit;
     if (verbose) {
       for (const auto& c : table.unknown_columns) Warn(kTool, table_path + ": ignored column '" + c + "'");
     }
     std::optional<io::ForceTableFile> predict;
     if (!predict_path.empty()) predict = io::ReadForceTable(predict_path, false);
-
-    drilling::ForceFitOptions options;
-    options.chisel = chisel == "orthogonal" ? drilling::ChiselModel::kOrthogonal
-                     : chisel == "none"     ? drilling::ChiselModel::kNone
-                                            : drilling::ChiselModel::kSeedScaling;
-    if (table.rows.size() < 2) {
-      throw InputError({table_path, table.lines.back(), 0},
-                       "expected at least 2 rows to fit 3 coefficients to thrust and torque");
-    }
-    const drilling::ForceFitResult fit = [&] {
-      try {
-        return drilling::FitDrillingForces(drill.drill, table.rows, options);
-      } catch (const drilling::ForceTableRowError& e) {
-        // Bad data (exit 65) at the row's line, not a bad command line.
-        throw InputError({table_path, table.lines.at(e.row()), 0}, e.what());
-      }
-    }();
     if (fit.status == drilling::FitStatus::kFailed) {
       std::cerr << kTool << ": the fit failed: " << fit.solver_message << "\n";
       return kExitSoftware;
     }
     // Everything computed: now write (each file atomically).
-    const std::string yaml = io::MaterialYaml(fit, drill.drill, table);
-    io::WriteFileAtomically(out_path.empty() ? "-" : out_path, yaml);
+    io::WriteFileAtomically(out_path.empty() ? "-" : out_path, run.material_yaml);
     if (!plot_path.empty()) Plot(plot_path, table, drill.drill, fit.material);
     if (predict) io::WriteFileAtomically(predictions_path, PredictionsCsv(*predict, drill.drill, fit.material));
 
@@ -185,10 +174,7 @@ int RunDrillForceFit(int argc, char** argv) {
       rc = kExitFlagged;
     }
     // Unit plausibility (drilling/plausibility.h): outputs stay written, exit 3.
-    std::vector<std::string> units = drilling::ForceTableFindings(table.rows);
-    for (const auto& more : {drilling::MaterialFindings(fit.material), drilling::ToolingFindings(drill.drill, nullptr)}) {
-      units.insert(units.end(), more.begin(), more.end());
-    }
+    const std::vector<std::string>& units = run.unit_findings;
     for (const std::string& f : units) Warn(kTool, "implausible (unit mistake?): " + f);
     if (!units.empty()) rc = kExitFlagged;
     return rc;

@@ -6,7 +6,9 @@
 
 #include "bindings.h"
 #include "robomach/drilling/controller_kinds.h"
+#include "robomach/common/solver_status.h"
 #include "robomach/drilling/controller_runs.h"
+#include "robomach/drilling/force_fit.h"
 #include "robomach/io/drill_series_file.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/drilling_setup.h"
@@ -94,6 +96,43 @@ void BindDrilling(py::module_& m) {
      "each controller kind simulated (tuned first with tune=True). gains: {kind: (omega_rad_s, zeta[, third[, "
      "filter_s]])}. Returns (runs, unit_findings): a list of ControllerRun, and the unit plausibility findings "
      "(drill-sim exits 3 on any). The GIL is released while it runs.");
+
+  m.def("fit_drill_forces", [](const std::string& table, const std::string& drill, const std::string& chisel) {
+    RequireReadableFile(table);
+    RequireReadableFile(drill);
+    drilling::ForceFitOptions o;
+    if (chisel == "seed_scaling") o.chisel = drilling::ChiselModel::kSeedScaling;
+    else if (chisel == "orthogonal") o.chisel = drilling::ChiselModel::kOrthogonal;
+    else if (chisel == "none") o.chisel = drilling::ChiselModel::kNone;
+    else throw std::invalid_argument("chisel: expected seed_scaling, orthogonal or none, got " + chisel);
+    io::ForceFitRun run;
+    {
+      py::gil_scoped_release release;
+      run = io::FitForceTableFiles(table, drill, o);
+    }
+    const drilling::ForceFitResult& f = run.fit;
+    py::dict d;
+    d["status"] = SolverStatusName(f.status);
+    d["solver_message"] = f.solver_message;
+    d["shear_stress_thrust_Pa"] = f.material.shear_stress_thrust;
+    d["shear_stress_torque_Pa"] = f.material.shear_stress_torque;
+    d["kienzle_exponent"] = f.material.kienzle_exponent;
+    d["std_dev_shear_stress_thrust_Pa"] = f.std_dev_shear_stress_thrust;
+    d["std_dev_shear_stress_torque_Pa"] = f.std_dev_shear_stress_torque;
+    d["std_dev_kienzle_exponent"] = f.std_dev_kienzle_exponent;
+    d["thrust_model_N"] = f.thrust_model;
+    d["torque_model_Nm"] = f.torque_model;
+    d["max_rel_error_thrust"] = f.max_rel_error_thrust;
+    d["max_rel_error_torque"] = f.max_rel_error_torque;
+    d["kienzle_exponent_at_bound"] = f.kienzle_exponent_at_bound;
+    d["material_yaml"] = run.material_yaml;
+    d["unit_findings"] = run.unit_findings;
+    return d;
+  }, py::arg("table"), py::arg("drill"), py::arg("chisel") = "seed_scaling",
+     "drill-force-fit's call: K_TH, K_TQ [Pa] and the Kienzle exponent fitted to a measured force table "
+     "(docs/formats.md §9.1) for a drill (§9.2). Returns a dict: the coefficients and their 1-sigma standard "
+     "deviations, the model per row, the largest relative errors, status (the library's solver status), "
+     "material_yaml (drill-force-fit's --out, byte for byte; empty when the fit failed), unit_findings.");
 
   m.def("write_drill_series_csv", [](const std::string& path, const ControllerRun& run) {
     io::WriteFileAtomically(path, io::DrillSeriesCsv(run.result));

@@ -36,6 +36,21 @@ def test_drill_sim_equals_the_tool(tmp):
     assert min(r.offset_rad) >= 0
 
 
+def test_force_fit_equals_the_tool(tmp):
+    table = os.path.join(D, 'q235_hss.csv')
+    run_tool('drill-force-fit', '--table', table, '--drill', DRILL, '--out', tmp / 'tool.yaml')
+    f = rm.fit_drill_forces(table, DRILL)
+    assert f['material_yaml'] == (tmp / 'tool.yaml').read_text()
+    assert f['status'] == 'converged' and f['unit_findings'] == []
+    # The table's own rows back: the model is within the largest relative error it reports.
+    import csv
+    with open(table) as fh:
+        rows = [r for r in csv.DictReader(line for line in fh if not line.startswith('#'))]
+    thrust = np.array([float(r['thrust_N']) for r in rows])
+    assert np.max(np.abs(np.array(f['thrust_model_N']) - thrust) / thrust) == pytest.approx(f['max_rel_error_thrust'],
+                                                                                           rel=1e-9)
+
+
 def test_bad_input(tmp):
     with pytest.raises(FileNotFoundError):
         rm.drill_sim(ROBOT, str(tmp / 'none.yaml'), MATERIAL)
@@ -48,3 +63,5 @@ def test_bad_input(tmp):
         rm.drill_sim(ROBOT, DRILL, MATERIAL, motor_torque_limit_Nm=1e-6)
     assert e.value.path == DRILL and 'cannot hold' in e.value.message
     assert 'pd-tdc' in rm.controller_kinds()
+    with pytest.raises(ValueError, match='chisel'):
+        rm.fit_drill_forces(os.path.join(D, 'q235_hss.csv'), DRILL, chisel='round')

@@ -37,4 +37,28 @@ DrillingSetup LoadDrillingSetup(const std::string& robot_path, const std::string
   return s;
 }
 
+ForceFitRun FitForceTableFiles(const std::string& table_path, const std::string& drill_path,
+                               const drilling::ForceFitOptions& options) {
+  ForceFitRun r;
+  r.table = ReadForceTable(table_path);
+  r.drill = ReadDrillFile(drill_path);
+  if (r.table.rows.size() < 2) {
+    throw InputError({table_path, r.table.lines.back(), 0},
+                     "expected at least 2 rows to fit 3 coefficients to thrust and torque");
+  }
+  try {
+    r.fit = drilling::FitDrillingForces(r.drill.drill, r.table.rows, options);
+  } catch (const drilling::ForceTableRowError& e) {
+    // Bad data at the row's line.
+    throw InputError({table_path, r.table.lines.at(e.row()), 0}, e.what());
+  }
+  if (r.fit.status == drilling::FitStatus::kFailed) return r;
+  r.material_yaml = MaterialYaml(r.fit, r.drill.drill, r.table);
+  r.unit_findings = drilling::ForceTableFindings(r.table.rows);
+  for (const auto& more : {drilling::MaterialFindings(r.fit.material), drilling::ToolingFindings(r.drill.drill, nullptr)}) {
+    r.unit_findings.insert(r.unit_findings.end(), more.begin(), more.end());
+  }
+  return r;
+}
+
 }  // namespace robomach::io

@@ -13,6 +13,7 @@
 
 #include "robomach/drilling/drilling_sim.h"
 #include "robomach/drilling/flexible_joint_robot.h"
+#include "robomach/drilling/force_fit.h"
 #include "robomach/io/drilling_files.h"
 
 namespace robomach::io {
@@ -35,5 +36,22 @@ struct DrillingSetup {
 ///   cannot feed along, a holding torque above the limit.
 DrillingSetup LoadDrillingSetup(const std::string& robot_path, const std::string& drill_path,
                                 const std::string& material_path, double motor_torque_limit_Nm);
+
+/// drill-force-fit's run on its two files: the measured force table and
+/// the drill, the fit, the material file's text, and the unit findings.
+struct ForceFitRun {
+  ForceTableFile table;
+  DrillFile drill;
+  drilling::ForceFitResult fit;
+  std::string material_yaml;  // MaterialYaml of the fit (empty when it failed)
+  /// Unit plausibility of the table, the fitted material and the drill
+  /// (drilling/plausibility.h): the tool exits 3 on any.
+  std::vector<std::string> unit_findings;
+};
+
+/// @throws InputError naming the file and line for a table of fewer than 2
+///   rows or a row the force model cannot use.
+ForceFitRun FitForceTableFiles(const std::string& table_path, const std::string& drill_path,
+                               const drilling::ForceFitOptions& options = {});
 
 }  // namespace robomach::io
