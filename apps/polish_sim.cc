@@ -16,6 +16,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/number_format.h"
+#include "robomach/io/polish_simulation.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/removal.h"
@@ -69,46 +70,18 @@ int Run(int argc, char** argv) {
 
     const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
-    io::PolishPathFile file = io::ReadPolishPath(path_in);
-    polishing::SampleGrid grid = [&] {
-      try {
-        return polishing::SampleGrid::Build(surface, MmToM(sample_mm), process.margin, process.flip_normal);
-      } catch (const std::domain_error& e) {
-        throw InputError({surface_path, 0, 0}, e.what());
-      }
-    }();
-    if (grid.num_in_region() == 0) {
-      throw InputError({process_path, 0, 0}, "process.margin_mm leaves no polished region on the patch");
-    }
-    auto row_error = [&](const polishing::PathRowError& e) {
-      return InputError({file.path, file.lines[e.row()], 0}, "path row " + std::to_string(e.row() + 1) + ": " + e.what());
-    };
-    std::vector<double> removal;
-    try {
-      polishing::AttachToSurface(surface, grid, process.flip_normal, &file.rows);
-      const polishing::RemovalSimulator sim(surface, process, grid.points(), grid.normals(), 0.0015);
-      removal = sim.Simulate(file.rows);
-    } catch (const polishing::PathRowError& e) {
-      throw row_error(e);
-    }
-    const double vmax = polishing::MaxSpeed(file.rows);
-    // Flag a segment only if it is too fast even when its length is read as
-    // short as the file's rounding allows: polish-plan writes positions to
-    // 1e-4 mm, so each end may be off by 0.5e-7 m per coordinate (a path
-    // timed exactly at the limit read 50.01 mm/s on 0.5 mm rows).
-    constexpr double kRounding = 2 * 0.5e-7 * 1.7320508075688772;  // [m]
-    double v_sure = 0.0;
-    for (size_t i = 1; i < file.rows.size(); ++i) {
-      const double len = (file.rows[i].p - file.rows[i - 1].p).norm();
-      v_sure = std::max(v_sure, std::max(0.0, len - kRounding) / (file.rows[i].t - file.rows[i - 1].t));
-    }
+    io::PolishSimulation sim =
+        io::SimulatePolishPathFile(surface, process, path_in, MmToM(sample_mm), surface_path, process_path);
+    io::PolishPathFile& file = sim.file;
+    const polishing::SampleGrid& grid = *sim.grid;
+    const std::vector<double>& removal = sim.removal;
+    const polishing::RemovalStats& stats = sim.stats;
     bool flagged = false;
-    if (v_sure > process.max_speed * (1 + 1e-6)) {
+    if (sim.speed_limit_exceeded) {
       flagged = true;
-      Warn(kTool, "the path's traverse speed reaches " + io::FormatDouble(1e3 * vmax) +
+      Warn(kTool, "the path's traverse speed reaches " + io::FormatDouble(1e3 * sim.max_speed) +
                       " mm/s, above max_speed_mm_per_s " + io::FormatDouble(1e3 * process.max_speed));
     }
-    const polishing::RemovalStats stats = polishing::ComputeRemovalStats(removal, grid.areas(), grid.in_region());
     nlohmann::json summary;
     summary["removal_um"] = RemovalJson(stats);
     summary["path"] = PathJson(file.rows);

@@ -46,6 +46,23 @@ def test_plan_equals_polish_plan(tmp, surface, options, tool_args):
     assert plan.p_m.shape == (len(plan.t_s), 3)
 
 
+def test_simulate_equals_polish_sim(tmp):
+    # A path polish-plan wrote, simulated by polish-sim and by Python: the
+    # same removal map; and the simulation of the plan's own path gives the
+    # plan's statistics (two routes to one removal).
+    surface, process = rm.load_surface(DOME), rm.read_polishing_process(BELT)
+    plan = rm.plan_polishing(surface, process)
+    rm.write_polish_path(str(tmp / 'path.csv'), plan)
+    run_tool('polish-sim', '--surface', DOME, '--process', BELT, '--path', tmp / 'path.csv', '--removal',
+             tmp / 'tool_removal.csv', '--summary', tmp / 'tool.json', expect_rc=None)
+    sim = rm.simulate_polish_path(surface, process, str(tmp / 'path.csv'))
+    rm.write_simulated_removal_map(str(tmp / 'py_removal.csv'), sim)
+    assert (tmp / 'py_removal.csv').read_text() == (tmp / 'tool_removal.csv').read_text()
+    assert sim.stats['cv'] == pytest.approx(plan.stats['cv'], rel=1e-3)
+    assert sim.stats['mean_um'] == pytest.approx(plan.stats['mean_um'], rel=1e-3)
+    assert not sim.speed_limit_exceeded
+
+
 def test_bad_input(tmp):
     surface = rm.load_surface(DOME)
     process = rm.read_polishing_process(BELT)

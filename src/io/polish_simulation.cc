@@ -1,0 +1,49 @@
+#include "robomach/io/polish_simulation.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "robomach/common/errors.h"
+#include "robomach/polishing/paths.h"
+
+namespace robomach::io {
+
+PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
+                                        const polishing::PolishingProcess& process, const std::string& path_file,
+                                        double sample_spacing, const std::string& surface_source,
+                                        const std::string& process_source) {
+  PolishSimulation s;
+  s.file = ReadPolishPath(path_file);
+  try {
+    s.grid = std::make_shared<const polishing::SampleGrid>(
+        polishing::SampleGrid::Build(surface, sample_spacing, process.margin, process.flip_normal));
+  } catch (const std::domain_error& e) {
+    throw InputError({surface_source, 0, 0}, e.what());
+  }
+  if (s.grid->num_in_region() == 0) {
+    throw InputError({process_source, 0, 0}, "process.margin_mm leaves no polished region on the patch");
+  }
+  try {
+    polishing::AttachToSurface(surface, *s.grid, process.flip_normal, &s.file.rows);
+    const polishing::RemovalSimulator sim(surface, process, s.grid->points(), s.grid->normals(), 0.0015);
+    s.removal = sim.Simulate(s.file.rows);
+  } catch (const polishing::PathRowError& e) {
+    throw InputError({s.file.path, s.file.lines[e.row()], 0}, "path row " + std::to_string(e.row() + 1) + ": " + e.what());
+  }
+  s.max_speed = polishing::MaxSpeed(s.file.rows);
+  // Flag a segment only if it is too fast even when its length is read as
+  // short as the file's rounding allows: polish-plan writes positions to
+  // 1e-4 mm, so each end may be off by 0.5e-7 m per coordinate (a path
+  // timed exactly at the limit read 50.01 mm/s on 0.5 mm rows).
+  constexpr double kRounding = 2 * 0.5e-7 * 1.7320508075688772;  // [m]
+  double v_sure = 0.0;
+  for (size_t i = 1; i < s.file.rows.size(); ++i) {
+    const double len = (s.file.rows[i].p - s.file.rows[i - 1].p).norm();
+    v_sure = std::max(v_sure, std::max(0.0, len - kRounding) / (s.file.rows[i].t - s.file.rows[i - 1].t));
+  }
+  s.speed_limit_exceeded = v_sure > process.max_speed * (1 + 1e-6);
+  s.stats = polishing::ComputeRemovalStats(s.removal, s.grid->areas(), s.grid->in_region());
+  return s;
+}
+
+}  // namespace robomach::io
