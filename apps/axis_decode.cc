@@ -2,17 +2,16 @@
 // (docs/formats.md §8.1), streamed in constant memory.
 #include <CLI/CLI.hpp>
 
-#include <bit>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "cli_support.h"
 #include "robomach/common/errors.h"
 #include "robomach/io/atomic_file.h"
-#include "robomach/io/machine_files.h"
+#include "robomach/io/capture_decoding.h"
+#include "robomach/io/counts_file.h"
+#include "robomach/io/machine_file.h"
 #include "robomach/io/number_format.h"
-#include "robomach/machine/quadrature_decoder.h"
 #include "robomach/report/posture_json.h"
 
 namespace robomach::apps {
@@ -56,68 +55,38 @@ int Run(int argc, char** argv) {
                        {{"--out", out_path}, {"--summary", summary_path}});
     const io::MachineFile mf = io::ReadMachineFile(machine_path);
     const auto& axes = mf.machine.axes;
-    const auto bytes = std::filesystem::file_size(capture_path);
-    if (bytes % 2 != 0) {
-      throw InputError({capture_path, 0, 0}, "size " + std::to_string(bytes) +
-                                                 " bytes is not a whole number of 16-bit words (truncated capture?)");
-    }
-    if (bytes == 0) throw InputError({capture_path, 0, 0}, "the capture is empty");
-    const long long total = static_cast<long long>(bytes / 2);
-
-    machine::QuadratureDecoder decoder({.num_axes = static_cast<int>(axes.size()), .glitch_filter_samples = filter});
-    ProgressLine progress(kTool, "samples", static_cast<long>(total));
+    ProgressLine progress(kTool, "samples", static_cast<long>(std::filesystem::file_size(capture_path) / 2));
+    io::CaptureDecoding d;
     io::WriteFileAtomically(out_path, [&](std::ostream& out) {
-      std::ifstream in(capture_path, std::ios::binary);
-      if (!in) throw InputError({capture_path, 0, 0}, "cannot open file for reading");
       io::CountsWriter writer(out, axes,
                               {{"generator", "axis-decode (robomach)"},
                                {"capture", capture_path},
                                {"sample_rate_hz", io::FormatDouble(rate_hz)},
                                {"every", std::to_string(every)},
                                {"glitch_filter", std::to_string(filter)}});
-      std::vector<std::uint16_t> block(1 << 16);
-      long long pos = 0, next_out = 0;
-      while (pos < total) {
-        const long long want = std::min<long long>(static_cast<long long>(block.size()), total - pos);
-        in.read(reinterpret_cast<char*>(block.data()), want * 2);
-        if (in.gcount() != want * 2) throw InputError({capture_path, 0, 0}, "read error");
-        if constexpr (std::endian::native == std::endian::big) {
-          for (auto& w : block) w = static_cast<std::uint16_t>((w >> 8) | (w << 8));
-        }
-        long long at = 0;
-        while (at < want) {
-          // Decode up to and including the next output sample.
-          const long long len = std::min(want - at, next_out - (pos + at) + 1);
-          decoder.Decode(block.data() + at, static_cast<std::size_t>(len));
-          at += len;
-          if (pos + at - 1 == next_out) {
-            writer.Row(static_cast<double>(next_out) / rate_hz, decoder.counts().data());
-            next_out += every;
-          }
-        }
-        pos += want;
-        progress.Update(static_cast<long>(pos));
-      }
+      d = io::DecodeCaptureFile(capture_path, mf, rate_hz, every, filter,
+                                [&](double t_s, const std::int64_t* counts) { writer.Row(t_s, counts); },
+                                [&](long done, long) { progress.Update(done); });
     });
     progress.Finish();
     long long events = 0;
     nlohmann::json j;
-    j["samples"] = decoder.samples();
+    j["samples"] = d.samples;
     j["sample_rate_hz"] = rate_hz;
     j["every"] = every;
     j["glitch_filter"] = filter;
     j["error_events"] = nlohmann::json::object();
     j["final_counts"] = nlohmann::json::object();
     for (size_t a = 0; a < axes.size(); ++a) {
-      j["error_events"][axes[a].name] = decoder.error_events()[a];
-      j["final_counts"][axes[a].name] = decoder.counts()[a];
-      events += decoder.error_events()[a];
+      j["error_events"][axes[a].name] = d.error_events[a];
+      j["final_counts"][axes[a].name] = d.final_counts[a];
+      events += d.error_events[a];
     }
     if (!summary_path.empty()) io::WriteFileAtomically(summary_path, report::DumpJson(j));
     if (events > 0) {
       std::string per;
       for (size_t a = 0; a < axes.size(); ++a) {
-        if (decoder.error_events()[a] > 0) per += " " + axes[a].name + ": " + std::to_string(decoder.error_events()[a]);
+        if (d.error_events[a] > 0) per += " " + axes[a].name + ": " + std::to_string(d.error_events[a]);
       }
       Warn(kTool, std::to_string(events) + " error events (A and B changed in one sample; each leaves the position "
                   "uncertain by 2 counts):" + per + ". Raise the sample rate or use --glitch-filter.");

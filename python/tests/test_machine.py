@@ -38,6 +38,23 @@ def test_acquire_equals_axis_acquire(tmp):
     assert a['unit_findings'] == []
 
 
+def test_decode_equals_axis_decode(tmp):
+    # A capture axis-synth made with glitches, decoded by axis-decode and by
+    # Python: the same counts file; the counts equal axis-synth's own (the
+    # glitch filter removes every glitch: no error event).
+    run_tool('axis-synth', '--machine', MACHINE, '--program', os.path.join(DATA, 'machine', 'cone_arc.csv'),
+             '--feed-mm-min', 2000, '--sample-rate-hz', 8000, '--capture', tmp / 'capture.bin', '--capture-every', 100,
+             '--glitch-probability', 0.01, '--seed', 3, '--machine-out', tmp / 'machine.yaml', '--out', tmp / 'synth.csv')
+    run_tool('axis-decode', '--machine', tmp / 'machine.yaml', '--capture', tmp / 'capture.bin', '--sample-rate-hz',
+             800000, '--every', 100, '--glitch-filter', 2, '--out', tmp / 'tool.csv')
+    d = rm.decode_capture(str(tmp / 'machine.yaml'), str(tmp / 'capture.bin'), 800000, every=100, glitch_filter=2,
+                          out=str(tmp / 'py.csv'))
+    assert (tmp / 'py.csv').read_text() == (tmp / 'tool.csv').read_text()
+    assert sum(d['error_events']) == 0
+    rows = [line.split(',') for line in (tmp / 'synth.csv').read_text().splitlines() if not line.startswith('#')][1:]
+    np.testing.assert_array_equal(d['counts'], np.array([[int(x) for x in r[1:]] for r in rows], dtype=np.int64))
+
+
 def test_iso230_equals_axis_accuracy(tmp):
     runs = os.path.join(DATA, 'machine', 'x_runs_hand.csv')
     run_tool('axis-accuracy', '--runs', runs, '--out', tmp / 'tool.json', expect_rc=None)
@@ -58,5 +75,9 @@ def test_bad_input(tmp):
     with pytest.raises(rm.InputError) as e:
         rm.acquire(MACHINE, os.path.join(DATA, 'machine', 'counts_first_row_nonzero.csv'))
     assert e.value.path.endswith('counts_first_row_nonzero.csv') and e.value.line == 3
+    odd = tmp / 'odd.bin'
+    odd.write_bytes(b'\x00\x01\x02')
+    with pytest.raises(rm.InputError, match='16-bit words'):
+        rm.decode_capture(MACHINE, str(odd), 1000.0)
     with pytest.raises(rm.InputError, match='axis'):
         rm.iso230_evaluate(os.path.join(DATA, 'machine', 'x_runs_no_down.csv'))

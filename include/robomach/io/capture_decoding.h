@@ -1,0 +1,32 @@
+#pragma once
+// axis-decode's run (issue #21): a raw quadrature capture (formats.md §8.2,
+// 16-bit little-endian words, two bits per axis) decoded to counts at every
+// `every`-th sample.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "robomach/common/progress.h"
+#include "robomach/io/machine_file.h"
+
+namespace robomach::io {
+
+struct CaptureDecoding {
+  std::int64_t samples{0};
+  std::vector<std::int64_t> error_events;  // per axis: both channels changed in one sample
+  std::vector<std::int64_t> final_counts;  // per axis
+};
+
+/// Decodes the capture for the machine file's axes (QuadratureDecoder with
+/// `glitch_filter` samples), calling `on_row(t_s, counts)` at samples 0,
+/// every, 2 every, ... (t_s = sample / rate_hz; counts in axes order).
+/// @throws InputError naming the capture for an odd size (a truncated
+///   16-bit word), an empty capture or a read error.
+CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const MachineFile& machine, double rate_hz,
+                                  long every, int glitch_filter,
+                                  const std::function<void(double, const std::int64_t*)>& on_row,
+                                  const ProgressCallback& progress = {});
+
+}  // namespace robomach::io
