@@ -37,27 +37,6 @@ namespace {
 
 constexpr char kTool[] = "polish-plan";
 
-std::string Short(double x) {
-  std::ostringstream o;
-  o.precision(4);
-  o << x;
-  return o.str();
-}
-
-std::string Short6(double x) {
-  std::ostringstream o;
-  o.precision(6);
-  o << x;
-  return o.str();
-}
-
-std::string CsvField(const std::string& x) {
-  if (x.find_first_of(",\"\n") == std::string::npos) return x;
-  std::string q = "\"";
-  for (char c : x) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
-  return q + "\"";
-}
-
 // --list-faces: one CSV row per face of a STEP/IGES file (docs/formats.md §5).
 int ListFaces(const std::string& surface_path, const std::string& process_path, const std::string& out,
               const SurfaceChoice& choice, const std::string& pattern, double radius_mm, double sample_mm,
@@ -92,14 +71,7 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
       });
   if (progress) progress->Finish();
   if (!info.unit_warning.empty()) Warn(kTool, surface_path + ": " + info.unit_warning);
-  std::ostringstream csv;
-  csv << "face,surface_type,area_mm2,u_size_mm,v_size_mm,trimmed,holes,polishable,reason\n";
-  for (const auto& r : rows) {
-    csv << r.face << ',' << r.surface_type << ',' << Short6(r.area_mm2) << ',' << Short6(r.u_size_mm) << ','
-        << Short6(r.v_size_mm) << ',' << (r.trimmed ? 1 : 0) << ','
-        << r.holes << ',' << (r.polishable ? 1 : 0) << ',' << CsvField(r.reason) << '\n';
-  }
-  io::WriteFileAtomically(out.empty() ? "-" : out, csv.str());
+  io::WriteFileAtomically(out.empty() ? "-" : out, io::CadFaceListCsv(rows));
   return kExitOk;
 }
 
@@ -107,28 +79,17 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
 // the estimate), and warns with the estimate before long work.
 void CheckFaceSize(const polishing::NurbsSurface& surface, const std::string& surface_path, double sample_mm,
                    const polishing::PathParameters& params) {
-  const polishing::SurfaceSize size = polishing::MeasureSurface(surface);
-  const double points = polishing::EstimateGridPoints(size, MmToM(sample_mm));
   const polishing::PolishableOptions limits;
-  const double area = surface.trim() ? surface.trim()->area : size.length_u * size.length_v;
-  const double rows = polishing::EstimatePathRows(area, params);
-  std::ostringstream m;
-  m.precision(3);
-  m << polishing::SurfaceName(surface) << " (" << 1e3 * size.length_u << " x " << 1e3 * size.length_v
-    << " mm, mean arc lengths along u and v; " << 1e6 * area << " mm^2)";
-  const std::string what = m.str();
-  m.str("");
-  m << points << " grid points at --sample-mm " << sample_mm << " (~" << points * 90e-9 << " GB) and a path of ~" << rows
-    << " rows";
-  const std::string estimate = m.str();
-  if (!(points <= limits.max_grid_points) || !(rows <= limits.max_path_rows)) {
-    m.str("");
-    m << what << " is too large to plan within the limits (" << limits.max_grid_points << " grid points, "
-      << limits.max_path_rows << " path rows; about a minute and 2 GB): " << estimate
+  const polishing::PlanSize size = polishing::EstimatePlanSize(surface, MmToM(sample_mm), params, limits);
+  if (size.too_large) {
+    std::ostringstream m;
+    m.precision(3);
+    m << size.what << " is too large to plan within the limits (" << limits.max_grid_points << " grid points, "
+      << limits.max_path_rows << " path rows; about a minute and 2 GB): " << size.estimate
       << " (check the file's unit: --cad-unit-scale; or choose a smaller face, --list-faces)";
     throw InputError({surface_path, 0, 0}, m.str());
   }
-  if (points > 2e5 || rows > 1e5) Warn(kTool, what + " is large: " + estimate + "; planning may take a minute");
+  if (size.large) Warn(kTool, size.what + " is large: " + size.estimate + "; planning may take a minute");
 }
 
 int Run(int argc, char** argv) {

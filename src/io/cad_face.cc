@@ -600,4 +600,27 @@ void SetUpOpenCascadeExchange() {
 }
 
 
+std::string CadFaceListCsv(const std::vector<CadFaceRow>& rows) {
+  auto short6 = [](double x) {
+    std::ostringstream o;
+    o.precision(6);
+    o << x;
+    return o.str();
+  };
+  auto field = [](const std::string& x) {
+    if (x.find_first_of(",\"\n") == std::string::npos) return x;
+    std::string q = "\"";
+    for (char c : x) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
+    return q + "\"";
+  };
+  std::ostringstream csv;
+  csv << "face,surface_type,area_mm2,u_size_mm,v_size_mm,trimmed,holes,polishable,reason\n";
+  for (const auto& r : rows) {
+    csv << r.face << ',' << r.surface_type << ',' << short6(r.area_mm2) << ',' << short6(r.u_size_mm) << ','
+        << short6(r.v_size_mm) << ',' << (r.trimmed ? 1 : 0) << ',' << r.holes << ',' << (r.polishable ? 1 : 0) << ','
+        << field(r.reason) << '\n';
+  }
+  return csv.str();
+}
+
 }  // namespace robomach::io

@@ -122,4 +122,25 @@ Polishability CheckPolishable(const NurbsSurface& surface, const PolishingProces
   return p;
 }
 
+PlanSize EstimatePlanSize(const NurbsSurface& surface, double sample_spacing, const PathParameters& params,
+                          const PolishableOptions& limits) {
+  PlanSize out;
+  const SurfaceSize size = MeasureSurface(surface);
+  out.grid_points = EstimateGridPoints(size, sample_spacing);
+  const double area = surface.trim() ? surface.trim()->area : size.length_u * size.length_v;
+  out.path_rows = EstimatePathRows(area, params);
+  std::ostringstream m;
+  m.precision(3);
+  m << SurfaceName(surface) << " (" << 1e3 * size.length_u << " x " << 1e3 * size.length_v
+    << " mm, mean arc lengths along u and v; " << 1e6 * area << " mm^2)";
+  out.what = m.str();
+  m.str("");
+  m << out.grid_points << " grid points at --sample-mm " << 1e3 * sample_spacing << " (~" << out.grid_points * 90e-9
+    << " GB) and a path of ~" << out.path_rows << " rows";
+  out.estimate = m.str();
+  out.too_large = !(out.grid_points <= limits.max_grid_points) || !(out.path_rows <= limits.max_path_rows);
+  out.large = out.grid_points > 2e5 || out.path_rows > 1e5;
+  return out;
+}
+
 }  // namespace robomach::polishing

@@ -79,6 +79,11 @@ std::vector<CadFaceRow> ListCadFaces(const std::string& path, const FaceCheck& c
                                      const CadReadOptions& options = {}, CadPartInfo* info = nullptr,
                                      const std::function<void(int, int)>& progress = {});
 
+/// polish-plan --list-faces' CSV (docs/formats.md §5): `face,surface_type,
+/// area_mm2,u_size_mm,v_size_mm,trimmed,holes,polishable,reason`, sizes to 6
+/// significant digits, the reason quoted where it needs it.
+std::string CadFaceListCsv(const std::vector<CadFaceRow>& rows);
+
 /// Writes `surface` (its untrimmed patch, lengths in mm) as a STEP AP214 file
 /// with one B-spline face; `comment` (lines) goes into a comment after the
 /// header line. Written to a temporary file and renamed into place.

@@ -72,4 +72,17 @@ double EstimatePathRows(double area, const PathParameters& params);
 Polishability CheckPolishable(const NurbsSurface& surface, const PolishingProcess& process,
                               const PathParameters& params, const PolishableOptions& options = {});
 
+/// How big planning on a surface will be, before the work (polish-plan
+/// refuses a face beyond the limits and warns about a large one).
+struct PlanSize {
+  std::string what;      // "<surface name> (L_u x L_v mm, mean arc lengths along u and v; A mm^2)"
+  std::string estimate;  // "<points> grid points at --sample-mm S (~G GB) and a path of ~R rows"
+  double grid_points{0.0};
+  double path_rows{0.0};
+  bool too_large{false};  // beyond options.max_grid_points or max_path_rows
+  bool large{false};      // over 2e5 grid points or 1e5 rows: a minute or more
+};
+PlanSize EstimatePlanSize(const NurbsSurface& surface, double sample_spacing, const PathParameters& params,
+                          const PolishableOptions& limits = {});
+
 }  // namespace robomach::polishing
