@@ -239,17 +239,15 @@ int RunDrillSim(int argc, char** argv) {
       if (p.finished) {
         if (progress) progress->Finish();
         progress.reset();
+        if (p.run && p.run->tde_condition_fails()) {
+          Warn(kTool, "pd-tdc: the TDE stability condition ||I - M^-1 Mbar|| < 1 fails (" +
+                          io::FormatDouble(p.run->tde_measure) + "); lower the Mbar ratio");
+        }
         return;
       }
       if (!progress) progress.emplace(kTool, "simulating " + p.kind, p.total);
       progress->Update(p.done);
     });
-    for (const Run& run : runs) {
-      if (run.tde_condition_fails()) {
-        Warn(kTool, "pd-tdc: the TDE stability condition ||I - M^-1 Mbar|| < 1 fails (" +
-                        io::FormatDouble(run.tde_measure) + "); lower the Mbar ratio");
-      }
-    }
 
     // All runs done: write every output (each atomically).
     int rc = kExitOk;

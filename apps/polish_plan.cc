@@ -5,6 +5,7 @@
 // pictures (seed 004; docs/formats.md §5-7).
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <limits>
@@ -181,20 +182,14 @@ int Run(int argc, char** argv) {
   choice.face_given = app.count("--face") > 0;
 
   return RunGuarded(kTool, [&]() -> int {
-    CheckOptionRange("--sample-mm", sample_mm, 0.05, 0.5);
-    CheckOptionRange("--row-step-mm", row_step_mm, 0.05, 5.0);
-    CheckOptionRange("--opt-sample-mm", opt_sample_mm, 0.1, 5.0);
-    CheckOptionRange("--target-removal-um", target_um, 0.0, 1e6);
-    CheckOptionRange("--offset-mm", offset_mm, 0.1, 1000);
-    CheckOptionRange("--radius-mm", radius_mm, 0.05, 1000);
-    CheckOptionRange("--pitch-mm", pitch_mm, 0.01, 1000);
-    CheckOptionRange("--opt-offset-max-mm", opt_offset_max_mm, 1.0, 1000);
-    CheckOptionRange("--opt-offset-min-contact-widths", opt_offset_min_cw, 0.2, 10.0);
-    CheckOptionRange("--stagger-loops", stagger_loops, 0.0, 1.0);
-    CheckOptionRange("--edge-overrun-mm", edge_overrun_mm, 0.0, 1000.0);
-    CheckOptionRange("--line-angle-deg", line_angle_deg, -360.0, 360.0);
-    CheckOptionRange("--max-time-s", max_time_s, 1.0, 86400.0);
-    CheckOptionRange("--threads", threads, 1, 64);
+    po.sample_mm = sample_mm;
+    if (offset_given) po.offset_mm = offset_mm;
+    // The library's ranges, under the command line's names.
+    for (const polishing::PlanOptionRange& r : polishing::PlanOptionRanges(po)) {
+      std::string option = "--" + r.name;
+      std::replace(option.begin(), option.end(), '_', '-');
+      CheckOptionRange(option, r.value, r.lo, r.hi);
+    }
     if (optimise != "none" && pattern == "parallel" && optimise == "pso") {
       throw UsageError("--optimise pso applies to the cycloid; the parallel pattern is optimised with --optimise nlopt");
     }
@@ -223,11 +218,10 @@ int Run(int argc, char** argv) {
       CheckFaceSize(surface, surface_path, sample_mm, p);
     }
     const polishing::PlanningContext ctx =
-        polishing::PreparePlanning(surface, process, MmToM(sample_mm), surface_path, process_path);
+        polishing::PreparePlanning(surface, process, MmToM(po.sample_mm), surface_path, process_path);
     const polishing::SampleGrid& grid = *ctx.grid;
     const double contact_width = ctx.contact_width;
 
-    if (offset_given) po.offset_mm = offset_mm;
     po.guides_given = guides_given;
     po.seed = static_cast<unsigned>(seed);
     // Every parameter comes from an option: a value out of its limits is exit 64.

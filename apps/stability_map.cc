@@ -114,12 +114,10 @@ int Run(int argc, char** argv) {
       rows = 1;
       cols = static_cast<int>(targets.size());
     }
-    for (const auto& t : targets) {
-      const Eigen::Vector3d f = t.feed_B - t.feed_B.dot(t.z_T.normalized()) * t.z_T.normalized();
-      if (f.norm() < 1e-6) {
-        throw InputError({cut_path, cut.feed_line, cut.feed_column}, "feed_direction is parallel to the tool axis of the " +
-                                               std::string(grid ? "region" : "path") + "; choose a feed in the work plane");
-      }
+    if (stability::FirstFeedAlongToolAxis(targets) >= 0) {
+      throw InputError({cut_path, cut.feed_line, cut.feed_column}, "feed_direction is parallel to the tool axis of the " +
+                                                                       std::string(grid ? "region" : "path") +
+                                                                       "; choose a feed in the work plane");
     }
     ProgressLine progress(kTool, "points", static_cast<long>(targets.size()));
     opt.progress = [&](long done, long) { progress.Update(done); };

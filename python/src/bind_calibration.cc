@@ -222,7 +222,7 @@ void BindCalibration(py::module_& m) {
       .def_readonly("outlier", &CaseResidual::outlier);
   py::class_<JointStiffnessResult>(m, "JointStiffnessResult", "What identify_joint_stiffness() found.")
       .def_property_readonly("status", [](const JointStiffnessResult& r) { return std::string(identification::ToString(r.status)); },
-                             "'converged', 'not converged' or 'failed', as kq-identify's summary writes it")
+                             "'converged', 'not_converged' or 'failed', as kq-identify's summary writes it")
       .def_readonly("solver_message", &JointStiffnessResult::solver_message)
       .def_readonly("num_cases", &JointStiffnessResult::num_cases)
       .def_readonly("joint_stiffness", &JointStiffnessResult::joint_stiffness,

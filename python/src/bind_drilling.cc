@@ -1,5 +1,6 @@
 // Python bindings of the drilling robot (docs/python.md): drill-sim's call
 // (io::LoadDrillingSetup, then drilling::RunControllers) and its series CSV.
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -66,10 +67,17 @@ void BindDrilling(py::module_& m) {
     o.kinds = controllers;
     o.tune = tune;
     o.tune_evaluations = tune_evaluations;
+    if (controllers.empty()) throw std::invalid_argument("controllers: expected at least one kind");
+    for (size_t i = 0; i < controllers.size(); ++i) {
+      drilling::FindControllerKind(controllers[i]);
+      for (size_t k = 0; k < i; ++k) {
+        if (controllers[k] == controllers[i]) throw std::invalid_argument("controllers: " + controllers[i] + " given twice");
+      }
+    }
     for (const auto& [kind, v] : gains) {
       drilling::FindControllerKind(kind);
-      if (v.size() < 2 || v.size() > 4 || v[0] <= 0 || v[1] <= 0 || (v.size() >= 3 && v[2] <= 0) ||
-          (v.size() == 4 && v[3] < 0)) {
+      if (v.size() < 2 || v.size() > 4 || !(v[0] > 0) || !(v[1] > 0) || (v.size() >= 3 && !(v[2] > 0)) ||
+          (v.size() == 4 && !(v[3] >= 0)) || !std::isfinite(v[0]) || !std::isfinite(v[1])) {
         throw std::invalid_argument("gains[" + kind + "]: expected (omega_rad_s, zeta[, third[, filter_s]]), positive");
       }
       drilling::ControllerParameters p = drilling::DefaultParameters(kind);

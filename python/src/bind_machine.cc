@@ -2,6 +2,7 @@
 // acquisition of axis-acquire (counts -> compensated axes -> tool pose, the
 // contour error against a programmed path) and the ISO 230-2 evaluation of
 // axis-accuracy.
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -92,8 +93,10 @@ void BindMachine(py::module_& m) {
                              long every, int glitch_filter, const std::optional<std::string>& out) {
     RequireReadableFile(machine_path);
     RequireReadableFile(capture);
-    if (!(sample_rate_hz > 0.0) || every < 1 || glitch_filter < 0) {
-      throw std::invalid_argument("expected sample_rate_hz > 0, every >= 1, glitch_filter >= 0");
+    if (!(sample_rate_hz > 0.0) || !std::isfinite(sample_rate_hz) || every < 1 || glitch_filter < 0 ||
+        glitch_filter > 1000000) {
+      throw std::invalid_argument("expected (axis-decode's ranges) a finite sample_rate_hz > 0, every >= 1, "
+                                  "glitch_filter in [0, 1000000]");
     }
     const io::MachineFile mf = io::ReadMachineFile(machine_path);
     const int n = static_cast<int>(mf.machine.axes.size());

@@ -11,6 +11,7 @@
 #include "robomach/io/cad_face.h"
 #include "robomach/io/polish_simulation.h"
 #include "robomach/io/polishing_files.h"
+#include "robomach/polishing/face_check.h"
 #include "robomach/polishing/path_patterns.h"
 #include "robomach/polishing/plan_workflow.h"
 
@@ -71,10 +72,10 @@ void BindPolishing(py::module_& m) {
       }
       return std::make_shared<NurbsSurface>(io::ReadNurbsYaml(path));
     }
-    io::SetUpOpenCascadeExchange();
+    // The GIL stays held: OpenCASCADE's readers keep global state
+    // (Interface_Static), so two Python threads must not read at once.
     io::CadReadOptions o;
     o.unit_scale = cad_unit_scale;
-    py::gil_scoped_release release;
     return std::make_shared<NurbsSurface>(io::ReadCadFace(path, face, o));
   }, py::arg("path"), py::arg("face") = 0, py::arg("cad_unit_scale") = 1.0,
      "A surface: NURBS YAML (docs/formats.md §5) or a face of a STEP/IGES file (1-based; 0: the largest by area), "
@@ -152,18 +153,18 @@ void BindPolishing(py::module_& m) {
 
   const polishing::PlanOptions kDefaults;
   m.def("plan_polishing", [](const SurfacePtr& surface, const PolishingProcess& process, const std::string& pattern,
-                             const std::string& guides, std::optional<double> offset_mm, double radius_mm, double pitch_mm,
+                             const std::optional<std::string>& guides, std::optional<double> offset_mm, double radius_mm, double pitch_mm,
                              double row_step_mm, double sample_mm, double edge_inset_mm, double stagger_loops,
                              double edge_overrun_mm, double line_angle_deg, double target_removal_um,
-                             const std::string& optimise, bool guides_given, double opt_sample_mm,
+                             const std::string& optimise, double opt_sample_mm,
                              double opt_offset_max_mm, double opt_offset_min_contact_widths, double max_time_s,
                              int threads, unsigned seed, const std::string& surface_source,
                              const std::string& process_source) {
-    if (!(sample_mm > 0.0 && sample_mm <= 0.5)) throw std::invalid_argument("sample_mm: expected in (0, 0.5]");
-    if (!(target_removal_um >= 0.0)) throw std::invalid_argument("target_removal_um: expected >= 0");
     polishing::PlanOptions o;
     o.pattern = pattern;
-    o.guides = guides;
+    o.guides = guides.value_or("offsets");
+    o.guides_given = guides.has_value();  // the optimiser keeps a family the caller chose
+    o.sample_mm = sample_mm;
     o.offset_mm = offset_mm;
     o.radius_mm = radius_mm;
     o.pitch_mm = pitch_mm;
@@ -174,7 +175,6 @@ void BindPolishing(py::module_& m) {
     o.line_angle_deg = line_angle_deg;
     o.target_removal_um = target_removal_um;
     o.optimise = optimise;
-    o.guides_given = guides_given;
     o.opt_sample_mm = opt_sample_mm;
     o.opt_offset_max_mm = opt_offset_max_mm;
     o.opt_offset_min_contact_widths = opt_offset_min_contact_widths;
@@ -183,25 +183,33 @@ void BindPolishing(py::module_& m) {
     o.seed = seed;
     auto plan = std::make_unique<PyPlan>();
     plan->surface = surface;
+    polishing::CheckRanges(o);
     {
       py::gil_scoped_release release;
+      // A face too large to plan within polish-plan's limits is refused before the work.
+      const polishing::PlanSize size = polishing::EstimatePlanSize(*surface, MmToM(sample_mm), {});
+      if (size.too_large) {
+        throw std::invalid_argument(size.what + " is too large to plan within the limits: " + size.estimate +
+                                    " (check the file's unit: cad_unit_scale; or choose a smaller face)");
+      }
       plan->context = polishing::PreparePlanning(*surface, process, MmToM(sample_mm), surface_source, process_source);
       plan->outcome = polishing::PlanPolishing(plan->context, polishing::ToPlanRequest(o, plan->context));
     }
     return plan;
-  }, py::arg("surface"), py::arg("process"), py::arg("pattern") = "cycloid", py::arg("guides") = "offsets",
+  }, py::arg("surface").none(false), py::arg("process"), py::arg("pattern") = "cycloid", py::arg("guides") = py::none(),
      py::arg("offset_mm") = py::none(), py::arg("radius_mm") = kDefaults.radius_mm,
      py::arg("pitch_mm") = kDefaults.pitch_mm, py::arg("row_step_mm") = kDefaults.row_step_mm, py::arg("sample_mm") = 0.5,
      py::arg("edge_inset_mm") = kDefaults.edge_inset_mm, py::arg("stagger_loops") = kDefaults.stagger_loops,
      py::arg("edge_overrun_mm") = kDefaults.edge_overrun_mm, py::arg("line_angle_deg") = kDefaults.line_angle_deg,
      py::arg("target_removal_um") = kDefaults.target_removal_um, py::arg("optimise") = kDefaults.optimise,
-     py::arg("guides_given") = false, py::arg("opt_sample_mm") = kDefaults.opt_sample_mm,
+     py::arg("opt_sample_mm") = kDefaults.opt_sample_mm,
      py::arg("opt_offset_max_mm") = kDefaults.opt_offset_max_mm,
      py::arg("opt_offset_min_contact_widths") = kDefaults.opt_offset_min_contact_widths,
      py::arg("max_time_s") = kDefaults.max_time_s, py::arg("threads") = kDefaults.threads, py::arg("seed") = kDefaults.seed,
      py::arg("surface_source") = "surface", py::arg("process_source") = "process",
-     "polish-plan's call with its defaults (the same names, units in them): the region sampled, the path planned "
-     "(optimised with optimise='nlopt' or 'pso'), simulated and timed for target_removal_um. offset_mm None: 8 mm "
+     "polish-plan's call with its defaults and ranges (the same names, units in them): the region sampled, the "
+     "path planned (optimised with optimise='nlopt' or 'pso'), simulated and timed for target_removal_um. "
+     "guides None: boundary offsets, and the optimiser chooses the family; given, it keeps it. offset_mm None: 8 mm "
      "for the cycloid, one contact width for the zig-zag. surface_source and process_source name the files in "
      "errors. The GIL is released while it runs.");
 
@@ -222,7 +230,7 @@ void BindPolishing(py::module_& m) {
     if (!(sample_mm > 0.0 && sample_mm <= 0.5)) throw std::invalid_argument("sample_mm: expected in (0, 0.5]");
     py::gil_scoped_release release;
     return io::SimulatePolishPathFile(*surface, process, path, MmToM(sample_mm), surface_source, process_source);
-  }, py::arg("surface"), py::arg("process"), py::arg("path"), py::arg("sample_mm") = 0.5,
+  }, py::arg("surface").none(false), py::arg("process"), py::arg("path"), py::arg("sample_mm") = 0.5,
      py::arg("surface_source") = "surface", py::arg("process_source") = "process",
      "polish-sim's call: the tool path file (docs/formats.md §6) attached to the surface and simulated "
      "(Hertz contact, Preston removal) on the region sampled every sample_mm.");

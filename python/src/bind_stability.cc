@@ -136,7 +136,7 @@ void BindStability(py::module_& m) {
     } catch (const std::invalid_argument& e) {
       throw InputError({cut.path, cut.feed_line, cut.feed_column}, std::string("feed_direction: ") + e.what());
     }
-  }, py::arg("model"), py::arg("q"), py::arg("cut"), py::arg("id") = "P",
+  }, py::arg("model").none(false), py::arg("q"), py::arg("cut"), py::arg("id") = "P",
      "The tool tip of the robot model at posture q [rad], as stability-lobes --robot makes it.");
 
   m.def("tips_from_modal_table", [](const std::string& path, const io::CutSpec& cut, const Eigen::Vector3d& tool_axis,
@@ -176,8 +176,10 @@ void BindStability(py::module_& m) {
       std::vector<io::FrfSetOfPose> ysets;
       if (frf_y) ysets = io::ReadTipFrfs(*frf_y, "", &warnings);
       for (const std::string& w : warnings) said.messages.push_back({stability::TipMessage::Kind::kWarning, w});
-      for (const std::string& f : io::ReceptanceUnitFindings(sets)) {
-        said.messages.push_back({stability::TipMessage::Kind::kWarning, "implausible (unit mistake?): " + f});
+      for (const std::vector<io::FrfSetOfPose>* s : {&sets, static_cast<const std::vector<io::FrfSetOfPose>*>(&ysets)}) {
+        for (const std::string& f : io::ReceptanceUnitFindings(*s)) {
+          said.messages.push_back({stability::TipMessage::Kind::kWarning, "implausible (unit mistake?): " + f});
+        }
       }
       tips = stability::TipsFromMeasuredFrfs(sets, ysets, o, said.Sink());
     }
@@ -195,10 +197,13 @@ void BindStability(py::module_& m) {
       throw std::invalid_argument("method: expected zoa, sd or both, got " + method);
     }
     if (speeds < 0 || sd_speeds < 1 || (sd_steps != 0 && sd_steps < 2) || sd_modes < 1 || !(sd_max_depth_mm > 0.0) ||
-        max_lobe < 0 || threads < 0 || !(sd_steps_per_mode_period >= 4.0)) {
+        max_lobe < 0 || threads < 0 || !(sd_steps_per_mode_period >= 4.0) || speeds > 100000 || sd_speeds > 10000 ||
+        sd_steps > 1000 || sd_modes > 200 || !(sd_max_depth_mm <= 1e4) || threads > 256 || max_lobe > 1000 ||
+        !(sd_steps_per_mode_period <= 1000.0)) {
       throw std::invalid_argument(
-          "expected speeds >= 0, sd_speeds >= 1, sd_steps 0 or >= 2, sd_steps_per_mode_period >= 4, sd_modes >= 1, "
-          "sd_max_depth_mm > 0, max_lobe >= 0, threads >= 0");
+          "expected (stability-lobes' ranges) speeds in [0, 100000], sd_speeds in [1, 10000], sd_steps 0 or in [2, "
+          "1000], sd_steps_per_mode_period in [4, 1000], sd_modes in [1, 200], sd_max_depth_mm in (0, 1e4], max_lobe "
+          "in [0, 1000], threads in [0, 256]");
     }
     stability::LobesOptions o;
     o.method = method == "zoa" ? stability::LobeMethod::kZoa
@@ -312,6 +317,17 @@ void BindStability(py::module_& m) {
                             int rows, int cols, const io::CutSpec& cut, const Eigen::VectorXd& seed_q, double rotation,
                             bool optimise_rotation, double rotation_min, double rotation_max, int rotation_evaluations,
                             int speeds, double max_depth_mm, int threads) {
+    if (stability::FirstFeedAlongToolAxis(targets) >= 0) {
+      throw InputError({cut.path, cut.feed_line, cut.feed_column},
+                       "feed_direction is parallel to the tool axis of target " +
+                           std::to_string(stability::FirstFeedAlongToolAxis(targets)) +
+                           "; choose a feed in the work plane");
+    }
+    if (speeds < 0 || speeds > 100000 || threads < 0 || threads > 256 || rotation_evaluations < 8 ||
+        !(max_depth_mm > 0.0)) {
+      throw std::invalid_argument("expected speeds in [0, 100000], threads in [0, 256], rotation_evaluations >= 8, "
+                                  "max_depth_mm > 0");
+    }
     stability::MapOptions o;
     o.seed_q = seed_q;
     o.rotation = rotation;
@@ -344,7 +360,7 @@ void BindStability(py::module_& m) {
       out.append(d);
     }
     return out;
-  }, py::arg("model"), py::arg("targets"), py::arg("rows"), py::arg("cols"), py::arg("cut"), py::arg("seed_q"),
+  }, py::arg("model").none(false), py::arg("targets"), py::arg("rows"), py::arg("cols"), py::arg("cut"), py::arg("seed_q"),
      py::arg("rotation") = 0.0, py::arg("optimise_rotation") = false, py::arg("rotation_min") = -0.5 * kPi,
      py::arg("rotation_max") = 0.5 * kPi, py::arg("rotation_evaluations") = 20, py::arg("speeds") = 0,
      py::arg("max_depth_mm") = 50.0, py::arg("threads") = 0,

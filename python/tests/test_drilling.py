@@ -63,5 +63,9 @@ def test_bad_input(tmp):
         rm.drill_sim(ROBOT, DRILL, MATERIAL, motor_torque_limit_Nm=1e-6)
     assert e.value.path == DRILL and 'cannot hold' in e.value.message
     assert 'pd-tdc' in rm.controller_kinds()
+    with pytest.raises(ValueError, match='given twice'):
+        rm.drill_sim(ROBOT, DRILL, MATERIAL, controllers=['pd', 'pd'])
+    with pytest.raises(ValueError, match='gains'):
+        rm.drill_sim(ROBOT, DRILL, MATERIAL, gains={'pd': (float('nan'), 1.0)})
     with pytest.raises(ValueError, match='chisel'):
         rm.fit_drill_forces(os.path.join(D, 'q235_hss.csv'), DRILL, chisel='round')

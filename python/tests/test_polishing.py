@@ -70,6 +70,13 @@ def test_bad_input(tmp):
         rm.plan_polishing(surface, process, pattern='spiral')
     with pytest.raises(ValueError, match='d <= 2r'):
         rm.plan_polishing(surface, process, offset_mm=20.0)
+    # polish-plan's ranges hold here too: a typo in the sampling is refused, not hours of work.
+    with pytest.raises(ValueError, match=r'sample_mm: expected a value in \[0.05, 0.5\]'):
+        rm.plan_polishing(surface, process, sample_mm=1e-6)
+    with pytest.raises(ValueError, match='pso applies to the cycloid'):
+        rm.plan_polishing(surface, process, pattern='parallel', optimise='pso')
+    with pytest.raises(TypeError):
+        rm.plan_polishing(None, process)
     with pytest.raises(ValueError, match='STEP/IGES'):
         rm.load_surface(DOME, face=2)
     bad = tmp / 'belt.yaml'

@@ -36,11 +36,12 @@ std::vector<ControllerRun> RunControllers(DrillingScenario& scenario, const Cont
       sim.progress = [&](long done, long) { progress({kind, false, done, total, false}); };
     }
     run.result = scenario.Run(*ctl, sim);
-    if (progress) progress({kind, false, total, total, true});
     if (FindControllerKind(kind).uses_time_delay_estimation()) {
       const Eigen::VectorXd mbar = scenario.effective_inertia().diagonal() * run.parameters.third;
+      run.uses_tde = true;
       run.tde_measure = TdeStabilityMeasure(scenario.effective_inertia(), mbar);
     }
+    if (progress) progress({kind, false, total, total, true, &run});
     runs.push_back(std::move(run));
   }
   return runs;

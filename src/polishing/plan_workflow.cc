@@ -85,6 +85,33 @@ EvaluatedPlan EvaluatePlanOnGrid(const PlanningContext& c, const PathParameters&
   return e;
 }
 
+std::vector<PlanOptionRange> PlanOptionRanges(const PlanOptions& o) {
+  return {{"sample_mm", o.sample_mm, 0.05, 0.5},
+          {"row_step_mm", o.row_step_mm, 0.05, 5.0},
+          {"opt_sample_mm", o.opt_sample_mm, 0.1, 5.0},
+          {"target_removal_um", o.target_removal_um, 0.0, 1e6},
+          {"offset_mm", o.offset_mm.value_or(8.0), 0.1, 1000},
+          {"radius_mm", o.radius_mm, 0.05, 1000},
+          {"pitch_mm", o.pitch_mm, 0.01, 1000},
+          {"opt_offset_max_mm", o.opt_offset_max_mm, 1.0, 1000},
+          {"opt_offset_min_contact_widths", o.opt_offset_min_contact_widths, 0.2, 10.0},
+          {"stagger_loops", o.stagger_loops, 0.0, 1.0},
+          {"edge_overrun_mm", o.edge_overrun_mm, 0.0, 1000.0},
+          {"line_angle_deg", o.line_angle_deg, -360.0, 360.0},
+          {"max_time_s", o.max_time_s, 1.0, 86400.0},
+          {"threads", static_cast<double>(o.threads), 1, 64}};
+}
+
+void CheckRanges(const PlanOptions& o) {
+  for (const PlanOptionRange& r : PlanOptionRanges(o)) {
+    if (!(r.value >= r.lo && r.value <= r.hi)) {
+      std::ostringstream s;
+      s << r.name << ": expected a value in [" << r.lo << ", " << r.hi << "], got " << r.value;
+      throw std::invalid_argument(s.str());
+    }
+  }
+}
+
 PlanRequest ToPlanRequest(const PlanOptions& o, const PlanningContext& c) {
   if (o.guides != "offsets" && o.guides != "parallel") {
     throw std::invalid_argument("guides: expected offsets or parallel, got " + o.guides);
@@ -95,6 +122,9 @@ PlanRequest ToPlanRequest(const PlanOptions& o, const PlanningContext& c) {
   PlanRequest req;
   PathParameters& params = req.params;
   params.pattern = FindPathPattern(o.pattern).id();
+  if (o.optimise == "pso" && params.pattern != Pattern::kCycloid) {
+    throw std::invalid_argument("optimise pso applies to the cycloid; the parallel pattern is optimised with nlopt");
+  }
   params.guides = o.guides == "offsets" ? GuideLines::kBoundaryOffsets : GuideLines::kParallelLines;
   params.offset = o.offset_mm ? MmToM(*o.offset_mm) : params.pattern == Pattern::kParallel ? c.contact_width : MmToM(8.0);
   params.radius = MmToM(o.radius_mm);
@@ -189,7 +219,7 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
       out.flagged = true;
       out.infeasible_message =
           req.target_removal > 0
-              ? "no plan the optimiser saw reaches the target removal " + FormatDouble(1e6 * req.target_removal) +
+              ? "no plan the optimiser saw reaches the target removal " + FormatNumber(1e6 * req.target_removal, 12) +
                     " um within max_speed_mm_per_s and covers the region: every covering one removes more at the "
                     "limit (written: the least infeasible, " + FormatDouble(1e6 * opt.best.mean) +
                     " um at the limit, coverage " + FormatDouble(opt.best.coverage) + ")"

@@ -253,4 +253,13 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
   return out;
 }
 
+int FirstFeedAlongToolAxis(const std::vector<ToolPoseTarget>& targets) {
+  for (size_t i = 0; i < targets.size(); ++i) {
+    const Eigen::Vector3d z = targets[i].z_T.normalized();
+    const Eigen::Vector3d f = targets[i].feed_B - targets[i].feed_B.dot(z) * z;
+    if (f.norm() < 1e-6) return static_cast<int>(i);
+  }
+  return -1;
+}
+
 }  // namespace robomach::stability

@@ -80,5 +80,19 @@ TEST(RunControllers, RefusesAnUnknownKindAndAWrongTorqueLimit) {
   EXPECT_THAT(robomach::testing::CaptureError([&] { RunControllers(sc, o); }), HasSubstr("one motor torque limit per joint (3)"));
 }
 
+// The TDE condition fails for a NaN measure (a singular inertia) of a kind
+// that uses it, and never for a kind that does not.
+TEST(ControllerRun, TdeConditionFailsOnNaNOnlyForKindsThatUseIt) {
+  ControllerRun r;
+  r.tde_measure = NAN;
+  EXPECT_FALSE(r.tde_condition_fails());
+  r.uses_tde = true;
+  EXPECT_TRUE(r.tde_condition_fails());
+  r.tde_measure = 0.5;
+  EXPECT_FALSE(r.tde_condition_fails());
+  r.tde_measure = 1.0;
+  EXPECT_TRUE(r.tde_condition_fails());
+}
+
 }  // namespace
 }  // namespace robomach::drilling

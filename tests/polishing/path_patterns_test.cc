@@ -68,7 +68,8 @@ TEST(PathPatterns, CycloidRateKeepsTheFastestPointAtTheLimit) {
   const PathPattern& c = FindPathPattern("cycloid");
   const double w = c.NominalRate(p, vmax);
   EXPECT_NEAR(w * p.radius + c.CentreSpeed(p, w), vmax, 1e-15);
-  EXPECT_NEAR(c.CentreSpeed(p, w), p.pitch * w / (2 * kPi), 1e-18);
+  // One loop takes 2 pi / omega, and the centre advances one pitch in it.
+  EXPECT_NEAR(c.CentreSpeed(p, w) * (2 * kPi / w), p.pitch, 1e-15);
   EXPECT_EQ(c.circle_radius(p), p.radius);
   const PathPattern& z = FindPathPattern("parallel");
   EXPECT_EQ(z.NominalRate(p, vmax), 0.0);

@@ -244,7 +244,9 @@ TEST(SummarizeLobes, MinimumAndMaximumOverThePointsWithABoundary) {
   EXPECT_EQ(s[0].max_depth_speed_rad_s, 400);
   EXPECT_EQ(s[1].id, "B");
   EXPECT_EQ(s[1].method, "sd");
-  EXPECT_EQ(s[1].min_depth, s[1].max_depth);
+  EXPECT_EQ(s[1].min_depth, 5e-4);
+  EXPECT_EQ(s[1].max_depth, 5e-4);
+  EXPECT_EQ(s[1].speeds, 1);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 // asked for, with its given or default gains (or tuned first), simulated on
 // one drilling scenario, with the time-delay estimation condition of the
 // kinds that use it.
+#include <cmath>
 #include <functional>
 #include <map>
 #include <string>
@@ -23,7 +24,7 @@ struct ControllerRunOptions {
   /// Tune each kind first (TuneController from its gains) with at most
   /// tune_evaluations simulations.
   bool tune{false};
-  int tune_evaluations{60};
+  int tune_evaluations{30};  // drill-sim's default
   /// Per joint [N·m].
   Eigen::VectorXd motor_torque_limit;
 };
@@ -35,9 +36,12 @@ struct ControllerRun {
   TuneResult tune;                  // when tuned
   SimResult result;
   /// ||I - M^-1 Mbar|| (TdeStabilityMeasure) for kinds with time-delay
-  /// estimation; NaN otherwise. The condition holds when < 1.
+  /// estimation (uses_tde); NaN otherwise. The condition holds when < 1.
+  bool uses_tde{false};
   double tde_measure{NAN};
-  bool tde_condition_fails() const { return tde_measure >= 1.0; }
+  /// The kind uses time-delay estimation and its condition does not hold
+  /// (a NaN measure, from a singular inertia, does not hold either).
+  bool tde_condition_fails() const { return uses_tde && !(tde_measure < 1.0); }
 };
 
 /// What the runs tell as they go: `kind` is being tuned (`tuning`) or
@@ -47,6 +51,7 @@ struct ControllerRunProgress {
   bool tuning{false};
   long done{0}, total{0};
   bool finished{false};
+  const ControllerRun* run{nullptr};  // with `finished`: the run just done
 };
 
 /// Runs every kind of `options` on `scenario`.

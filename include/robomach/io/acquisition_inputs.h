@@ -24,7 +24,9 @@ struct AcquisitionInputs {
   std::optional<machine::ProgrammedPath> program;
   machine::CountsRecord counts;
   /// The compensation the acquisition applies (null when there is none).
-  const machine::Compensation* applied() const { return compensation->empty() ? nullptr : compensation.get(); }
+  const machine::Compensation* applied() const {
+    return compensation && !compensation->empty() ? compensation.get() : nullptr;
+  }
 };
 
 /// Reads every input before any work (an empty path: not given).

@@ -7,6 +7,7 @@
 // PathParameters (an invalid one is a command-line error) and writes what
 // comes back.
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -79,13 +80,28 @@ struct PlanOptions {
   double opt_sample_mm{1.0}, opt_offset_max_mm{30.0}, opt_offset_min_contact_widths{0.3}, max_time_s{50.0};
   int threads{2};
   unsigned seed{20240404};
+  double sample_mm{0.5};  // the region's sampling, PreparePlanning's spacing
 };
+
+/// One numeric option with the range it must lie in: the limits keep a typo
+/// from hours of work or an allocation failure (a 1e-6 mm sampling), and
+/// are those of polish-plan's command line (`name` is the option's name
+/// with '_' for '-').
+struct PlanOptionRange {
+  std::string name;
+  double value, lo, hi;
+};
+std::vector<PlanOptionRange> PlanOptionRanges(const PlanOptions& options);
+
+/// @throws std::invalid_argument "name: expected a value in [lo, hi], got v"
+///   for the first option outside its range.
+void CheckRanges(const PlanOptions& options);
 
 /// The request `options` make on `context` (the zig-zag's default spacing
 /// is its contact width); `progress` is not set.
 /// @throws std::invalid_argument for an unknown pattern, guides or
-///   optimiser and for path parameters outside their limits (CheckValid):
-///   all of them mistakes in the options.
+///   optimiser, the PSO asked for the zig-zag, and path parameters outside
+///   their limits (CheckValid): all of them mistakes in the options.
 PlanRequest ToPlanRequest(const PlanOptions& options, const PlanningContext& context);
 
 /// A planned, simulated path.

@@ -3,6 +3,7 @@
 // the semi-discretization lobes of a set of tool tips (tip_dynamics.h), the
 // checks of the tips' modal fits, and the comparison of the two methods.
 
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -34,7 +35,7 @@ struct LobesOptions {
   Eigen::VectorXd sd_speeds_rad_s;   // where the SD is solved
   int max_lobe_index{30};            // ZoaOptions::max_lobe_index
   SdOptions sd;
-  int sd_modes{4};  // dominant modes of a model (not fitted) tip the SD keeps
+  int sd_modes{3};  // stability-lobes' default: dominant modes of a model (not fitted) tip the SD keeps
   int threads{0};   // SD threads (0 = all cores)
 };
 

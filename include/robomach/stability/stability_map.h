@@ -55,6 +55,11 @@ struct MapPoint {
   std::string optimiser_status;  // NLopt outcome when the rotation is optimised
 };
 
+/// The first target whose feed direction has no part in the work plane
+/// (normal to its tool axis, within 1e-6 of its length): no cutting frame;
+/// -1 when every target has one.
+int FirstFeedAlongToolAxis(const std::vector<ToolPoseTarget>& targets);
+
 /// Evaluates a grid of rows × cols targets (row-major) or, with rows = 1, a
 /// path. IK (KDL ChainIkSolverPos_LMA) is seeded from the neighbour so
 /// the arm stays on one configuration: the first column from the point

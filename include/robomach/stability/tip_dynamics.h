@@ -79,7 +79,7 @@ struct MeasuredTipOptions {
   /// How the caller gave the tool axis, for messages ("--tool-axis 0,0,1").
   std::string tool_axis_source;
   bool fit{true};    // fit modes to the direct FRFs (for the SD and the usable band)
-  int sd_modes{4};   // dominant modes kept per direct FRF
+  int sd_modes{3};   // dominant modes kept per direct FRF (stability-lobes' default)
 };
 
 /// What building the tool tips has to say, as it happens: the noise model
