@@ -25,15 +25,6 @@ namespace {
 
 constexpr char kTool[] = "frf-estimate";
 
-io::FrfQuantity QuantityOf(calibration::ResponseQuantity q) {
-  switch (q) {
-    case calibration::ResponseQuantity::kDisplacement: return io::FrfQuantity::kReceptance;
-    case calibration::ResponseQuantity::kVelocity: return io::FrfQuantity::kMobility;
-    case calibration::ResponseQuantity::kAcceleration: return io::FrfQuantity::kAccelerance;
-  }
-  return io::FrfQuantity::kReceptance;
-}
-
 Axis ParseAxisOption(const std::string& option, const std::string& text) {
   if (text == "x") return Axis::kX;
   if (text == "y") return Axis::kY;
@@ -267,36 +258,11 @@ int Run(int argc, char** argv) {
     std::vector<std::string> labels;
     std::vector<int> channel_of;
     if (r.status == calibration::FrfEstimateStatus::kOk) {
-      std::vector<std::pair<dynamics::FrfKey, int>> order;
-      for (size_t c = 0; c < keys.size(); ++c) order.push_back({keys[c], static_cast<int>(c)});
-      std::sort(order.begin(), order.end());
-      for (const auto& [key, c] : order) {
-        const auto& ch = r.channels[c];
-        const Eigen::VectorXcd& h = estimator == "h1" ? ch.h1 : ch.h2;
-        const io::FrfQuantity in_q = QuantityOf(rec.channels[c].quantity);
-        Eigen::VectorXcd hr(h.size());
-        for (int k = 0; k < h.size(); ++k) hr(k) = io::ToReceptance(in_q, r.freq_hz(k), h(k));
-        frfs.Insert(key, dynamics::Frf::FromSamples(r.freq_hz, hr, ch.coherence));
-        labels.push_back(rec.channels[c].name + " (H" + std::string(1, AxisName(key.response)) +
-                         std::string(1, AxisName(key.excitation)) + ")");
-        channel_of.push_back(c);
-      }
-      std::vector<std::pair<std::string, std::string>> meta;
-      meta.push_back({"estimator", estimator == "h1" ? "H1" : "H2"});
-      meta.push_back({"hits_averaged", std::to_string(r.averages) + " of " + std::to_string(r.hits.size())});
-      if (!rejected.empty()) {
-        std::string s;
-        for (const auto& x : rejected) s += (s.empty() ? "" : ", ") + x;
-        meta.push_back({"hits_rejected", s});
-      }
-      meta.push_back({"force_window_s", r.force_window_s < 0 ? std::string("off") : io::FormatDouble(r.force_window_s)});
-      meta.push_back({"exponential_window_tau_s",
-                      r.exponential_tau_s > 0 ? io::FormatDouble(r.exponential_tau_s) : std::string("none")});
-      if (r.exponential_tau_s > 0) {
-        meta.push_back({"exponential_window_note",
-                        "fitted damping ratios are too high by 1/(tau*omega_n); correct them with "
-                        "calibration::CorrectExponentialWindowDamping"});
-      }
+      io::EstimatedFrfs est = io::ToEstimatedFrfs(r, rec, keys, estimator == "h2");
+      frfs = std::move(est.frfs);
+      labels = std::move(est.labels);
+      channel_of = std::move(est.channel_of);
+      const auto& meta = est.metadata;
       io::WriteEstimatedFrfCsv(out_path, frfs, out_q, r.averages, meta);
     }
     if (!plot_path.empty() && r.status == calibration::FrfEstimateStatus::kOk) {
@@ -335,7 +301,7 @@ int Run(int argc, char** argv) {
       for (size_t c = 0; c < rec.channels.size(); ++c) {
         nlohmann::json cj = {{"name", rec.channels[c].name},
                              {"column", rec.channel_columns[c]},
-                             {"quantity", io::QuantityName(QuantityOf(rec.channels[c].quantity))},
+                             {"quantity", io::QuantityName(io::QuantityOf(rec.channels[c].quantity))},
                              {"response", std::string(1, AxisName(keys[c].response))},
                              {"excitation", std::string(1, AxisName(keys[c].excitation))}};
         if (r.status == calibration::FrfEstimateStatus::kOk) {

@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include "robomach/common/frames.h"
 #include "robomach/common/number_format.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
@@ -236,6 +237,56 @@ void WriteEstimatedFrfCsv(const std::string& path, const dynamics::FrfSet& frfs,
     for (const auto& [key, value] : metadata) os << "# " << key << ": " << value << '\n';
     WriteFrfCsv(os, frfs, quantity, averages);
   });
+}
+
+FrfQuantity QuantityOf(calibration::ResponseQuantity q) {
+  switch (q) {
+    case calibration::ResponseQuantity::kDisplacement: return FrfQuantity::kReceptance;
+    case calibration::ResponseQuantity::kVelocity: return FrfQuantity::kMobility;
+    case calibration::ResponseQuantity::kAcceleration: return FrfQuantity::kAccelerance;
+  }
+  return FrfQuantity::kReceptance;
+}
+
+EstimatedFrfs ToEstimatedFrfs(const calibration::FrfEstimateResult& r, const HammerRecords& rec,
+                              const std::vector<dynamics::FrfKey>& keys, bool h2) {
+  if (r.status != calibration::FrfEstimateStatus::kOk) throw std::invalid_argument("ToEstimatedFrfs: no estimate");
+  if (keys.size() != rec.channels.size() || r.channels.size() != rec.channels.size()) {
+    throw std::invalid_argument("ToEstimatedFrfs: expected one key per response channel");
+  }
+  EstimatedFrfs out;
+  std::vector<std::pair<dynamics::FrfKey, int>> order;
+  for (size_t c = 0; c < keys.size(); ++c) order.push_back({keys[c], static_cast<int>(c)});
+  std::sort(order.begin(), order.end());
+  for (const auto& [key, c] : order) {
+    const auto& ch = r.channels[c];
+    const Eigen::VectorXcd& h = h2 ? ch.h2 : ch.h1;
+    const FrfQuantity in_q = QuantityOf(rec.channels[c].quantity);
+    Eigen::VectorXcd hr(h.size());
+    for (int k = 0; k < h.size(); ++k) hr(k) = ToReceptance(in_q, r.freq_hz(k), h(k));
+    out.frfs.Insert(key, dynamics::Frf::FromSamples(r.freq_hz, hr, ch.coherence));
+    out.labels.push_back(rec.channels[c].name + " (H" + std::string(1, AxisName(key.response)) +
+                         std::string(1, AxisName(key.excitation)) + ")");
+    out.channel_of.push_back(c);
+  }
+  std::string rejected;
+  for (const auto& hit : r.hits) {
+    if (hit.status == calibration::HitStatus::kAccepted) continue;
+    rejected += (rejected.empty() ? "" : ", ") + hit.id + " (" + calibration::HitStatusName(hit.status) + ")";
+  }
+  auto& meta = out.metadata;
+  meta.push_back({"estimator", h2 ? "H2" : "H1"});
+  meta.push_back({"hits_averaged", std::to_string(r.averages) + " of " + std::to_string(r.hits.size())});
+  if (!rejected.empty()) meta.push_back({"hits_rejected", rejected});
+  meta.push_back({"force_window_s", r.force_window_s < 0 ? std::string("off") : FormatDouble(r.force_window_s)});
+  meta.push_back({"exponential_window_tau_s",
+                  r.exponential_tau_s > 0 ? FormatDouble(r.exponential_tau_s) : std::string("none")});
+  if (r.exponential_tau_s > 0) {
+    meta.push_back({"exponential_window_note",
+                    "fitted damping ratios are too high by 1/(tau*omega_n); correct them with "
+                    "calibration::CorrectExponentialWindowDamping"});
+  }
+  return out;
 }
 
 }  // namespace robomach::io

@@ -175,5 +175,47 @@ TEST(HammerRecords, EstimatedFrfFileReadsBack) {
                std::invalid_argument);
 }
 
+// frf-estimate's FRFs: an accelerance channel becomes receptance by
+// H = -A / omega^2 (e^{i omega t}), a displacement channel stays as it is;
+// the FRFs come in key order with their channel; the header lines name the
+// estimator and the rejected hits.
+TEST(ToEstimatedFrfs, ConvertsEachChannelToReceptanceInKeyOrder) {
+  HammerRecords rec;
+  rec.channels = {{"acc_z", calibration::ResponseQuantity::kAcceleration},
+                  {"disp_x", calibration::ResponseQuantity::kDisplacement}};
+  calibration::FrfEstimateResult r;
+  r.status = calibration::FrfEstimateStatus::kOk;
+  r.freq_hz = Eigen::Vector3d(10.0, 20.0, 30.0);
+  r.averages = 2;
+  r.hits.resize(3);
+  r.hits[2].id = "h3";
+  r.hits[2].status = calibration::HitStatus::kDoubleHit;
+  r.force_window_s = -1.0;
+  r.channels.resize(2);
+  for (auto& ch : r.channels) {
+    ch.h1 = Eigen::Vector3cd(std::complex<double>(1, 2), std::complex<double>(3, -1), std::complex<double>(-2, 0.5));
+    ch.h2 = 2.0 * ch.h1;
+    ch.coherence = Eigen::Vector3d(0.9, 0.95, 0.99);
+  }
+  const std::vector<dynamics::FrfKey> keys = {{"P1", Axis::kZ, Axis::kZ}, {"P1", Axis::kX, Axis::kZ}};
+  const EstimatedFrfs e = ToEstimatedFrfs(r, rec, keys, false);
+  ASSERT_EQ(e.labels.size(), 2u);
+  EXPECT_EQ(e.labels[0], "disp_x (Hxz)");  // key order: x before z
+  EXPECT_EQ(e.channel_of, (std::vector<int>{1, 0}));
+  const dynamics::Frf& acc = e.frfs.at(keys[0]);
+  const dynamics::Frf& disp = e.frfs.at(keys[1]);
+  for (int k = 0; k < 3; ++k) {
+    const double w = 2 * M_PI * r.freq_hz(k);
+    EXPECT_LT(std::abs(acc.receptance()(k) - (-r.channels[0].h1(k) / (w * w))), 1e-15 * std::abs(r.channels[0].h1(k)));
+    EXPECT_EQ(disp.receptance()(k), r.channels[1].h1(k));
+  }
+  std::map<std::string, std::string> meta(e.metadata.begin(), e.metadata.end());
+  EXPECT_EQ(meta["estimator"], "H1");
+  EXPECT_EQ(meta["hits_averaged"], "2 of 3");
+  EXPECT_EQ(meta["hits_rejected"], "h3 (double hit)");
+  EXPECT_EQ(meta["force_window_s"], "off");
+  EXPECT_EQ(ToEstimatedFrfs(r, rec, keys, true).frfs.at(keys[1]).receptance()(0), r.channels[1].h2(0));
+}
+
 }  // namespace
 }  // namespace robomach::io

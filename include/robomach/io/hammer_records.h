@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "robomach/calibration/frf_estimate.h"
 #include "robomach/calibration/impact_record.h"
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/io/frf_files.h"
@@ -54,5 +55,26 @@ HammerRecords ReadHammerRecords(const std::vector<std::string>& paths);
 ///   with a line break.
 void WriteEstimatedFrfCsv(const std::string& path, const dynamics::FrfSet& frfs, FrfQuantity quantity,
                           int averages, const std::vector<std::pair<std::string, std::string>>& metadata);
+
+/// The file quantity of a response channel's quantity (displacement:
+/// receptance, velocity: mobility, acceleration: accelerance).
+FrfQuantity QuantityOf(calibration::ResponseQuantity q);
+
+/// The estimated FRFs of hammer records as receptance, keyed by `keys` (one
+/// per channel, in channel order), and what frf-estimate writes with them.
+struct EstimatedFrfs {
+  dynamics::FrfSet frfs;            // receptance [m/N] with the coherence
+  std::vector<std::string> labels;  // "acc_x (Hxz)", in key order
+  std::vector<int> channel_of;      // the channel of each FRF, in key order
+  /// `# key: value` lines: estimator, hits averaged and rejected, windows.
+  std::vector<std::pair<std::string, std::string>> metadata;
+};
+
+/// H1 (or H2 with `h2`) of every channel converted from its quantity to
+/// receptance. Requires result.status kOk.
+/// @throws std::invalid_argument for a result without an estimate or keys
+///   that do not match the channels.
+EstimatedFrfs ToEstimatedFrfs(const calibration::FrfEstimateResult& result, const HammerRecords& records,
+                              const std::vector<dynamics::FrfKey>& keys, bool h2);
 
 }  // namespace robomach::io
