@@ -1,6 +1,10 @@
 #include "robomach/io/cad_face.h"
 
 #include <algorithm>
+#include <vector>
+#include <iterator>
+#include <unordered_map>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -111,6 +115,114 @@ struct ReadResult {
   std::string unit;  // declared length unit of the file, "" if unknown
 };
 
+// A STEP file's instances reference each other without cycles. One that
+// reaches itself through its references (an ORIENTED_EDGE that is its own
+// edge element) sends OpenCASCADE into endless recursion already while it
+// reads the file (its entity check calls StepShape_OrientedEdge::EdgeStart
+// without end: a stack overflow; issue #22, found by fuzz_cad_face). So the
+// DATA section is scanned first: each instance `#n = ...;` and the `#m`
+// references in it (outside strings and comments), then an iterative
+// depth-first search, O(instances + references). Returns the instance on a
+// cycle and its line, or {0, 0}.
+std::pair<long, int> FirstStepReferenceCycle(const std::string& text) {
+  std::unordered_map<long, std::vector<long>> refs;
+  std::unordered_map<long, int> line_of;
+  const size_t data = text.find("DATA;");
+  if (data == std::string::npos) return {0, 0};
+  int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(data), '\n'));
+  long current = 0;  // the instance being read, 0 between instances
+  bool in_string = false, in_comment = false;
+  auto number_at = [&](size_t& i) {
+    long v = 0;
+    while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i])) && v < 1000000000L) v = 10 * v + (text[i++] - '0');
+    return v;
+  };
+  for (size_t i = data + 5; i < text.size();) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+      // A line that starts an instance (`#n =`) starts one even after an
+      // unbalanced quote or comment of a damaged file: resynchronise there,
+      // as OpenCASCADE's reader does.
+      size_t j = i + 1;
+      while (j < text.size() && (text[j] == ' ' || text[j] == '\t' || text[j] == '\r')) ++j;
+      if (j + 1 < text.size() && text[j] == '#' && std::isdigit(static_cast<unsigned char>(text[j + 1]))) {
+        size_t k = j + 1;
+        while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
+        while (k < text.size() && (text[k] == ' ' || text[k] == '\t')) ++k;
+        if (k < text.size() && text[k] == '=') {
+          in_string = in_comment = false;
+          current = 0;
+          i = j;
+          continue;
+        }
+      }
+    }
+    if (in_comment) {
+      if (c == '*' && i + 1 < text.size() && text[i + 1] == '/') in_comment = false, ++i;
+      ++i;
+      continue;
+    }
+    if (in_string) {
+      if (c == '\'') in_string = false;  // '' (an escaped quote) ends and reopens: same result
+      ++i;
+      continue;
+    }
+    if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
+      in_comment = true;
+      i += 2;
+      continue;
+    }
+    if (c == '\'') {
+      in_string = true;
+      ++i;
+      continue;
+    }
+    if (c == '#') {
+      ++i;
+      const long id = number_at(i);
+      if (current == 0) {
+        current = id;
+        line_of[id] = line;
+        refs[id];
+      } else {
+        refs[current].push_back(id);
+      }
+      continue;
+    }
+    // To the end of the file, not to the first ENDSEC: OpenCASCADE's parser
+    // reads instances after a stray one too.
+    if (c == ';') current = 0;
+    ++i;
+  }
+  std::unordered_map<long, char> state;  // absent unseen, 1 on the path, 2 done
+  std::vector<std::pair<long, size_t>> path;
+  for (const auto& [start, _] : refs) {
+    if (state.count(start)) continue;
+    state[start] = 1;
+    path.emplace_back(start, 0);
+    while (!path.empty()) {
+      auto& [v, next] = path.back();
+      const std::vector<long>& out = refs[v];
+      if (next == out.size()) {
+        state[v] = 2;
+        path.pop_back();
+        continue;
+      }
+      const long w = out[next++];
+      if (!refs.count(w)) continue;  // a reference to no instance: OpenCASCADE's check reports it
+      const auto st = state.find(w);
+      if (st == state.end()) {
+        state[w] = 1;
+        path.emplace_back(w, 0);
+      } else if (st->second == 1) {
+        return {w, line_of[w]};
+      }
+    }
+  }
+  return {0, 0};
+}
+
 ReadResult ReadShape(const std::string& path) {
   SetUpOpenCascadeExchange();
   const bool iges = IsIges(path);
@@ -131,6 +243,15 @@ ReadResult ReadShape(const std::string& path) {
         }
       }
     } else {
+      {
+        std::ifstream in(path, std::ios::binary);
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        if (const auto [id, line] = FirstStepReferenceCycle(text); id > 0) {
+          throw InputError({path, line, 0}, "not a readable STEP file: instance #" + std::to_string(id) +
+                                                " refers to itself through its references (a cycle; OpenCASCADE "
+                                                "would recurse without end)");
+        }
+      }
       STEPControl_Reader r;
       status = r.ReadFile(path.c_str());
       if (status == IFSelect_RetDone) {

@@ -314,6 +314,32 @@ TEST(CadFace, UnresolvedReferenceIsRefusedBeforeTranslation) {
   EXPECT_THAT(e, ::testing::HasSubstr("first, entity 17 in file order: Parameter n0.2 (face_bound)"));
 }
 
+// A reference cycle: OpenCASCADE's reader recursed without end on an
+// ORIENTED_EDGE that is its own edge element (a stack overflow while it
+// checked the file; issue #22, found by fuzz_cad_face, input kept in
+// tests/fuzz/corpus/cad_face). Two cycles made from plate_hole.step: the
+// edge on itself, and a longer one through a vertex (#22 -> #23 -> #20 ->
+// #21 -> #22); both refused with the line of an instance on the cycle. The
+// file as it is (no cycle) still reads.
+TEST(CadFace, ReferenceCycleIsRefusedBeforeReading) {
+  std::ifstream in(ROBOMACH_SOURCE_DIR "/tests/data/polishing/plate_hole.step");
+  const std::string step((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto with = [&](const std::string& from, const std::string& to, const std::string& name) {
+    std::string text = step;
+    EXPECT_NE(text.find(from), std::string::npos) << from;
+    text.replace(text.find(from), from.size(), to);
+    const std::string path = TmpPath(name);
+    std::ofstream(path) << text;
+    return ErrorOf([&] { ReadCadFace(path, 0); });
+  };
+  EXPECT_THAT(with("#20 = ORIENTED_EDGE('',*,*,#21,.T.);", "#20 = ORIENTED_EDGE('',*,*,#20,.T.);", "self.step"),
+              ::testing::HasSubstr("self.step:32: not a readable STEP file: instance #20 refers to itself"));
+  const std::string e = with("#23 = CARTESIAN_POINT('',", "#23 = CARTESIAN_POINT(#20,", "loop.step");
+  EXPECT_THAT(e, ::testing::HasSubstr("loop.step:"));
+  EXPECT_THAT(e, ::testing::HasSubstr("refers to itself through its references"));
+  EXPECT_NO_THROW(ReadCadFace(ROBOMACH_SOURCE_DIR "/tests/data/polishing/plate_hole.step", 0));
+}
+
 TEST(CadFace, CorruptAndEmptyFiles) {
   const std::string bad = TmpPath("corrupt.step");
   {
