@@ -13,12 +13,13 @@
 #include "robomach/io/csv_table.h"
 #include "robomach/io/number_format.h"
 
+#include "text.h"
+
 namespace robomach::io {
 
 using machine::AxisScale;
 using machine_text::ReadWholeFile;
 using machine_text::ToSi;
-using machine_text::Trim;
 
 namespace {
 

@@ -7,15 +7,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "text.h"
+
 namespace robomach::io {
 namespace {
-
-std::string Trim(std::string_view s) {
-  size_t b = 0, e = s.size();
-  while (b < e && std::isspace(static_cast<unsigned char>(s[b]))) ++b;
-  while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1]))) --e;
-  return std::string(s.substr(b, e - b));
-}
 
 // Splits one CSV line (RFC 4180 quoting, no embedded newlines).
 std::vector<std::string> SplitLine(std::string_view line, const std::string& path, int line_no) {
@@ -59,11 +54,6 @@ std::vector<std::string> SplitLine(std::string_view line, const std::string& pat
   }
   cells.push_back(was_quoted ? cur : Trim(cur));
   return cells;
-}
-
-std::string Lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 }  // namespace

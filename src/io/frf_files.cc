@@ -3,9 +3,10 @@
 #include "robomach/io/uff58.h"
 #include "frf_text.h"
 
+#include "text.h"
+
 namespace robomach::io {
 
-using frf_text::Lower;
 
 FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_pose_id) {
   std::string ext;

@@ -3,10 +3,10 @@
 #include "robomach/common/units.h"
 #include "frf_text.h"
 
+#include "text.h"
+
 namespace robomach::io {
 
-using frf_text::Lower;
-using frf_text::Trim;
 
 std::string QuantityName(FrfQuantity q) {
   switch (q) {

@@ -1,6 +1,7 @@
 #pragma once
 // Private helpers of the FRF file formats (formats.md §3, §4): the CSV and
-// the UFF58 mapping have a source file each (issue #21); these they share.
+// the UFF58 mapping have a source file each (issue #21); these they share
+// (Trim and Lower are io's, text.h).
 
 #include <string>
 #include <vector>
@@ -9,8 +10,6 @@
 
 namespace robomach::io::frf_text {
 
-std::string Lower(std::string s);
-std::string Trim(const std::string& s);
 /// Ten significant digits, for messages.
 std::string Fmt(double v);
 /// "x", "y", "z" (any case) to an axis; false for anything else.

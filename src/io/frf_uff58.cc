@@ -14,6 +14,8 @@
 #include "robomach/io/uff58.h"
 #include "frf_text.h"
 
+#include "text.h"
+
 namespace robomach::io {
 
 using dynamics::Frf;
@@ -21,7 +23,6 @@ using dynamics::FrfKey;
 using dynamics::FrfSet;
 using frf_text::CheckLowFrequencyTrend;
 using frf_text::Fmt;
-using frf_text::Lower;
 using frf_text::Pad80;
 using frf_text::PadTo;
 using frf_text::ParseAxis;

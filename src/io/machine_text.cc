@@ -1,6 +1,5 @@
 #include "machine_text.h"
 
-#include <cctype>
 #include <fstream>
 #include <sstream>
 
@@ -11,13 +10,6 @@ namespace robomach::io::machine_text {
 
 using machine::AxisKind;
 using machine::AxisScale;
-
-std::string Trim(std::string_view s) {
-  size_t a = 0, b = s.size();
-  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
-  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
-  return std::string(s.substr(a, b - a));
-}
 
 std::string ReadWholeFile(const std::string& path) {
   // One read into a string of the file's size.

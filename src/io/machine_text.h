@@ -9,8 +9,6 @@
 
 namespace robomach::io::machine_text {
 
-/// `s` without leading and trailing white space.
-std::string Trim(std::string_view s);
 /// The whole file in one read (a counts file of a 60 s, 8 kHz record is
 /// 21 MB; a stringstream would copy it twice).
 /// @throws InputError when the file cannot be opened.
