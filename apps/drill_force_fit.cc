@@ -131,9 +131,7 @@ int RunDrillForceFit(int argc, char** argv) {
     RequireReadableFile(drill_path, "drill file");
     if (!predict_path.empty()) RequireReadableFile(predict_path, "rows to predict");
     drilling::ForceFitOptions options;
-    options.chisel = chisel == "orthogonal" ? drilling::ChiselModel::kOrthogonal
-                     : chisel == "none"     ? drilling::ChiselModel::kNone
-                                            : drilling::ChiselModel::kSeedScaling;
+    options.chisel = FromOption("--chisel", [&] { return drilling::ParseChiselModel(chisel); });
     const io::ForceFitRun run = io::FitForceTableFiles(table_path, drill_path, options);
     const io::ForceTableFile& table = run.table;
     const io::DrillFile& drill = run.drill;

@@ -211,18 +211,8 @@ int RunDrillSim(int argc, char** argv) {
         throw UsageError("--gains: expected KIND=OMEGA,ZETA[,THIRD] with KIND " + drilling::ControllerKindList() +
                          ", got \"" + text + "\"");
       }
-      FromOption("--gains " + text, [&] { drilling::FindControllerKind(kind); });
       const std::vector<double> v = ParseNumberList("--gains", text.substr(eq + 1));
-      if (v.size() < 2 || v.size() > 4 || v[0] <= 0 || v[1] <= 0 || (v.size() >= 3 && v[2] <= 0) ||
-          (v.size() == 4 && v[3] < 0)) {
-        throw UsageError("--gains: expected 2 to 4 positive numbers after " + kind + "=");
-      }
-      drilling::ControllerParameters p = drilling::DefaultParameters(kind);
-      p.omega = v[0];
-      p.zeta = v[1];
-      if (v.size() >= 3) p.third = v[2];
-      if (v.size() == 4) p.filter_time_constant = v[3];
-      given[kind] = p;
+      given[kind] = FromOption("--gains " + text, [&] { return drilling::ParametersFromGains(kind, v); });
     }
     drilling::ControllerRunOptions ro;
     ro.kinds = kinds;

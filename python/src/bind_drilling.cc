@@ -75,17 +75,11 @@ void BindDrilling(py::module_& m) {
       }
     }
     for (const auto& [kind, v] : gains) {
-      drilling::FindControllerKind(kind);
-      if (v.size() < 2 || v.size() > 4 || !(v[0] > 0) || !(v[1] > 0) || (v.size() >= 3 && !(v[2] > 0)) ||
-          (v.size() == 4 && !(v[3] >= 0)) || !std::isfinite(v[0]) || !std::isfinite(v[1])) {
-        throw std::invalid_argument("gains[" + kind + "]: expected (omega_rad_s, zeta[, third[, filter_s]]), positive");
+      try {
+        o.given[kind] = drilling::ParametersFromGains(kind, v);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("gains[" + kind + "]: " + e.what());
       }
-      drilling::ControllerParameters p = drilling::DefaultParameters(kind);
-      p.omega = v[0];
-      p.zeta = v[1];
-      if (v.size() >= 3) p.third = v[2];
-      if (v.size() == 4) p.filter_time_constant = v[3];
-      o.given[kind] = p;
     }
     std::vector<ControllerRun> runs;
     std::vector<std::string> findings;
@@ -109,10 +103,7 @@ void BindDrilling(py::module_& m) {
     RequireReadableFile(table);
     RequireReadableFile(drill);
     drilling::ForceFitOptions o;
-    if (chisel == "seed_scaling") o.chisel = drilling::ChiselModel::kSeedScaling;
-    else if (chisel == "orthogonal") o.chisel = drilling::ChiselModel::kOrthogonal;
-    else if (chisel == "none") o.chisel = drilling::ChiselModel::kNone;
-    else throw std::invalid_argument("chisel: expected seed_scaling, orthogonal or none, got " + chisel);
+    o.chisel = drilling::ParseChiselModel(chisel);
     io::ForceFitRun run;
     {
       py::gil_scoped_release release;

@@ -285,4 +285,11 @@ DrillForces ComputeDrillForces(const DrillGeometry& d, const DrillingMaterial& m
   return out;
 }
 
+ChiselModel ParseChiselModel(const std::string& name) {
+  if (name == "seed_scaling") return ChiselModel::kSeedScaling;
+  if (name == "orthogonal") return ChiselModel::kOrthogonal;
+  if (name == "none") return ChiselModel::kNone;
+  throw std::invalid_argument("expected a chisel model seed_scaling, orthogonal or none, got '" + name + "'");
+}
+
 }  // namespace robomach::drilling

@@ -310,4 +310,20 @@ TuneResult TuneController(const ControllerParameters& start, DrillingScenario& s
   return out;
 }
 
+ControllerParameters ParametersFromGains(const std::string& kind, const std::vector<double>& v) {
+  ControllerParameters p = DefaultParameters(kind);
+  auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
+  if (v.size() < 2 || v.size() > 4 || !positive(v[0]) || !positive(v[1]) || (v.size() >= 3 && !positive(v[2])) ||
+      (v.size() == 4 && !(v[3] >= 0.0 && std::isfinite(v[3])))) {
+    throw std::invalid_argument("expected 2 to 4 numbers after " + kind +
+                                "=: omega_rad_s and zeta > 0, the third parameter > 0, the filter time constant "
+                                ">= 0 [s]");
+  }
+  p.omega = v[0];
+  p.zeta = v[1];
+  if (v.size() >= 3) p.third = v[2];
+  if (v.size() == 4) p.filter_time_constant = v[3];
+  return p;
+}
+
 }  // namespace robomach::drilling

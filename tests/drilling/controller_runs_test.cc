@@ -94,5 +94,33 @@ TEST(ControllerRun, TdeConditionFailsOnNaNOnlyForKindsThatUseIt) {
   EXPECT_TRUE(r.tde_condition_fails());
 }
 
+// --gains KIND=OMEGA,ZETA[,THIRD[,FILTER_S]]: the numbers given replace the
+// kind's defaults in that order; a missing, extra, negative, zero or NaN
+// value is refused (the filter time constant may be 0: no filter).
+TEST(ParametersFromGains, GivenNumbersReplaceTheDefaultsInOrder) {
+  const ControllerParameters d = DefaultParameters("pid");
+  const ControllerParameters two = ParametersFromGains("pid", {50.0, 0.8});
+  EXPECT_EQ(two.kind, "pid");
+  EXPECT_EQ(two.omega, 50.0);
+  EXPECT_EQ(two.zeta, 0.8);
+  EXPECT_EQ(two.third, d.third);
+  EXPECT_EQ(two.filter_time_constant, d.filter_time_constant);
+  const ControllerParameters four = ParametersFromGains("pid", {50.0, 0.8, 3.0, 0.0});
+  EXPECT_EQ(four.third, 3.0);
+  EXPECT_EQ(four.filter_time_constant, 0.0);
+  for (const std::vector<double>& bad : std::vector<std::vector<double>>{
+           {50.0}, {50.0, 0.8, 3.0, 0.01, 1.0}, {-50.0, 0.8}, {50.0, 0.0}, {NAN, 0.8}, {50.0, 0.8, 0.0}, {50.0, 0.8, 3.0, -1.0}}) {
+    EXPECT_THAT(robomach::testing::CaptureError([&] { ParametersFromGains("pid", bad); }), HasSubstr("expected 2 to 4 numbers"));
+  }
+  EXPECT_THAT(robomach::testing::CaptureError([&] { ParametersFromGains("lqr", {50.0, 0.8}); }), HasSubstr("lqr"));
+}
+
+TEST(ParseChiselModel, TheThreeNamesAndNothingElse) {
+  EXPECT_EQ(ParseChiselModel("seed_scaling"), ChiselModel::kSeedScaling);
+  EXPECT_EQ(ParseChiselModel("orthogonal"), ChiselModel::kOrthogonal);
+  EXPECT_EQ(ParseChiselModel("none"), ChiselModel::kNone);
+  EXPECT_THAT(robomach::testing::CaptureError([] { ParseChiselModel("Orthogonal"); }), HasSubstr("seed_scaling, orthogonal or none"));
+}
+
 }  // namespace
 }  // namespace robomach::drilling

@@ -41,6 +41,10 @@ enum class ChiselModel {
   kNone,
 };
 
+/// "seed_scaling", "orthogonal", "none" (drill-force-fit's --chisel).
+/// @throws std::invalid_argument naming the three for anything else.
+ChiselModel ParseChiselModel(const std::string& name);
+
 /// Fitted coefficients of the force model for one drill/work-material pair
 /// (the `material_*.yaml` file written by drill-force-fit).
 ///

@@ -128,6 +128,15 @@ std::unique_ptr<JointController> MakeController(const ControllerParameters& p,
                                                 const DrillingScenario& scenario,
                                                 const Eigen::VectorXd& torque_limit);
 
+/// Gains of `kind` from the numbers a user gives (drill-sim's --gains
+/// KIND=OMEGA,ZETA[,THIRD[,FILTER_S]]): omega [rad/s] and zeta, then the
+/// third parameter and the filter time constant [s]; the others keep
+/// DefaultParameters(kind).
+/// @throws std::invalid_argument for an unknown kind, fewer than 2 or more
+///   than 4 numbers, or a value that is not finite and positive (the
+///   filter time constant may be 0).
+ControllerParameters ParametersFromGains(const std::string& kind, const std::vector<double>& values);
+
 /// Defaults found by TuneController on the default scenario
 /// (config/drilling/, see README).
 ControllerParameters DefaultParameters(const std::string& kind);
