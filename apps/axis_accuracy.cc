@@ -53,22 +53,17 @@ int Run(int argc, char** argv) {
   return RunGuarded(kTool, [&]() -> int {
     RequireReadableFile(runs_path, "runs file");
     CheckDistinctPaths({{"--runs", runs_path}}, {{"--out", out_path}, {"--plot", plot_path}});
-    const io::IsoRuns runs = io::ReadIsoRuns(runs_path);
+    const io::IsoEvaluation eval = io::EvaluateIsoRunsFile(runs_path);
+    const io::IsoRuns& runs = eval.runs;
     const std::string unit = runs.rotary ? "deg" : "mm";
     nlohmann::json j;
     j["standard"] = "ISO 230-2";
     j["unit"] = unit;
     j["axes"] = nlohmann::json::object();
-    std::vector<std::pair<std::string, machine::Iso230Result>> results;
-    int min_runs = 1 << 30;
-    std::vector<std::string> units;  // unit plausibility findings: exit 3
-    for (const std::string& axis : runs.axis_order) {
-      machine::Iso230Result r;
-      try {
-        r = machine::EvaluateIso230(runs.approaches.at(axis));
-      } catch (const std::invalid_argument& e) {
-        throw InputError({runs_path, 0, 0}, "axis " + axis + ": " + e.what());
-      }
+    const auto& results = eval.results;
+    const int min_runs = eval.min_runs;
+    const std::vector<std::string>& units = eval.unit_findings;  // unit plausibility findings: exit 3
+    for (const auto& [axis, r] : results) {
       nlohmann::json a = {{"A", r.A},       {"A_up", r.A_up}, {"A_down", r.A_down}, {"E", r.E},
                           {"E_up", r.E_up}, {"E_down", r.E_down}, {"M", r.M},       {"R", r.R},
                           {"R_up", r.R_up}, {"R_down", r.R_down}, {"B", r.B},       {"B_mean", r.B_mean}};
@@ -78,11 +73,8 @@ int Run(int argc, char** argv) {
                                 {"mean_up", t.mean_up},     {"mean_down", t.mean_down}, {"s_up", t.s_up},
                                 {"s_down", t.s_down},       {"mean", t.mean},         {"B", t.reversal},
                                 {"R_up", t.R_up},           {"R_down", t.R_down},     {"R", t.R}});
-        min_runs = std::min({min_runs, t.runs_up, t.runs_down});
       }
       j["axes"][axis] = a;
-      for (const std::string& f : machine::Iso230UnitFindings(axis, r, runs.rotary)) units.push_back(f);
-      results.emplace_back(axis, r);
     }
     if (!plot_path.empty()) {
       report::Figure fig(static_cast<int>(results.size()), 1, 900, 380);

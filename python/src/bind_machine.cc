@@ -144,16 +144,9 @@ void BindMachine(py::module_& m) {
 
   m.def("iso230_evaluate", [](const std::string& runs_path) {
     RequireReadableFile(runs_path);
-    const io::IsoRuns runs = io::ReadIsoRuns(runs_path);
+    const io::IsoEvaluation eval = io::EvaluateIsoRunsFile(runs_path);
     py::dict axes;
-    std::vector<std::string> findings;
-    for (const std::string& axis : runs.axis_order) {
-      machine::Iso230Result r;
-      try {
-        r = machine::EvaluateIso230(runs.approaches.at(axis));
-      } catch (const std::invalid_argument& e) {
-        throw InputError({runs_path, 0, 0}, "axis " + axis + ": " + e.what());
-      }
+    for (const auto& [axis, r] : eval.results) {
       py::dict a;
       a["A"] = r.A;
       a["A_up"] = r.A_up;
@@ -184,12 +177,12 @@ void BindMachine(py::module_& m) {
       }
       a["targets"] = targets;
       axes[py::str(axis)] = a;
-      for (const std::string& f : machine::Iso230UnitFindings(axis, r, runs.rotary)) findings.push_back(f);
     }
     py::dict d;
-    d["unit"] = runs.rotary ? "deg" : "mm";
+    d["unit"] = eval.runs.rotary ? "deg" : "mm";
     d["axes"] = axes;
-    d["unit_findings"] = findings;
+    d["unit_findings"] = eval.unit_findings;
+    d["min_runs"] = eval.min_runs;
     return d;
   }, py::arg("runs"),
      "axis-accuracy's evaluation: ISO 230-2 accuracy A, systematic error E, mean error M, repeatability R, "

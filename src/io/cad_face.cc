@@ -78,6 +78,7 @@
 #include <gp_Pnt2d.hxx>
 
 #include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
 #include "robomach/polishing/surface_grid.h"
 
 namespace robomach::io {
@@ -327,14 +328,9 @@ int CountCadFaces(const std::string& path) { return Faces(ReadShape(path).shape)
 
 namespace {
 
-std::string Fmt(double x) {
-  std::ostringstream o;
-  o.precision(3);
-  o << x;
-  return o.str();
+std::string SizeText(const Eigen::Vector3d& s) {
+  return FormatNumber(s.x(), 3) + " x " + FormatNumber(s.y(), 3) + " x " + FormatNumber(s.z(), 3) + " mm";
 }
-
-std::string SizeText(const Eigen::Vector3d& s) { return Fmt(s.x()) + " x " + Fmt(s.y()) + " x " + Fmt(s.z()) + " mm"; }
 
 CadPartInfo PartInfo(const ReadResult& rr, int num_faces, const CadReadOptions& options) {
   CadPartInfo info;
@@ -350,7 +346,7 @@ CadPartInfo PartInfo(const ReadResult& rr, int num_faces, const CadReadOptions& 
   }
   const double big = info.bbox_size_mm.maxCoeff();
   const std::string says = rr.unit.empty() ? "the file's unit" : "the file says " + rr.unit;
-  const std::string scaled = options.unit_scale != 1.0 ? " (after --cad-unit-scale " + Fmt(options.unit_scale) + ")" : "";
+  const std::string scaled = options.unit_scale != 1.0 ? " (after --cad-unit-scale " + FormatNumber(options.unit_scale, 3) + ")" : "";
   if (big > 0 && big < 1.0) {
     info.unit_warning = says + "; the part is " + SizeText(info.bbox_size_mm) + scaled + ", a part under 1 mm is probably "
                         "in metres (or inches); --cad-unit-scale 1000 (metres) or 25.4 (inches) to override";
@@ -544,7 +540,8 @@ int LargestFace(const TopTools_IndexedMapOfShape& faces) {
 
 void CheckScale(const std::string& path, const CadReadOptions& options) {
   if (!(options.unit_scale > 0) || !std::isfinite(options.unit_scale)) {
-    throw std::invalid_argument("--cad-unit-scale: expected a number > 0, got " + Fmt(options.unit_scale) + " (for " + path + ")");
+    throw std::invalid_argument("--cad-unit-scale: expected a number > 0, got " + FormatNumber(options.unit_scale, 3) +
+                                " (for " + path + ")");
   }
 }
 

@@ -1,5 +1,6 @@
 #include "robomach/io/iso_runs_file.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "robomach/common/errors.h"
@@ -46,6 +47,24 @@ IsoRuns ReadIsoRuns(const std::string& path) {
   }
   if (runs.axis_order.empty()) throw InputError({path, t.header_line(), 0}, "no data rows");
   return runs;
+}
+
+IsoEvaluation EvaluateIsoRunsFile(const std::string& path) {
+  IsoEvaluation e;
+  e.runs = ReadIsoRuns(path);
+  e.min_runs = 1 << 30;
+  for (const std::string& axis : e.runs.axis_order) {
+    machine::Iso230Result r;
+    try {
+      r = machine::EvaluateIso230(e.runs.approaches.at(axis));
+    } catch (const std::invalid_argument& err) {
+      throw InputError({path, 0, 0}, "axis " + axis + ": " + err.what());
+    }
+    for (const auto& t : r.targets) e.min_runs = std::min({e.min_runs, t.runs_up, t.runs_down});
+    for (const std::string& f : machine::Iso230UnitFindings(axis, r, e.runs.rotary)) e.unit_findings.push_back(f);
+    e.results.emplace_back(axis, std::move(r));
+  }
+  return e;
 }
 
 }  // namespace robomach::io

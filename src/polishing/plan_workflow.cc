@@ -16,13 +16,6 @@
 namespace robomach::polishing {
 namespace {
 
-std::string Short(double x) {
-  std::ostringstream o;
-  o.precision(4);
-  o << x;
-  return o.str();
-}
-
 std::shared_ptr<const SampleGrid> BuildGrid(const NurbsSurface& surface, const PolishingProcess& process,
                                             double spacing, const std::string& surface_source) {
   try {
@@ -56,8 +49,8 @@ PlanningContext PreparePlanning(const NurbsSurface& surface, const PolishingProc
   if (c.grid->num_in_region() == 0) {
     throw InputError({process_source, 0, 0}, "process.margin_mm " + FormatDouble(1e3 * process.margin) +
                                                  " leaves no polished region on " + SurfaceName(surface) + " (" +
-                                                 Short(1e3 * c.grid->length_s()) + " x " +
-                                                 Short(1e3 * c.grid->length_t()) + " mm, mean arc lengths along u and v)");
+                                                 FormatNumber(1e3 * c.grid->length_s(), 4) + " x " +
+                                                 FormatNumber(1e3 * c.grid->length_t(), 4) + " mm, mean arc lengths along u and v)");
   }
   try {
     c.contact_width = ContactWidthAtCentre(surface, *c.grid, process);

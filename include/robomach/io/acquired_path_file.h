@@ -1,6 +1,6 @@
 #pragma once
 // Acquired path (formats.md §8.5): rows, and axis-acquire's pipelined main loop.
-// Units are converted here, once: mm -> m, deg -> rad.
+// The writer converts back for the file: m -> mm, rad -> deg.
 
 #include <ostream>
 #include <string>

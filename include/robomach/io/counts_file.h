@@ -1,6 +1,6 @@
 #pragma once
 // Encoder counts file (formats.md §8.1): reader and a streaming writer.
-// Units are converted here, once: mm -> m, deg -> rad.
+// Counts are integers and stay so; time in s.
 
 #include <cstdint>
 #include <ostream>

@@ -1,9 +1,10 @@
 #pragma once
 // ISO 230-2 runs (formats.md §8.6).
-// Units are converted here, once: mm -> m, deg -> rad.
+// Deviations stay in the file's unit (mm or deg): ISO 230-2 reports them so.
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "robomach/machine/iso230.h"
@@ -18,5 +19,18 @@ struct IsoRuns {
   std::map<std::string, std::vector<machine::Iso230Approach>> approaches;
 };
 IsoRuns ReadIsoRuns(const std::string& path);
+
+/// axis-accuracy's evaluation of a runs file: ISO 230-2 per axis, in file
+/// order, with the unit plausibility findings and the fewest runs any target
+/// has in a direction (ISO 230-2 asks for 5).
+struct IsoEvaluation {
+  IsoRuns runs;
+  std::vector<std::pair<std::string, machine::Iso230Result>> results;
+  std::vector<std::string> unit_findings;
+  int min_runs{0};
+};
+/// @throws InputError naming the file and the axis for runs ISO 230-2
+///   cannot evaluate (a target without one direction, fewer than 2 runs).
+IsoEvaluation EvaluateIsoRunsFile(const std::string& path);
 
 }  // namespace robomach::io
