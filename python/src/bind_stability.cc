@@ -304,18 +304,18 @@ void BindStability(py::module_& m) {
     d["rows"] = region.num_v();
     d["cols"] = region.num_u();
     d["seed_q"] = region.seed_q;
-    d["rotation"] = region.rotation_fixed;
+    d["rotation_rad"] = region.rotation_fixed;
     d["rotation_free"] = region.rotation_free;
-    d["rotation_min"] = region.rotation_min;
-    d["rotation_max"] = region.rotation_max;
+    d["rotation_min_rad"] = region.rotation_min;
+    d["rotation_max_rad"] = region.rotation_max;
     return d;
   }, py::arg("path"), py::arg("num_joints"), py::arg("cut"),
      "A region file's grid of tool poses (stability-map --region): dict with targets (row-major), rows, cols, "
-     "seed_q [rad], rotation [rad], rotation_free, rotation_min, rotation_max [rad].");
+     "seed_q [rad], rotation_rad, rotation_free, rotation_min_rad, rotation_max_rad.");
 
   m.def("stability_map", [](const std::shared_ptr<dynamics::RobotModel>& model, const std::vector<stability::ToolPoseTarget>& targets,
-                            int rows, int cols, const io::CutSpec& cut, const Eigen::VectorXd& seed_q, double rotation,
-                            bool optimise_rotation, double rotation_min, double rotation_max, int rotation_evaluations,
+                            int rows, int cols, const io::CutSpec& cut, const Eigen::VectorXd& seed_q, double rotation_rad,
+                            bool optimise_rotation, double rotation_min_rad, double rotation_max_rad, int rotation_evaluations,
                             int speeds, double max_depth_mm, int threads) {
     if (stability::FirstFeedAlongToolAxis(targets) >= 0) {
       throw InputError({cut.path, cut.feed_line, cut.feed_column},
@@ -330,10 +330,10 @@ void BindStability(py::module_& m) {
     }
     stability::MapOptions o;
     o.seed_q = seed_q;
-    o.rotation = rotation;
+    o.rotation = rotation_rad;
     o.optimise_rotation = optimise_rotation;
-    o.rotation_min = rotation_min;
-    o.rotation_max = rotation_max;
+    o.rotation_min = rotation_min_rad;
+    o.rotation_max = rotation_max_rad;
     o.rotation_evaluations = rotation_evaluations;
     o.threads = threads;
     o.analysis.spindle_speed_rad_s =
@@ -349,7 +349,7 @@ void BindStability(py::module_& m) {
       py::dict d;
       d["status"] = stability::ToString(p.status);
       d["q"] = p.q;
-      d["rotation"] = p.rotation;
+      d["rotation_rad"] = p.rotation;
       d["jacobian_condition"] = p.jacobian_condition;
       d["critical_depth_mm"] = MToMm(p.stability.critical_depth);
       d["limiting_mechanism"] = stability::ToString(p.stability.limiting);
@@ -361,8 +361,8 @@ void BindStability(py::module_& m) {
     }
     return out;
   }, py::arg("model").none(false), py::arg("targets"), py::arg("rows"), py::arg("cols"), py::arg("cut"), py::arg("seed_q"),
-     py::arg("rotation") = 0.0, py::arg("optimise_rotation") = false, py::arg("rotation_min") = -0.5 * kPi,
-     py::arg("rotation_max") = 0.5 * kPi, py::arg("rotation_evaluations") = 20, py::arg("speeds") = 0,
+     py::arg("rotation_rad") = 0.0, py::arg("optimise_rotation") = false,
+     py::arg("rotation_min_rad") = -0.5 * kPi, py::arg("rotation_max_rad") = 0.5 * kPi, py::arg("rotation_evaluations") = 20, py::arg("speeds") = 0,
      py::arg("max_depth_mm") = 50.0, py::arg("threads") = 0,
      "stability-map's analysis of rows × cols tool poses (row-major; rows = 1: a path): IK from seed_q [rad] "
      "along the grid, then mode coupling and the regenerative ZOA at each point, as EvaluateStabilityMap. "

@@ -31,7 +31,7 @@ def test_acquire_equals_axis_acquire(tmp):
     d_um = a['contour_error_m'] * 1e6
     assert d_um.max() == pytest.approx(s['contour_error_um']['max'], rel=1e-12)
     assert np.sqrt(np.mean(d_um ** 2)) == pytest.approx(s['contour_error_um']['rms'], rel=1e-9)
-    assert a['axes'].shape == (len(a['t_s']), 5) and a['tip_m'].shape == (len(a['t_s']), 3)
+    assert a['axes_si'].shape == (len(a['t_s']), 5) and a['tip_m'].shape == (len(a['t_s']), 3)
     # The tool axis is a unit vector; the synthesised machine follows the path to well under a millimetre.
     np.testing.assert_allclose(np.linalg.norm(a['tool_axis'], axis=1), 1.0, atol=1e-12)
     assert d_um.max() < 1000.0

@@ -77,8 +77,8 @@ def test_region_map_equals_stability_map(tmp):
     cut = rm.read_cut_file(CUT)
     region = rm.region_targets(REGION, model.num_joints, cut)
     points = rm.stability_map(model, region['targets'], region['rows'], region['cols'], cut, region['seed_q'],
-                              rotation=region['rotation'], optimise_rotation=region['rotation_free'],
-                              rotation_min=region['rotation_min'], rotation_max=region['rotation_max'])
+                              rotation_rad=region['rotation_rad'], optimise_rotation=region['rotation_free'],
+                              rotation_min_rad=region['rotation_min_rad'], rotation_max_rad=region['rotation_max_rad'])
     rows = read_lobes(tmp / 'map.csv')
     assert len(points) == len(rows) == region['rows'] * region['cols']
     for p, r in zip(points, rows):
