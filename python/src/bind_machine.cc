@@ -86,7 +86,8 @@ void BindMachine(py::module_& m) {
      "axis-acquire's call: encoder counts (docs/formats.md §8.1) through the machine file's scales, the controller's "
      "compensation tables and temperature log, to compensated axis positions [m, rad] and the tool tip and axis in "
      "workpiece coordinates; with a programmed path, the contour error of every sample (and axis-acquire's unit "
-     "findings). out: also write axis-acquire's --out file. Returns a dict of arrays (rows first): axes_si holds each axis in SI (m or rad). The GIL is "
+     "findings). out: also write axis-acquire's --out file. Returns a dict of arrays (rows first): axes_si holds "
+     "each axis in SI (m or rad). The GIL is "
      "released while it runs.");
 
   m.def("decode_capture", [](const std::string& machine_path, const std::string& capture, double sample_rate_hz,

@@ -49,7 +49,9 @@ def test_plan_equals_polish_plan(tmp, surface, options, tool_args):
 def test_simulate_equals_polish_sim(tmp):
     # A path polish-plan wrote, simulated by polish-sim and by Python: the
     # same removal map; and the simulation of the plan's own path gives the
-    # plan's statistics (two routes to one removal).
+    # plan's statistics (two routes to one removal): the file rounds the
+    # positions to 1e-4 mm, about 2e-5 of the 4.9 mm contact width, so the
+    # statistics agree to 1e-4 (measured: 6e-7 for the cv).
     surface, process = rm.load_surface(DOME), rm.read_polishing_process(BELT)
     plan = rm.plan_polishing(surface, process)
     rm.write_polish_path(str(tmp / 'path.csv'), plan)
@@ -58,8 +60,8 @@ def test_simulate_equals_polish_sim(tmp):
     sim = rm.simulate_polish_path(surface, process, str(tmp / 'path.csv'))
     rm.write_simulated_removal_map(str(tmp / 'py_removal.csv'), sim)
     assert (tmp / 'py_removal.csv').read_text() == (tmp / 'tool_removal.csv').read_text()
-    assert sim.stats['cv'] == pytest.approx(plan.stats['cv'], rel=1e-3)
-    assert sim.stats['mean_um'] == pytest.approx(plan.stats['mean_um'], rel=1e-3)
+    assert sim.stats['cv'] == pytest.approx(plan.stats['cv'], rel=1e-4)
+    assert sim.stats['mean_um'] == pytest.approx(plan.stats['mean_um'], rel=1e-4)
     assert not sim.speed_limit_exceeded
 
 

@@ -46,8 +46,9 @@ TEST(PlanPolishing, ZigZagOnAPlateReachesItsTargetMean) {
     area += ctx.grid->areas()[k];
     removed += ctx.grid->areas()[k] * out.plan.removal[k];
   }
-  EXPECT_NEAR(removed / area, 2e-6, 1e-9);
-  EXPECT_NEAR(out.plan.stats.mean, 2e-6, 1e-9);
+  // ScaleToTargetRemoval's fixed-point steps stop within 1e-6 (relative) of the target.
+  EXPECT_NEAR(removed / area, 2e-6, 2e-6 * 1e-6);
+  EXPECT_NEAR(out.plan.stats.mean, 2e-6, 2e-6 * 1e-6);
   const EvaluatedPlan at_limit = EvaluatePlanOnGrid(ctx, req.params);
   ASSERT_EQ(at_limit.path.rows.size(), out.plan.path.rows.size());
   for (size_t i = 0; i < at_limit.path.rows.size(); ++i) {
