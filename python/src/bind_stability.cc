@@ -317,10 +317,9 @@ void BindStability(py::module_& m) {
                             int rows, int cols, const io::CutSpec& cut, const Eigen::VectorXd& seed_q, double rotation_rad,
                             bool optimise_rotation, double rotation_min_rad, double rotation_max_rad, int rotation_evaluations,
                             int speeds, double max_depth_mm, int threads) {
-    if (stability::FirstFeedAlongToolAxis(targets) >= 0) {
+    if (const int bad = stability::FirstFeedAlongToolAxis(targets); bad >= 0) {
       throw InputError({cut.path, cut.feed_line, cut.feed_column},
-                       "feed_direction is parallel to the tool axis of target " +
-                           std::to_string(stability::FirstFeedAlongToolAxis(targets)) +
+                       "feed_direction is parallel to the tool axis of target " + std::to_string(bad) +
                            "; choose a feed in the work plane");
     }
     if (speeds < 0 || speeds > 100000 || threads < 0 || threads > 256 || rotation_evaluations < 8 ||
