@@ -76,10 +76,18 @@ void BindPolishing(py::module_& m) {
     // (Interface_Static), so two Python threads must not read at once.
     io::CadReadOptions o;
     o.unit_scale = cad_unit_scale;
-    return std::make_shared<NurbsSurface>(io::ReadCadFace(path, face, o));
+    io::CadPartInfo info;
+    auto surface = std::make_shared<NurbsSurface>(io::ReadCadFace(path, face, o, &info));
+    // A part whose size says its unit is wrong (polish-plan warns the same).
+    if (!info.unit_warning.empty()) {
+      py::module_::import("warnings").attr("warn")(path + ": " + info.unit_warning,
+                                                   py::module_::import("builtins").attr("UserWarning"));
+    }
+    return surface;
   }, py::arg("path"), py::arg("face") = 0, py::arg("cad_unit_scale") = 1.0,
      "A surface: NURBS YAML (docs/formats.md §5) or a face of a STEP/IGES file (1-based; 0: the largest by area), "
-     "as polish-plan --surface/--face/--cad-unit-scale.");
+     "as polish-plan --surface/--face/--cad-unit-scale. A part whose size suggests another unit gives a "
+     "UserWarning, as polish-plan warns.");
 
   py::class_<PolishingProcess>(m, "PolishingProcess", "The belt-grinding process (docs/formats.md §7).")
       .def_property_readonly("force_N", [](const PolishingProcess& p) { return p.force; })

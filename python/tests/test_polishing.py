@@ -79,6 +79,9 @@ def test_bad_input(tmp):
         rm.plan_polishing(surface, process, pattern='parallel', optimise='pso')
     with pytest.raises(TypeError):
         rm.plan_polishing(None, process)
+    # A part whose size says its unit is wrong: a warning, as polish-plan gives.
+    with pytest.warns(UserWarning, match='probably in metres'):
+        rm.load_surface(os.path.join(P, 'blade.step'), cad_unit_scale=1e-4)
     with pytest.raises(ValueError, match='STEP/IGES'):
         rm.load_surface(DOME, face=2)
     bad = tmp / 'belt.yaml'
