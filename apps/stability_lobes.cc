@@ -44,17 +44,12 @@ namespace {
 
 constexpr char kTool[] = "stability-lobes";
 
-// FRF files, CSV or UFF58 by extension; reader warnings go to stderr, and
-// so do receptances outside the plausible range (counted: exit 3).
-int g_implausible_frfs = 0;
+// FRF files, CSV or UFF58 by extension; reader warnings go to stderr (the
+// receptances' plausibility comes with the tips: ComputeLobes warns).
 std::vector<stability::TipFrfs> ReadFrfFile(const std::string& path) {
   std::vector<std::string> warnings;
   auto sets = io::ReadTipFrfs(path, "", &warnings);
   for (const std::string& w : warnings) Warn(kTool, w);
-  for (const std::string& f : io::ReceptanceUnitFindings(sets)) {
-    Warn(kTool, "implausible (unit mistake?): " + f);
-    ++g_implausible_frfs;
-  }
   return sets;
 }
 
@@ -316,7 +311,7 @@ int Run(int argc, char** argv) {
         });
     const std::vector<stability::LobeRow>& rows = lobes.rows;
     const bool no_boundary = lobes.no_boundary;
-    bool flagged = g_implausible_frfs > 0 || lobes.flagged;
+    bool flagged = lobes.flagged;
 
     io::WriteLobesCsv(out_path.empty() ? "-" : out_path, rows);
     if (!plot_path.empty()) {

@@ -115,6 +115,9 @@ void BindStability(py::module_& m) {
                              [](const TipDynamics& t) { return Eigen::VectorXd(t.modes_C.omega_rad_s / (2.0 * kPi)); })
       .def_property_readonly("mode_damping_ratio", [](const TipDynamics& t) { return Eigen::VectorXd(t.modes_C.zeta); })
       .def_readonly("modes_fitted", &TipDynamics::modes_fitted)
+      .def_readonly("unit_finding", &TipDynamics::unit_finding,
+                    "the measured FRFs' receptance outside the plausible range (a unit mistake); stability_lobes "
+                    "warns and flags it; empty when plausible")
       .def_property_readonly("R_BC", [](const TipDynamics& t) { return Eigen::Matrix3d(t.R_BC); },
                              "the cutting frame in the source's frame")
       .def_property_readonly("fit_labels", [](const TipDynamics& t) {
@@ -176,11 +179,6 @@ void BindStability(py::module_& m) {
       std::vector<io::FrfSetOfPose> ysets;
       if (frf_y) ysets = io::ReadTipFrfs(*frf_y, "", &warnings);
       for (const std::string& w : warnings) said.messages.push_back({stability::TipMessage::Kind::kWarning, w});
-      for (const std::vector<io::FrfSetOfPose>* s : {&sets, static_cast<const std::vector<io::FrfSetOfPose>*>(&ysets)}) {
-        for (const std::string& f : io::ReceptanceUnitFindings(*s)) {
-          said.messages.push_back({stability::TipMessage::Kind::kWarning, "implausible (unit mistake?): " + f});
-        }
-      }
       tips = stability::TipsFromMeasuredFrfs(sets, ysets, o, said.Sink());
     }
     return py::make_tuple(tips, said.List());
@@ -188,7 +186,8 @@ void BindStability(py::module_& m) {
      py::arg("poses") = std::vector<std::string>{}, py::arg("sd_modes") = 3,
      "The tool tips of a measured FRF file (CSV or UFF58), each direct FRF with a noise model and a modal fit, "
      "as stability-lobes --frf makes them. Returns (tips, messages): messages are dicts {kind: 'info' | 'note' | "
-     "'warning', text} (the reader's warnings, receptances outside the plausible range, the fits).");
+     "'warning', text} (the reader's warnings, the fits); a receptance outside the plausible range is each tip's "
+     "unit_finding, and stability_lobes warns and flags it.");
 
   m.def("stability_lobes", [](const std::vector<TipDynamics>& tips, const io::CutSpec& cut, const std::string& method,
                               int speeds, int sd_speeds, int sd_steps, double sd_steps_per_mode_period, int sd_modes,

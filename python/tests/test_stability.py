@@ -55,6 +55,29 @@ def test_measured_frf_lobes_equal_stability_lobes(tmp):
             assert m['text'].splitlines()[0] in r.stderr
 
 
+def test_mobility_read_as_receptance_is_flagged(tmp):
+    # The shipped receptance times i omega (a mobility) under a receptance
+    # header: the tip carries the unit finding, the lobes are flagged and warn.
+    lines = open(FRF).read().splitlines()
+    out = []
+    for line in lines:
+        if line.startswith('#') or line.startswith('pose_id'):
+            out.append(line)
+            continue
+        pose, r, e, f, re, im = line.split(',')
+        h = complex(float(re), float(im)) * 2j * math.pi * float(f)
+        out.append(f'{pose},{r},{e},{f},{h.real!r},{h.imag!r}')
+    (tmp / 'mobility.csv').write_text('\n'.join(out) + '\n')
+    cut = rm.read_cut_file(CUT)
+    good, _ = rm.tips_from_frf_file(FRF, cut)
+    assert good[0].unit_finding == ''
+    tips, _ = rm.tips_from_frf_file(str(tmp / 'mobility.csv'), cut)
+    assert 'outside the plausible' in tips[0].unit_finding
+    lobes, messages = rm.stability_lobes(tips, cut)
+    assert lobes.flagged
+    assert any(m['kind'] == 'warning' and m['text'].startswith('implausible (unit mistake?)') for m in messages)
+
+
 def test_robot_posture_lobes_equal_stability_lobes(tmp):
     run_tool('stability-lobes', '--robot', KR210, '--postures', os.path.join(SOURCE_DIR, 'config', 'postures_demo.csv'),
              '--posture', 'P1', '--cut', CUT, '--out', tmp / 'tool.csv', expect_rc=None)

@@ -111,18 +111,7 @@ std::vector<ModalTableEntry> ReadModalTable(const std::string& path) {
 std::vector<std::string> ReceptanceUnitFindings(const std::vector<FrfSetOfPose>& sets) {
   std::vector<std::string> out;
   for (const FrfSetOfPose& s : sets) {
-    double peak = 0.0;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) {
-        if (!s.present[i][j]) continue;
-        Eigen::VectorXcd h(static_cast<int>(s.H.size()));
-        for (size_t k = 0; k < s.H.size(); ++k) h(static_cast<int>(k)) = s.H[k](i, j);
-        peak = std::max(peak, dynamics::PeakReceptance(dynamics::Frf::FromSamples(s.freq_hz, h)));
-      }
-    }
-    const std::string f = dynamics::ReceptancePeakFinding(
-        s.source + (s.pose_id.empty() ? std::string() : ": posture " + s.pose_id), peak);
-    if (!f.empty()) out.push_back(f);
+    if (std::string f = stability::TipFrfsUnitFinding(s); !f.empty()) out.push_back(std::move(f));
   }
   return out;
 }

@@ -94,6 +94,7 @@ bool CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
 
 std::vector<std::string> TipFitWarnings(const TipDynamics& t, bool sd) {
   std::vector<std::string> w;
+  if (!t.unit_finding.empty()) w.push_back("implausible (unit mistake?): " + t.unit_finding);
   for (const DirectionFit& d : t.fits) {
     if (d.fit.not_driving_point) {
       w.push_back(d.label + ": Im H > 0 (beyond twice the noise) on " +

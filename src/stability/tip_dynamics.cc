@@ -70,6 +70,19 @@ std::pair<double, double> CommonUsableBand(const std::vector<DirectionFit>& fits
 
 }  // namespace
 
+std::string TipFrfsUnitFinding(const TipFrfs& s) {
+  double peak = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (!s.present[i][j]) continue;
+      Eigen::VectorXcd h(static_cast<Eigen::Index>(s.H.size()));
+      for (size_t k = 0; k < s.H.size(); ++k) h(static_cast<Eigen::Index>(k)) = s.H[k](i, j);
+      peak = std::max(peak, dynamics::PeakReceptance(dynamics::Frf::FromSamples(s.freq_hz, h)));
+    }
+  }
+  return dynamics::ReceptancePeakFinding(s.source + (s.pose_id.empty() ? std::string() : ": posture " + s.pose_id), peak);
+}
+
 TipDynamics TipFromPosture(const std::string& id, const dynamics::PostureDynamics& d, const Eigen::Vector3d& feed_B,
                            int teeth, double max_speed_rad_s, int lines) {
   const Eigen::Matrix3d R = CuttingFrameAtPosture(d.X_BT, feed_B);
@@ -121,6 +134,7 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
     const std::vector<int> direct = DirectFrfs(s, &total);
     TipDynamics t;
     t.id = id;
+    t.unit_finding = TipFrfsUnitFinding(s);
     // Drop a 0 Hz line (the ZOA needs ω > 0); the fit keeps every line.
     const Eigen::Index first = s.freq_hz.size() > 0 && s.freq_hz(0) == 0.0 ? 1 : 0;
     t.freq_hz = s.freq_hz.tail(s.freq_hz.size() - first);
@@ -145,6 +159,9 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
       if (y->freq_hz.size() != s.freq_hz.size() || y->freq_hz != s.freq_hz) {
         throw InputError({o.frf_y_path, 0, 0}, "posture " + id + ": the FRF of --frf-y uses another frequency grid than "
                                                    "the one of --frf; both must use the same lines");
+      }
+      if (const std::string fy = TipFrfsUnitFinding(*y); !fy.empty()) {
+        t.unit_finding += (t.unit_finding.empty() ? "" : "; ") + fy;
       }
       const dynamics::Frf hx = DirectFrf(s, a), hy = DirectFrf(*y, b);
       diagonal(hx.receptance(), hy.receptance());

@@ -129,6 +129,26 @@ TEST(TipsFromMeasuredFrfs, OneDirectFrfIsASymmetricTool) {
   EXPECT_TRUE(fitted);
 }
 
+// The plausibility of measured FRFs: the tap test's receptance (peak
+// 0.85 um/N) passes, the same FRF times 1e6 (a response in um under _m)
+// is outside the range, and the tip and its warnings say so.
+TEST(TipsFromMeasuredFrfs, ReceptanceOutsideThePlausibleRangeIsAFinding) {
+  const testing::TapTest t = testing::MakeTapTest(testing::TapTestOptions{});
+  TipFrfs s = TapTestFrfs(t, 2);
+  EXPECT_EQ(TipFrfsUnitFinding(s), "");
+  for (auto& h : s.H) h *= 1e6;
+  EXPECT_THAT(TipFrfsUnitFinding(s), HasSubstr("tap.csv: posture P1"));
+  MeasuredTipOptions o;
+  o.frf_path = "tap.csv";
+  o.fit = false;
+  const std::vector<TipDynamics> tips = TipsFromMeasuredFrfs({s}, {}, o, {});
+  ASSERT_EQ(tips.size(), 1u);
+  EXPECT_EQ(tips[0].unit_finding, TipFrfsUnitFinding(s));
+  const std::vector<std::string> w = TipFitWarnings(tips[0], false);
+  ASSERT_FALSE(w.empty());
+  EXPECT_THAT(w[0], HasSubstr("implausible (unit mistake?): tap.csv: posture P1"));
+}
+
 // FRFs in B whose directions do not span the cutting plane: the error names
 // the file, the posture and the FRF missing.
 TEST(TipsFromMeasuredFrfs, CuttingPlaneTheFileDoesNotSpanNamesTheFrfMissing) {

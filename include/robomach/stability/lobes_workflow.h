@@ -60,8 +60,9 @@ struct LobesResult {
   bool flagged{false};
 };
 
-/// The warnings about one tip's modal fits (empty for a model tip): one per
-/// problem, each naming the FRF. `sd` adds "no mode, no SD lobes".
+/// The warnings about one tip's measured FRFs (empty for a model tip): its
+/// unit finding, then one per problem of its modal fits, each naming the
+/// FRF. `sd` adds "no mode, no SD lobes".
 std::vector<std::string> TipFitWarnings(const TipDynamics& tip, bool sd);
 
 /// The lobes of every tip: the ZOA on its FRF (ComputeZoaLobes sampled at

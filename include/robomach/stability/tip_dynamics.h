@@ -46,7 +46,16 @@ struct TipDynamics {
   bool no_modes{false};                 // fitted, but no mode: no SD
   std::vector<DirectionFit> fits;       // measured FRFs: one per direct FRF fitted
   Eigen::Matrix3d R_BC{Eigen::Matrix3d::Identity()};  // the frame the modes were oriented with
+  /// Measured FRFs whose largest receptance is outside the plausible range
+  /// (TipFrfsUnitFinding: a mobility or accelerance read as receptance, a
+  /// response in mm under _m); empty when plausible or not measured.
+  std::string unit_finding;
 };
+
+/// dynamics::ReceptancePeakFinding of the largest dynamics::PeakReceptance
+/// of the FRFs `frfs` gives, naming its file and posture; empty when
+/// plausible.
+std::string TipFrfsUnitFinding(const TipFrfs& frfs);
 
 /// Lines of the log frequency grid of the model sources: ln(100)/4000 ≈ 1e-3
 /// relative spacing, below ζ/10 for ζ ≥ 1 %.
@@ -99,6 +108,7 @@ using TipMessageSink = std::function<void(const TipMessage&)>;
 ///   directions;
 /// - else the 3×3 FRF in B oriented into the cutting plane, which its
 ///   directions must span (a missing cross FRF is taken as zero, a warning).
+/// Every tip carries the unit findings of its FRFs (TipFrfsUnitFinding).
 /// With `fit`, every direct FRF gets a noise model and a modal fit
 /// (FitDirectFrf); the SD's modes come from them (a mode seen in two direct
 /// FRFs with a cross FRF is one mode, ModesOfTwoDirections), and the ZOA
