@@ -83,12 +83,8 @@ void CheckFaceSize(const polishing::NurbsSurface& surface, const std::string& su
   const polishing::PolishableOptions limits;
   const polishing::PlanSize size = polishing::EstimatePlanSize(surface, MmToM(sample_mm), params, limits);
   if (size.too_large) {
-    std::ostringstream m;
-    m.precision(3);
-    m << size.what << " is too large to plan within the limits (" << limits.max_grid_points << " grid points, "
-      << limits.max_path_rows << " path rows; about a minute and 2 GB): " << size.estimate
-      << " (check the file's unit: --cad-unit-scale; or choose a smaller face, --list-faces)";
-    throw InputError({surface_path, 0, 0}, m.str());
+    throw InputError({surface_path, 0, 0}, size.too_large_message + " (check the file's unit: --cad-unit-scale; or "
+                                                                    "choose a smaller face, --list-faces)");
   }
   if (size.large) Warn(kTool, size.what + " is large: " + size.estimate + "; planning may take a minute");
 }

@@ -197,7 +197,7 @@ void BindPolishing(py::module_& m) {
       // A face too large to plan within polish-plan's limits is refused before the work.
       const polishing::PlanSize size = polishing::EstimatePlanSize(*surface, MmToM(sample_mm), {});
       if (size.too_large) {
-        throw std::invalid_argument(size.what + " is too large to plan within the limits: " + size.estimate +
+        throw std::invalid_argument(size.too_large_message +
                                     " (check the file's unit: cad_unit_scale; or choose a smaller face)");
       }
       plan->context = polishing::PreparePlanning(*surface, process, MmToM(sample_mm), surface_source, process_source);

@@ -82,6 +82,9 @@ def test_bad_input(tmp):
     # A part whose size says its unit is wrong: a warning, as polish-plan gives.
     with pytest.warns(UserWarning, match='probably in metres'):
         rm.load_surface(os.path.join(P, 'blade.step'), cad_unit_scale=1e-4)
+    # A face 100 times too large (a unit mistake): refused before the work, with the estimate.
+    with pytest.warns(UserWarning), pytest.raises(ValueError, match='too large to plan within the limits'):
+        rm.plan_polishing(rm.load_surface(os.path.join(P, 'blade.step'), cad_unit_scale=100.0), process)
     with pytest.raises(ValueError, match='STEP/IGES'):
         rm.load_surface(DOME, face=2)
     bad = tmp / 'belt.yaml'

@@ -140,6 +140,12 @@ PlanSize EstimatePlanSize(const NurbsSurface& surface, double sample_spacing, co
   out.estimate = m.str();
   out.too_large = !(out.grid_points <= limits.max_grid_points) || !(out.path_rows <= limits.max_path_rows);
   out.large = out.grid_points > 2e5 || out.path_rows > 1e5;
+  if (out.too_large) {
+    m.str("");
+    m << out.what << " is too large to plan within the limits (" << limits.max_grid_points << " grid points, "
+      << limits.max_path_rows << " path rows; about a minute and 2 GB): " << out.estimate;
+    out.too_large_message = m.str();
+  }
   return out;
 }
 

@@ -80,6 +80,9 @@ struct PlanSize {
   double grid_points{0.0};
   double path_rows{0.0};
   bool too_large{false};  // beyond options.max_grid_points or max_path_rows
+  /// With too_large: "<what> is too large to plan within the limits (...):
+  /// <estimate>", for the caller to add how to fix it in its own terms.
+  std::string too_large_message;
   bool large{false};      // over 2e5 grid points or 1e5 rows: a minute or more
 };
 PlanSize EstimatePlanSize(const NurbsSurface& surface, double sample_spacing, const PathParameters& params,
