@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "robomach/common/run_status.h"
 #include "robomach/io/robot_config.h"
 
 namespace CLI {
@@ -29,6 +30,9 @@ inline constexpr int kExitDataError = 65;  // EX_DATAERR
 inline constexpr int kExitNoInput = 66;    // EX_NOINPUT
 inline constexpr int kExitSoftware = 70;   // EX_SOFTWARE
 inline constexpr int kExitCantCreate = 73; // EX_CANTCREAT
+
+/// kExitOk for RunStatus::kOk, kExitFlagged for kFlagged.
+inline int ExitCodeFor(RunStatus s) { return s == RunStatus::kOk ? kExitOk : kExitFlagged; }
 
 /// The exit-code table for --help footers.
 std::string ExitCodeHelp();

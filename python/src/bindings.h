@@ -14,6 +14,7 @@
 #include <pybind11/stl.h>
 
 #include "robomach/common/frames.h"
+#include "robomach/common/run_status.h"
 #include "robomach/dynamics/measured_frf.h"
 
 namespace robomach::python {
@@ -31,6 +32,13 @@ void BindMachine(py::module_& m);
 
 /// Receptance matrices per line -> complex128 array of shape (lines, 3, 3).
 py::array_t<std::complex<double>> ToArray(const std::vector<Eigen::Matrix3cd>& h);
+
+/// A workflow's findings as Python sees them: one sentence each.
+inline std::vector<std::string> FindingMessages(const RunFindings& r) {
+  std::vector<std::string> v;
+  for (const Finding& f : r.findings) v.push_back(f.message);
+  return v;
+}
 
 /// 'x', 'y', 'z' <-> Axis; @throws std::invalid_argument for anything else.
 Axis ParseAxis(const std::string& name);

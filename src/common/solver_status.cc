@@ -1,5 +1,7 @@
 #include "robomach/common/solver_status.h"
 
+#include "robomach/common/run_status.h"
+
 namespace robomach {
 
 const char* SolverStatusName(SolverStatus s) {
@@ -11,5 +13,7 @@ const char* SolverStatusName(SolverStatus s) {
   }
   return "?";
 }
+
+const char* RunStatusName(RunStatus s) { return s == RunStatus::kOk ? "ok" : "flagged"; }
 
 }  // namespace robomach
