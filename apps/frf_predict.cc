@@ -12,8 +12,7 @@
 #include "cli_support.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
-#include "robomach/dynamics/posture_dynamics.h"
-#include "robomach/dynamics/tool_tip_frf.h"
+#include "robomach/dynamics/frf_prediction.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/posture_file.h"
@@ -149,47 +148,23 @@ int Run(int argc, char** argv) {
                        "posture file or coarsen the grid");
     }
 
-    bool flagged = false;
-    dynamics::PostureEvaluator evaluator(model);
+    std::vector<dynamics::NamedPosture> named;
+    for (const io::Posture& p : postures) named.push_back({p.id, p.q});
+    ProgressLine progress(kTool, "postures", static_cast<long>(postures.size()));
+    dynamics::PredictOptions po;
+    po.method = dynamics::ParseReceptanceMethod(method);
+    po.progress = [&](long done, long) { progress.Update(done); };
+    dynamics::FrfPredictionResult result = dynamics::PredictFrfs(model, named, freq_hz, po);
+    progress.Finish();
+    for (const Finding& f : result.findings) {
+      Warn(kTool, postures_path + ":" + std::to_string(postures[f.input_index].line) + ": " + f.message);
+    }
     std::vector<io::PosturePrediction> preds;
     std::vector<dynamics::PostureDynamics> dyns;
-    ProgressLine progress(kTool, "postures", static_cast<long>(postures.size()));
-    for (size_t p = 0; p < postures.size(); ++p) {
-      const io::Posture& pose = postures[p];
-      for (int j : model->chain().JointsOutsideLimits(pose.q)) {
-        const auto& lim = model->chain().limits()[j];
-        std::ostringstream msg;
-        msg << postures_path << ":" << pose.line << ": posture " << pose.id << ": joint " << j + 1
-            << " at " << RadToDeg(pose.q(j)) << " deg is outside its limits [" << RadToDeg(lim.lower)
-            << ", " << RadToDeg(lim.upper) << "] deg";
-        Warn(kTool, msg.str());
-        flagged = true;
-      }
-      dynamics::PostureDynamics d = evaluator.Evaluate(pose.q);
-      if (d.near_singular) {
-        std::ostringstream msg;
-        msg << postures_path << ":" << pose.line << ": posture " << pose.id
-            << " is near a singularity (condition number of J " << d.jacobian_condition
-            << "); the FRF is computed in joint space and stays valid, but the Cartesian M, K, C "
-               "are not reported";
-        Warn(kTool, msg.str());
-        flagged = true;
-      }
-      io::PosturePrediction pred;
-      pred.pose_id = pose.id;
-      pred.freq_hz = freq_hz;
-      pred.H = method == "direct" ? dynamics::ReceptanceDirect(d.system, freq_hz)
-                                  : dynamics::Receptance(d, freq_hz);
-      for (const auto& h : pred.H) {
-        if (!h.allFinite()) {
-          throw std::runtime_error("non-finite receptance at posture " + pose.id);
-        }
-      }
-      preds.push_back(std::move(pred));
-      dyns.push_back(std::move(d));
-      progress.Update(static_cast<long>(p + 1));
+    for (dynamics::PosturePredictionResult& r : result.postures) {
+      preds.push_back({r.id, freq_hz, std::move(r.H)});
+      dyns.push_back(std::move(r.dynamics));
     }
-    progress.Finish();
 
     // Every output is complete before it appears (docs/formats.md §4).
     io::WritePredictedFrfCsv(out_path.empty() ? "-" : out_path, preds, pairs);
@@ -233,7 +208,7 @@ int Run(int argc, char** argv) {
             .SavePng((std::filesystem::path(plot_dir) / (preds[p].pose_id + ".png")).string());
       }
     }
-    return flagged ? kExitFlagged : kExitOk;
+    return ExitCodeFor(result.status());
   });
 }
 

@@ -7,6 +7,7 @@
 
 #include "bindings.h"
 #include "robomach/dynamics/effect.h"
+#include "robomach/dynamics/frf_prediction.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -59,9 +60,7 @@ RobotConfig LoadConfig(const std::string& path, const std::vector<std::string>& 
 
 std::vector<Eigen::Matrix3cd> ReceptanceByMethod(const PostureDynamics& d, const Eigen::VectorXd& freq_hz,
                                                  const std::string& method) {
-  if (method == "modal") return dynamics::Receptance(d, freq_hz);
-  if (method == "direct") return dynamics::ReceptanceDirect(d.system, freq_hz);
-  throw std::invalid_argument("method '" + method + "': expected 'modal' or 'direct'");
+  return dynamics::ReceptanceBy(dynamics::ParseReceptanceMethod(method), d, freq_hz);
 }
 
 void CheckFrequencies(const Eigen::VectorXd& f) {
@@ -327,6 +326,44 @@ void BindDynamics(py::module_& m) {
     py::gil_scoped_release release;
     io::WritePostureFile(path, postures);
   }, py::arg("path"), py::arg("postures"), "Writes a posture file in degrees (atomic).");
+
+  m.def("predict_frfs", [](const ModelPtr& model, const std::vector<io::Posture>& postures,
+                           const Eigen::VectorXd& freq_hz, const std::string& method) {
+    CheckFrequencies(freq_hz);
+    std::vector<dynamics::NamedPosture> named;
+    for (const io::Posture& p : postures) named.push_back({p.id, p.q});
+    dynamics::PredictOptions o;
+    o.method = dynamics::ParseReceptanceMethod(method);
+    dynamics::FrfPredictionResult r;
+    {
+      py::gil_scoped_release release;
+      r = dynamics::PredictFrfs(model, named, freq_hz, o);
+    }
+    py::dict out;
+    out["status"] = RunStatusName(r.status());
+    py::list findings, results;
+    for (const Finding& f : r.findings) {
+      // The posture file's line in front, as frf-predict prints it.
+      const int line = f.input_index >= 0 ? postures[f.input_index].line : 0;
+      findings.append(line > 0 ? "line " + std::to_string(line) + ": " + f.message : f.message);
+    }
+    for (dynamics::PosturePredictionResult& p : r.postures) {
+      py::dict d;
+      d["id"] = p.id;
+      d["H"] = ToArray(p.H);
+      d["joints_outside_limits"] = p.joints_outside_limits;
+      d["dynamics"] = std::move(p.dynamics);
+      results.append(d);
+    }
+    out["findings"] = findings;
+    out["postures"] = results;
+    return out;
+  }, py::arg("model"), py::arg("postures"), py::arg("freq_hz"), py::arg("method") = "modal",
+     "frf-predict's workflow: the model evaluated at each Posture and its tool-tip receptance at freq_hz [Hz]. "
+     "Returns {'status': 'ok' or 'flagged', 'findings': [str] (a joint outside its limits, a posture near a "
+     "singularity; 'line N: ' in front for postures read from a file), 'postures': [{'id', 'H' (complex (lines, 3, "
+     "3) [m/N] in B), 'joints_outside_limits' (0-based), 'dynamics' (PostureDynamics)}]}. frf-predict exits 3 when "
+     "the status is 'flagged'. Releases the GIL.");
 
   m.def("write_predicted_frf_csv", [](const std::string& path, const std::vector<py::tuple>& predictions,
                                        const std::string& directions) {

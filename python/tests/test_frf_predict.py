@@ -79,3 +79,32 @@ def test_threads_get_the_same_answer():
         got = list(pool.map(lambda q: model.predict_frf(q, f), qs))
     for a, b in zip(got, ref):
         np.testing.assert_array_equal(a, b)
+
+
+def test_predict_frfs_is_frf_predicts_workflow(tmp):
+    """predict_frfs: frf-predict's run in one call. Its FRFs written with
+    write_predicted_frf_csv are the tool's --out byte for byte, and its status
+    is the tool's exit code: a joint outside its limits and the wrist
+    singularity (q5 = 0) flag the run (exit 3), with the posture file's line."""
+    (tmp / 'p.csv').write_text('pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\n'
+                               'A,20,-75,105,-10,35,60\n'
+                               'OUT,20,-75,105,-10,35,400\n'
+                               'W,0,-90,90,0,0,0\n')
+    r = run_tool('frf-predict', '--robot', KR210, '--postures', tmp / 'p.csv', '--fmax-hz', 100,
+                 '--out', tmp / 'tool.csv', expect_rc=3)
+    model = rm.RobotConfig(KR210).build()
+    postures = rm.read_posture_file(str(tmp / 'p.csv'), model.num_joints)
+    freq_hz = 0.625 * np.arange(1, 161)
+    p = rm.predict_frfs(model, postures, freq_hz)
+    rm.write_predicted_frf_csv(str(tmp / 'py.csv'), [(x['id'], freq_hz, x['H']) for x in p['postures']])
+    assert (tmp / 'py.csv').read_text() == (tmp / 'tool.csv').read_text()
+    assert p['status'] == 'flagged'
+    assert [x['id'] for x in p['postures']] == ['A', 'OUT', 'W']
+    assert p['postures'][1]['joints_outside_limits'] == [5]
+    assert len(p['findings']) == 2
+    assert p['findings'][0].startswith('line 3: posture OUT: joint 6 at 400 deg is outside its limits')
+    assert p['findings'][1].startswith('line 4: posture W is near a singularity')
+    for f in p['findings']:  # the tool says the same, after the file name
+        assert f.split(': ', 1)[1] in r.stderr
+    ok = rm.predict_frfs(model, postures[:1], freq_hz, method='direct')
+    assert ok['status'] == 'ok' and ok['findings'] == []

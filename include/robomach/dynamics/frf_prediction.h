@@ -1,0 +1,61 @@
+#pragma once
+// The prediction workflow (frf-predict, Python's predict_frfs): the tool-tip
+// receptance and the dynamics of a robot model at a list of postures, with
+// the checks a user expects - a posture outside the joint limits and one
+// near a singularity are flagged, not refused.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "robomach/common/eigen_types.h"
+#include "robomach/common/run_status.h"
+#include "robomach/dynamics/posture_dynamics.h"
+
+namespace robomach::dynamics {
+
+enum class ReceptanceMethod {
+  kModal,   // superposition of the real modes (complex modes for non-proportional damping)
+  kDirect,  // solve (K - w^2 M + i w C) x = f per line
+};
+
+/// "modal" or "direct". @throws std::invalid_argument for anything else.
+ReceptanceMethod ParseReceptanceMethod(const std::string& name);
+
+/// H(f) [m/N] by `method` (Receptance or ReceptanceDirect).
+std::vector<Eigen::Matrix3cd> ReceptanceBy(ReceptanceMethod method, const PostureDynamics& dynamics,
+                                           const Eigen::VectorXd& freq_hz);
+
+struct NamedPosture {
+  std::string id;
+  Eigen::VectorXd q;  // [rad]
+};
+
+struct PredictOptions {
+  ReceptanceMethod method{ReceptanceMethod::kModal};
+  /// Called after each posture with (postures done, postures in all).
+  std::function<void(long, long)> progress;
+};
+
+struct PosturePredictionResult {
+  std::string id;
+  PostureDynamics dynamics;
+  std::vector<Eigen::Matrix3cd> H;  // [m/N] per line of freq_hz, in B
+  std::vector<int> joints_outside_limits;  // 0-based
+};
+
+struct FrfPredictionResult : RunFindings {
+  std::vector<PosturePredictionResult> postures;  // in the order given
+};
+
+/// Evaluates `model` at each posture and its receptance at `freq_hz`
+/// (finite, >= 0). Findings (input_index = the posture's index): each joint
+/// outside its limits, each posture near a singularity (the FRF, in joint
+/// space, stays valid; the Cartesian M, K, C do not).
+/// @throws std::invalid_argument for a non-finite frequency or a posture of
+///   the wrong size; std::runtime_error for a non-finite receptance.
+FrfPredictionResult PredictFrfs(const std::shared_ptr<const RobotModel>& model,
+                                const std::vector<NamedPosture>& postures, const Eigen::VectorXd& freq_hz,
+                                const PredictOptions& options = {});
+
+}  // namespace robomach::dynamics
