@@ -4,8 +4,6 @@
 #include <CLI/CLI.hpp>
 
 #include <filesystem>
-#include <fstream>
-#include <regex>
 #include <sstream>
 
 #include "cli_support.h"
@@ -24,48 +22,7 @@ namespace robomach::apps {
 namespace {
 
 constexpr char kTool[] = "frf-calibrate";
-// A calibrated model is flagged when its rms whole-curve residual exceeds
-// 1.3 noise standard deviations (mean square 1.69): the audit's
-// significance factor (audit::AuditOptions::significance_factor).
-constexpr double kMisfitFlag = 1.3 * 1.3;
 namespace fs = std::filesystem;
-
-// The input config text with a new `parameters:` block (an old one is
-// replaced) and the URDF path made valid from the output's folder.
-std::string CalibratedConfigText(const std::string& input_path, const std::string& output_path,
-                                 const std::string& parameters_yaml) {
-  std::ifstream in(input_path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::istringstream lines(ss.str());
-  std::ostringstream out;
-  std::string line;
-  bool skipping = false;
-  const fs::path in_dir = fs::absolute(input_path).parent_path();
-  const fs::path out_dir = fs::absolute(output_path).parent_path();
-  const std::regex urdf_re(R"(^(\s+urdf:\s*)([^#\s]+)(.*)$)");
-  while (std::getline(lines, line)) {
-    if (skipping) {
-      if (line.empty() || line[0] == ' ' || line[0] == '\t' || line[0] == '#') continue;
-      skipping = false;
-    }
-    if (line.rfind("parameters:", 0) == 0) {
-      skipping = true;
-      continue;
-    }
-    std::smatch m;
-    if (std::regex_match(line, m, urdf_re) && in_dir != out_dir) {
-      fs::path p = m[2].str();
-      if (p.is_relative()) {
-        p = fs::relative(fs::weakly_canonical(in_dir / p), out_dir);
-        line = m[1].str() + p.string() + m[3].str();
-      }
-    }
-    out << line << '\n';
-  }
-  out << "\n# Calibrated by robomach frf-calibrate against measured FRFs.\n" << parameters_yaml;
-  return out.str();
-}
 
 int Run(int argc, char** argv) {
   CLI::App app{
@@ -209,20 +166,13 @@ int Run(int argc, char** argv) {
     }
 
     // Outputs: each complete or absent (docs/formats.md §4).
-    std::string config_text = CalibratedConfigText(
-        robot_path, out_path, io::ParametersYaml(result.parameters, dynamics::DefaultParameters(cfg.description)));
-    if (!adds.empty()) {
-      // Effects switched on with --add go into an `effects:` list, so that the
-      // calibrated parameters (which may include theirs) load; an existing
-      // list is not edited (its layout is the user's).
-      if (config_text.find("\neffects:") == std::string::npos && config_text.rfind("effects:", 0) != 0) {
-        std::string block = "effects:\n";
-        for (const std::string& a : adds) block += "  - name: " + a + "\n";
-        config_text += block;
-      } else {
-        Warn(kTool, "the config already has an `effects:` list; add the effects given with --add to " +
-                        out_path + " by hand");
-      }
+    bool effects_left_out = false;
+    const std::string config_text = io::CalibratedConfigText(
+        robot_path, out_path, io::ParametersYaml(result.parameters, dynamics::DefaultParameters(cfg.description)),
+        adds, &effects_left_out);
+    if (effects_left_out) {
+      Warn(kTool, "the config already has an `effects:` list; add the effects given with --add to " + out_path +
+                      " by hand");
     }
     io::WriteFileAtomically(out_path, config_text);
     io::EnsureDirectory(report_dir);
@@ -230,40 +180,17 @@ int Run(int argc, char** argv) {
     report::WriteTable3Csv((dir / "table3.csv").string(), sets_out);
     report::WriteTable3Markdown((dir / "table3.md").string(), sets_out,
                                 "frf-calibrate: " + robot_path + " against the measured FRFs");
+    const calibration::CalibrationVerdict verdict = calibration::JudgeCalibration(result, measured, opt);
     std::vector<std::string> flags = measured_read.unit_findings;  // implausible units, warned when read
     flags.insert(flags.end(), holdout_read.unit_findings.begin(), holdout_read.unit_findings.end());
-    bool flagged = !flags.empty();
-    double per_residual = NAN;
-    if (result.status == calibration::FitStatus::kNotImproved) {
-      Warn(kTool, "the calibration did not improve on the start values; " + out_path +
-                      " keeps them. " + result.message);
-      flagged = true;
-    } else if (result.status != calibration::FitStatus::kConverged || !result.weakly_identified.empty()) {
-      Warn(kTool, result.message);
-      flagged = true;
-    }
-    // Goodness of fit against the noise: with a noise model, a model that
-    // represents the data leaves a misfit of about one noise variance per
-    // residual (two residuals per line).
-    if (!noise.empty()) {
-      int lines = 0;
-      for (const auto& [k, f] : measured) lines += f.Band(opt.fmin_hz, opt.fmax_hz).size();
-      per_residual = result.misfit_final / std::max(1, 2 * lines);
-      if (per_residual > kMisfitFlag) {
-        std::ostringstream m;
-        m.precision(3);
-        m << "the calibrated model misses the data by " << std::sqrt(per_residual)
-          << " times the noise (rms over " << 2 * lines << " residuals): it cannot represent these data with "
-          << "the free parameters (another effect, another robot?); see the overlays and model-audit";
-        Warn(kTool, m.str());
-        flags.push_back(m.str());
-        flagged = true;
-      }
+    for (const Finding& f : verdict.findings) {
+      Warn(kTool, f.message);
+      flags.push_back(f.message);
     }
     nlohmann::json summary = report::CalibrationSummaryJson(result, opt, sets_out);
     summary["misfit"] = {{"start", result.misfit_start},
                          {"calibrated", result.misfit_final},
-                         {"rms_per_residual_in_noise_units", noise.empty() ? NAN : std::sqrt(per_residual)},
+                         {"rms_per_residual_in_noise_units", verdict.rms_per_residual_in_noise_units},
                          {"starts_tried", result.starts_tried},
                          {"start_used", result.start_used},
                          {"flags", flags}};
@@ -327,7 +254,7 @@ int Run(int argc, char** argv) {
         << result.start_used << ")\n";
       std::cerr << m.str();
     }
-    return flagged ? kExitFlagged : kExitOk;
+    return flags.empty() ? kExitOk : kExitFlagged;
   });
 }
 

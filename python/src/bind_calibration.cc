@@ -163,6 +163,25 @@ void BindCalibration(py::module_& m) {
      "of measured (computed here if None). Returns a CalibrationResult; a poor fit is a status, not "
      "an exception. ValueError for an unknown parameter or a measured posture missing from "
      "postures. Releases the GIL (it can take seconds to minutes).");
+  m.def("judge_calibration", [](const CalibrationResult& result, const dynamics::FrfSet& measured, double fmin_hz,
+                                double fmax_hz) {
+    CalibrationOptions o;
+    o.fmin_hz = fmin_hz;
+    o.fmax_hz = fmax_hz;
+    const calibration::CalibrationVerdict v = calibration::JudgeCalibration(result, measured, o);
+    py::dict d;
+    d["status"] = RunStatusName(v.status());
+    d["findings"] = FindingMessages(v);
+    d["residuals"] = v.residuals;
+    d["rms_per_residual_in_noise_units"] = v.rms_per_residual_in_noise_units;
+    return d;
+  }, py::arg("result"), py::arg("measured"), py::arg("fmin_hz") = 0.0,
+     py::arg("fmax_hz") = std::numeric_limits<double>::infinity(),
+     "frf-calibrate's verdict on a CalibrationResult of calibrate(..., measured, fmin_hz, fmax_hz): "
+     "{'status': 'ok' or 'flagged', 'findings': [str], 'residuals', 'rms_per_residual_in_noise_units'}. Flagged "
+     "when no start improved on the config, a stage did not converge, a parameter is weakly identified, or (every "
+     "FRF with its noise model, as usable_data gives) the rms residual exceeds 1.3 times the noise. frf-calibrate "
+     "exits 3 then.");
   m.def("whole_curve_misfit", [](const io::RobotConfig& config, const std::map<std::string, Eigen::VectorXd>& postures,
                                  const dynamics::FrfSet& measured, double fmin_hz, double fmax_hz) {
     py::gil_scoped_release release;
@@ -247,7 +266,11 @@ void BindCalibration(py::module_& m) {
       .def_readonly("condition_number", &JointStiffnessResult::condition_number)
       .def_readonly("linear_start", &JointStiffnessResult::linear_start, "[N·m/rad]")
       .def_readonly("iterations", &JointStiffnessResult::iterations)
-      .def_property_readonly("flagged", &JointStiffnessResult::flagged);
+      .def_readonly("outliers_in_fit", &JointStiffnessResult::outliers_in_fit,
+                    "outliers found and, without a robust loss, kept in the fit")
+      .def_property_readonly("flagged", &JointStiffnessResult::flagged,
+                             "kq-identify's exit 3: not converged, a joint weakly or not determined, or outliers "
+                             "kept in the fit");
   m.def("identify_joint_stiffness", [](const std::shared_ptr<dynamics::RobotModel>& model,
                                        const std::vector<LoadCase>& cases, double tracker_noise_m,
                                        const std::string& loss, double loss_scale, double outlier_false_alarm,

@@ -64,6 +64,22 @@ def test_calibrate_equals_frf_calibrate_and_finds_the_truth(hammer):
     written = rm.RobotConfig(str(tmp / 'cal.yaml'))
     for name in FREE:
         assert written.get(name) == pytest.approx(result.parameters[name], rel=REL)
+    # The tool's verdict (it exited 0, so ok) and its rms in noise units.
+    verdict = rm.judge_calibration(result, data)
+    assert verdict['status'] == 'ok' and verdict['findings'] == summary['misfit']['flags'] == []
+    assert verdict['rms_per_residual_in_noise_units'] == pytest.approx(
+        summary['misfit']['rms_per_residual_in_noise_units'], rel=1e-9)
+    # Data the model cannot represent (the measured FRFs 1.5 times larger at
+    # every line: no mass or tool length does that without moving the
+    # modes): calibrated, the model misses them by far more than the noise.
+    scaled = rm.FrfSet()
+    for k, f in data.items():
+        scaled[k] = rm.Frf(f.freq_hz, 1.5 * f.receptance, f.coherence).with_noise(1.5 * f.noise_sigma)
+    poor = rm.calibrate(cfg, postures, scaled, free_parameters=FREE)
+    bad = rm.judge_calibration(poor, scaled)
+    assert bad['status'] == 'flagged'
+    assert any('misses the data by' in m for m in bad['findings']), bad['findings']
+    assert bad['rms_per_residual_in_noise_units'] > 1.3
 
 
 def test_calibrate_rejects_unknown_parameters_and_postures(hammer):

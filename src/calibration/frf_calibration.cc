@@ -229,6 +229,40 @@ Objective ParseObjective(const std::string& name) {
 
 std::string FitStatusName(FitStatus s) { return SolverStatusName(s); }
 
+CalibrationVerdict JudgeCalibration(const CalibrationResult& result, const dynamics::FrfSet& measured,
+                                    const CalibrationOptions& options) {
+  CalibrationVerdict v;
+  if (result.status == FitStatus::kNotImproved) {
+    v.Flag("the calibration did not improve on the start values; the calibrated config keeps them. " +
+           result.message);
+  } else if (result.status != FitStatus::kConverged || !result.weakly_identified.empty()) {
+    v.Flag(result.message);
+  }
+  // Goodness of fit against the noise: a model that represents the data
+  // leaves a misfit of about one noise variance per residual (two residuals
+  // per line).
+  bool in_noise_units = !measured.empty();
+  int lines = 0;
+  for (const auto& [k, f] : measured) {
+    in_noise_units = in_noise_units && f.noise_sigma().has_value();
+    lines += static_cast<int>(f.Band(options.fmin_hz, options.fmax_hz).size());
+  }
+  v.residuals = 2 * lines;
+  if (in_noise_units) {
+    const double per_residual = result.misfit_final / std::max(1, v.residuals);
+    v.rms_per_residual_in_noise_units = std::sqrt(per_residual);
+    if (per_residual > kCalibrationMisfitFlagNoiseUnits * kCalibrationMisfitFlagNoiseUnits) {
+      std::ostringstream m;
+      m.precision(3);
+      m << "the calibrated model misses the data by " << v.rms_per_residual_in_noise_units
+        << " times the noise (rms over " << v.residuals << " residuals): it cannot represent these data with "
+        << "the free parameters (another effect, another robot?); see the overlays and model-audit";
+      v.Flag(m.str());
+    }
+  }
+  return v;
+}
+
 namespace {
 
 enum class ResidualKind { kFrequency, kPeak, kJoint, kWholeCurve };

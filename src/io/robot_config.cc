@@ -1,6 +1,9 @@
 #include "robomach/io/robot_config.h"
 
 #include <cmath>
+#include <regex>
+#include <fstream>
+#include <filesystem>
 #include <sstream>
 
 #include "robomach/common/units.h"
@@ -250,6 +253,53 @@ std::string ParametersYaml(const dynamics::ParameterSet& p, const dynamics::Para
       << spec.description << "\n";
   }
   return s.str();
+}
+
+std::string CalibratedConfigText(const std::string& input_path, const std::string& output_path,
+                                 const std::string& parameters_yaml, const std::vector<std::string>& effects,
+                                 bool* effects_left_out) {
+  namespace fs = std::filesystem;
+  std::ifstream in(input_path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::istringstream lines(ss.str());
+  std::ostringstream out;
+  std::string line;
+  bool skipping = false;
+  const fs::path in_dir = fs::absolute(input_path).parent_path();
+  const fs::path out_dir = fs::absolute(output_path).parent_path();
+  const std::regex urdf_re(R"(^(\s+urdf:\s*)([^#\s]+)(.*)$)");
+  while (std::getline(lines, line)) {
+    if (skipping) {
+      if (line.empty() || line[0] == ' ' || line[0] == '\t' || line[0] == '#') continue;
+      skipping = false;
+    }
+    if (line.rfind("parameters:", 0) == 0) {
+      skipping = true;
+      continue;
+    }
+    std::smatch m;
+    if (std::regex_match(line, m, urdf_re) && in_dir != out_dir) {
+      fs::path p = m[2].str();
+      if (p.is_relative()) {
+        p = fs::relative(fs::weakly_canonical(in_dir / p), out_dir);
+        line = m[1].str() + p.string() + m[3].str();
+      }
+    }
+    out << line << '\n';
+  }
+  out << "\n# Calibrated by robomach frf-calibrate against measured FRFs.\n" << parameters_yaml;
+  std::string text = out.str();
+  if (effects_left_out) *effects_left_out = false;
+  if (!effects.empty()) {
+    if (text.find("\neffects:") == std::string::npos && text.rfind("effects:", 0) != 0) {
+      text += "effects:\n";
+      for (const std::string& e : effects) text += "  - name: " + e + "\n";
+    } else if (effects_left_out) {
+      *effects_left_out = true;
+    }
+  }
+  return text;
 }
 
 }  // namespace robomach::io

@@ -1,9 +1,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "robomach/dynamics/robot_model.h"
 #include "robomach/io/robot_config.h"
 #include "test_support.h"
 
@@ -97,6 +99,38 @@ TEST(RobotConfig, DuplicateKeysAreRejectedWithBothLines) {
   const std::string p = Variant("dupkey", "damping:\n", "damping:\n  alpha_s: 2.0e-4\n");
   EXPECT_THAT(CaptureError([&] { LoadRobotConfig(p); }),
               HasSubstr("robot.yaml:31:3: key 'alpha_s' appears twice (first on line 30)"));
+}
+
+// frf-calibrate's calibrated config, written to another folder: it loads
+// (the URDF path follows), the calibrated values and the effect switched on
+// for the calibration come back, and the input's old parameters block is
+// gone. A config with its own effects list is left to the user.
+TEST(RobotConfig, CalibratedConfigLoadsFromAnotherFolderWithItsValues) {
+  const RobotConfig in = LoadRobotConfig(SourcePath("config/kr210.yaml"));
+  auto [desc, params] = dynamics::WithEffect(in.description, in.parameters, "tip_mass");
+  params.Set("m6_kg", 31.25);
+  params.Set("tip_mass.mass_kg", 0.125);
+  const std::string out = TempDir("calibrated_config") + "/sub/cal.yaml";
+  std::filesystem::create_directories(std::filesystem::path(out).parent_path());
+  bool left_out = true;
+  const std::string text = CalibratedConfigText(SourcePath("config/kr210.yaml"), out,
+                                                ParametersYaml(params, dynamics::DefaultParameters(desc)),
+                                                {"tip_mass"}, &left_out);
+  EXPECT_FALSE(left_out);
+  WriteText(out, text);
+  const RobotConfig back = LoadRobotConfig(out);
+  EXPECT_EQ(back.parameters.Get("m6_kg"), 31.25);
+  EXPECT_EQ(back.parameters.Get("tip_mass.mass_kg"), 0.125);
+  // Once more from the calibrated config (it has a parameters block and an
+  // effects list now): one parameters block, the effects list kept as it is.
+  const std::string again =
+      CalibratedConfigText(out, out, ParametersYaml(params, dynamics::DefaultParameters(desc)), {"tip_mass"}, &left_out);
+  EXPECT_TRUE(left_out);
+  size_t blocks = 0;
+  for (size_t at = again.find("\nparameters:"); at != std::string::npos; at = again.find("\nparameters:", at + 1)) {
+    ++blocks;
+  }
+  EXPECT_EQ(blocks, 1u);
 }
 
 }  // namespace

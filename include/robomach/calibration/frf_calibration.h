@@ -18,6 +18,7 @@
 
 #include "robomach/calibration/modal_fit.h"
 #include "robomach/calibration/virtual_hammer_test.h"
+#include "robomach/common/run_status.h"
 #include "robomach/common/solver_status.h"
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/dynamics/parameters.h"
@@ -274,5 +275,27 @@ CalibrationResult Calibrate(const dynamics::RobotDescription& description,
                             const dynamics::ParameterSet& initial, const PostureMap& postures,
                             const dynamics::FrfSet& measured, const MeasuredFeatures& features,
                             const CalibrationOptions& options = {});
+
+/// A calibrated model is flagged when its rms whole-curve residual exceeds
+/// this many noise standard deviations: the audit's significance factor
+/// (audit::AuditOptions::significance_factor).
+inline constexpr double kCalibrationMisfitFlagNoiseUnits = 1.3;
+
+/// The verdict on a calibration (frf-calibrate's exit 3, Python's
+/// judge_calibration): kFlagged, with one finding each, when no start
+/// improved on the start values, a stage did not converge or failed, a
+/// parameter is weakly identified, or - when every measured FRF carries a
+/// noise model, so that the misfit is a chi^2 - the rms residual exceeds
+/// kCalibrationMisfitFlagNoiseUnits (the model cannot represent the data with
+/// its free parameters: another effect, another robot).
+struct CalibrationVerdict : RunFindings {
+  int residuals{0};  // two per measured line in the band
+  /// sqrt(misfit_final / residuals) with noise models; NaN without.
+  double rms_per_residual_in_noise_units{NAN};
+};
+
+/// `measured` and the band of `options` as given to Calibrate.
+CalibrationVerdict JudgeCalibration(const CalibrationResult& result, const dynamics::FrfSet& measured,
+                                    const CalibrationOptions& options);
 
 }  // namespace robomach::calibration

@@ -2,6 +2,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "robomach/dynamics/parameters.h"
 #include "robomach/dynamics/robot_model.h"
@@ -41,5 +42,17 @@ kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& 
 /// from the description's defaults (all of them if `all`), as YAML text.
 std::string ParametersYaml(const dynamics::ParameterSet& parameters,
                            const dynamics::ParameterSet& defaults, bool all = false);
+
+/// frf-calibrate's calibrated config: the text of the config at
+/// `input_path` with its `parameters:` block (if any) replaced by
+/// `parameters_yaml` at the end, a relative `urdf:` path made valid from
+/// `output_path`'s folder, and an `effects:` list of `effects` (those
+/// switched on for the calibration, whose parameters the block may set)
+/// when the config has none. A config that has its own `effects:` list is
+/// not edited there (its layout is the user's): `*effects_left_out` is then
+/// true, for the caller to tell the user.
+std::string CalibratedConfigText(const std::string& input_path, const std::string& output_path,
+                                 const std::string& parameters_yaml, const std::vector<std::string>& effects = {},
+                                 bool* effects_left_out = nullptr);
 
 }  // namespace robomach::io
