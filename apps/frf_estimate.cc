@@ -237,20 +237,17 @@ int Run(int argc, char** argv) {
     }
     for (const std::string& w : r.warnings) Warn(kTool, w);
 
-    int rc = kExitOk;
-    std::vector<std::string> flags;
-    if (r.averages < min_hits && r.averages > 0) {
-      flags.push_back(std::to_string(r.averages) + " accepted hit(s), fewer than --min-hits " +
-                      std::to_string(min_hits));
-    }
     if (r.averages > 0 && r.averages < 3) {
       Warn(kTool, "only " + std::to_string(r.averages) +
                       " hit(s) averaged: the coherence needs at least 3 to mean much, 5 or more are usual");
     }
-    if (r.leakage) flags.push_back("leakage (a response has not decayed by the end of its record)");
-    if (r.implausible) flags.push_back("a receptance outside the plausible range: a unit mistake (see the warning)");
-    for (const std::string& f : flags) Warn(kTool, "result flagged: " + f);
-    if (!flags.empty()) rc = kExitFlagged;
+    const RunFindings verdict = calibration::JudgeFrfEstimate(r, min_hits, "--min-hits");
+    std::vector<std::string> flags;
+    for (const Finding& f : verdict.findings) {
+      Warn(kTool, "result flagged: " + f.message);
+      flags.push_back(f.message);
+    }
+    int rc = ExitCodeFor(verdict.status());
 
     // The FRFs, in receptance inside; written in --quantity.
     const io::FrfQuantity out_q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });

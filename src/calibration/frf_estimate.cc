@@ -437,4 +437,14 @@ void CorrectExponentialWindowDamping(double tau_s, std::vector<FittedMode>* mode
   }
 }
 
+RunFindings JudgeFrfEstimate(const FrfEstimateResult& r, int min_hits, const std::string& min_hits_name) {
+  RunFindings v;
+  if (r.averages < min_hits && r.averages > 0) {
+    v.Flag(std::to_string(r.averages) + " accepted hit(s), fewer than " + min_hits_name + " " + std::to_string(min_hits));
+  }
+  if (r.leakage) v.Flag("leakage (a response has not decayed by the end of its record)");
+  if (r.implausible) v.Flag("a receptance outside the plausible range: a unit mistake (see the warning)");
+  return v;
+}
+
 }  // namespace robomach::calibration

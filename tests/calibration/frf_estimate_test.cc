@@ -324,6 +324,15 @@ TEST(FrfEstimate, ShortRecordIsReportedAsLeakage) {
   o.exponential_tau_s = 0.02;  // e^{-0.105/0.02} = 0.5 % at the end
   const FrfEstimateResult w = EstimateFrf(hits, testing::SimulatedChannels(), o);
   EXPECT_FALSE(w.leakage);
+  // The verdict: leakage flags the leaking estimate; 3 hits against a
+  // minimum of 5 flag both; the windowed one with a minimum of 3 is ok.
+  const RunFindings leak = JudgeFrfEstimate(r, 3);
+  ASSERT_EQ(leak.findings.size(), 1u);
+  EXPECT_NE(leak.findings[0].message.find("leakage"), std::string::npos);
+  const RunFindings few = JudgeFrfEstimate(r, 5, "--min-hits");
+  ASSERT_EQ(few.findings.size(), 2u);
+  EXPECT_EQ(few.findings[0].message, "3 accepted hit(s), fewer than --min-hits 5");
+  EXPECT_EQ(JudgeFrfEstimate(w, 3).status(), RunStatus::kOk);
 }
 
 // Wrong units on purpose: responses recorded in mm under columns named in m

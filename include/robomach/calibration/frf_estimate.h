@@ -42,6 +42,7 @@
 
 #include "robomach/calibration/impact_record.h"
 #include "robomach/calibration/modal_fit.h"
+#include "robomach/common/run_status.h"
 
 namespace robomach::calibration {
 
@@ -157,6 +158,14 @@ using dynamics::kMinPlausibleReceptance;
 FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits,
                               const std::vector<ResponseChannel>& channels,
                               const FrfEstimateOptions& options = {});
+
+/// frf-estimate's verdict on an estimate (its exit 3; Python's
+/// judge_frf_estimate): flagged, one finding each, for fewer accepted hits
+/// than `min_hits` (when there is at least one), leakage, and a receptance
+/// outside the plausible range (a unit mistake). `min_hits_name` is how the
+/// caller calls the minimum ("--min-hits" in the tool).
+RunFindings JudgeFrfEstimate(const FrfEstimateResult& result, int min_hits = 1,
+                             const std::string& min_hits_name = "min_hits");
 
 /// Clipping of a converter or amplifier, as the first sample of either
 ///  (a) a run of at least `min_run` consecutive samples exactly equal to the
