@@ -187,19 +187,17 @@ int Run(int argc, char** argv) {
                                                              measured_read.frfs, noise, ro);
     const json& j = rep.summary;
     const std::string& yaml = rep.effects_yaml;
-    const bool failed_candidate = rep.failed_candidate;
     if (!summary_path.empty() && summary_path != "-") io::WriteFileAtomically(summary_path, report::DumpJson(j));
 
-    std::cerr << kTool << ": " << r.verdict << '\n';
-    for (const auto& w : r.warnings) Warn(kTool, w);
-    if (failed_candidate) Warn(kTool, "a candidate's fit failed; its row in candidates.csv says why");
+    std::cerr << kTool << ": " << r.verdict << '\n';  // always; a finding when unexplained
+    const RunFindings verdict = audit::JudgeAudit(r);
+    for (const Finding& f : verdict.findings) {
+      if (f.message != r.verdict) Warn(kTool, f.message);
+    }
     io::WriteFileAtomically("-", yaml);
     if (summary_path == "-") io::WriteFileAtomically("-", report::DumpJson(j));
     // measured_read.unit_findings: receptances outside the plausible range, warned when read.
-    return (r.significant_failure && !r.explained) || !r.warnings.empty() || failed_candidate ||
-                   !measured_read.unit_findings.empty()
-               ? kExitFlagged
-               : kExitOk;
+    return verdict.flagged() || !measured_read.unit_findings.empty() ? kExitFlagged : kExitOk;
   });
 }
 

@@ -38,6 +38,9 @@ py::dict ResultDict(const audit::AuditResult& r) {
   d["runner_up"] = r.runner_up;
   d["reasons"] = r.reasons;
   d["warnings"] = r.warnings;
+  const RunFindings verdict = audit::JudgeAudit(r);
+  d["status"] = RunStatusName(verdict.status());
+  d["findings"] = FindingMessages(verdict);
   py::list cands;
   for (const auto& c : r.candidates) {
     py::dict cd;
@@ -113,7 +116,8 @@ void BindAudit(py::module_& m) {
      "library effect not in the model (or `candidates`) and grades the best. Returns a dict of plain "
      "Python objects: grade, headline, verdict, explained, missing_effects, candidate, errors "
      "(rms of ln|H| differences; in units of the noise when the FRFs carry sigma), candidates (name, "
-     "bic_change, error_after, plausible, note, parameters {name: (value, std)}) and effects_yaml. "
+     "bic_change, error_after, plausible, note, parameters {name: (value, std)}), effects_yaml, and status ('ok' "
+     "or 'flagged': model-audit's exit 3 but for the unit checks of its reader) with its findings. "
      "With report_dir it also writes model-audit's report folder there (noise: the noise models of "
      "estimate_noise; measured_all: every measured line for the overlays) and adds 'report' and "
      "'summary' (summary.json as a dict). Releases the GIL (seconds to minutes).");

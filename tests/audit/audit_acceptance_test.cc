@@ -157,6 +157,9 @@ TEST(HiddenEffectBelowDetection, GravityStiffnessIsWithinTheNoiseAndRaisesNoAlar
   EXPECT_FALSE(o.result.significant_failure) << o.result.errors_before.total_rms_log_mag;
   EXPECT_LT(o.result.errors_before.total_rms_log_mag, 1.05 * o.true_error);
   EXPECT_TRUE(o.result.missing_effects.empty());
+  // No alarm: the verdict is not among model-audit's findings.
+  for (const Finding& f : JudgeAudit(o.result).findings) EXPECT_NE(f.message, o.result.verdict);
+
 }
 
 // A soft quick-change flange on a soft foundation: flexibilities at both
@@ -196,6 +199,11 @@ TEST(EffectOutsideTheLibrary, IsReportedAsUnexplainedWithItsPattern) {
   EXPECT_FALSE(r.explained) << r.verdict;
   EXPECT_TRUE(r.missing_effects.empty()) << r.verdict;
   EXPECT_NE(r.verdict.find("unexplained"), std::string::npos) << r.verdict;
+  // model-audit's exit 3: the verdict is the first finding.
+  const RunFindings v = JudgeAudit(r);
+  EXPECT_EQ(v.status(), RunStatus::kFlagged);
+  ASSERT_FALSE(v.findings.empty());
+  EXPECT_EQ(v.findings[0].message, r.verdict);
   // The pattern: the band with 320 Hz is the worst at every posture (in at
   // least one direction; the calibration may bend a robot mode elsewhere in
   // the other), and the verdict says so.

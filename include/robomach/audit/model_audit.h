@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "robomach/common/run_status.h"
 #include "robomach/calibration/frf_calibration.h"
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/dynamics/parameters.h"
@@ -63,6 +64,8 @@ struct AuditOptions {
   /// Skip the candidate ranking when the current model has no significant
   /// failure (nothing to explain).
   bool rank_only_if_failing{true};
+  /// Iterations of one candidate fit; a fit that stops there is run again
+  /// from its start with four times as many (the better of the two counts).
   int max_iterations{100};
   /// The fits use every fit_line_stride-th line of each FRF (errors are
   /// always on all lines). 0: automatic, the largest stride (at most 4) that
@@ -249,6 +252,12 @@ struct AuditResult {
   /// with --add), for the caller to report.
   std::vector<std::string> warnings;
 };
+
+/// model-audit's verdict (its exit 3; Python's audit()["status"]): flagged,
+/// one finding each, when the model fails significantly and is not
+/// explained (the finding is the verdict), for each of the result's
+/// warnings, and when a candidate's fit failed.
+RunFindings JudgeAudit(const AuditResult& r);
 
 /// The candidate that stands for "the model after": the named one when the
 /// grade is explained or mostly explained, else the accepted one (r.best),
