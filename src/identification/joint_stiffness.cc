@@ -614,6 +614,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     s << "; or repeat the cases to average the tracker noise";
     res.advice.push_back(s.str());
   }
+  res.outliers_in_fit = !res.outliers.empty() && options.loss == RobustLoss::kNone;
   if (!res.outliers.empty()) {
     std::string ids;
     for (size_t i = 0; i < res.outliers.size(); ++i) {

@@ -216,6 +216,17 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
   plan.log_det_information = LogDet(info);
   plan.expected_relative_std = internal::MarginalStdFromInformation(info);
   plan.expected_std_dev = kq.cwiseProduct(plan.expected_relative_std);
+  for (int j = 0; j < n; ++j) {
+    plan.expected_determination.push_back(
+        DeterminationFromRelativeStd(plan.expected_relative_std(j), o.weak_relative_std));
+    if (plan.expected_determination.back() == Determination::kNotDetermined) {
+      // The last joint turns the tool about its own axis: only a load or a
+      // target off that axis feels it.
+      plan.Flag("joint " + std::to_string(j + 1) + " cannot be determined with this set-up" +
+                    (j == n - 1 ? ": put the load point and the target off the tool axis" : ": allow more postures or rope directions"),
+                j);
+    }
+  }
   for (int s = 0; s < o.num_postures; ++s) {
     const Candidate& c = cands[sel[s]];
     const std::string pose_id = "P" + std::to_string(s + 1);

@@ -196,6 +196,13 @@ TEST(IdentifyJointStiffness, RobustFitNamesOutliersAndRecoversValues) {
   // Without a robust loss the two cases are still flagged (they are 70σ off).
   const JointStiffnessResult plain = IdentifyJointStiffness(*model, dirty);
   for (int c : bad) EXPECT_TRUE(plain.residuals[c].outlier);
+  // ...and, kept in the fit, they flag the result (kq-identify exits 3);
+  // the robust fit that left them out is not flagged for them.
+  EXPECT_TRUE(plain.outliers_in_fit);
+  EXPECT_TRUE(plain.flagged());
+  EXPECT_FALSE(r.outliers_in_fit);
+  EXPECT_EQ(r.flagged(), !r.weakly_identified.empty() || !r.not_determined.empty());
+  EXPECT_FALSE(clean.outliers_in_fit);
 }
 
 // Issue #3: one posture with vertical loads only cannot determine the

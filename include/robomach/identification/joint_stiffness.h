@@ -97,6 +97,9 @@ struct JointStiffnessResult {
   std::vector<std::string> advice;
   std::vector<CaseResidual> residuals;  // every case, in input order
   std::vector<int> outliers;            // indices into residuals
+  /// Outliers were found and, without a robust loss, stayed in the fit (the
+  /// result is then flagged; with a loss they were left out).
+  bool outliers_in_fit{false};
   double rms_residual{NAN};             // RMS of |residual| over inliers [m]
   double rms_residual_all{NAN};         // RMS of |residual| over all cases [m]
   double noise_sigma_displacement{NAN}; // σ_D per coordinate [m]
@@ -115,8 +118,11 @@ struct JointStiffnessResult {
   /// largest lever of the target about it [m] (what the advice is built on).
   Eigen::VectorXd max_joint_torque;
   Eigen::VectorXd max_target_lever;
+  /// kq-identify's exit 3 and Python's `flagged`: the fit did not converge, a
+  /// joint is weakly or not determined, or outliers stayed in the fit.
   bool flagged() const {
-    return status != FitStatus::kConverged || !not_determined.empty() || !weakly_identified.empty();
+    return status != FitStatus::kConverged || !not_determined.empty() || !weakly_identified.empty() ||
+           outliers_in_fit;
   }
 };
 

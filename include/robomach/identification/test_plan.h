@@ -6,7 +6,9 @@
 
 #include <Eigen/Core>
 
+#include "robomach/common/run_status.h"
 #include "robomach/dynamics/robot_model.h"
+#include "robomach/identification/joint_stiffness.h"
 #include "robomach/identification/load_case.h"
 
 namespace robomach::identification {
@@ -34,6 +36,9 @@ struct PlanOptions {
   unsigned seed{1};
   std::optional<Eigen::Vector3d> p_load_tip;          // [m] in the tip frame; nullopt = TCP
   std::optional<Eigen::Vector3d> p_target_tip;        // [m] in the tip frame; nullopt = TCP
+  /// A joint whose expected relative standard deviation exceeds this is
+  /// weakly determined (the identification's own threshold).
+  double weak_relative_std{IdentificationOptions{}.weak_relative_std};
 };
 
 /// @throws std::invalid_argument naming the field and the violated bound.
@@ -48,13 +53,18 @@ struct PlannedLoad {
   Eigen::Vector3d p_pulley;            // where the rope meets the floor, in B [m]
 };
 
-struct TestPlan {
+/// Flagged (RunFindings, kq-identify --plan's exit 3) with one finding per
+/// joint the planned tests cannot determine; weakly determined joints are in
+/// expected_determination, not findings (more postures fix them).
+struct TestPlan : RunFindings {
   std::vector<PlannedLoad> loads;        // num_postures × directions_per_posture
   std::vector<LoadCase> cases;           // the loads with every mass (no displacement)
   double log_det_information{NAN};       // D-optimality index, log det I (θ = log k)
   Eigen::VectorXd expected_relative_std; // √diag(I⁻¹) [-]; +inf where I is singular
   Eigen::VectorXd expected_std_dev;      // [N·m/rad] at the model's stiffness
   int num_candidates{0};                 // feasible candidate postures found
+  /// Per joint, by DeterminationFromRelativeStd(expected_relative_std).
+  std::vector<Determination> expected_determination;
 };
 
 /// Chooses postures (within the joint limits with a margin) and rope
