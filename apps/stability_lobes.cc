@@ -15,43 +15,29 @@
 #include <sstream>
 
 #include "cli_support.h"
+#include "robomach/calibration/frf_noise.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
-#include "robomach/dynamics/posture_dynamics.h"
-#include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/cut_file.h"
 #include "robomach/io/number_format.h"
-#include "robomach/io/posture_file.h"
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/lobes_file.h"
-#include "robomach/io/tip_dynamics_files.h"
+#include "robomach/io/tip_sources.h"
 #include "robomach/report/modal_fit_plot.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/posture_json.h"
-#include "robomach/stability/measured_tip_model.h"
 #include "robomach/stability/semi_discretization.h"
-#include "robomach/stability/tool_tip_model.h"
 #include "robomach/stability/lobes_workflow.h"
 #include "robomach/stability/tip_dynamics.h"
-#include "robomach/stability/zoa_lobes.h"
 
 namespace robomach::apps {
 namespace {
 
 constexpr char kTool[] = "stability-lobes";
-
-// FRF files, CSV or UFF58 by extension; reader warnings go to stderr (the
-// receptances' plausibility comes with the tips: ComputeLobes warns).
-std::vector<stability::TipFrfs> ReadFrfFile(const std::string& path) {
-  std::vector<std::string> warnings;
-  auto sets = io::ReadTipFrfs(path, "", &warnings);
-  for (const std::string& w : warnings) Warn(kTool, w);
-  return sets;
-}
 
 Eigen::Vector3d ParseVector(const std::string& option, const std::string& text) {
   std::stringstream ss(text);
@@ -219,67 +205,23 @@ int Run(int argc, char** argv) {
     const io::CutSpec cut = io::ReadCutFile(cut_path);
 
     std::vector<stability::TipDynamics> tips;
+    const std::string axis_source = "--tool-axis " + tool_axis_text;
     if (!robot_path.empty()) {
-      const auto model = io::LoadRobotConfig(robot_path).Build();
-      const auto postures = io::ReadPostureFile(postures_path, model->num_joints());
-      std::vector<const io::Posture*> chosen;
-      for (const std::string& id : pose_ids) {
-        auto it = std::find_if(postures.begin(), postures.end(), [&](const auto& p) { return p.id == id; });
-        if (it == postures.end()) {
-          std::string known;
-          for (const auto& p : postures) known += (known.empty() ? "" : ", ") + p.id;
-          throw InputError({postures_path, 0, 0}, "no posture \"" + id + "\" in the file; it has " + known);
-        }
-        chosen.push_back(&*it);
-      }
-      if (chosen.empty()) for (const auto& p : postures) chosen.push_back(&p);
-      dynamics::PostureEvaluator ev(model);
-      for (const io::Posture* p : chosen) {
-        const dynamics::PostureDynamics d = ev.Evaluate(p->q);
-        if (d.near_singular) {
-          Warn(kTool, postures_path + ":" + std::to_string(p->line) + ": posture " + p->id +
-                          " is near a singularity; the tool-tip FRF (joint space) stays valid");
-        }
-        try {
-          tips.push_back(stability::TipFromPosture(p->id, d, cut.feed_direction_B, cut.process.teeth,
-                                                   cut.spindle_speed_max_rad_s));
-        } catch (const std::invalid_argument& e) {
-          throw InputError({cut_path, cut.feed_line, cut.feed_column},
-                           std::string("feed_direction: ") + e.what() + " at posture " + p->id);
-        }
-      }
+      tips = io::TipsFromRobotPostures(io::LoadRobotConfig(robot_path).Build(), postures_path, pose_ids, cut, Tell);
+    } else if (!frf_path.empty()) {
+      stability::MeasuredTipOptions mo;
+      mo.frf_path = frf_path;
+      mo.frf_y_path = frf_y_path;
+      mo.pose_ids = pose_ids;
+      // The cutting frame only when the FRFs need orienting.
+      mo.cutting_frame = [&] { return io::CutFrame(cut, ParseVector("--tool-axis", tool_axis_text), axis_source); };
+      mo.tool_axis_source = axis_source;
+      mo.fit = true;  // always: the noise model's usable band serves the ZOA too
+      mo.sd_modes = sd_modes;
+      tips = io::TipsFromFrfFiles(mo, Tell);
     } else {
-      // The cutting frame of --tool-axis and the cut's feed, when needed.
-      auto frame = [&]() {
-        const Eigen::Vector3d axis = ParseVector("--tool-axis", tool_axis_text);
-        try {
-          return stability::CuttingFrame(axis, cut.feed_direction_B);
-        } catch (const std::invalid_argument& e) {
-          throw InputError({cut_path, cut.feed_line, cut.feed_column},
-                           std::string("feed_direction: ") + e.what() + " (--tool-axis " + tool_axis_text + ")");
-        }
-      };
-      if (!frf_path.empty()) {
-        stability::MeasuredTipOptions mo;
-        mo.frf_path = frf_path;
-        mo.frf_y_path = frf_y_path;
-        mo.pose_ids = pose_ids;
-        mo.cutting_frame = frame;
-        mo.tool_axis_source = "--tool-axis " + tool_axis_text;
-        mo.fit = true;  // always: the noise model's usable band serves the ZOA too
-        mo.sd_modes = sd_modes;
-        const std::vector<stability::TipFrfs> sets = ReadFrfFile(frf_path);
-        std::vector<stability::TipFrfs> ysets;
-        if (!frf_y_path.empty()) ysets = ReadFrfFile(frf_y_path);
-        tips = stability::TipsFromMeasuredFrfs(sets, ysets, mo, Tell);
-      } else {
-        const Eigen::Matrix3d R = frame();
-        for (const io::ModalTableEntry& e : io::ReadModalTable(modal_path)) {
-          if (!pose_ids.empty() && std::find(pose_ids.begin(), pose_ids.end(), e.pose_id) == pose_ids.end()) continue;
-          tips.push_back(stability::TipFromModes(e.pose_id, e.modes, R, cut.process.teeth, cut.spindle_speed_max_rad_s));
-        }
-        if (tips.empty()) throw InputError({modal_path, 0, 0}, "none of the requested postures is in the file");
-      }
+      const Eigen::Matrix3d R = io::CutFrame(cut, ParseVector("--tool-axis", tool_axis_text), axis_source);
+      tips = io::TipsFromModalTableFile(modal_path, pose_ids, R, cut);
     }
 
     stability::LobesOptions lo;
@@ -310,8 +252,6 @@ int Run(int argc, char** argv) {
           }
         });
     const std::vector<stability::LobeRow>& rows = lobes.rows;
-    const bool no_boundary = lobes.no_boundary;
-    bool flagged = lobes.flagged;
 
     io::WriteLobesCsv(out_path.empty() ? "-" : out_path, rows);
     if (!plot_path.empty()) {
@@ -351,8 +291,7 @@ int Run(int argc, char** argv) {
       io::WriteModalTableCsv(modes_out_path, ids, modes);
     }
     if (!fit_plot_path.empty()) PlotFits(fit_plot_path, frf_path, tips);
-    if (no_boundary) Warn(kTool, "some speeds have no boundary (status column): widen the FRF band or the lobe range");
-    flagged |= no_boundary;
+    const bool flagged = lobes.flagged();
     if (!summary_path.empty()) {
       nlohmann::json j;
       j["tool"] = kTool;
@@ -386,7 +325,7 @@ int Run(int argc, char** argv) {
         results.push_back(r);
       }
       j["lobes"] = results;
-      j["no_boundary_at_some_speeds"] = no_boundary;
+      j["no_boundary_at_some_speeds"] = lobes.no_boundary;
       j["flagged"] = flagged;
       j["exit_code"] = flagged ? kExitFlagged : kExitOk;
       io::WriteFileAtomically(summary_path, report::DumpJson(j));

@@ -121,16 +121,11 @@ int Run(int argc, char** argv) {
     }
     ProgressLine progress(kTool, "points", static_cast<long>(targets.size()));
     opt.progress = [&](long done, long) { progress.Update(done); };
-    const std::vector<stability::MapPoint> pts =
-        stability::EvaluateStabilityMap(model, targets, rows, cols, cut.process, opt);
+    const stability::StabilityMapResult map =
+        stability::ComputeStabilityMap(model, targets, rows, cols, cut.process, opt);
+    const std::vector<stability::MapPoint>& pts = map.points;
     progress.Finish();
-
-    long reached = 0, flagged = 0;
-    for (const auto& p : pts) {
-      reached += p.status != stability::PointStatus::kUnreachable && p.status != stability::PointStatus::kJointLimits;
-      flagged += p.status != stability::PointStatus::kOk;
-    }
-    if (reached == 0) {
+    if (map.reached == 0) {
       throw InputError({grid ? region_path : path_path, grid ? region.origin_line : 0, grid ? region.origin_column : 0},
                        grid ? "no point of the region is reachable by the robot from seed_posture_deg within its joint limits "
                               "(origin, axes and size place it out of reach)"
@@ -226,8 +221,8 @@ int Run(int argc, char** argv) {
         j["grid_rows"] = rows;
         j["grid_cols"] = cols;
       }
-      j["points_reached"] = reached;
-      j["points_flagged"] = flagged;
+      j["points_reached"] = map.reached;
+      j["points_flagged"] = map.flagged_points;
       std::map<std::string, int> by_status;
       for (const auto& p : pts) ++by_status[stability::ToString(p.status)];
       j["points_by_status"] = by_status;
@@ -266,15 +261,11 @@ int Run(int argc, char** argv) {
         j["min_critical_depth_point"] = where(lo);
         j["max_critical_depth_point"] = where(hi);
       }
-      j["exit_code"] = flagged > 0 ? kExitFlagged : kExitOk;
+      j["exit_code"] = ExitCodeFor(map.status());
       io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }
-    if (flagged > 0) {
-      Warn(kTool, std::to_string(flagged) + " of " + std::to_string(pts.size()) +
-                      " points are flagged (status column: unreachable, joint_limits, near_singular, other_configuration)");
-      return kExitFlagged;
-    }
-    return kExitOk;
+    for (const Finding& f : map.findings) Warn(kTool, f.message);
+    return ExitCodeFor(map.status());
   });
 }
 

@@ -16,6 +16,7 @@
 #include "robomach/io/lobes_file.h"
 #include "robomach/io/region_file.h"
 #include "robomach/io/tip_dynamics_files.h"
+#include "robomach/io/tip_sources.h"
 #include "robomach/stability/lobes_workflow.h"
 #include "robomach/stability/stability_map.h"
 #include "robomach/stability/tip_dynamics.h"
@@ -25,19 +26,15 @@ namespace {
 
 using stability::TipDynamics;
 
+std::string AxisText(const Eigen::Vector3d& a) {
+  return "tool_axis " + FormatDouble(a(0)) + "," + FormatDouble(a(1)) + "," + FormatDouble(a(2));
+}
+
 // The cutting frame of a tool axis and the cut's feed, as stability-lobes
 // makes it (an InputError naming the cut file's feed_direction).
 Eigen::Matrix3d FrameOf(const io::CutSpec& cut, const Eigen::Vector3d& tool_axis) {
   if (!(tool_axis.norm() > 0.0)) throw std::invalid_argument("tool_axis: expected a non-zero vector");
-  try {
-    return stability::CuttingFrame(tool_axis, cut.feed_direction_B);
-  } catch (const std::invalid_argument& e) {
-    throw InputError({cut.path, cut.feed_line, cut.feed_column}, std::string("feed_direction: ") + e.what());
-  }
-}
-
-std::string AxisText(const Eigen::Vector3d& a) {
-  return "tool_axis " + FormatDouble(a(0)) + "," + FormatDouble(a(1)) + "," + FormatDouble(a(2));
+  return io::CutFrame(cut, tool_axis, AxisText(tool_axis));
 }
 
 py::dict MessageDict(const stability::TipMessage& m) {
@@ -145,14 +142,7 @@ void BindStability(py::module_& m) {
   m.def("tips_from_modal_table", [](const std::string& path, const io::CutSpec& cut, const Eigen::Vector3d& tool_axis,
                                     const std::vector<std::string>& poses) {
     RequireReadableFile(path);
-    const Eigen::Matrix3d R = FrameOf(cut, tool_axis);
-    std::vector<TipDynamics> tips;
-    for (const io::ModalTableEntry& e : io::ReadModalTable(path)) {
-      if (!poses.empty() && std::find(poses.begin(), poses.end(), e.pose_id) == poses.end()) continue;
-      tips.push_back(stability::TipFromModes(e.pose_id, e.modes, R, cut.process.teeth, cut.spindle_speed_max_rad_s));
-    }
-    if (tips.empty()) throw InputError({path, 0, 0}, "none of the requested postures is in the file");
-    return tips;
+    return io::TipsFromModalTableFile(path, poses, FrameOf(cut, tool_axis), cut);
   }, py::arg("path"), py::arg("cut"), py::arg("tool_axis") = Eigen::Vector3d::UnitZ(),
      py::arg("poses") = std::vector<std::string>{},
      "The tool tips of a modal table (docs/formats.md §4), as stability-lobes --modal-table makes them.");
@@ -174,12 +164,7 @@ void BindStability(py::module_& m) {
     std::vector<TipDynamics> tips;
     {
       py::gil_scoped_release release;
-      std::vector<std::string> warnings;
-      const auto sets = io::ReadTipFrfs(path, "", &warnings);
-      std::vector<io::FrfSetOfPose> ysets;
-      if (frf_y) ysets = io::ReadTipFrfs(*frf_y, "", &warnings);
-      for (const std::string& w : warnings) said.messages.push_back({stability::TipMessage::Kind::kWarning, w});
-      tips = stability::TipsFromMeasuredFrfs(sets, ysets, o, said.Sink());
+      tips = io::TipsFromFrfFiles(o, said.Sink());
     }
     return py::make_tuple(tips, said.List());
   }, py::arg("path"), py::arg("cut"), py::arg("tool_axis") = Eigen::Vector3d::UnitZ(), py::arg("frf_y") = py::none(),
@@ -234,8 +219,13 @@ void BindStability(py::module_& m) {
      "(Lobes, messages). The GIL is released while it runs.");
 
   py::class_<stability::LobesResult>(m, "Lobes", "The lobes of every tool tip: one row per speed, tip and method.")
-      .def_readonly("flagged", &stability::LobesResult::flagged,
-                    "a modal fit that does not describe a tool tip, or ZOA and SD more than 10 % apart")
+      .def_property_readonly("flagged", &stability::LobesResult::flagged,
+                             "stability-lobes' exit 3: a modal fit that does not describe a tool tip, ZOA and SD "
+                             "more than 10 % apart, or speeds without a boundary")
+      .def_property_readonly("run_status", [](const stability::LobesResult& r) { return RunStatusName(r.status()); },
+                             "'ok' or 'flagged' (`status` is each row's)")
+      .def_property_readonly("findings", [](const stability::LobesResult& r) { return FindingMessages(r); },
+                             "why it is flagged, one sentence each (also among the messages, as warnings)")
       .def_readonly("no_boundary", &stability::LobesResult::no_boundary, "some speeds have no stability boundary")
       .def_property_readonly("pose_id", [](const stability::LobesResult& r) {
         std::vector<std::string> v;
@@ -274,7 +264,7 @@ void BindStability(py::module_& m) {
       }, "-1 where none")
       .def("__len__", [](const stability::LobesResult& r) { return r.rows.size(); })
       .def("__repr__", [](const stability::LobesResult& r) {
-        return "<Lobes " + std::to_string(r.rows.size()) + " rows" + (r.flagged ? ", flagged" : "") + ">";
+        return "<Lobes " + std::to_string(r.rows.size()) + " rows" + (r.flagged() ? ", flagged" : "") + ">";
       });
   m.def("write_lobes_csv", [](const std::string& path, const stability::LobesResult& r) {
     io::WriteLobesCsv(path, r.rows);

@@ -74,7 +74,9 @@ def test_mobility_read_as_receptance_is_flagged(tmp):
     tips, _ = rm.tips_from_frf_file(str(tmp / 'mobility.csv'), cut)
     assert 'outside the plausible' in tips[0].unit_finding
     lobes, messages = rm.stability_lobes(tips, cut)
-    assert lobes.flagged
+    assert lobes.flagged and lobes.run_status == 'flagged'
+    assert any(f.startswith('implausible (unit mistake?)') for f in lobes.findings)
+    assert all(any(m['text'] == f for m in messages) for f in lobes.findings)  # each was told as it was found
     assert any(m['kind'] == 'warning' and m['text'].startswith('implausible (unit mistake?)') for m in messages)
 
 

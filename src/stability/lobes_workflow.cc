@@ -38,11 +38,10 @@ TipModalModel SdModel(const TipDynamics& t, int sd_modes) {
 // speeds within ±4 % of the bottom of each of the (at most 4) lowest ZOA
 // lobes; the ZOA's lobe bottoms are all about equally deep, the SD's are
 // not (on issue #18's tap test, 0.886 mm at lobe 0 and 0.971 mm at lobe 2
-// against the ZOA's 0.896 mm). Returns true when they disagree.
-bool CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<LobeRow>& rows, const LobesOptions& o,
-                     const TipMessageSink& tell) {
-  bool flagged = false;
-  if (o.process.radial_immersion < 0.3) return flagged;
+// against the ZOA's 0.896 mm). A disagreement is a finding.
+void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<LobeRow>& rows, const LobesOptions& o,
+                     const TipMessageSink& tell, RunFindings* findings) {
+  if (o.process.radial_immersion < 0.3) return;
   for (const TipDynamics& t : tips) {
     double sd = MinDepth(rows, t.id, "sd");
     const double zoa = MinDepth(rows, t.id, "zoa");
@@ -74,20 +73,17 @@ bool CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
     m << t.id << ": smallest critical depth SD " << FormatNumber(MToMm(sd)) << " mm, ZOA " << FormatNumber(MToMm(zoa))
       << " mm";
     if (diff > 0.10) {
-      if (tell) {
-        tell({TipMessage::Kind::kWarning,
-              m.str() + ": they differ by " + FormatDouble(std::round(diff * 1000.0) / 10.0) +
-                  " % (more than 10 % at a radial immersion of " + FormatDouble(o.process.radial_immersion) +
-                  ", where they should agree): check " +
-                  (t.fits.empty() ? std::string("") : "the modal fit (--fit-plot), ") +
-                  "the modes the SD keeps (--sd-modes) and its steps per tooth period (--sd-steps)"});
-      }
-      flagged = true;
+      const std::string w = m.str() + ": they differ by " + FormatDouble(std::round(diff * 1000.0) / 10.0) +
+                            " % (more than 10 % at a radial immersion of " + FormatDouble(o.process.radial_immersion) +
+                            ", where they should agree): check " +
+                            (t.fits.empty() ? std::string("") : "the modal fit (--fit-plot), ") +
+                            "the modes the SD keeps (--sd-modes) and its steps per tooth period (--sd-steps)";
+      if (tell) tell({TipMessage::Kind::kWarning, w});
+      findings->Flag(w);
     } else if (tell) {
       tell({TipMessage::Kind::kFit, m.str() + " (they agree within 10 %)"});
     }
   }
-  return flagged;
 }
 
 }  // namespace
@@ -128,7 +124,7 @@ LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOption
   for (const TipDynamics& t : tips) {
     for (const std::string& w : TipFitWarnings(t, do_sd)) {
       tell(TipMessage::Kind::kWarning, w);
-      result.flagged = true;
+      result.Flag(w);
     }
   }
   for (const TipDynamics& t : tips) {
@@ -186,7 +182,12 @@ LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOption
       }
     }
   }
-  if (do_zoa && do_sd) result.flagged |= CompareZoaAndSd(tips, result.rows, o, on_message);
+  if (do_zoa && do_sd) CompareZoaAndSd(tips, result.rows, o, on_message, &result);
+  if (result.no_boundary) {
+    const std::string w = "some speeds have no boundary (status column): widen the FRF band or the lobe range";
+    tell(TipMessage::Kind::kWarning, w);
+    result.Flag(w);
+  }
   return result;
 }
 

@@ -262,4 +262,20 @@ int FirstFeedAlongToolAxis(const std::vector<ToolPoseTarget>& targets) {
   return -1;
 }
 
+StabilityMapResult ComputeStabilityMap(std::shared_ptr<const dynamics::RobotModel> model,
+                                       const std::vector<ToolPoseTarget>& targets, int rows, int cols,
+                                       const MillingProcess& process, const MapOptions& options) {
+  StabilityMapResult r;
+  r.points = EvaluateStabilityMap(std::move(model), targets, rows, cols, process, options);
+  for (const MapPoint& p : r.points) {
+    r.reached += p.status != PointStatus::kUnreachable && p.status != PointStatus::kJointLimits;
+    r.flagged_points += p.status != PointStatus::kOk;
+  }
+  if (r.flagged_points > 0) {
+    r.Flag(std::to_string(r.flagged_points) + " of " + std::to_string(r.points.size()) +
+           " points are flagged (status column: unreachable, joint_limits, near_singular, other_configuration)");
+  }
+  return r;
+}
+
 }  // namespace robomach::stability

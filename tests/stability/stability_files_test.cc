@@ -9,7 +9,9 @@
 #include "robomach/io/cut_file.h"
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/region_file.h"
+#include "robomach/io/robot_config.h"
 #include "robomach/io/tip_dynamics_files.h"
+#include "robomach/io/tip_sources.h"
 #include "test_support.h"
 
 namespace robomach::io {
@@ -168,6 +170,61 @@ TEST(ModalTable, StiffnessFormGivesTheSameModes) {
   // std::to_string keeps 6 decimals of k ≈ 1.3e6: ~1e-12 relative.
   EXPECT_NEAR(a[0].modes.p(0, 0), 1.0 / std::sqrt(m), 1e-12);
   EXPECT_NEAR(b[0].modes.p(0, 0), a[0].modes.p(0, 0), 1e-9 * a[0].modes.p(0, 0));
+}
+
+// stability-lobes' sources of tool tips (io/tip_sources.h). The modal
+// table's 1-DOF benchmark lies along x_B, in the cutting plane of a tool
+// along z_B: the tip keeps its frequency and |p|^2 = 1/m of the file.
+TEST(TipSources, ModalTableTipKeepsTheFilesModeAndUnknownPosturesAreNamed) {
+  const std::string cut_path = WriteText(TempDir("tip_sources") + "/cut.yaml", kCut);
+  const CutSpec cut = ReadCutFile(cut_path);
+  const std::string table = SourcePath("tests/data/stability/modal_benchmark.csv");
+  const Eigen::Matrix3d R = CutFrame(cut, Eigen::Vector3d::UnitZ(), "tool_axis 0,0,1");
+  const auto tips = TipsFromModalTableFile(table, {}, R, cut);
+  ASSERT_EQ(tips.size(), 1u);
+  EXPECT_EQ(tips[0].id, "IS2004");
+  ASSERT_EQ(tips[0].modes_C.num_modes(), 1);
+  EXPECT_NEAR(tips[0].modes_C.omega_rad_s(0), HzToRadPerSec(922.0), 1e-9);
+  EXPECT_NEAR(tips[0].modes_C.p.col(0).squaredNorm(), 1.0 / 0.03993, 1e-9 / 0.03993);
+  const std::string none = CaptureError([&] { TipsFromModalTableFile(table, {"P7"}, R, cut); });
+  EXPECT_THAT(none, HasSubstr("modal_benchmark.csv"));
+  EXPECT_THAT(none, HasSubstr("none of the requested postures"));
+  // A tool axis along the feed has no cutting plane: the cut file's
+  // feed_direction is named, with how the axis was given.
+  const std::string along = CaptureError([&] { CutFrame(cut, Eigen::Vector3d::UnitY(), "--tool-axis 0,1,0"); });
+  EXPECT_THAT(along, HasSubstr(cut_path + ":5:"));
+  EXPECT_THAT(along, HasSubstr("feed_direction"));
+  EXPECT_THAT(along, HasSubstr("(--tool-axis 0,1,0)"));
+}
+
+// The robot source: the postures asked for, in the order asked; an unknown
+// one names the file and lists the known ones; a posture at the wrist
+// singularity (q5 = 0) is told as a warning with its line.
+TEST(TipSources, RobotPosturesInTheOrderAskedAndSingularOnesTold) {
+  const std::string dir = TempDir("tip_sources_robot");
+  const std::string cut_path = WriteText(dir + "/cut.yaml", kCut);
+  const CutSpec cut = ReadCutFile(cut_path);
+  const std::string postures = WriteText(dir + "/postures.csv",
+                                         "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\n"
+                                         "A,0,-90,90,0,45,0\n"
+                                         "B,30,-60,100,10,60,0\n"
+                                         "W,0,-90,90,0,0,0\n");
+  const auto model = LoadRobotConfig(SourcePath("config/kr210.yaml")).Build();
+  std::vector<std::string> warnings;
+  auto tell = [&](const stability::TipMessage& m) {
+    if (m.kind == stability::TipMessage::Kind::kWarning) warnings.push_back(m.text);
+  };
+  const auto two = TipsFromRobotPostures(model, postures, {"B", "A"}, cut, tell);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[0].id, "B");
+  EXPECT_EQ(two[1].id, "A");
+  EXPECT_TRUE(warnings.empty());
+  const auto all = TipsFromRobotPostures(model, postures, {}, cut, tell);
+  ASSERT_EQ(all.size(), 3u);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_THAT(warnings[0], HasSubstr(postures + ":4: posture W is near a singularity"));
+  const std::string unknown = CaptureError([&] { TipsFromRobotPostures(model, postures, {"C"}, cut); });
+  EXPECT_THAT(unknown, HasSubstr("no posture \"C\" in the file; it has A, B, W"));
 }
 
 }  // namespace

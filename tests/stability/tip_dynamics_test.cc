@@ -207,7 +207,8 @@ TEST(ComputeLobes, TapTestZoaAndSdAgreeAndTheCsvHoldsTheRows) {
   long progress_ends = 0;
   const LobesResult r = ComputeLobes(tips, o, [&](const TipMessage& m) { said.push_back(m); },
                                      [&](const SdProgress& p) { progress_ends += p.finished; });
-  EXPECT_FALSE(r.flagged);
+  EXPECT_FALSE(r.flagged());
+  EXPECT_TRUE(r.findings.empty());
   EXPECT_EQ(progress_ends, 1);
   int zoa = 0, sd = 0;
   for (const LobeRow& row : r.rows) {

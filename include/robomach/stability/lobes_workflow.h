@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "robomach/common/run_status.h"
 #include "robomach/stability/milling.h"
 #include "robomach/stability/semi_discretization.h"
 #include "robomach/stability/tip_dynamics.h"
@@ -49,15 +50,17 @@ struct SdProgress {
 };
 using SdProgressSink = std::function<void(const SdProgress&)>;
 
-struct LobesResult {
+/// Flagged (RunFindings; stability-lobes' exit 3), one finding each, for a
+/// modal fit that does not describe a tool tip (TipFitWarnings: an
+/// implausible unit, not a driving point, a mode at the edge of the usable
+/// band, a poor fit, no mode for the SD), the ZOA and the SD more than 10 %
+/// apart where they should agree, and speeds without a boundary. Each
+/// finding is also told to the message sink as a warning when it is found.
+struct LobesResult : RunFindings {
   std::vector<LobeRow> rows;  // per tip: the ZOA's rows, then the SD's
   /// Some speeds have no boundary (a ZOA point that is not ok, an SD point
   /// unstable at depth zero).
   bool no_boundary{false};
-  /// A modal fit that does not describe a tool tip (not a driving point,
-  /// a mode at the edge of the usable band, a poor fit, no mode for the
-  /// SD), or the ZOA and the SD more than 10 % apart where they should agree.
-  bool flagged{false};
 };
 
 /// The warnings about one tip's measured FRFs (empty for a model tip): its

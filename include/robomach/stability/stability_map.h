@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "robomach/common/progress.h"
+#include "robomach/common/run_status.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/stability/posture_stability.h"
@@ -76,5 +77,20 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
                                            const std::vector<ToolPoseTarget>& targets, int rows,
                                            int cols, const MillingProcess& process,
                                            const MapOptions& options);
+
+/// stability-map's run: the points of EvaluateStabilityMap and its verdict,
+/// flagged (exit 3) with one finding when any point is not kOk.
+struct StabilityMapResult : RunFindings {
+  std::vector<MapPoint> points;
+  /// Points the IK reached within the joint limits (ok, near singular,
+  /// other configuration); none is an error of the caller's region or path.
+  long reached{0};
+  long flagged_points{0};  // points whose status is not kOk
+};
+
+/// EvaluateStabilityMap with its verdict (the same arguments and errors).
+StabilityMapResult ComputeStabilityMap(std::shared_ptr<const dynamics::RobotModel> model,
+                                       const std::vector<ToolPoseTarget>& targets, int rows, int cols,
+                                       const MillingProcess& process, const MapOptions& options);
 
 }  // namespace robomach::stability
