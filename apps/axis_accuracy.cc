@@ -62,7 +62,6 @@ int Run(int argc, char** argv) {
     j["axes"] = nlohmann::json::object();
     const auto& results = eval.results;
     const int min_runs = eval.min_runs;
-    const std::vector<std::string>& units = eval.unit_findings;  // unit plausibility findings: exit 3
     for (const auto& [axis, r] : results) {
       nlohmann::json a = {{"A", r.A},       {"A_up", r.A_up}, {"A_down", r.A_down}, {"E", r.E},
                           {"E_up", r.E_up}, {"E_down", r.E_down}, {"M", r.M},       {"R", r.R},
@@ -126,8 +125,8 @@ int Run(int argc, char** argv) {
     const std::string text = report::DumpJson(j);
     io::WriteFileAtomically(out_path.empty() ? "-" : out_path, text);
     if (min_runs < 5) Warn(kTool, "fewer than the 5 runs per target and direction ISO 230-2 asks for (" + std::to_string(min_runs) + ")");
-    for (const std::string& f : units) Warn(kTool, "implausible (unit mistake?): " + f);
-    return units.empty() ? kExitOk : kExitFlagged;
+    for (const Finding& f : eval.findings) Warn(kTool, f.message);
+    return ExitCodeFor(eval.status());
   });
 }
 

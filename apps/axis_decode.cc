@@ -69,7 +69,6 @@ int Run(int argc, char** argv) {
                                 [&](long done, long) { progress.Update(done); });
     });
     progress.Finish();
-    long long events = 0;
     nlohmann::json j;
     j["samples"] = d.samples;
     j["sample_rate_hz"] = rate_hz;
@@ -80,19 +79,10 @@ int Run(int argc, char** argv) {
     for (size_t a = 0; a < axes.size(); ++a) {
       j["error_events"][axes[a].name] = d.error_events[a];
       j["final_counts"][axes[a].name] = d.final_counts[a];
-      events += d.error_events[a];
     }
     if (!summary_path.empty()) io::WriteFileAtomically(summary_path, report::DumpJson(j));
-    if (events > 0) {
-      std::string per;
-      for (size_t a = 0; a < axes.size(); ++a) {
-        if (d.error_events[a] > 0) per += " " + axes[a].name + ": " + std::to_string(d.error_events[a]);
-      }
-      Warn(kTool, std::to_string(events) + " error events (A and B changed in one sample; each leaves the position "
-                  "uncertain by 2 counts):" + per + ". Raise the sample rate or use --glitch-filter.");
-      return kExitFlagged;
-    }
-    return kExitOk;
+    for (const Finding& f : d.findings) Warn(kTool, f.message);
+    return ExitCodeFor(d.status());
   });
 }
 

@@ -156,26 +156,8 @@ int RunDrillForceFit(int argc, char** argv) {
               << io::FormatDouble(std::round(fit.material.kienzle_exponent * 1e4) / 1e4)
               << "; largest error thrust " << io::FormatDouble(std::round(fit.max_rel_error_thrust * 1e3) / 10)
               << " %, torque " << io::FormatDouble(std::round(fit.max_rel_error_torque * 1e3) / 10) << " %\n";
-    int rc = kExitOk;
-    if (fit.status != drilling::FitStatus::kConverged) {
-      Warn(kTool, "the fit did not converge: " + fit.solver_message);
-      rc = kExitFlagged;
-    }
-    if (fit.kienzle_exponent_at_bound) {
-      Warn(kTool, "the Kienzle exponent ended on its bound (" + io::FormatDouble(fit.material.kienzle_exponent) +
-                      ", range 0..0.95): the forces do not grow with the feed as a size effect can; check the "
-                      "units of feed_mm_per_rev, thrust_N and torque_Nm");
-      rc = kExitFlagged;
-    }
-    if (fit.max_rel_error_thrust > 0.10 || fit.max_rel_error_torque > 0.10) {
-      Warn(kTool, "the model misses a row by more than 10 %; check the table and the drill geometry");
-      rc = kExitFlagged;
-    }
-    // Unit plausibility (drilling/plausibility.h): outputs stay written, exit 3.
-    const std::vector<std::string>& units = run.unit_findings;
-    for (const std::string& f : units) Warn(kTool, "implausible (unit mistake?): " + f);
-    if (!units.empty()) rc = kExitFlagged;
-    return rc;
+    for (const Finding& f : run.findings) Warn(kTool, f.message);
+    return ExitCodeFor(run.status());
   });
 }
 

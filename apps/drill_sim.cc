@@ -240,7 +240,6 @@ int RunDrillSim(int argc, char** argv) {
     });
 
     // All runs done: write every output (each atomically).
-    int rc = kExitOk;
     for (const Run& run : runs) {
       const std::string kind = run.parameters.kind;
       const nlohmann::json j = Summary(run, *sc, limit);
@@ -261,15 +260,11 @@ int RunDrillSim(int argc, char** argv) {
            << " deg, last 10 % max |e| " << io::FormatDouble(RadToDeg(r.max_abs_error_last_10pc.maxCoeff()))
            << " deg";
       std::cerr << kTool << ": " << line.str() << "\n";
-      if (r.diverged) {
-        Warn(kTool, run.parameters.kind + ": the run left the 10 deg error range and was stopped");
-        rc = kExitFlagged;
-      }
     }
-    // Unit plausibility (drilling/plausibility.h): outputs stay written, exit 3.
-    for (const std::string& f : setup.unit_findings) Warn(kTool, "implausible (unit mistake?): " + f);
-    if (!setup.unit_findings.empty()) rc = kExitFlagged;
-    return rc;
+    // Diverged runs and unit plausibility (drilling/plausibility.h): outputs stay written, exit 3.
+    const RunFindings verdict = drilling::JudgeControllerRuns(runs, setup.unit_findings);
+    for (const Finding& f : verdict.findings) Warn(kTool, f.message);
+    return ExitCodeFor(verdict.status());
   });
 }
 

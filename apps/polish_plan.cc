@@ -239,7 +239,8 @@ int Run(int argc, char** argv) {
     if (progress) progress->Finish();
     params = outcome.params;
     const polishing::EvaluatedPlan& e = outcome.plan;
-    bool flagged = false;
+    for (const Finding& f : outcome.findings) Warn(kTool, f.message);
+    bool flagged = outcome.flagged();
     nlohmann::json opt_json;
     if (outcome.optimisation) {
       const polishing::PlanOptimiseResult& opt = *outcome.optimisation;
@@ -286,11 +287,7 @@ int Run(int argc, char** argv) {
         opt_json["families"] = fams;
         if (opt.best_parallel.valid) opt_json["parallel"] = family_json(opt.best_parallel);
       }
-      if (!outcome.infeasible_message.empty()) {
-        flagged = true;
-        opt_json["message"] = outcome.infeasible_message;
-        Warn(kTool, outcome.infeasible_message);
-      }
+      if (!outcome.infeasible_message.empty()) opt_json["message"] = outcome.infeasible_message;
       if (opt.status == "max_time") {
         Note(kTool, "the optimiser stopped at --max-time-s " + io::FormatDouble(max_time_s) +
                         " before its local searches converged; the best plan so far is written");
@@ -299,18 +296,13 @@ int Run(int argc, char** argv) {
     nlohmann::json target_json;
     if (outcome.target_given) {
       target_json = {{"removal_um", target_um}, {"reached", outcome.target.reached}};
-      if (!outcome.target.reached) {
-        flagged = true;
-        target_json["message"] = outcome.target.message;
-        Warn(kTool, outcome.target.message);
-      }
+      if (!outcome.target.reached) target_json["message"] = outcome.target.message;
     }
     const bool cyc = params.pattern == polishing::Pattern::kCycloid;
     nlohmann::json summary;
     if (outcome.comparison) {
       const polishing::PlanOutcome::Comparison& cmp = *outcome.comparison;
       const polishing::PathParameters& pp = cmp.parallel;
-      const bool cycloid_ok = !outcome.target_given || outcome.target.reached;
       summary["comparison"] = {{"cycloid_cv", e.stats.cv},
                                {"parallel_cv", cmp.parallel_stats.cv},
                                {"parallel_offset_mm", 1e3 * pp.offset},
@@ -318,11 +310,7 @@ int Run(int argc, char** argv) {
                                {"parallel_reaches_target", cmp.parallel_reaches_target},
                                {"better", cmp.zigzag_better ? "parallel" : "cycloid"}};
       if (cmp.zigzag_better) {
-        flagged = true;
-        Warn(kTool, "the optimised zig-zag is better than the optimised cycloid: cv " +
-                        io::FormatDouble(cmp.parallel_stats.cv) + (cmp.parallel_reaches_target ? "" : " (target not reached)") +
-                        " against " + io::FormatDouble(e.stats.cv) + (cycloid_ok ? "" : " (target not reached)") +
-                        "; plan it with --pattern parallel --offset-mm " + io::FormatDouble(1e3 * pp.offset) +
+        Note(kTool, "to plan the zig-zag: --pattern parallel --offset-mm " + io::FormatDouble(1e3 * pp.offset) +
                         " --line-angle-deg " + io::FormatDouble(pp.line_angle * 180.0 / kPi) + " --edge-overrun-mm " +
                         io::FormatDouble(1e3 * pp.edge_overrun));
       }
@@ -353,10 +341,6 @@ int Run(int argc, char** argv) {
       const int off = outcome.rows_off_face;
       summary["region"]["face"] = surface.trim()->source;
       summary["region"]["rows_off_face"] = off;
-      if (off > 0) {
-        flagged = true;
-        Warn(kTool, std::to_string(off) + " path rows lie off the trimmed face (in a hole or outside its boundary)");
-      }
     }
     summary["contact"] = {{"width_across_mm", 1e3 * contact_width}};
     if (!target_json.is_null()) summary["target"] = target_json;

@@ -76,12 +76,8 @@ int Run(int argc, char** argv) {
     const polishing::SampleGrid& grid = *sim.grid;
     const std::vector<double>& removal = sim.removal;
     const polishing::RemovalStats& stats = sim.stats;
-    bool flagged = false;
-    if (sim.speed_limit_exceeded) {
-      flagged = true;
-      Warn(kTool, "the path's traverse speed reaches " + io::FormatDouble(1e3 * sim.max_speed) +
-                      " mm/s, above max_speed_mm_per_s " + io::FormatDouble(1e3 * process.max_speed));
-    }
+    for (const Finding& f : sim.findings) Warn(kTool, f.message);
+    bool flagged = sim.flagged();
     nlohmann::json summary;
     summary["removal_um"] = RemovalJson(stats);
     summary["path"] = PathJson(file.rows);
@@ -98,7 +94,7 @@ int Run(int argc, char** argv) {
                              {"centre_speed_mm_per_s", 0.0}};
     summary["region"] = {{"sample_mm", sample_mm}, {"points", grid.num_in_region()}, {"margin_mm", 1e3 * process.margin}};
     ReportUnpolished(kTool, stats, grid, &summary["region"]);
-    summary["speed_limit_exceeded"] = flagged;
+    summary["speed_limit_exceeded"] = sim.speed_limit_exceeded;
     if (robot.Check(kTool, process, file.rows, &summary)) flagged = true;
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, removal);
     robot.WriteJoints(file.rows);

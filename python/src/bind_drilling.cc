@@ -126,12 +126,15 @@ void BindDrilling(py::module_& m) {
     d["kienzle_exponent_at_bound"] = f.kienzle_exponent_at_bound;
     d["material_yaml"] = run.material_yaml;
     d["unit_findings"] = run.unit_findings;
+    d["flagged"] = run.flagged();
+    d["findings"] = FindingMessages(run);
     return d;
   }, py::arg("table"), py::arg("drill"), py::arg("chisel") = "seed_scaling",
      "drill-force-fit's call: K_TH, K_TQ [Pa] and the Kienzle exponent fitted to a measured force table "
      "(docs/formats.md §9.1) for a drill (§9.2). Returns a dict: the coefficients and their 1-sigma standard "
      "deviations, the model per row, the largest relative errors, status (the library's solver status), "
-     "material_yaml (drill-force-fit's --out, byte for byte; empty when the fit failed), unit_findings.");
+     "material_yaml (drill-force-fit's --out, byte for byte; empty when the fit failed), unit_findings, "
+     "flagged (drill-force-fit's exit 3) and findings (why, its warnings).");
 
   m.def("write_drill_series_csv", [](const std::string& path, const ControllerRun& run) {
     io::WriteFileAtomically(path, io::DrillSeriesCsv(run.result));

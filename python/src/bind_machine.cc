@@ -136,12 +136,15 @@ void BindMachine(py::module_& m) {
     res["samples"] = d.samples;
     res["error_events"] = d.error_events;
     res["final_counts"] = d.final_counts;
+    res["status"] = RunStatusName(d.status());
+    res["findings"] = FindingMessages(d);
     return res;
   }, py::arg("machine"), py::arg("capture"), py::arg("sample_rate_hz"), py::arg("every") = 1, py::arg("glitch_filter") = 0,
      py::arg("out") = py::none(),
      "axis-decode's call: a raw quadrature capture (docs/formats.md §8.2) decoded to counts at samples 0, every, "
      "2 every, ... Returns a dict: t_s, counts (rows × axes, int64), samples, error_events and final_counts per "
-     "axis; out: also write axis-decode's --out file. The GIL is released while it runs.");
+     "axis, status ('flagged' with error events: axis-decode's exit 3) and findings; out: also write "
+     "axis-decode's --out file. The GIL is released while it runs.");
 
   m.def("iso230_evaluate", [](const std::string& runs_path) {
     RequireReadableFile(runs_path);
@@ -184,11 +187,14 @@ void BindMachine(py::module_& m) {
     d["axes"] = axes;
     d["unit_findings"] = eval.unit_findings;
     d["min_runs"] = eval.min_runs;
+    d["status"] = RunStatusName(eval.status());
+    d["findings"] = FindingMessages(eval);
     return d;
   }, py::arg("runs"),
      "axis-accuracy's evaluation: ISO 230-2 accuracy A, systematic error E, mean error M, repeatability R, "
      "reversal B per axis of a runs file (docs/formats.md §8.6), in the file's unit (mm or deg), with the "
-     "per-target statistics and the unit plausibility findings.");
+     "per-target statistics, the unit plausibility findings, status ('flagged': axis-accuracy's exit 3) and "
+     "findings.");
 }
 
 }  // namespace robomach::python

@@ -130,8 +130,12 @@ void BindPolishing(py::module_& m) {
       .def_property_readonly("target_message", [](const PyPlan& p) { return p.outcome.target.message; })
       .def_property_readonly("infeasible_message", [](const PyPlan& p) { return p.outcome.infeasible_message; })
       .def_property_readonly("rows_off_face", [](const PyPlan& p) { return p.outcome.rows_off_face; })
-      .def_property_readonly("flagged", [](const PyPlan& p) { return p.outcome.flagged; },
+      .def_property_readonly("flagged", [](const PyPlan& p) { return p.outcome.flagged(); },
                              "polish-plan exits 3: a target out of reach, no feasible plan, a better zig-zag, rows off the face")
+      .def_property_readonly("status", [](const PyPlan& p) { return RunStatusName(p.outcome.status()); },
+                             "'ok' or 'flagged'")
+      .def_property_readonly("findings", [](const PyPlan& p) { return FindingMessages(p.outcome); },
+                             "why it is flagged, one sentence each (polish-plan's warnings)")
       .def_property_readonly("optimisation", [](const PyPlan& p) -> py::object {
         if (!p.outcome.optimisation) return py::none();
         const auto& o = *p.outcome.optimisation;
@@ -228,6 +232,10 @@ void BindPolishing(py::module_& m) {
       .def_readonly("max_speed_m_per_s", &io::PolishSimulation::max_speed)
       .def_readonly("speed_limit_exceeded", &io::PolishSimulation::speed_limit_exceeded,
                     "polish-sim exits 3: a segment faster than the process's max_speed beyond the file's rounding")
+      .def_property_readonly("status", [](const io::PolishSimulation& r) { return RunStatusName(r.status()); },
+                             "'ok' or 'flagged'")
+      .def_property_readonly("findings", [](const io::PolishSimulation& r) { return FindingMessages(r); },
+                             "why it is flagged (polish-sim's warnings)")
       .def_property_readonly("rows", [](const io::PolishSimulation& r) { return r.file.rows.size(); })
       .def("__repr__", [](const io::PolishSimulation& r) {
         return "<PolishSimulation " + std::to_string(r.file.rows.size()) + " rows>";

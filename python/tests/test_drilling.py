@@ -42,6 +42,7 @@ def test_force_fit_equals_the_tool(tmp):
     f = rm.fit_drill_forces(table, DRILL)
     assert f['material_yaml'] == (tmp / 'tool.yaml').read_text()
     assert f['status'] == 'converged' and f['unit_findings'] == []
+    assert f['flagged'] is False and f['findings'] == []  # drill-force-fit exited 0
     # The table's own rows back: the model is within the largest relative error it reports.
     import csv
     with open(table) as fh:

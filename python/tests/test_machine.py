@@ -50,17 +50,31 @@ def test_decode_equals_axis_decode(tmp):
     d = rm.decode_capture(str(tmp / 'machine.yaml'), str(tmp / 'capture.bin'), 800000, every=100, glitch_filter=2,
                           out=str(tmp / 'py.csv'))
     assert (tmp / 'py.csv').read_text() == (tmp / 'tool.csv').read_text()
-    assert sum(d['error_events']) == 0
+    assert sum(d['error_events']) == 0 and d['status'] == 'ok' and d['findings'] == []
+    # A and B of the first axis flipped together in one sample (formats.md
+    # §8.2: bits 0 and 1): an error event into that sample and one out of it
+    # (without the glitch filter, which would take the one-sample pulse out;
+    # axis-synth's glitches are on one channel at a time: no event).
+    words = bytearray((tmp / 'capture.bin').read_bytes())
+    words[2 * 1000] ^= 0b11
+    (tmp / 'events.bin').write_bytes(bytes(words))
+    r = run_tool('axis-decode', '--machine', tmp / 'machine.yaml', '--capture', tmp / 'events.bin',
+                 '--sample-rate-hz', 800000, '--every', 100, '--out', tmp / 'events.csv', expect_rc=3)
+    bad = rm.decode_capture(str(tmp / 'machine.yaml'), str(tmp / 'events.bin'), 800000, every=100)
+    assert bad['error_events'][0] == 2 and sum(bad['error_events']) == 2 and bad['status'] == 'flagged'
+    assert len(bad['findings']) == 1 and bad['findings'][0] in r.stderr
     rows = [line.split(',') for line in (tmp / 'synth.csv').read_text().splitlines() if not line.startswith('#')][1:]
     np.testing.assert_array_equal(d['counts'], np.array([[int(x) for x in r[1:]] for r in rows], dtype=np.int64))
 
 
 def test_iso230_equals_axis_accuracy(tmp):
     runs = os.path.join(DATA, 'machine', 'x_runs_hand.csv')
-    run_tool('axis-accuracy', '--runs', runs, '--out', tmp / 'tool.json', expect_rc=None)
+    rc = run_tool('axis-accuracy', '--runs', runs, '--out', tmp / 'tool.json', expect_rc=None).returncode
     tool = json.loads((tmp / 'tool.json').read_text())
     r = rm.iso230_evaluate(runs)
     assert r['unit'] == tool['unit']
+    assert r['status'] == ('flagged' if rc == 3 else 'ok')
+    assert len(r['findings']) == len(r['unit_findings'])
     for axis, t in tool['axes'].items():
         for k in ('A', 'A_up', 'A_down', 'E', 'M', 'R', 'R_up', 'R_down', 'B', 'B_mean'):
             assert r['axes'][axis][k] == pytest.approx(t[k], rel=1e-12, abs=1e-15)

@@ -31,6 +31,9 @@ def test_plan_equals_polish_plan(tmp, surface, options, tool_args):
     assert plan.stats['cv'] == pytest.approx(s['removal_um']['cv'], rel=1e-12)
     assert plan.stats['mean_um'] == pytest.approx(s['removal_um']['mean'], rel=1e-12)
     assert plan.flagged == (r.returncode == 3)
+    assert plan.status == ('flagged' if plan.flagged else 'ok') and bool(plan.findings) == plan.flagged
+    for f in plan.findings:  # the tool's warnings are the findings
+        assert f in r.stderr
     # With a target: reached, the mean is the target; out of reach within the
     # speed limit, the path runs at the limit and removes more (flagged).
     if 'target_removal_um' in options:

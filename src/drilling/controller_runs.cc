@@ -47,4 +47,13 @@ std::vector<ControllerRun> RunControllers(DrillingScenario& scenario, const Cont
   return runs;
 }
 
+RunFindings JudgeControllerRuns(const std::vector<ControllerRun>& runs, const std::vector<std::string>& unit_findings) {
+  RunFindings v;
+  for (const ControllerRun& run : runs) {
+    if (run.result.diverged) v.Flag(run.parameters.kind + ": the run left the 10 deg error range and was stopped");
+  }
+  for (const std::string& f : unit_findings) v.Flag("implausible (unit mistake?): " + f);
+  return v;
+}
+
 }  // namespace robomach::drilling

@@ -56,6 +56,16 @@ CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const Machine
   out.samples = decoder.samples();
   out.error_events.assign(decoder.error_events().begin(), decoder.error_events().end());
   out.final_counts.assign(decoder.counts().begin(), decoder.counts().end());
+  std::int64_t events = 0;
+  std::string per;
+  for (size_t a = 0; a < out.error_events.size(); ++a) {
+    events += out.error_events[a];
+    if (out.error_events[a] > 0) per += " " + mf.machine.axes[a].name + ": " + std::to_string(out.error_events[a]);
+  }
+  if (events > 0) {
+    out.Flag(std::to_string(events) + " error events (A and B changed in one sample; each leaves the position "
+             "uncertain by 2 counts):" + per + ". Raise the sample rate or use --glitch-filter.");
+  }
   return out;
 }
 

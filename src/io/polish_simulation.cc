@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
 #include "robomach/polishing/paths.h"
 
 namespace robomach::io {
@@ -42,6 +43,10 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
     v_sure = std::max(v_sure, std::max(0.0, len - kRounding) / (s.file.rows[i].t - s.file.rows[i - 1].t));
   }
   s.speed_limit_exceeded = v_sure > process.max_speed * (1 + 1e-6);
+  if (s.speed_limit_exceeded) {
+    s.Flag("the path's traverse speed reaches " + FormatDouble(1e3 * s.max_speed) + " mm/s, above max_speed_mm_per_s " +
+           FormatDouble(1e3 * process.max_speed));
+  }
   s.stats = polishing::ComputeRemovalStats(s.removal, s.grid->areas(), s.grid->in_region());
   return s;
 }

@@ -209,7 +209,6 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
       out.history_best.push_back(best_so_far);
     }
     if (!opt.best.feasible) {
-      out.flagged = true;
       out.infeasible_message =
           req.target_removal > 0
               ? "no plan the optimiser saw reaches the target removal " + FormatNumber(1e6 * req.target_removal, 12) +
@@ -217,6 +216,7 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
                     "limit (written: the least infeasible, " + FormatDouble(1e6 * opt.best.mean) +
                     " um at the limit, coverage " + FormatDouble(opt.best.coverage) + ")"
               : "the optimiser found no feasible plan";
+      out.Flag(out.infeasible_message);
     }
     out.optimisation = std::move(opt);
   }
@@ -228,7 +228,7 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
     out.target = ScaleToTargetRemoval(*c.simulator, grid, req.target_removal, c.process.max_speed, &out.plan.path);
     out.plan.removal = out.target.removal;
     out.plan.stats = ComputeRemovalStats(out.plan.removal, grid.areas(), grid.in_region());
-    if (!out.target.reached) out.flagged = true;
+    if (!out.target.reached) out.Flag(out.target.message);
   }
   if (PathPatternCircles(params) && out.optimisation && out.optimisation->best_parallel.valid) {
     // The cycloid against the optimised zig-zag, both on the final grid
@@ -246,12 +246,23 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
     const bool cycloid_ok = !out.target_given || out.target.reached;
     cmp.zigzag_better = (cmp.parallel_reaches_target && !cycloid_ok) ||
                         (cmp.parallel_reaches_target == cycloid_ok && cmp.parallel_stats.cv < out.plan.stats.cv);
-    if (cmp.zigzag_better) out.flagged = true;
+    if (cmp.zigzag_better) {
+      const polishing::PathParameters& pp = cmp.parallel;
+      out.Flag("the optimised zig-zag is better than the optimised cycloid: cv " + FormatDouble(cmp.parallel_stats.cv) +
+               (cmp.parallel_reaches_target ? "" : " (target not reached)") + " against " +
+               FormatDouble(out.plan.stats.cv) + (cycloid_ok ? "" : " (target not reached)") +
+               "; plan it as pattern parallel, offset " + FormatDouble(1e3 * pp.offset) + " mm, line angle " +
+               FormatDouble(pp.line_angle * 180.0 / kPi) + " deg, edge overrun " + FormatDouble(1e3 * pp.edge_overrun) +
+               " mm");
+    }
     out.comparison = cmp;
   }
   if (surface.trim()) {
     out.rows_off_face = RowsOffFace(surface, out.plan.path.rows);
-    if (out.rows_off_face > 0) out.flagged = true;
+    if (out.rows_off_face > 0) {
+      out.Flag(std::to_string(out.rows_off_face) +
+               " path rows lie off the trimmed face (in a hole or outside its boundary)");
+    }
   }
   return out;
 }

@@ -37,7 +37,8 @@ TEST(PlanPolishing, ZigZagOnAPlateReachesItsTargetMean) {
   const PlanOutcome out = PlanPolishing(ctx, req);
   ASSERT_TRUE(out.target_given);
   EXPECT_TRUE(out.target.reached) << out.target.message;
-  EXPECT_FALSE(out.flagged);
+  EXPECT_FALSE(out.flagged());
+  EXPECT_EQ(out.status(), RunStatus::kOk);
   EXPECT_FALSE(out.optimisation.has_value());
   EXPECT_FALSE(out.comparison.has_value());
   double area = 0.0, removed = 0.0;
@@ -56,6 +57,32 @@ TEST(PlanPolishing, ZigZagOnAPlateReachesItsTargetMean) {
   }
   // Timed for the target: slower than the speed limit, so more removal at the limit is less.
   EXPECT_GT(out.plan.path.rows.back().t, at_limit.path.rows.back().t);
+}
+
+// A target below what one pass removes at the speed limit is out of reach
+// (going faster is not allowed): the plan is flagged, with the target's own
+// message as its one finding. A target just above it only slows the path
+// down and is reached.
+TEST(PlanPolishing, TargetOutOfReachIsAFindingNotAnError) {
+  const NurbsSurface plate = testing::Plane(0.100, 0.060);
+  const PlanningContext ctx = PreparePlanning(plate, Belt(), 1e-3, "plate.yaml", "belt.yaml");
+  PlanRequest req;
+  req.params.pattern = Pattern::kParallel;
+  req.params.offset = ctx.contact_width;
+  req.params.row_step = 1e-3;
+  const double at_limit = EvaluatePlanOnGrid(ctx, req.params).stats.mean;
+  ASSERT_GT(at_limit, 0.0);
+  req.target_removal = 0.5 * at_limit;
+  const PlanOutcome low = PlanPolishing(ctx, req);
+  EXPECT_FALSE(low.target.reached);
+  EXPECT_EQ(low.status(), RunStatus::kFlagged);
+  ASSERT_EQ(low.findings.size(), 1u);
+  EXPECT_EQ(low.findings[0].message, low.target.message);
+  EXPECT_FALSE(low.target.message.empty());
+  req.target_removal = 1.01 * at_limit;
+  const PlanOutcome ok = PlanPolishing(ctx, req);
+  EXPECT_TRUE(ok.target.reached) << ok.target.message;
+  EXPECT_EQ(ok.status(), RunStatus::kOk);
 }
 
 // A margin that leaves no region names the process file; a cycloid wider

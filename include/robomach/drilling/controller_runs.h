@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "robomach/common/run_status.h"
 #include "robomach/drilling/drilling_sim.h"
 
 namespace robomach::drilling {
@@ -59,5 +60,10 @@ struct ControllerRunProgress {
 ///   the wrong size.
 std::vector<ControllerRun> RunControllers(DrillingScenario& scenario, const ControllerRunOptions& options,
                                           const std::function<void(const ControllerRunProgress&)>& progress = {});
+
+/// drill-sim's verdict (its exit 3): one finding per run that diverged, then
+/// one per implausible unit of the set-up (`unit_findings`, as
+/// io::LoadDrillingSetup gives them).
+RunFindings JudgeControllerRuns(const std::vector<ControllerRun>& runs, const std::vector<std::string>& unit_findings);
 
 }  // namespace robomach::drilling

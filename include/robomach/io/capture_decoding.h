@@ -9,11 +9,14 @@
 #include <vector>
 
 #include "robomach/common/progress.h"
+#include "robomach/common/run_status.h"
 #include "robomach/io/machine_file.h"
 
 namespace robomach::io {
 
-struct CaptureDecoding {
+/// Flagged (RunFindings; axis-decode's exit 3) when any axis has error
+/// events: each leaves its position uncertain by 2 counts.
+struct CaptureDecoding : RunFindings {
   std::int64_t samples{0};
   std::vector<std::int64_t> error_events;  // per axis: both channels changed in one sample
   std::vector<std::int64_t> final_counts;  // per axis

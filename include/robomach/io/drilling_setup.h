@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "robomach/common/run_status.h"
 #include "robomach/drilling/drilling_sim.h"
 #include "robomach/drilling/flexible_joint_robot.h"
 #include "robomach/drilling/force_fit.h"
@@ -39,7 +40,10 @@ DrillingSetup LoadDrillingSetup(const std::string& robot_path, const std::string
 
 /// drill-force-fit's run on its two files: the measured force table and
 /// the drill, the fit, the material file's text, and the unit findings.
-struct ForceFitRun {
+/// Flagged (RunFindings; the tool's exit 3), one finding each, when the fit
+/// did not converge, the Kienzle exponent ended on its bound, the model
+/// misses a row by more than 10 %, or a unit is implausible.
+struct ForceFitRun : RunFindings {
   ForceTableFile table;
   DrillFile drill;
   drilling::ForceFitResult fit;

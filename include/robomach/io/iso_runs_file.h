@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "robomach/common/run_status.h"
 #include "robomach/machine/iso230.h"
 
 namespace robomach::io {
@@ -22,8 +23,9 @@ IsoRuns ReadIsoRuns(const std::string& path);
 
 /// axis-accuracy's evaluation of a runs file: ISO 230-2 per axis, in file
 /// order, with the unit plausibility findings and the fewest runs any target
-/// has in a direction (ISO 230-2 asks for 5).
-struct IsoEvaluation {
+/// has in a direction (ISO 230-2 asks for 5). Flagged (RunFindings;
+/// axis-accuracy's exit 3) with one finding per implausible unit.
+struct IsoEvaluation : RunFindings {
   IsoRuns runs;
   std::vector<std::pair<std::string, machine::Iso230Result>> results;
   std::vector<std::string> unit_findings;

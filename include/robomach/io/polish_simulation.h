@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "robomach/common/run_status.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/nurbs_surface.h"
 #include "robomach/polishing/process.h"
@@ -15,7 +16,9 @@
 
 namespace robomach::io {
 
-struct PolishSimulation {
+/// Flagged (RunFindings; polish-sim's exit 3) when the path is faster than
+/// the process allows.
+struct PolishSimulation : RunFindings {
   PolishPathFile file;      // the rows attached to the surface (u, v filled)
   std::shared_ptr<const polishing::SampleGrid> grid;
   std::vector<double> removal;  // at every grid point [m]

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "robomach/common/run_status.h"
 #include "robomach/polishing/nurbs_surface.h"
 #include "robomach/polishing/optimise.h"
 #include "robomach/polishing/paths.h"
@@ -111,7 +112,10 @@ struct EvaluatedPlan {
   RemovalStats stats;
 };
 
-struct PlanOutcome {
+/// Flagged (RunFindings; exit 3 in the tool) with one finding for each
+/// thing the user should act on: no feasible plan, a target out of reach, a
+/// better zig-zag, rows off the face.
+struct PlanOutcome : RunFindings {
   PathParameters params;  // what was planned (the optimum with optimise)
   EvaluatedPlan plan;
   /// With optimise: the optimiser's result, the bounds it searched, and
@@ -138,9 +142,6 @@ struct PlanOutcome {
   /// Rows in contact off a trimmed face (a planner bug, or the developed
   /// plane's distortion on a strongly doubly curved face); 0 on a patch.
   int rows_off_face{0};
-  /// Something the user should act on: a target out of reach, no feasible
-  /// plan, a better zig-zag, rows off the face (exit 3 in the tool).
-  bool flagged{false};
 };
 
 /// Plans `request.params` (or the optimum) on the context's region.
