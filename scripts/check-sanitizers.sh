@@ -4,7 +4,7 @@
 # sanitizer report, in a test or in a tool a test runs, fails the script.
 #
 # Usage: scripts/check-sanitizers.sh [ctest arguments]
-#   scripts/check-sanitizers.sh                    # the whole suite (40+ min on 2 cores)
+#   scripts/check-sanitizers.sh                    # the whole suite (about 2 h on 2 cores)
 #   scripts/check-sanitizers.sh -L readers         # the readers' tests only
 #   scripts/check-sanitizers.sh -R 'FrfCsv|Uff58'  # a subset by name
 # Environment:
