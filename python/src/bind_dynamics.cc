@@ -350,7 +350,7 @@ void BindDynamics(py::module_& m) {
     for (dynamics::PosturePredictionResult& p : r.postures) {
       py::dict d;
       d["id"] = p.id;
-      d["H"] = ToArray(p.H);
+      d["H_m_per_N"] = ToArray(p.H);
       d["joints_outside_limits"] = p.joints_outside_limits;
       d["dynamics"] = std::move(p.dynamics);
       results.append(d);
@@ -361,7 +361,7 @@ void BindDynamics(py::module_& m) {
   }, py::arg("model"), py::arg("postures"), py::arg("freq_hz"), py::arg("method") = "modal",
      "frf-predict's workflow: the model evaluated at each Posture and its tool-tip receptance at freq_hz [Hz]. "
      "Returns {'status': 'ok' or 'flagged', 'findings': [str] (a joint outside its limits, a posture near a "
-     "singularity; 'line N: ' in front for postures read from a file), 'postures': [{'id', 'H' (complex (lines, 3, "
+     "singularity; 'line N: ' in front for postures read from a file), 'postures': [{'id', 'H_m_per_N' (complex (lines, 3, "
      "3) [m/N] in B), 'joints_outside_limits' (0-based), 'dynamics' (PostureDynamics)}]}. frf-predict exits 3 when "
      "the status is 'flagged'. Releases the GIL.");
 

@@ -96,7 +96,7 @@ def test_predict_frfs_is_frf_predicts_workflow(tmp):
     postures = rm.read_posture_file(str(tmp / 'p.csv'), model.num_joints)
     freq_hz = 0.625 * np.arange(1, 161)
     p = rm.predict_frfs(model, postures, freq_hz)
-    rm.write_predicted_frf_csv(str(tmp / 'py.csv'), [(x['id'], freq_hz, x['H']) for x in p['postures']])
+    rm.write_predicted_frf_csv(str(tmp / 'py.csv'), [(x['id'], freq_hz, x['H_m_per_N']) for x in p['postures']])
     assert (tmp / 'py.csv').read_text() == (tmp / 'tool.csv').read_text()
     assert p['status'] == 'flagged'
     assert [x['id'] for x in p['postures']] == ['A', 'OUT', 'W']
