@@ -12,6 +12,10 @@
 #   ROBOMACH_SAN_TARGETS    space-separated targets to build (default: all)
 #   ROBOMACH_SAN_JOBS       parallel build and test jobs (default: 2)
 #   ROBOMACH_SAN_NICE       nice level of the build and the tests (default: 5)
+#   ROBOMACH_SAN_TIMEOUT    per-test timeout [s] (default: 7200; CTest's own
+#                           1500 s is too short here: the sanitized build runs
+#                           10-15 times slower, and OptimisePlanLong.Saddle,
+#                           160-260 s in a normal build, needs about 40 min)
 #   ROBOMACH_SAN_EXTRA_FLAGS  more compile flags (the fuzz build: -fsanitize=fuzzer-no-link)
 #   ROBOMACH_SAN_CMAKE_ARGS   more cmake arguments (the fuzz build: -DROBOMACH_FUZZ=ON)
 #   CXX                     compiler (default: clang++ when installed, else g++)
@@ -80,7 +84,7 @@ fi
 status=0
 cd "$build"
 rm -f Testing/Temporary/LastTest*.log
-nice -n "$nice_level" ctest --output-on-failure --parallel "$jobs" "$@" || status=1
+nice -n "$nice_level" ctest --output-on-failure --parallel "$jobs" --timeout "${ROBOMACH_SAN_TIMEOUT:-7200}" "$@" || status=1
 
 pattern='runtime error:|ERROR: AddressSanitizer|ERROR: LeakSanitizer|SUMMARY: UndefinedBehaviorSanitizer'
 for f in Testing/Temporary/LastTest*.log; do
