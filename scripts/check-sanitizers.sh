@@ -15,7 +15,7 @@
 #   ROBOMACH_SAN_TIMEOUT    per-test timeout [s] (default: 7200; CTest's own
 #                           1500 s is too short here: the sanitized build runs
 #                           10-15 times slower, and OptimisePlanLong.Saddle,
-#                           160-260 s in a normal build, needs about 40 min)
+#                           160-260 s in a normal build, took 1514 s)
 #   ROBOMACH_SAN_EXTRA_FLAGS  more compile flags (the fuzz build: -fsanitize=fuzzer-no-link)
 #   ROBOMACH_SAN_CMAKE_ARGS   more cmake arguments (the fuzz build: -DROBOMACH_FUZZ=ON)
 #   CXX                     compiler (default: clang++ when installed, else g++)
