@@ -13,7 +13,7 @@
 #include "robomach/io/machine_files.h"
 #include "robomach/machine/iso230.h"
 #include "robomach/report/plot.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {
@@ -56,25 +56,9 @@ int Run(int argc, char** argv) {
     const io::IsoEvaluation eval = io::EvaluateIsoRunsFile(runs_path);
     const io::IsoRuns& runs = eval.runs;
     const std::string unit = runs.rotary ? "deg" : "mm";
-    nlohmann::json j;
-    j["standard"] = "ISO 230-2";
-    j["unit"] = unit;
-    j["axes"] = nlohmann::json::object();
+    const nlohmann::json j = io::IsoSummaryJson(eval);
     const auto& results = eval.results;
     const int min_runs = eval.min_runs;
-    for (const auto& [axis, r] : results) {
-      nlohmann::json a = {{"A", r.A},       {"A_up", r.A_up}, {"A_down", r.A_down}, {"E", r.E},
-                          {"E_up", r.E_up}, {"E_down", r.E_down}, {"M", r.M},       {"R", r.R},
-                          {"R_up", r.R_up}, {"R_down", r.R_down}, {"B", r.B},       {"B_mean", r.B_mean}};
-      a["targets"] = nlohmann::json::array();
-      for (const auto& t : r.targets) {
-        a["targets"].push_back({{"target", t.target},       {"runs_up", t.runs_up},   {"runs_down", t.runs_down},
-                                {"mean_up", t.mean_up},     {"mean_down", t.mean_down}, {"s_up", t.s_up},
-                                {"s_down", t.s_down},       {"mean", t.mean},         {"B", t.reversal},
-                                {"R_up", t.R_up},           {"R_down", t.R_down},     {"R", t.R}});
-      }
-      j["axes"][axis] = a;
-    }
     if (!plot_path.empty()) {
       report::Figure fig(static_cast<int>(results.size()), 1, 900, 380);
       fig.title = "ISO 230-2: mean deviation and +-2s per direction";

@@ -14,7 +14,7 @@
 #include "robomach/io/acquisition_inputs.h"
 #include "robomach/machine/acquisition.h"
 #include "robomach/report/plot.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {
@@ -39,10 +39,6 @@ void BinnedMax(const std::vector<double>& x, const std::vector<double>& y, size_
     bx->push_back(x[best]);
     by->push_back(y[best]);
   }
-}
-
-nlohmann::json StatsJson(const machine::SeriesStats& s) {
-  return {{"max", s.max_abs}, {"mean", s.mean}, {"rms", s.rms}, {"std", s.std_dev}};
 }
 
 int Run(int argc, char** argv) {
@@ -86,7 +82,6 @@ int Run(int argc, char** argv) {
     const std::vector<machine::TemperatureCompensation>& temps = in.temperatures;
     const std::optional<machine::ProgrammedPath>& path = in.program;
     const machine::CountsRecord& rec = in.counts;
-    const size_t n = mf.machine.axes.size();
 
     machine::Acquisition acq(mf.machine, in.applied());
     std::optional<machine::ContourTracker> tracker;
@@ -106,18 +101,14 @@ int Run(int argc, char** argv) {
                          {"cross_axis_tables", tables.cross_axis.size()},
                          {"temperature_axes", temps.size()}};
     if (path) {
-      std::vector<double> d_um(contour.size()), a_deg(contour.size()), s_mm(contour.size());
-      for (size_t i = 0; i < contour.size(); ++i) {
-        d_um[i] = contour[i].distance * 1e6;
-        a_deg[i] = RadToDeg(contour[i].axis_angle);
-        s_mm[i] = MToMm(contour[i].s);
-      }
-      j["contour_error_um"] = StatsJson(machine::Stats(d_um));
-      j["axis_error_deg"] = StatsJson(machine::Stats(a_deg));
-      j["path_length_mm"] = MToMm(path->length());
-      j["covered_mm"] = {s_mm.empty() ? 0.0 : *std::min_element(s_mm.begin(), s_mm.end()),
-                         s_mm.empty() ? 0.0 : *std::max_element(s_mm.begin(), s_mm.end())};
+      j.update(io::ContourSummaryJson(contour, *path));
       if (!plot_path.empty()) {
+        std::vector<double> d_um, a_deg, s_mm;
+        for (const machine::ContourError& c : contour) {
+          d_um.push_back(c.distance * 1e6);
+          a_deg.push_back(RadToDeg(c.axis_angle));
+          s_mm.push_back(MToMm(c.s));
+        }
         report::Figure fig(2, 1);
         fig.title = "axis-acquire: contour error along the programmed path";
         std::vector<double> bx, by;
@@ -143,9 +134,9 @@ int Run(int argc, char** argv) {
       std::cerr << kTool << ": " << rec.rows() << " samples; contour error max " << j["contour_error_um"]["max"].get<double>()
                 << " um, rms " << j["contour_error_um"]["rms"].get<double>() << " um; axis error max "
                 << j["axis_error_deg"]["max"].get<double>() << " deg\n";
-      const std::vector<std::string> units = machine::ContourUnitFindings(contour, *path);
-      for (const std::string& f : units) Warn(kTool, "implausible (unit or column mistake?): " + f);
-      if (!units.empty()) return kExitFlagged;
+      const RunFindings verdict = machine::JudgeContour(contour, *path);
+      for (const Finding& f : verdict.findings) Warn(kTool, f.message);
+      return ExitCodeFor(verdict.status());
     }
     return kExitOk;
   });

@@ -12,7 +12,7 @@
 #include "robomach/io/counts_file.h"
 #include "robomach/io/machine_file.h"
 #include "robomach/io/number_format.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {
@@ -69,17 +69,7 @@ int Run(int argc, char** argv) {
                                 [&](long done, long) { progress.Update(done); });
     });
     progress.Finish();
-    nlohmann::json j;
-    j["samples"] = d.samples;
-    j["sample_rate_hz"] = rate_hz;
-    j["every"] = every;
-    j["glitch_filter"] = filter;
-    j["error_events"] = nlohmann::json::object();
-    j["final_counts"] = nlohmann::json::object();
-    for (size_t a = 0; a < axes.size(); ++a) {
-      j["error_events"][axes[a].name] = d.error_events[a];
-      j["final_counts"][axes[a].name] = d.final_counts[a];
-    }
+    const nlohmann::json j = io::CaptureDecodingSummaryJson(d, axes, rate_hz, every, filter);
     if (!summary_path.empty()) io::WriteFileAtomically(summary_path, report::DumpJson(j));
     for (const Finding& f : d.findings) Warn(kTool, f.message);
     return ExitCodeFor(d.status());

@@ -18,7 +18,7 @@
 #include "robomach/io/hammer_records.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {
@@ -30,18 +30,6 @@ Axis ParseAxisOption(const std::string& option, const std::string& text) {
   if (text == "y") return Axis::kY;
   if (text == "z") return Axis::kZ;
   throw UsageError(option + ": expected x, y or z, got '" + text + "'");
-}
-
-// A channel's direction: --direction NAME=AXIS, else a name that is x, y or
-// z or ends in _x, _y or _z.
-Axis ChannelDirection(const std::string& name, const std::map<std::string, std::string>& given) {
-  if (auto it = given.find(name); it != given.end()) return ParseAxisOption("--direction " + name, it->second);
-  const char last = name.empty() ? '\0' : name.back();
-  const bool suffix = name.size() == 1 || (name.size() >= 2 && name[name.size() - 2] == '_');
-  if (suffix && (last == 'x' || last == 'y' || last == 'z')) return static_cast<Axis>(last - 'x');
-  throw UsageError("response channel '" + name +
-                   "': its direction is not in its name (…_x, …_y, …_z); give --direction " + name +
-                   "=x (or y, z)");
 }
 
 void SavePlot(const std::string& path, const calibration::FrfEstimateResult& r, const dynamics::FrfSet& frfs,
@@ -190,20 +178,10 @@ int Run(int argc, char** argv) {
     const io::HammerRecords rec = io::ReadHammerRecords(records);
     // Keys before the work, so that a naming problem is reported at once.
     std::vector<dynamics::FrfKey> keys;
-    for (const auto& [name, v] : dir_given) {
-      bool known = false;
-      for (const auto& c : rec.channels) known = known || c.name == name;
-      if (!known) throw UsageError("--direction " + name + "=" + v + ": no response channel '" + name + "'");
-    }
-    for (const auto& ch : rec.channels) {
-      dynamics::FrfKey key{pose_id, ChannelDirection(ch.name, dir_given), exc};
-      for (size_t k = 0; k < keys.size(); ++k) {
-        if (keys[k] == key) {
-          throw UsageError("response channels '" + rec.channels[k].name + "' and '" + ch.name +
-                           "' both give " + key.ToString() + "; give --direction for one of them");
-        }
-      }
-      keys.push_back(key);
+    try {
+      keys = io::ChannelKeys(rec, pose_id, exc, dir_given);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--direction ") + e.what());
     }
     if (!response_ranges.empty()) {
       o.response_range.assign(rec.channels.size(), 0.0);
@@ -268,48 +246,12 @@ int Run(int argc, char** argv) {
     if (r.status != calibration::FrfEstimateStatus::kOk) rc = kExitDataError;
 
     if (!summary_path.empty()) {
-      nlohmann::json j;
+      nlohmann::json j = io::FrfEstimateSummaryJson(r, rec, keys);
       j["tool"] = kTool;
       j["records"] = records;
       j["exit_code"] = rc;
-      j["sample_rate_hz"] = r.sample_rate_hz;
-      j["block_samples"] = r.block_samples;
-      j["line_spacing_hz"] = r.block_samples > 0 ? r.sample_rate_hz / r.block_samples : 0.0;
       j["estimator"] = estimator == "h1" ? "H1" : "H2";
-      j["averages"] = r.averages;
-      j["force_window_s"] = r.force_window_s;
-      j["force_window_pre_s"] = r.force_window_pre_s;
-      j["exponential_window_tau_s"] = r.exponential_tau_s;
-      j["leakage"] = r.leakage;
-      j["warnings"] = r.warnings;
       j["flags"] = flags;
-      nlohmann::json hits = nlohmann::json::array();
-      for (const auto& h : r.hits) {
-        hits.push_back({{"id", h.id},
-                        {"source", h.source},
-                        {"status", calibration::HitStatusName(h.status)},
-                        {"hit_time_s", h.hit_time_s},
-                        {"peak_force_N", h.peak_force_N},
-                        {"pulse_duration_s", h.pulse_duration_s},
-                        {"notes", h.notes}});
-      }
-      j["hits"] = hits;
-      nlohmann::json chans = nlohmann::json::array();
-      for (size_t c = 0; c < rec.channels.size(); ++c) {
-        nlohmann::json cj = {{"name", rec.channels[c].name},
-                             {"column", rec.channel_columns[c]},
-                             {"quantity", io::QuantityName(io::QuantityOf(rec.channels[c].quantity))},
-                             {"response", std::string(1, AxisName(keys[c].response))},
-                             {"excitation", std::string(1, AxisName(keys[c].excitation))}};
-        if (r.status == calibration::FrfEstimateStatus::kOk) {
-          const auto& g = r.channels[c].coherence;
-          cj["lines"] = g.size();
-          cj["lines_coherence_above_0_9"] = (g.array() > 0.9).count();
-          cj["min_coherence"] = g.minCoeff();
-        }
-        chans.push_back(cj);
-      }
-      j["channels"] = chans;
       io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }
     if (r.status != calibration::FrfEstimateStatus::kOk) {

@@ -19,7 +19,7 @@
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/report/frf_plot.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {
@@ -182,7 +182,7 @@ int Run(int argc, char** argv) {
       for (const auto& s : model->parameters().specs()) params[s.name] = model->parameters().Get(s.name);
       j["parameters"] = params;
       j["postures"] = nlohmann::json::array();
-      for (size_t p = 0; p < postures.size(); ++p) j["postures"].push_back(report::PostureToJson(ids[p], dyns[p]));
+      for (size_t p = 0; p < postures.size(); ++p) j["postures"].push_back(io::PostureToJson(ids[p], dyns[p]));
       io::WriteFileAtomically(details_path, report::DumpJson(j));
     }
     std::string title = "robomach frf-predict: " + robot_path;

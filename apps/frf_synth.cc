@@ -16,7 +16,7 @@
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/robot_config.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {
@@ -89,12 +89,7 @@ int Run(int argc, char** argv) {
     }
     io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
     ApplyAddsAndSets(adds, sets, &cfg);
-    if (std::isfinite(fs_hz)) {
-      o.sample_rate_hz = fs_hz;
-    } else if (auto it = cfg.description.extra_values.find("hammer_test.sample_rate_hz");
-               it != cfg.description.extra_values.end()) {
-      o.sample_rate_hz = it->second;
-    }
+    o.sample_rate_hz = std::isfinite(fs_hz) ? fs_hz : calibration::ConfiguredSampleRateHz(cfg.description);
     calibration::CheckValid(o);
     const auto model = cfg.Build();
     std::vector<calibration::NamedPosture> postures;

@@ -22,7 +22,7 @@
 #include "robomach/io/robot_config.h"
 #include "robomach/io/tracker_file.h"
 #include "robomach/report/plot.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {
@@ -299,46 +299,7 @@ int Run(int argc, char** argv) {
     if (!plot_path.empty()) {
       PlotResiduals(plot_path, r, r.outlier_threshold, "kq-identify: " + tracker_path);
     }
-    if (!json_path.empty()) {
-      nlohmann::json j;
-      j["status"] = identification::ToString(r.status);
-      j["solver_message"] = r.solver_message;
-      j["num_cases"] = r.num_cases;
-      auto vec = [](const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); };
-      j["joint_stiffness_Nm_per_rad"] = vec(r.joint_stiffness);
-      j["std_dev_Nm_per_rad"] = vec(r.std_dev);
-      j["lower_95_Nm_per_rad"] = vec(r.lower_95);
-      j["upper_95_Nm_per_rad"] = vec(r.upper_95);
-      j["relative_std"] = vec(r.relative_std);
-      j["linear_start_Nm_per_rad"] = vec(r.linear_start);
-      std::vector<std::string> det;
-      for (auto d : r.determination) det.push_back(identification::ToString(d));
-      j["determination"] = det;
-      j["variance_inflation"] = vec(r.variance_inflation);
-      j["trade_off_with"] = nlohmann::json::array();
-      for (const auto& t : r.trade_off_with) {
-        std::vector<int> one_based;
-        for (int i : t) one_based.push_back(i + 1);
-        j["trade_off_with"].push_back(one_based);
-      }
-      j["correlation"] = nlohmann::json::array();
-      for (int a = 0; a < r.correlation.rows(); ++a) j["correlation"].push_back(vec(r.correlation.row(a).transpose()));
-      j["rms_residual_mm"] = MToMm(r.rms_residual);
-      j["reduced_chi2"] = r.reduced_chi2;
-      j["condition_number"] = r.condition_number;
-      j["advice"] = r.advice;
-      std::vector<std::string> out_ids;
-      for (int c : r.outliers) out_ids.push_back(r.residuals[c].case_id);
-      j["outliers"] = out_ids;
-      j["residuals"] = nlohmann::json::array();
-      for (const auto& x : r.residuals) {
-        j["residuals"].push_back({{"case_id", x.case_id},
-                                  {"residual_mm", {MToMm(x.residual.x()), MToMm(x.residual.y()), MToMm(x.residual.z())}},
-                                  {"r_over_sigma", x.normalized},
-                                  {"outlier", x.outlier}});
-      }
-      io::WriteFileAtomically(json_path, report::DumpJson(j));
-    }
+    if (!json_path.empty()) io::WriteFileAtomically(json_path, report::DumpJson(io::KqSummaryJson(r)));
     PrintReport(r, std::cerr);
     return r.flagged() ? kExitFlagged : kExitOk;
   });

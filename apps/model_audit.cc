@@ -18,7 +18,7 @@
 #include "robomach/io/posture_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/report/audit_report.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {

@@ -23,6 +23,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/polishing_files.h"
+#include "robomach/io/polishing_summary.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/io/cad_face.h"
@@ -32,6 +33,7 @@
 #include "robomach/polishing/plan_workflow.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/removal.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {
@@ -216,7 +218,6 @@ int Run(int argc, char** argv) {
     const polishing::PlanningContext ctx =
         polishing::PreparePlanning(surface, process, MmToM(po.sample_mm), surface_path, process_path);
     const polishing::SampleGrid& grid = *ctx.grid;
-    const double contact_width = ctx.contact_width;
 
     po.guides_given = guides_given;
     po.seed = static_cast<unsigned>(seed);
@@ -241,122 +242,33 @@ int Run(int argc, char** argv) {
     const polishing::EvaluatedPlan& e = outcome.plan;
     for (const Finding& f : outcome.findings) Warn(kTool, f.message);
     bool flagged = outcome.flagged();
-    nlohmann::json opt_json;
-    if (outcome.optimisation) {
-      const polishing::PlanOptimiseResult& opt = *outcome.optimisation;
-      auto family_json = [&](const polishing::PlanEvaluation& ev) {
-        const bool c = ev.params.pattern == polishing::Pattern::kCycloid;
-        nlohmann::json j = {{"pattern", polishing::PathPatternOf(ev.params.pattern).name()},
-                            {"guides", c ? polishing::FamilyName({ev.params.guides, ev.params.line_angle})
-                                         : polishing::FamilyName({polishing::GuideLines::kParallelLines, ev.params.line_angle})},
-                            {"offset_mm", 1e3 * ev.params.offset},
-                            {"line_angle_deg", ev.params.line_angle * 180.0 / kPi},
-                            {"edge_overrun_mm", 1e3 * std::min(ev.params.edge_overrun, polishing::MaxEdgeOverrun(ev.params, process))},
-                            {"cv", ev.cv},
-                            {"mean_at_max_speed_um", 1e6 * ev.mean},
-                            {"coverage", ev.coverage},
-                            {"feasible", ev.feasible}};
-        if (c) {
-          j["radius_mm"] = 1e3 * ev.params.radius;
-          j["pitch_mm"] = 1e3 * ev.params.pitch;
-          j["stagger_loops"] = ev.params.stagger;
-        }
-        return j;
-      };
-      opt_json = {{"method", opt.method},
-                  {"evaluations", opt.evaluations},
-                  {"seconds", opt.seconds},
-                  {"max_time_s", max_time_s},
-                  {"status", opt.status},
-                  {"local_searches", opt.local_searches},
-                  {"local_searches_converged", opt.local_converged},
-                  {"sample_mm", opt_sample_mm},
-                  {"best_cv", opt.best.cv},
-                  {"feasible", opt.best.feasible},
-                  {"best", family_json(opt.best)}};
-      opt_json["history"] = outcome.history_best;     // best feasible cv so far (null before the first)
-      opt_json["history_cv"] = outcome.history_cv;    // each evaluation's cv (null: infeasible)
-      if (params.pattern == polishing::Pattern::kCycloid) {
-        opt_json["bounds"] = {{"offset_mm", {1e3 * outcome.opt_offset_min, 1e3 * outcome.opt_offset_max}},
-                              {"radius_over_offset", {0.5, 1.0}},
-                              {"pitch_over_radius", {0.5, kPi}},
-                              {"stagger_loops", {0.0, 1.0}},
-                              {"edge_overrun_over_its_largest", {0.0, 1.0}}};
-        nlohmann::json fams = nlohmann::json::array();
-        for (const auto& f : opt.family_best) fams.push_back(family_json(f));
-        opt_json["families"] = fams;
-        if (opt.best_parallel.valid) opt_json["parallel"] = family_json(opt.best_parallel);
-      }
-      if (!outcome.infeasible_message.empty()) opt_json["message"] = outcome.infeasible_message;
-      if (opt.status == "max_time") {
-        Note(kTool, "the optimiser stopped at --max-time-s " + io::FormatDouble(max_time_s) +
-                        " before its local searches converged; the best plan so far is written");
-      }
+    if (outcome.optimisation && outcome.optimisation->status == "max_time") {
+      Note(kTool, "the optimiser stopped at --max-time-s " + io::FormatDouble(max_time_s) +
+                      " before its local searches converged; the best plan so far is written");
     }
-    nlohmann::json target_json;
-    if (outcome.target_given) {
-      target_json = {{"removal_um", target_um}, {"reached", outcome.target.reached}};
-      if (!outcome.target.reached) target_json["message"] = outcome.target.message;
+    if (outcome.comparison && outcome.comparison->zigzag_better) {
+      const polishing::PathParameters& pp = outcome.comparison->parallel;
+      Note(kTool, "to plan the zig-zag: --pattern parallel --offset-mm " + io::FormatDouble(1e3 * pp.offset) +
+                      " --line-angle-deg " + io::FormatDouble(pp.line_angle * 180.0 / kPi) + " --edge-overrun-mm " +
+                      io::FormatDouble(1e3 * pp.edge_overrun));
     }
-    const bool cyc = params.pattern == polishing::Pattern::kCycloid;
-    nlohmann::json summary;
-    if (outcome.comparison) {
-      const polishing::PlanOutcome::Comparison& cmp = *outcome.comparison;
-      const polishing::PathParameters& pp = cmp.parallel;
-      summary["comparison"] = {{"cycloid_cv", e.stats.cv},
-                               {"parallel_cv", cmp.parallel_stats.cv},
-                               {"parallel_offset_mm", 1e3 * pp.offset},
-                               {"parallel_line_angle_deg", pp.line_angle * 180.0 / kPi},
-                               {"parallel_reaches_target", cmp.parallel_reaches_target},
-                               {"better", cmp.zigzag_better ? "parallel" : "cycloid"}};
-      if (cmp.zigzag_better) {
-        Note(kTool, "to plan the zig-zag: --pattern parallel --offset-mm " + io::FormatDouble(1e3 * pp.offset) +
-                        " --line-angle-deg " + io::FormatDouble(pp.line_angle * 180.0 / kPi) + " --edge-overrun-mm " +
-                        io::FormatDouble(1e3 * pp.edge_overrun));
-      }
-    }
-    const std::vector<double>& history = outcome.history_best;
-    const std::vector<double>& evaluated = outcome.history_cv;
-    summary["removal_um"] = RemovalJson(e.stats);
-    summary["path"] = PathJson(e.path.rows);
-    const std::string guides_used = !cyc ? "parallel"
-                                    : params.guides == polishing::GuideLines::kBoundaryOffsets ? "offsets" : "parallel";
-    summary["parameters"] = {{"pattern", pattern},
-                             {"guides", guides_used},
-                             {"line_angle_deg", params.line_angle * 180.0 / kPi},
-                             {"stagger_loops", cyc ? params.stagger : 0.0},
-                             {"edge_overrun_mm", 1e3 * std::min(params.edge_overrun, polishing::MaxEdgeOverrun(params, process))},
-                             {"offset_mm", 1e3 * params.offset},
-                             {"radius_mm", cyc ? 1e3 * params.radius : 0.0},
-                             {"pitch_mm", cyc ? 1e3 * params.pitch : 0.0},
-                             {"omega_rad_per_s", cyc ? e.path.omega_rad_per_s : 0.0},
-                             {"centre_speed_mm_per_s", cyc ? 1e3 * e.path.centre_speed : 0.0}};
-    summary["region"] = {{"sample_mm", sample_mm}, {"points", grid.num_in_region()}, {"margin_mm", 1e3 * process.margin}};
-    ReportUnpolished(kTool, e.stats, grid, &summary["region"]);
-    if (surface.trim()) {
-      // The guide lines follow the trimmed outline and the holes, and links
-      // that would cross a hole are lifted; a row in contact off the face
-      // would be a planner bug, or the developed plane's distortion on a
-      // strongly doubly curved face (README "CAD faces").
-      const int off = outcome.rows_off_face;
-      summary["region"]["face"] = surface.trim()->source;
-      summary["region"]["rows_off_face"] = off;
-    }
-    summary["contact"] = {{"width_across_mm", 1e3 * contact_width}};
-    if (!target_json.is_null()) summary["target"] = target_json;
-    if (!opt_json.is_null()) summary["optimisation"] = opt_json;
+    const std::string unpolished = polishing::DescribeUnpolished(e.stats, grid.region_area());
+    if (!unpolished.empty()) Warn(kTool, unpolished);
     if (e.stats.coverage < 0.99) {
       Warn(kTool, "coverage " + io::FormatDouble(e.stats.coverage) + " < 0.99: parts of the region are barely polished");
     }
+    nlohmann::json summary = io::PolishPlanSummaryJson(outcome, ctx, po);
 
     if (robot.Check(kTool, process, e.path.rows, &summary)) flagged = true;
     const auto meta = io::PlannedPathMetadata(params, process);
     if (!path_out.empty()) io::WritePolishPath(path_out, e.path.rows, meta);
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, e.removal);
     robot.WriteJoints(e.path.rows);
-    if (!plot_out.empty()) WritePictures(plot_out, grid, e.removal, e.path.rows, e.path.guide_lines_st, history, pattern, evaluated);
-    const std::string text = summary.dump(2) + "\n";
-    io::WriteFileAtomically(summary_out.empty() ? "-" : summary_out, text);
+    if (!plot_out.empty()) {
+      WritePictures(plot_out, grid, e.removal, e.path.rows, e.path.guide_lines_st, outcome.history_best, pattern,
+                    outcome.history_cv);
+    }
+    io::WriteFileAtomically(summary_out.empty() ? "-" : summary_out, report::DumpJson(summary));
     return flagged ? kExitFlagged : kExitOk;
   });
 }

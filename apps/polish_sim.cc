@@ -17,10 +17,11 @@
 #include "robomach/io/csv_table.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/polish_simulation.h"
+#include "robomach/io/polishing_summary.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/removal.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {
@@ -78,23 +79,9 @@ int Run(int argc, char** argv) {
     const polishing::RemovalStats& stats = sim.stats;
     for (const Finding& f : sim.findings) Warn(kTool, f.message);
     bool flagged = sim.flagged();
-    nlohmann::json summary;
-    summary["removal_um"] = RemovalJson(stats);
-    summary["path"] = PathJson(file.rows);
-    auto meta = [&](const char* k) {
-      const auto it = file.metadata.find(k);
-      double v = 0;
-      return it != file.metadata.end() && io::ParseFiniteNumber(it->second, &v) ? v : 0.0;
-    };
-    const auto pat = file.metadata.find("pattern");
-    const std::string pattern = pat != file.metadata.end() ? pat->second : std::string("unknown");
-    summary["parameters"] = {{"pattern", pattern},
-                             {"offset_mm", meta("offset_mm")}, {"radius_mm", meta("radius_mm")},
-                             {"pitch_mm", meta("pitch_mm")}, {"omega_rad_per_s", 0.0},
-                             {"centre_speed_mm_per_s", 0.0}};
-    summary["region"] = {{"sample_mm", sample_mm}, {"points", grid.num_in_region()}, {"margin_mm", 1e3 * process.margin}};
-    ReportUnpolished(kTool, stats, grid, &summary["region"]);
-    summary["speed_limit_exceeded"] = sim.speed_limit_exceeded;
+    const std::string unpolished = polishing::DescribeUnpolished(stats, grid.region_area());
+    if (!unpolished.empty()) Warn(kTool, unpolished);
+    nlohmann::json summary = io::PolishSimSummaryJson(sim, process, sample_mm);
     if (robot.Check(kTool, process, file.rows, &summary)) flagged = true;
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, removal);
     robot.WriteJoints(file.rows);

@@ -56,36 +56,6 @@ void AddSurfaceChoiceOptions(CLI::App* app, SurfaceChoice* choice) {
       ->capture_default_str();
 }
 
-void ReportUnpolished(const std::string& tool, const polishing::RemovalStats& stats,
-                      const polishing::SampleGrid& grid, nlohmann::json* region) {
-  double area = 0.0;
-  for (int k = 0; k < grid.size(); ++k) area += grid.in_region()[k] ? grid.areas()[k] : 0.0;
-  (*region)["area_mm2"] = 1e6 * area;
-  (*region)["unpolished_area_mm2"] = 1e6 * stats.unpolished_area;
-  if (stats.unpolished_area > 0.0) {
-    std::ostringstream m;
-    m << 1e6 * stats.unpolished_area << " mm^2 of the region (" << 100 * stats.unpolished_area / area
-      << " %) gets less than 1 % of the mean removal: gaps between rows, or necks and lobes of a trimmed face "
-         "too narrow for the cycloid's circle to enter without leaving the face (a smaller radius or row "
-         "spacing reaches them)";
-    Warn(tool, m.str());
-  }
-}
-
-nlohmann::json RemovalJson(const polishing::RemovalStats& s) {
-  return {{"mean", 1e6 * s.mean}, {"std", 1e6 * s.std}, {"variance", 1e12 * s.variance}, {"cv", s.cv},
-          {"min", 1e6 * s.min}, {"max", 1e6 * s.max}, {"peak_to_valley", 1e6 * s.peak_to_valley},
-          {"coverage", s.coverage}};
-}
-
-nlohmann::json PathJson(const std::vector<polishing::PathRow>& rows) {
-  return {{"length_mm", 1e3 * polishing::ContactLength(rows)},
-          {"lifts", polishing::CountLifts(rows)},
-          {"time_s", rows.empty() ? 0.0 : rows.back().t - rows.front().t},
-          {"rows", rows.size()},
-          {"max_speed_mm_per_s", 1e3 * polishing::MaxSpeed(rows)}};
-}
-
 std::vector<std::string> PicturePaths(const std::string& png, bool with_convergence) {
   const std::filesystem::path p(png);
   const std::string stem = (p.parent_path() / p.stem()).string();
@@ -250,35 +220,9 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/number_format.h"
-#include "robomach/kinematics/pose_path.h"
+#include "robomach/io/polish_robot_check.h"
 
 namespace robomach::apps {
-
-RobotCheck CheckOnRobot(const dynamics::RobotModel& model, const Eigen::Isometry3d& X_BP,
-                        const Eigen::Isometry3d& X_FC, const std::vector<polishing::PathRow>& rows,
-                        const Eigen::VectorXd& seed) {
-  const Eigen::Isometry3d X_CF = X_FC.inverse();
-  std::vector<Eigen::Isometry3d> X_BF;
-  X_BF.reserve(rows.size());
-  for (const polishing::PathRow& row : rows) X_BF.push_back(X_BP * polishing::ContactFrame(row) * X_CF);
-  return kinematics::CheckPosePath(model.description().arm, X_BF, seed);
-}
-
-void WriteJointTrajectory(const std::string& path, const std::vector<polishing::PathRow>& rows,
-                          const RobotCheck& check, int num_joints) {
-  io::WriteFileAtomically(path, [&](std::ostream& out) {
-    out << "t_s";
-    for (int j = 0; j < num_joints; ++j) out << ",q" << j + 1 << "_deg";
-    out << ",reachable,limit_margin_deg,jacobian_condition\n";
-    for (size_t r = 0; r < rows.size(); ++r) {
-      out << io::FormatDouble(rows[r].t);
-      for (int j = 0; j < num_joints; ++j) out << ',' << (check.reachable[r] ? io::FormatDouble(RadToDeg(check.q[r](j))) : "");
-      out << ',' << (check.reachable[r] ? 1 : 0) << ','
-          << (check.reachable[r] ? io::FormatDouble(RadToDeg(check.limit_margin[r])) : "") << ','
-          << (check.reachable[r] ? io::FormatDouble(check.condition[r]) : "") << '\n';
-    }
-  });
-}
 
 void RobotOptions::Add(CLI::App* app) {
   app->add_option("--robot", robot_path_, "robot config YAML: solve the IK of every tool frame, flag unreachable rows, "
@@ -308,35 +252,17 @@ void RobotOptions::Prepare(std::vector<std::pair<std::string, std::string>>* out
 bool RobotOptions::Check(const std::string& tool, const polishing::PolishingProcess& process,
                          const std::vector<polishing::PathRow>& rows, nlohmann::json* summary) {
   if (!robot_) return false;
-  Eigen::Isometry3d X_BP = Eigen::Isometry3d::Identity();
-  X_BP.translation() = Eigen::Vector3d(part_[0], part_[1], part_[2]) * 1e-3;
-  X_BP.linear() = (Eigen::AngleAxisd(DegToRad(part_[5]), Eigen::Vector3d::UnitZ()) *
-                   Eigen::AngleAxisd(DegToRad(part_[4]), Eigen::Vector3d::UnitY()) *
-                   Eigen::AngleAxisd(DegToRad(part_[3]), Eigen::Vector3d::UnitX()))
-                      .toRotationMatrix();
-  Eigen::Isometry3d X_FC = Eigen::Isometry3d::Identity();
-  X_FC.linear() = process.R_FC;
-  X_FC.translation() = process.p_FC;
   Eigen::VectorXd q0(robot_->num_joints());
   for (int j = 0; j < q0.size(); ++j) q0(j) = DegToRad(seed_deg_[j]);
-  check_ = CheckOnRobot(*robot_, X_BP, X_FC, rows, q0);
-  (*summary)["robot"] = {
-      {"rows", rows.size()},
-      {"unreachable_rows", check_.num_unreachable},
-      {"outside_joint_limits_rows", check_.num_outside_limits},
-      {"joint_jump_rows", check_.num_jumps},
-      {"first_flagged_row", check_.first_bad_row >= 0 ? nlohmann::json(check_.first_bad_row + 1) : nlohmann::json(nullptr)},
-      {"min_joint_limit_margin_deg", RadToDeg(check_.min_limit_margin)},
-      {"max_jacobian_condition", check_.max_condition}};
-  if (check_.num_unreachable + check_.num_outside_limits + check_.num_jumps == 0) return false;
-  Warn(tool, std::to_string(check_.num_unreachable) + " rows unreachable, " + std::to_string(check_.num_outside_limits) +
-                 " outside the joint limits, " + std::to_string(check_.num_jumps) +
-                 " with a joint jump > 0.5 rad (first: row " + std::to_string(check_.first_bad_row + 1) + ")");
-  return true;
+  check_ = io::CheckPolishPathOnRobot(*robot_, io::PartFrameFromMmDeg(part_), process, rows, q0);
+  (*summary)["robot"] = io::PolishRobotSummaryJson(rows, check_);
+  const RunFindings verdict = io::JudgePolishPathOnRobot(check_);
+  for (const Finding& f : verdict.findings) Warn(tool, f.message);
+  return verdict.flagged();
 }
 
 void RobotOptions::WriteJoints(const std::vector<polishing::PathRow>& rows) const {
-  if (robot_ && !joints_out_.empty()) WriteJointTrajectory(joints_out_, rows, check_, robot_->num_joints());
+  if (robot_ && !joints_out_.empty()) io::WriteJointTrajectoryCsv(joints_out_, rows, check_, robot_->num_joints());
 }
 
 }  // namespace robomach::apps

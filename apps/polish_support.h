@@ -1,7 +1,7 @@
 #pragma once
 
-// Shared by polish-plan and polish-sim: surface loading, the removal
-// statistics in um, the summary JSON (formats.md §7) and the pictures.
+// Shared by polish-plan and polish-sim: surface loading, the pictures and
+// the "on the robot" options (the work is in io/polish_robot_check.h).
 
 #include <memory>
 #include <string>
@@ -42,15 +42,6 @@ polishing::NurbsSurface LoadSurface(const std::string& tool, const std::string& 
 /// Registers --face and --cad-unit-scale on `app` (polish-plan, polish-sim).
 void AddSurfaceChoiceOptions(CLI::App* app, SurfaceChoice* choice);
 
-/// formats.md §7 "removal_um" block (area-weighted over the region).
-nlohmann::json RemovalJson(const polishing::RemovalStats& stats_m);
-nlohmann::json PathJson(const std::vector<polishing::PathRow>& rows);
-
-/// Adds the region's area and the area left unpolished (removal below 1 %
-/// of the mean) to `region` (mm^2) and warns under `tool` if any is.
-void ReportUnpolished(const std::string& tool, const polishing::RemovalStats& stats,
-                      const polishing::SampleGrid& grid, nlohmann::json* region);
-
 /// Pictures next to `png`: the removal map (png itself, colour scale in
 /// um on the developed s, t plane), <stem>_histogram.png, <stem>_path.png
 /// (path, lifted moves and guide lines in the developed s, t plane) and, if `history` is not empty,
@@ -78,21 +69,6 @@ class App;
 
 namespace robomach::apps {
 
-/// Executability of a path on a robot (issue 11 "on the robot"): the part
-/// frame P placed in the robot base B, each row's contact frame C (z = the
-/// surface normal towards the tool, x = tool x) in B, the flange pose
-/// X_BF = X_BP X_PC X_FC^-1 with the process's contact frame in the flange,
-/// followed by the arm (kinematics::CheckPosePath: IK seeded from the
-/// previous row, the first row from `seed`).
-using RobotCheck = kinematics::PosePathCheck;
-RobotCheck CheckOnRobot(const dynamics::RobotModel& model, const Eigen::Isometry3d& X_BP,
-                        const Eigen::Isometry3d& X_FC, const std::vector<polishing::PathRow>& rows,
-                        const Eigen::VectorXd& seed);
-
-/// Joint trajectory CSV: t_s,q1_deg..qn_deg,reachable,limit_margin_deg,jacobian_condition.
-void WriteJointTrajectory(const std::string& path, const std::vector<polishing::PathRow>& rows,
-                          const RobotCheck& check, int num_joints);
-
 /// The "on the robot" options of polish-plan and polish-sim (--robot,
 /// --part-frame-mm-deg, --robot-seed-deg, --joints) and what they do, in one
 /// place for both tools.
@@ -106,8 +82,9 @@ class RobotOptions {
   void Prepare(std::vector<std::pair<std::string, std::string>>* outs);
   bool enabled() const { return robot_ != nullptr; }
   const std::string& robot_path() const { return robot_path_; }
-  /// Checks `rows` on the robot, fills summary["robot"], warns on stderr
-  /// under `tool` for flagged rows and returns true if any row is flagged.
+  /// Checks `rows` on the robot (io::CheckPolishPathOnRobot), fills
+  /// summary["robot"], warns on stderr under `tool` for flagged rows and
+  /// returns true if any row is flagged.
   bool Check(const std::string& tool, const polishing::PolishingProcess& process,
              const std::vector<polishing::PathRow>& rows, nlohmann::json* summary);
   /// Writes the joint trajectory if --joints was given.
@@ -117,7 +94,7 @@ class RobotOptions {
   std::string robot_path_, part_frame_text_ = "0,0,0,0,0,0", joints_out_, seed_text_ = "0,-90,90,0,45,0";
   std::vector<double> part_, seed_deg_;
   std::shared_ptr<const dynamics::RobotModel> robot_;
-  RobotCheck check_;
+  kinematics::PosePathCheck check_;
 };
 
 }  // namespace robomach::apps

@@ -29,7 +29,7 @@
 #include "robomach/io/tip_sources.h"
 #include "robomach/report/modal_fit_plot.h"
 #include "robomach/report/plot.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 #include "robomach/stability/semi_discretization.h"
 #include "robomach/stability/lobes_workflow.h"
 #include "robomach/stability/tip_dynamics.h"
@@ -293,7 +293,7 @@ int Run(int argc, char** argv) {
     if (!fit_plot_path.empty()) PlotFits(fit_plot_path, frf_path, tips);
     const bool flagged = lobes.flagged();
     if (!summary_path.empty()) {
-      nlohmann::json j;
+      nlohmann::json j = io::LobesSummaryJson(tips, lobes);
       j["tool"] = kTool;
       j["cut"] = cut_path;
       j["source"] = !robot_path.empty() ? "robot" : !frf_path.empty() ? "frf" : "modal_table";
@@ -308,25 +308,6 @@ int Run(int argc, char** argv) {
       j["teeth"] = cut.process.teeth;
       j["radial_immersion"] = cut.process.radial_immersion;
       j["lobes_csv"] = out_path.empty() ? "-" : out_path;
-      nlohmann::json results = nlohmann::json::array();
-      for (const stability::LobeSummary& l : stability::SummarizeLobes(tips, rows)) {
-        nlohmann::json r;
-        r["pose_id"] = l.id;
-        r["method"] = l.method;
-        r["speeds"] = l.speeds;
-        r["speeds_with_boundary"] = l.speeds_with_boundary;
-        if (l.speeds_with_boundary > 0) {
-          r["min_critical_depth_mm"] = MToMm(l.min_depth);
-          r["min_critical_depth_speed_rpm"] = io::LobeSpeedRpm(l.min_depth_speed_rad_s);
-          if (std::isfinite(l.min_depth_chatter_freq_hz)) r["min_critical_depth_chatter_freq_hz"] = l.min_depth_chatter_freq_hz;
-          r["max_critical_depth_mm"] = MToMm(l.max_depth);
-          r["max_critical_depth_speed_rpm"] = io::LobeSpeedRpm(l.max_depth_speed_rad_s);
-        }
-        results.push_back(r);
-      }
-      j["lobes"] = results;
-      j["no_boundary_at_some_speeds"] = lobes.no_boundary;
-      j["flagged"] = flagged;
       j["exit_code"] = flagged ? kExitFlagged : kExitOk;
       io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }

@@ -3,8 +3,6 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <map>
-
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -17,17 +15,14 @@
 #include "robomach/io/cut_file.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/region_file.h"
+#include "robomach/io/stability_map_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/report/heat_map.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 #include "robomach/stability/stability_map.h"
 
 namespace robomach::apps {
 namespace {
-
-// Speeds went rpm -> rad/s -> rpm; 1e-9 rpm is far below any meaningful
-// speed and hides the last-bit residue (6000.000000000001).
-double RoundRpm(double rpm) { return std::round(rpm * 1e9) / 1e9; }
 
 constexpr char kTool[] = "stability-map";
 
@@ -93,27 +88,10 @@ int Run(int argc, char** argv) {
         cut.spindle_speed_rad_s ? cut.SpeedGrid() : cut.SpeedRange(speeds);
     opt.analysis.mode_coupling.max_depth = MmToM(max_depth_mm);
 
-    std::vector<stability::ToolPoseTarget> targets;
-    std::vector<std::string> ids;
-    std::vector<double> path_rotation;  // per-point rotation added to the region's
-    int rows = 0, cols = 0;
     const bool grid = path_path.empty();
-    if (grid) {
-      targets = region.Targets(cut.feed_direction_B);
-      rows = region.num_v();
-      cols = region.num_u();
-    } else {
-      for (const io::PathPoint& p : io::ReadToolPathFile(path_path, cut.feed_direction_B)) {
-        stability::ToolPoseTarget t = p.target;
-        // A per-point rotation turns the reference x about the tool axis.
-        t.x_ref = Eigen::AngleAxisd(p.rotation, t.z_T.normalized()) * t.x_ref;
-        targets.push_back(t);
-        ids.push_back(p.id);
-        path_rotation.push_back(p.rotation);
-      }
-      rows = 1;
-      cols = static_cast<int>(targets.size());
-    }
+    const io::MapPoints points = grid ? io::MapPointsOfRegion(region, cut.feed_direction_B)
+                                      : io::MapPointsOfPathFile(path_path, cut.feed_direction_B);
+    const std::vector<stability::ToolPoseTarget>& targets = points.targets;
     if (stability::FirstFeedAlongToolAxis(targets) >= 0) {
       throw InputError({cut_path, cut.feed_line, cut.feed_column}, "feed_direction is parallel to the tool axis of the " +
                                                                        std::string(grid ? "region" : "path") +
@@ -122,7 +100,7 @@ int Run(int argc, char** argv) {
     ProgressLine progress(kTool, "points", static_cast<long>(targets.size()));
     opt.progress = [&](long done, long) { progress.Update(done); };
     const stability::StabilityMapResult map =
-        stability::ComputeStabilityMap(model, targets, rows, cols, cut.process, opt);
+        stability::ComputeStabilityMap(model, targets, points.rows, points.cols, cut.process, opt);
     const std::vector<stability::MapPoint>& pts = map.points;
     progress.Finish();
     if (map.reached == 0) {
@@ -132,63 +110,16 @@ int Run(int argc, char** argv) {
                             : "no pose of the path is reachable by the robot from the region's seed_posture_deg");
     }
 
-    {
-      // How far the seed's simplified closed form agrees with the eigenvalue
-      // criterion (issue #6 asks to report it).
-      std::vector<double> ratio;
-      for (const auto& p : pts) {
-        const auto& s = p.stability;
-        if (s.mode_coupling.status == stability::ModeCouplingStatus::kFound &&
-            std::isfinite(s.closed_form.critical_depth) && s.closed_form.critical_depth > 0.0) {
-          ratio.push_back(s.closed_form.critical_depth / s.mode_coupling.critical_depth);
-        }
-      }
-      if (!ratio.empty()) {
-        std::sort(ratio.begin(), ratio.end());
-        std::ostringstream msg;
-        msg << kTool << ": mode coupling, closed form / eigenvalue criterion over " << ratio.size()
-            << " points: median " << ratio[ratio.size() / 2] << ", range [" << ratio.front() << ", "
-            << ratio.back() << "]\n";
-        std::cerr << msg.str();
-      }
+    // How far the seed's simplified closed form agrees with the eigenvalue
+    // criterion (issue #6 asks to report it).
+    if (const stability::ClosedFormAgreement a = stability::CompareClosedForm(pts); a.points > 0) {
+      std::ostringstream msg;
+      msg << kTool << ": mode coupling, closed form / eigenvalue criterion over " << a.points << " points: median "
+          << a.median << ", range [" << a.min << ", " << a.max << "]\n";
+      std::cerr << msg.str();
     }
-    const int n = model->num_joints();
-    auto write = [&](std::ostream& os) {
-      os << (grid ? "row,col,x_mm,y_mm," : "point_id,") << "px_mm,py_mm,pz_mm,rotation_deg";
-      for (int j = 0; j < n; ++j) os << ",q" << j + 1 << "_deg";
-      os << ",depth_mode_coupling_mm,depth_closed_form_mm,deformation_ratio,depth_regenerative_mm,"
-            "spindle_speed_rpm,critical_depth_mm,limiting_mechanism,chatter_freq_hz,jacobian_condition,status\n";
-      for (size_t i = 0; i < pts.size(); ++i) {
-        const auto& p = pts[i];
-        const auto& s = p.stability;
-        const bool analysed = std::isfinite(s.critical_depth) || s.limiting != stability::Mechanism::kNone ||
-                              s.mode_coupling.evaluations > 0;
-        if (grid) {
-          const int r = static_cast<int>(i) / cols, c = static_cast<int>(i) % cols;
-          const Eigen::Vector2d uv = region.PlaneCoordinates(r, c);
-          os << r << ',' << c << ',' << FormatCell(uv(0) * 1e3) << ',' << FormatCell(uv(1) * 1e3) << ',';
-        } else {
-          os << ids[i] << ',';
-        }
-        os << FormatCell(targets[i].p_BT.x() * 1e3) << ',' << FormatCell(targets[i].p_BT.y() * 1e3) << ','
-           << FormatCell(targets[i].p_BT.z() * 1e3) << ','
-           << FormatCell(RadToDeg(p.rotation + (grid ? 0.0 : path_rotation[i])));
-        for (int j = 0; j < n; ++j) os << ',' << (p.q.size() == n ? FormatCell(RadToDeg(p.q(j))) : "");
-        const bool mc = analysed && s.mode_coupling.status == stability::ModeCouplingStatus::kFound;
-        const bool rg = analysed && s.regenerative.status == stability::LobeStatus::kOk;
-        os << ',' << (mc ? FormatCell(s.mode_coupling.critical_depth * 1e3) : "") << ','
-           << (analysed ? FormatCell(s.closed_form.critical_depth * 1e3) : "") << ','
-           << (analysed ? FormatCell(s.closed_form.deformation_ratio) : "") << ','
-           << (rg ? FormatCell(s.regenerative.critical_depth * 1e3) : "") << ','
-           << (rg ? FormatCell(RoundRpm(RadPerSecToRpm(s.regenerative.spindle_speed_rad_s))) : "") << ','
-           << (analysed ? FormatCell(s.critical_depth * 1e3) : "") << ','
-           << (analysed ? stability::ToString(s.limiting) : "") << ','
-           << (analysed ? FormatCell(s.chatter_freq_hz) : "") << ',' << FormatCell(p.jacobian_condition) << ','
-           << stability::ToString(p.status) << '\n';
-      }
-    };
     if (!plot_path.empty() && !grid) Warn(kTool, "--plot draws grids only; ignored with --path");
-    io::WriteFileAtomically(out_path.empty() ? "-" : out_path, write);
+    io::WriteStabilityMapCsv(out_path.empty() ? "-" : out_path, points, pts, model->num_joints());
     if (!plot_path.empty() && grid) {
       report::HeatMap hm;
       hm.title = "robomach stability-map: critical axial depth (" + cut_path + ")";
@@ -196,8 +127,8 @@ int Run(int argc, char** argv) {
       hm.y_label = "v [mm] from the region origin";
       hm.colorbar_label = "depth [mm]";
       hm.dx = hm.dy = MToMm(region.grid_step);
-      hm.nx = cols;
-      hm.ny = rows;
+      hm.nx = points.cols;
+      hm.ny = points.rows;
       hm.mark_label = "unreachable / joint limits";
       hm.nan_label = "no limit found";
       for (const auto& p : pts) {
@@ -208,59 +139,13 @@ int Run(int argc, char** argv) {
       report::SaveHeatMapPng(hm, plot_path);
     }
     if (!summary_path.empty()) {
-      nlohmann::json j;
+      nlohmann::json j = io::StabilityMapSummaryJson(points, map);
       j["tool"] = kTool;
       j["robot"] = robot_path;
       j["cut"] = cut_path;
       if (!region_path.empty()) j["region"] = region_path;
       if (!path_path.empty()) j["path"] = path_path;
-      j["mode"] = grid ? "grid" : "path";
       j["points_csv"] = out_path.empty() ? "-" : out_path;
-      j["points"] = pts.size();
-      if (grid) {
-        j["grid_rows"] = rows;
-        j["grid_cols"] = cols;
-      }
-      j["points_reached"] = map.reached;
-      j["points_flagged"] = map.flagged_points;
-      std::map<std::string, int> by_status;
-      for (const auto& p : pts) ++by_status[stability::ToString(p.status)];
-      j["points_by_status"] = by_status;
-      // The extremes of critical_depth_mm over the points that have one, with
-      // the point as in the CSV (row,col or point_id).
-      auto where = [&](size_t i) {
-        nlohmann::json w;
-        if (grid) {
-          w["row"] = static_cast<int>(i) / cols;
-          w["col"] = static_cast<int>(i) % cols;
-        } else {
-          w["point_id"] = ids[i];
-        }
-        w["px_mm"] = MToMm(targets[i].p_BT.x());
-        w["py_mm"] = MToMm(targets[i].p_BT.y());
-        w["pz_mm"] = MToMm(targets[i].p_BT.z());
-        w["critical_depth_mm"] = MToMm(pts[i].stability.critical_depth);
-        w["limiting_mechanism"] = stability::ToString(pts[i].stability.limiting);
-        if (std::isfinite(pts[i].stability.chatter_freq_hz)) w["chatter_freq_hz"] = pts[i].stability.chatter_freq_hz;
-        w["status"] = stability::ToString(pts[i].status);
-        return w;
-      };
-      long with_depth = 0;
-      size_t lo = 0, hi = 0;
-      for (size_t i = 0; i < pts.size(); ++i) {
-        const double d = pts[i].stability.critical_depth;
-        if (!std::isfinite(d)) continue;
-        if (with_depth == 0 || d < pts[lo].stability.critical_depth) lo = i;
-        if (with_depth == 0 || d > pts[hi].stability.critical_depth) hi = i;
-        ++with_depth;
-      }
-      j["points_with_critical_depth"] = with_depth;
-      if (with_depth > 0) {
-        j["min_critical_depth_mm"] = MToMm(pts[lo].stability.critical_depth);
-        j["max_critical_depth_mm"] = MToMm(pts[hi].stability.critical_depth);
-        j["min_critical_depth_point"] = where(lo);
-        j["max_critical_depth_point"] = where(hi);
-      }
       j["exit_code"] = ExitCodeFor(map.status());
       io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }

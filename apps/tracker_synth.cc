@@ -14,12 +14,13 @@
 #include "robomach/common/units.h"
 #include "robomach/identification/campaign_synth.h"
 #include "robomach/io/csv_table.h"
+#include "robomach/io/kq_files.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/tracker_file.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 namespace {
@@ -125,27 +126,12 @@ int Run(int argc, char** argv) {
     std::vector<Eigen::VectorXd> qs;
     std::vector<std::vector<Eigen::Vector3d>> plan_pulleys;
     if (!plan_path.empty()) {
-      // The plan CSV of kq-identify --plan: one row per posture and rope
-      // direction, rows of one posture together.
-      const io::CsvTable t = io::CsvTable::ReadFile(plan_path);
-      t.RequireColumn("pose_id");
-      for (int r = 0; r < t.num_rows(); ++r) {
-        const std::string id = t.Text(r, "pose_id");
-        if (ids.empty() || ids.back() != id) {
-          for (const auto& seen : ids) {
-            if (seen == id) throw t.ErrorAt(r, "pose_id", "rows of posture " + id + " must be adjacent");
-          }
-          Eigen::VectorXd q(model->num_joints());
-          for (int j = 0; j < q.size(); ++j) q(j) = DegToRad(t.Number(r, "q" + std::to_string(j + 1) + "_deg"));
-          ids.push_back(id);
-          qs.push_back(q);
-          plan_pulleys.emplace_back();
-        }
-        plan_pulleys.back().emplace_back(MmToM(t.Number(r, "pulley_x_mm")), MmToM(t.Number(r, "pulley_y_mm")),
-                                         MmToM(t.Number(r, "pulley_z_mm")));
-      }
-      if (ids.empty()) throw InputError({plan_path, 0, 0}, "no postures in the plan");
-      const auto& meta = t.metadata();
+      // The plan CSV of kq-identify --plan.
+      io::LoadTestPlanFile plan = io::ReadLoadTestPlanCsv(plan_path, model->num_joints());
+      ids = std::move(plan.pose_ids);
+      qs = std::move(plan.q);
+      plan_pulleys = std::move(plan.pulleys);
+      const auto& meta = plan.metadata;
       if (app.count("--load-point-mm") == 0 && meta.count("load_point_mm")) {
         o.p_load_tip = ParsePointMm(plan_path + ": load_point_mm", meta.at("load_point_mm"));
       }

@@ -11,7 +11,7 @@
 #include "robomach/audit/model_audit.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/report/audit_report.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::python {
 

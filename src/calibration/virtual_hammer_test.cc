@@ -39,6 +39,11 @@ void CheckValid(const VirtualHammerOptions& o) {
   if (o.directions.empty()) fail("no direction pairs");
 }
 
+double ConfiguredSampleRateHz(const dynamics::RobotDescription& description, double fallback) {
+  const auto it = description.extra_values.find("hammer_test.sample_rate_hz");
+  return it != description.extra_values.end() ? it->second : fallback;
+}
+
 double SynthNoiseFloor(const VirtualHammerOptions& o, double freq_hz) {
   const double w = HzToRadPerSec(freq_hz);
   double a2 = o.absolute_noise_m_per_N * o.absolute_noise_m_per_N;

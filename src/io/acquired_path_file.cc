@@ -93,4 +93,29 @@ std::vector<machine::ContourError> WriteAcquiredPath(std::ostream& out, const ma
   return contour;
 }
 
+namespace {
+
+nlohmann::json StatsJson(const machine::SeriesStats& s) {
+  return {{"max", s.max_abs}, {"mean", s.mean}, {"rms", s.rms}, {"std", s.std_dev}};
+}
+
+}  // namespace
+
+nlohmann::json ContourSummaryJson(const std::vector<machine::ContourError>& contour,
+                                  const machine::ProgrammedPath& path) {
+  std::vector<double> d_um(contour.size()), a_deg(contour.size()), s_mm(contour.size());
+  for (size_t i = 0; i < contour.size(); ++i) {
+    d_um[i] = contour[i].distance * 1e6;
+    a_deg[i] = RadToDeg(contour[i].axis_angle);
+    s_mm[i] = MToMm(contour[i].s);
+  }
+  nlohmann::json j;
+  j["contour_error_um"] = StatsJson(machine::Stats(d_um));
+  j["axis_error_deg"] = StatsJson(machine::Stats(a_deg));
+  j["path_length_mm"] = MToMm(path.length());
+  j["covered_mm"] = {s_mm.empty() ? 0.0 : *std::min_element(s_mm.begin(), s_mm.end()),
+                     s_mm.empty() ? 0.0 : *std::max_element(s_mm.begin(), s_mm.end())};
+  return j;
+}
+
 }  // namespace robomach::io

@@ -69,4 +69,20 @@ CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const Machine
   return out;
 }
 
+nlohmann::json CaptureDecodingSummaryJson(const CaptureDecoding& d, const std::vector<machine::AxisScale>& axes,
+                                          double rate_hz, long every, int glitch_filter) {
+  nlohmann::json j;
+  j["samples"] = d.samples;
+  j["sample_rate_hz"] = rate_hz;
+  j["every"] = every;
+  j["glitch_filter"] = glitch_filter;
+  j["error_events"] = nlohmann::json::object();
+  j["final_counts"] = nlohmann::json::object();
+  for (size_t a = 0; a < axes.size(); ++a) {
+    j["error_events"][axes[a].name] = d.error_events.at(a);
+    j["final_counts"][axes[a].name] = d.final_counts.at(a);
+  }
+  return j;
+}
+
 }  // namespace robomach::io

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 #include <set>
+#include <stdexcept>
 
 #include "robomach/common/frames.h"
 #include "robomach/common/number_format.h"
@@ -287,6 +288,86 @@ EstimatedFrfs ToEstimatedFrfs(const calibration::FrfEstimateResult& r, const Ham
                     "calibration::CorrectExponentialWindowDamping"});
   }
   return out;
+}
+
+std::vector<dynamics::FrfKey> ChannelKeys(const HammerRecords& rec, const std::string& pose_id, Axis excitation,
+                                          const std::map<std::string, std::string>& directions) {
+  for (const auto& [name, v] : directions) {
+    bool known = false;
+    for (const auto& c : rec.channels) known = known || c.name == name;
+    if (!known) throw std::invalid_argument(name + "=" + v + ": no response channel '" + name + "'");
+  }
+  std::vector<dynamics::FrfKey> keys;
+  for (const auto& ch : rec.channels) {
+    const std::string& name = ch.name;
+    Axis response = Axis::kX;
+    if (const auto it = directions.find(name); it != directions.end()) {
+      if (it->second != "x" && it->second != "y" && it->second != "z") {
+        throw std::invalid_argument(name + ": expected x, y or z, got '" + it->second + "'");
+      }
+      response = static_cast<Axis>(it->second[0] - 'x');
+    } else {
+      const char last = name.empty() ? '\0' : name.back();
+      const bool suffix = name.size() == 1 || (name.size() >= 2 && name[name.size() - 2] == '_');
+      if (!suffix || (last != 'x' && last != 'y' && last != 'z')) {
+        throw std::invalid_argument(name + ": response channel '" + name +
+                                    "' has no direction in its name (…_x, …_y, …_z); give " + name +
+                                    "=x (or y, z)");
+      }
+      response = static_cast<Axis>(last - 'x');
+    }
+    const dynamics::FrfKey key{pose_id, response, excitation};
+    for (size_t k = 0; k < keys.size(); ++k) {
+      if (keys[k] == key) {
+        throw std::invalid_argument(name + ": response channels '" + rec.channels[k].name + "' and '" + name +
+                                    "' both give " + key.ToString() + "; give a direction for one of them");
+      }
+    }
+    keys.push_back(key);
+  }
+  return keys;
+}
+
+nlohmann::json FrfEstimateSummaryJson(const calibration::FrfEstimateResult& r, const HammerRecords& rec,
+                                      const std::vector<dynamics::FrfKey>& keys) {
+  nlohmann::json j;
+  j["sample_rate_hz"] = r.sample_rate_hz;
+  j["block_samples"] = r.block_samples;
+  j["line_spacing_hz"] = r.block_samples > 0 ? r.sample_rate_hz / r.block_samples : 0.0;
+  j["averages"] = r.averages;
+  j["force_window_s"] = r.force_window_s;
+  j["force_window_pre_s"] = r.force_window_pre_s;
+  j["exponential_window_tau_s"] = r.exponential_tau_s;
+  j["leakage"] = r.leakage;
+  j["warnings"] = r.warnings;
+  nlohmann::json hits = nlohmann::json::array();
+  for (const auto& h : r.hits) {
+    hits.push_back({{"id", h.id},
+                    {"source", h.source},
+                    {"status", calibration::HitStatusName(h.status)},
+                    {"hit_time_s", h.hit_time_s},
+                    {"peak_force_N", h.peak_force_N},
+                    {"pulse_duration_s", h.pulse_duration_s},
+                    {"notes", h.notes}});
+  }
+  j["hits"] = hits;
+  nlohmann::json chans = nlohmann::json::array();
+  for (size_t c = 0; c < rec.channels.size(); ++c) {
+    nlohmann::json cj = {{"name", rec.channels[c].name},
+                         {"column", rec.channel_columns[c]},
+                         {"quantity", QuantityName(QuantityOf(rec.channels[c].quantity))},
+                         {"response", std::string(1, AxisName(keys.at(c).response))},
+                         {"excitation", std::string(1, AxisName(keys.at(c).excitation))}};
+    if (r.status == calibration::FrfEstimateStatus::kOk) {
+      const auto& g = r.channels[c].coherence;
+      cj["lines"] = g.size();
+      cj["lines_coherence_above_0_9"] = (g.array() > 0.9).count();
+      cj["min_coherence"] = g.minCoeff();
+    }
+    chans.push_back(cj);
+  }
+  j["channels"] = chans;
+  return j;
 }
 
 }  // namespace robomach::io

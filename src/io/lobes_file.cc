@@ -26,4 +26,28 @@ void WriteLobesCsv(const std::string& path, const std::vector<stability::LobeRow
   WriteFileAtomically(path, [&](std::ostream& os) { WriteLobesCsv(os, rows); });
 }
 
+nlohmann::json LobesSummaryJson(const std::vector<stability::TipDynamics>& tips, const stability::LobesResult& lobes) {
+  nlohmann::json results = nlohmann::json::array();
+  for (const stability::LobeSummary& l : stability::SummarizeLobes(tips, lobes.rows)) {
+    nlohmann::json r;
+    r["pose_id"] = l.id;
+    r["method"] = l.method;
+    r["speeds"] = l.speeds;
+    r["speeds_with_boundary"] = l.speeds_with_boundary;
+    if (l.speeds_with_boundary > 0) {
+      r["min_critical_depth_mm"] = MToMm(l.min_depth);
+      r["min_critical_depth_speed_rpm"] = LobeSpeedRpm(l.min_depth_speed_rad_s);
+      if (std::isfinite(l.min_depth_chatter_freq_hz)) r["min_critical_depth_chatter_freq_hz"] = l.min_depth_chatter_freq_hz;
+      r["max_critical_depth_mm"] = MToMm(l.max_depth);
+      r["max_critical_depth_speed_rpm"] = LobeSpeedRpm(l.max_depth_speed_rad_s);
+    }
+    results.push_back(r);
+  }
+  nlohmann::json j;
+  j["lobes"] = results;
+  j["no_boundary_at_some_speeds"] = lobes.no_boundary;
+  j["flagged"] = lobes.flagged();
+  return j;
+}
+
 }  // namespace robomach::io

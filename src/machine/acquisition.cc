@@ -235,4 +235,12 @@ std::vector<std::string> ContourUnitFindings(const std::vector<ContourError>& co
   return out;
 }
 
+RunFindings JudgeContour(const std::vector<ContourError>& contour, const ProgrammedPath& path) {
+  RunFindings verdict;
+  for (const std::string& f : ContourUnitFindings(contour, path)) {
+    verdict.Flag("implausible (unit or column mistake?): " + f);
+  }
+  return verdict;
+}
+
 }  // namespace robomach::machine

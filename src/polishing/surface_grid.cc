@@ -258,6 +258,11 @@ SampleGrid SampleGrid::Build(const NurbsSurface& surface, double max_spacing, do
 int SampleGrid::num_in_region() const {
   return static_cast<int>(std::count(in_region_.begin(), in_region_.end(), 1));
 }
+double SampleGrid::region_area() const {
+  double area = 0.0;
+  for (size_t k = 0; k < area_.size(); ++k) area += in_region_[k] ? area_[k] : 0.0;
+  return area;
+}
 double SampleGrid::UOfS(double s) const { return Interp(table_s_, table_u_, s); }
 double SampleGrid::VOfT(double t) const { return Interp(table_t_, table_v_, t); }
 double SampleGrid::SOfU(double u) const { return Interp(table_u_, table_s_, u); }

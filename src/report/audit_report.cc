@@ -15,7 +15,7 @@
 #include "robomach/report/audit_patterns_report.h"
 #include "robomach/report/calibration_report.h"
 #include "robomach/report/html.h"
-#include "robomach/report/posture_json.h"
+#include "robomach/report/json.h"
 
 namespace robomach::report {
 namespace {

@@ -278,4 +278,36 @@ StabilityMapResult ComputeStabilityMap(std::shared_ptr<const dynamics::RobotMode
   return r;
 }
 
+ClosedFormAgreement CompareClosedForm(const std::vector<MapPoint>& points) {
+  std::vector<double> ratio;
+  for (const MapPoint& p : points) {
+    const PostureStability& s = p.stability;
+    if (s.mode_coupling.status == ModeCouplingStatus::kFound && std::isfinite(s.closed_form.critical_depth) &&
+        s.closed_form.critical_depth > 0.0) {
+      ratio.push_back(s.closed_form.critical_depth / s.mode_coupling.critical_depth);
+    }
+  }
+  ClosedFormAgreement a;
+  a.points = static_cast<long>(ratio.size());
+  if (ratio.empty()) return a;
+  std::sort(ratio.begin(), ratio.end());
+  a.median = ratio[ratio.size() / 2];
+  a.min = ratio.front();
+  a.max = ratio.back();
+  return a;
+}
+
+CriticalDepthExtremes FindCriticalDepthExtremes(const std::vector<MapPoint>& points) {
+  CriticalDepthExtremes e;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double d = points[i].stability.critical_depth;
+    if (!std::isfinite(d)) continue;
+    const long k = static_cast<long>(i);
+    if (e.with_depth == 0 || d < points[e.min_index].stability.critical_depth) e.min_index = k;
+    if (e.with_depth == 0 || d > points[e.max_index].stability.critical_depth) e.max_index = k;
+    ++e.with_depth;
+  }
+  return e;
+}
+
 }  // namespace robomach::stability

@@ -241,6 +241,7 @@ TEST(ContourUnitFindings, FlagsErrorsBeyondWhatAMachineCanBeOff) {
       if (swap) std::swap(p.p_W.x(), p.p_W.y());
       c.push_back(tracker.Next(p));
     }
+    EXPECT_EQ(JudgeContour(c, path).findings.size(), ContourUnitFindings(c, path).size());
     return ContourUnitFindings(c, path);
   };
   EXPECT_TRUE(run(0.0, 0.0, false).empty());
@@ -253,6 +254,31 @@ TEST(ContourUnitFindings, FlagsErrorsBeyondWhatAMachineCanBeOff) {
   ASSERT_EQ(g.size(), 1u);
   EXPECT_NE(g[0].find("tool axis error up to 2 deg"), std::string::npos) << g[0];
   EXPECT_EQ(run(0.0, 0.0, true).size(), 1u);
+}
+
+// axis-acquire's verdict: one finding per sentence, prefixed, and exit 3.
+TEST(JudgeContour, FlagsEachImplausibleErrorWithItsPrefix) {
+  std::vector<Eigen::Vector3d> tips, axes;
+  for (int i = 0; i <= 10; ++i) {
+    tips.emplace_back(0.01 * i, 0.0, 0.0);
+    axes.emplace_back(0.0, 0.0, 1.0);
+  }
+  const ProgrammedPath path(tips, axes);
+  ContourTracker ok_tracker(path), off_tracker(path);
+  std::vector<ContourError> ok, off;
+  for (int k = 0; k <= 100; ++k) {
+    ToolPose p = path.At(path.length() * k / 100.0);
+    ok.push_back(ok_tracker.Next(p));
+    p.p_W.y() += 5e-3;  // 5 mm off a 100 mm path: beyond the 1 mm limit
+    off.push_back(off_tracker.Next(p));
+  }
+  EXPECT_FALSE(JudgeContour(ok, path).flagged());
+  const RunFindings v = JudgeContour(off, path);
+  ASSERT_TRUE(v.flagged());
+  EXPECT_EQ(v.status(), RunStatus::kFlagged);
+  for (const Finding& f : v.findings) {
+    EXPECT_EQ(f.message.rfind("implausible (unit or column mistake?): ", 0), 0u) << f.message;
+  }
 }
 
 }  // namespace

@@ -182,5 +182,17 @@ TEST(Removal, ContactWiderThanTheBeltIsAnError) {
   }
 }
 
+// What the tools warn when part of the region is left unpolished: the area
+// in mm^2 and its share of the region, worked out by hand.
+TEST(DescribeUnpolished, NamesTheAreaAndItsShareOrNothing) {
+  RemovalStats s;
+  EXPECT_EQ(DescribeUnpolished(s, 8e-6), "");
+  s.unpolished_area = NAN;
+  EXPECT_EQ(DescribeUnpolished(s, 8e-6), "");
+  s.unpolished_area = 2e-6;  // 2 mm^2 of 8 mm^2
+  const std::string m = DescribeUnpolished(s, 8e-6);
+  EXPECT_EQ(m.rfind("2 mm^2 of the region (25 %) gets less than 1 % of the mean removal", 0), 0u) << m;
+}
+
 }  // namespace
 }  // namespace robomach::polishing

@@ -246,5 +246,48 @@ TEST(StabilityMap, SixModeModalSearchEqualsTheGeneralSearch) {
   EXPECT_NEAR(modal.chatter_freq_hz, general.chatter_freq_hz, 1e-6 * general.chatter_freq_hz);
 }
 
+// The map's statistics on hand-made points (the answers worked out by hand).
+MapPoint PointWith(double depth, ModeCouplingStatus mc, double mc_depth, double closed_form_depth) {
+  MapPoint p;
+  p.stability.critical_depth = depth;
+  p.stability.mode_coupling.status = mc;
+  p.stability.mode_coupling.critical_depth = mc_depth;
+  p.stability.closed_form.critical_depth = closed_form_depth;
+  return p;
+}
+
+TEST(StabilityMapStatistics, CriticalDepthExtremesSkipPointsWithoutADepth) {
+  const std::vector<MapPoint> pts = {PointWith(NAN, ModeCouplingStatus::kStableUpToMax, NAN, INFINITY),
+                                     PointWith(3e-3, ModeCouplingStatus::kFound, 3e-3, 6e-3),
+                                     PointWith(1e-3, ModeCouplingStatus::kFound, 1e-3, 1e-3),
+                                     PointWith(INFINITY, ModeCouplingStatus::kStableUpToMax, NAN, INFINITY),
+                                     PointWith(5e-3, ModeCouplingStatus::kFound, 5e-3, 0.0),
+                                     PointWith(1e-3, ModeCouplingStatus::kFound, 1e-3, 2e-3)};
+  const CriticalDepthExtremes e = FindCriticalDepthExtremes(pts);
+  EXPECT_EQ(e.with_depth, 4);
+  EXPECT_EQ(e.min_index, 2);  // the first of the two 1 mm points
+  EXPECT_EQ(e.max_index, 4);
+
+  // Ratios closed form / eigenvalue criterion: 2 (point 1), 1 (point 2),
+  // 2 (point 5); point 4's closed form is 0 and points 0 and 3 found no
+  // mode coupling. Sorted 1, 2, 2: median 2.
+  const ClosedFormAgreement a = CompareClosedForm(pts);
+  EXPECT_EQ(a.points, 3);
+  EXPECT_DOUBLE_EQ(a.median, 2.0);
+  EXPECT_DOUBLE_EQ(a.min, 1.0);
+  EXPECT_DOUBLE_EQ(a.max, 2.0);
+}
+
+TEST(StabilityMapStatistics, NoPointGivesEmptyStatistics) {
+  const std::vector<MapPoint> pts = {PointWith(NAN, ModeCouplingStatus::kStableUpToMax, NAN, INFINITY)};
+  const CriticalDepthExtremes e = FindCriticalDepthExtremes(pts);
+  EXPECT_EQ(e.with_depth, 0);
+  EXPECT_EQ(e.min_index, -1);
+  EXPECT_EQ(e.max_index, -1);
+  const ClosedFormAgreement a = CompareClosedForm(pts);
+  EXPECT_EQ(a.points, 0);
+  EXPECT_TRUE(std::isnan(a.median));
+}
+
 }  // namespace
 }  // namespace robomach::stability

@@ -70,6 +70,11 @@ struct VirtualHammerOptions {
 /// @throws std::invalid_argument naming the field for a bad option.
 void CheckValid(const VirtualHammerOptions& options);
 
+/// The sample rate a robot config gives its hammer tests (the value
+/// `hammer_test.sample_rate_hz`), else `fallback` [Hz]: frf-synth's default.
+double ConfiguredSampleRateHz(const dynamics::RobotDescription& description,
+                              double fallback = VirtualHammerOptions{}.sample_rate_hz);
+
 /// The additive noise floor of the options at one line [m/N] (see above).
 double SynthNoiseFloor(const VirtualHammerOptions& options, double freq_hz);
 

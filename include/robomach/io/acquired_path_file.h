@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "robomach/machine/acquisition.h"
 #include "robomach/machine/synthesis.h"
 
@@ -38,5 +40,12 @@ std::vector<machine::ContourError> WriteAcquiredPath(std::ostream& out, const ma
                                                      const std::vector<machine::AxisScale>& axes,
                                                      machine::Acquisition* acquisition,
                                                      machine::ContourTracker* tracker, int threads = 2);
+
+/// The contour part of axis-acquire's summary (docs/formats.md §4.1): the
+/// statistics (max, mean, rms, std) of the contour error [um] and of the
+/// tool axis error [deg], the programmed path's length and the part of it
+/// the run covered [mm].
+nlohmann::json ContourSummaryJson(const std::vector<machine::ContourError>& contour,
+                                  const machine::ProgrammedPath& path);
 
 }  // namespace robomach::io

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "robomach/common/progress.h"
 #include "robomach/common/run_status.h"
 #include "robomach/io/machine_file.h"
@@ -31,5 +33,10 @@ CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const Machine
                                   long every, int glitch_filter,
                                   const std::function<void(double, const std::int64_t*)>& on_row,
                                   const ProgressCallback& progress = {});
+
+/// axis-decode's summary (docs/formats.md §8.2): samples, the decoding
+/// settings, and per axis (by name) the error events and the final count.
+nlohmann::json CaptureDecodingSummaryJson(const CaptureDecoding& decoding, const std::vector<machine::AxisScale>& axes,
+                                          double rate_hz, long every, int glitch_filter);
 
 }  // namespace robomach::io

@@ -14,8 +14,13 @@
 // is 1/(mean time step), snapped to a whole number of hertz when that is
 // within the rounding of the written times.
 
+#include <map>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "robomach/common/frames.h"
 
 #include "robomach/calibration/frf_estimate.h"
 #include "robomach/calibration/impact_record.h"
@@ -45,6 +50,17 @@ bool ParseResponseColumn(const std::string& column, calibration::ResponseQuantit
 ///   hit, sample rates that differ between hits by more than 1e-4 (relative), files
 ///   with different response columns, or a duplicate hit id.
 HammerRecords ReadHammerRecords(const std::vector<std::string>& paths);
+
+/// The FRF key of every response channel, in channel order: (pose_id, the
+/// channel's direction, excitation). A channel's direction is
+/// `directions[name]` ("x", "y" or "z") when given, else its name's: a name
+/// that is x, y or z or ends in _x, _y or _z.
+/// @throws std::invalid_argument, a message that names the channel (and
+///   reads after "--direction "): a direction for no channel ("acc=z: no
+///   response channel 'acc'"), one that is not x, y or z, a channel without
+///   a direction, two channels with the same key.
+std::vector<dynamics::FrfKey> ChannelKeys(const HammerRecords& records, const std::string& pose_id, Axis excitation,
+                                          const std::map<std::string, std::string>& directions = {});
 
 /// Writes estimated FRFs as the CSV of formats.md §3 (WriteFrfCsv, with
 /// `# averages: N`), preceded by `# key: value` lines that record how they
@@ -76,5 +92,13 @@ struct EstimatedFrfs {
 ///   that do not match the channels.
 EstimatedFrfs ToEstimatedFrfs(const calibration::FrfEstimateResult& result, const HammerRecords& records,
                               const std::vector<dynamics::FrfKey>& keys, bool h2);
+
+/// frf-estimate's summary JSON, its result part (docs/formats.md §4.1):
+/// sample rate, block, line spacing, averages, windows, leakage, the
+/// estimator's warnings, every hit (status, time, peak force, pulse,
+/// notes) and every channel (name, column, quantity, direction and, for
+/// an estimate, its coherence: lines, lines above 0.9, minimum).
+nlohmann::json FrfEstimateSummaryJson(const calibration::FrfEstimateResult& result, const HammerRecords& records,
+                                      const std::vector<dynamics::FrfKey>& keys);
 
 }  // namespace robomach::io

@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "robomach/common/run_status.h"
 #include "robomach/machine/iso230.h"
 
@@ -34,5 +36,11 @@ struct IsoEvaluation : RunFindings {
 /// @throws InputError naming the file and the axis for runs ISO 230-2
 ///   cannot evaluate (a target without one direction, fewer than 2 runs).
 IsoEvaluation EvaluateIsoRunsFile(const std::string& path);
+
+/// axis-accuracy's JSON (docs/formats.md §8.6): the standard, the unit and
+/// per axis A, E, M, R, B (each way where ISO 230-2 defines it) and every
+/// target's runs, means, standard deviations, reversal and repeatability,
+/// in the file's unit.
+nlohmann::json IsoSummaryJson(const IsoEvaluation& evaluation);
 
 }  // namespace robomach::io

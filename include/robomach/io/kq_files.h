@@ -1,12 +1,14 @@
 #pragma once
-// kq-identify's CSV outputs (docs/kq-identify.md): the residuals of an
-// identification, and a D-optimal load-test plan.
+// kq-identify's outputs (docs/kq-identify.md): the residuals of an
+// identification, its summary JSON, and a D-optimal load-test plan.
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 
 #include "robomach/identification/joint_stiffness.h"
 #include "robomach/identification/test_plan.h"
@@ -18,6 +20,13 @@ namespace robomach::io {
 /// Atomic.
 void WriteKqResidualsCsv(const std::string& path, const identification::JointStiffnessResult& result,
                          const std::vector<identification::LoadCase>& cases);
+
+/// The summary JSON (docs/formats.md §4.1): status and solver message, the
+/// stiffness of every joint with its standard deviation, 95 % interval,
+/// relative std, start, determination, variance inflation and trade-offs
+/// (1-based joints), the correlation matrix, the residual statistics, the
+/// advice, the outliers and every case's residual [mm].
+nlohmann::json KqSummaryJson(const identification::JointStiffnessResult& result);
 
 /// What a plan file records about how it was made.
 struct LoadTestPlanHeader {
@@ -35,5 +44,21 @@ struct LoadTestPlanHeader {
 /// direction, the load point and the pulley [mm]. "-" is stdout; atomic.
 void WriteLoadTestPlanCsv(const std::string& path, const identification::TestPlan& plan,
                           const LoadTestPlanHeader& header);
+
+/// A plan file read back (tracker-synth --plan): its postures in file
+/// order with their rope directions' pulleys, and its `# key: value` lines
+/// (load_point_mm and target_mm among them).
+struct LoadTestPlanFile {
+  std::vector<std::string> pose_ids;
+  std::vector<Eigen::VectorXd> q;                     // [rad], per posture
+  std::vector<std::vector<Eigen::Vector3d>> pulleys;  // [m], per posture, per rope direction
+  std::map<std::string, std::string> metadata;
+};
+
+/// Reads the plan CSV of WriteLoadTestPlanCsv (columns pose_id,
+/// q<i>_deg and pulley_x_mm..pulley_z_mm are used; the rows of one posture
+/// must be adjacent).
+/// @throws InputError with file:line:column.
+LoadTestPlanFile ReadLoadTestPlanCsv(const std::string& path, int num_joints);
 
 }  // namespace robomach::io

@@ -1,9 +1,12 @@
 #pragma once
-// The lobes CSV of stability-lobes (docs/stability.md).
+// The lobes CSV of stability-lobes (docs/stability.md) and its summary JSON's
+// result part.
 
 #include <ostream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "robomach/stability/lobes_workflow.h"
 
@@ -19,5 +22,12 @@ void WriteLobesCsv(const std::string& path, const std::vector<stability::LobeRow
 
 /// A speed [rad/s] in rpm as the lobes CSV writes it (rounded to 1e-9 rpm).
 double LobeSpeedRpm(double speed_rad_s);
+
+/// The summary's result part (docs/formats.md §4.1): `lobes`, per tip and
+/// method (SummarizeLobes) the speeds, those with a boundary and, when
+/// any, the smallest and largest critical depth [mm] with their speed
+/// [rpm] (and the chatter frequency at the smallest); then
+/// `no_boundary_at_some_speeds` and `flagged`.
+nlohmann::json LobesSummaryJson(const std::vector<stability::TipDynamics>& tips, const stability::LobesResult& lobes);
 
 }  // namespace robomach::io

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 
 #include "robomach/dynamics/posture_dynamics.h"
 
@@ -35,5 +36,11 @@ void WritePredictedFrfCsv(std::ostream& os, const std::vector<PosturePrediction>
 /// pose_id,mode,freq_hz,damping_ratio,modal_mass_kg,ux,uy,uz.
 void WriteModalTableCsv(const std::string& path, const std::vector<std::string>& pose_ids,
                         const std::vector<std::vector<dynamics::Mode>>& modes);
+
+/// Everything of one posture as JSON with unit-suffixed keys (frf-predict's
+/// --summary, one per posture): q_rad, tcp position, J and its condition
+/// number, M_q/K_q/C_q, Cartesian M/K/C (null when near singular), static
+/// compliance, modes. Matrices are row-major arrays of rows.
+nlohmann::json PostureToJson(const std::string& pose_id, const dynamics::PostureDynamics& d);
 
 }  // namespace robomach::io

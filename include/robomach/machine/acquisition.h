@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "robomach/common/run_status.h"
 #include "robomach/machine/axes.h"
 #include "robomach/machine/compensation.h"
 #include "robomach/machine/kinematics.h"
@@ -116,6 +117,11 @@ inline constexpr double kMaxPlausibleAxisError = 0.0174532925;  // [rad] = 1 deg
 /// axis error only when the contour error is plausible: a tip far off its
 /// path is compared with another point's axis).
 std::vector<std::string> ContourUnitFindings(const std::vector<ContourError>& contour, const ProgrammedPath& path);
+
+/// axis-acquire's verdict on a run with a programmed path: flagged (exit 3)
+/// with one finding per ContourUnitFindings sentence, prefixed
+/// "implausible (unit or column mistake?): ".
+RunFindings JudgeContour(const std::vector<ContourError>& contour, const ProgrammedPath& path);
 
 /// Statistics of a series (max |v|, mean, rms, standard deviation).
 struct SeriesStats {

@@ -8,6 +8,7 @@
 // integral over the segment is then done in closed form (the pressure along
 // a straight line through an ellipse is the square root of a quadratic).
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -96,5 +97,10 @@ struct RemovalStats {
 /// Over the entries with mask != 0 (all if mask empty).
 RemovalStats ComputeRemovalStats(const std::vector<double>& removal, const std::vector<double>& area,
                                  const std::vector<char>& mask = {});
+
+/// What a user should hear when part of the region is left unpolished
+/// (stats in m and m^2, `region_area` [m^2]): how much, and the likely
+/// reasons. Empty when nothing is.
+std::string DescribeUnpolished(const RemovalStats& stats, double region_area);
 
 }  // namespace robomach::polishing

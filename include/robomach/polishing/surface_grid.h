@@ -62,6 +62,8 @@ class SampleGrid {
   const std::vector<double>& areas() const { return area_; }    // area weight [m^2]
   const std::vector<char>& in_region() const { return in_region_; }
   int num_in_region() const;
+  /// Area of the polished region: the area weights of its points [m^2].
+  double region_area() const;
   /// Bounding box of the polished region in the (s, t) plane [m].
   double s_lo() const { return s_lo_; }
   double s_hi() const { return s_hi_; }

@@ -93,4 +93,23 @@ StabilityMapResult ComputeStabilityMap(std::shared_ptr<const dynamics::RobotMode
                                        const std::vector<ToolPoseTarget>& targets, int rows, int cols,
                                        const MillingProcess& process, const MapOptions& options);
 
+/// How far the seed's simplified closed form agrees with the eigenvalue
+/// criterion over a map (issue #6 asks to report it): the ratio closed-form
+/// depth / mode-coupling depth at the points where the mode coupling found a
+/// limit and the closed form a positive depth. NaN statistics when none.
+struct ClosedFormAgreement {
+  long points{0};
+  double median{NAN};  // the upper median for an even count
+  double min{NAN}, max{NAN};
+};
+ClosedFormAgreement CompareClosedForm(const std::vector<MapPoint>& points);
+
+/// The points with the smallest and the largest finite critical depth (the
+/// first of equal ones; -1 when no point has one) and how many have one.
+struct CriticalDepthExtremes {
+  long with_depth{0};
+  long min_index{-1}, max_index{-1};
+};
+CriticalDepthExtremes FindCriticalDepthExtremes(const std::vector<MapPoint>& points);
+
 }  // namespace robomach::stability
