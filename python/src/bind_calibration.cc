@@ -4,7 +4,12 @@
 // objects with read-only attributes.
 #include <limits>
 
+#include <optional>
+
 #include "bindings.h"
+#include "robomach/io/prediction_files.h"
+#include "robomach/io/posture_file.h"
+#include "robomach/calibration/virtual_hammer_test.h"
 #include "robomach/calibration/frf_calibration.h"
 #include "robomach/calibration/modal_fit.h"
 #include "robomach/identification/joint_stiffness.h"
@@ -163,6 +168,48 @@ void BindCalibration(py::module_& m) {
      "of measured (computed here if None). Returns a CalibrationResult; a poor fit is a status, not "
      "an exception. ValueError for an unknown parameter or a measured posture missing from "
      "postures. Releases the GIL (it can take seconds to minutes).");
+  m.def("synthesize_hammer_test",
+        [](const io::RobotConfig& config, const std::vector<io::Posture>& postures, std::optional<double> sample_rate_hz,
+           int block_samples, double fmin_hz, double fmax_hz, const std::string& directions, double noise_rel,
+           double noise_abs_m_per_N, double noise_abs_m_per_s_per_N, double noise_abs_m_per_s2_per_N,
+           double hammer_cutoff_hz, int averages, unsigned seed, bool coherence) {
+          calibration::VirtualHammerOptions o;
+          o.sample_rate_hz = sample_rate_hz ? *sample_rate_hz : calibration::ConfiguredSampleRateHz(config.description);
+          o.block_samples = block_samples;
+          o.fmin_hz = fmin_hz;
+          o.fmax_hz = fmax_hz;
+          o.directions.clear();
+          for (const auto& [r, e] : io::ParseDirectionPairs(directions)) {
+            o.directions.emplace_back(static_cast<Axis>(r), static_cast<Axis>(e));
+          }
+          o.relative_noise = noise_rel;
+          o.absolute_noise_m_per_N = noise_abs_m_per_N;
+          o.absolute_noise_m_per_s_per_N = noise_abs_m_per_s_per_N;
+          o.absolute_noise_m_per_s2_per_N = noise_abs_m_per_s2_per_N;
+          o.hammer_cutoff_hz = hammer_cutoff_hz;
+          o.averages = averages;
+          o.seed = seed;
+          o.coherence = coherence;
+          calibration::CheckValid(o);
+          const auto model = config.Build();
+          std::vector<calibration::NamedPosture> named;
+          for (const io::Posture& p : postures) named.push_back({p.id, p.q});
+          py::gil_scoped_release release;
+          return calibration::SynthesizeHammerTest(model, named, o);
+        },
+        py::arg("config"), py::arg("postures"), py::arg("sample_rate_hz") = py::none(),
+        py::arg("block_samples") = 20480, py::arg("fmin_hz") = 0.25, py::arg("fmax_hz") = 500.0,
+        py::arg("directions") = "xx,yy", py::arg("noise_rel") = 0.0, py::arg("noise_abs_m_per_N") = 0.0,
+        py::arg("noise_abs_m_per_s_per_N") = 0.0, py::arg("noise_abs_m_per_s2_per_N") = 0.0,
+        py::arg("hammer_cutoff_hz") = 0.0, py::arg("averages") = 5, py::arg("seed") = 1u,
+        py::arg("coherence") = false,
+        "frf-synth's call: a virtual hammer test with known truth. The tool-tip receptance [m/N] of the "
+        "config's model at `postures` (a list of Posture, as read_posture_file gives; their order fixes the "
+        "noise) on the grid k*fs/N within [fmin_hz, fmax_hz], with seeded noise H (1 + noise_rel n1) + floor(f) "
+        "n2 (floors flat in receptance, mobility, accelerance, raised above hammer_cutoff_hz). sample_rate_hz "
+        "None: the config's hammer_test.sample_rate_hz, else 5120. coherence: the H1 coherence of that noise "
+        "for `averages` impacts. Returns an FrfSet; write_frf_csv(path, frfs, quantity, averages if coherence "
+        "else 0) writes what frf-synth writes. ValueError for bad options. Releases the GIL.");
   m.def("judge_calibration", [](const CalibrationResult& result, const dynamics::FrfSet& measured, double fmin_hz,
                                 double fmax_hz) {
     CalibrationOptions o;

@@ -1,12 +1,19 @@
 // Measured FRFs (dynamics/measured_frf.h), their files (io/frf_files.h: the
-// long CSV of docs/formats.md §3 and UFF58) and the noise model
-// (calibration/frf_noise.h).
+// long CSV of docs/formats.md §3 and UFF58), the noise model
+// (calibration/frf_noise.h) and frf-estimate's call (FRFs from raw hammer
+// records: io/hammer_records.h, calibration/frf_estimate.h).
+#include <map>
 #include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "bindings.h"
+#include "robomach/calibration/frf_estimate.h"
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/io/frf_files.h"
+#include "robomach/io/hammer_records.h"
 
 namespace robomach::python {
 namespace {
@@ -73,6 +80,48 @@ NoiseOptions MakeNoiseOptions(double min_snr, int averages, bool use_coherence, 
   o.wide_floor = wide_floor;
   calibration::CheckValid(o);
   return o;
+}
+
+// frf-estimate's call: read the records, key the channels, estimate, judge.
+py::dict EstimateFrfs(const std::vector<std::string>& records, const std::string& pose_id,
+                      const std::string& excitation, const std::map<std::string, std::string>& directions,
+                      const std::string& estimator, int min_hits, const calibration::FrfEstimateOptions& o) {
+  if (records.empty()) throw std::invalid_argument("records: expected at least one hammer record file");
+  for (const std::string& r : records) RequireReadableFile(r);
+  if (estimator != "h1" && estimator != "h2") {
+    throw std::invalid_argument("estimator: expected 'h1' or 'h2', got '" + estimator + "'");
+  }
+  if (min_hits < 1) throw std::invalid_argument("min_hits: expected at least 1");
+  calibration::CheckValid(o);
+  const Axis exc = ParseAxis(excitation);
+  io::HammerRecords rec;
+  std::vector<dynamics::FrfKey> keys;
+  calibration::FrfEstimateResult r;
+  {
+    py::gil_scoped_release release;
+    rec = io::ReadHammerRecords(records);
+    keys = io::ChannelKeys(rec, pose_id, exc, directions);
+    r = calibration::EstimateFrf(rec.hits, rec.channels, o);
+  }
+  const RunFindings verdict = calibration::JudgeFrfEstimate(r, min_hits, "min_hits");
+  py::dict d;
+  const bool estimated = r.status == calibration::FrfEstimateStatus::kOk;
+  d["status"] = estimated ? RunStatusName(verdict.status()) : "no_estimate";
+  std::vector<std::string> findings = FindingMessages(verdict);
+  if (!estimated) findings.insert(findings.begin(), "every hit was rejected: no estimate (summary['hits'] says why)");
+  d["findings"] = findings;
+  d["averages"] = r.averages;
+  if (estimated) {
+    io::EstimatedFrfs est = io::ToEstimatedFrfs(r, rec, keys, estimator == "h2");
+    d["frfs"] = est.frfs;
+    d["labels"] = est.labels;
+  } else {
+    d["frfs"] = py::none();
+    d["labels"] = std::vector<std::string>{};
+  }
+  // The result part of frf-estimate's --summary, as a dict.
+  d["summary"] = py::module_::import("json").attr("loads")(io::FrfEstimateSummaryJson(r, rec, keys).dump());
+  return d;
 }
 
 }  // namespace
@@ -232,6 +281,43 @@ void BindFrf(py::module_& m) {
   }, py::arg("frfs"), py::arg("noise"),
      "The usable lines of every FRF with their sigma attached: what the calibration fits. FRFs "
      "with no usable line are left out; ValueError if an FRF has no noise model.");
+
+  m.def("estimate_frf",
+        [](const std::vector<std::string>& records, const std::string& pose_id, const std::string& excitation,
+           const std::optional<std::map<std::string, std::string>>& directions, const std::string& estimator,
+           int min_hits, double fmax_hz, double force_window_s, double force_window_pre_s,
+           double force_window_taper_s, double exponential_tau_s, double double_hit_fraction,
+           double trigger_fraction, int flat_top_samples, double force_range_N) {
+          calibration::FrfEstimateOptions o;
+          o.fmax_hz = fmax_hz;
+          o.force_window_s = force_window_s;
+          o.force_window_pre_s = force_window_pre_s;
+          o.force_window_taper_s = force_window_taper_s;
+          o.exponential_tau_s = exponential_tau_s;
+          o.double_hit_fraction = double_hit_fraction;
+          o.trigger_fraction = trigger_fraction;
+          o.flat_top_samples = flat_top_samples;
+          o.force_range_N = force_range_N;
+          return EstimateFrfs(records, pose_id, excitation, directions.value_or(std::map<std::string, std::string>{}),
+                              estimator, min_hits, o);
+        },
+        py::arg("records"), py::arg("pose_id") = "P1", py::arg("excitation") = "x", py::arg("directions") = py::none(),
+        py::arg("estimator") = "h1", py::arg("min_hits") = 3, py::arg("fmax_hz") = 0.0, py::arg("force_window_s") = 0.0,
+        py::arg("force_window_pre_s") = 0.0, py::arg("force_window_taper_s") = 0.0,
+        py::arg("exponential_tau_s") = 0.0, py::arg("double_hit_fraction") = 0.10,
+        py::arg("trigger_fraction") = 0.05, py::arg("flat_top_samples") = 3, py::arg("force_range_N") = 0.0,
+        "frf-estimate's call: tool-tip FRFs from raw impact-hammer records (files of docs/formats.md §10: "
+        "time_s, force_N, responses <name>_m / _m_per_s / _m_per_s2, optional hit). Each response channel's "
+        "direction comes from `directions` ({name: 'x'|'y'|'z'}) or its name (..._x, ..._y, ..._z); "
+        "excitation is the hammer's direction. H1 (or H2) averaged over the accepted hits; hits with a double "
+        "hit or an overload are rejected. Windows in seconds as frf-estimate's options (0: automatic; a "
+        "negative force_window_s: none); fmax_hz 0: sample rate / 2.56; force_range_N 0: unknown. Returns "
+        "{'status': 'ok', 'flagged' (fewer accepted hits than min_hits, leakage, an implausible receptance) "
+        "or 'no_estimate' (every hit rejected), 'findings': [str], 'averages': int, 'frfs': FrfSet "
+        "(receptance [m/N] with the coherence; None without an estimate), 'labels': [str], 'summary': dict "
+        "(frf-estimate's --summary without the tool's fields: hits, channels, windows, warnings)}. "
+        "FileNotFoundError for a missing file, InputError (path:line:col) for a bad record, ValueError for bad "
+        "options or channel directions. Releases the GIL.");
 }
 
 }  // namespace robomach::python

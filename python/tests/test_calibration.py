@@ -124,3 +124,31 @@ def test_load_case_from_python_and_bad_options():
         rm.identify_joint_stiffness(model, [c], loss='lts')
     with pytest.raises(ValueError):
         rm.identify_joint_stiffness(model, [])
+
+
+def test_synthesize_hammer_test_equals_frf_synth_byte_for_byte(hammer):
+    tmp, _ = hammer  # the fixture's hammer.csv is frf-synth's output for these options
+    cfg = rm.RobotConfig(KR210, set={'m6_kg': TRUTH['m6_kg'], 'd6_m': TRUTH['d6_m']})
+    postures = rm.read_posture_file(POSTURES, cfg.num_joints)
+    frfs = rm.synthesize_hammer_test(cfg, postures, noise_rel=0.01, seed=5, coherence=True)
+    rm.write_frf_csv(str(tmp / 'python.csv'), frfs, 'receptance', 5)
+    assert (tmp / 'python.csv').read_bytes() == (tmp / 'hammer.csv').read_bytes()
+
+
+def test_noise_free_synthesis_equals_the_predicted_receptance():
+    # A second route to the same numbers: predict_frfs at the grid's lines.
+    cfg = rm.RobotConfig(KR210)
+    postures = rm.read_posture_file(POSTURES, cfg.num_joints)
+    frfs = rm.synthesize_hammer_test(cfg, postures, directions='xx,yx', block_samples=2048, fmax_hz=400.0)
+    some = frfs[postures[0].id, 'y', 'x']
+    f = np.asarray(some.freq_hz)
+    assert f[0] == pytest.approx(2.5) and np.allclose(np.diff(f), 2.5)  # 5120 Hz / 2048
+    pred = rm.predict_frfs(cfg.build(), postures, f)
+    for p, post in zip(pred['postures'], postures):
+        for (r, e), (i, j) in ((('x', 'x'), (0, 0)), (('y', 'x'), (1, 0))):
+            h = np.asarray(frfs[post.id, r, e].receptance)
+            ref = p['H_m_per_N'][:, i, j]
+            # Synthesis rounds to 13 significant digits (UFF58's E20.12).
+            assert np.abs(h - ref).max() <= 1e-12 * np.abs(ref).max()
+    with pytest.raises(ValueError, match='averages >= 2'):
+        rm.synthesize_hammer_test(cfg, postures, coherence=True, averages=1)
