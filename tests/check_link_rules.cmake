@@ -2,7 +2,8 @@
 # §2.1): report draws (figures, heat maps, HTML, JSON) with io_base's atomic
 # files and number format; report_fits draws calibration and audit results
 # and may link those (and report), not io or the other domain modules;
-# io_base is CSV, YAML, atomic files and parallel rows on top of common. LINKS is a file of "target=link|link|..." lines written by
+# io_base is CSV, YAML, atomic files and parallel rows on top of common.
+# LINKS is a file of "target=link|link|..." lines written by
 # tests/CMakeLists.txt at generate time.
 cmake_minimum_required(VERSION 3.16)
 set(forbidden_report robomach::io robomach::kinematics robomach::dynamics
