@@ -168,6 +168,8 @@ void BindCalibration(py::module_& m) {
      "of measured (computed here if None). Returns a CalibrationResult; a poor fit is a status, not "
      "an exception. ValueError for an unknown parameter or a measured posture missing from "
      "postures. Releases the GIL (it can take seconds to minutes).");
+  // The library's defaults (frf-synth's), so that the two cannot drift apart.
+  const calibration::VirtualHammerOptions kHammer;
   m.def("synthesize_hammer_test",
         [](const io::RobotConfig& config, const std::vector<io::Posture>& postures, std::optional<double> sample_rate_hz,
            int block_samples, double fmin_hz, double fmax_hz, const std::string& directions, double noise_rel,
@@ -198,11 +200,13 @@ void BindCalibration(py::module_& m) {
           return calibration::SynthesizeHammerTest(model, named, o);
         },
         py::arg("config"), py::arg("postures"), py::arg("sample_rate_hz") = py::none(),
-        py::arg("block_samples") = 20480, py::arg("fmin_hz") = 0.25, py::arg("fmax_hz") = 500.0,
-        py::arg("directions") = "xx,yy", py::arg("noise_rel") = 0.0, py::arg("noise_abs_m_per_N") = 0.0,
-        py::arg("noise_abs_m_per_s_per_N") = 0.0, py::arg("noise_abs_m_per_s2_per_N") = 0.0,
-        py::arg("hammer_cutoff_hz") = 0.0, py::arg("averages") = 5, py::arg("seed") = 1u,
-        py::arg("coherence") = false,
+        py::arg("block_samples") = kHammer.block_samples, py::arg("fmin_hz") = kHammer.fmin_hz,
+        py::arg("fmax_hz") = kHammer.fmax_hz, py::arg("directions") = "xx,yy",
+        py::arg("noise_rel") = kHammer.relative_noise, py::arg("noise_abs_m_per_N") = kHammer.absolute_noise_m_per_N,
+        py::arg("noise_abs_m_per_s_per_N") = kHammer.absolute_noise_m_per_s_per_N,
+        py::arg("noise_abs_m_per_s2_per_N") = kHammer.absolute_noise_m_per_s2_per_N,
+        py::arg("hammer_cutoff_hz") = kHammer.hammer_cutoff_hz, py::arg("averages") = kHammer.averages,
+        py::arg("seed") = kHammer.seed, py::arg("coherence") = kHammer.coherence,
         "frf-synth's call: a virtual hammer test with known truth. The tool-tip receptance [m/N] of the "
         "config's model at `postures` (a list of Posture, as read_posture_file gives; their order fixes the "
         "noise) on the grid k*fs/N within [fmin_hz, fmax_hz], with seeded noise H (1 + noise_rel n1) + floor(f) "

@@ -282,6 +282,8 @@ void BindFrf(py::module_& m) {
      "The usable lines of every FRF with their sigma attached: what the calibration fits. FRFs "
      "with no usable line are left out; ValueError if an FRF has no noise model.");
 
+  // The library's defaults, so that Python and frf-estimate cannot drift apart.
+  const calibration::FrfEstimateOptions kEstimate;
   m.def("estimate_frf",
         [](const std::vector<std::string>& records, const std::string& pose_id, const std::string& excitation,
            const std::optional<std::map<std::string, std::string>>& directions, const std::string& estimator,
@@ -302,10 +304,13 @@ void BindFrf(py::module_& m) {
                               estimator, min_hits, o);
         },
         py::arg("records"), py::arg("pose_id") = "P1", py::arg("excitation") = "x", py::arg("directions") = py::none(),
-        py::arg("estimator") = "h1", py::arg("min_hits") = 3, py::arg("fmax_hz") = 0.0, py::arg("force_window_s") = 0.0,
-        py::arg("force_window_pre_s") = 0.0, py::arg("force_window_taper_s") = 0.0,
-        py::arg("exponential_tau_s") = 0.0, py::arg("double_hit_fraction") = 0.10,
-        py::arg("trigger_fraction") = 0.05, py::arg("flat_top_samples") = 3, py::arg("force_range_N") = 0.0,
+        py::arg("estimator") = "h1", py::arg("min_hits") = 3, py::arg("fmax_hz") = kEstimate.fmax_hz,
+        py::arg("force_window_s") = kEstimate.force_window_s, py::arg("force_window_pre_s") = kEstimate.force_window_pre_s,
+        py::arg("force_window_taper_s") = kEstimate.force_window_taper_s,
+        py::arg("exponential_tau_s") = kEstimate.exponential_tau_s,
+        py::arg("double_hit_fraction") = kEstimate.double_hit_fraction,
+        py::arg("trigger_fraction") = kEstimate.trigger_fraction, py::arg("flat_top_samples") = kEstimate.flat_top_samples,
+        py::arg("force_range_N") = kEstimate.force_range_N,
         "frf-estimate's call: tool-tip FRFs from raw impact-hammer records (files of docs/formats.md §10: "
         "time_s, force_N, responses <name>_m / _m_per_s / _m_per_s2, optional hit). Each response channel's "
         "direction comes from `directions` ({name: 'x'|'y'|'z'}) or its name (..._x, ..._y, ..._z); "
