@@ -129,7 +129,6 @@ int RunPlan(const io::RobotConfig& cfg, int num_postures, double noise_mm, unsig
   o.p_target_tip = target;
   o.masses_kg = masses_kg;
   o.max_rope_angle = DegToRad(max_rope_angle_deg);
-  o.num_candidate_postures = std::max(400, 4 * num_postures);
   const identification::TestPlan plan = identification::PlanLoadTests(*model, o);
   io::LoadTestPlanHeader header;
   header.num_postures = num_postures;

@@ -1,12 +1,14 @@
 // Calibration against measured FRFs (calibration/frf_calibration.h) and
 // joint-stiffness identification from load tests
-// (identification/joint_stiffness.h, io/tracker_file.h). Results are plain
+// (identification/joint_stiffness.h, io/tracker_file.h) and its D-optimal
+// test plan (identification/test_plan.h, io/kq_files.h). Results are plain
 // objects with read-only attributes.
 #include <limits>
 
 #include <optional>
 
 #include "bindings.h"
+#include "robomach/common/units.h"
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/calibration/virtual_hammer_test.h"
@@ -14,6 +16,8 @@
 #include "robomach/calibration/modal_fit.h"
 #include "robomach/identification/joint_stiffness.h"
 #include "robomach/identification/load_case.h"
+#include "robomach/identification/test_plan.h"
+#include "robomach/io/kq_files.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/tracker_file.h"
 
@@ -29,6 +33,12 @@ using calibration::StageSummary;
 using identification::CaseResidual;
 using identification::JointStiffnessResult;
 using identification::LoadCase;
+
+/// A plan with the options it was made with: the plan file records them.
+struct PyTestPlan {
+  identification::TestPlan plan;
+  identification::PlanOptions options;
+};
 
 std::map<std::string, double> ParameterDict(const dynamics::ParameterSet& p) {
   std::map<std::string, double> out;
@@ -322,6 +332,7 @@ void BindCalibration(py::module_& m) {
       .def_property_readonly("flagged", &JointStiffnessResult::flagged,
                              "kq-identify's exit 3: not converged, a joint weakly or not determined, or outliers "
                              "kept in the fit");
+  const identification::IdentificationOptions id_defaults;
   m.def("identify_joint_stiffness", [](const std::shared_ptr<dynamics::RobotModel>& model,
                                        const std::vector<LoadCase>& cases, double tracker_noise_m,
                                        const std::string& loss, double loss_scale, double outlier_false_alarm,
@@ -344,13 +355,92 @@ void BindCalibration(py::module_& m) {
     identification::CheckValid(o);
     py::gil_scoped_release release;
     return identification::IdentifyJointStiffness(*model, cases, o);
-  }, py::arg("model"), py::arg("cases"), py::arg("tracker_noise_m") = 1e-5, py::arg("loss") = "none",
-     py::arg("loss_scale") = 3.0, py::arg("outlier_false_alarm") = 0.01, py::arg("weak_relative_std") = 0.1,
-     py::arg("max_iterations") = 100,
+  }, py::arg("model"), py::arg("cases"), py::arg("tracker_noise_m") = id_defaults.tracker_noise,
+     py::arg("loss") = "none", py::arg("loss_scale") = id_defaults.loss_scale,
+     py::arg("outlier_false_alarm") = id_defaults.outlier_false_alarm,
+     py::arg("weak_relative_std") = id_defaults.weak_relative_std, py::arg("max_iterations") = id_defaults.max_iterations,
      "Identifies the diagonal joint stiffness [N·m/rad] from load cases (kq-identify's library "
      "call); the model's stiffness is the prior. tracker_noise_m: 1 sigma per measured coordinate "
      "[m]; loss: 'none', 'huber', 'cauchy'. Numerical trouble is a status in the result. Releases "
      "the GIL.");
+
+  py::class_<identification::PlannedLoad>(m, "PlannedLoad", "One planned rope direction at one posture [SI, in B].")
+      .def_readonly("pose_id", &identification::PlannedLoad::pose_id)
+      .def_property_readonly("q", [](const identification::PlannedLoad& l) { return Eigen::VectorXd(l.q); }, "[rad]")
+      .def_property_readonly("rope_direction", [](const identification::PlannedLoad& l) {
+        return Eigen::Vector3d(l.rope_direction);
+      }, "unit vector from the load point to the pulley")
+      .def_property_readonly("p_load_m", [](const identification::PlannedLoad& l) { return Eigen::Vector3d(l.p_load); })
+      .def_property_readonly("p_pulley_m", [](const identification::PlannedLoad& l) {
+        return Eigen::Vector3d(l.p_pulley);
+      }, "where the rope meets the floor [m]");
+  py::class_<PyTestPlan>(m, "TestPlan", "What plan_load_tests() chose (kq-identify --plan).")
+      .def_property_readonly("loads", [](const PyTestPlan& p) { return p.plan.loads; },
+                             "num_postures x directions_per_posture PlannedLoads")
+      .def_property_readonly("cases", [](const PyTestPlan& p) { return p.plan.cases; },
+                             "the loads with every mass, as LoadCases without displacement")
+      .def_property_readonly("log_det_information", [](const PyTestPlan& p) { return p.plan.log_det_information; },
+                             "D-optimality index, log det of the Fisher information of log k")
+      .def_property_readonly("expected_relative_std", [](const PyTestPlan& p) { return p.plan.expected_relative_std; },
+                             "per joint, sigma(log k) the plan promises [-]; inf where not determined")
+      .def_property_readonly("expected_std_dev", [](const PyTestPlan& p) { return p.plan.expected_std_dev; },
+                             "per joint [N·m/rad], at the model's stiffness")
+      .def_property_readonly("expected_determination", [](const PyTestPlan& p) {
+        std::vector<std::string> out;
+        for (auto d : p.plan.expected_determination) out.emplace_back(identification::ToString(d));
+        return out;
+      }, "per joint: 'determined', 'weak' or 'not determined'")
+      .def_property_readonly("num_candidates", [](const PyTestPlan& p) { return p.plan.num_candidates; },
+                             "feasible candidate postures found")
+      .def_property_readonly("findings", [](const PyTestPlan& p) { return FindingMessages(p.plan); },
+                             "one sentence per joint the plan cannot determine")
+      .def_property_readonly("flagged", [](const PyTestPlan& p) { return p.plan.flagged(); },
+                             "kq-identify --plan's exit 3: a joint the plan cannot determine");
+  const identification::PlanOptions plan_defaults;
+  m.def("plan_load_tests", [](const std::shared_ptr<dynamics::RobotModel>& model, int num_postures,
+                              double tracker_noise_m, const std::vector<double>& masses_kg,
+                              const std::optional<Eigen::Vector3d>& p_load_tip_m,
+                              const std::optional<Eigen::Vector3d>& p_target_tip_m, double max_rope_angle_rad,
+                              int directions_per_posture, unsigned seed, int num_candidate_postures) {
+    PyTestPlan p;
+    identification::PlanOptions& o = p.options;
+    o.num_postures = num_postures;
+    o.tracker_noise = tracker_noise_m;
+    o.masses_kg = masses_kg;
+    o.p_load_tip = p_load_tip_m;
+    o.p_target_tip = p_target_tip_m;
+    o.max_rope_angle = max_rope_angle_rad;
+    o.directions_per_posture = directions_per_posture;
+    o.seed = seed;
+    o.num_candidate_postures = num_candidate_postures;
+    identification::CheckValid(o);
+    py::gil_scoped_release release;
+    p.plan = identification::PlanLoadTests(*model, o);
+    return p;
+  }, py::arg("model"), py::arg("num_postures") = plan_defaults.num_postures,
+     py::arg("tracker_noise_m") = plan_defaults.tracker_noise, py::arg("masses_kg") = plan_defaults.masses_kg,
+     py::arg("p_load_tip_m") = py::none(), py::arg("p_target_tip_m") = py::none(),
+     py::arg("max_rope_angle_rad") = plan_defaults.max_rope_angle,
+     py::arg("directions_per_posture") = plan_defaults.directions_per_posture, py::arg("seed") = plan_defaults.seed,
+     py::arg("num_candidate_postures") = plan_defaults.num_candidate_postures,
+     "Plans load tests (kq-identify --plan's library call): postures within the joint limits and "
+     "rope directions that maximise log det of the Fisher information of log-stiffness at the "
+     "model's stiffness (D-optimal). p_load_tip_m, p_target_tip_m: load point and tracker target "
+     "in the tip frame [m], None = the TCP. num_candidate_postures 0 = max(400, 4 num_postures). "
+     "Deterministic for a seed. Releases the GIL.");
+  m.def("write_load_test_plan_csv", [](const std::string& path, const PyTestPlan& p, const std::string& robot_config) {
+    io::LoadTestPlanHeader h;
+    h.num_postures = p.options.num_postures;
+    h.robot_config = robot_config;
+    h.tracker_noise_mm = MToMm(p.options.tracker_noise);
+    h.masses_kg = p.options.masses_kg;
+    h.load_point = p.options.p_load_tip;
+    h.target = p.options.p_target_tip;
+    py::gil_scoped_release release;
+    io::WriteLoadTestPlanCsv(path, p.plan, h);
+  }, py::arg("path"), py::arg("plan"), py::arg("robot_config") = "",
+     "Writes the plan CSV of kq-identify --plan (docs/kq-identify.md; tracker-synth --plan reads it). "
+     "robot_config: the config path its header names. Atomic.");
 }
 
 }  // namespace robomach::python

@@ -126,6 +126,41 @@ def test_load_case_from_python_and_bad_options():
         rm.identify_joint_stiffness(model, [])
 
 
+@pytest.mark.parametrize('offsets_mm, rc', [([], 3), (['--load-point-mm', '150,0,0', '--target-mm', '0,120,0'], 0)])
+def test_plan_load_tests_equals_kq_identify_plan_byte_for_byte(tmp, offsets_mm, rc):
+    # kq-identify --plan on the TCP (exit 3: a force at the TCP has no moment
+    # about joint 6's axis, so joint 6 is not determined) and off the axis.
+    r = run_tool('kq-identify', '--robot', KR210, '--plan', 4, '--seed', 3, '--out', tmp / 'tool.csv',
+                 *offsets_mm, expect_rc=rc)
+    model = rm.RobotConfig(KR210).build()
+    points = {}
+    for k, name in (('--load-point-mm', 'p_load_tip_m'), ('--target-mm', 'p_target_tip_m')):
+        if k in offsets_mm:
+            points[name] = np.array([float(x) for x in offsets_mm[offsets_mm.index(k) + 1].split(',')]) * 1e-3
+    plan = rm.plan_load_tests(model, 4, tracker_noise_m=1e-5, seed=3, **points)  # the tool's defaults otherwise
+    rm.write_load_test_plan_csv(str(tmp / 'python.csv'), plan, KR210)
+    assert (tmp / 'python.csv').read_bytes() == (tmp / 'tool.csv').read_bytes()
+    assert plan.flagged == (rc == 3) and len(plan.findings) == (1 if rc == 3 else 0)
+    assert (plan.expected_determination[5] == 'not determined') == (rc == 3), r.stderr
+    assert len(plan.loads) == 4 * 2 and len(plan.cases) == 4 * 2 * 3
+    # Geometry, independently of the planner: every rope goes down from the
+    # load point to the floor (z = 0) within 45 degrees of vertical.
+    for load in plan.loads:
+        d = load.rope_direction
+        assert abs(np.linalg.norm(d) - 1) < 1e-12 and -d[2] >= np.cos(np.radians(45)) - 1e-12
+        t = -load.p_load_m[2] / d[2]
+        np.testing.assert_allclose(load.p_load_m + t * d, load.p_pulley_m, atol=1e-9)
+        assert load.p_load_m[2] >= 0.3 - 1e-12
+
+
+def test_plan_load_tests_bad_options():
+    model = rm.RobotConfig(KR210).build()
+    with pytest.raises(ValueError, match='num_postures'):
+        rm.plan_load_tests(model, 0)
+    with pytest.raises(ValueError, match='masses_kg'):
+        rm.plan_load_tests(model, 4, masses_kg=[10, -1])
+
+
 def test_synthesize_hammer_test_equals_frf_synth_byte_for_byte(hammer):
     tmp, _ = hammer  # the fixture's hammer.csv is frf-synth's output for these options
     cfg = rm.RobotConfig(KR210, set={'m6_kg': TRUTH['m6_kg'], 'd6_m': TRUTH['d6_m']})

@@ -89,8 +89,8 @@ void CheckValid(const PlanOptions& o) {
   if (!(o.max_rope_angle >= 0.0 && o.max_rope_angle < 0.5 * kPi)) {
     fail("max_rope_angle", o.max_rope_angle, "an angle in [0, pi/2) rad");
   }
-  if (o.num_candidate_postures < o.num_postures) {
-    fail("num_candidate_postures", o.num_candidate_postures, "at least num_postures");
+  if (o.num_candidate_postures != 0 && o.num_candidate_postures < o.num_postures) {
+    fail("num_candidate_postures", o.num_candidate_postures, "0 (automatic) or at least num_postures");
   }
   if (o.num_azimuths < 1) fail("num_azimuths", o.num_azimuths, "at least 1");
   if (!(o.joint_limit_margin >= 0.0)) fail("joint_limit_margin", o.joint_limit_margin, "a value >= 0 rad");
@@ -121,8 +121,10 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
   std::mt19937 rng(o.seed);
   std::vector<Candidate> cands;
   const auto& limits = model.chain().limits();
-  const int max_tries = 50 * o.num_candidate_postures;
-  for (int tries = 0; tries < max_tries && static_cast<int>(cands.size()) < o.num_candidate_postures; ++tries) {
+  const int num_wanted =
+      o.num_candidate_postures > 0 ? o.num_candidate_postures : std::max(400, 4 * o.num_postures);
+  const int max_tries = 50 * num_wanted;
+  for (int tries = 0; tries < max_tries && static_cast<int>(cands.size()) < num_wanted; ++tries) {
     Candidate c;
     c.q.resize(n);
     for (int j = 0; j < n; ++j) {

@@ -91,5 +91,21 @@ TEST(PlanLoadTests, TcpOnToolAxisCannotDetermineJoint6) {
   EXPECT_LT(plan.expected_relative_std(0), 0.1);
 }
 
+// num_candidate_postures 0 (the default) draws max(400, 4 N) candidates:
+// the KR210's limits with the margin leave almost every random posture
+// feasible, so the count is reached; an explicit count smaller than N is
+// refused, 0 is not.
+TEST(PlanLoadTests, AutomaticCandidateCount) {
+  const auto model = Kr210();
+  PlanOptions o;
+  o.num_postures = 2;
+  o.directions_per_posture = 1;
+  o.masses_kg = {20.0};
+  EXPECT_NO_THROW(CheckValid(o));
+  EXPECT_EQ(PlanLoadTests(*model, o).num_candidates, 400);
+  o.num_candidate_postures = 1;
+  EXPECT_THROW(CheckValid(o), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace robomach::identification

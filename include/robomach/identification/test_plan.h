@@ -31,7 +31,9 @@ struct PlanOptions {
   double min_load_height{0.3};                        // load point above the floor [m]
   double max_rope_angle{0.7853981633974483};          // rope from vertical [rad] (45°)
   double joint_limit_margin{0.08726646259971647};     // keep this far inside the limits [rad] (5°)
-  int num_candidate_postures{400};
+  /// Random feasible postures the design chooses from; 0 = automatic,
+  /// max(400, 4 · num_postures) (kq-identify --plan's choice).
+  int num_candidate_postures{0};
   int num_azimuths{8};                                // candidate rope azimuths per tilt
   unsigned seed{1};
   std::optional<Eigen::Vector3d> p_load_tip;          // [m] in the tip frame; nullopt = TCP
