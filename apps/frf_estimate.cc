@@ -215,10 +215,6 @@ int Run(int argc, char** argv) {
     }
     for (const std::string& w : r.warnings) Warn(kTool, w);
 
-    if (r.averages > 0 && r.averages < 3) {
-      Warn(kTool, "only " + std::to_string(r.averages) +
-                      " hit(s) averaged: the coherence needs at least 3 to mean much, 5 or more are usual");
-    }
     const RunFindings verdict = calibration::JudgeFrfEstimate(r, min_hits, "--min-hits");
     std::vector<std::string> flags;
     for (const Finding& f : verdict.findings) {

@@ -379,6 +379,9 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
   }
   if (result.averages == 1) {
     result.warnings.push_back("one accepted hit: the coherence is 1 on every line by construction and says nothing");
+  } else if (result.averages == 2) {
+    result.warnings.push_back(
+        "only 2 hits averaged: the coherence needs at least 3 to mean much, 5 or more are usual");
   }
   // Unit plausibility: the largest receptance on the coherent lines.
   for (int c = 0; c < nc; ++c) {

@@ -386,6 +386,33 @@ TEST(FrfEstimate, PrimeLengthIsCutToAFastLength) {
   EXPECT_LT(worst, 0.02);
 }
 
+// One or two averaged hits: the coherence cannot mean much, and the result
+// says so in its warnings (the tool prints them, Python returns them); three
+// hits do not warn about it.
+TEST(FrfEstimate, FewHitsWarnAboutTheCoherence) {
+  const ThreeDofChain sys = ThreeDofChain::Default();
+  AcquisitionSpec acq;
+  std::mt19937 rng(11);
+  HammerSimulator sim(sys, acq);
+  std::vector<ImpactRecord> hits;
+  for (int i = 0; i < 3; ++i) hits.push_back(sim.Simulate(HitSpec{}, &rng, std::to_string(i + 1)));
+  auto warns = [](const FrfEstimateResult& r, const std::string& text) {
+    for (const std::string& w : r.warnings) {
+      if (w.find(text) != std::string::npos) return true;
+    }
+    return false;
+  };
+  const FrfEstimateResult one = EstimateFrf({hits[0]}, testing::SimulatedChannels());
+  ASSERT_EQ(one.averages, 1);
+  EXPECT_TRUE(warns(one, "one accepted hit: the coherence is 1 on every line"));
+  const FrfEstimateResult two = EstimateFrf({hits[0], hits[1]}, testing::SimulatedChannels());
+  ASSERT_EQ(two.averages, 2);
+  EXPECT_TRUE(warns(two, "only 2 hits averaged"));
+  const FrfEstimateResult three = EstimateFrf(hits, testing::SimulatedChannels());
+  ASSERT_EQ(three.averages, 3);
+  EXPECT_FALSE(warns(three, "hits averaged") || warns(three, "one accepted hit"));
+}
+
 // The known biases [Bendat & Piersol 2010]: noise on the response
 // only leaves H1 unbiased and biases H2 up by 1/γ²; noise on the force only
 // (no force window, so that it stays) leaves H2 unbiased and biases H1 down.
