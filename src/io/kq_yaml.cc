@@ -1,7 +1,6 @@
 #include "robomach/io/kq_yaml.h"
 
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <regex>
@@ -83,7 +82,6 @@ std::string JointStiffnessYaml(const identification::JointStiffnessResult& r,
 std::string MergeJointStiffness(const std::string& config_path, const Eigen::VectorXd& kq,
                                 const std::string& output_path,
                                 const std::vector<std::string>& header_comments) {
-  namespace fs = std::filesystem;
   std::ifstream in(config_path);
   if (!in) throw InputError({config_path, 0, 0}, "cannot read the robot config");
   // Check the structure with the YAML reader first (file:line:col errors).
@@ -101,7 +99,6 @@ std::string MergeJointStiffness(const std::string& config_path, const Eigen::Vec
   for (const auto& c : header_comments) out << "# " << c << "\n";
   const std::regex kq_line(R"(^joint_stiffness_Nm_per_rad\s*:\s*\[.*\]\s*(#.*)?$)");
   const std::regex urdf_line(R"(^(\s+urdf\s*:\s*)([^#\s]+)(.*)$)");
-  const fs::path out_dir = fs::absolute(fs::path(output_path)).parent_path();
   std::string line;
   int line_no = 0, replaced = 0;
   while (std::getline(in, line)) {
@@ -112,10 +109,8 @@ std::string MergeJointStiffness(const std::string& config_path, const Eigen::Vec
       for (int j = 0; j < kq.size(); ++j) out << (j ? ", " : "") << Value(kq(j));
       out << "]   # identified by kq-identify\n";
       ++replaced;
-    } else if (std::regex_match(line, m, urdf_line) && !fs::path(m[2].str()).is_absolute()) {
-      const fs::path urdf = fs::absolute(ResolveRelative(config_path, m[2].str()));
-      out << m[1].str() << urdf.lexically_normal().lexically_relative(out_dir).string() << m[3].str()
-          << "\n";
+    } else if (std::regex_match(line, m, urdf_line)) {
+      out << m[1].str() << RebaseRelative(config_path, m[2].str(), output_path) << m[3].str() << "\n";
     } else {
       out << line << "\n";
     }

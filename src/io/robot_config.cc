@@ -3,7 +3,6 @@
 #include <cmath>
 #include <regex>
 #include <fstream>
-#include <filesystem>
 #include <sstream>
 
 #include "robomach/common/units.h"
@@ -258,7 +257,6 @@ std::string ParametersYaml(const dynamics::ParameterSet& p, const dynamics::Para
 std::string CalibratedConfigText(const std::string& input_path, const std::string& output_path,
                                  const std::string& parameters_yaml, const std::vector<std::string>& effects,
                                  bool* effects_left_out) {
-  namespace fs = std::filesystem;
   std::ifstream in(input_path);
   std::stringstream ss;
   ss << in.rdbuf();
@@ -266,8 +264,6 @@ std::string CalibratedConfigText(const std::string& input_path, const std::strin
   std::ostringstream out;
   std::string line;
   bool skipping = false;
-  const fs::path in_dir = fs::absolute(input_path).parent_path();
-  const fs::path out_dir = fs::absolute(output_path).parent_path();
   const std::regex urdf_re(R"(^(\s+urdf:\s*)([^#\s]+)(.*)$)");
   while (std::getline(lines, line)) {
     if (skipping) {
@@ -279,12 +275,8 @@ std::string CalibratedConfigText(const std::string& input_path, const std::strin
       continue;
     }
     std::smatch m;
-    if (std::regex_match(line, m, urdf_re) && in_dir != out_dir) {
-      fs::path p = m[2].str();
-      if (p.is_relative()) {
-        p = fs::relative(fs::weakly_canonical(in_dir / p), out_dir);
-        line = m[1].str() + p.string() + m[3].str();
-      }
+    if (std::regex_match(line, m, urdf_re)) {
+      line = m[1].str() + RebaseRelative(input_path, m[2].str(), output_path) + m[3].str();
     }
     out << line << '\n';
   }

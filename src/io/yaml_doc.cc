@@ -217,4 +217,14 @@ std::string ResolveRelative(const std::string& config_path, const std::string& r
   return (base / rel).lexically_normal().string();
 }
 
+std::string RebaseRelative(const std::string& config_path, const std::string& path,
+                           const std::string& output_path) {
+  namespace fs = std::filesystem;
+  if (fs::path(path).is_absolute()) return path;
+  const fs::path target = fs::absolute(ResolveRelative(config_path, path)).lexically_normal();
+  const fs::path out_dir = fs::absolute(output_path).parent_path().lexically_normal();
+  const fs::path rel = target.lexically_relative(out_dir);
+  return rel.empty() ? target.string() : rel.string();
+}
+
 }  // namespace robomach::io

@@ -6,7 +6,9 @@
 #include <sstream>
 
 #include "robomach/dynamics/robot_model.h"
+#include "robomach/io/kq_yaml.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/io/yaml_doc.h"
 #include "test_support.h"
 
 namespace robomach::io {
@@ -131,6 +133,34 @@ TEST(RobotConfig, CalibratedConfigLoadsFromAnotherFolderWithItsValues) {
     ++blocks;
   }
   EXPECT_EQ(blocks, 1u);
+}
+
+// Both writers of a config copy (frf-calibrate's calibrated config,
+// kq-identify --merge) re-base the relative URDF path so that the copy
+// loads, also when the copy's folder is reached through a symbolic link to a
+// folder at another depth: the loader resolves '..' lexically, and a path
+// re-based from the link's target would climb too far.
+TEST(RobotConfig, CopiesLoadThroughASymbolicLinkToAnotherDepth) {
+  namespace fs = std::filesystem;
+  EXPECT_EQ(RebaseRelative("/a/b/c.yaml", "../r.urdf", "/a/x/y/out.yaml"), "../../r.urdf");
+  EXPECT_EQ(RebaseRelative("/a/b/c.yaml", "r.urdf", "/a/b/out.yaml"), "r.urdf");
+  EXPECT_EQ(RebaseRelative("/a/b/c.yaml", "/abs/r.urdf", "/q/out.yaml"), "/abs/r.urdf");
+
+  const fs::path dir = TempDir("config_copy_symlink");
+  fs::create_directories(dir / "deep" / "er" / "real");
+  std::error_code ec;
+  fs::remove(dir / "link", ec);
+  fs::create_directory_symlink(dir / "deep" / "er" / "real", dir / "link");
+  const std::string src = SourcePath("config/kr210.yaml");
+  const RobotConfig in = LoadRobotConfig(src);
+  const std::string cal = (dir / "link" / "cal.yaml").string();
+  WriteText(cal, CalibratedConfigText(src, cal, ParametersYaml(in.parameters, dynamics::DefaultParameters(in.description)),
+                                      {}, nullptr));
+  EXPECT_EQ(LoadRobotConfig(cal).Build()->num_joints(), 6);
+  const std::string merged = (dir / "link" / "merged.yaml").string();
+  Eigen::VectorXd kq = in.Build()->joint_stiffness();
+  WriteText(merged, MergeJointStiffness(src, kq, merged, {"merged"}));
+  EXPECT_EQ(LoadRobotConfig(merged).Build()->num_joints(), 6);
 }
 
 }  // namespace

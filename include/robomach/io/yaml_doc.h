@@ -63,4 +63,13 @@ class YamlDoc {
 /// Resolves a path given inside a config file relative to that file's folder.
 std::string ResolveRelative(const std::string& config_path, const std::string& relative);
 
+/// A path given inside the config at `config_path`, rewritten for a copy of
+/// that config written to `output_path`: a relative path is re-based onto the
+/// copy's folder so that ResolveRelative(output_path, result) names the file
+/// ResolveRelative(config_path, path) names; an absolute path is returned
+/// unchanged. Lexical, as ResolveRelative is: the '..' of a path through a
+/// symbolic link undoes the link's name, not the folder it points to.
+std::string RebaseRelative(const std::string& config_path, const std::string& path,
+                           const std::string& output_path);
+
 }  // namespace robomach::io
