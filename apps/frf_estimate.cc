@@ -183,18 +183,15 @@ int Run(int argc, char** argv) {
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--direction ") + e.what());
     }
-    if (!response_ranges.empty()) {
-      o.response_range.assign(rec.channels.size(), 0.0);
-      for (const std::string& text : response_ranges) {
-        const auto [name, value] = ParseAssignment("--response-range", text);
-        size_t c = 0;
-        while (c < rec.channels.size() && rec.channels[c].name != name) ++c;
-        if (c == rec.channels.size()) {
-          throw UsageError("--response-range " + text + ": no response channel '" + name + "'");
-        }
-        CheckOptionRange("--response-range " + name, value, 0.0, 1e300);
-        o.response_range[c] = value;
-      }
+    std::map<std::string, double> ranges;
+    for (const std::string& text : response_ranges) {
+      const auto [name, value] = ParseAssignment("--response-range", text);
+      ranges[name] = value;
+    }
+    try {
+      o.response_range = io::ResponseRanges(rec, ranges);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--response-range ") + e.what());
     }
     std::cerr << kTool << ": " << rec.hits.size() << " hit(s) at " << FormatNumber(rec.hits.front().sample_rate_hz, 7)
               << " Hz; pose " << pose_id << ", excitation " << AxisName(exc) << ", responses";

@@ -85,7 +85,8 @@ NoiseOptions MakeNoiseOptions(double min_snr, int averages, bool use_coherence, 
 // frf-estimate's call: read the records, key the channels, estimate, judge.
 py::dict EstimateFrfs(const std::vector<std::string>& records, const std::string& pose_id,
                       const std::string& excitation, const std::map<std::string, std::string>& directions,
-                      const std::string& estimator, int min_hits, const calibration::FrfEstimateOptions& o) {
+                      const std::string& estimator, int min_hits, calibration::FrfEstimateOptions o,
+                      const std::map<std::string, double>& response_range) {
   if (records.empty()) throw std::invalid_argument("records: expected at least one hammer record file");
   for (const std::string& r : records) RequireReadableFile(r);
   if (estimator != "h1" && estimator != "h2") {
@@ -101,6 +102,7 @@ py::dict EstimateFrfs(const std::vector<std::string>& records, const std::string
     py::gil_scoped_release release;
     rec = io::ReadHammerRecords(records);
     keys = io::ChannelKeys(rec, pose_id, exc, directions);
+    o.response_range = io::ResponseRanges(rec, response_range);
     r = calibration::EstimateFrf(rec.hits, rec.channels, o);
   }
   const RunFindings verdict = calibration::JudgeFrfEstimate(r, min_hits, "min_hits");
@@ -289,7 +291,8 @@ void BindFrf(py::module_& m) {
            const std::optional<std::map<std::string, std::string>>& directions, const std::string& estimator,
            int min_hits, double fmax_hz, double force_window_s, double force_window_pre_s,
            double force_window_taper_s, double exponential_tau_s, double double_hit_fraction,
-           double trigger_fraction, int flat_top_samples, double force_range_N) {
+           double trigger_fraction, int flat_top_samples, double force_range_N,
+           const std::map<std::string, double>& response_range) {
           calibration::FrfEstimateOptions o;
           o.fmax_hz = fmax_hz;
           o.force_window_s = force_window_s;
@@ -301,7 +304,7 @@ void BindFrf(py::module_& m) {
           o.flat_top_samples = flat_top_samples;
           o.force_range_N = force_range_N;
           return EstimateFrfs(records, pose_id, excitation, directions.value_or(std::map<std::string, std::string>{}),
-                              estimator, min_hits, o);
+                              estimator, min_hits, o, response_range);
         },
         py::arg("records"), py::arg("pose_id") = "P1", py::arg("excitation") = "x", py::arg("directions") = py::none(),
         py::arg("estimator") = "h1", py::arg("min_hits") = 3, py::arg("fmax_hz") = kEstimate.fmax_hz,
@@ -311,12 +314,14 @@ void BindFrf(py::module_& m) {
         py::arg("double_hit_fraction") = kEstimate.double_hit_fraction,
         py::arg("trigger_fraction") = kEstimate.trigger_fraction, py::arg("flat_top_samples") = kEstimate.flat_top_samples,
         py::arg("force_range_N") = kEstimate.force_range_N,
+        py::arg("response_range") = std::map<std::string, double>{},
         "frf-estimate's call: tool-tip FRFs from raw impact-hammer records (files of docs/formats.md §10: "
         "time_s, force_N, responses <name>_m / _m_per_s / _m_per_s2, optional hit). Each response channel's "
         "direction comes from `directions` ({name: 'x'|'y'|'z'}) or its name (..._x, ..._y, ..._z); "
         "excitation is the hammer's direction. H1 (or H2) averaged over the accepted hits; hits with a double "
         "hit or an overload are rejected. Windows in seconds as frf-estimate's options (0: automatic; a "
-        "negative force_window_s: none); fmax_hz 0: sample rate / 2.56; force_range_N 0: unknown. Returns "
+        "negative force_window_s: none); fmax_hz 0: sample rate / 2.56; force_range_N 0: unknown; response_range {name: range in the "
+        "channel's SI unit} (frf-estimate's --response-range; a sample at or beyond it is an overload). Returns "
         "{'status': 'ok', 'flagged' (fewer accepted hits than min_hits, leakage, an implausible receptance) "
         "or 'no_estimate' (every hit rejected), 'findings': [str], 'averages': int, 'frfs': FrfSet "
         "(receptance [m/N] with the coherence; None without an estimate), 'labels': [str], 'summary': dict "

@@ -110,6 +110,33 @@ def test_few_hits_are_flagged_and_every_rejected_hit_gives_no_estimate(records):
         '1': 'overload', '2': 'overload', '3': 'overload', '4': 'double hit', '5': 'overload'}
 
 
+def test_response_range_rejects_the_hits_that_reach_it_as_the_tool_does(records, tmp_path):
+    # The accelerometer's peak per hit, read from the file with numpy: a range
+    # just under the largest peak of hits 1-3 makes that hit an overload and
+    # leaves the others accepted.
+    lines = [x for x in open(records / 'hits.csv') if not x.startswith('#')]
+    names = lines[0].strip().split(',')
+    rows = np.array([[float(v) for v in x.split(',')] for x in lines[1:]])
+    hit, acc = rows[:, names.index('hit')], rows[:, names.index('acc_y_m_per_s2')]
+    peaks = {h: np.abs(acc[hit == h]).max() for h in (1, 2, 3)}
+    loudest = max(peaks, key=peaks.get)
+    limit = 0.999 * peaks[loudest]
+    assert sorted(peaks.values())[1] < limit, 'the two largest peaks are too close for this test'
+    r = rm.estimate_frf([str(records / 'hits.csv')], min_hits=2, response_range={'acc_y': limit})
+    statuses = {h['id']: h['status'] for h in r['summary']['hits']}
+    expected = {str(h): ('overload' if h == loudest else 'accepted') for h in (1, 2, 3)}
+    assert {k: statuses[k] for k in expected} == expected and r['averages'] == 2
+    if tool_path('frf-estimate') is not None:
+        summary = tmp_path / 'summary.json'
+        run_tool('frf-estimate', records / 'hits.csv', '--min-hits', 2, '--out', tmp_path / 'frf.csv', '--summary',
+                 summary, '--response-range', f'acc_y={limit!r}')
+        assert json.load(open(summary))['hits'] == r['summary']['hits']
+    with pytest.raises(ValueError, match="acc=50: no response channel 'acc'"):
+        rm.estimate_frf([str(records / 'hits.csv')], response_range={'acc': 50.0})
+    with pytest.raises(ValueError, match='tip_x=-1: expected a finite range >= 0'):
+        rm.estimate_frf([str(records / 'hits.csv')], response_range={'tip_x': -1.0})
+
+
 def test_bad_input_raises_with_the_message(records):
     with pytest.raises(ValueError, match="acc=z: no response channel 'acc'"):
         rm.estimate_frf([str(records / 'hits.csv')], directions={'acc': 'z'})

@@ -290,6 +290,22 @@ EstimatedFrfs ToEstimatedFrfs(const calibration::FrfEstimateResult& r, const Ham
   return out;
 }
 
+std::vector<double> ResponseRanges(const HammerRecords& rec, const std::map<std::string, double>& ranges) {
+  if (ranges.empty()) return {};
+  std::vector<double> out(rec.channels.size(), 0.0);
+  for (const auto& [name, value] : ranges) {
+    const std::string entry = name + "=" + FormatDouble(value);
+    size_t c = 0;
+    while (c < rec.channels.size() && rec.channels[c].name != name) ++c;
+    if (c == rec.channels.size()) throw std::invalid_argument(entry + ": no response channel '" + name + "'");
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      throw std::invalid_argument(entry + ": expected a finite range >= 0 in the channel's SI unit (0 = unknown)");
+    }
+    out[c] = value;
+  }
+  return out;
+}
+
 std::vector<dynamics::FrfKey> ChannelKeys(const HammerRecords& rec, const std::string& pose_id, Axis excitation,
                                           const std::map<std::string, std::string>& directions) {
   for (const auto& [name, v] : directions) {

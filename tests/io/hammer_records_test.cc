@@ -52,6 +52,22 @@ TEST(HammerRecords, HitColumnSplitsHitsAndSuffixesGiveQuantities) {
   EXPECT_DOUBLE_EQ(r.hits[0].response(3, 1), 1.5);
 }
 
+// Ranges given by channel name come back in channel order, 0 where none is
+// given; an unknown name or a negative range is refused with the entry.
+TEST(HammerRecords, ResponseRangesByChannelName) {
+  const std::string dir = TempDir("hammer_records_ranges");
+  const std::string path =
+      WriteText(dir + "/run.csv", "hit,time_s,force_N,tip_x_m,acc_y_m_per_s2\n" + Rows("1", 20));
+  const HammerRecords r = ReadHammerRecords({path});
+  EXPECT_TRUE(ResponseRanges(r, {}).empty());
+  EXPECT_EQ(ResponseRanges(r, {{"acc_y", 490.0}}), (std::vector<double>{0.0, 490.0}));
+  EXPECT_EQ(ResponseRanges(r, {{"acc_y", 490.0}, {"tip_x", 0.002}}), (std::vector<double>{0.002, 490.0}));
+  EXPECT_THAT(CaptureError([&] { ResponseRanges(r, {{"acc", 50.0}}); }),
+              HasSubstr("acc=50: no response channel 'acc'"));
+  EXPECT_THAT(CaptureError([&] { ResponseRanges(r, {{"tip_x", -1.0}}); }),
+              HasSubstr("tip_x=-1: expected a finite range >= 0"));
+}
+
 // A rate that is not a whole number of hertz stays as it is: 1/(1.0005 ms)
 // = 999.50 Hz, 0.5 Hz from 1000 while the times' rounding (1e-9 s over
 // 19 ms) allows 1e-4 Hz.

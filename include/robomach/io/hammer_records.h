@@ -62,6 +62,14 @@ HammerRecords ReadHammerRecords(const std::vector<std::string>& paths);
 std::vector<dynamics::FrfKey> ChannelKeys(const HammerRecords& records, const std::string& pose_id, Axis excitation,
                                           const std::map<std::string, std::string>& directions = {});
 
+/// FrfEstimateOptions::response_range from ranges given by channel name, in
+/// each channel's SI unit (m, m/s, m/s²; 0 = unknown): one entry per
+/// channel in channel order, 0 where no range is given; empty when `ranges`
+/// is.
+/// @throws std::invalid_argument naming the entry ("acc=50: no response
+///   channel 'acc'", a range that is negative or not finite).
+std::vector<double> ResponseRanges(const HammerRecords& records, const std::map<std::string, double>& ranges);
+
 /// Writes estimated FRFs as the CSV of formats.md §3 (WriteFrfCsv, with
 /// `# averages: N`), preceded by `# key: value` lines that record how they
 /// were estimated (estimator, hits, windows). ReadFrfCsv reads such a file
