@@ -3,6 +3,7 @@ the FRF of config/kr210.yaml at a posture and it equals the frf-predict
 tool's --out file to 1e-12. Then a second method (direct solve against modal
 superposition) and the static limit."""
 import csv
+import os
 
 import numpy as np
 import pytest
@@ -22,6 +23,15 @@ def read_tool_csv(path, pose_id):
         if pose == pose_id:
             H[index[float(f)], 'xyz'.index(resp), 'xyz'.index(exc)] = complex(float(re), float(im))
     return np.array(freq), H
+
+
+def test_module_comes_from_where_it_was_put():
+    # Set by run_installed.py (ctest python.installed): the module must be the
+    # one `cmake --install` wrote under the scratch prefix, not the build tree's.
+    expected = os.environ.get('ROBOMACH_EXPECT_MODULE_DIR')
+    if expected is None:
+        pytest.skip('not run from an install prefix')
+    assert os.path.dirname(os.path.realpath(rm.__file__)) == os.path.realpath(expected)
 
 
 @pytest.mark.parametrize('method', ['modal', 'direct'])
