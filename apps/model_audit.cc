@@ -63,7 +63,7 @@ int Run(int argc, char** argv) {
              "explained (the effect is named and effects.yaml written, but a misfit remains), or a fit failed (the "
              "report is complete; candidates.csv says which and why), or a measured receptance is outside 1e-12..1e-3 "
              "m/N (a unit mistake).");
-  std::string robot_path, postures_path, report_dir, compare_dir, candidates_list, summary_path;
+  std::string robot_path, postures_path, report_dir, compare_dir, candidates_list, summary_path, write_config;
   std::vector<std::string> measured_files, pose_files, adds;
   audit::AuditOptions opt;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
@@ -74,6 +74,17 @@ int Run(int argc, char** argv) {
   app.add_option("--summary", summary_path, "also write the report's summary.json here ('-' = stdout, after the effects YAML)");
   app.add_option("--add", adds, "switch on an effect before the audit (e.g. the winner of a previous one); its fittable parameters are calibrated too; repeatable");
   app.add_option("--compare", compare_dir, "a previous audit's report folder: its errors are shown next to these");
+  app.add_option("--write-config", write_config,
+                 "write the robot config with the named change: the effect (or the parameters found off) and every "
+                 "calibration value fitted with it; with no failure, the calibrated current model; with no named "
+                 "change, nothing (a warning says so). Loadable by every tool");
+  bool no_parameters = false;
+  app.add_flag("--no-parameter-hypotheses", no_parameters,
+               "do not try freeing the model's joint stiffnesses (kq1..kqn) as explanations");
+  int virtual_joints = opt.virtual_joints_fitted;
+  app.add_option("--virtual-joints", virtual_joints,
+                 "how many of the best virtual joints (compliance along the chain) to fit after the screen; 0: none")
+      ->capture_default_str();
   app.add_option("--candidates", candidates_list, "comma-separated effects to try; default: every library effect not in the model");
   app.add_option("--fmin-hz", opt.fmin_hz, "lowest frequency used [Hz]")->capture_default_str();
   app.add_option("--fmax-hz", opt.fmax_hz, "highest frequency used [Hz]; default: all lines");
@@ -95,6 +106,9 @@ int Run(int argc, char** argv) {
                        FormatNumber(opt.fmax_hz));
     }
     CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
+    CheckOptionRange("--virtual-joints", virtual_joints, 0, 50);
+    opt.virtual_joints_fitted = virtual_joints;
+    opt.try_parameters = !no_parameters;
     {
       std::set<std::string> seen;
       for (const std::string& a : adds) {
@@ -111,7 +125,7 @@ int Run(int argc, char** argv) {
                                                                   {"--postures", postures_path}};
       for (const auto& f : measured_files) inputs.push_back({"--measured", f});
       for (const auto& f : pose_files) inputs.push_back({"--pose", f.substr(f.find('=') + 1)});
-      CheckDistinctPaths(inputs, {{"--report", report_dir}, {"--summary", summary_path}});
+      CheckDistinctPaths(inputs, {{"--report", report_dir}, {"--summary", summary_path}, {"--write-config", write_config}});
     }
     if (measured_files.empty() && pose_files.empty()) {
       throw UsageError("no measured FRFs: give --measured FILE or --pose ID=file.uff");
@@ -183,11 +197,51 @@ int Run(int argc, char** argv) {
     ro.previous = previous;
     ro.compare_dir = compare_dir;
     ro.progress = opt.progress;
+    // The config with the named change (issue #33 §6): built and checked
+    // (loaded back) before anything is written.
+    std::string config_text;
+    if (!write_config.empty()) {
+      const audit::CandidateResult* named =
+          r.grade == audit::AuditGrade::kExplained || r.grade == audit::AuditGrade::kMostlyExplained
+              ? audit::AcceptedCandidate(r)
+              : nullptr;
+      if (named || r.grade == audit::AuditGrade::kNoFailure) {
+        audit::CandidateResult change;
+        if (named) {
+          change = *named;
+        } else {
+          change.fit = r.baseline_fit;  // no failure: the calibrated current model
+        }
+        const auto [desc, params] = audit::CandidateModel(cfg.description, change);
+        std::vector<std::string> effects = adds;
+        for (const std::string& e : change.effects) effects.push_back(e);
+        bool left_out = false;
+        config_text = io::CalibratedConfigText(
+            robot_path, write_config, io::ParametersYaml(params, dynamics::DefaultParameters(desc)), effects, &left_out,
+            "Written by robomach model-audit --write-config: " +
+                (named ? audit::DescribeCandidate(*named, r.configured) : std::string("the calibrated current model")) +
+                ", with the calibration values fitted with it.");
+        if (left_out) {
+          Warn(kTool, "the config's `effects:` list is a flow list; add " + [&] {
+            std::string l;
+            for (const auto& e : effects) l += (l.empty() ? "" : ", ") + e;
+            return l;
+          }() + " to " + write_config + " by hand");
+        }
+        ro.written_config = write_config;
+      } else {
+        Warn(kTool, "--write-config " + write_config + " not written: the audit names no change (" +
+                        audit::AuditGradeName(r.grade) + ")");
+      }
+    }
+    for (const audit::BoundFlag& f : r.baseline_on_bound) Warn(kTool, f.message);
+    ro.input_warnings = WarningsGiven();
     const report::AuditReport rep = report::WriteAuditReport(report_dir, r, cfg.description, postures, measured,
                                                              measured_read.frfs, noise, ro);
     const json& j = rep.summary;
     const std::string& yaml = rep.effects_yaml;
     if (!summary_path.empty() && summary_path != "-") io::WriteFileAtomically(summary_path, report::DumpJson(j));
+    if (!config_text.empty()) io::WriteFileAtomically(write_config, config_text);
 
     std::cerr << kTool << ": " << r.verdict << '\n';  // always; a finding when unexplained
     const RunFindings verdict = audit::JudgeAudit(r);

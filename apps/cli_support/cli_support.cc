@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <mutex>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -116,8 +117,26 @@ void ProgressLine::Finish() {
   if (active_ && tty_) std::cerr << '\n';
 }
 
+namespace {
+std::mutex& WarningsMutex() {
+  static std::mutex m;
+  return m;
+}
+std::vector<std::string>& WarningsList() {
+  static std::vector<std::string> w;
+  return w;
+}
+}  // namespace
+
 void Warn(const std::string& tool, const std::string& message) {
   std::cerr << tool << ": warning: " << message << '\n';
+  std::lock_guard<std::mutex> lock(WarningsMutex());
+  WarningsList().push_back(message);
+}
+
+std::vector<std::string> WarningsGiven() {
+  std::lock_guard<std::mutex> lock(WarningsMutex());
+  return WarningsList();
 }
 
 std::function<std::string(const std::string&)> PngFileName() {

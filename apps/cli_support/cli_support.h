@@ -110,6 +110,10 @@ class ProgressLine {
 
 /// Prints "tool: warning: message" on stderr.
 void Warn(const std::string& tool, const std::string& message);
+/// Every message given to Warn() so far in this process, in order: the tools
+/// put them in their summary and report (every warning a tool prints is
+/// also there).
+std::vector<std::string> WarningsGiven();
 /// "tool: note: message" on stderr: what a reader inferred or skipped; not
 /// a warning, and no reason for exit 3.
 void Note(const std::string& tool, const std::string& message);

@@ -37,7 +37,36 @@ py::dict ResultDict(const audit::AuditResult& r) {
   d["bic_gap"] = number(r.bic_gap);
   d["runner_up"] = r.runner_up;
   d["reasons"] = r.reasons;
+  d["next_steps"] = r.next_steps;
   d["warnings"] = r.warnings;
+  py::list changes;
+  for (const auto& pc : r.parameter_changes) {
+    py::dict c;
+    c["name"] = pc.name;
+    c["unit"] = pc.unit;
+    c["configured"] = pc.configured;
+    c["fitted"] = number(pc.fitted);
+    c["std"] = number(pc.std_dev);
+    c["ratio"] = number(pc.ratio());
+    changes.append(c);
+  }
+  d["parameter_changes"] = changes;
+  d["description"] = r.graded >= 0 ? py::object(py::str(audit::DescribeCandidate(r.candidates[r.graded], r.configured)))
+                                   : py::none();
+  py::list on_bound;
+  for (const auto& f : r.baseline_on_bound) on_bound.append(f.message);
+  d["baseline_on_bound"] = on_bound;
+  d["error_configured"] = r.errors_configured.total_rms_log_mag;
+  py::list screen;
+  for (const auto& s : r.virtual_joint_screen) {
+    py::dict sd;
+    sd["effect"] = s.effect;
+    sd["stiffness"] = number(s.stiffness);
+    sd["predicted_error"] = number(s.predicted_error);
+    sd["fitted"] = s.fitted;
+    screen.append(sd);
+  }
+  d["virtual_joint_screen"] = screen;
   const RunFindings verdict = audit::JudgeAudit(r);
   d["status"] = RunStatusName(verdict.status());
   d["findings"] = FindingMessages(verdict);
@@ -46,6 +75,7 @@ py::dict ResultDict(const audit::AuditResult& r) {
     py::dict cd;
     cd["name"] = c.name();
     cd["effects"] = c.effects;
+    cd["freed_parameters"] = c.parameters;
     cd["bic_change"] = c.bic_change;
     cd["error_after"] = c.errors.total_rms_log_mag;
     cd["plausible"] = c.plausible;

@@ -23,13 +23,27 @@ void EffectRegistry::Register(Factory factory) {
   factories_.emplace_back(name, std::move(factory));
 }
 
+void EffectRegistry::RegisterFamily(std::string pattern, FamilyFactory factory) {
+  families_.emplace_back(std::move(pattern), std::move(factory));
+}
+
 std::shared_ptr<const Effect> EffectRegistry::Create(std::string_view name) const {
   for (const auto& [n, f] : factories_) {
     if (n == name) return f();
   }
+  for (const auto& [pattern, f] : families_) {
+    if (auto e = f(name)) return e;
+  }
   std::string known;
   for (const auto& n : Names()) known += (known.empty() ? "" : ", ") + n;
+  for (const auto& p : FamilyPatterns()) known += (known.empty() ? "" : ", ") + p;
   throw std::invalid_argument("unknown effect '" + std::string(name) + "'; available: " + known);
+}
+
+std::vector<std::string> EffectRegistry::FamilyPatterns() const {
+  std::vector<std::string> out;
+  for (const auto& [p, f] : families_) out.push_back(p);
+  return out;
 }
 
 std::vector<std::string> EffectRegistry::Names() const {

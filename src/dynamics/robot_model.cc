@@ -81,6 +81,7 @@ ParameterSet DefaultParameters(const RobotDescription& d) {
   p.Add({"beta_per_s", "1/s", d.beta, 0.0, 1e3, true, "mass-proportional Rayleigh damping"});
   for (const EffectConfig& ec : d.effects) {
     const auto effect = EffectRegistry::Instance().Create(ec.name);
+    effect->CheckApplicable(d);
     const auto specs = effect->parameters();
     for (ParameterSpec spec : specs) {
       spec.name = ec.name + "." + spec.name;
@@ -172,7 +173,8 @@ std::shared_ptr<const RobotModel> RobotModel::Build(const RobotDescription& d,
   // tip, whatever their order in the config (EffectStage).
   std::stable_sort(m->effects_.begin(), m->effects_.end(),
                    [](const BoundEffect& a, const BoundEffect& b) {
-                     return a.effect->stage() < b.effect->stage();
+                     if (a.effect->stage() != b.effect->stage()) return a.effect->stage() < b.effect->stage();
+                     return a.effect->stage_order() < b.effect->stage_order();
                    });
   int next_dof = n;
   for (BoundEffect& be : m->effects_) {

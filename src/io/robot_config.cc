@@ -256,12 +256,12 @@ std::string ParametersYaml(const dynamics::ParameterSet& p, const dynamics::Para
 
 std::string CalibratedConfigText(const std::string& input_path, const std::string& output_path,
                                  const std::string& parameters_yaml, const std::vector<std::string>& effects,
-                                 bool* effects_left_out) {
+                                 bool* effects_left_out, const std::string& comment) {
   std::ifstream in(input_path);
   std::stringstream ss;
   ss << in.rdbuf();
   std::istringstream lines(ss.str());
-  std::ostringstream out;
+  std::vector<std::string> out;
   std::string line;
   bool skipping = false;
   const std::regex urdf_re(R"(^(\s+urdf:\s*)([^#\s]+)(.*)$)");
@@ -278,19 +278,48 @@ std::string CalibratedConfigText(const std::string& input_path, const std::strin
     if (std::regex_match(line, m, urdf_re)) {
       line = m[1].str() + RebaseRelative(input_path, m[2].str(), output_path) + m[3].str();
     }
-    out << line << '\n';
+    out.push_back(line);
   }
-  out << "\n# Calibrated by robomach frf-calibrate against measured FRFs.\n" << parameters_yaml;
-  std::string text = out.str();
   if (effects_left_out) *effects_left_out = false;
+  std::string added;  // a new effects: block, when the config has none
   if (!effects.empty()) {
-    if (text.find("\neffects:") == std::string::npos && text.rfind("effects:", 0) != 0) {
-      text += "effects:\n";
-      for (const std::string& e : effects) text += "  - name: " + e + "\n";
-    } else if (effects_left_out) {
-      *effects_left_out = true;
+    // The config's own top-level `effects:` list, if any: the new entries
+    // go at its end, with the indentation of its items (block style), or
+    // replace an empty flow list `effects: []`.
+    int at = -1;
+    for (size_t i = 0; i < out.size(); ++i) {
+      if (out[i].rfind("effects:", 0) == 0) at = static_cast<int>(i);
+    }
+    if (at < 0) {
+      added = "effects:\n";
+      for (const std::string& e : effects) added += "  - name: " + e + "\n";
+    } else {
+      const std::string rest = std::regex_replace(out[at].substr(8), std::regex(R"(\s*(#.*)?$)"), "");
+      if (rest.empty() || rest == "[]") {
+        out[at] = "effects:";
+        std::string indent = "  ";
+        size_t last = static_cast<size_t>(at);
+        const std::regex item_re(R"(^(\s*)- .*$)");
+        for (size_t i = at + 1; i < out.size(); ++i) {
+          const std::string& l = out[i];
+          if (!l.empty() && l[0] != ' ' && l[0] != '\t' && l[0] != '#') break;
+          std::smatch m;
+          if (std::regex_match(l, m, item_re) && last == static_cast<size_t>(at)) indent = m[1].str();
+          if (!l.empty() && l.find_first_not_of(" \t") != std::string::npos && l[l.find_first_not_of(" \t")] != '#') {
+            last = i;
+          }
+        }
+        std::vector<std::string> items;
+        for (const std::string& e : effects) items.push_back(indent + "- name: " + e);
+        out.insert(out.begin() + static_cast<long>(last) + 1, items.begin(), items.end());
+      } else if (effects_left_out) {
+        *effects_left_out = true;  // a non-empty flow list: the user's layout, not edited
+      }
     }
   }
+  std::string text;
+  for (const std::string& l : out) text += l + "\n";
+  text += "\n# " + comment + "\n" + parameters_yaml + added;
   return text;
 }
 

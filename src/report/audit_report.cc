@@ -48,7 +48,34 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
 
   // ---- where it fails: trends, error map, modes without a counterpart.
   if (ro.progress) ro.progress("error patterns: trends against posture descriptors, mode error map, unmatched modes");
-  const auto base_model = dynamics::RobotModel::Build(description, r.baseline_fit.parameters);
+  // The pictures' model: the calibrated one, or the model as configured when
+  // the calibration ended on a bound (AuditResult::pictures_from).
+  const bool pictures_configured = r.pictures_from == "configured" && r.pictures_parameters.size() > 0;
+  const auto base_model =
+      dynamics::RobotModel::Build(description, pictures_configured ? r.pictures_parameters : r.baseline_fit.parameters);
+  std::vector<std::string> warnings = ro.input_warnings;
+  const auto warn_once = [&](const std::string& w) {
+    if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
+  };
+  for (const auto& f : r.baseline_on_bound) warn_once(f.message);
+  for (const auto& w : r.warnings) warn_once(w);
+  // The headline, with the previous audit's errors beside these (--compare).
+  std::string headline = r.headline;
+  if (!ro.previous.is_null() && ro.previous.contains("error_before")) {
+    std::ostringstream m;
+    m.precision(3);
+    const auto prev = [&](const char* key) {
+      return ro.previous.contains(key) && ro.previous[key].is_number() ? ro.previous[key].get<double>() : NAN;
+    };
+    const double nf = ro.previous.contains("noise_floor") && ro.previous["noise_floor"].is_number()
+                          ? ro.previous["noise_floor"].get<double>()
+                          : 1.0;
+    m << " Previous audit (" << ro.compare_dir << "): " << prev("error_before") / nf << " x the noise floor";
+    const double pa = prev("error_after") / nf;
+    if (std::isfinite(pa) && pa != prev("error_before") / nf) m << ", " << pa << " with its named change";
+    m << "; now " << r.errors_before.total_rms_log_mag / r.noise_floor << ".";
+    headline += m.str();
+  }
   const calibration::MeasuredFeatures& features = r.features;
   audit::ErrorPatternOptions popt;
   popt.fmin_hz = ro.fmin_hz;
@@ -68,8 +95,18 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
   // that is right); with --noise-model none, an rms of ln|H| differences.
   j["error_units"] = noise.empty() ? "log_magnitude" : "noise_sigma";
   j["noise"] = NoiseSummaryJson(noise, ro.noise_model, ro.min_snr);
-  j["warnings"] = r.warnings;
+  j["warnings"] = warnings;
   j["significant_failure"] = r.significant_failure;
+  // The baseline the user can trust (issue #33): the model as configured,
+  // the calibration parameters on a bound, and which model the pictures show.
+  j["baseline"] = {{"error_configured", r.errors_configured.total_rms_log_mag},
+                   {"error_calibrated", r.errors_before.total_rms_log_mag},
+                   {"pictures_from", r.pictures_from},
+                   {"on_bound", json::array()}};
+  for (const auto& f : r.baseline_on_bound) {
+    j["baseline"]["on_bound"].push_back(
+        {{"name", f.name}, {"value", f.value}, {"bound", f.lower ? "lower" : "upper"}, {"message", f.message}});
+  }
   j["baseline_calibration"] = {{"status", calibration::FitStatusName(r.baseline_fit.status)},
                                {"message", r.baseline_fit.message},
                                {"parameters", json::object()}};
@@ -100,7 +137,11 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
   j["unmatched_measured_modes"] = pr.unmatched_measured_modes;
   j["candidates"] = json::array();
   for (const auto& c : r.candidates) {
-    json cj{{"name", c.name()}, {"bic_change", c.bic_change}, {"error_after", c.errors.total_rms_log_mag},
+    json cj{{"name", c.name()},
+            {"kind", c.is_parameter_hypothesis() ? "parameters"
+                     : c.name().rfind("virtual_joint_", 0) == 0 ? "virtual_joint"
+                                                               : "effect"},
+            {"bic_change", c.bic_change}, {"error_after", c.errors.total_rms_log_mag},
             {"plausible", c.plausible}, {"note", c.note}, {"parameters", json::object()},
             {"not_identifiable", c.not_identifiable}, {"held_calibration", c.held_calibration},
             {"start", c.start}};
@@ -112,8 +153,11 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
   j["verdict"] = {{"grade", audit::AuditGradeName(r.grade)},
                   {"missing_effects", r.missing_effects},
                   {"explained", r.explained},
-                  {"headline", r.headline},
+                  {"headline", headline},
                   {"text", r.verdict},
+                  {"parameter_changes", json::array()},
+                  {"description", r.graded >= 0 ? json(audit::DescribeCandidate(r.candidates[r.graded], r.configured))
+                                                : json(nullptr)},
                   {"pattern", r.pattern},
                   {"candidate", r.graded >= 0 ? json(r.candidates[r.graded].name()) : json(nullptr)},
                   {"error_before_noise_units", number(r.error_before_noise_units)},
@@ -121,7 +165,24 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
                   {"fraction_removed", number(r.fraction_removed)},
                   {"bic_gap", number(r.bic_gap)},
                   {"runner_up", r.runner_up},
-                  {"reasons", r.reasons}};
+                  {"reasons", r.reasons},
+                  {"next_steps", r.next_steps}};
+  for (const auto& pc : r.parameter_changes) {
+    j["verdict"]["parameter_changes"].push_back({{"name", pc.name},
+                                                 {"unit", pc.unit},
+                                                 {"configured", pc.configured},
+                                                 {"fitted", number(pc.fitted)},
+                                                 {"std", number(pc.std_dev)},
+                                                 {"ratio", number(pc.ratio())}});
+  }
+  j["virtual_joint_screen"] = {{"baseline", number(r.virtual_joint_screen_baseline)}, {"joints", json::array()}};
+  for (const auto& s : r.virtual_joint_screen) {
+    j["virtual_joint_screen"]["joints"].push_back({{"effect", s.effect},
+                                                   {"stiffness", number(s.stiffness)},
+                                                   {"predicted_error", number(s.predicted_error)},
+                                                   {"fitted", s.fitted}});
+  }
+  if (!ro.written_config.empty()) j["written_config"] = ro.written_config;
   // The YAML to paste: the accepted candidate's effects, or else the
   // effects switched on with --add, with their calibrated values.
   std::string yaml;
@@ -167,7 +228,8 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
   // as not accepted, so that the unexplained pattern can be seen; with no
   // candidate fitted, the current model alone.
   const audit::CandidateResult* shown = best ? best : (r.candidates.empty() ? nullptr : &r.candidates[0]);
-  const std::string before_label = "current model (calibrated)";
+  const std::string before_label =
+      pictures_configured ? "current model (as configured)" : "current model (calibrated)";
   const std::string after_label =
       shown ? "with " + shown->name() +
                   (!best ? " (not accepted)"
@@ -194,7 +256,7 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
        "</style></head><body><h1>model-audit: " << HtmlEscape(ro.robot_path) << "</h1>\n";
   {
     // The library's plain-text arrows and times signs, typeset.
-    std::string line = HtmlEscape(r.headline);
+    std::string line = HtmlEscape(headline);
     for (const auto& [from, to] : {std::pair<std::string, std::string>{" -&gt; ", " → "}, {" x the noise", " × the noise"}}) {
       for (size_t at = line.find(from); at != std::string::npos; at = line.find(from, at + to.size())) {
         line.replace(at, from.size(), to);
@@ -213,11 +275,30 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
       h << "; " << FormatNumber(shown->errors.curves[worst].rms_log_mag / r.noise_floor, 3) << " with "
         << HtmlEscape(shown->name());
     }
-    h << "): measured (wide, with its noise where known), the calibrated current model (dashed)";
+    h << "): measured (wide, with its noise where known), the " << before_label << " (dashed)";
     if (shown) {
       h << " and the model with " << HtmlEscape(shown->name()) << " (" << (best ? "" : "not accepted; ") << "thin line)";
     }
     h << ".</p>\n";
+  }
+  // What to do, right after the verdict and its picture (issue #33, #35).
+  if (!yaml.empty()) {
+    h << "<h2>What to do: " << (best ? (best->is_parameter_hypothesis() ? "set the fitted parameters" : "add the effect")
+                                      : "the added effects, calibrated")
+      << "</h2>";
+    if (!ro.written_config.empty()) {
+      h << "<p>The config with the change is written to <code>" << HtmlEscape(ro.written_config)
+        << "</code> (--write-config): every tool loads it as it is.</p>";
+    }
+    h << "<p>Or append these lines to the robot config (they hold the effect and every parameter fitted with it; "
+         "merge them into its <code>effects:</code> and <code>parameters:</code> blocks if it has them, or use "
+         "model-audit --write-config):</p><pre>"
+      << HtmlEscape(yaml) << "</pre>\n";
+  }
+  if (!warnings.empty()) {
+    h << "<h2>Warnings</h2><ul>";
+    for (const auto& w : warnings) h << "<li>" << HtmlEscape(w) << "</li>";
+    h << "</ul>\n";
   }
   h << "<h2>Verdict</h2>\n";
   if (r.grade == audit::AuditGrade::kMostlyExplained) {
@@ -228,6 +309,11 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
     h << "</ul>\n<p>Pattern of the remainder: " << HtmlEscape(r.pattern) << ".</p>\n";
   } else {
     h << "<p>" << HtmlEscape(r.verdict) << "</p>\n";
+  }
+  if (!r.next_steps.empty()) {
+    h << "<p>What to try next:</p><ul>";
+    for (const auto& n : r.next_steps) h << "<li>" << HtmlEscape(n) << "</li>";
+    h << "</ul>\n";
   }
   if (r.graded >= 0) {
     h << "<p>Graded on " << HtmlEscape(r.candidates[r.graded].name()) << ": error " << FormatNumber(r.error_before_noise_units, 3)
@@ -242,14 +328,16 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
     << "): before " << FormatNumber(r.errors_before.total_rms_log_mag) << ", after "
     << FormatNumber(after.total_rms_log_mag) << "; noise floor " << FormatNumber(r.noise_floor) << " ("
     << (r.significant_failure ? "significant failure" : "consistent with the noise") << ").</p>\n";
-  if (!noise.empty()) {
-    h << "<h2>Noise model and usable band per FRF</h2><p>Lines used where |H| ≥ " << FormatNumber(ro.min_snr)
-      << " × the additive noise floor (--min-snr).</p><table><tr><th>FRF</th><th>noise model</th></tr>\n";
-    for (const auto& [key, n] : noise) {
-      h << "<tr><td>" << HtmlEscape(KeyLabel(key)) << "</td><td style=\"text-align:left\">" << HtmlEscape(n.description)
-        << "</td></tr>\n";
-    }
-    h << "</table>\n";
+  h << "<h2>The baseline</h2><p>The model as configured: error " << FormatNumber(r.errors_configured.total_rms_log_mag)
+    << "; calibrated (m6, d6, alpha, beta and any effect given with --add): " << FormatNumber(r.errors_before.total_rms_log_mag)
+    << ". The pictures of where it fails (the mode table and error map, the overlays) show the "
+    << (pictures_configured ? "model as configured, because the calibration ended with a parameter on a bound"
+                            : "calibrated model")
+    << ".</p>\n";
+  if (!r.baseline_on_bound.empty()) {
+    h << "<ul>";
+    for (const auto& f : r.baseline_on_bound) h << "<li>" << HtmlEscape(f.message) << "</li>";
+    h << "</ul>\n";
   }
   h << "<h2>Error per posture</h2><table><tr><th>posture</th><th>before</th><th>after</th>";
   if (!ro.previous.is_null()) h << "<th>previous before</th><th>previous after</th>";
@@ -283,7 +371,7 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
     }
     h << "</tr>\n";
   }
-  h << "</table>\n<h2>Modes (current model, calibrated)</h2><table><tr><th>FRF</th><th>measured [Hz]</th>"
+  h << "</table>\n<h2>Modes (" << HtmlEscape(before_label) << ")</h2><table><tr><th>FRF</th><th>measured [Hz]</th>"
        "<th>frequency error</th><th>damping meas.</th><th>damping model</th><th>peak error</th></tr>\n";
   for (const auto& m : r.modes_before.matches) {
     h << "<tr><td>" << HtmlEscape(KeyLabel(m.key)) << "</td><td>" << FormatNumber(m.measured_freq_hz) << "</td><td>"
@@ -305,12 +393,32 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
     h << "</td></tr>\n";
   }
   h << "</table>\n";
-  if (!yaml.empty()) {
-    h << "<h2>" << (best ? "Add the effect" : "The added effects, calibrated")
-      << "</h2><p>Append to the robot config (merge into its <code>effects:</code> list if it has one):</p><pre>"
-      << HtmlEscape(yaml) << "</pre>\n";
+  if (!r.virtual_joint_screen.empty()) {
+    h << "<h2>Compliance along the chain: the virtual-joint screen</h2><p>Each elastic virtual joint added to the "
+         "calibrated model at stiffnesses a factor of 4 apart, with a linearised re-adjustment of the calibration "
+         "parameters: the rms whole-curve residual in units of the noise (the calibrated model: "
+      << FormatNumber(r.virtual_joint_screen_baseline, 4) << "). The best were fitted as candidates.</p><table>"
+         "<tr><th>virtual joint</th><th>where</th><th>best stiffness</th><th>screened error</th><th>fitted</th></tr>\n";
+    for (size_t i = 0; i < r.virtual_joint_screen.size() && i < 10; ++i) {
+      const auto& v = r.virtual_joint_screen[i];
+      audit::CandidateResult named;
+      named.effects = {v.effect};
+      h << "<tr><td>" << HtmlEscape(v.effect) << "</td><td style=\"text-align:left\">"
+        << HtmlEscape(audit::DescribeVirtualJoint(v.effect)) << "</td><td>" << FormatNumber(v.stiffness, 2)
+        << "</td><td>" << FormatNumber(v.predicted_error, 4) << "</td><td>" << (v.fitted ? "yes" : "") << "</td></tr>\n";
+    }
+    h << "</table>\n";
   }
-  h << "<h2>Overlays per posture</h2><p>Measured FRFs (wide band), the calibrated current model (dashed)"
+  if (!noise.empty()) {
+    h << "<h2>Noise model and usable band per FRF</h2><p>Lines used where |H| ≥ " << FormatNumber(ro.min_snr)
+      << " × the additive noise floor (--min-snr).</p><table><tr><th>FRF</th><th>noise model</th></tr>\n";
+    for (const auto& [key, n] : noise) {
+      h << "<tr><td>" << HtmlEscape(KeyLabel(key)) << "</td><td style=\"text-align:left\">" << HtmlEscape(n.description)
+        << "</td></tr>\n";
+    }
+    h << "</table>\n";
+  }
+  h << "<h2>Overlays per posture</h2><p>Measured FRFs (wide band), the " << HtmlEscape(before_label) << " (dashed)"
     << (shown ? " and the model " + HtmlEscape(after_label) + " (thin line)" : std::string())
     << "; vertical lines: the natural frequencies of the " << (shown ? "latter" : "model") << ".</p>\n";
   for (const auto& id : measured_fit.pose_ids()) {
@@ -326,9 +434,8 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
     dynamics::PostureEvaluator eb(base_model);
     std::unique_ptr<dynamics::PostureEvaluator> ea;
     if (shown) {
-      dynamics::RobotDescription desc = description;
-      for (const auto& e : shown->effects) desc.effects.push_back({e, {}});
-      ea = std::make_unique<dynamics::PostureEvaluator>(dynamics::RobotModel::Build(desc, shown->fit.parameters));
+      const auto [desc, params] = audit::CandidateModel(description, *shown);
+      ea = std::make_unique<dynamics::PostureEvaluator>(dynamics::RobotModel::Build(desc, params));
     }
     for (const std::string& pose : measured_fit.pose_ids()) {
       const auto db = eb.Evaluate(postures.at(pose));

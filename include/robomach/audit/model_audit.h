@@ -78,6 +78,23 @@ struct AuditOptions {
   /// on a parameter must change the χ² (residuals over the noise floor) by
   /// at least this much for it to be fitted (4: a 2σ change).
   double identifiable_chi2{4.0};
+  /// Parameter hypotheses (issue #33): before and beside the effects, the
+  /// model's own parameters named here are freed, each alone and the best
+  /// pairs, with the calibration parameters; one that explains the data is
+  /// reported as a parameter that is off, not as a missing effect.
+  /// Default: every joint stiffness kq1..kqn (the names must be parameters
+  /// of the model and not calibration parameters).
+  std::vector<std::string> parameter_candidates;
+  bool try_parameters{true};
+  /// Pairs of parameter hypotheses fitted: every pair of the best
+  /// `parameter_pairs_from` single hypotheses (by BIC; 3: three pairs).
+  int parameter_pairs_from{3};
+  /// Compliance anywhere along the chain (issue #33): every virtual joint
+  /// (dynamics effect virtual_joint_<place>_<axis>) is screened by a
+  /// stiffness scan with a linearised re-adjustment of the calibration
+  /// parameters, and the `virtual_joints_fitted` best are fitted fully as
+  /// candidates. 0: no virtual joints.
+  int virtual_joints_fitted{3};
   /// Candidates fitted at the same time (each fit is single-threaded).
   int threads{2};
   /// Called with one line per step (for progress on stderr); may be empty.
@@ -161,9 +178,14 @@ std::string AuditGradeName(AuditGrade grade);
 /// finite.
 double FractionRemoved(double before, double after, double noise_floor);
 
-/// One candidate effect (or pair, in the greedy round) fitted to the data.
+/// One candidate fitted to the data: an effect (or pair, in the greedy
+/// round) added to the model, or model parameters freed (a parameter
+/// hypothesis: `effects` empty, `parameters` the freed ones).
 struct CandidateResult {
   std::vector<std::string> effects;  // the added effects, in order of addition
+  /// Model parameters freed besides the calibration parameters (parameter
+  /// hypotheses: "kq2_Nm_per_rad"); empty for effects.
+  std::vector<std::string> parameters;
   calibration::CalibrationResult fit;
   ModelErrors errors;
   double bic{0.0};
@@ -188,14 +210,61 @@ struct CandidateResult {
   std::vector<std::string> pinned;
   /// Every fitted effect parameter converged, inside its bounds and not pinned at one.
   bool plausible{false};
+  /// A pair whose effect of this name adds nothing (pinned where it
+  /// vanishes; removing it changes χ² by less than identifiable_chi2): the
+  /// pair is the other effect alone and is never named.
+  std::string redundant;
   std::string note;         // why not plausible, or the fit's message
-  std::string name() const;  // "a" or "a+b"
+  std::string name() const;  // "a" or "a+b" (effects, then freed parameters)
+  /// Effects plus freed parameters: 1 for a single candidate, 2 for a pair.
+  int size() const { return static_cast<int>(effects.size() + parameters.size()); }
+  bool is_parameter_hypothesis() const { return effects.empty() && !parameters.empty(); }
+};
+
+/// A model parameter that a parameter hypothesis finds off its configured value.
+struct ParameterChange {
+  std::string name;     // "kq2_Nm_per_rad"
+  std::string unit;     // "N·m/rad"
+  double configured{NAN};  // the value the audit started from (the config's)
+  double fitted{NAN};
+  double std_dev{NAN};     // 1 σ of the fitted value
+  double ratio() const { return fitted / configured; }
+};
+
+/// One virtual joint of the screen (issue #33): its best stiffness on the
+/// scan and the error there after a linearised re-adjustment of the
+/// calibration parameters, in units of the noise floor.
+struct ScreenedVirtualJoint {
+  std::string effect;
+  double stiffness{NAN};         // [N·m/rad or N/m]
+  double predicted_error{NAN};   // rms whole-curve residual after a linearised recalibration, noise units
+  bool fitted{false};            // one of the best, fitted fully as a candidate
+};
+
+/// A calibration parameter of the calibrated current model that ended on a
+/// bound: the calibration stands in for something missing (issue #33).
+struct BoundFlag {
+  std::string name;
+  double value{NAN};
+  bool lower{true};
+  std::string message;  // "m6_kg on its lower bound 2.9 kg: ..."
 };
 
 struct AuditResult {
+  /// The parameter values the audit started from (the config's).
+  dynamics::ParameterSet configured;
   calibration::CalibrationResult baseline_fit;  // the current model calibrated
+  /// The model as configured (the start values, not calibrated): its errors,
+  /// and the calibration parameters the calibration left on a bound.
+  ModelErrors errors_configured;
+  std::vector<BoundFlag> baseline_on_bound;
+  /// The model the where-it-fails pictures are drawn from: "calibrated", or
+  /// "configured" when the calibration ended with a parameter on a bound
+  /// and the configured model's modes are closer to the measured ones.
+  std::string pictures_from{"calibrated"};
+  dynamics::ParameterSet pictures_parameters;  // the parameters of that model
   ModelErrors errors_before;
-  calibration::Comparison modes_before;         // per-mode errors (matching)
+  calibration::Comparison modes_before;         // per-mode errors (matching) of the pictures' model
   calibration::MeasuredFeatures features;       // the measured modes modes_before indexes
   double noise_floor{0.0};
   double baseline_bic{0.0};
@@ -207,8 +276,16 @@ struct AuditResult {
   /// kExplained; see `graded` for the one a kMostlyExplained grade names).
   int best{-1};
   /// The named effects: the accepted candidate's when the grade is
-  /// kExplained or kMostlyExplained, empty otherwise.
+  /// kExplained or kMostlyExplained, empty otherwise (and empty when the
+  /// named candidate is a parameter hypothesis).
   std::vector<std::string> missing_effects;
+  /// The parameters that are off when the named candidate is a parameter
+  /// hypothesis (issue #33), with their configured and fitted values.
+  std::vector<ParameterChange> parameter_changes;
+  /// The virtual-joint screen, best first (empty when not run), and the
+  /// same measure for the calibrated model without one.
+  std::vector<ScreenedVirtualJoint> virtual_joint_screen;
+  double virtual_joint_screen_baseline{NAN};
   AuditGrade grade{AuditGrade::kUnexplained};
   /// grade is kNoFailure or kExplained: the model (with the named effects)
   /// agrees with the measurement within the noise. False for
@@ -248,6 +325,11 @@ struct AuditResult {
   /// and, when no parameter is on a bound, "its form" (the real effect is
   /// not exactly of the library's form). Empty otherwise.
   std::vector<std::string> reasons;
+  /// When a significant failure is not explained: what to try next, one
+  /// sentence each (the closest parameter hypothesis and virtual joint with
+  /// the error each reaches, calibration parameters on a bound, the
+  /// measurement chain). Empty otherwise.
+  std::vector<std::string> next_steps;
   /// Trouble that did not stop the audit (a failed fit of an effect given
   /// with --add), for the caller to report.
   std::vector<std::string> warnings;
@@ -285,7 +367,26 @@ using dynamics::WithEffect;
 std::string DescribePattern(const ModelErrors& errors, double noise_floor, double significance_factor);
 
 /// The YAML lines that add the candidate's effects with their fitted
-/// parameters to a robot config's `effects:` list.
+/// parameters to a robot config's `effects:` list, and (issue #33) the
+/// `parameters:` block with the model and calibration parameters fitted
+/// with them, so that the config plus these lines is the fitted model.
 std::string EffectYaml(const CandidateResult& candidate);
+
+/// The named candidate in words for people: a library effect's name; a
+/// virtual joint's place, axis and stiffness ("virtual_joint_link3_rx (an
+/// elastic rotation about link 3's x axis, right after joint 3; 4.1e6
+/// N·m/rad)"); a parameter hypothesis's changes ("kq2_Nm_per_rad 40 %
+/// lower than configured (1.88e6 instead of 3.13e6 N·m/rad)").
+std::string DescribeCandidate(const CandidateResult& candidate, const dynamics::ParameterSet& configured);
+
+/// Where a virtual joint sits, in words ("an elastic rotation about link
+/// 3's x axis, right after joint 3"); the effect's own description for
+/// any other effect.
+std::string DescribeVirtualJoint(const std::string& effect);
+
+/// The description and parameters of the model with the candidate's change
+/// (effects added, parameters fitted): what --write-config writes.
+std::pair<dynamics::RobotDescription, dynamics::ParameterSet> CandidateModel(
+    const dynamics::RobotDescription& description, const CandidateResult& candidate);
 
 }  // namespace robomach::audit

@@ -16,6 +16,7 @@
 namespace robomach::dynamics {
 
 class RobotModel;
+struct RobotDescription;
 
 /// The linear system about a posture, in generalised coordinates
 /// z = [q (n joints); extra DOFs of effects]:
@@ -59,10 +60,11 @@ struct EffectContext {
 enum class EffectStage {
   kJointSpace = 0,  // terms on the joint coordinates only (damping, gravity)
   kBase = 1,        // the robot's base on a foundation
-  kFlange = 2,      // the end effector on the flange
-  kSpindle = 3,     // the tool holder in the spindle
-  kTool = 4,        // the tool in the holder
-  kToolTip = 5,     // loads at the tool tip
+  kArm = 2,         // compliance inside the arm (virtual joints between the links)
+  kFlange = 3,      // the end effector on the flange
+  kSpindle = 4,     // the tool holder in the spindle
+  kTool = 5,        // the tool in the holder
+  kToolTip = 6,     // loads at the tool tip
 };
 
 /// A physical effect added to the base robot model: joint-space terms and/or
@@ -82,6 +84,15 @@ class Effect {
   virtual std::vector<ParameterSpec> parameters() const = 0;
   /// Where the effect acts; see EffectStage.
   virtual EffectStage stage() const { return EffectStage::kJointSpace; }
+  /// Order within a stage (ascending, then as in the config): a virtual
+  /// joint's place along the chain, so that the joints nearer the floor are
+  /// applied first (see virtual_joint.cc).
+  virtual int stage_order() const { return 0; }
+  /// Throws std::invalid_argument when the effect cannot act on the robot
+  /// of `description` (a virtual joint after joint 7 of a 6-axis robot, or
+  /// one that turns about a joint's own axis). Checked when a description's
+  /// parameters are made (DefaultParameters).
+  virtual void CheckApplicable(const RobotDescription& /*description*/) const {}
   /// Extra generalised coordinates this effect adds (0 for joint-space terms).
   virtual int num_extra_dofs(std::span<const double> /*values*/) const { return 0; }
   /// Adds the effect's terms to `system`. Extra DOFs occupy indices
@@ -95,14 +106,25 @@ class Effect {
 class EffectRegistry {
  public:
   using Factory = std::function<std::shared_ptr<const Effect>()>;
+  /// A family of effects named by a pattern (virtual_joint_<place>_<axis>):
+  /// returns the effect of `name`, or nullptr when the name is not of the family.
+  using FamilyFactory = std::function<std::shared_ptr<const Effect>(std::string_view name)>;
   static EffectRegistry& Instance();
   void Register(Factory factory);
+  /// `pattern` is the family's names for people ("virtual_joint_<place>_<axis>
+  /// (place: base, link1..linkN; axis: rx, ry, rz, tx, ty, tz)").
+  void RegisterFamily(std::string pattern, FamilyFactory factory);
   /// @throws std::invalid_argument "unknown effect 'x'; available: ...".
   std::shared_ptr<const Effect> Create(std::string_view name) const;
+  /// The single effects (not the members of families): the audit's default
+  /// candidates, Python's available_effects().
   std::vector<std::string> Names() const;
+  /// The families' patterns, for messages and --help.
+  std::vector<std::string> FamilyPatterns() const;
 
  private:
   std::vector<std::pair<std::string, Factory>> factories_;
+  std::vector<std::pair<std::string, FamilyFactory>> families_;
 };
 
 }  // namespace robomach::dynamics

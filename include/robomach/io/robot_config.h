@@ -43,16 +43,19 @@ kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& 
 std::string ParametersYaml(const dynamics::ParameterSet& parameters,
                            const dynamics::ParameterSet& defaults, bool all = false);
 
-/// frf-calibrate's calibrated config: the text of the config at
-/// `input_path` with its `parameters:` block (if any) replaced by
-/// `parameters_yaml` at the end, a relative `urdf:` path made valid from
-/// `output_path`'s folder, and an `effects:` list of `effects` (those
-/// switched on for the calibration, whose parameters the block may set)
-/// when the config has none. A config that has its own `effects:` list is
-/// not edited there (its layout is the user's): `*effects_left_out` is then
-/// true, for the caller to tell the user.
+/// frf-calibrate's calibrated config (and model-audit --write-config's): the
+/// text of the config at `input_path` with its `parameters:` block (if any)
+/// replaced by `parameters_yaml` at the end under the comment line
+/// `comment`, a relative `urdf:` path made valid from `output_path`'s
+/// folder, and `effects` (those switched on for the calibration, whose
+/// parameters the block may set) added to the config's `effects:` list: at
+/// the end of its block-style list with the indentation of its items, in
+/// place of an empty `effects: []`, or as a new list. Only a non-empty flow
+/// list (`effects: [{...}]`) is not edited (its layout is the user's):
+/// `*effects_left_out` is then true, for the caller to tell the user.
 std::string CalibratedConfigText(const std::string& input_path, const std::string& output_path,
                                  const std::string& parameters_yaml, const std::vector<std::string>& effects = {},
-                                 bool* effects_left_out = nullptr);
+                                 bool* effects_left_out = nullptr,
+                                 const std::string& comment = "Calibrated by robomach frf-calibrate against measured FRFs.");
 
 }  // namespace robomach::io

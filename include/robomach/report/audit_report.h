@@ -30,6 +30,13 @@ struct AuditReportOptions {
   nlohmann::json previous;
   std::string compare_dir;
   std::function<void(const std::string&)> progress;  // may be empty
+  /// Warnings the caller gave while reading the inputs (a file that looks
+  /// like accelerance, a receptance of implausible size): in summary.json's
+  /// `warnings` and the report, with the audit's own.
+  std::vector<std::string> input_warnings;
+  /// Where model-audit --write-config wrote the config with the named
+  /// change (empty: not asked), for the report's "what to do".
+  std::string written_config;
 };
 
 struct AuditReport {

@@ -1,0 +1,174 @@
+// Issue #33 acceptance: the audit when the cause is not one of the library's
+// effects. Hammer data as they really come (issue #10's accelerance files at
+// six postures, through a CSV file and back, with the noise model of the
+// data's scatter); the truth's calibration parameters off the config as in
+// every audit test (+10 %, −8 %, +20 %, −15 %).
+//
+// - Joint stiffness off on two joints (kq2 40 % lower, kq3 30 % higher than
+//   configured; nothing missing): the audit must name the two parameters,
+//   each factor within 10 %, and no effect.
+// - An elastic hinge inside the arm, made by a second route that shares no
+//   code with the virtual-joint effect: a URDF with a real revolute joint
+//   inserted between joint 3 and link 3 (about link 3's x axis), whose
+//   spring is that joint's stiffness in a 7-joint model. The audit must
+//   localise it to link 3 and the x axis and remove at least 80 % of the
+//   excess misfit.
+//
+// Seeds 331-333 were not used while tuning.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <regex>
+#include <sstream>
+
+#include "audit_test_support.h"
+#include "realistic_hammer_test.h"
+#include "robomach/calibration/frf_noise.h"
+#include "robomach/common/units.h"
+#include "robomach/io/frf_files.h"
+#include "robomach/io/urdf_loader.h"
+
+namespace robomach::audit {
+namespace {
+
+using testing::Campaign;
+
+Campaign MakeSixPostureCampaign() {
+  Campaign c = testing::MakeCampaign();
+  const auto [id, deg] = robomach::testing::SixthPostureDeg();
+  Eigen::VectorXd q(6);
+  for (int j = 0; j < 6; ++j) q(j) = DegToRad(deg[j]);
+  c.poses.push_back({id, q});
+  c.postures[id] = q;
+  return c;
+}
+
+// The truth's calibration parameters off the config, as testing::Truth does.
+void OffsetCalibration(const dynamics::ParameterSet& config, dynamics::ParameterSet* p) {
+  p->Set("m6_kg", 1.10 * config.Get("m6_kg"));
+  p->Set("d6_m", 0.92 * config.Get("d6_m"));
+  p->Set("alpha_s", 1.20 * config.Get("alpha_s"));
+  p->Set("beta_per_s", 0.85 * config.Get("beta_per_s"));
+}
+
+// Realistic hammer data of `model` at `poses`, as read from an accelerance
+// CSV file, with their noise model's usable lines.
+dynamics::FrfSet Measure(const std::shared_ptr<const dynamics::RobotModel>& model,
+                         const std::vector<calibration::NamedPosture>& poses, unsigned seed, const std::string& name) {
+  const dynamics::FrfSet synth =
+      calibration::SynthesizeHammerTest(model, poses, robomach::testing::RealisticHammerTest(seed));
+  const std::string path = robomach::testing::TempDir("audit_hypotheses_" + name) + "/hammer.csv";
+  io::WriteFrfCsv(path, synth, io::FrfQuantity::kAccelerance, 0);
+  const dynamics::FrfSet read = io::ReadFrfCsv(path).frfs;
+  return calibration::UsableData(read, calibration::EstimateNoise(read, {}));
+}
+
+AuditResult RunCase(const Campaign& c, const dynamics::FrfSet& measured) {
+  AuditOptions o;
+  o.progress = [](const std::string& m) { std::cout << "  " << m << std::endl; };
+  const auto t0 = std::chrono::steady_clock::now();
+  AuditResult r = RunAudit(c.cfg.description, c.cfg.parameters, c.postures, measured, o);
+  testing::PrintAudit(r, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  std::cout << "headline: " << r.headline << "\n";
+  return r;
+}
+
+TEST(AuditHypotheses, JointStiffnessOffOnTwoJointsIsNamedAsParametersNotAsAnEffect) {
+  const Campaign c = MakeSixPostureCampaign();
+  dynamics::ParameterSet truth = c.cfg.parameters;
+  OffsetCalibration(c.cfg.parameters, &truth);
+  truth.Set("kq2_Nm_per_rad", 0.6 * c.cfg.parameters.Get("kq2_Nm_per_rad"));
+  truth.Set("kq3_Nm_per_rad", 1.3 * c.cfg.parameters.Get("kq3_Nm_per_rad"));
+  const dynamics::FrfSet measured =
+      Measure(dynamics::RobotModel::Build(c.cfg.description, truth), c.poses, 331, "kq");
+  const AuditResult r = RunCase(c, measured);
+  EXPECT_TRUE(r.significant_failure);
+  EXPECT_EQ(r.grade, AuditGrade::kExplained) << r.verdict;
+  EXPECT_TRUE(r.missing_effects.empty()) << r.verdict;
+  ASSERT_GE(r.graded, 0);
+  EXPECT_TRUE(r.candidates[r.graded].is_parameter_hypothesis()) << r.candidates[r.graded].name();
+  ASSERT_EQ(r.parameter_changes.size(), 2u) << r.verdict;
+  for (const ParameterChange& pc : r.parameter_changes) {
+    const double expected = pc.name == "kq2_Nm_per_rad" ? 0.6 : pc.name == "kq3_Nm_per_rad" ? 1.3 : NAN;
+    ASSERT_TRUE(std::isfinite(expected)) << "named " << pc.name;
+    EXPECT_NEAR(pc.ratio() / expected, 1.0, 0.10) << pc.name << " ratio " << pc.ratio();
+  }
+  // The words lead to the fix: the parameters, the direction and the tools.
+  EXPECT_NE(r.headline.find("no effect is missing"), std::string::npos) << r.headline;
+  EXPECT_NE(r.headline.find("kq2_Nm_per_rad"), std::string::npos) << r.headline;
+  EXPECT_NE(r.headline.find("lower than configured"), std::string::npos) << r.headline;
+  EXPECT_NE(r.headline.find("kq-identify"), std::string::npos) << r.headline;
+  EXPECT_NE(r.headline.find("--free kq2_Nm_per_rad"), std::string::npos) << r.headline;
+  // The model with them is right: within the noise.
+  EXPECT_LE(r.remainder_noise_units, 1.3);
+}
+
+// The KR210's URDF with a revolute joint "hinge_3x" inserted between joint_3
+// and link_3, at link 3's frame, about its x axis: link 3 and everything
+// beyond turn about it.
+std::string HingedUrdf() {
+  std::ifstream in(robomach::testing::SourcePath("config/kr210_r2700_2.urdf"));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string urdf = ss.str();
+  const std::string joint3 = "<joint name=\"joint_3\" type=\"revolute\">";
+  const size_t at = urdf.find(joint3);
+  const size_t child = urdf.find("<child link=\"link_3\"/>", at);
+  EXPECT_NE(child, std::string::npos);
+  urdf.replace(child, std::string("<child link=\"link_3\"/>").size(), "<child link=\"link_3_hinge\"/>");
+  const size_t end = urdf.find("</joint>", at) + std::string("</joint>").size();
+  urdf.insert(end,
+              "\n  <link name=\"link_3_hinge\"/>\n"
+              "  <joint name=\"hinge_3x\" type=\"revolute\">\n"
+              "    <parent link=\"link_3_hinge\"/>\n    <child link=\"link_3\"/>\n"
+              "    <origin rpy=\"0 0 0\" xyz=\"0 0 0\"/>\n    <axis xyz=\"1 0 0\"/>\n"
+              "    <limit effort=\"1\" lower=\"-0.1\" upper=\"0.1\" velocity=\"1\"/>\n  </joint>");
+  return urdf;
+}
+
+TEST(AuditHypotheses, ElasticHingeInTheArmIsLocalisedToItsLinkAndAxis) {
+  const Campaign c = MakeSixPostureCampaign();
+  const std::string path = robomach::testing::TempDir("audit_hypotheses_hinge") + "/kr210_hinged.urdf";
+  std::ofstream(path) << HingedUrdf();
+  // The 7-joint truth: the hinge's spring is its joint stiffness.
+  dynamics::RobotDescription d7 = c.cfg.description;
+  d7.arm = io::LoadUrdfChain(path, "base_link", "tool0");
+  ASSERT_EQ(d7.arm.num_joints(), 7);
+  constexpr double kHinge = 4e6;  // N·m/rad
+  const Eigen::VectorXd& kq = c.cfg.description.joint_stiffness;
+  d7.joint_stiffness.resize(7);
+  d7.joint_stiffness << kq(0), kq(1), kq(2), kHinge, kq(3), kq(4), kq(5);
+  dynamics::ParameterSet p7 = dynamics::DefaultParameters(d7);
+  for (const auto& s : p7.specs()) {
+    if (s.name.rfind("kq", 0) != 0 && c.cfg.parameters.Has(s.name)) p7.Set(s.name, c.cfg.parameters.Get(s.name));
+  }
+  OffsetCalibration(c.cfg.parameters, &p7);
+  std::vector<calibration::NamedPosture> poses7;
+  for (const auto& [id, q] : c.poses) {
+    Eigen::VectorXd q7(7);
+    q7 << q(0), q(1), q(2), 0.0, q(3), q(4), q(5);
+    poses7.push_back({id, q7});
+  }
+  const dynamics::FrfSet measured = Measure(dynamics::RobotModel::Build(d7, p7), poses7, 332, "hinge");
+  const AuditResult r = RunCase(c, measured);
+  EXPECT_TRUE(r.significant_failure);
+  ASSERT_GE(r.graded, 0) << r.verdict;
+  const CandidateResult& g = r.candidates[r.graded];
+  EXPECT_TRUE(r.grade == AuditGrade::kExplained || r.grade == AuditGrade::kMostlyExplained) << r.verdict;
+  EXPECT_EQ(g.name(), "virtual_joint_link3_rx") << r.verdict;
+  EXPECT_GE(r.fraction_removed, 0.8) << r.verdict;
+  // Its stiffness is the hinge's (the model is the same system, so within
+  // the fit's scatter: 10 %).
+  EXPECT_NEAR(g.fit.parameters.Get("virtual_joint_link3_rx.stiffness_Nm_per_rad") / kHinge, 1.0, 0.10);
+  EXPECT_NE(r.headline.find("link 3's x axis"), std::string::npos) << r.headline;
+  // The screen put it among the few fitted.
+  bool screened = false;
+  for (const auto& s : r.virtual_joint_screen) screened |= s.effect == "virtual_joint_link3_rx" && s.fitted;
+  EXPECT_TRUE(screened);
+}
+
+}  // namespace
+}  // namespace robomach::audit
