@@ -47,8 +47,10 @@ int Run(int argc, char** argv) {
       "model-audit: where a robot model fails against measured tool-tip FRFs, and which physical effect\n"
       "of the library is missing. Calibrates the model (whole curve), reports the rms log-magnitude error\n"
       "per posture and direction with its worst bands, the per-mode errors and a noise-floor estimate; if\n"
-      "the failure is significant, adds each library effect not in the model, fits it with the calibration\n"
-      "parameters and ranks the candidates by BIC (greedily a second one). Also reports the trends of the\n"
+      "the failure is significant, frees each joint stiffness (and the best pairs), screens an elastic virtual\n"
+      "joint at every place and axis of the chain and fits the best, adds each library effect not in the model,\n"
+      "fits each with the calibration parameters and ranks the candidates by BIC (greedily a second effect). A\n"
+      "joint stiffness that explains the data is named as a parameter that is off. Also reports the trends of the\n"
       "error against posture descriptors, an error map of postures against modes, and modes without a\n"
       "counterpart either way. Writes REPORT/summary.json, index.html, errors.csv, candidates.csv,\n"
       "trends.csv, posture_descriptors.csv, mode_errors.csv, unmatched_modes.csv, trends.png,\n"
@@ -85,7 +87,10 @@ int Run(int argc, char** argv) {
   app.add_option("--virtual-joints", virtual_joints,
                  "how many of the best virtual joints (compliance along the chain) to fit after the screen; 0: none")
       ->capture_default_str();
-  app.add_option("--candidates", candidates_list, "comma-separated effects to try; default: every library effect not in the model");
+  app.add_option("--candidates", candidates_list,
+                 "comma-separated candidates, the whole list: effects (virtual_joint_<place>_<axis> too) and joint "
+                 "stiffnesses (kq2_Nm_per_rad); default: every library effect not in the model, every joint stiffness "
+                 "and the virtual-joint screen");
   app.add_option("--fmin-hz", opt.fmin_hz, "lowest frequency used [Hz]")->capture_default_str();
   app.add_option("--fmax-hz", opt.fmax_hz, "highest frequency used [Hz]; default: all lines");
   app.add_option("--max-iterations", opt.max_iterations, "solver iterations per fit")->capture_default_str();
@@ -133,7 +138,8 @@ int Run(int argc, char** argv) {
     std::stringstream cl(candidates_list);
     for (std::string n; std::getline(cl, n, ',');) {
       if (n.empty()) continue;
-      FromOption("--candidates", [&] { dynamics::EffectRegistry::Instance().Create(n); });
+      const bool is_parameter = n.rfind("kq", 0) == 0 && n.find('.') == std::string::npos;
+      if (!is_parameter) FromOption("--candidates", [&] { dynamics::EffectRegistry::Instance().Create(n); });
       opt.candidates.push_back(n);
     }
     opt.progress = [](const std::string& s) { std::cerr << kTool << ": " << s << '\n'; };

@@ -31,6 +31,7 @@ CandidateResult FitParameterHypothesis(const dynamics::RobotDescription& desc, c
   const AuditOptions& o = x.options;
   CandidateResult c;
   c.parameters = freed;
+  std::sort(c.parameters.begin(), c.parameters.end());  // kq2 before kq3 in every message
   std::vector<std::string> free = calibration;
   for (const std::string& n : freed) {
     if (!Contains(free, n)) free.push_back(n);

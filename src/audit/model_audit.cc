@@ -192,8 +192,25 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   const auto say = [&](const std::string& s) {
     if (o.progress) o.progress(s);
   };
-  std::vector<std::string> candidates = o.candidates;
-  if (candidates.empty()) {
+  // An explicit candidate list is the whole list: its effects (virtual
+  // joints included) and its model parameters (parameter hypotheses); the
+  // virtual-joint screen and the default parameter hypotheses run only
+  // when no list is given.
+  std::vector<std::string> candidates;
+  const bool explicit_list = !o.candidates.empty();
+  if (explicit_list) {
+    std::vector<std::string> named_parameters;
+    for (const std::string& n : o.candidates) {
+      if (parameters.Has(n) && n.find('.') == std::string::npos) {
+        named_parameters.push_back(n);
+      } else {
+        candidates.push_back(n);
+      }
+    }
+    o.parameter_candidates = named_parameters;
+    o.try_parameters = o.try_parameters && !named_parameters.empty();
+    o.virtual_joints_fitted = 0;
+  } else {
     for (const std::string& n : dynamics::EffectRegistry::Instance().Names()) {
       bool present = false;
       for (const auto& e : description.effects) present |= e.name == n;

@@ -343,7 +343,10 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
   if (!ro.previous.is_null()) h << "<th>previous before</th><th>previous after</th>";
   h << "</tr>\n";
   for (const auto& [id, e] : pb) {
-    h << "<tr><td>" << HtmlEscape(id) << "</td><td>" << FormatNumber(e) << "</td><td>" << FormatNumber(pa.at(id)) << "</td>";
+    // "after" only where a change is named or accepted (issue #33: with no
+    // candidate the column repeated "before").
+    h << "<tr><td>" << HtmlEscape(id) << "</td><td>" << FormatNumber(e) << "</td><td>"
+      << (best ? FormatNumber(pa.at(id)) : std::string("–")) << "</td>";
     if (!ro.previous.is_null()) {
       const bool has = ro.previous["postures"].contains(id);
       h << "<td>" << (has ? FormatNumber(ro.previous["postures"][id]["error_before"].get<double>()) : "–") << "</td><td>"
@@ -352,7 +355,7 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
     h << "</tr>\n";
   }
   h << "<tr><th>total</th><th>" << FormatNumber(r.errors_before.total_rms_log_mag) << "</th><th>"
-    << FormatNumber(after.total_rms_log_mag) << "</th>";
+    << (best ? FormatNumber(after.total_rms_log_mag) : std::string("–")) << "</th>";
   if (!ro.previous.is_null()) {
     h << "<th>" << FormatNumber(ro.previous["error_before"].get<double>()) << "</th><th>"
       << FormatNumber(ro.previous["error_after"].get<double>()) << "</th>";
@@ -362,7 +365,7 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
   for (size_t i = 0; i < r.errors_before.curves.size(); ++i) {
     const auto& c = r.errors_before.curves[i];
     h << "<tr><td>" << HtmlEscape(KeyLabel(c.key)) << "</td><td>" << FormatNumber(c.rms_log_mag) << "</td><td>"
-      << FormatNumber(after.curves[i].rms_log_mag) << "</td>";
+      << (best ? FormatNumber(after.curves[i].rms_log_mag) : std::string("–")) << "</td>";
     if (!c.bands.empty()) {
       h << "<td>" << FormatNumber(c.bands[0].fmin_hz, 3) << "–" << FormatNumber(c.bands[0].fmax_hz, 3) << "</td><td>"
         << FormatNumber(c.bands[0].rms_log_mag) << "</td>";

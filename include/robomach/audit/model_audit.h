@@ -23,7 +23,11 @@ struct AuditOptions {
   /// Calibration parameters, always free (the audit first calibrates the
   /// current model with them, then refits them with every candidate).
   std::vector<std::string> calibration_parameters{"m6_kg", "d6_m", "alpha_s", "beta_per_s"};
-  /// Effects to try; empty: every library effect not yet in the model.
+  /// Candidates to try; empty: every library effect not yet in the model,
+  /// the parameter hypotheses and the virtual-joint screen below. A list is
+  /// the whole list: effect names (virtual_joint_<place>_<axis> included)
+  /// and model parameter names (kq2_Nm_per_rad: a parameter hypothesis,
+  /// paired with the others named); no screen, no other hypotheses.
   std::vector<std::string> candidates;
   /// Band of all errors and fits [Hz].
   double fmin_hz{0.0};
