@@ -141,6 +141,15 @@ nlohmann::json NoiseSummaryJson(const calibration::NoiseModels& noise, const std
   for (const auto& [key, n] : noise) {
     nlohmann::json bands = nlohmann::json::array();
     for (const auto& [lo, hi] : n.usable_bands) bands.push_back({lo, hi});
+    // Isolated lines left out of every fit (hum, spikes): issue #33.
+    nlohmann::json excluded = nlohmann::json::array();
+    for (const calibration::ExcludedLine& e : n.excluded_lines) {
+      excluded.push_back({{"freq_hz", e.freq_hz},
+                          {"ratio", e.ratio},
+                          {"excess_m_per_N", e.excess_m_per_N},
+                          {"mains_hz", e.mains_hz > 0.0 ? nlohmann::json(e.mains_hz) : nlohmann::json(nullptr)},
+                          {"description", calibration::DescribeExcludedLine(e)}});
+    }
     j["frfs"].push_back({{"pose_id", key.pose_id},
                          {"response", std::string(1, AxisName(key.response))},
                          {"excitation", std::string(1, AxisName(key.excitation))},
@@ -151,6 +160,7 @@ nlohmann::json NoiseSummaryJson(const calibration::NoiseModels& noise, const std
                          {"floor_max_m_per_N", n.floor_m_per_N.maxCoeff()},
                          {"usable_bands_hz", bands},
                          {"usable_lines", n.usable_lines},
+                         {"excluded_lines", excluded},
                          {"lines", static_cast<int>(n.usable.size())},
                          {"converged", n.converged}});
   }
