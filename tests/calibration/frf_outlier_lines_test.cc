@@ -185,6 +185,9 @@ TEST(FrfOutlierLines, OptionsAndTheSwitch) {
   o.outlier_threshold = 2.0;
   EXPECT_THROW(CheckValid(o), std::invalid_argument);
   o = {};
+  o.outlier_threshold_off_mains = 5.0;  // below outlier_threshold
+  EXPECT_THROW(CheckValid(o), std::invalid_argument);
+  o = {};
   o.outlier_window_lines = 2;
   EXPECT_THROW(CheckValid(o), std::invalid_argument);
   o = {};
@@ -264,6 +267,7 @@ TEST(FrfOutlierLines, TheFitWithoutTheHumLinesLandsWhereTheHumFreeFitLands) {
 TEST(FrfOutlierLines, TheStatisticHasTheGaussianTailAtALowThreshold) {
   NoiseOptions o;
   o.outlier_threshold = 3.0;
+  o.outlier_threshold_off_mains = 3.0;  // the statistic on every line, not only at mains multiples
   int flags = 0, candidates = 0;
   for (unsigned seed = 100; seed < 120; ++seed) {
     const Measured m = Measure(seed, false);

@@ -75,12 +75,23 @@ struct NoiseOptions {
   /// if σ were underestimated by a factor of 1.5 (the noise model's floor
   /// is within 25 %).
   double outlier_threshold{6.0};
+  /// The threshold for a line that is not at a mains multiple (50 or 60 Hz
+  /// and harmonics, within half a line): a single-line spike must be far
+  /// beyond the noise to be told from structure the local fit does not
+  /// follow, a weak mode narrower than two lines on the flank of a strong
+  /// one (seen at 7.9 × the noise at 32.5 Hz of a robot on a compliant
+  /// base, 0.625 Hz lines, in clean data).
+  double outlier_threshold_off_mains{15.0};
   /// Neighbours on each side of a line that its local fit uses (the lines
   /// next to it and flagged lines are left out of its fit).
   int outlier_window_lines{8};
   /// A run of more than this many neighbouring flagged lines is not an
   /// isolated line but structure the local fit does not follow (two close
-  /// modes, a mode narrower than a line): it is kept and not flagged.
+  /// modes, a mode narrower than a line): it is kept and not flagged. A run
+  /// of two or more is flagged only at a mains multiple (hum leaking
+  /// between grid lines); elsewhere only single lines are spikes. A line
+  /// whose neighbours the local model does not describe (reduced χ² above
+  /// 4) is not judged at all.
   int max_outlier_run_lines{3};
 };
 
