@@ -23,6 +23,7 @@
 #include "robomach/common/golden_section.h"
 #include "robomach/common/parallel.h"
 #include "robomach/dynamics/effect.h"
+#include "robomach/dynamics/gravity_torque.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 
@@ -232,6 +233,16 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   // The library's effects (the greedy round's second effects); the virtual
   // joints the screen picks join `candidates` as single candidates only.
   const std::vector<std::string> library_candidates = candidates;
+  // The free parameters besides an effect's own: the calibration
+  // parameters, and kq_j for a load-dependent stiffness of joint j.
+  const auto FreeFor = [&](const std::string& effect) {
+    std::vector<std::string> free = o.calibration_parameters;
+    if (effect.rfind("load_stiffness_j", 0) == 0) {
+      const std::string kq = "kq" + effect.substr(16) + "_Nm_per_rad";
+      if (parameters.Has(kq) && !Contains(free, kq)) free.push_back(kq);
+    }
+    return free;
+  };
 
   AuditResult r;
   r.noise_floor = EstimateNoiseFloor(measured, o.fmin_hz, o.fmax_hz);
@@ -450,6 +461,30 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
     }
     say(m.str());
   }
+  // Posture-dependent joint stiffness (issue #33 §3): a joint whose gravity
+  // torque varies over the measured postures (at least a fifth of the
+  // largest variation of any joint) is a candidate for load_stiffness_j<j>,
+  // fitted with its kq_j free.
+  if (!explicit_list && o.try_parameters) {
+    const auto base_model = dynamics::RobotModel::Build(description, r.baseline_fit.parameters);
+    const int n = description.arm.num_joints();
+    Eigen::VectorXd lo = Eigen::VectorXd::Constant(n, INFINITY), hi = Eigen::VectorXd::Zero(n);
+    for (const std::string& pose : measured.pose_ids()) {
+      const Eigen::VectorXd g = dynamics::GravityTorque(*base_model, postures.at(pose)).cwiseAbs();
+      lo = lo.cwiseMin(g);
+      hi = hi.cwiseMax(g);
+    }
+    const Eigen::VectorXd range = hi - lo;
+    const double largest = range.maxCoeff();
+    for (int j = 0; j < n && largest > 0.0; ++j) {
+      const std::string name = "load_stiffness_j" + std::to_string(j + 1);
+      bool present = false;
+      for (const auto& e : description.effects) present |= e.name == name;
+      if (!present && range(j) >= 0.2 * largest && parameters.Has("kq" + std::to_string(j + 1) + "_Nm_per_rad")) {
+        candidates.push_back(name);
+      }
+    }
+  }
   say("fitting " + std::to_string(candidates.size()) + " candidate effects");
   // Every candidate from its scan first; the further starts (FitCandidate)
   // only where they could change the verdict: best BIC first, until a
@@ -472,7 +507,7 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
       static_cast<int>(candidates.size()), o.threads,
       [&](int i) {
         return timed([&] {
-          return FitCandidate(description, r.baseline_fit.parameters, {}, candidates[i], o.calibration_parameters,
+          return FitCandidate(description, r.baseline_fit.parameters, {}, candidates[i], FreeFor(candidates[i]),
                               context, false);
         });
       },
@@ -500,7 +535,7 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
           say("more starts for " + first.name());
           return timed([&] {
             return FitCandidate(description, r.baseline_fit.parameters, {}, first.effects.back(),
-                                o.calibration_parameters, context, true, &first.fit.parameters);
+                                FreeFor(first.effects.back()), context, true, &first.fit.parameters);
           });
         },
         [&](int k) {
@@ -555,7 +590,7 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
       for (const auto& e : top.fit.estimates) {
         if (e.at_bound && e.name.find('.') != std::string::npos) start1.Set(e.name, start1.spec(e.name).default_value);
       }
-      const std::vector<std::string> free1 = FreeAfter(o.calibration_parameters, top.effects[0], top);
+      const std::vector<std::string> free1 = FreeAfter(FreeFor(top.effects[0]), top.effects[0], top);
       std::vector<std::string> others;
       for (const std::string& n : library_candidates) {
         if (n != top.effects[0]) others.push_back(n);
@@ -595,8 +630,7 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
       p.redundant = gone;
       say(p.name() + ": " + gone + " adds nothing; fitting " + kept + " alone from the pair's values");
       CandidateResult alone = timed([&] {
-        return FitCandidate(description, r.baseline_fit.parameters, {}, kept, o.calibration_parameters, context, true,
-                            &pk);
+        return FitCandidate(description, r.baseline_fit.parameters, {}, kept, FreeFor(kept), context, true, &pk);
       });
       for (CandidateResult& c : r.candidates) {
         if (c.name() == kept && Replaces(alone, c)) c = alone;

@@ -94,6 +94,19 @@ std::string DescribeCandidate(const CandidateResult& c, const dynamics::Paramete
   m << c.name();
   std::string inner;
   for (const std::string& e : c.effects) {
+    if (e.rfind("load_stiffness_j", 0) == 0) {
+      const std::string j = e.substr(16);
+      const std::string kq = "kq" + j + "_Nm_per_rad";
+      std::ostringstream d;
+      d.precision(3);
+      d << "joint " << j << "'s stiffness varies with the gravity torque on it: " << kq << " = "
+        << c.fit.parameters.Get(kq) << " N·m/rad";
+      if (configured.Has(kq)) d << " (configured " << configured.Get(kq) << ")";
+      d << " x (1 + " << c.fit.parameters.Get(e + ".stiffening_per_kNm") << " |G" << j
+        << "| / kN·m): a counterbalance or a gear that stiffens under load";
+      inner += (inner.empty() ? "" : "; ") + d.str();
+      continue;
+    }
     if (e.rfind("virtual_joint_", 0) != 0) continue;
     const auto effect = dynamics::EffectRegistry::Instance().Create(e);
     const auto spec = effect->parameters().at(0);

@@ -107,6 +107,28 @@ TEST(AuditHypotheses, JointStiffnessOffOnTwoJointsIsNamedAsParametersNotAsAnEffe
   EXPECT_LE(r.remainder_noise_units, 1.3);
 }
 
+// A posture-dependent joint stiffness (issue #33 §3): kq2 20 % lower than
+// configured and stiffening by 30 % per kN·m of the gravity torque on
+// joint 2 (a counterbalance, a preloaded gear). The audit must name the
+// load-dependent form of joint 2 with both values within 10 %.
+TEST(AuditHypotheses, JointStiffnessVaryingWithTheGravityTorqueIsNamed) {
+  const Campaign c = MakeSixPostureCampaign();
+  auto [d, p] = dynamics::WithEffect(c.cfg.description, c.cfg.parameters, "load_stiffness_j2");
+  OffsetCalibration(c.cfg.parameters, &p);
+  p.Set("kq2_Nm_per_rad", 0.8 * c.cfg.parameters.Get("kq2_Nm_per_rad"));
+  p.Set("load_stiffness_j2.stiffening_per_kNm", 0.3);
+  const dynamics::FrfSet measured = Measure(dynamics::RobotModel::Build(d, p), c.poses, 334, "load");
+  const AuditResult r = RunCase(c, measured);
+  EXPECT_TRUE(r.significant_failure);
+  ASSERT_GE(r.graded, 0) << r.verdict;
+  const CandidateResult& g = r.candidates[r.graded];
+  EXPECT_EQ(r.grade, AuditGrade::kExplained) << r.verdict;
+  EXPECT_EQ(g.name(), "load_stiffness_j2") << r.verdict;
+  EXPECT_NEAR(g.fit.parameters.Get("kq2_Nm_per_rad") / p.Get("kq2_Nm_per_rad"), 1.0, 0.10);
+  EXPECT_NEAR(g.fit.parameters.Get("load_stiffness_j2.stiffening_per_kNm") / 0.3, 1.0, 0.10);
+  EXPECT_NE(r.headline.find("varies with the gravity torque"), std::string::npos) << r.headline;
+}
+
 // The KR210's URDF with a revolute joint "hinge_3x" inserted between joint_3
 // and link_3, at link 3's frame, about its x axis: link 3 and everything
 // beyond turn about it.
