@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "cli_support.h"
+#include "robomach/common/number_format.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/drilling/controller_kinds.h"
@@ -183,7 +184,7 @@ int RunDrillSim(int argc, char** argv) {
         progress.reset();
         if (p.run && p.run->tde_condition_fails()) {
           Warn(kTool, "pd-tdc: the TDE stability condition ||I - M^-1 Mbar|| < 1 fails (" +
-                          io::FormatDouble(p.run->tde_measure) + "); lower the Mbar ratio");
+                          FormatNumber(p.run->tde_measure) + "); lower the Mbar ratio");
         }
         return;
       }
@@ -207,9 +208,9 @@ int RunDrillSim(int argc, char** argv) {
       const drilling::SimResult& r = run.result;
       std::ostringstream line;
       line << run.parameters.kind << ": settling "
-           << (std::isnan(r.settling_time) ? std::string("never") : io::FormatDouble(r.settling_time) + " s")
-           << ", max |e| " << io::FormatDouble(RadToDeg(r.max_abs_error.maxCoeff()))
-           << " deg, last 10 % max |e| " << io::FormatDouble(RadToDeg(r.max_abs_error_last_10pc.maxCoeff()))
+           << (std::isnan(r.settling_time) ? std::string("never") : FormatNumber(r.settling_time) + " s")
+           << ", max |e| " << FormatNumber(RadToDeg(r.max_abs_error.maxCoeff()))
+           << " deg, last 10 % max |e| " << FormatNumber(RadToDeg(r.max_abs_error_last_10pc.maxCoeff()))
            << " deg";
       std::cerr << kTool << ": " << line.str() << "\n";
     }

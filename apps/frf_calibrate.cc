@@ -67,8 +67,8 @@ int Run(int argc, char** argv) {
   }
   return RunGuarded(kTool, [&]() -> int {
     RequireFolderOption("--report", report_dir);
-    RequireReadableFile(robot_path, "robot config");
-    RequireReadableFile(postures_path, "posture file");
+    RequireInputFile("--robot", robot_path, "robot config", {io::FileKind::kYaml}, io::kRobotConfigFormat);
+    RequireInputFile("--postures", postures_path, "posture file", {io::FileKind::kCsv}, io::kPostureCsvFormat);
     CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
     {
       std::vector<std::pair<std::string, std::string>> inputs = {{"--robot", robot_path},
@@ -101,7 +101,8 @@ int Run(int argc, char** argv) {
     const auto model_before = cfg.Build();
     calibration::PostureMap postures;
     std::map<std::string, int> posture_line;
-    for (const io::Posture& p : io::ReadPostureFile(postures_path, model_before->num_joints())) {
+    std::vector<std::string> posture_units;  // radians under _deg headers, ...
+    for (const io::Posture& p : io::ReadPostureFile(postures_path, model_before->num_joints(), &posture_units)) {
       postures[p.id] = p.q;
       posture_line[p.id] = p.line;
     }
@@ -183,6 +184,10 @@ int Run(int argc, char** argv) {
     const calibration::CalibrationVerdict verdict = calibration::JudgeCalibration(result, measured, opt);
     std::vector<std::string> flags = measured_read.unit_findings;  // implausible units, warned when read
     flags.insert(flags.end(), holdout_read.unit_findings.begin(), holdout_read.unit_findings.end());
+    for (const std::string& w : posture_units) {
+      Warn(kTool, w);
+      flags.push_back(w);
+    }
     for (const Finding& f : verdict.findings) {
       Warn(kTool, f.message);
       flags.push_back(f.message);

@@ -81,7 +81,9 @@ int Run(int argc, char** argv) {
   bool verbose = false;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
-  app.add_option("--out", out_path, "predicted FRFs, CSV receptance [m/N]; stdout if omitted");
+  app.add_option("--out", out_path,
+                 "predicted FRFs, CSV receptance [m/N]; '-' = stdout; if omitted: stdout when no other output "
+                 "(--plot, --plot-dir, --modes, --summary) is given, else not written");
   app.add_option("--modes", modes_path, "modal table CSV: freq_hz, damping_ratio, modal_mass_kg, ux,uy,uz");
   app.add_option("--summary,--details", details_path, "summary JSON per posture ('-' = stdout; --details is the old name): J, cond(J), M_q, K_q, C_q, Cartesian M, K, C, compliance, modes");
   app.add_option("--plot", plot_path, "one PNG sheet with all postures (magnitude and phase)")->check(PngFileName());
@@ -105,8 +107,8 @@ int Run(int argc, char** argv) {
 
   return RunGuarded(kTool, [&]() -> int {
     RequireFolderOption("--plot-dir", plot_dir);
-    RequireReadableFile(robot_path, "robot config");
-    RequireReadableFile(postures_path, "posture file");
+    RequireInputFile("--robot", robot_path, "robot config", {io::FileKind::kYaml}, io::kRobotConfigFormat);
+    RequireInputFile("--postures", postures_path, "posture file", {io::FileKind::kCsv}, io::kPostureCsvFormat);
     if (!freq_file.empty()) RequireReadableFile(freq_file, "frequency file");
     CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}, {"--freq-file", freq_file}},
                        {{"--out", out_path}, {"--modes", modes_path}, {"--summary", details_path},
@@ -136,8 +138,10 @@ int Run(int argc, char** argv) {
       }
     }
     const auto model = cfg.Build();
+    std::vector<std::string> posture_units;  // radians under _deg headers, ...
     const std::vector<io::Posture> postures =
-        io::ReadPostureFile(postures_path, model->num_joints());
+        io::ReadPostureFile(postures_path, model->num_joints(), &posture_units);
+    for (const std::string& w : posture_units) Warn(kTool, w);
     // Everything is computed before anything is written (no partial
     // outputs), so bound the memory: 3×3 complex values per line and posture.
     const double values = static_cast<double>(postures.size()) * static_cast<double>(freq_hz.size());
@@ -167,7 +171,16 @@ int Run(int argc, char** argv) {
     }
 
     // Every output is complete before it appears (docs/formats.md §4).
-    io::WritePredictedFrfCsv(out_path.empty() ? "-" : out_path, preds, pairs);
+    // Without --out the FRF CSV goes to stdout only when nothing else was
+    // asked for: `--plot p.png` alone must not pour megabytes of CSV into
+    // the terminal (issue #35).
+    const bool other_outputs = !plot_path.empty() || !plot_dir.empty() || !modes_path.empty() || !details_path.empty();
+    if (!out_path.empty() || !other_outputs) {
+      io::WritePredictedFrfCsv(out_path.empty() ? "-" : out_path, preds, pairs);
+    } else {
+      Note(kTool, "no --out: the FRF CSV is not written, only the outputs asked for (give --out FILE, or --out - "
+                  "for standard output)");
+    }
     std::vector<std::string> ids;
     std::vector<std::vector<dynamics::Mode>> modes;
     for (size_t p = 0; p < postures.size(); ++p) {
@@ -208,7 +221,7 @@ int Run(int argc, char** argv) {
             .SavePng((std::filesystem::path(plot_dir) / (preds[p].pose_id + ".png")).string());
       }
     }
-    return ExitCodeFor(result.status());
+    return posture_units.empty() ? ExitCodeFor(result.status()) : kExitFlagged;
   });
 }
 

@@ -11,6 +11,7 @@
 
 #include "cli_support.h"
 #include "robomach/calibration/virtual_hammer_test.h"
+#include "robomach/common/number_format.h"
 #include "robomach/io/frf_files.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/prediction_files.h"
@@ -22,6 +23,11 @@ namespace robomach::apps {
 namespace {
 
 constexpr char kTool[] = "frf-synth";
+// --noise-rel is a fraction of |H| (docs/plausibility.md): hammer tests show
+// 0.1 to 10 %; above 50 % it is flagged (a percentage typed for a fraction:
+// --noise-rel 2 for 2 %), above 1000 % nothing of the FRF is left: refused.
+constexpr double kMaxPlausibleRelativeNoise = 0.5;
+constexpr double kMaxRelativeNoise = 10.0;
 
 int Run(int argc, char** argv) {
   CLI::App app{
@@ -79,8 +85,20 @@ int Run(int argc, char** argv) {
   return RunGuarded(kTool, [&]() -> int {
     CheckOptionRange("--block-samples", static_cast<double>(o.block_samples), 2, 1 << 22);
     CheckOptionRange("--averages", o.averages, o.coherence ? 2 : 1, 100000);
-    RequireReadableFile(robot_path, "robot config");
-    RequireReadableFile(postures_path, "posture file");
+    if (o.relative_noise > kMaxRelativeNoise) {
+      throw UsageError("--noise-rel " + FormatNumber(o.relative_noise, 7) +
+                       ": expected the noise as a fraction of the FRF (0.02 = 2 %), at most 10; the noise would bury "
+                       "the FRF " + FormatNumber(o.relative_noise, 7) + " times over: for 2 % give --noise-rel 0.02");
+    }
+    std::vector<std::string> implausible;
+    if (o.relative_noise > kMaxPlausibleRelativeNoise) {
+      implausible.push_back("implausible (unit mistake?): --noise-rel " + FormatNumber(o.relative_noise, 7) +
+                            " is a noise rms of " + FormatNumber(100.0 * o.relative_noise, 3) +
+                            " % of the FRF; hammer tests have 0.1 to 10 % (plausible up to 50 %): a percentage typed "
+                            "for a fraction? 2 % is --noise-rel 0.02");
+    }
+    RequireInputFile("--robot", robot_path, "robot config", {io::FileKind::kYaml}, io::kRobotConfigFormat);
+    RequireInputFile("--postures", postures_path, "posture file", {io::FileKind::kCsv}, io::kPostureCsvFormat);
     CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}},
                        {{"--out", out_path}, {"--summary", summary_path}});
     o.directions.clear();
@@ -93,9 +111,11 @@ int Run(int argc, char** argv) {
     calibration::CheckValid(o);
     const auto model = cfg.Build();
     std::vector<calibration::NamedPosture> postures;
-    for (const io::Posture& p : io::ReadPostureFile(postures_path, model->num_joints())) {
+    std::vector<std::string> posture_units;  // radians under _deg headers, ...
+    for (const io::Posture& p : io::ReadPostureFile(postures_path, model->num_joints(), &posture_units)) {
       postures.push_back({p.id, p.q});
     }
+    for (const std::string& w : posture_units) Warn(kTool, w);
     const dynamics::FrfSet frfs = calibration::SynthesizeHammerTest(model, postures, o);
     const io::FrfQuantity q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
     std::string ext = out_path.substr(out_path.find_last_of('.') + 1);
@@ -154,7 +174,8 @@ int Run(int argc, char** argv) {
     msg << kTool << ": wrote " << frfs.size() << " FRFs of " << calibration::HammerTestGrid(o).size()
         << " lines to " << out_path << '\n';
     std::cerr << msg.str();
-    return kExitOk;
+    for (const std::string& w : implausible) Warn(kTool, w);
+    return implausible.empty() && posture_units.empty() ? kExitOk : kExitFlagged;
   });
 }
 

@@ -234,7 +234,7 @@ int Run(int argc, char** argv) {
       throw UsageError("--noise-mm: expected a finite noise > 0 mm");
     }
     CheckOptionRange("--plan", plan_n, 0, 500);  // 500 postures: ~15 s of planning
-    RequireReadableFile(robot_path, "robot config");
+    RequireInputFile("--robot", robot_path, "robot config", {io::FileKind::kYaml}, io::kRobotConfigFormat);
     CheckDistinctPaths({{"--robot", robot_path}, {"--tracker", tracker_path}},
                        {{"--out", out_path}, {"--residuals", residuals_path}, {"--plot", plot_path},
                         {"--summary", json_path}});
@@ -248,7 +248,7 @@ int Run(int argc, char** argv) {
     }
     if (tracker_path.empty()) throw UsageError("--tracker is required (or --plan N)");
     if (merge && out_path.empty()) throw UsageError("--merge needs --out for the merged config");
-    RequireReadableFile(tracker_path, "tracker file");
+    RequireInputFile("--tracker", tracker_path, "tracker file", {io::FileKind::kCsv}, io::kTrackerCsvFormat);
     const auto model = cfg.Build();
     if (!model->effects().empty()) {
       Warn(kTool, robot_path + " enables effects with their own compliance; the load-test model "

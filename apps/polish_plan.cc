@@ -49,7 +49,10 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
                      "the faces of a STEP/IGES file");
   }
   if (choice.face_given) throw UsageError("--list-faces lists every face; drop --face");
-  const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
+  // Listing needs nothing but the file (issue #35); with --process each face
+  // is also checked against the contact.
+  std::optional<polishing::PolishingProcess> process;
+  if (!process_path.empty()) process = io::ReadPolishingProcess(process_path);
   polishing::PathParameters params;
   params.pattern = polishing::FindPathPattern(pattern).id();
   params.radius = MmToM(radius_mm);
@@ -65,7 +68,8 @@ int ListFaces(const std::string& surface_path, const std::string& process_path, 
   const auto rows = io::ListCadFaces(
       surface_path,
       [&](const polishing::NurbsSurface& s) {
-        const polishing::Polishability p = polishing::CheckPolishable(s, process, params, po);
+        if (!process) return std::make_pair(true, std::string("contact not checked (give --process)"));
+        const polishing::Polishability p = polishing::CheckPolishable(s, *process, params, po);
         return std::make_pair(p.polishable, p.reason);
       },
       options, &info, [&](int done, int total) {
@@ -126,7 +130,9 @@ int Run(int argc, char** argv) {
                "list the faces of a STEP/IGES file as CSV (face, surface_type, area_mm2, u_size_mm, v_size_mm, "
                "trimmed, holes, polishable, reason; polishable with --process, --pattern and --radius-mm) and stop");
   app.add_option("--out", list_out, "with --list-faces: write the CSV here instead of stdout");
-  app.add_option("--process", process_path, "process YAML (docs/formats.md §7), e.g. config/polishing/belt_2N.yaml")->required();
+  app.add_option("--process", process_path,
+                 "process YAML (docs/formats.md §7), e.g. config/polishing/belt_2N.yaml; required except with "
+                 "--list-faces");
   {
     std::string help;
     std::vector<std::string> names;
@@ -192,7 +198,8 @@ int Run(int argc, char** argv) {
       throw UsageError("--optimise pso applies to the cycloid; the parallel pattern is optimised with --optimise nlopt");
     }
     RequireReadableFile(surface_path, "surface");
-    RequireReadableFile(process_path, "process file");
+    if (process_path.empty() && !list_faces) throw UsageError("--process is required (except with --list-faces)");
+    if (!process_path.empty()) RequireReadableFile(process_path, "process file");
     std::vector<std::pair<std::string, std::string>> outs = {
         {"--path", path_out}, {"--removal", removal_out}, {"--summary", summary_out}};
     robot.Prepare(&outs);

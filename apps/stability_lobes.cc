@@ -192,7 +192,7 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--sd-max-depth-mm", sd_max_depth_mm, 1e-6, 1e4);
     CheckOptionRange("--threads", threads, 0, 256);
     CheckOptionRange("--max-lobe", max_lobe, 0, 1000);
-    RequireReadableFile(cut_path, "cut file");
+    RequireInputFile("--cut", cut_path, "cut file", {io::FileKind::kYaml}, io::kCutFileFormat);
     CheckDistinctPaths({{"--cut", cut_path}, {"--robot", robot_path}, {"--postures", postures_path},
                         {"--frf", frf_path}, {"--frf-y", frf_y_path}, {"--modal-table", modal_path}},
                        {{"--out", out_path}, {"--plot", plot_path}, {"--fit-plot", fit_plot_path},
@@ -202,7 +202,11 @@ int Run(int argc, char** argv) {
                                   {modal_path, "modal table"}}) {
       if (!p.empty()) RequireReadableFile(p, what);
     }
+    if (!frf_path.empty()) {
+      RequireInputFile("--frf", frf_path, "FRF file", {io::FileKind::kCsv, io::FileKind::kUff58}, io::kFrfFileFormat);
+    }
     const io::CutSpec cut = io::ReadCutFile(cut_path);
+    for (const std::string& w : cut.implausible) Warn(kTool, w);
 
     std::vector<stability::TipDynamics> tips;
     const std::string axis_source = "--tool-axis " + tool_axis_text;
@@ -242,13 +246,14 @@ int Run(int argc, char** argv) {
     std::optional<ProgressLine> progress;
     const stability::LobesResult lobes =
         stability::ComputeLobes(tips, lo, Tell, [&](const stability::SdProgress& p) {
-          if (p.done == 0 && !p.finished) progress.emplace(kTool, "SD speeds of " + p.id, p.total >= 20 ? 1000 : 0);
+          // Counts the speeds themselves ("12/60"), from 20 speeds on.
+          if (p.done == 0 && !p.finished) progress.emplace(kTool, "SD speeds of " + p.id, p.total, 20);
           if (!progress) return;
           if (p.finished) {
             progress->Finish();
             progress.reset();
           } else if (p.total > 0) {
-            progress->Update(p.done * 1000 / p.total);
+            progress->Update(p.done);
           }
         });
     const std::vector<stability::LobeRow>& rows = lobes.rows;
@@ -291,7 +296,7 @@ int Run(int argc, char** argv) {
       io::WriteModalTableCsv(modes_out_path, ids, modes);
     }
     if (!fit_plot_path.empty()) PlotFits(fit_plot_path, frf_path, tips);
-    const bool flagged = lobes.flagged();
+    const bool flagged = lobes.flagged() || !cut.implausible.empty();
     if (!summary_path.empty()) {
       nlohmann::json j = io::LobesSummaryJson(tips, lobes);
       j["tool"] = kTool;

@@ -74,6 +74,7 @@ int Run(int argc, char** argv) {
     if (!path_path.empty()) RequireReadableFile(path_path, "tool-path file");
     const auto model = io::LoadRobotConfig(robot_path).Build();
     const io::CutSpec cut = io::ReadCutFile(cut_path);
+    for (const std::string& w : cut.implausible) Warn(kTool, w);
     const io::RegionSpec region = io::ReadRegionFile(region_path, model->num_joints());
 
     stability::MapOptions opt;
@@ -146,11 +147,11 @@ int Run(int argc, char** argv) {
       if (!region_path.empty()) j["region"] = region_path;
       if (!path_path.empty()) j["path"] = path_path;
       j["points_csv"] = out_path.empty() ? "-" : out_path;
-      j["exit_code"] = ExitCodeFor(map.status());
+      j["exit_code"] = cut.implausible.empty() ? ExitCodeFor(map.status()) : kExitFlagged;
       io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }
     for (const Finding& f : map.findings) Warn(kTool, f.message);
-    return ExitCodeFor(map.status());
+    return cut.implausible.empty() ? ExitCodeFor(map.status()) : kExitFlagged;
   });
 }
 

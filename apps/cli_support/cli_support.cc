@@ -16,6 +16,7 @@
 #include "robomach/common/version.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
+#include "robomach/io/file_kind.h"
 
 namespace robomach::apps {
 
@@ -47,6 +48,10 @@ int RunGuarded(const std::string& tool, const std::function<int()>& body) {
     }
     return rc;
   } catch (const NoInputError& e) {
+    std::cerr << tool << ": " << e.what() << '\n';
+    return kExitNoInput;
+  } catch (const io::MissingFileError& e) {
+    // A file named inside an input (a config's urdf:) that is not there.
     std::cerr << tool << ": " << e.what() << '\n';
     return kExitNoInput;
   } catch (const InputError& e) {
@@ -88,12 +93,18 @@ void RequireReadableFile(const std::string& path, const std::string& what) {
   if (!in) throw NoInputError(path + ": " + what + " cannot be read");
 }
 
-ProgressLine::ProgressLine(std::string tool, std::string what, long total)
+void RequireInputFile(const std::string& option, const std::string& path, const std::string& what,
+                      std::initializer_list<io::FileKind> accepted, const std::string& expected) {
+  RequireReadableFile(path, what);
+  io::RequireFileKind(path, accepted, expected, option);
+}
+
+ProgressLine::ProgressLine(std::string tool, std::string what, long total, long min_total)
     : tool_(std::move(tool)),
       what_(std::move(what)),
       total_(total),
       tty_(::isatty(2) != 0),
-      active_(total >= 200),
+      active_(total >= min_total),
       start_(std::chrono::steady_clock::now()) {}
 
 void ProgressLine::Update(long done) { Update(done, ""); }
@@ -151,6 +162,11 @@ std::function<std::string(const std::string&)> PngFileName() {
 
 void AddVersionFlag(CLI::App& app, const std::string& tool) {
   app.set_version_flag("--version", tool + " " + Version(), "print the version (and git commit) and exit");
+  // Command-line errors CLI11 reports (a --plot x.jpg, an unknown option)
+  // start with the tool's name like every other message (issue #35).
+  app.failure_message([tool](const CLI::App* a, const CLI::Error& e) {
+    return tool + ": " + CLI::FailureMessage::simple(a, e);
+  });
 }
 
 void Note(const std::string& tool, const std::string& message) {

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "robomach/common/run_status.h"
+#include "robomach/io/file_kind.h"
 #include "robomach/io/robot_config.h"
 
 namespace CLI {
@@ -83,6 +84,13 @@ void RequireFolderOption(const std::string& option, const std::string& path);
 
 void RequireReadableFile(const std::string& path, const std::string& what);
 
+/// RequireReadableFile, then what the file is (io::RequireFileKind): a file
+/// recognised as another kind than `accepted` is bad input (65) named with
+/// the option, "kr210.yaml: this is a YAML file; --postures expects the
+/// posture CSV of docs/formats.md §1". Unrecognised text passes.
+void RequireInputFile(const std::string& option, const std::string& path, const std::string& what,
+                      std::initializer_list<io::FileKind> accepted, const std::string& expected);
+
 /// A missing input file (exit 66).
 class NoInputError : public std::runtime_error {
  public:
@@ -90,10 +98,12 @@ class NoInputError : public std::runtime_error {
 };
 
 /// Progress on stderr: one line per ~10 % (or a \r-updated line on a TTY),
-/// only for long jobs.
+/// only for long jobs: `total` items, shown when there are at least
+/// `min_total` (fewer items that are each slow, such as SD speeds, pass a
+/// smaller `min_total`). The count printed is of the items themselves.
 class ProgressLine {
  public:
-  ProgressLine(std::string tool, std::string what, long total);
+  ProgressLine(std::string tool, std::string what, long total, long min_total = 200);
   void Update(long done);
   /// The same with a short text after the count (e.g. the best value so far).
   void Update(long done, const std::string& detail);
@@ -119,6 +129,7 @@ std::vector<std::string> WarningsGiven();
 void Note(const std::string& tool, const std::string& message);
 
 /// Adds --version to `app`: prints "tool 0.1.0 (git <commit>)" and exits 0.
+/// Also prefixes CLI11's command-line error messages with the tool's name.
 void AddVersionFlag(CLI::App& app, const std::string& tool);
 
 /// Checks a picture option's file name when the command line is parsed:

@@ -21,6 +21,7 @@
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/golden_section.h"
+#include "robomach/common/number_format.h"
 #include "robomach/common/parallel.h"
 #include "robomach/dynamics/effect.h"
 #include "robomach/dynamics/gravity_torque.h"
@@ -255,8 +256,8 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   const calibration::MeasuredFeatures& features = r.features;
   if (o.fit_line_stride == 0) {
     o.fit_line_stride = AutoLineStride(measured, features);
-    say("fits use every " + std::to_string(o.fit_line_stride) + (o.fit_line_stride == 1 ? "st" : "th") +
-        " line (half-power bands of the measured modes)");
+    say("fits use every " + (o.fit_line_stride == 1 ? std::string() : Ordinal(o.fit_line_stride) + " ") +
+        "line (half-power bands of the measured modes)");
   }
   say("calibrating the current model (whole curve)");
   std::vector<std::string> core;

@@ -20,4 +20,18 @@ std::string FormatNumber(double v, int significant_digits) {
 
 std::string FormatCell(double v) { return std::isfinite(v) ? FormatDouble(v) : std::string(); }
 
+std::string Ordinal(long n) {
+  const long a = n < 0 ? -n : n;
+  const char* suffix = "th";
+  if (a % 100 < 11 || a % 100 > 13) {
+    switch (a % 10) {
+      case 1: suffix = "st"; break;
+      case 2: suffix = "nd"; break;
+      case 3: suffix = "rd"; break;
+      default: break;
+    }
+  }
+  return std::to_string(n) + suffix;
+}
+
 }  // namespace robomach

@@ -71,9 +71,10 @@ bool ParseFiniteNumber(std::string_view text, double* value) {
   return true;
 }
 
-CsvTable CsvTable::ReadFile(const std::string& path) {
+CsvTable CsvTable::ReadFile(const std::string& path, const std::string& expected) {
+  RequireFileKind(path, {FileKind::kCsv}, expected);
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError({path, 0, 0}, "cannot open file for reading");
+  if (!in) throw MissingFileError({path, 0, 0}, "cannot open file for reading");
   std::stringstream ss;
   ss << in.rdbuf();
   return Parse(ss.str(), path);

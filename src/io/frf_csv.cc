@@ -20,7 +20,7 @@ using frf_text::Fmt;
 using frf_text::ParseAxis;
 
 FrfReadResult ReadFrfCsv(const std::string& path) {
-  const CsvTable t = CsvTable::ReadFile(path);
+  const CsvTable t = CsvTable::ReadFile(path, kFrfFileFormat);
   FrfReadResult out;
   if (auto it = t.metadata().find("quantity"); it != t.metadata().end()) {
     try {

@@ -1,5 +1,6 @@
 #include "robomach/io/frf_files.h"
 
+#include "robomach/io/file_kind.h"
 #include "robomach/io/uff58.h"
 #include "frf_text.h"
 
@@ -11,6 +12,9 @@ namespace robomach::io {
 FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_pose_id) {
   std::string ext;
   if (auto dot = path.find_last_of('.'); dot != std::string::npos) ext = Lower(path.substr(dot + 1));
+  // A YAML config, a picture or a spreadsheet is named before either parser
+  // sees it (io/file_kind.h).
+  RequireFileKind(path, {FileKind::kCsv, FileKind::kUff58}, kFrfFileFormat);
   if (ext == "uff" || ext == "unv" || ext == "uf" || ext == "ufb" || LooksLikeUff(path)) {
     return ReadUff58(path, default_pose_id);
   }

@@ -1,6 +1,8 @@
 #include "robomach/io/posture_file.h"
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -13,8 +15,42 @@
 
 namespace robomach::io {
 
-std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints) {
-  const CsvTable t = CsvTable::ReadFile(path);
+std::vector<std::string> PostureUnitWarnings(const std::string& path, const std::vector<std::vector<double>>& written,
+                                             const std::vector<bool>& is_deg) {
+  double max_deg = 0.0, max_rad = 0.0;
+  bool deg_fraction = false;  // a non-zero degree value that is not whole
+  int deg_nonzero = 0;
+  for (const auto& row : written) {
+    for (size_t j = 0; j < row.size() && j < is_deg.size(); ++j) {
+      const double a = std::abs(row[j]);
+      if (is_deg[j]) {
+        max_deg = std::max(max_deg, a);
+        if (a > 0.0) ++deg_nonzero;
+        if (a > 0.0 && a != std::floor(a)) deg_fraction = true;
+      } else {
+        max_rad = std::max(max_rad, a);
+      }
+    }
+  }
+  std::vector<std::string> out;
+  if (deg_nonzero > 0 && deg_fraction && max_deg <= kOneTurnRad) {
+    out.push_back("implausible (unit mistake?): " + path + ": every angle under the _deg headers is within "
+                  "2 pi = 6.28 (largest " + FormatDouble(max_deg) +
+                  "), as radians are: these look like radians; name the columns q1_rad, q2_rad, ... or convert to "
+                  "degrees");
+  }
+  if (max_rad > kOneTurnRad) {
+    out.push_back("implausible (unit mistake?): " + path + ": an angle of " + FormatDouble(max_rad) +
+                  " under a _rad header is " + FormatNumber(RadToDeg(max_rad)) +
+                  " deg, more than a turn: these look like degrees; name the columns q1_deg, q2_deg, ... or "
+                  "convert to radians");
+  }
+  return out;
+}
+
+std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints,
+                                     std::vector<std::string>* unit_warnings) {
+  const CsvTable t = CsvTable::ReadFile(path, kPostureCsvFormat);
   t.RequireColumn("pose_id");
   // Which joint columns exist, and in which unit.
   const std::regex qcol(R"(q(\d+)_(deg|rad))");
@@ -58,6 +94,7 @@ std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints) {
     cols[j] = is_deg[j] ? deg : rad;
   }
   std::vector<Posture> out;
+  std::vector<std::vector<double>> written;
   std::map<std::string, int> seen;
   for (int r = 0; r < t.num_rows(); ++r) {
     Posture p;
@@ -74,13 +111,23 @@ std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints) {
                                 std::to_string(it->second) + ")");
     }
     p.q.resize(num_joints);
+    std::vector<double>& as_written = written.emplace_back(num_joints);
     for (int j = 0; j < num_joints; ++j) {
       const double v = t.Number(r, cols[j]);
+      as_written[j] = v;
       p.q(j) = is_deg[j] ? DegToRad(v) : v;
+      // Finite but absurd (1e308): no robot joint turns that far in any
+      // unit; refused before anything is computed (issue #35).
+      if (std::abs(RadToDeg(p.q(j))) > kMaxJointAngleDeg) {
+        throw t.ErrorAt(r, cols[j],
+                        t.Cell(r, t.ColumnIndex(cols[j])) + (is_deg[j] ? " deg" : " rad") + " is not a joint angle (more than 100000 deg, 278 turns, in "
+                            "magnitude): a typo or a value in another unit");
+      }
     }
     out.push_back(std::move(p));
   }
   if (out.empty()) throw InputError({path, 0, 0}, "no postures (the file has a header only)");
+  if (unit_warnings) *unit_warnings = PostureUnitWarnings(path, written, is_deg);
   return out;
 }
 

@@ -1,12 +1,14 @@
 #include "robomach/io/robot_config.h"
 
 #include <cmath>
+#include <filesystem>
 #include <regex>
 #include <fstream>
 #include <sstream>
 
 #include "robomach/common/units.h"
 #include "robomach/dynamics/effect.h"
+#include "robomach/io/file_kind.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/urdf_loader.h"
 #include "robomach/io/yaml_doc.h"
@@ -32,7 +34,12 @@ Eigen::Matrix3d Inertia6(const YamlDoc& node) {
 
 Inertial ReadInertial(const YamlDoc& node) {
   Inertial b;
-  b.mass = node["mass_kg"].Number();
+  {
+    // A negative mass is reported on its own line, not on inertia_kgm2's.
+    const YamlDoc m = node["mass_kg"];
+    b.mass = m.Number();
+    if (b.mass < 0.0) throw m.Error("expected a mass >= 0 kg, got " + m.String() + " (a link's mass cannot be negative)");
+  }
   b.com = Vec3(node["com_m"]);
   const YamlDoc inertia = node["inertia_kgm2"];
   b.inertia_com = Inertia6(inertia);
@@ -111,6 +118,24 @@ kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& 
   } else {
     const YamlDoc urdf = robot["urdf"];
     const std::string urdf_path = ResolveRelative(path, urdf.String());
+    const FileSniff sniff = SniffFileKind(urdf_path);
+    if (sniff.kind == FileKind::kMissing) {
+      // Say where the file was looked for: a config copied to another
+      // folder without its URDF is the usual cause (issue #35).
+      namespace fs = std::filesystem;
+      const std::string where =
+          fs::path(urdf.String()).is_absolute()
+              ? " (an absolute path): check it, or copy the URDF there"
+              : "; a relative urdf: path is resolved against the config's folder " +
+                    fs::absolute(fs::path(path).parent_path()).lexically_normal().string() +
+                    " (not the working folder), which gives " + fs::absolute(urdf_path).lexically_normal().string() +
+                    ": copy the URDF there or write its absolute path";
+      const InputError e = urdf.Error(urdf.String() + ": " + sniff.description + where);
+      throw MissingFileError(e.where(), e.message());
+    }
+    if (sniff.kind != FileKind::kXml && sniff.kind != FileKind::kText && sniff.kind != FileKind::kEmpty) {
+      throw urdf.Error(urdf_path + ": " + WrongFileKindMessage(sniff, "a URDF (XML) file"));
+    }
     const std::string base = robot["base_link"].String();
     const std::string tip = robot["tip_frame"].String();
     arm = LoadUrdfChain(urdf_path, base, tip);
@@ -129,7 +154,7 @@ kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& 
 }
 
 RobotConfig LoadRobotConfig(const std::string& path) {
-  const YamlDoc doc = YamlDoc::LoadFile(path);
+  const YamlDoc doc = YamlDoc::LoadFile(path, kRobotConfigFormat);
   if (!doc.IsMap()) throw doc.Error("expected a robot config (a YAML map)");
   RobotConfig cfg;
   cfg.path = path;

@@ -72,7 +72,7 @@ void CheckTriple(const CsvTable& t, const std::vector<std::string>& cols, const 
 }  // namespace
 
 TrackerFile ReadTrackerFile(const std::string& path, int num_joints) {
-  const CsvTable t = CsvTable::ReadFile(path);
+  const CsvTable t = CsvTable::ReadFile(path, kTrackerCsvFormat);
   TrackerFile f;
   f.path = path;
   f.metadata = t.metadata();

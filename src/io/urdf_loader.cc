@@ -12,6 +12,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include "robomach/common/errors.h"
+#include "robomach/io/file_kind.h"
 
 namespace robomach::io {
 namespace {
@@ -99,7 +100,7 @@ KDL::Frame ToKdl(const urdf::Pose& p) { return KDL::Frame(ToKdl(p.rotation), ToK
 kinematics::SerialChain LoadUrdfChain(const std::string& path, const std::string& base_link,
                                       const std::string& tip_link) {
   std::ifstream in(path);
-  if (!in) throw InputError({path, 0, 0}, "cannot open URDF file for reading");
+  if (!in) throw MissingFileError({path, 0, 0}, "cannot open URDF file for reading");
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string xml = ss.str();

@@ -16,9 +16,10 @@ YamlDoc::YamlDoc(YAML::Node node, std::shared_ptr<const std::string> path, std::
       key_path_(std::move(key_path)),
       used_keys_(std::make_shared<std::vector<std::string>>()) {}
 
-YamlDoc YamlDoc::LoadFile(const std::string& path) {
+YamlDoc YamlDoc::LoadFile(const std::string& path, const std::string& expected) {
+  RequireFileKind(path, {FileKind::kYaml}, expected);
   std::ifstream in(path);
-  if (!in) throw InputError({path, 0, 0}, "cannot open file for reading");
+  if (!in) throw MissingFileError({path, 0, 0}, "cannot open file for reading");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   return LoadString(text, path);
 }
@@ -140,21 +141,29 @@ double YamlDoc::NumberInRange(double lo, double hi, bool include_lo, bool includ
   return v;
 }
 
+namespace {
+constexpr double kMaxWholeNumber = 1e9;  // every count robomach reads is far below
+}  // namespace
+
 int YamlDoc::Int() const {
   const double v = Number();
-  if (v != std::floor(v) || std::abs(v) > 1e9) {
-    throw Error("expected a whole number, got " + node_.Scalar());
+  if (v != std::floor(v)) throw Error("expected a whole number, got " + node_.Scalar());
+  if (std::abs(v) > kMaxWholeNumber) {
+    // A whole number, but too large (issue #35: it said "expected a whole
+    // number" of 2000000000).
+    throw Error(node_.Scalar() + " is too large: expected a whole number of at most 1000000000 in magnitude");
   }
   return static_cast<int>(v);
 }
 
 int YamlDoc::IntInRange(int lo, int hi) const {
-  const int v = Int();
+  const double v = Number();
+  if (v != std::floor(v)) throw Error("expected a whole number, got " + node_.Scalar());
   if (v < lo || v > hi) {
-    throw Error("expected a whole number in [" + std::to_string(lo) + ", " +
-                std::to_string(hi) + "], got " + node_.Scalar());
+    throw Error(node_.Scalar() + " is too " + (v > hi ? "large" : "small") + ": expected a whole number in [" +
+                std::to_string(lo) + ", " + std::to_string(hi) + "]");
   }
-  return v;
+  return static_cast<int>(v);
 }
 
 bool YamlDoc::Bool() const {

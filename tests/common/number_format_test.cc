@@ -64,3 +64,12 @@ TEST(Skew, IsTheCrossProductMatrix) {
 
 }  // namespace
 }  // namespace robomach
+
+// Ordinals as an English text writes them (the audit said "every 2th line").
+TEST(NumberFormat, OrdinalSuffixes) {
+  const std::pair<long, const char*> cases[] = {
+      {1, "1st"},     {2, "2nd"},     {3, "3rd"},     {4, "4th"},     {10, "10th"},   {11, "11th"},
+      {12, "12th"},   {13, "13th"},   {21, "21st"},   {22, "22nd"},   {23, "23rd"},   {101, "101st"},
+      {111, "111th"}, {112, "112th"}, {1002, "1002nd"}, {0, "0th"}};
+  for (const auto& [n, text] : cases) EXPECT_EQ(robomach::Ordinal(n), text) << n;
+}

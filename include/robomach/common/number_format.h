@@ -19,4 +19,8 @@ std::string FormatNumber(double v, int significant_digits = 4);
 /// infinite.
 std::string FormatCell(double v);
 
+/// An English ordinal: 1st 2nd 3rd 4th ... 11th 12th 13th ... 21st 22nd
+/// 101st 111th ("every 2nd line").
+std::string Ordinal(long n);
+
 }  // namespace robomach

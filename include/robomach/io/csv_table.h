@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "robomach/common/errors.h"
+#include "robomach/io/file_kind.h"
 
 namespace robomach::io {
 
@@ -16,9 +17,11 @@ namespace robomach::io {
 /// `tracker.csv:17: column fy_N: expected a number, got "12,5" (decimal comma?)`.
 class CsvTable {
  public:
-  /// @throws InputError if the file cannot be read, has no header, or a data
-  ///   row has more cells than the header.
-  static CsvTable ReadFile(const std::string& path);
+  /// @throws MissingFileError if the file is missing or cannot be read;
+  ///   InputError if it is recognised as another kind of file (YAML, UFF58,
+  ///   a picture; the message names `expected`, see io/file_kind.h), has no
+  ///   header, or a data row has more cells than the header.
+  static CsvTable ReadFile(const std::string& path, const std::string& expected = kCsvTableFormat);
   /// Parses text; `path` is used in messages only.
   static CsvTable Parse(std::string_view text, const std::string& path);
 

@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "robomach/common/errors.h"
+#include "robomach/io/file_kind.h"
 
 namespace robomach::io {
 
@@ -15,8 +16,11 @@ namespace robomach::io {
 /// Maps remember which keys were read; RejectUnknownKeys() reports the rest.
 class YamlDoc {
  public:
-  /// @throws InputError if the file is missing or not valid YAML.
-  static YamlDoc LoadFile(const std::string& path);
+  /// @throws MissingFileError if the file is missing or cannot be read;
+  ///   InputError if it is recognised as another kind of file (a CSV table,
+  ///   UFF58, a picture; the message names `expected`, see io/file_kind.h)
+  ///   or is not valid YAML.
+  static YamlDoc LoadFile(const std::string& path, const std::string& expected = kYamlFileFormat);
   static YamlDoc LoadString(const std::string& text, const std::string& path);
 
   const std::string& path() const { return *path_; }
