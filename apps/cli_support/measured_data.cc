@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "cli_support.h"
+#include "robomach/calibration/frf_noise.h"
 #include "robomach/common/errors.h"
 #include "robomach/io/frf_files.h"
 
@@ -20,7 +21,9 @@ MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::s
     const io::FrfReadResult r = io::ReadFrfFile(path, pose);
     for (const std::string& w : r.warnings) Warn(tool, w);
     for (const std::string& n : r.notes) Note(tool, n);
-    for (const std::string& f : dynamics::ReceptanceUnitFindings(r.frfs, path)) {
+    // On each FRF's usable band only (issue #34 item 5): a tap test's drift
+    // lines are no measure of the unit.
+    for (const std::string& f : calibration::ReceptanceUnitFindings(r.frfs, path, r.averages)) {
       Warn(tool, "implausible (unit mistake?): " + f);
       all.unit_findings.push_back(f);
     }

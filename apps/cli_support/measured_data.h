@@ -24,9 +24,9 @@ struct MeasuredData {
   dynamics::FrfSet frfs;
   std::map<dynamics::FrfKey, int> averages;
   std::map<dynamics::FrfKey, std::string> file;
-  /// FRFs whose receptance is outside the plausible range
-  /// (dynamics::ReceptanceUnitFindings; printed as warnings): a unit
-  /// mistake, which the tools flag (exit 3).
+  /// FRFs whose receptance on its usable band is outside the plausible
+  /// range (calibration::ReceptanceUnitFindings; printed as warnings): a
+  /// unit mistake, which the tools flag (exit 3).
   std::vector<std::string> unit_findings;
 };
 

@@ -11,6 +11,7 @@
 // libeigen3-dev): see third_party_notes.md for why this one.
 #include <unsupported/Eigen/FFT>
 
+#include "robomach/calibration/frf_noise.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 
@@ -383,16 +384,19 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
     result.warnings.push_back(
         "only 2 hits averaged: the coherence needs at least 3 to mean much, 5 or more are usual");
   }
-  // Unit plausibility: the largest receptance on the coherent lines.
+  // Unit plausibility: the largest receptance on the coherent lines of the
+  // band the noise model finds usable (issue #34 item 5: on a single hit the
+  // 1/ω² of an accelerometer's slow drift made the lowest lines 1e-3 m/N).
   for (int c = 0; c < nc; ++c) {
     const int p = static_cast<int>(channels[c].quantity);  // 0 displacement, 1 velocity, 2 acceleration
-    double peak = 0.0;
+    Eigen::VectorXcd receptance(lines);
     for (int k = 0; k < lines; ++k) {
-      if (result.channels[c].coherence(k) < 0.5) continue;
       const double w = 2.0 * M_PI * result.freq_hz(k);
-      peak = std::max(peak, std::abs(result.channels[c].h1(k)) / std::pow(w, p));
+      receptance(k) = result.channels[c].h1(k) / std::pow(w, p);
     }
-    const std::string finding = dynamics::ReceptancePeakFinding("response " + channels[c].name, peak);
+    const UsableBandPeak peak = PeakReceptanceInUsableBand(
+        dynamics::Frf::FromSamples(result.freq_hz, receptance, result.channels[c].coherence), result.averages);
+    const std::string finding = UsableBandUnitFinding("response " + channels[c].name, peak);
     if (!finding.empty()) {
       result.implausible = true;
       result.warnings.push_back(finding);

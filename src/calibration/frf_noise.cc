@@ -814,4 +814,73 @@ Eigen::VectorXd LogResidualWeights(const dynamics::Frf& frf) {
   return w;
 }
 
+UsableBandPeak PeakReceptanceInUsableBand(const dynamics::Frf& frf, int averages) {
+  UsableBandPeak out;
+  // The usable lines are a subset of all lines, so their peak is at most the
+  // peak of all lines: when that is plausible the noise model (seconds on a
+  // few thousand lines) can change no verdict on the upper limit.
+  const double all_lines = dynamics::PeakReceptance(frf);
+  if (all_lines <= dynamics::kMaxPlausibleReceptance) {
+    out.peak_m_per_N = all_lines;
+    return out;
+  }
+  FrfNoise noise;
+  try {
+    NoiseOptions o;
+    o.wide_floor = true;
+    o.averages = averages;
+    noise = EstimateFrfNoise(frf, o);
+  } catch (const std::invalid_argument&) {
+    noise.usable_lines = 0;  // fewer than 8 lines: no noise model
+  }
+  if (noise.usable_lines == 0) {
+    out.peak_m_per_N = all_lines;
+    return out;
+  }
+  // A line counts when it is usable, above 0 Hz and coherent (as
+  // dynamics::PeakReceptance); the peak is the largest median of three
+  // neighbouring counted lines (a resonance spans several lines).
+  const int n = frf.size();
+  std::vector<char> counted(n, 0);
+  for (int k = 0; k < n; ++k) {
+    counted[k] = noise.usable[k] && frf.freq_hz()(k) > 0.0 && !(frf.coherence() && (*frf.coherence())(k) < 0.5);
+  }
+  double peak = 0.0;
+  bool any = false;
+  for (int k = 1; k + 1 < n; ++k) {
+    if (!(counted[k - 1] && counted[k] && counted[k + 1])) continue;
+    const double a = std::abs(frf.receptance()(k - 1)), b = std::abs(frf.receptance()(k)),
+                 c = std::abs(frf.receptance()(k + 1));
+    peak = std::max(peak, std::max(std::min(a, b), std::min(std::max(a, b), c)));  // median of three
+    any = true;
+  }
+  if (!any) {
+    out.peak_m_per_N = all_lines;
+    return out;
+  }
+  out.peak_m_per_N = peak;
+  out.fmin_hz = noise.usable_bands.front().first;
+  out.fmax_hz = noise.usable_bands.back().second;
+  out.on_usable_band = true;
+  return out;
+}
+
+std::string UsableBandUnitFinding(const std::string& what, const UsableBandPeak& p) {
+  std::string f = dynamics::ReceptancePeakFinding(what, p.peak_m_per_N);
+  if (f.empty()) return f;
+  return f + (p.on_usable_band ? " (the largest on the usable band " + Sci(p.fmin_hz) + "-" + Sci(p.fmax_hz) +
+                                     " Hz of the noise model)"
+                               : std::string(" (the largest of all lines)"));
+}
+
+std::vector<std::string> ReceptanceUnitFindings(const dynamics::FrfSet& frfs, const std::string& source,
+                                                int averages) {
+  std::vector<std::string> out;
+  for (const auto& [key, frf] : frfs) {
+    std::string f = UsableBandUnitFinding(source + ": " + key.ToString(), PeakReceptanceInUsableBand(frf, averages));
+    if (!f.empty()) out.push_back(std::move(f));
+  }
+  return out;
+}
+
 }  // namespace robomach::calibration

@@ -112,7 +112,7 @@ std::vector<std::string> Iso230UnitFindings(const std::string& axis, const Iso23
   }
   const double travel = r.targets.back().target - r.targets.front().target;
   const double magnitude = std::max(target, travel);
-  char b[400];
+  char b[512];
   if (rotary) {
     if (dev > kMaxPlausibleRotaryDeviationDeg) {
       std::snprintf(b, sizeof b,
@@ -123,12 +123,14 @@ std::vector<std::string> Iso230UnitFindings(const std::string& axis, const Iso23
     }
     return out;
   }
-  if (magnitude > 0 && dev > kMaxPlausibleDeviationFraction * magnitude) {
+  // Relative limit with a floor for short strokes (iso230.h).
+  if (magnitude > 0 && dev > std::max(kMaxPlausibleDeviationFraction * magnitude, kMinPlausibleDeviationLimitMm)) {
     std::snprintf(b, sizeof b,
                   "axis %s: deviations up to %.4g mm are %.3g %% of the targets' magnitude (%.4g mm; more than "
-                  "%.3g %% is not a positioning error): measured values in um (or targets in m) under the _mm "
-                  "headers?",
-                  axis.c_str(), dev, 100 * dev / magnitude, magnitude, 100 * kMaxPlausibleDeviationFraction);
+                  "%.3g %% of it or %.3g mm, whichever is larger, is not a positioning error): measured values in "
+                  "um (or targets in m) under the _mm headers?",
+                  axis.c_str(), dev, 100 * dev / magnitude, magnitude, 100 * kMaxPlausibleDeviationFraction,
+                  kMinPlausibleDeviationLimitMm);
     out.push_back(b);
   } else if (dev > kMaxPlausibleLinearDeviationMm) {
     std::snprintf(b, sizeof b,

@@ -5,9 +5,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "robomach/common/units.h"
+#include "robomach/io/iso_runs_file.h"
 #include "test_support.h"
 
 namespace robomach::io {
@@ -223,6 +226,55 @@ TEST(IsoRuns, ReadsAndWrapsRotaryDeviations) {
                 ReadIsoRuns(WriteText(dir + "/e.csv", "axis,target_mm,run,direction,measured_deg\nX,0,1,+,0.1\n"));
               }),
               HasSubstr("not both"));
+}
+
+// Issue #34 item 5: a short-stroke axis (targets -4..4 mm, 5 runs each way,
+// a stage measured by a laser triangulation sensor) with deviations
+//   up: 0.015 x + 0.02 + r_k,  down: 0.015 x - 0.02 + r_k  [mm],
+//   r_k = -0.01, -0.005, 0, 0.005, 0.01  (mean 0, s = sqrt(2.5e-4 / 4)),
+// so by hand the largest |mean| + 2 s is 0.08 + 2 x 0.0079057 = 0.095811 mm
+// at 4 mm up: 1.2 % of the 8 mm travel, over the former 1 % limit (the
+// issue's false alarm) and under the 0.25 mm floor of short strokes: no
+// finding. The same runs in um under _mm still are one, both ways a file
+// can carry it: deviations 1000 x (measured = target + 1000 dev) and the
+// measured positions in um beside targets in mm.
+TEST(IsoRuns, ShortStrokeAxisIsPlausibleAndMicrometresUnderMmAreNot) {
+  const std::string dir = TempDir("iso_short_stroke");
+  auto file = [&](const std::string& name, double dev_scale, double measured_scale) {
+    std::ostringstream os;
+    os.precision(12);
+    os << "axis,target_mm,run,direction,measured_mm\n";
+    const double r[5] = {-0.01, -0.005, 0.0, 0.005, 0.01};
+    for (int x = -4; x <= 4; x += 2) {
+      for (int up = 1; up >= 0; --up) {
+        for (int k = 0; k < 5; ++k) {
+          const double dev = 0.015 * x + (up ? 0.02 : -0.02) + r[k];
+          os << "X," << x << ',' << k + 1 << ',' << (up ? '+' : '-') << ','
+             << measured_scale * (x + dev_scale * dev) << '\n';
+        }
+      }
+    }
+    return EvaluateIsoRunsFile(WriteText(dir + "/" + name, os.str()));
+  };
+  const IsoEvaluation good = file("short.csv", 1.0, 1.0);
+  ASSERT_EQ(good.results.size(), 1u);
+  double dev = 0.0;
+  for (const machine::Iso230Target& t : good.results[0].second.targets) {
+    dev = std::max({dev, std::abs(t.mean_up) + 2 * t.s_up, std::abs(t.mean_down) + 2 * t.s_down});
+  }
+  EXPECT_NEAR(dev, 0.08 + 2.0 * std::sqrt(2.5e-4 / 4.0), 1e-9);  // rounding of the 12-digit file
+  EXPECT_GT(dev, machine::kMaxPlausibleDeviationFraction * 8.0);  // the former rule's false alarm
+  EXPECT_TRUE(good.unit_findings.empty()) << good.unit_findings.front();
+  EXPECT_EQ(good.status(), RunStatus::kOk);
+  const IsoEvaluation dev_um = file("short_dev_um.csv", 1000.0, 1.0);
+  ASSERT_EQ(dev_um.unit_findings.size(), 1u);
+  EXPECT_THAT(dev_um.unit_findings[0], HasSubstr("axis X: deviations up to 95.81 mm are 1.2e+03 % of the targets' "
+                                                  "magnitude (8 mm"));
+  EXPECT_THAT(dev_um.unit_findings[0], HasSubstr("measured values in um (or targets in m) under the _mm headers"));
+  EXPECT_EQ(dev_um.status(), RunStatus::kFlagged);
+  const IsoEvaluation measured_um = file("short_measured_um.csv", 1.0, 1000.0);
+  ASSERT_EQ(measured_um.unit_findings.size(), 1u);
+  EXPECT_THAT(measured_um.unit_findings[0], HasSubstr("measured values in um"));
 }
 
 }  // namespace

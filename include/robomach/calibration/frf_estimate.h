@@ -135,8 +135,9 @@ struct FrfEstimateResult {
   std::vector<std::string> warnings;
   bool leakage{false};  // a response had not decayed by the end of its window
   /// A channel's receptance (converted from its quantity) is outside
-  /// [kMinPlausibleReceptance, kMaxPlausibleReceptance] on its coherent
-  /// lines: almost surely a unit mistake (mm or um under an _m column, kN
+  /// [kMinPlausibleReceptance, kMaxPlausibleReceptance] on the coherent
+  /// lines of its usable band (PeakReceptanceInUsableBand, frf_noise.h):
+  /// almost surely a unit mistake (mm or um under an _m column, kN
   /// under force_N); a warning names the channel and the likely mistake.
   bool implausible{false};
 };

@@ -228,4 +228,49 @@ dynamics::FrfSet UsableData(const dynamics::FrfSet& measured, const NoiseModels&
 /// Without a noise model, all ones.
 Eigen::VectorXd LogResidualWeights(const dynamics::Frf& frf);
 
+/// The largest receptance of an FRF on the band its noise model finds
+/// usable (issue #34 item 5), for the unit plausibility
+/// (dynamics::ReceptancePeakFinding). The largest |H| over all lines is no
+/// measure of the unit: a tap test's integrated-accelerometer drift makes
+/// its lowest lines 1e-3 m/N and more where the tool tip is 1e-6 m/N (a
+/// real tap test: 1.02e-3 m/N at 1-3 Hz, 6.8e-7 m/N on its usable
+/// 89-4615 Hz), and a single hit's 1/ω² of any accelerometer offset does the
+/// same. The noise model here is EstimateFrfNoise with the wide floor on
+/// (the drift, smooth over a few lines, counts as noise: NoiseOptions::
+/// wide_floor) and the coherence when `averages` >= 2; the peak is the
+/// largest median of three neighbouring usable lines above 0 Hz with
+/// coherence >= 0.5 (as dynamics::PeakReceptance). A wrong unit scales
+/// every line alike (mm or um under _m: x1e3 or x1e6; kN: x1e3) or by ω
+/// (a mobility, an accelerance), and the noise model is invariant to a
+/// scale, so its usable band and the resonances in it keep the mistake.
+///
+/// The usable lines being a subset of all lines, the noise model (seconds on
+/// a few thousand lines) is estimated only when the peak of all lines
+/// (dynamics::PeakReceptance) is above kMaxPlausibleReceptance: below, the
+/// usable band cannot change the verdict on the upper limit, and the lower
+/// limit (1e-12 m/N, a force in mN on the stiffest structure) is judged on
+/// all lines as before.
+struct UsableBandPeak {
+  double peak_m_per_N{0.0};
+  /// The usable band the peak was taken on [Hz] (first and last usable line).
+  double fmin_hz{0.0};
+  double fmax_hz{0.0};
+  /// True when the peak is the one of the usable band; false when the peak
+  /// of all lines is plausible already (no noise model estimated), the
+  /// noise model found no usable line or the FRF has fewer than 8 lines:
+  /// then the peak is dynamics::PeakReceptance of all lines.
+  bool on_usable_band{false};
+};
+UsableBandPeak PeakReceptanceInUsableBand(const dynamics::Frf& frf, int averages = 0);
+
+/// dynamics::ReceptancePeakFinding of PeakReceptanceInUsableBand, naming
+/// the band: "" when plausible. `what` starts the sentence.
+std::string UsableBandUnitFinding(const std::string& what, const UsableBandPeak& peak);
+
+/// UsableBandUnitFinding of PeakReceptanceInUsableBand of every FRF of the
+/// set (`averages` behind each, 0 unknown): one finding per FRF out of
+/// range, each starting with `source` and the FRF's key.
+std::vector<std::string> ReceptanceUnitFindings(const dynamics::FrfSet& frfs, const std::string& source,
+                                                int averages = 0);
+
 }  // namespace robomach::calibration

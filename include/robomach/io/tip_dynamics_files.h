@@ -27,11 +27,10 @@ std::vector<FrfSetOfPose> ReadTipFrfs(const std::string& path, const std::string
                                       std::vector<std::string>* warnings = nullptr,
                                       std::vector<std::string>* notes = nullptr);
 
-/// The unit plausibility of the FRFs read (dynamics::ReceptancePeakFinding
-/// of the largest dynamics::PeakReceptance of each posture's FRFs): one
-/// finding per
-/// posture out of range, naming the file and posture (a mobility or
-/// accelerance read as receptance, a response in mm under _m).
+/// The unit plausibility of the FRFs read (stability::TipFrfsUnitFinding:
+/// the largest receptance of each posture's FRFs on their usable bands):
+/// one finding per posture out of range, naming the file and posture (a
+/// mobility or accelerance read as receptance, a response in mm under _m).
 std::vector<std::string> ReceptanceUnitFindings(const std::vector<FrfSetOfPose>& sets);
 
 /// One posture of a modal table.

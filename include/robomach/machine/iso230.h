@@ -55,9 +55,27 @@ Iso230Result EvaluateIso230(const std::vector<Iso230Approach>& approaches);
 // times wider, so only a unit mistake exceeds them: micrometres under an
 // _mm header (deviations 1000 times too large), measured values in um with
 // targets in mm (deviations as large as the targets), arcsec under _deg.
+//
+// Short strokes (issue #34 item 5): the relative limit alone flagged a real
+// stage of 8 mm stroke (targets -4..4 mm, deviations up to 0.10 mm, 1.25 %,
+// measured by a laser triangulation sensor). Part of a small axis's error
+// does not shrink with its stroke: the backlash of a lead-screw stage
+// without a preloaded nut (0.02-0.1 mm), the lead error of a rolled screw
+// (ISO 3408-3 class 10: 0.21 mm per 300 mm, and its periodic part within
+// any turn), a triangulation sensor's linearity (0.1 % of a 10-50 mm
+// range). So the relative limit has a floor, kMinPlausibleDeviationLimitMm
+// = 0.25 mm (3.1 % of that 8 mm stroke, 2.5 times its 0.10 mm). The
+// unit mistake stays caught: um under _mm multiplies every deviation by
+// 1000, so a short axis is missed only if its true deviations are below
+// 0.25 um (a nanopositioning stage; the plain 1 % missed those below
+// 0.08 um of an 8 mm stroke), and any axis off by more than 1 um is caught
+// by the absolute 1 mm limit whatever its stroke.
 /// Largest plausible |deviation| of a linear axis as a fraction of the
 /// targets' magnitude (max(|target|, travel)): 1 % is 10 mm per metre.
+/// The limit is max(this x magnitude, kMinPlausibleDeviationLimitMm).
 inline constexpr double kMaxPlausibleDeviationFraction = 0.01;
+/// Floor of the relative limit [mm] (short strokes, see above).
+inline constexpr double kMinPlausibleDeviationLimitMm = 0.25;
 /// Largest plausible |deviation| of a linear axis [mm].
 inline constexpr double kMaxPlausibleLinearDeviationMm = 1.0;
 /// Largest plausible |deviation| of a rotary axis [deg] (3600 arcsec).

@@ -52,9 +52,10 @@ struct TipDynamics {
   std::string unit_finding;
 };
 
-/// dynamics::ReceptancePeakFinding of the largest dynamics::PeakReceptance
-/// of the FRFs `frfs` gives, naming its file and posture; empty when
-/// plausible.
+/// calibration::UsableBandUnitFinding of the largest
+/// calibration::PeakReceptanceInUsableBand of the FRFs `frfs` gives (each
+/// on the band its noise model finds usable), naming its file and posture;
+/// empty when plausible.
 std::string TipFrfsUnitFinding(const TipFrfs& frfs);
 
 /// Lines of the log frequency grid of the model sources: ln(100)/4000 ≈ 1e-3
