@@ -140,6 +140,21 @@ std::pair<dynamics::RobotDescription, dynamics::ParameterSet> CandidateModel(
 
 namespace internal {
 
+// A fraction removed in per cent for a headline: whole per cent, but never
+// "100 %" for a fit that leaves a remainder (issue #33: "removes 100 % of
+// the excess misfit ... a remainder is left"): 99.5 % and above with one
+// decimal, cut (not rounded) below 100.
+std::string PercentRemoved(double fraction) {
+  const double p = 100.0 * fraction;
+  if (!std::isfinite(p)) return "?";
+  if (p < 99.5) return std::to_string(std::lround(p));
+  std::ostringstream m;
+  m.setf(std::ios::fixed);
+  m.precision(1);
+  m << std::min(99.9, std::floor(p * 10.0) / 10.0);
+  return m.str();
+}
+
 // What to do about a parameter hypothesis: measure the parameters, or fit
 // them against the hammer tests.
 std::string ParameterAdvice(const CandidateResult& b) {
@@ -263,14 +278,14 @@ std::string Headline(const AuditResult& r, const AuditOptions& o) {
       break;
     case AuditGrade::kMostlyExplained:
       m << "Mostly explained by " << DescribeCandidate(*b, r.configured) << ": it removes "
-        << std::lround(100.0 * r.fraction_removed)
+        << PercentRemoved(r.fraction_removed)
         << " % of the excess misfit (error " << before << " -> " << after
         << " x the noise floor); a remainder is left.";
       break;
     case AuditGrade::kUnexplained:
       if (b && r.best >= 0) {
         m << "Unexplained: the best candidate, " << b->name() << ", takes the error only from " << before << " to "
-          << after << " x the noise floor (" << std::lround(100.0 * r.fraction_removed) << " % of the excess misfit";
+          << after << " x the noise floor (" << PercentRemoved(r.fraction_removed) << " % of the excess misfit";
         if (r.fraction_removed >= o.mostly_explained_fraction) {
           m << ", but it is not clearly ahead of " << r.runner_up << " by BIC";
         }
