@@ -94,6 +94,10 @@ int Run(int argc, char** argv) {
   app.add_option("--fmin-hz", opt.fmin_hz, "lowest frequency used [Hz]")->capture_default_str();
   app.add_option("--fmax-hz", opt.fmax_hz, "highest frequency used [Hz]; default: all lines");
   app.add_option("--max-iterations", opt.max_iterations, "solver iterations per fit")->capture_default_str();
+  app.add_option("--robust-loss", opt.robust_scale,
+                 "Huber loss per line in every fit, its scale in units of the noise (e.g. 3); 0: plain least squares "
+                 "(errors and BIC stay plain)")
+      ->capture_default_str();
   NoiseCliOptions noise_opt;
   AddNoiseOptions(app, &noise_opt);
   try {
@@ -112,6 +116,7 @@ int Run(int argc, char** argv) {
     }
     CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
     CheckOptionRange("--virtual-joints", virtual_joints, 0, 50);
+    CheckOptionRange("--robust-loss", opt.robust_scale, 0.0, 1e6);
     opt.virtual_joints_fitted = virtual_joints;
     opt.try_parameters = !no_parameters;
     {

@@ -42,6 +42,7 @@ calibration::CalibrationOptions FitOptions(const AuditOptions& o, std::vector<st
   c.modal_fit.fmin_hz = o.fmin_hz;
   c.modal_fit.fmax_hz = o.fmax_hz;
   c.max_iterations = o.max_iterations;
+  c.robust_scale = o.robust_scale;
   // The audit chooses its own starts (scan, defaults) per candidate.
   c.extra_starts = false;
   return c;

@@ -51,6 +51,9 @@ void CheckValid(const AuditOptions& o) {
   if (o.max_iterations < 1) throw std::invalid_argument("AuditOptions::max_iterations must be >= 1");
   if (o.fit_line_stride < 0) throw std::invalid_argument("AuditOptions::fit_line_stride must be >= 0 (0: automatic)");
   if (o.threads < 1) throw std::invalid_argument("AuditOptions::threads must be >= 1");
+  if (!(o.robust_scale >= 0.0) || !std::isfinite(o.robust_scale)) {
+    throw std::invalid_argument("AuditOptions::robust_scale must be >= 0 (0: none), got " + std::to_string(o.robust_scale));
+  }
 }
 
 double Bic(double rss, int n, int k) {

@@ -288,6 +288,7 @@ struct ModelResidual {
   std::vector<std::pair<FrfKey, dynamics::Frf>> curves;  // whole curve, band-limited
   std::vector<Eigen::VectorXd> curve_weights;            // LogResidualWeights of each curve
   double freq_sigma{1.0}, peak_sigma{1.0};
+  double robust_scale{0.0};  // CalibrationOptions::robust_scale (whole curve)
   int num_residuals{0};
   // The first exception other than a NumericalError raised in an evaluation
   // (bad input, a bug). Ceres cannot carry it, so the evaluation fails and
@@ -351,8 +352,18 @@ struct ModelResidual {
           const Eigen::VectorXd& w = curve_weights[c];
           for (int i = 0; i < frf.size(); ++i) {
             const auto e = WholeCurveResiduals(H(i), frf.receptance()(i));
-            residuals[r++] = w(i) * e[0];
-            residuals[r++] = w(i) * e[1];
+            double a = w(i) * e[0], b = w(i) * e[1];
+            if (robust_scale > 0.0) {
+              // √ρ per line: both residuals scaled by √ρ(s) / √s.
+              const double sq = a * a + b * b;
+              if (sq > robust_scale * robust_scale) {
+                const double f = std::sqrt(HuberRho(sq, robust_scale) / sq);
+                a *= f;
+                b *= f;
+              }
+            }
+            residuals[r++] = a;
+            residuals[r++] = b;
           }
         }
         return true;
@@ -590,6 +601,7 @@ CalibrationResult CalibrateOnce(const dynamics::RobotDescription& description, c
       }
       r.kind = kind;
       r.matches = matches;
+      r.robust_scale = o.robust_scale;
       if (kind == ResidualKind::kWholeCurve) {
         for (const auto& [key, frf] : measured) {
           dynamics::Frf band = frf.Band(std::max(o.fmin_hz, 1e-12), o.fmax_hz);
@@ -669,9 +681,14 @@ CalibrationResult CalibrateOnce(const dynamics::RobotDescription& description, c
 
 }  // namespace
 
+double HuberRho(double s, double c) {
+  if (!(c > 0.0) || s <= c * c) return s;
+  return 2.0 * c * std::sqrt(s) - c * c;
+}
+
 double WholeCurveMisfit(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
                         const PostureMap& postures, const dynamics::FrfSet& measured, double fmin_hz,
-                        double fmax_hz) {
+                        double fmax_hz, double robust_scale) {
   try {
     const auto dyn = EvaluatePostures(dynamics::RobotModel::Build(description, parameters), postures,
                                       measured.pose_ids());
@@ -686,7 +703,7 @@ double WholeCurveMisfit(const dynamics::RobotDescription& description, const dyn
       for (int i = 0; i < band.size(); ++i) {
         if (std::abs(band.receptance()(i)) == 0.0) continue;
         const auto r = WholeCurveResiduals(H(i), band.receptance()(i));
-        s += w(i) * w(i) * (r[0] * r[0] + r[1] * r[1]);
+        s += HuberRho(w(i) * w(i) * (r[0] * r[0] + r[1] * r[1]), robust_scale);
       }
     }
     return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
@@ -701,9 +718,14 @@ double WholeCurveMisfit(const dynamics::RobotDescription& description, const dyn
 CalibrationResult Calibrate(const dynamics::RobotDescription& description, const dynamics::ParameterSet& initial,
                             const PostureMap& postures, const dynamics::FrfSet& measured,
                             const MeasuredFeatures& features, const CalibrationOptions& o) {
-  const double misfit_start = WholeCurveMisfit(description, initial, postures, measured, o.fmin_hz, o.fmax_hz);
+  if (!(o.robust_scale >= 0.0) || !std::isfinite(o.robust_scale)) {
+    throw std::invalid_argument("CalibrationOptions::robust_scale must be >= 0 (0: no robust loss), got " +
+                                std::to_string(o.robust_scale));
+  }
+  const double misfit_start =
+      WholeCurveMisfit(description, initial, postures, measured, o.fmin_hz, o.fmax_hz, o.robust_scale);
   const auto misfit_of = [&](const CalibrationResult& r) {
-    return WholeCurveMisfit(description, r.parameters, postures, measured, o.fmin_hz, o.fmax_hz);
+    return WholeCurveMisfit(description, r.parameters, postures, measured, o.fmin_hz, o.fmax_hz, o.robust_scale);
   };
   const auto doubtful = [](const CalibrationResult& r) {
     if (r.status != FitStatus::kConverged) return true;

@@ -155,6 +155,53 @@ TEST(FrfCalibration, AcceptanceJointAndWholeCurveObjectives) {
   }
 }
 
+// Issue #33 §4, the second line of defence: outlier lines that the noise
+// model kept (its outlier detection off here; 300 × the noise, at three
+// lines of every FRF, away from the mains) pull a least-squares fit off the
+// truth; with the Huber loss at 3 σ (CalibrationOptions::robust_scale) the
+// whole-curve fit lands where the fit of the clean data lands. Expected:
+// m6 and d6 within 0.5 % of the clean fit, and less than half the spikes'
+// pull on the plain fit.
+TEST(FrfCalibration, RobustLossKeepsTheFitOffOutliersTheNoiseModelKept) {
+  const TestCampaign s = MakeSetup();
+  const auto truth_model = dynamics::RobotModel::Build(s.cfg.description, s.truth);
+  const dynamics::FrfSet clean = SynthesizeHammerTest(truth_model, s.fit_postures, NoisyTest(33));
+  NoiseOptions keep;
+  keep.exclude_outlier_lines = false;
+  dynamics::FrfSet spiked;
+  for (const auto& [key, frf] : clean) {
+    Eigen::VectorXcd h = frf.receptance();
+    for (double f : {37.25, 143.75, 311.0}) {
+      const int i = static_cast<int>(std::lround(f / 0.25)) - 1;
+      h(i) *= 1.0 + 300.0 * 0.02;  // 300 × the 2 % noise, in phase
+    }
+    spiked.Insert(key, dynamics::Frf::FromSamples(frf.freq_hz(), h));
+  }
+  const dynamics::FrfSet clean_data = UsableData(clean, EstimateNoise(clean, keep));
+  const dynamics::FrfSet spiked_data = UsableData(spiked, EstimateNoise(spiked, keep));
+  const auto fit = [&](const dynamics::FrfSet& data, double robust) {
+    CalibrationOptions o;
+    o.objective = Objective::kWholeCurve;
+    o.robust_scale = robust;
+    return Calibrate(s.cfg.description, s.cfg.parameters, s.postures, data, ExtractFeatures(data), o);
+  };
+  const CalibrationResult reference = fit(clean_data, 0.0);
+  const CalibrationResult plain = fit(spiked_data, 0.0);
+  const CalibrationResult robust = fit(spiked_data, 3.0);
+  double pull_plain = 0.0, pull_robust = 0.0;
+  for (const std::string name : {"m6_kg", "d6_m"}) {
+    const double ref = reference.parameters.Get(name);
+    pull_plain = std::max(pull_plain, std::abs(plain.parameters.Get(name) / ref - 1.0));
+    pull_robust = std::max(pull_robust, std::abs(robust.parameters.Get(name) / ref - 1.0));
+    std::printf("%s: clean %.6g, plain %.6g, robust %.6g\n", name.c_str(), ref, plain.parameters.Get(name),
+                robust.parameters.Get(name));
+  }
+  EXPECT_EQ(robust.status, FitStatus::kConverged) << robust.message;
+  EXPECT_LT(pull_robust, 0.005);
+  EXPECT_LT(pull_robust, 0.5 * pull_plain);  // the loss is what keeps it there
+  EXPECT_THROW(fit(spiked_data, -1.0), std::invalid_argument);
+}
+
 // ---------------------------------------------------------------------------
 // Issue #10: hammer data as they really come. Accelerance files of a
 // 5120 Hz test (0.625..2560 Hz, 4096 lines) at 6 postures, 2 % relative

@@ -99,6 +99,10 @@ struct AuditOptions {
   /// parameters, and the `virtual_joints_fitted` best are fitted fully as
   /// candidates. 0: no virtual joints.
   int virtual_joints_fitted{3};
+  /// calibration::CalibrationOptions::robust_scale of every fit (a Huber
+  /// loss per line, in units of the noise; 0: plain least squares). The
+  /// errors, the BIC and the grades stay those of plain least squares.
+  double robust_scale{0.0};
   /// Candidates fitted at the same time (each fit is single-threaded).
   int threads{2};
   /// Called with one line per step (for progress on stderr); may be empty.

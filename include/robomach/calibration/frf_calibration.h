@@ -190,6 +190,19 @@ struct CalibrationOptions {
   /// defaults, and for a modal objective a whole-curve fit from the best
   /// result so far. The best by misfit is kept.
   bool extra_starts{true};
+  /// Robust loss on the whole-curve objective (issue #33 §4, the second
+  /// line of defence after the noise model's outlier lines): each line's
+  /// pair of residuals r (log magnitude and phase chord, in units of the
+  /// noise when the data carry a noise model) enters the cost through
+  /// Huber's ρ(s) = s for s = |r|² <= c², 2 c |r| − c² above [Huber 1964],
+  /// c = robust_scale (3: lines beyond 3 σ count linearly, a Gaussian line
+  /// passes it with probability e^-4.5 = 1 %). The solver sees √ρ per line
+  /// (both residuals scaled by √ρ / |r|), and the misfit that compares the
+  /// starts (WholeCurveMisfit) uses the same ρ. 0: plain least squares, the
+  /// default (the audit's BIC and the calibration's covariance assume it).
+  /// - [Huber 1964] P. J. Huber, Robust estimation of a location parameter,
+  ///   Ann. Math. Statist. 35(1), 73-101, 1964.
+  double robust_scale{0.0};
 };
 
 /// kNotImproved: no start lowered the whole-curve misfit below that of the
@@ -247,7 +260,12 @@ struct CalibrationResult {
 /// cannot be built or evaluated.
 double WholeCurveMisfit(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
                         const PostureMap& postures, const dynamics::FrfSet& measured,
-                        double fmin_hz = 0.0, double fmax_hz = std::numeric_limits<double>::infinity());
+                        double fmin_hz = 0.0, double fmax_hz = std::numeric_limits<double>::infinity(),
+                        double robust_scale = 0.0);
+
+/// Huber's ρ(s) of a line's squared residual s with scale c (CalibrationOptions::robust_scale):
+/// s for s <= c² (and for c <= 0), 2 c √s − c² above.
+double HuberRho(double s, double c);
 
 /// Calibrates `options.free_parameters` of `description` starting from
 /// `initial` against `measured` (with its modal `features`) at `postures`.
