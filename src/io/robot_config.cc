@@ -1,5 +1,6 @@
 #include "robomach/io/robot_config.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <regex>
@@ -334,8 +335,18 @@ std::string CalibratedConfigText(const std::string& input_path, const std::strin
             last = i;
           }
         }
+        // Effects the list already has (a config calibrated before) are not
+        // listed twice.
+        std::vector<std::string> listed;
+        const std::regex name_re(R"(^\s*-?\s*name:\s*([A-Za-z0-9_]+).*$)");
+        for (size_t i = at + 1; i <= last && i < out.size(); ++i) {
+          std::smatch m;
+          if (std::regex_match(out[i], m, name_re)) listed.push_back(m[1].str());
+        }
         std::vector<std::string> items;
-        for (const std::string& e : effects) items.push_back(indent + "- name: " + e);
+        for (const std::string& e : effects) {
+          if (std::find(listed.begin(), listed.end(), e) == listed.end()) items.push_back(indent + "- name: " + e);
+        }
         out.insert(out.begin() + static_cast<long>(last) + 1, items.begin(), items.end());
       } else if (effects_left_out) {
         *effects_left_out = true;  // a non-empty flow list: the user's layout, not edited

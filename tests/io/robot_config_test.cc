@@ -106,7 +106,7 @@ TEST(RobotConfig, DuplicateKeysAreRejectedWithBothLines) {
 // frf-calibrate's calibrated config, written to another folder: it loads
 // (the URDF path follows), the calibrated values and the effect switched on
 // for the calibration come back, and the input's old parameters block is
-// gone. A config with its own effects list is left to the user.
+// gone. A config with its own effects list gets the effects it lacks.
 TEST(RobotConfig, CalibratedConfigLoadsFromAnotherFolderWithItsValues) {
   const RobotConfig in = LoadRobotConfig(SourcePath("config/kr210.yaml"));
   auto [desc, params] = dynamics::WithEffect(in.description, in.parameters, "tip_mass");
@@ -124,10 +124,24 @@ TEST(RobotConfig, CalibratedConfigLoadsFromAnotherFolderWithItsValues) {
   EXPECT_EQ(back.parameters.Get("m6_kg"), 31.25);
   EXPECT_EQ(back.parameters.Get("tip_mass.mass_kg"), 0.125);
   // Once more from the calibrated config (it has a parameters block and an
-  // effects list now): one parameters block, the effects list kept as it is.
+  // effects list now): one parameters block, and the effects list has
+  // tip_mass once (it is not added again; issue #33: effects are added to a
+  // config's own list, so nothing is left to the user here).
   const std::string again =
       CalibratedConfigText(out, out, ParametersYaml(params, dynamics::DefaultParameters(desc)), {"tip_mass"}, &left_out);
-  EXPECT_TRUE(left_out);
+  EXPECT_FALSE(left_out);
+  size_t listed = 0;
+  for (size_t at = again.find("name: tip_mass"); at != std::string::npos; at = again.find("name: tip_mass", at + 1)) {
+    ++listed;
+  }
+  EXPECT_EQ(listed, 1u) << again;
+  WriteText(out, again);
+  EXPECT_EQ(LoadRobotConfig(out).parameters.Get("tip_mass.mass_kg"), 0.125);
+  // A config with its own effects list gets a new effect at the end of it.
+  const std::string more = CalibratedConfigText(out, out, ParametersYaml(params, dynamics::DefaultParameters(desc)),
+                                                {"tip_mass", "joint_damping"}, &left_out);
+  EXPECT_FALSE(left_out);
+  EXPECT_NE(more.find("  - name: tip_mass\n  - name: joint_damping\n"), std::string::npos) << more;
   size_t blocks = 0;
   for (size_t at = again.find("\nparameters:"); at != std::string::npos; at = again.find("\nparameters:", at + 1)) {
     ++blocks;
