@@ -51,7 +51,7 @@ int Run(int argc, char** argv) {
   app.add_option("--validate-pose", validate_pose_files, "held-out UFF58 file of one posture: ID=file.uff; repeatable");
   app.add_option("--free", frees, "also fit this parameter (any name of the model, e.g. kq2_Nm_per_rad); repeatable");
   app.add_flag("--only-free", only_free, "fit only the --free parameters, not the default m6_kg, d6_m, alpha_s, beta_per_s");
-  app.add_option("--robust-loss", opt.robust_scale,
+  app.add_option("--robust-loss-sigma", opt.robust_scale,
                  "Huber loss per line on the whole-curve objective, its scale in units of the noise (e.g. 3); 0: "
                  "plain least squares. A second line of defence against outlier lines the noise model kept")
       ->capture_default_str();
@@ -74,7 +74,7 @@ int Run(int argc, char** argv) {
     RequireInputFile("--robot", robot_path, "robot config", {io::FileKind::kYaml}, io::kRobotConfigFormat);
     RequireInputFile("--postures", postures_path, "posture file", {io::FileKind::kCsv}, io::kPostureCsvFormat);
     CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
-    CheckOptionRange("--robust-loss", opt.robust_scale, 0.0, 1e6);
+    CheckOptionRange("--robust-loss-sigma", opt.robust_scale, 0.0, 1e6);
     {
       std::vector<std::pair<std::string, std::string>> inputs = {{"--robot", robot_path},
                                                                  {"--postures", postures_path}};

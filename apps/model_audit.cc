@@ -94,7 +94,7 @@ int Run(int argc, char** argv) {
   app.add_option("--fmin-hz", opt.fmin_hz, "lowest frequency used [Hz]")->capture_default_str();
   app.add_option("--fmax-hz", opt.fmax_hz, "highest frequency used [Hz]; default: all lines");
   app.add_option("--max-iterations", opt.max_iterations, "solver iterations per fit")->capture_default_str();
-  app.add_option("--robust-loss", opt.robust_scale,
+  app.add_option("--robust-loss-sigma", opt.robust_scale,
                  "Huber loss per line in every fit, its scale in units of the noise (e.g. 3); 0: plain least squares "
                  "(errors and BIC stay plain)")
       ->capture_default_str();
@@ -116,7 +116,7 @@ int Run(int argc, char** argv) {
     }
     CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
     CheckOptionRange("--virtual-joints", virtual_joints, 0, 50);
-    CheckOptionRange("--robust-loss", opt.robust_scale, 0.0, 1e6);
+    CheckOptionRange("--robust-loss-sigma", opt.robust_scale, 0.0, 1e6);
     opt.virtual_joints_fitted = virtual_joints;
     opt.try_parameters = !no_parameters;
     {
@@ -126,6 +126,13 @@ int Run(int argc, char** argv) {
       }
     }
     RequireFolderOption("--report", report_dir);
+    if (!write_config.empty()) {
+      // Before minutes of fitting: the written config's folder must exist.
+      const fs::path parent = fs::path(write_config).parent_path();
+      if (!parent.empty() && !fs::is_directory(parent)) {
+        throw UsageError("--write-config " + write_config + ": the folder " + parent.string() + " does not exist");
+      }
+    }
     RequireFolderOption("--compare", compare_dir);
     if (fs::exists(report_dir) && !fs::is_directory(report_dir)) {
       throw UsageError("--report " + report_dir + " exists and is not a folder");

@@ -411,21 +411,7 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
     }
     cand.added_parameters = 0;
     for (const std::string& n : free) cand.added_parameters += n.find('.') != std::string::npos;
-    cand.fit = calibration::Calibrate(desc, from, x.postures, x.fit_data, x.features, FitOptions(o, free));
-    // A fit stopped by the iteration limit is run again from the same start
-    // with four times the limit, and the better of the two kept: where a fit
-    // happens to stop must not decide the verdict. (Seen: the offset-flange
-    // near miss, whose flange compliance from the defaults start took more
-    // than 100 iterations with clang's rounding and fewer with gcc's; not
-    // converged, it did not count, and the pair flange + base was named in
-    // one build and the flange alone in the other.)
-    if (cand.fit.status == calibration::FitStatus::kNotConverged) {
-      calibration::CalibrationOptions longer = FitOptions(o, free);
-      longer.max_iterations = 4 * o.max_iterations;
-      calibration::CalibrationResult again =
-          calibration::Calibrate(desc, from, x.postures, x.fit_data, x.features, longer);
-      if (again.misfit_final <= cand.fit.misfit_final) cand.fit = std::move(again);
-    }
+    cand.fit = CalibrateWithRetry(desc, from, free, x);
     finish(cand, free);
     return cand;
   };
@@ -554,6 +540,28 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
     c.note += (c.note.empty() ? "" : "; ") + std::string("not identifiable from these data, held at start: ") + names;
   }
   return c;
+}
+
+calibration::CalibrationResult CalibrateWithRetry(const dynamics::RobotDescription& desc, const dynamics::ParameterSet& from,
+                                          const std::vector<std::string>& free, const FitContext& x) {
+  const AuditOptions& o = x.options;
+  calibration::CalibrationResult fit =
+      calibration::Calibrate(desc, from, x.postures, x.fit_data, x.features, FitOptions(o, free));
+  // A fit stopped by the iteration limit is run again from the same start
+  // with four times the limit, and the better of the two kept: where a fit
+  // happens to stop must not decide the verdict. (Seen: the offset-flange
+  // near miss, whose flange compliance from the defaults start took more
+  // than 100 iterations with clang's rounding and fewer with gcc's; not
+  // converged, it did not count, and the pair flange + base was named in
+  // one build and the flange alone in the other.)
+  if (fit.status == calibration::FitStatus::kNotConverged) {
+    calibration::CalibrationOptions longer = FitOptions(o, free);
+    longer.max_iterations = 4 * o.max_iterations;
+    calibration::CalibrationResult again =
+        calibration::Calibrate(desc, from, x.postures, x.fit_data, x.features, longer);
+    if (again.misfit_final <= fit.misfit_final) fit = std::move(again);
+  }
+  return fit;
 }
 
 // Every stride-th line of each FRF (coherence dropped: the fits do not use it).

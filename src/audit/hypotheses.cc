@@ -43,14 +43,7 @@ CandidateResult FitParameterHypothesis(const dynamics::RobotDescription& desc, c
     // the fit starts no worse than the calibrated model it contains).
     const dynamics::ParameterSet from = ScanStart(desc, start, freed, x.banded);
     c.start = "scan";
-    c.fit = calibration::Calibrate(desc, from, x.postures, x.fit_data, x.features, FitOptions(o, free));
-    if (c.fit.status == calibration::FitStatus::kNotConverged) {
-      calibration::CalibrationOptions longer = FitOptions(o, free);
-      longer.max_iterations = 4 * o.max_iterations;
-      calibration::CalibrationResult again =
-          calibration::Calibrate(desc, from, x.postures, x.fit_data, x.features, longer);
-      if (again.misfit_final <= c.fit.misfit_final) c.fit = std::move(again);
-    }
+    c.fit = CalibrateWithRetry(desc, from, free, x);
   } catch (const NumericalError& e) {
     c.fit.status = calibration::FitStatus::kFailed;
     c.fit.message = e.what();

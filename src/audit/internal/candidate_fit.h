@@ -97,6 +97,11 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
                              const std::vector<std::string>& base_effects_added, const std::string& effect,
                              const std::vector<std::string>& base_free, const FitContext& x,
                              bool more_starts = true, const dynamics::ParameterSet* resume = nullptr);
+/// The fit of `free` from `from`; a fit stopped by the iteration limit is
+/// run again with four times the limit and the better kept.
+calibration::CalibrationResult CalibrateWithRetry(const dynamics::RobotDescription& desc,
+                                                  const dynamics::ParameterSet& from,
+                                                  const std::vector<std::string>& free, const FitContext& x);
 /// Every stride-th line of each FRF.
 dynamics::FrfSet Decimate(const dynamics::FrfSet& in, int stride);
 int AutoLineStride(const dynamics::FrfSet& measured, const calibration::MeasuredFeatures& features);
