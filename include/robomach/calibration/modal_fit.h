@@ -109,6 +109,10 @@ struct ModalFitResult {
   std::vector<FittedMode> modes;       // ascending frequency
   std::complex<double> upper_residual{0.0};  // constant term [m/N]
   std::complex<double> lower_residual{0.0};  // coefficient of 1/(iω)² [m/N · (rad/s)²]
+  /// Coefficient of (iω)² [m/N · s²]: the curvature of the modes above the
+  /// band (Σ A_r/(ω_r² − ω²) ≈ Σ A_r/ω_r² + ω² Σ A_r/ω_r⁴). The global fit
+  /// (global_modal_fit.h) uses it; FitModes leaves it 0.
+  std::complex<double> upper_residual_slope{0.0};
   /// Fit-quality figure: sqrt(Σ|H_fit − H|² / Σ|H|²) over the band.
   double relative_rms_error{NAN};
   double fmin_hz{0.0}, fmax_hz{0.0};

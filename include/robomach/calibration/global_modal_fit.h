@@ -1,0 +1,129 @@
+#pragma once
+
+// Modal parameter estimation of several FRFs that share their poles (the
+// directions of one posture, the points of a roving-hammer or roving-sensor
+// test, the direct and cross FRFs of a tap test): one set of poles for all,
+// residues per FRF, and from them the mode shapes (issue #34 §1-2).
+//
+// The single-FRF fit (FitModes, modal_fit.h) stays the fit of one curve;
+// this is the fit modal software calls "global" or "poly-reference".
+
+#include <complex>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/calibration/modal_fit.h"
+#include "robomach/dynamics/measured_frf.h"
+
+namespace robomach::calibration {
+
+struct GlobalModalFitOptions {
+  /// Band to fit [Hz]; the default is the whole of the FRFs.
+  double fmin_hz{0.0};
+  double fmax_hz{std::numeric_limits<double>::infinity()};
+  /// Orders of the common denominator (number of poles, physical and
+  /// conjugate) of the stabilisation diagram. Capped at a third of the
+  /// lines in the band.
+  int min_order{4};
+  int max_order{100};
+  /// A pole is stable at order n if order n − 1 has a pole within these
+  /// relative differences of frequency and damping ratio.
+  double stable_freq_tol{0.01};
+  double stable_damping_tol{0.05};
+  /// Stable poles within this relative frequency of a cluster's mean join
+  /// it; a cluster is a mode if it holds stable poles of at least
+  /// max(min_stable_orders, min_cluster_fraction × orders tried) orders.
+  double cluster_freq_tol{0.005};
+  int min_stable_orders{5};
+  double min_cluster_fraction{0.2};
+  /// Physical poles: 0 < ζ < max_damping_ratio.
+  double max_damping_ratio{0.3};
+  /// A mode is kept if in at least one FRF its peak contribution reaches
+  /// this fraction of the measured |H| at its frequency.
+  double min_relative_contribution{0.005};
+  /// Refine the poles (common to all FRFs) by Levenberg–Marquardt on the
+  /// weighted residuals of all FRFs, residues eliminated (variable
+  /// projection).
+  bool refine{true};
+  /// At most this many modes added where the residual of the FRFs together
+  /// is structured rather than noise; kept if the BIC falls.
+  int max_added_modes{4};
+  /// Index of the driving-point FRF (response = reference) among the FRFs,
+  /// or −1: with it the mode shapes are mass-normalised
+  /// (φ_j = A_j / sqrt(A_driving)); without it they are unit-normalised.
+  int driving_point{-1};
+};
+
+/// One mode of the global fit.
+struct GlobalMode {
+  double freq_hz{0.0};        // undamped natural frequency |λ| / 2π [Hz]
+  double damping_ratio{0.0};  // −Re λ / |λ|
+  std::complex<double> pole;  // λ [rad/s]
+  /// Number of orders of the stabilisation diagram in the pole's cluster
+  /// (0 for a pole added from the residual).
+  int stable_orders{0};
+};
+
+struct GlobalModalFitResult {
+  ModalFitStatus status{ModalFitStatus::kFailed};
+  std::string message;
+  std::vector<GlobalMode> modes;  // ascending frequency
+  /// Per FRF, in the order given: the modes with the common poles and the
+  /// FRF's own residues (FittedMode::modal_constant), its residual terms and
+  /// relative_rms_error. per_frf[i].modes[r] is mode r of `modes`.
+  std::vector<ModalFitResult> per_frf;
+  /// Per FRF: sqrt(mean |H_fit − H|² / σ²) over the band when the FRF
+  /// carries a noise model (Frf::noise_sigma), else NaN. About 1 when the
+  /// model explains the data to within the noise.
+  std::vector<double> misfit_in_noise;
+  /// Power p of iω the LSCF stage multiplied the receptances by (0, 1 or 2:
+  /// receptance, mobility or accelerance), the one with the flattest
+  /// magnitude; the poles do not depend on it.
+  int lscf_power{0};
+  int orders_tried{0};
+  double fmin_hz{0.0}, fmax_hz{0.0};
+  std::vector<StabilisationPole> stabilisation;
+
+  /// Modal constants A (rows: FRFs, columns: modes) [m/N · (rad/s)²].
+  Eigen::MatrixXcd ModalConstants() const;
+  /// Mode shapes (rows: FRFs = points, columns: modes). With a driving
+  /// point, mass-normalised φ_j = A_j / sqrt(A_dd) [1/sqrt(kg)]; else each
+  /// column is scaled so that its largest component is 1 (real, positive).
+  Eigen::MatrixXcd ModeShapes(int driving_point = -1) const;
+};
+
+/// Fits common poles to `frfs` (which must share their frequency lines in
+/// the band): a common-denominator LSCF [Guillaume et al. 2003] on the
+/// stacked FRFs, each scaled to unit rms and multiplied by (iω)^p with p the
+/// power that makes the data flattest, through the reduced normal equations
+/// Σ_o (T_o − S_oᵀ R⁻¹ S_o) a = 0 (numerator coefficients eliminated, so the
+/// cost per order is that of one (n+1)² system per FRF). The poles of each
+/// order form the stabilisation diagram; stable poles are clustered across
+/// orders (frequency within cluster_freq_tol) and a cluster that spans
+/// enough orders is a mode, its pole the median of the cluster. Residues
+/// per FRF (LSFD with ModalFitWeights: 1/σ with a noise model, else 1/|H|),
+/// then the poles are refined together on the weighted residuals of every
+/// FRF (residues eliminated), weak or redundant modes are dropped and modes
+/// are added where the residual is structured, both judged by the Bayesian
+/// information criterion of all FRFs together. Numerical trouble is a
+/// status, not an exception.
+/// @throws std::invalid_argument if `frfs` is empty or the FRFs' lines in
+///   the band differ.
+GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& frfs,
+                                    const GlobalModalFitOptions& options = {});
+
+/// Modal assurance criterion between the columns of two shape matrices
+/// (same number of rows): MAC_ij = |a_iᴴ b_j|² / ((a_iᴴ a_i)(b_jᴴ b_j)),
+/// in [0, 1]; 1 for shapes that are multiples of each other.
+/// @throws std::invalid_argument if the row counts differ.
+Eigen::MatrixXd ModalAssuranceCriterion(const Eigen::MatrixXcd& a, const Eigen::MatrixXcd& b);
+
+/// Relative rms misfit of a fit on an FRF in the quantity (iω)^p H
+/// (p = 0 receptance, 1 mobility, 2 accelerance):
+/// sqrt(Σ |(iω)^p (H_fit − H)|² / Σ |(iω)^p H|²) over the FRF's lines.
+double RelativeMisfit(const ModalFitResult& fit, const dynamics::Frf& frf, int power = 0);
+
+}  // namespace robomach::calibration

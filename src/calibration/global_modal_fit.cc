@@ -1,0 +1,770 @@
+#include "robomach/calibration/global_modal_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
+
+#include "robomach/common/units.h"
+
+namespace robomach::calibration {
+namespace {
+
+using cd = std::complex<double>;
+
+// 1/z as conj(z)/|z|²: std::complex's division (__divdc3, with its care for
+// infinities and scaling) was a sixth of the modal fit's time; the poles
+// and frequencies here are far from overflow.
+inline cd Reciprocal(cd z) {
+  const double n = z.real() * z.real() + z.imag() * z.imag();
+  return cd(z.real() / n, -z.imag() / n);
+}
+
+cd PowerOf(cd s, int p) {
+  cd v = 1.0;
+  for (int i = 0; i < p; ++i) v *= s;
+  return v;
+}
+
+// |H| of the data at the line nearest to f.
+double LevelAt(const dynamics::Frf& frf, double f_hz) {
+  const Eigen::VectorXd& f = frf.freq_hz();
+  const auto it = std::lower_bound(f.data(), f.data() + f.size(), f_hz);
+  int i = static_cast<int>(it - f.data());
+  if (i >= f.size()) i = static_cast<int>(f.size()) - 1;
+  if (i > 0 && std::abs(f(i - 1) - f_hz) < std::abs(f(i) - f_hz)) --i;
+  return std::abs(frf.receptance()(i));
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  const size_t h = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + h, v.end());
+  if (v.size() % 2 == 1) return v[h];
+  const double hi = v[h];
+  std::nth_element(v.begin(), v.begin() + h - 1, v.end());
+  return 0.5 * (hi + v[h - 1]);
+}
+
+cd PoleFrom(double f_hz, double zeta) {
+  const double wn = HzToRadPerSec(f_hz);
+  return cd(-zeta * wn, wn * std::sqrt(std::max(0.0, 1.0 - zeta * zeta)));
+}
+
+// The power p of iω (0, 1, 2) that makes (iω)^p H flattest: the smallest
+// summed variance of ln|(iω)^p H| over the FRFs' nonzero lines.
+int FlattestPower(const std::vector<dynamics::Frf>& frfs) {
+  int best_p = 0;
+  double best_v = 1e300;
+  for (int p = 0; p <= 2; ++p) {
+    double total = 0.0;
+    for (const dynamics::Frf& frf : frfs) {
+      double sum = 0.0, sum2 = 0.0;
+      int n = 0;
+      for (int k = 0; k < frf.size(); ++k) {
+        const double a = std::abs(frf.receptance()(k)) * std::pow(HzToRadPerSec(frf.freq_hz()(k)), p);
+        if (!(a > 0.0)) continue;
+        const double l = std::log(a);
+        sum += l;
+        sum2 += l * l;
+        ++n;
+      }
+      if (n > 1) total += sum2 / n - (sum / n) * (sum / n);
+    }
+    if (total < best_v) {
+      best_v = total;
+      best_p = p;
+    }
+  }
+  return best_p;
+}
+
+struct OrderPole {
+  double f_hz, zeta;
+  cd lambda;
+  int order;
+  bool stable;
+};
+
+// The common-denominator LSCF for orders min..max: the poles of every order
+// with their stability flag.
+std::vector<std::vector<OrderPole>> LscfPoles(const std::vector<dynamics::Frf>& frfs, int power, int nmin, int nmax,
+                                              double fmin_hz, double fmax_hz, const GlobalModalFitOptions& o) {
+  const int N = frfs.front().size();
+  const double dt = 1.0 / (2.0 * fmax_hz);
+  const int L = 2 * nmax + 1;
+  const int nf = static_cast<int>(frfs.size());
+  std::vector<double> r(L, 0.0);
+  std::vector<std::vector<double>> s(nf, std::vector<double>(L, 0.0)), t(nf, std::vector<double>(L, 0.0));
+  // Each FRF scaled to unit rms, so that every FRF weighs the same in the
+  // stacked equations whatever its level.
+  std::vector<double> scale(nf, 1.0);
+  std::vector<Eigen::VectorXcd> g(nf);
+  for (int o_i = 0; o_i < nf; ++o_i) {
+    g[o_i].resize(N);
+    double ss = 0.0;
+    for (int k = 0; k < N; ++k) {
+      const cd sk(0.0, HzToRadPerSec(frfs[o_i].freq_hz()(k)));
+      g[o_i](k) = PowerOf(sk, power) * frfs[o_i].receptance()(k);
+      ss += std::norm(g[o_i](k));
+    }
+    scale[o_i] = ss > 0.0 ? 1.0 / std::sqrt(ss / N) : 1.0;
+    g[o_i] *= scale[o_i];
+  }
+  std::vector<cd> e_row(L);
+  for (int k = 0; k < N; ++k) {
+    const double th = HzToRadPerSec(frfs.front().freq_hz()(k)) * dt;
+    const cd step = std::polar(1.0, th);
+    cd e = std::polar(1.0, -th * nmax);
+    for (int m = 0; m < L; ++m) {
+      e_row[m] = e;
+      e *= step;
+      if ((m & 31) == 31) e = std::polar(1.0, th * (m + 1 - nmax));  // limit drift
+    }
+    for (int m = 0; m < L; ++m) r[m] += e_row[m].real();
+    for (int o_i = 0; o_i < nf; ++o_i) {
+      const cd h = g[o_i](k);
+      const double a2 = std::norm(h);
+      std::vector<double>& so = s[o_i];
+      std::vector<double>& to = t[o_i];
+      for (int m = 0; m < L; ++m) {
+        so[m] += (h * e_row[m]).real();
+        to[m] += a2 * e_row[m].real();
+      }
+    }
+  }
+  std::vector<std::vector<OrderPole>> by_order(nmax + 1);
+  for (int n = nmin; n <= nmax; ++n) {
+    const int m = n + 1;
+    Eigen::MatrixXd Rm(m, m);
+    for (int j = 0; j < m; ++j)
+      for (int l = 0; l < m; ++l) Rm(j, l) = r[l - j + nmax];
+    const Eigen::LLT<Eigen::MatrixXd> llt(Rm);
+    if (llt.info() != Eigen::Success) continue;
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(m, m);
+    Eigen::MatrixXd Sm(m, m);
+    for (int o_i = 0; o_i < nf; ++o_i) {
+      for (int j = 0; j < m; ++j)
+        for (int l = 0; l < m; ++l) {
+          Sm(j, l) = -s[o_i][l - j + nmax];
+          M(j, l) += t[o_i][l - j + nmax];
+        }
+      // Sᵀ R⁻¹ S = Yᵀ Y with Y = L⁻¹ S.
+      const Eigen::MatrixXd Y = llt.matrixL().solve(Sm);
+      M.noalias() -= Y.transpose() * Y;
+    }
+    const Eigen::VectorXd a = M.topLeftCorner(n, n).ldlt().solve(-M.col(n).head(n));
+    if (!a.allFinite()) continue;
+    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
+    for (int i = 1; i < n; ++i) C(i, i - 1) = 1.0;
+    for (int i = 0; i < n; ++i) C(i, n - 1) = -a(i);
+    const Eigen::EigenSolver<Eigen::MatrixXd> es(C, false);
+    if (es.info() != Eigen::Success) continue;
+    for (int i = 0; i < n; ++i) {
+      const cd z = es.eigenvalues()(i);
+      if (std::abs(z) == 0.0) continue;
+      const cd lambda = std::log(z) / dt;
+      if (!(lambda.imag() > 0.0)) continue;
+      const double wn = std::abs(lambda);
+      const double zeta = -lambda.real() / wn;
+      const double f_hz = RadPerSecToHz(wn);
+      if (!(zeta > 0.0 && zeta < o.max_damping_ratio)) continue;
+      if (f_hz < fmin_hz || f_hz > fmax_hz) continue;
+      OrderPole p{f_hz, zeta, lambda, n, false};
+      if (n > nmin) {
+        for (const OrderPole& q : by_order[n - 1]) {
+          if (std::abs(q.f_hz - f_hz) / f_hz < o.stable_freq_tol &&
+              std::abs(q.zeta - zeta) / zeta < o.stable_damping_tol) {
+            p.stable = true;
+            break;
+          }
+        }
+      }
+      by_order[n].push_back(p);
+    }
+  }
+  return by_order;
+}
+
+struct Cluster {
+  double f_hz, zeta;
+  int orders;
+};
+
+// Stable poles clustered by frequency across orders; a cluster spanning at
+// least `min_orders` distinct orders is a mode.
+std::vector<Cluster> ClusterStablePoles(const std::vector<std::vector<OrderPole>>& by_order, int min_orders,
+                                        double tol) {
+  std::vector<const OrderPole*> stable;
+  for (const auto& poles : by_order)
+    for (const OrderPole& p : poles)
+      if (p.stable) stable.push_back(&p);
+  std::sort(stable.begin(), stable.end(), [](const OrderPole* a, const OrderPole* b) { return a->f_hz < b->f_hz; });
+  std::vector<Cluster> out;
+  size_t i = 0;
+  while (i < stable.size()) {
+    std::vector<const OrderPole*> members{stable[i]};
+    double sum_f = stable[i]->f_hz;
+    size_t j = i + 1;
+    while (j < stable.size() && std::abs(stable[j]->f_hz - sum_f / members.size()) <= tol * stable[j]->f_hz) {
+      members.push_back(stable[j]);
+      sum_f += stable[j]->f_hz;
+      ++j;
+    }
+    std::vector<int> orders;
+    std::vector<double> fs, zs;
+    for (const OrderPole* p : members) {
+      orders.push_back(p->order);
+      fs.push_back(p->f_hz);
+      zs.push_back(p->zeta);
+    }
+    std::sort(orders.begin(), orders.end());
+    const int distinct = static_cast<int>(std::unique(orders.begin(), orders.end()) - orders.begin());
+    if (distinct >= min_orders) out.push_back({Median(fs), Median(zs), distinct});
+    i = j;
+  }
+  return out;
+}
+
+// The fit of all FRFs for given common poles: residues per FRF by weighted
+// linear least squares. Returns the summed squared weighted error.
+struct SetFit {
+  std::vector<ModalFitResult> per_frf;
+  double cost{1e300};
+};
+
+class GlobalProblem {
+ public:
+  GlobalProblem(const std::vector<dynamics::Frf>& frfs, double fmin_hz) : frfs_(frfs), fmin_hz_(fmin_hz) {
+    for (const dynamics::Frf& f : frfs_) weights_.push_back(ModalFitWeights(f));
+  }
+
+  bool LowerResidual(const std::vector<cd>& poles) const {
+    double lowest = 1e300;
+    for (const cd& p : poles) lowest = std::min(lowest, RadPerSecToHz(std::abs(p)));
+    return fmin_hz_ > 0.2 * lowest;
+  }
+
+  // The weighted LSFD of one FRF for given poles, as FitResidues, keeping
+  // what the Jacobian needs: the residues, the weighted residual
+  // e = W (H_fit − H) (real, imaginary per line) and an orthonormal basis Q of
+  // the weighted design matrix's columns.
+  struct Lsfd {
+    std::vector<cd> residues;
+    cd upper{0.0}, lower{0.0}, slope{0.0};
+    Eigen::VectorXd e;
+    Eigen::MatrixXd Q;
+  };
+  Lsfd Solve(size_t o, const std::vector<cd>& poles, bool lower, bool want_q = false) const {
+    const dynamics::Frf& frf = frfs_[o];
+    const Eigen::VectorXd& w = weights_[o];
+    const int n = frf.size();
+    const int nm = static_cast<int>(poles.size());
+    const int nc = 2 * nm + 4 + (lower ? 2 : 0);
+    Eigen::MatrixXd A(2 * n, nc);
+    Eigen::VectorXd b(2 * n);
+    for (int k = 0; k < n; ++k) {
+      const cd s(0.0, HzToRadPerSec(frf.freq_hz()(k)));
+      auto put = [&](int col, cd v) {
+        A(2 * k, col) = w(k) * v.real();
+        A(2 * k + 1, col) = w(k) * v.imag();
+      };
+      for (int r = 0; r < nm; ++r) {
+        const cd p = Reciprocal(s - poles[r]), q = Reciprocal(s - std::conj(poles[r]));
+        put(2 * r, p + q);
+        put(2 * r + 1, cd(0, 1) * (p - q));
+      }
+      put(2 * nm, 1.0);
+      put(2 * nm + 1, cd(0, 1));
+      put(2 * nm + 2, s * s);
+      put(2 * nm + 3, cd(0, 1) * s * s);
+      if (lower) {
+        const cd inv = 1.0 / (s * s);
+        put(2 * nm + 4, inv);
+        put(2 * nm + 5, cd(0, 1) * inv);
+      }
+      b(2 * k) = w(k) * frf.receptance()(k).real();
+      b(2 * k + 1) = w(k) * frf.receptance()(k).imag();
+    }
+    Eigen::VectorXd scale(nc);
+    for (int c = 0; c < nc; ++c) {
+      scale(c) = A.col(c).norm();
+      if (scale(c) > 0.0) A.col(c) /= scale(c);
+      else scale(c) = 1.0;
+    }
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+    const Eigen::VectorXd xs = qr.solve(b);
+    Lsfd out;
+    out.e = A * xs - b;
+    if (want_q) out.Q = qr.householderQ() * Eigen::MatrixXd::Identity(2 * n, std::min<int>(qr.rank(), nc));
+    const Eigen::VectorXd x = xs.cwiseQuotient(scale);
+    for (int r = 0; r < nm; ++r) out.residues.emplace_back(x(2 * r), x(2 * r + 1));
+    out.upper = cd(x(2 * nm), x(2 * nm + 1));
+    out.slope = cd(x(2 * nm + 2), x(2 * nm + 3));
+    if (lower) out.lower = cd(x(2 * nm + 4), x(2 * nm + 5));
+    return out;
+  }
+
+  // The fit of every FRF for given poles (residues and residual terms by
+  // weighted linear least squares).
+  SetFit Fit(const std::vector<cd>& poles) const {
+    SetFit out;
+    out.per_frf.resize(frfs_.size());
+    const bool lower = LowerResidual(poles);
+    double cost = 0.0;
+    for (size_t o = 0; o < frfs_.size(); ++o) {
+      const Lsfd sol = Solve(o, poles, lower);
+      cost += sol.e.squaredNorm();
+      ModalFitResult& r = out.per_frf[o];
+      for (size_t k = 0; k < poles.size(); ++k) {
+        FittedMode m;
+        m.pole = poles[k];
+        const double wn = std::abs(poles[k]);
+        m.freq_hz = RadPerSecToHz(wn);
+        m.damping_ratio = -poles[k].real() / wn;
+        m.residue = sol.residues[k];
+        m.modal_constant = cd(0.0, 2.0 * poles[k].imag()) * m.residue;
+        m.peak_contribution = std::abs(m.modal_constant) / (2.0 * m.damping_ratio * wn * wn);
+        r.modes.push_back(m);
+      }
+      r.upper_residual = sol.upper;
+      r.lower_residual = sol.lower;
+      r.upper_residual_slope = sol.slope;
+      r.relative_rms_error = RelativeMisfit(r, frfs_[o], 0);
+    }
+    out.cost = std::isfinite(cost) ? cost : 1e300;
+    return out;
+  }
+
+  // Levenberg–Marquardt on the poles (σ, ω of each), residues eliminated
+  // (variable projection with Kaufman's Jacobian: the derivative of the model
+  // with the residues held, projected onto the complement of the design
+  // matrix's columns).
+  // `free_from`: only the poles from this index on move (the others are
+  // held), for a trial pole added to a refined set.
+  std::vector<cd> Refine(std::vector<cd> poles, int free_from = 0) const {
+    const int nm = static_cast<int>(poles.size());
+    const int np = 2 * (nm - free_from);
+    if (np <= 0) return poles;
+    const bool lower = LowerResidual(poles);
+    int rows = 0;
+    for (const dynamics::Frf& f : frfs_) rows += 2 * f.size();
+    auto evaluate = [&](const std::vector<cd>& p, Eigen::VectorXd* e, Eigen::MatrixXd* J) {
+      e->resize(rows);
+      if (J) J->resize(rows, np);
+      int row = 0;
+      for (size_t o = 0; o < frfs_.size(); ++o) {
+        const Lsfd sol = Solve(o, p, lower, J != nullptr);
+        const int n2 = static_cast<int>(sol.e.size());
+        e->segment(row, n2) = sol.e;
+        if (J) {
+          const dynamics::Frf& frf = frfs_[o];
+          Eigen::MatrixXd V(n2, np);
+          for (int k = 0; k < frf.size(); ++k) {
+            const cd s(0.0, HzToRadPerSec(frf.freq_hz()(k)));
+            const double wk = weights_[o](k);
+            for (int r = free_from; r < nm; ++r) {
+              const cd R = sol.residues[r];
+              const cd pp = Reciprocal(s - p[r]), qq = Reciprocal(s - std::conj(p[r]));
+              const cd d_sigma = R * pp * pp + std::conj(R) * qq * qq;
+              const cd d_omega = cd(0, 1) * (R * pp * pp - std::conj(R) * qq * qq);
+              const int c = 2 * (r - free_from);
+              V(2 * k, c) = wk * d_sigma.real();
+              V(2 * k + 1, c) = wk * d_sigma.imag();
+              V(2 * k, c + 1) = wk * d_omega.real();
+              V(2 * k + 1, c + 1) = wk * d_omega.imag();
+            }
+          }
+          J->middleRows(row, n2) = V - sol.Q * (sol.Q.transpose() * V);
+        }
+        row += n2;
+      }
+      const double c = e->squaredNorm();
+      return std::isfinite(c) ? c : 1e300;
+    };
+    Eigen::VectorXd e, e2;
+    Eigen::MatrixXd J;
+    double cost = evaluate(poles, &e, &J);
+    if (!(cost < 1e300)) return poles;
+    double mu = 1e-3;
+    for (int it = 0; it < 30; ++it) {
+      const Eigen::MatrixXd JtJ = J.transpose() * J;
+      const Eigen::VectorXd grad = J.transpose() * e;
+      bool improved = false;
+      for (int tries = 0; tries < 10; ++tries) {
+        Eigen::MatrixXd A = JtJ;
+        A.diagonal() += mu * JtJ.diagonal().cwiseMax(1e-300);
+        const Eigen::VectorXd step = A.ldlt().solve(-grad);
+        if (!step.allFinite()) {
+          mu *= 10.0;
+          continue;
+        }
+        std::vector<cd> trial = poles;
+        bool physical = true;
+        for (int r = free_from; r < nm; ++r) {
+          const int c = 2 * (r - free_from);
+          trial[r] = poles[r] + cd(step(c), step(c + 1));
+          physical = physical && trial[r].real() < 0.0 && trial[r].imag() > 0.0;
+        }
+        if (!physical) {
+          mu *= 10.0;
+          continue;
+        }
+        const double c2 = evaluate(trial, &e2, nullptr);
+        if (c2 < cost) {
+          const double rel = (cost - c2) / cost;
+          poles = trial;
+          cost = c2;
+          mu = std::max(mu / 10.0, 1e-12);
+          improved = true;
+          if (rel < 1e-7) it = 1000;
+          break;
+        }
+        mu *= 10.0;
+      }
+      if (!improved || it >= 1000) break;
+      cost = evaluate(poles, &e, &J);
+    }
+    return poles;
+  }
+
+  const std::vector<dynamics::Frf>& frfs() const { return frfs_; }
+  const Eigen::VectorXd& weights(size_t o) const { return weights_[o]; }
+
+ private:
+  const std::vector<dynamics::Frf>& frfs_;
+  double fmin_hz_;
+  std::vector<Eigen::VectorXd> weights_;
+};
+
+// A mode's largest peak contribution over the FRFs relative to the measured
+// level at its frequency.
+double RelativeStrength(const SetFit& fit, const std::vector<dynamics::Frf>& frfs, size_t r) {
+  double best = 0.0;
+  for (size_t o = 0; o < frfs.size(); ++o) {
+    const FittedMode& m = fit.per_frf[o].modes[r];
+    const double level = LevelAt(frfs[o], m.freq_hz);
+    if (level > 0.0) best = std::max(best, m.peak_contribution / level);
+  }
+  return best;
+}
+
+}  // namespace
+
+Eigen::MatrixXd ModalAssuranceCriterion(const Eigen::MatrixXcd& a, const Eigen::MatrixXcd& b) {
+  if (a.rows() != b.rows()) {
+    throw std::invalid_argument("ModalAssuranceCriterion: the shapes have " + std::to_string(a.rows()) + " and " +
+                                std::to_string(b.rows()) + " points; they must have the same points");
+  }
+  Eigen::MatrixXd mac(a.cols(), b.cols());
+  for (int i = 0; i < a.cols(); ++i) {
+    for (int j = 0; j < b.cols(); ++j) {
+      const double den = a.col(i).squaredNorm() * b.col(j).squaredNorm();
+      mac(i, j) = den > 0.0 ? std::norm(a.col(i).dot(b.col(j))) / den : 0.0;
+    }
+  }
+  return mac;
+}
+
+double RelativeMisfit(const ModalFitResult& fit, const dynamics::Frf& frf, int power) {
+  double num = 0.0, den = 0.0;
+  for (int k = 0; k < frf.size(); ++k) {
+    const cd s(0.0, HzToRadPerSec(frf.freq_hz()(k)));
+    const cd w = PowerOf(s, power);
+    num += std::norm(w * (fit.Evaluate(frf.freq_hz()(k)) - frf.receptance()(k)));
+    den += std::norm(w * frf.receptance()(k));
+  }
+  return den > 0.0 ? std::sqrt(num / den) : NAN;
+}
+
+Eigen::MatrixXcd GlobalModalFitResult::ModalConstants() const {
+  Eigen::MatrixXcd a(per_frf.size(), modes.size());
+  for (size_t o = 0; o < per_frf.size(); ++o)
+    for (size_t r = 0; r < modes.size(); ++r) a(o, r) = per_frf[o].modes[r].modal_constant;
+  return a;
+}
+
+Eigen::MatrixXcd GlobalModalFitResult::ModeShapes(int driving_point) const {
+  Eigen::MatrixXcd phi = ModalConstants();
+  for (int r = 0; r < phi.cols(); ++r) {
+    if (driving_point >= 0 && driving_point < phi.rows()) {
+      const cd root = std::sqrt(phi(driving_point, r));
+      if (std::abs(root) > 0.0) phi.col(r) /= root;
+      continue;
+    }
+    int imax = 0;
+    phi.col(r).cwiseAbs().maxCoeff(&imax);
+    const cd pivot = phi(imax, r);
+    if (std::abs(pivot) > 0.0) phi.col(r) /= pivot;
+  }
+  return phi;
+}
+
+GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const GlobalModalFitOptions& o) {
+  if (all.empty()) throw std::invalid_argument("FitModesGlobal: no FRFs given");
+  GlobalModalFitResult result;
+  std::vector<dynamics::Frf> frfs;
+  // The 0 Hz line carries no pole information and a receptance that a
+  // converted accelerance or mobility does not have.
+  const double fmin = std::max(o.fmin_hz, 1e-12);
+  for (const dynamics::Frf& f : all) frfs.push_back(f.Band(fmin, o.fmax_hz));
+  const int N = frfs.front().size();
+  for (size_t i = 1; i < frfs.size(); ++i) {
+    if (frfs[i].size() != N || (N > 0 && (frfs[i].freq_hz() - frfs.front().freq_hz()).cwiseAbs().maxCoeff() >
+                                             1e-9 * frfs.front().freq_hz()(N - 1))) {
+      throw std::invalid_argument("FitModesGlobal: FRF " + std::to_string(i + 1) +
+                                  " has other frequency lines in the band than FRF 1 (" + std::to_string(frfs[i].size()) +
+                                  " vs " + std::to_string(N) + " lines); a global fit needs common lines");
+    }
+  }
+  if (N == 0) {
+    result.message = "no frequency lines in the band";
+    return result;
+  }
+  result.fmin_hz = frfs.front().freq_hz()(0);
+  result.fmax_hz = frfs.front().freq_hz()(N - 1);
+  const int nmax = std::min(o.max_order, N / 3);
+  if (o.min_order < 2 || nmax < o.min_order + 2) {
+    result.message = "too few lines (" + std::to_string(N) + ") for model orders " + std::to_string(o.min_order) +
+                     ".." + std::to_string(o.max_order);
+    return result;
+  }
+  result.orders_tried = nmax - o.min_order + 1;
+  result.lscf_power = FlattestPower(frfs);
+  const auto by_order = LscfPoles(frfs, result.lscf_power, o.min_order, nmax, result.fmin_hz, result.fmax_hz, o);
+  for (const auto& poles : by_order)
+    for (const OrderPole& p : poles) result.stabilisation.push_back({p.order, p.f_hz, p.zeta, p.stable});
+  const int min_orders = std::max(o.min_stable_orders,
+                                  static_cast<int>(std::ceil(o.min_cluster_fraction * result.orders_tried)));
+  std::vector<Cluster> clusters = ClusterStablePoles(by_order, min_orders, o.cluster_freq_tol);
+
+  const GlobalProblem problem(frfs, result.fmin_hz);
+  std::vector<cd> poles;
+  std::vector<int> support;
+  for (const Cluster& c : clusters) {
+    poles.push_back(PoleFrom(c.f_hz, c.zeta));
+    support.push_back(c.orders);
+  }
+  bool from_peaks = false;
+  if (poles.empty()) {
+    // No stable cluster: the peaks of the summed |H| start the refinement,
+    // so that a clear resonance in noisy data is not lost.
+    Eigen::VectorXcd sum = Eigen::VectorXcd::Zero(N);
+    for (size_t i = 0; i < frfs.size(); ++i) {
+      const double level = frfs[i].receptance().cwiseAbs().maxCoeff();
+      if (level > 0.0) sum += frfs[i].receptance().cwiseAbs().cast<cd>() / level;
+    }
+    const dynamics::Frf summed = dynamics::Frf::FromSamples(frfs.front().freq_hz(), sum);
+    std::vector<PeakEstimate> peaks = PickPeaks(summed);
+    std::sort(peaks.begin(), peaks.end(),
+              [](const PeakEstimate& a, const PeakEstimate& b) { return a.peak_magnitude > b.peak_magnitude; });
+    if (peaks.size() > 12) peaks.resize(12);
+    for (const PeakEstimate& p : peaks) {
+      const double z = std::isfinite(p.damping_ratio) ? std::clamp(p.damping_ratio, 1e-3, 0.2) : 0.02;
+      poles.push_back(PoleFrom(p.peak_freq_hz, z));
+      support.push_back(0);
+    }
+    from_peaks = !poles.empty();
+  }
+
+  // Fit, refine, prune (unphysical, out of band, negligible in every FRF,
+  // duplicates) until the set no longer changes.
+  auto settle = [&](std::vector<cd> p, std::vector<int> sup, SetFit* fit, bool refine = true) {
+    for (int pass = 0; pass < 4 && !p.empty(); ++pass) {
+      if (o.refine && refine) p = problem.Refine(p);
+      *fit = problem.Fit(p);
+      std::vector<size_t> order(p.size());
+      std::iota(order.begin(), order.end(), size_t{0});
+      std::vector<double> strength(p.size());
+      for (size_t r = 0; r < p.size(); ++r) strength[r] = RelativeStrength(*fit, frfs, r);
+      std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return strength[a] > strength[b]; });
+      std::vector<cd> keep;
+      std::vector<int> keep_sup;
+      for (size_t r : order) {
+        const double wn = std::abs(p[r]);
+        const double f_hz = RadPerSecToHz(wn), zeta = -p[r].real() / wn;
+        if (!(zeta > 0.0 && zeta < o.max_damping_ratio && f_hz >= result.fmin_hz && f_hz <= result.fmax_hz &&
+              strength[r] >= o.min_relative_contribution)) {
+          continue;
+        }
+        bool duplicate = false;
+        for (const cd& k : keep) {
+          const double fk = RadPerSecToHz(std::abs(k)), zk = -k.real() / std::abs(k);
+          if (std::abs(fk - f_hz) < 0.1 * (zk + zeta) * f_hz) duplicate = true;
+        }
+        if (duplicate) continue;
+        keep.push_back(p[r]);
+        keep_sup.push_back(sup[r]);
+      }
+      if (keep.size() == p.size()) break;
+      p = keep;
+      sup = keep_sup;
+      if (p.empty()) break;
+    }
+    if (!p.empty()) *fit = problem.Fit(p);
+    return std::pair{p, sup};
+  };
+  const int total_lines = N * static_cast<int>(frfs.size());
+  auto bic = [&](double cost, size_t modes, const std::vector<cd>& p) {
+    const double n2 = 2.0 * total_lines;
+    const double params = 2.0 * modes + frfs.size() * (2.0 * modes + 4.0 + (problem.LowerResidual(p) ? 2.0 : 0.0));
+    return n2 * std::log(std::max(cost, 1e-300)) + params * std::log(n2);
+  };
+
+  SetFit best;
+  if (!poles.empty()) std::tie(poles, support) = settle(poles, support, &best);
+  if (poles.empty()) {
+    result.status = ModalFitStatus::kNoStableModes;
+    result.message = "no cluster of stable poles over " + std::to_string(min_orders) + " of the orders " +
+                     std::to_string(o.min_order) + ".." + std::to_string(nmax) +
+                     " and no peak of |H| fitted as a mode";
+    return result;
+  }
+  // Residual-driven additions on the summed weighted residual of all FRFs.
+  int added = 0;
+  for (int attempt = 0; attempt < o.max_added_modes; ++attempt) {
+    Eigen::VectorXd e2 = Eigen::VectorXd::Zero(N);
+    for (size_t i = 0; i < frfs.size(); ++i) {
+      for (int k = 0; k < N; ++k) {
+        e2(k) += std::norm((best.per_frf[i].Evaluate(frfs[i].freq_hz()(k)) - frfs[i].receptance()(k)) *
+                           problem.weights(i)(k));
+      }
+    }
+    const int W = std::max(3, N / 200);
+    Eigen::VectorXd csum(N + 1), local(N);
+    csum(0) = 0.0;
+    for (int k = 0; k < N; ++k) csum(k + 1) = csum(k) + e2(k);
+    for (int k = 0; k < N; ++k) {
+      const int a = std::max(0, k - W), b = std::min(N, k + W + 1);
+      local(k) = (csum(b) - csum(a)) / (b - a);
+    }
+    std::vector<double> sorted(local.data(), local.data() + N);
+    const double median = Median(sorted);
+    int kmax = 0;
+    local.maxCoeff(&kmax);
+    if (!(local(kmax) > 4.0 * median)) break;
+    const double f_peak = frfs.front().freq_hz()(kmax);
+    double z0 = 0.02, nearest = 1e300;
+    for (const cd& p : poles) {
+      const double fp = RadPerSecToHz(std::abs(p));
+      if (std::abs(fp - f_peak) < nearest) {
+        nearest = std::abs(fp - f_peak);
+        z0 = -p.real() / std::abs(p);
+      }
+    }
+    SetFit trial_best;
+    std::vector<cd> trial_poles;
+    std::vector<int> trial_sup;
+    // Each trial refines only the new pole (the others are refined
+    // already); the best trial, if the BIC falls, is then refined with all.
+    for (double shift : {0.0, -2.0, 2.0}) {
+      std::vector<cd> p = poles;
+      p.push_back(PoleFrom(f_peak * (1.0 + shift * z0), z0));
+      if (o.refine) p = problem.Refine(p, static_cast<int>(poles.size()));
+      const SetFit fit = problem.Fit(p);
+      if (fit.cost < trial_best.cost) {
+        trial_best = fit;
+        trial_poles = p;
+      }
+    }
+    if (!trial_poles.empty() && bic(trial_best.cost, trial_poles.size(), trial_poles) <
+                                    bic(best.cost, poles.size(), poles)) {
+      trial_sup = support;
+      trial_sup.push_back(0);
+      std::tie(trial_poles, trial_sup) = settle(trial_poles, trial_sup, &trial_best);
+    }
+    if (trial_poles.size() > poles.size() &&
+        bic(trial_best.cost, trial_poles.size(), trial_poles) < bic(best.cost, poles.size(), poles)) {
+      best = trial_best;
+      poles = trial_poles;
+      support = trial_sup;
+      ++added;
+    } else {
+      break;
+    }
+  }
+  // Backward elimination: drop the weakest mode while that lowers the BIC.
+  for (int attempt = 0; attempt < 8 && poles.size() > 1; ++attempt) {
+    size_t weakest = 0;
+    double weakest_s = 1e300;
+    for (size_t r = 0; r < poles.size(); ++r) {
+      const double s = RelativeStrength(best, frfs, r);
+      if (s < weakest_s) {
+        weakest_s = s;
+        weakest = r;
+      }
+    }
+    std::vector<cd> p;
+    std::vector<int> sup;
+    for (size_t r = 0; r < poles.size(); ++r) {
+      if (r == weakest) continue;
+      p.push_back(poles[r]);
+      sup.push_back(support[r]);
+    }
+    // Judged without refinement first (the remaining poles are already
+    // refined; a drop that does not pay without refitting is rarely worth
+    // the refinement's cost), refined when it is kept.
+    SetFit fit;
+    std::tie(p, sup) = settle(p, sup, &fit, /*refine=*/false);
+    if (!p.empty() && bic(fit.cost, p.size(), p) < bic(best.cost, poles.size(), poles)) {
+      std::tie(p, sup) = settle(p, sup, &fit);
+      best = fit;
+      poles = p;
+      support = sup;
+    } else {
+      break;
+    }
+  }
+  // Ascending frequency, the same order in every FRF's table.
+  std::vector<size_t> order(poles.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return std::abs(poles[a]) < std::abs(poles[b]); });
+  result.per_frf = best.per_frf;
+  for (size_t i = 0; i < frfs.size(); ++i) {
+    ModalFitResult& r = result.per_frf[i];
+    std::vector<FittedMode> sorted;
+    for (size_t k : order) {
+      sorted.push_back(best.per_frf[i].modes[k]);
+      sorted.back().stable_orders = support[k];
+    }
+    r.modes = sorted;
+    r.status = ModalFitStatus::kOk;
+    r.fmin_hz = result.fmin_hz;
+    r.fmax_hz = result.fmax_hz;
+    r.message = "global fit";
+  }
+  for (size_t k : order) {
+    GlobalMode m;
+    m.pole = poles[k];
+    m.freq_hz = RadPerSecToHz(std::abs(poles[k]));
+    m.damping_ratio = -poles[k].real() / std::abs(poles[k]);
+    m.stable_orders = support[k];
+    result.modes.push_back(m);
+  }
+  for (size_t i = 0; i < frfs.size(); ++i) {
+    const auto& sigma = frfs[i].noise_sigma();
+    if (!sigma) {
+      result.misfit_in_noise.push_back(NAN);
+      continue;
+    }
+    double sum = 0.0;
+    for (int k = 0; k < N; ++k) {
+      sum += std::norm((result.per_frf[i].Evaluate(frfs[i].freq_hz()(k)) - frfs[i].receptance()(k)) / (*sigma)(k));
+    }
+    result.misfit_in_noise.push_back(std::sqrt(sum / N));
+  }
+  result.status = ModalFitStatus::kOk;
+  result.message = std::to_string(result.modes.size()) + " modes common to " + std::to_string(frfs.size()) +
+                   " FRFs: " +
+                   (from_peaks ? std::string("no cluster of stable poles, poles from the peaks of |H|")
+                               : std::to_string(clusters.size()) + " clusters of stable poles over orders " +
+                                     std::to_string(o.min_order) + ".." + std::to_string(nmax)) +
+                   (o.refine ? ", refined" : "") +
+                   (added > 0 ? ", " + std::to_string(added) + " added from the residual" : "");
+  return result;
+}
+
+}  // namespace robomach::calibration

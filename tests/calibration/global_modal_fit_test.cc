@@ -1,0 +1,297 @@
+// The global modal fit (common poles, residues per FRF, mode shapes, MAC;
+// issue #34 §1-2) against analytic references: a simply supported
+// Euler–Bernoulli beam in a roving-hammer test (natural frequencies and
+// mode shapes in closed form), two modes 3 % apart seen by three FRFs, and
+// on real files other software wrote (../shared/external, read where they
+// lie, skipped when absent).
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cmath>
+#include <complex>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "robomach/calibration/frf_noise.h"
+#include "robomach/calibration/global_modal_fit.h"
+#include "robomach/common/units.h"
+#include "robomach/io/frf_files.h"
+
+namespace robomach::calibration {
+namespace {
+
+using cd = std::complex<double>;
+constexpr double kPi = 3.14159265358979323846;
+
+// Simply supported beam, length 1 m, steel 30 x 10 mm (bending about the
+// thin side): ω_n = (nπ/L)² sqrt(EI/(ρA)), mass-normalised shapes
+// φ_n(x) = sqrt(2/(ρAL)) sin(nπx/L) [Blevins, Formulas for natural frequency
+// and mode shape, Table 8-1].
+struct Beam {
+  double L = 1.0, E = 2.1e11, rho = 7850.0, b = 0.03, h = 0.01;
+  double EI() const { return E * b * h * h * h / 12.0; }
+  double rhoA() const { return rho * b * h; }
+  double OmegaN(int n) const { return std::pow(n * kPi / L, 2) * std::sqrt(EI() / rhoA()); }
+  double Phi(int n, double x) const { return std::sqrt(2.0 / (rhoA() * L)) * std::sin(n * kPi * x / L); }
+};
+
+// H(x_j, x_ref) with modal damping ζ_n, modes 1..12 (those above the band
+// act as the upper residual), complex Gaussian noise of `noise_rel` × |H|.
+std::vector<dynamics::Frf> RovingBeam(const Beam& beam, const std::vector<double>& points, double x_ref,
+                                      double noise_rel, unsigned seed, double fmax_hz, double df_hz) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const int n_lines = static_cast<int>(std::round(fmax_hz / df_hz));
+  Eigen::VectorXd f(n_lines);
+  for (int k = 0; k < n_lines; ++k) f(k) = (k + 1) * df_hz;
+  std::vector<dynamics::Frf> out;
+  for (double x : points) {
+    Eigen::VectorXcd H(n_lines);
+    for (int k = 0; k < n_lines; ++k) {
+      const double w = HzToRadPerSec(f(k));
+      cd h = 0.0;
+      for (int n = 1; n <= 12; ++n) {
+        const double wn = beam.OmegaN(n), zeta = 0.01 + 0.002 * n;
+        h += beam.Phi(n, x) * beam.Phi(n, x_ref) / (wn * wn - w * w + cd(0, 2.0 * zeta * wn * w));
+      }
+      H(k) = h * (1.0 + noise_rel / std::sqrt(2.0) * cd(gauss(rng), gauss(rng)));
+    }
+    out.push_back(dynamics::Frf::FromSamples(f, H));
+  }
+  return out;
+}
+
+TEST(GlobalModalFit, RovingHammerOnEulerBernoulliBeamGivesAnalyticModesAndShapes) {
+  const Beam beam;
+  std::vector<double> points;
+  for (int j = 1; j <= 11; ++j) points.push_back(j / 12.0);
+  const double x_ref = 0.37;
+  const double fmax = 1.2 * RadPerSecToHz(beam.OmegaN(5));  // modes 1-5 in the band, mode 6 at 1.44 f5
+  const auto frfs = RovingBeam(beam, points, x_ref, 0.01, 3401, fmax, fmax / 2000.0);
+  const GlobalModalFitResult fit = FitModesGlobal(frfs);
+  ASSERT_EQ(fit.status, ModalFitStatus::kOk) << fit.message;
+  ASSERT_EQ(fit.modes.size(), 5u) << fit.message;
+  Eigen::MatrixXcd analytic(points.size(), 5);
+  for (int n = 1; n <= 5; ++n) {
+    const double fn = RadPerSecToHz(beam.OmegaN(n));
+    EXPECT_NEAR(fit.modes[n - 1].freq_hz, fn, 0.002 * fn) << "mode " << n;
+    EXPECT_NEAR(fit.modes[n - 1].damping_ratio, 0.01 + 0.002 * n, 0.05 * (0.01 + 0.002 * n)) << "mode " << n;
+    for (size_t j = 0; j < points.size(); ++j) analytic(j, n - 1) = beam.Phi(n, points[j]);
+  }
+  const Eigen::MatrixXd mac = ModalAssuranceCriterion(fit.ModeShapes(), analytic);
+  for (int n = 0; n < 5; ++n) {
+    EXPECT_GE(mac(n, n), 0.99) << "mode " << n + 1;
+    for (int m = 0; m < 5; ++m) {
+      if (m != n) EXPECT_LT(mac(n, m), 0.1) << "modes " << n + 1 << ", " << m + 1;
+    }
+  }
+  // The residue of point j is φ_n(x_j) φ_n(x_ref): with the reference point
+  // (x_ref) among the points, shapes are mass-normalised; here the scale is
+  // checked through A = φ(x_j) φ(x_ref) directly on the point nearest the
+  // middle, mode 1.
+  const Eigen::MatrixXcd A = fit.ModalConstants();
+  const double a_expect = beam.Phi(1, points[5]) * beam.Phi(1, x_ref);
+  EXPECT_NEAR(A(5, 0).real(), a_expect, 0.02 * std::abs(a_expect));
+  EXPECT_LT(std::abs(A(5, 0).imag()), 0.02 * std::abs(a_expect));
+}
+
+TEST(GlobalModalFit, MassNormalisedShapesWithADrivingPoint) {
+  const Beam beam;
+  const std::vector<double> points{0.15, 0.3, 0.37, 0.55, 0.8};
+  const double fmax = 1.3 * RadPerSecToHz(beam.OmegaN(3));
+  // 4000 lines: mode 1 (23 Hz, zeta 1.2 %) spans 8 lines of its half-power band.
+  const auto frfs = RovingBeam(beam, points, 0.37, 0.005, 3402, fmax, fmax / 4000.0);
+  const GlobalModalFitResult fit = FitModesGlobal(frfs);
+  ASSERT_EQ(fit.modes.size(), 3u) << fit.message;
+  for (int n = 1; n <= 3; ++n) {
+    const double fn = RadPerSecToHz(beam.OmegaN(n));
+    EXPECT_NEAR(fit.modes[n - 1].freq_hz, fn, 0.002 * fn) << "mode " << n;
+    EXPECT_NEAR(fit.modes[n - 1].damping_ratio, 0.01 + 0.002 * n, 0.05 * (0.01 + 0.002 * n)) << "mode " << n;
+  }
+  const Eigen::MatrixXcd phi = fit.ModeShapes(/*driving_point=*/2);
+  for (int n = 1; n <= 3; ++n) {
+    // Sign of a mass-normalised shape is arbitrary; compare up to it.
+    const double sign = phi(2, n - 1).real() * beam.Phi(n, 0.37) > 0 ? 1.0 : -1.0;
+    for (size_t j = 0; j < points.size(); ++j) {
+      const double expect = beam.Phi(n, points[j]);
+      EXPECT_NEAR(sign * phi(j, n - 1).real(), expect, 0.02 * beam.Phi(n, 0.5 / n) + 1e-12)
+          << "mode " << n << " point " << j;
+    }
+  }
+}
+
+// Two modes 3 % apart (a nearly symmetric structure: the same frequency in
+// two directions, split by a small asymmetry) and a third mode, seen by
+// three FRFs with different mixtures, 2 % noise.
+TEST(GlobalModalFit, ResolvesTwoModesThreePercentApart) {
+  const double f1 = 400.0, f2 = 412.0, f3 = 900.0;
+  const double z1 = 0.012, z2 = 0.015, z3 = 0.02;
+  const double phi[3][3] = {{1.0, 0.8, 0.5}, {0.7, -1.0, 0.4}, {0.3, 0.6, -0.9}};  // [frf][mode]
+  const double m = 2.0;                                                            // modal mass [kg]
+  std::mt19937 rng(3403);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const int n_lines = 1500;
+  Eigen::VectorXd f(n_lines);
+  for (int k = 0; k < n_lines; ++k) f(k) = 100.0 + k * (1200.0 - 100.0) / (n_lines - 1);
+  std::vector<dynamics::Frf> frfs;
+  for (int o = 0; o < 3; ++o) {
+    Eigen::VectorXcd H(n_lines);
+    for (int k = 0; k < n_lines; ++k) {
+      const double w = HzToRadPerSec(f(k));
+      cd h = 0.0;
+      const double fr[3] = {f1, f2, f3}, zr[3] = {z1, z2, z3};
+      for (int r = 0; r < 3; ++r) {
+        const double wn = HzToRadPerSec(fr[r]);
+        h += phi[o][r] / m / (wn * wn - w * w + cd(0, 2 * zr[r] * wn * w));
+      }
+      H(k) = h * (1.0 + 0.02 / std::sqrt(2.0) * cd(gauss(rng), gauss(rng)));
+    }
+    frfs.push_back(dynamics::Frf::FromSamples(f, H));
+  }
+  const GlobalModalFitResult fit = FitModesGlobal(frfs);
+  ASSERT_EQ(fit.modes.size(), 3u) << fit.message;
+  EXPECT_NEAR(fit.modes[0].freq_hz, f1, 0.002 * f1);
+  EXPECT_NEAR(fit.modes[1].freq_hz, f2, 0.002 * f2);
+  EXPECT_NEAR(fit.modes[2].freq_hz, f3, 0.002 * f3);
+  EXPECT_NEAR(fit.modes[0].damping_ratio, z1, 0.1 * z1);
+  EXPECT_NEAR(fit.modes[1].damping_ratio, z2, 0.1 * z2);
+  Eigen::MatrixXcd truth(3, 3);
+  for (int o = 0; o < 3; ++o)
+    for (int r = 0; r < 3; ++r) truth(o, r) = phi[o][r];
+  const Eigen::MatrixXd mac = ModalAssuranceCriterion(fit.ModalConstants(), truth);
+  for (int r = 0; r < 3; ++r) EXPECT_GE(mac(r, r), 0.99) << "mode " << r + 1;
+}
+
+TEST(GlobalModalFit, MacOfKnownVectors) {
+  Eigen::MatrixXcd a(3, 2), b(3, 1);
+  a << 1, 0, 2, 1, 3, 0;
+  b << cd(0, -2), cd(0, -4), cd(0, -6);  // −2i × a's first column
+  const Eigen::MatrixXd mac = ModalAssuranceCriterion(a, b);
+  EXPECT_NEAR(mac(0, 0), 1.0, 1e-15);
+  // a₂ = (0,1,0): |a₂ᴴ b|² / (|a₂|²|b|²) = 16 / (1 · 56).
+  EXPECT_NEAR(mac(1, 0), 16.0 / 56.0, 1e-15);
+  EXPECT_THROW(ModalAssuranceCriterion(a, Eigen::MatrixXcd(2, 1)), std::invalid_argument);
+}
+
+TEST(GlobalModalFit, RefusesFrfsOnOtherLines) {
+  Eigen::VectorXd f1 = Eigen::VectorXd::LinSpaced(100, 10, 100), f2 = Eigen::VectorXd::LinSpaced(100, 10, 110);
+  const Eigen::VectorXcd h = Eigen::VectorXcd::Constant(100, cd(1e-6, 0));
+  EXPECT_THROW(FitModesGlobal({dynamics::Frf::FromSamples(f1, h), dynamics::Frf::FromSamples(f2, h)}),
+               std::invalid_argument);
+}
+
+// ------------------------------------------------ real files (../shared) --
+
+std::string Shared(const std::string& rel) {
+  return std::string(ROBOMACH_SOURCE_DIR) + "/../shared/external/frf_uff58/" + rel;
+}
+
+// pyuff's measured beam accelerances (numpy text, one complex per line,
+// 0..1000 Hz in 1 Hz steps, roving hammer, response node 1).
+std::vector<dynamics::Frf> PyuffBeam() {
+  std::vector<dynamics::Frf> out;
+  for (int p = 1; p <= 3; ++p) {
+    std::ifstream in(Shared("pyuff/meas_point_" + std::to_string(p) + ".txt"));
+    std::vector<cd> v;
+    std::string line;
+    while (std::getline(in, line)) {
+      // "(re+imj)"
+      for (char& c : line)
+        if (c == '(' || c == ')') c = ' ';
+      const size_t j = line.find('j');
+      if (j == std::string::npos) continue;
+      // split at the sign that starts the imaginary part (not an exponent's)
+      size_t split = std::string::npos;
+      for (size_t i = j; i-- > 1;) {
+        if ((line[i] == '+' || line[i] == '-') && line[i - 1] != 'e' && line[i - 1] != 'E' && line[i - 1] != ' ') {
+          split = i;
+          break;
+        }
+      }
+      v.emplace_back(std::stod(line.substr(0, split)), std::stod(line.substr(split, j - split)));
+    }
+    const int n = static_cast<int>(v.size()) - 1;  // 0 Hz dropped: no receptance
+    Eigen::VectorXd f(n);
+    Eigen::VectorXcd H(n);
+    for (int k = 0; k < n; ++k) {
+      f(k) = k + 1.0;
+      const double w = HzToRadPerSec(f(k));
+      H(k) = v[k + 1] / (-w * w);  // accelerance to receptance
+    }
+    out.push_back(dynamics::Frf::FromSamples(f, H));
+  }
+  return out;
+}
+
+// The noise model the tools attach (frf_noise.h): measured data have a
+// floor, and 1/|H| weights would make the anti-resonances' noise dominate.
+std::vector<dynamics::Frf> WithNoiseModels(std::vector<dynamics::Frf> frfs) {
+  for (dynamics::Frf& f : frfs) f = f.WithNoise(EstimateFrfNoise(f).sigma_m_per_N);
+  return frfs;
+}
+
+void DumpFit(const GlobalModalFitResult& fit, const std::vector<dynamics::Frf>& frfs, int power) {
+  std::printf("%s\n", fit.message.c_str());
+  for (const GlobalMode& m : fit.modes) std::printf("  %.2f Hz zeta %.4f support %d\n", m.freq_hz, m.damping_ratio, m.stable_orders);
+  for (size_t i = 0; i < frfs.size(); ++i)
+    std::printf("  FRF %zu misfit %.4f noise %.2f\n", i + 1, RelativeMisfit(fit.per_frf[i], frfs[i], power), fit.misfit_in_noise[i]);
+}
+
+TEST(GlobalModalFitRealFiles, PyuffBeamEveryPeakFoundWithCommonPoles) {
+  if (!std::filesystem::exists(Shared("pyuff/meas_point_1.txt"))) {
+    GTEST_SKIP() << "../shared/external/frf_uff58/pyuff is absent (a clone without ../shared)";
+  }
+  const auto frfs = WithNoiseModels(PyuffBeam());
+  const GlobalModalFitResult fit = FitModesGlobal(frfs);
+  ASSERT_EQ(fit.status, ModalFitStatus::kOk) << fit.message;
+  if (std::getenv("ROBOMACH_DUMP_FIT")) DumpFit(fit, frfs, 2);
+  // The peaks the files show (SOURCES.md, read on the 1 Hz grid): 52, 142,
+  // 279, 460, 687, 959 Hz; a mode within one line of each. (Misfit against
+  // sdypy-EMA's 0.026 / 0.045 / 0.029: measured 0.056 / 0.083 / 0.053, not
+  // yet at the peer's, see docs/testing.md; not asserted.)
+  for (double f : {52.0, 142.0, 279.0, 460.0, 687.0, 959.0}) {
+    double nearest = 1e300;
+    for (const GlobalMode& m : fit.modes) nearest = std::min(nearest, std::abs(m.freq_hz - f));
+    EXPECT_LE(nearest, 1.0) << "no mode within a line of " << f << " Hz: " << fit.message;
+  }
+  // One set of poles: every FRF's table has the same modes.
+  for (const ModalFitResult& r : fit.per_frf) ASSERT_EQ(r.modes.size(), fit.modes.size());
+}
+
+TEST(GlobalModalFitRealFiles, Dataset58ModesAtTheFilesPeaks) {
+  const std::string path = Shared("ufffiles_jl/dataset58_FRF.unv");
+  if (!std::filesystem::exists(path)) {
+    GTEST_SKIP() << "../shared/external/frf_uff58/ufffiles_jl is absent (a clone without ../shared)";
+  }
+  const io::FrfReadResult read = io::ReadFrfFile(path);
+  ASSERT_EQ(read.frfs.size(), 1);
+  const dynamics::Frf frf = WithNoiseModels({read.frfs.begin()->second}).front();
+  const auto t0 = std::chrono::steady_clock::now();
+  const GlobalModalFitResult fit = FitModesGlobal({frf});
+  std::printf("fit %.2f s (CPU contended; bench_modal measures it)\n",
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  ASSERT_EQ(fit.status, ModalFitStatus::kOk) << fit.message;
+  if (std::getenv("ROBOMACH_DUMP_FIT")) DumpFit(fit, {frf}, 1);
+  // The peaks of the file (SOURCES.md, 0.5 Hz grid): 175, 376.5, 464,
+  // 544 Hz, each within 0.5 %. The fifth, 81.5 Hz, is split by this fit
+  // into 81.0 Hz (zeta 5 %) and 82.5 Hz (zeta 9.6 %): a known gap of issue
+  // #34, checked here only to within 1 %.
+  for (double f : {175.0, 376.5, 464.0, 544.0}) {
+    double nearest = 1e300;
+    for (const GlobalMode& m : fit.modes) nearest = std::min(nearest, std::abs(m.freq_hz - f));
+    EXPECT_LT(nearest, 0.005 * f) << "mode near " << f << " Hz: " << fit.message;
+  }
+  double nearest = 1e300;
+  for (const GlobalMode& m : fit.modes) nearest = std::min(nearest, std::abs(m.freq_hz - 81.5));
+  EXPECT_LT(nearest, 0.01 * 81.5) << fit.message;
+}
+
+}  // namespace
+}  // namespace robomach::calibration
