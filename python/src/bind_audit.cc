@@ -30,6 +30,9 @@ py::dict ResultDict(const audit::AuditResult& r) {
   d["missing_effects"] = r.missing_effects;
   d["candidate"] = r.graded >= 0 ? py::object(py::str(r.candidates[r.graded].name())) : py::none();
   d["error_before"] = r.errors_before.total_rms_log_mag;
+  // As summary.json's error_after: with the accepted candidate, else before.
+  const audit::CandidateResult* accepted = audit::AcceptedCandidate(r);
+  d["error_after"] = accepted ? accepted->errors.total_rms_log_mag : r.errors_before.total_rms_log_mag;
   d["noise_floor"] = r.noise_floor;
   d["error_before_noise_units"] = number(r.error_before_noise_units);
   d["remainder_noise_units"] = number(r.remainder_noise_units);

@@ -124,15 +124,23 @@ void BindDynamics(py::module_& m) {
         }
         return l;
       }, "(num_joints, 2) array of [lower, upper] joint limits [rad]; ±inf for continuous joints")
-      .def("joints_outside_limits", [](const RobotModel& r, const Eigen::VectorXd& q) {
-        return r.chain().JointsOutsideLimits(q);
-      }, py::arg("q"), "0-based indices of the joints of q [rad] outside their limits (1e-9 rad tolerance)")
-      .def("evaluate", [](const ModelPtr& r, const Eigen::VectorXd& q, bool cartesian, bool modes) {
+      .def("joints_outside_limits", [](const RobotModel& r, const std::optional<Eigen::VectorXd>& q_rad,
+                                       const std::optional<Eigen::VectorXd>& q_deg) {
+        return r.chain().JointsOutsideLimits(JointAnglesRad("joints_outside_limits", q_rad, q_deg));
+      }, py::arg("q_rad") = py::none(), py::kw_only(), py::arg("q_deg") = py::none(),
+         "0-based indices of the joints outside their limits (1e-9 rad tolerance), at q_rad [rad] or "
+         "q_deg=[deg] (UnitWarning if the angles look like the other unit)")
+      .def("evaluate", [](const ModelPtr& r, const std::optional<Eigen::VectorXd>& q_rad, bool cartesian, bool modes,
+                          const std::optional<Eigen::VectorXd>& q_deg) {
+        const Eigen::VectorXd q = JointAnglesRad("evaluate", q_rad, q_deg);
         return dynamics::EvaluatePosture(r, q, {.cartesian = cartesian, .modes = modes});
-      }, py::arg("q"), py::arg("cartesian") = true, py::arg("modes") = true,
-         "One-off posture evaluation (PostureEvaluator(model).evaluate). q: joint angles [rad].")
-      .def("predict_frf", [](const ModelPtr& r, const Eigen::VectorXd& q, const Eigen::VectorXd& freq_hz,
+      }, py::arg("q_rad") = py::none(), py::arg("cartesian") = true, py::arg("modes") = true, py::kw_only(),
+         py::arg("q_deg") = py::none(),
+         "One-off posture evaluation (PostureEvaluator(model).evaluate) at joint angles q_rad [rad], or "
+         "q_deg=[deg]; a UnitWarning names angles that look like the other unit.")
+      .def("predict_frf", [](const ModelPtr& r, const Eigen::VectorXd& q_rad, const Eigen::VectorXd& freq_hz,
                              const std::string& method) {
+        const Eigen::VectorXd q = JointAnglesRad("predict_frf", q_rad);
         CheckFrequencies(freq_hz);
         std::vector<Eigen::Matrix3cd> h;
         {
@@ -141,8 +149,9 @@ void BindDynamics(py::module_& m) {
           h = ReceptanceByMethod(d, freq_hz, method);
         }
         return ToArray(h);
-      }, py::arg("q"), py::arg("freq_hz"), py::arg("method") = "modal",
-         "Tool-tip receptance at posture q [rad], as frf-predict computes it: evaluate, then "
+      }, py::arg("q_rad"), py::arg("freq_hz"), py::arg("method") = "modal",
+         "Tool-tip receptance at posture q_rad [rad] (a UnitWarning if it looks like degrees), as frf-predict "
+         "computes it: evaluate, then "
          "PostureDynamics.receptance(freq_hz, method). Returns complex (lines, 3, 3) [m/N].");
 
   py::class_<RobotConfig>(
@@ -290,10 +299,15 @@ void BindDynamics(py::module_& m) {
       "evaluator per thread.")
       .def(py::init([](const ModelPtr& model) { return std::make_unique<PostureEvaluator>(model); }),
            py::arg("model"))
-      .def("evaluate", [](PostureEvaluator& ev, const Eigen::VectorXd& q, bool cartesian, bool modes) {
+      .def("evaluate", [](PostureEvaluator& ev, const std::optional<Eigen::VectorXd>& q_rad, bool cartesian,
+                          bool modes, const std::optional<Eigen::VectorXd>& q_deg) {
+        const Eigen::VectorXd q = JointAnglesRad("evaluate", q_rad, q_deg);
         return ev.Evaluate(q, {.cartesian = cartesian, .modes = modes});
-      }, py::arg("q"), py::arg("cartesian") = true, py::arg("modes") = true,
-         "PostureDynamics at joint angles q [rad] (length num_joints). cartesian: form M_X, K_X, "
+      }, py::arg("q_rad") = py::none(), py::arg("cartesian") = true, py::arg("modes") = true, py::kw_only(),
+         py::arg("q_deg") = py::none(),
+         "PostureDynamics at joint angles q_rad [rad], or q_deg=[deg] (length num_joints; a UnitWarning names "
+         "angles that look like the other unit: more than a turn in q_rad, all within 2 pi with fractions in "
+         "q_deg). cartesian: form M_X, K_X, "
          "C_X; modes: undamped modes and damping ratios. ValueError if q has the wrong size or is "
          "not finite; NumericalError if the assembled mass matrix is not positive definite (a bad model, not a bad "
          "posture).");
@@ -309,8 +323,13 @@ void BindDynamics(py::module_& m) {
   }, py::arg("dynamics"), py::arg("freq_hz"), py::arg("method") = "modal", kReceptanceDoc);
 
   py::class_<io::Posture>(m, "Posture", "One row of a posture file.")
-      .def(py::init([](std::string id, Eigen::VectorXd q) { return io::Posture{std::move(id), std::move(q), 0}; }),
-           py::arg("id"), py::arg("q"))
+      .def(py::init([](std::string id, const std::optional<Eigen::VectorXd>& q_rad,
+                       const std::optional<Eigen::VectorXd>& q_deg) {
+             return io::Posture{std::move(id), JointAnglesRad("Posture", q_rad, q_deg), 0};
+           }),
+           py::arg("id"), py::arg("q_rad") = py::none(), py::kw_only(), py::arg("q_deg") = py::none(),
+           "A posture from joint angles q_rad [rad] or q_deg=[deg] (a UnitWarning if they look like the other "
+           "unit).")
       .def_readonly("id", &io::Posture::id)
       .def_property_readonly("q", [](const io::Posture& p) { return Eigen::VectorXd(p.q); }, "joint angles [rad]")
       .def_readonly("line", &io::Posture::line, "line in the file (0 if not read from one)")

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <complex>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -49,6 +50,22 @@ std::string AxisString(Axis a);
 using KeyTuple = std::tuple<std::string, std::string, std::string>;
 dynamics::FrfKey ToKey(const KeyTuple& t);
 KeyTuple FromKey(const dynamics::FrfKey& k);
+
+/// Joint angles as the library takes them [rad], from the `q_rad` or the
+/// `q_deg` of a Python call (exactly one of them; ValueError otherwise).
+/// Names cross the API with their unit (issue #35: `evaluate` took degrees
+/// silently). An angle that fits the other unit far better is a
+/// robomach.UnitWarning (a UserWarning) naming the likely mistake, with the
+/// posture files' rule (io::PostureUnitWarnings, exit 3 in the tools):
+/// q_rad with an angle beyond one turn (2 pi) looks like degrees; q_deg whose
+/// non-zero angles are all within 2 pi and not all whole numbers looks like
+/// radians. `call` names the function in the message.
+Eigen::VectorXd JointAnglesRad(const std::string& call, const std::optional<Eigen::VectorXd>& q_rad,
+                               const std::optional<Eigen::VectorXd>& q_deg = std::nullopt);
+
+/// Issues a robomach.UnitWarning (a UserWarning subclass) with `message`;
+/// raises if the warnings filter turns it into an error.
+void WarnUnit(const std::string& message);
 
 /// Raises FileNotFoundError ("path: no such file", as the tools' exit 66)
 /// unless `path` is a readable regular file.

@@ -1,12 +1,18 @@
 // The Python module `robomach`: exceptions and the module definition.
 // docs/python.md lists the bindings.
 #include <cerrno>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
+#include <glog/logging.h>
+
 #include "bindings.h"
 #include "robomach/common/errors.h"
+#include "robomach/common/units.h"
 #include "robomach/common/version.h"
+#include "robomach/common/number_format.h"
+#include "robomach/io/posture_file.h"
 
 namespace robomach::python {
 
@@ -36,6 +42,49 @@ dynamics::FrfKey ToKey(const KeyTuple& t) {
 
 KeyTuple FromKey(const dynamics::FrfKey& k) { return {k.pose_id, AxisString(k.response), AxisString(k.excitation)}; }
 
+namespace {
+PyObject* g_unit_warning = nullptr;  // robomach.UnitWarning, made at import
+}  // namespace
+
+void WarnUnit(const std::string& message) {
+  if (PyErr_WarnEx(g_unit_warning ? g_unit_warning : PyExc_UserWarning, message.c_str(), 1) != 0) {
+    throw py::error_already_set();
+  }
+}
+
+Eigen::VectorXd JointAnglesRad(const std::string& call, const std::optional<Eigen::VectorXd>& q_rad,
+                               const std::optional<Eigen::VectorXd>& q_deg) {
+  if (q_rad.has_value() == q_deg.has_value()) {
+    throw std::invalid_argument(call + ": give the joint angles once, as q_rad [rad] or as q_deg=[deg]" +
+                                (q_rad ? std::string(", not both") : std::string()));
+  }
+  if (q_rad) {
+    const double largest = q_rad->size() > 0 ? q_rad->cwiseAbs().maxCoeff() : 0.0;
+    if (largest > io::kOneTurnRad) {
+      WarnUnit("implausible (unit mistake?): " + call + ": q_rad has an angle of " + FormatNumber(largest) +
+               " rad = " + FormatNumber(RadToDeg(largest)) +
+               " deg, more than a turn: these look like degrees; pass q_deg=... or numpy.radians(q)");
+    }
+    return *q_rad;
+  }
+  const Eigen::VectorXd& d = *q_deg;
+  bool fraction = false;
+  int nonzero = 0;
+  double largest = 0.0;
+  for (Eigen::Index j = 0; j < d.size(); ++j) {
+    const double a = std::abs(d(j));
+    largest = std::max(largest, a);
+    if (a > 0.0) ++nonzero;
+    if (a > 0.0 && a != std::floor(a)) fraction = true;
+  }
+  if (nonzero > 0 && fraction && largest <= io::kOneTurnRad) {
+    WarnUnit("implausible (unit mistake?): " + call + ": every angle of q_deg is within 2 pi = 6.28 (largest " +
+             FormatNumber(largest) + "), as radians are: these look like radians; pass q_rad=... or "
+             "numpy.degrees(q)");
+  }
+  return d * DegToRad(1.0);
+}
+
 void RequireReadableFile(const std::string& path) {
   std::error_code ec;
   const bool regular = std::filesystem::is_regular_file(path, ec);
@@ -58,6 +107,15 @@ PYBIND11_MODULE(robomach, m) {
       "calibration). SI units throughout, angles in radians; receptance in m/N. See docs/python.md.";
   m.attr("__version__") = robomach::Version();
 
+  // Ceres logs through glog on stderr: "Covariance matrix is near rank
+  // deficient", "Terminating: ..." (issue #35: they reached Python's
+  // stderr). The library reports the same conditions in its results
+  // (StageSummary.covariance_ok, std_dev NaN, solver_message, the status),
+  // so glog's lines below FATAL are silenced, as the tools do
+  // (apps/cli_support RunGuarded). GLOG_minloglevel in the environment (0
+  // shows them all) is respected.
+  if (std::getenv("GLOG_minloglevel") == nullptr) FLAGS_minloglevel = google::GLOG_FATAL;
+
   // Library exceptions keep their messages (what()). InputError carries the
   // location as attributes path, line, column (0 = unknown) and message
   // (without the location prefix).
@@ -71,6 +129,15 @@ PYBIND11_MODULE(robomach, m) {
   numerical_error.doc() =
       "A numerical method failed at the values it was given (robomach::NumericalError): a "
       "factorisation or eigensolver did not succeed, a result is not finite.";
+  // Implausible units (an angle that fits the other unit far better): a
+  // warning, as the tools' exit 3 is a flag and not a refusal.
+  g_unit_warning = PyErr_NewExceptionWithDoc(
+      "robomach.UnitWarning",
+      "A value that fits another unit far better than the one its name says (degrees passed as q_rad, say): the "
+      "call went ahead with the value as given; the message names the likely mistake.",
+      PyExc_UserWarning, nullptr);
+  if (!g_unit_warning) throw py::error_already_set();
+  m.attr("UnitWarning") = py::reinterpret_borrow<py::object>(g_unit_warning);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

@@ -83,3 +83,31 @@ def test_bad_config_raises_input_error_with_the_tools_message(tmp):
     assert str(err).startswith(f'{bad}:{err.line}')
     r = run_tool('frf-predict', '--robot', bad, '--postures', write_posture(tmp / 'p.csv'), expect_rc=65)
     assert str(err) in r.stderr
+
+
+# Issue #35: Ceres's glog lines ("Covariance matrix is near rank deficient")
+# reached Python's stderr. Importing the module sets glog's minloglevel to
+# FATAL (3), as the tools do; the conditions are in the results
+# (covariance_ok, std_dev NaN, solver messages). GLOG_minloglevel in the
+# environment is respected. Read from the libglog the module loaded.
+GLOG_PROBE = '''
+import ctypes, robomach
+path = next(l.split()[-1] for l in open('/proc/self/maps') if 'libglog' in l)
+print(ctypes.c_int.in_dll(ctypes.CDLL(path), '_ZN3fLI17FLAGS_minloglevelE').value)
+'''
+
+
+def glog_minloglevel(env_value):
+    import subprocess
+    import sys
+    env = {k: v for k, v in os.environ.items() if k != 'GLOG_minloglevel'}
+    if env_value is not None:
+        env['GLOG_minloglevel'] = env_value
+    r = subprocess.run([sys.executable, '-c', GLOG_PROBE], capture_output=True, text=True, env=env, timeout=60)
+    assert r.returncode == 0, r.stderr
+    return int(r.stdout)
+
+
+def test_import_silences_ceres_log_lines_unless_asked():
+    assert glog_minloglevel(None) == 3
+    assert glog_minloglevel('0') == 0

@@ -43,6 +43,11 @@ def test_worked_example_runs_and_recovers_the_truth(tmp_path, monkeypatch):
     assert (tmp_path / 'audit_report' / 'index.html').stat().st_size > 0
     assert audit['summary']['verdict']['grade'] == 'explained'
     assert audit['summary']['verdict']['candidate'] == 'spindle_interface'
+    # The dict's errors carry summary.json's names and values (issue #35: the
+    # docs named a key `errors` that neither has).
+    for key in ('error_before', 'error_after', 'noise_floor'):
+        assert audit[key] == audit['summary'][key], key
+    assert 'errors' not in audit and 'errors' not in audit['summary']
     assert after.status == 'converged'
     for e in after.estimates:
         # Within 3 standard deviations of the value the data were made with.

@@ -108,3 +108,52 @@ def test_options_and_errors():
     f = np.array([5.0, 10.5, 40.0])
     h0, h1 = d.receptance(f), ev.evaluate(d.q).receptance(f)
     assert np.abs(h0 - h1).max() <= 1e-9 * np.abs(h1).max()
+
+
+# Issue #35: evaluate took degrees silently. The angles' unit is in the
+# argument's name (q_rad, or q_deg=), and angles that fit the other unit far
+# better are a robomach.UnitWarning, by the posture files' rule (exit 3 in
+# the tools): more than a turn in q_rad; all within 2 pi, with fractions,
+# in q_deg.
+DEMO_DEG = np.array([0.0, -90.0, 90.0, 0.0, 45.0, 0.0])
+
+
+def test_angles_in_degrees_by_name_equal_radians():
+    ev = rm.PostureEvaluator(rm.RobotConfig(KR210).build())
+    # The conversion is one multiplication by pi/180, as numpy.radians does.
+    close(ev.evaluate(q_deg=DEMO_DEG).K_X, ev.evaluate(np.radians(DEMO_DEG)).K_X, rel=1e-15)
+    close(ev.evaluate(q_rad=np.radians(DEMO_DEG)).q, np.radians(DEMO_DEG), rel=1e-15)
+    close(rm.Posture('P1', q_deg=DEMO_DEG).q, np.radians(DEMO_DEG), rel=1e-15)
+
+
+def test_degrees_passed_as_radians_are_named():
+    model = rm.RobotConfig(KR210).build()
+    ev = rm.PostureEvaluator(model)
+    msg = r'evaluate: q_rad has an angle of 90 rad = 5157 deg, more than a turn: these look like degrees'
+    for call in (lambda: ev.evaluate(DEMO_DEG), lambda: model.evaluate(DEMO_DEG)):
+        with pytest.warns(rm.UnitWarning, match=msg):
+            call()
+    with pytest.warns(rm.UnitWarning, match='predict_frf: q_rad has an angle of 90 rad'):
+        model.predict_frf(DEMO_DEG, np.array([10.0]))
+    with pytest.warns(rm.UnitWarning, match='Posture: q_rad'):
+        rm.Posture('P1', DEMO_DEG)
+    assert issubclass(rm.UnitWarning, UserWarning)
+    # Radians passed as degrees (the demo posture in radians: 1.5708 ...).
+    with pytest.warns(rm.UnitWarning, match=r'every angle of q_deg is within 2 pi = 6.28 \(largest 1.571\).*'
+                                             r'these look like radians'):
+        ev.evaluate(q_deg=np.radians(DEMO_DEG))
+
+
+def test_plausible_angles_do_not_warn_and_one_unit_is_required():
+    ev = rm.PostureEvaluator(rm.RobotConfig(KR210).build())
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        ev.evaluate(np.radians(DEMO_DEG))
+        ev.evaluate(q_deg=DEMO_DEG)
+        ev.evaluate(q_deg=np.array([0.0, -2.0, 3.0, 0.0, 1.0, 0.0]))  # small whole degrees
+        ev.evaluate(np.full(6, 0.3))
+    with pytest.raises(ValueError, match='give the joint angles once, as q_rad'):
+        ev.evaluate()
+    with pytest.raises(ValueError, match='not both'):
+        ev.evaluate(np.zeros(6), q_deg=np.zeros(6))

@@ -40,62 +40,126 @@ Shown Display(const std::string& name, const std::string& unit) {
   return {name, unit, 1.0};
 }
 
-std::vector<unsigned char> TrendsPng(const audit::ErrorPatterns& p, double noise_floor, const std::string& title) {
+// The descriptors trends.png draws (issue #35: ten panels of the same
+// errors against q1 … gravity_torque_j3 looked alike and told nothing):
+// those whose correlation is defined (the value varies over the postures),
+// strongest first by the larger of |r| before and after, significant ones
+// before the others, at most kMaxTrendPanels. The table in index.html and
+// trends.csv keep every descriptor.
+constexpr size_t kMaxTrendPanels = 4;
+
+std::vector<size_t> TrendsToDraw(const audit::ErrorTrends& t) {
+  std::vector<size_t> idx;
+  for (size_t i = 0; i < t.trends.size(); ++i) {
+    if (std::isfinite(t.trends[i].correlation_before)) idx.push_back(i);
+  }
+  const auto strength = [&](size_t i) {
+    const audit::Trend& tr = t.trends[i];
+    double r = std::abs(tr.correlation_before);
+    if (std::isfinite(tr.correlation_after)) r = std::max(r, std::abs(tr.correlation_after));
+    return r;
+  };
+  std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) {
+    const bool sa = t.trends[a].significant_before || t.trends[a].significant_after;
+    const bool sb = t.trends[b].significant_before || t.trends[b].significant_after;
+    if (sa != sb) return sa;
+    return strength(a) > strength(b);
+  });
+  if (idx.size() > kMaxTrendPanels) idx.resize(kMaxTrendPanels);
+  return idx;
+}
+
+// One panel: the error per posture against one descriptor, its
+// least-squares line (Pearson's r measures how well that line fits), and the
+// noise floor where the errors come near it. The y axis is fitted to these
+// errors, not started at 0: a trend of 70 → 75 noise units is what the
+// panel is for, and on 0 … 80 it would be a flat row of points.
+void TrendPanel(Axes* ax, const std::vector<double>& x, const Eigen::VectorXd& err, double r, bool significant,
+                const std::string& title, const std::string& x_label, Rgb colour, double noise_floor) {
+  ax->title = title + ": r = " + Fixed(r, 2) + (significant ? " (significant)" : "");
+  ax->x_label = x_label;
+  ax->y_label = "error per posture [-]";
+  Series points, fit, floor;
+  points.markers = true;
+  points.color = colour;
+  points.label = "postures";
+  double sx = 0, sy = 0, n = 0, ylo = INFINITY, yhi = -INFINITY, xlo = INFINITY, xhi = -INFINITY;
+  for (size_t k = 0; k < x.size(); ++k) {
+    const double y = err(static_cast<Eigen::Index>(k));
+    if (!std::isfinite(y) || !std::isfinite(x[k])) continue;
+    points.x.push_back(x[k]);
+    points.y.push_back(y);
+    sx += x[k], sy += y, n += 1;
+    ylo = std::min(ylo, y), yhi = std::max(yhi, y), xlo = std::min(xlo, x[k]), xhi = std::max(xhi, x[k]);
+  }
+  if (n >= 2 && xhi > xlo) {
+    double sxx = 0, sxy = 0;
+    for (size_t k = 0; k < points.x.size(); ++k) {
+      sxx += (points.x[k] - sx / n) * (points.x[k] - sx / n);
+      sxy += (points.x[k] - sx / n) * (points.y[k] - sy / n);
+    }
+    const double slope = sxy / sxx, y0 = sy / n - slope * sx / n;
+    fit.x = {xlo, xhi};
+    fit.y = {y0 + slope * xlo, y0 + slope * xhi};
+    fit.color = colour;
+    fit.thickness = 1;
+    fit.label = "least-squares line";
+  }
+  if (std::isfinite(xlo)) {
+    // A point on the axis's end would be cut in half by the frame.
+    const double pad = xhi > xlo ? 0.05 * (xhi - xlo) : std::max(1.0, 0.05 * std::abs(xlo));
+    ax->x_min = xlo - pad;
+    ax->x_max = xhi + pad;
+  }
+  ax->series.push_back(std::move(points));
+  if (!fit.x.empty()) ax->series.push_back(std::move(fit));
+  // The floor is drawn where the errors come within 3 x of it (after a
+  // change that explains the failure); far below them it would squeeze
+  // the points into one row.
+  if (std::isfinite(noise_floor) && std::isfinite(ylo) && ylo < 3.0 * noise_floor) {
+    const double pad = xhi > xlo ? 0.05 * (xhi - xlo) : 1.0;
+    floor.x = {xlo - pad, xhi + pad};
+    floor.y = {noise_floor, noise_floor};
+    floor.label = "noise floor";
+    floor.color = {120, 120, 120};
+    floor.dashed = true;
+    floor.thickness = 1;
+    ylo = std::min(ylo, noise_floor), yhi = std::max(yhi, noise_floor);
+    ax->series.push_back(std::move(floor));
+  }
+  if (std::isfinite(ylo)) {
+    // The spread of the points, at least 2 % of their level (so that
+    // equal errors do not blow rounding up to the panel's height), with
+    // room above for the legend.
+    const double span = std::max(yhi - ylo, 0.02 * std::max(std::abs(yhi), 1e-12));
+    ax->y_min = std::max(0.0, ylo - 0.15 * span);
+    ax->y_max = yhi + 0.9 * span;
+  }
+}
+
+std::vector<unsigned char> TrendsPng(const audit::ErrorPatterns& p, const std::vector<size_t>& drawn,
+                                     double noise_floor, const std::string& title) {
   const audit::ErrorTrends& t = p.trends;
-  const int n = static_cast<int>(t.trends.size());
-  const int cols = 2, rows = std::max(1, (n + cols - 1) / cols);
+  const bool has_after = t.error_after.size() > 0;
+  const int cols = has_after ? 2 : 1, rows = std::max<int>(1, static_cast<int>(drawn.size()));
   Figure fig(rows, cols, 620, 300);
   fig.title = title;
-  for (int i = 0; i < n; ++i) {
-    const audit::Trend& tr = t.trends[i];
+  if (drawn.empty()) {
+    fig.at(0, 0).title = "no descriptor varies over these postures: nothing to draw";
+    return fig.EncodePng();
+  }
+  for (size_t row = 0; row < drawn.size(); ++row) {
+    const audit::Trend& tr = t.trends[drawn[row]];
     const Shown s = Display(tr.descriptor, tr.unit);
-    Axes& ax = fig.at(i / cols, i % cols);
-    std::string head = tr.descriptor + ": r = " + Fixed(tr.correlation_before, 2);
-    if (t.error_after.size() > 0) head += " before, " + Fixed(tr.correlation_after, 2) + " after";
-    head += " (n = " + std::to_string(t.n) + (tr.significant_before ? ", significant)" : ")");
-    ax.title = head;
-    ax.x_label = s.name + " [" + s.unit + "]";
-    ax.y_label = "rms log-mag error [-]";
-    ax.y_min = 0.0;
-    ax.legend = Axes::LegendPosition::kTopRight;
-    Series before, after, floor;
-    before.markers = after.markers = true;
-    before.label = "before";
-    before.color = PaletteColor(1);
-    after.label = "after best candidate";
-    after.color = PaletteColor(2);
-    double xlo = INFINITY, xhi = -INFINITY;
-    for (int k = 0; k < t.n; ++k) {
-      const double x = s.scale * tr.values(k);
-      xlo = std::min(xlo, x);
-      xhi = std::max(xhi, x);
-      before.x.push_back(x);
-      before.y.push_back(t.error_before(k));
-      if (t.error_after.size() > 0) {
-        after.x.push_back(x);
-        after.y.push_back(t.error_after(k));
-      }
+    std::vector<double> x;
+    for (int k = 0; k < t.n; ++k) x.push_back(s.scale * tr.values(k));
+    const std::string x_label = s.name + " [" + s.unit + "]";
+    TrendPanel(&fig.at(static_cast<int>(row), 0), x, t.error_before, tr.correlation_before, tr.significant_before,
+               tr.descriptor + ", current model", x_label, PaletteColor(1), noise_floor);
+    if (has_after) {
+      TrendPanel(&fig.at(static_cast<int>(row), 1), x, t.error_after, tr.correlation_after, tr.significant_after,
+                 tr.descriptor + ", after the best candidate", x_label, PaletteColor(2), noise_floor);
     }
-    ax.series.push_back(std::move(before));
-    if (!after.x.empty()) ax.series.push_back(std::move(after));
-    if (std::isfinite(noise_floor) && std::isfinite(xlo)) {
-      const double pad = xhi > xlo ? 0.05 * (xhi - xlo) : 1.0;
-      floor.x = {xlo - pad, xhi + pad};
-      floor.y = {noise_floor, noise_floor};
-      floor.label = "noise floor";
-      floor.color = {120, 120, 120};
-      floor.dashed = true;
-      floor.thickness = 1;
-      ax.series.push_back(std::move(floor));
-    }
-    // Headroom for the legend above the highest point.
-    double ymax = std::isfinite(noise_floor) ? noise_floor : 0.0;
-    for (const Series& se : ax.series) {
-      for (double y : se.y) {
-        if (std::isfinite(y)) ymax = std::max(ymax, y);
-      }
-    }
-    ax.y_max = ymax > 0.0 ? 1.6 * ymax : 1.0;
   }
   return fig.EncodePng();
 }
@@ -231,14 +295,19 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
   out.unmatched_modes_csv = ucsv.str();
 
   // ---- pictures
-  std::string figure_title = title + ": error per posture against posture descriptors (n = " + std::to_string(t.n);
+  const std::vector<size_t> drawn = TrendsToDraw(t);
+  for (size_t i : drawn) out.trends_png_descriptors.push_back(t.trends[i].descriptor);
+  std::string figure_title = title + ": error per posture against the " +
+                             (drawn.size() == 1 ? std::string("most correlated descriptor")
+                                                : std::to_string(drawn.size()) + " most correlated descriptors") +
+                             " (n = " + std::to_string(t.n);
   if (std::isfinite(t.critical_correlation)) {
-    figure_title += "; |r| > " + Fixed(t.critical_correlation, 2) + " is significant at " +
-                    Fixed(100 * t.significance_level, 0) + " %)";
+    figure_title += "; significant at " + Fixed(100 * t.significance_level, 0) + " %: |r| > " +
+                    Fixed(t.critical_correlation, 2) + ")";
   } else {
     figure_title += "; too few postures for a test)";
   }
-  out.trends_png = TrendsPng(p, noise_floor, figure_title);
+  out.trends_png = TrendsPng(p, drawn, noise_floor, figure_title);
   out.mode_error_map_png = ModeMapPng(m, title);
 
   // ---- HTML
@@ -274,7 +343,20 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
       << (has_after ? std::string(" / ") + (tr.significant_after ? "<b>yes</b>" : "no") + " after" : "")
       << "</td></tr>\n";
   }
-  h << "</table>\n<p><img src=\"" << HtmlEscape(files.trends_png) << "\" alt=\"error against posture descriptors\"></p>\n";
+  h << "</table>\n<p><img src=\"" << HtmlEscape(files.trends_png) << "\" alt=\"error against posture descriptors\"><br>";
+  if (out.trends_png_descriptors.empty()) {
+    h << "No descriptor varies over these postures: there is no trend to draw.";
+  } else {
+    h << "The picture: the error per posture against ";
+    for (size_t i = 0; i < out.trends_png_descriptors.size(); ++i) {
+      h << (i == 0 ? "" : i + 1 == out.trends_png_descriptors.size() ? " and " : ", ")
+        << HtmlEscape(out.trends_png_descriptors[i]);
+    }
+    h << " (the strongest correlations" << (t.trends.size() > out.trends_png_descriptors.size() ? "; the table has them all" : "")
+      << "), " << (has_after ? "the current model on the left and after the best candidate on the right, " : "")
+      << "each panel with its own error scale and the least-squares line whose fit r measures.";
+  }
+  h << "</p>\n";
 
   h << "<h2>Error map: postures against model modes</h2>\n";
   if (out.mode_error_map_png.empty()) {

@@ -117,7 +117,108 @@ Range DataRange(const Axes& ax, bool x_axis) {
   return {lo, hi};
 }
 
-void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area) {
+// ---- marker labels (issue #35: "10.4 Hz" read "1.4 Hz" where a curve ran
+// through it).
+constexpr double kLabelScale = 0.4;
+constexpr int kLabelPad = 1;   // [px] between the text and its box
+constexpr int kLabelGap = 3;   // [px] between a marker line and its label's box
+
+int TextBaseline(const std::string& s, double scale) {
+  int base = 0;
+  cv::getTextSize(s, kFont, scale, 1, &base);
+  return base;
+}
+
+struct MarkerLabel {
+  std::string text;
+  double data_x;
+  int line_x;        // the marker line's column in the plot area [px]
+  cv::Scalar color;
+  cv::Rect box;      // in the plot area, set by PlaceLabels
+  bool clear;        // set by PlaceLabels
+  bool over_line;    // set by PlaceLabels: the box crosses another marker line
+};
+
+// Places each label beside its marker line, left or right of it, as high in
+// the plot as it can go, on pixels that no curve (`ink`, 255 where a curve
+// or the legend is), no label placed before it and, if at all possible, no
+// other marker line occupies. Where marker lines are closer than a label is
+// wide, it may cross other marker lines (over_line = true; it is drawn on a
+// white ground that interrupts them, so that a dashed line through "10.4"
+// cannot read "1.4"). A label that finds no place free of curves goes where
+// it covers the fewest curve pixels, with clear = false. Exhaustive over the
+// plot's rows: a few hundred candidate boxes per label, each checked with
+// the summed-area table in constant time.
+void PlaceLabels(const cv::Mat1b& ink, const std::vector<int>& line_x, std::vector<MarkerLabel>* labels) {
+  const int W = ink.cols, H = ink.rows;
+  cv::Mat1b taken(ink.size(), static_cast<unsigned char>(0));
+  cv::Mat1i ink_sum;
+  cv::integral(ink / 255, ink_sum, CV_32S);
+  auto sum_of = [](const cv::Mat1i& s, const cv::Rect& r) {
+    return s(r.y + r.height, r.x + r.width) - s(r.y, r.x + r.width) - s(r.y + r.height, r.x) + s(r.y, r.x);
+  };
+  // Left to right: the label of the lower frequency takes its place first.
+  std::vector<MarkerLabel*> order;
+  for (auto& l : *labels) order.push_back(&l);
+  std::stable_sort(order.begin(), order.end(), [](auto* a, auto* b) { return a->line_x < b->line_x; });
+  for (MarkerLabel* l : order) {
+    const cv::Size sz = TextSize(l->text, kLabelScale);
+    const int bw = sz.width + 2 * kLabelPad;
+    const int bh = sz.height + TextBaseline(l->text, kLabelScale) + 2 * kLabelPad;
+    cv::Mat1i taken_sum;
+    cv::integral(taken / 255, taken_sum, CV_32S);
+    const auto crosses_other_line = [&](const cv::Rect& r) {
+      for (int x : line_x) {
+        if (x != l->line_x && x >= r.x - 1 && x <= r.x + r.width) return true;
+      }
+      return false;
+    };
+    // Cost in pixels: the height below the top, and a label left of its
+    // line costs as if it were 8 px lower (right of the line reads first).
+    long best_cost = std::numeric_limits<long>::max();
+    cv::Rect best;
+    bool found = false, over_line = false;
+    for (int pass = 0; pass < 2 && !found; ++pass) {
+      for (int side = 0; side < 2; ++side) {
+        const int bx = side == 0 ? l->line_x + kLabelGap : l->line_x - kLabelGap - bw;
+        if (bx < 1 || bx + bw > W - 1) continue;
+        for (int by = 3; by + bh <= H - 2; ++by) {
+          const cv::Rect r(bx, by, bw, bh);
+          const long cost = by + 8L * side;
+          if (cost >= best_cost) break;
+          if (sum_of(ink_sum, r) > 0 || sum_of(taken_sum, r) > 0) continue;
+          if (pass == 0 && crosses_other_line(r)) continue;
+          best_cost = cost;
+          best = r;
+          found = true;
+          over_line = pass == 1;
+          break;
+        }
+      }
+    }
+    if (!found) {
+      // No clear place: the fewest curve pixels, then the highest.
+      long fewest = std::numeric_limits<long>::max();
+      for (int side = 0; side < 2; ++side) {
+        const int bx = std::clamp(side == 0 ? l->line_x + kLabelGap : l->line_x - kLabelGap - bw, 0, std::max(0, W - bw));
+        for (int by = 0; by + bh <= H; ++by) {
+          const cv::Rect r(bx, by, std::min(bw, W), bh);
+          const long c = 1000L * (sum_of(ink_sum, r) + sum_of(taken_sum, r)) + by;
+          if (c < fewest) fewest = c, best = r;
+        }
+      }
+    }
+    l->box = best;
+    l->clear = found;
+    l->over_line = over_line || (!found && crosses_other_line(best));
+    // A label keeps 6 px of space beside it and 1 px above and below: two
+    // labels side by side would read as one line of text.
+    const cv::Rect grown = cv::Rect(best.x - 6, best.y - 1, best.width + 12, best.height + 2) & cv::Rect(0, 0, W, H);
+    taken(grown).setTo(255);
+  }
+}
+
+void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vector<PlacedLabel>* placed) {
   const int left = 80, right = 20, top = 28, bottom = 48;
   const cv::Rect plot(area.x + left, area.y + top, area.width - left - right,
                       area.height - top - bottom);
@@ -156,8 +257,11 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area) {
     const cv::Size sz = TextSize(s);
     PutText(img, s, {plot.x - sz.width - 6, y + sz.height / 2});
   }
-  // Curves, clipped to the plot area.
+  // Curves, clipped to the plot area. `ink` marks every pixel a curve
+  // covers, widened by a pixel on each side for the antialiased edge: the
+  // marker labels are placed where it is clear (PlaceLabels).
   cv::Mat roi = img(plot);
+  cv::Mat1b ink(plot.size(), static_cast<unsigned char>(0));
   for (const Series& s : ax.series) {
     std::vector<cv::Point> pts;
     auto flush = [&] {
@@ -167,6 +271,7 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area) {
         } else {
           cv::polylines(roi, pts, false, ToCv(s.color), s.thickness, cv::LINE_AA);
         }
+        cv::polylines(ink, pts, false, cv::Scalar(255), s.thickness + 2, cv::LINE_8);
       }
       pts.clear();
     };
@@ -181,22 +286,49 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area) {
       const double px = std::clamp(tx(s.x[i]) - plot.x, -1e4, 1e4);
       const double py = std::clamp(ty(s.y[i]) - plot.y, -1e4, 1e4);
       const cv::Point p(static_cast<int>(std::lround(px)), static_cast<int>(std::lround(py)));
-      if (s.markers) cv::circle(roi, p, 3, ToCv(s.color), cv::FILLED, cv::LINE_AA);
+      if (s.markers) {
+        cv::circle(roi, p, 3, ToCv(s.color), cv::FILLED, cv::LINE_AA);
+        cv::circle(ink, p, 5, cv::Scalar(255), cv::FILLED);
+      }
       pts.push_back(p);
     }
     flush();
   }
-  // Vertical markers with labels.
-  int label_row = 0;
+  // The legend's box, top right inside the plot (drawn last, reserved now
+  // so that no label is put under it).
+  int legend_width = 0;
+  for (const Series& s : ax.series) legend_width = std::max(legend_width, TextSize(s.label).width);
+  int count = 0;
+  for (const Series& s : ax.series) count += !s.label.empty();
+  using LP = Axes::LegendPosition;
+  const bool at_right = ax.legend == LP::kTopRight || ax.legend == LP::kBottomRight;
+  const bool at_top = ax.legend == LP::kTopRight || ax.legend == LP::kTopLeft;
+  const int legend_x = at_right ? plot.x + plot.width - legend_width - 50 : plot.x + 14;
+  const int legend_y = at_top ? plot.y + 8 : plot.y + plot.height - 18 * count - 10;
+  const cv::Rect legend_box(legend_x - 6, legend_y - 2, legend_width + 54, 18 * count + 6);
+  if (count > 0) cv::rectangle(ink, legend_box - plot.tl(), cv::Scalar(255), cv::FILLED);
+  // Vertical markers: the dashed lines, then their labels where they cross
+  // no curve, no other label and, if possible, no other marker line.
+  std::vector<MarkerLabel> labels;
+  std::vector<int> line_x;
   for (const auto& m : ax.markers) {
     if (!std::isfinite(m.x) || m.x < std::min(xr.lo, xr.hi) || m.x > std::max(xr.lo, xr.hi)) continue;
     const int x = static_cast<int>(std::lround(tx(m.x)));
     DashedLine(img, {x, plot.y}, {x, plot.y + plot.height}, ToCv(m.color), 1);
-    if (!m.label.empty()) {
-      const int w = TextSize(m.label, 0.4).width;
-      const int lx = x + 3 + w > plot.x + plot.width ? x - 3 - w : x + 3;  // keep it inside
-      PutText(img, m.label, {lx, plot.y + 14 + 14 * (label_row++ % 3)}, 0.4, ToCv(m.color));
-    }
+    line_x.push_back(x - plot.x);
+    if (!m.label.empty()) labels.push_back({m.label, m.x, x - plot.x, ToCv(m.color), {}, true, false});
+  }
+  PlaceLabels(ink, line_x, &labels);
+  for (MarkerLabel& l : labels) {
+    const cv::Rect box = l.box + plot.tl();
+    // Over another marker line, or without a clear place, the label gets a
+    // white ground: it then hides a piece of that line or curve instead of
+    // being crossed by it.
+    if (!l.clear || l.over_line) cv::rectangle(img, box, cv::Scalar(255, 255, 255), cv::FILLED);
+    PutText(img, l.text, {box.x + kLabelPad, box.y + box.height - kLabelPad - TextBaseline(l.text, kLabelScale)},
+            kLabelScale, l.color);
+    if (placed) placed->push_back({panel, l.text, l.data_x, box.x, box.y, box.width, box.height, l.line_x + plot.x, l.clear,
+                                 l.over_line});
   }
   cv::rectangle(img, plot, kBlack, 1);
   // Labels and title.
@@ -206,19 +338,11 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area) {
   if (!ax.title.empty()) {
     PutText(img, ax.title, {plot.x, area.y + 19}, 0.55, kBlack, 1);
   }
-  // Legend, top right inside the plot.
-  int width = 0;
-  for (const Series& s : ax.series) width = std::max(width, TextSize(s.label).width);
-  int count = 0;
-  for (const Series& s : ax.series) count += !s.label.empty();
-  using LP = Axes::LegendPosition;
-  const bool at_right = ax.legend == LP::kTopRight || ax.legend == LP::kBottomRight;
-  const bool at_top = ax.legend == LP::kTopRight || ax.legend == LP::kTopLeft;
-  const int lx = at_right ? plot.x + plot.width - width - 50 : plot.x + 14;
-  int ly = at_top ? plot.y + 8 : plot.y + plot.height - 18 * count - 10;
+  // Legend.
+  int lx = legend_x, ly = legend_y;
   if (count > 0) {
-    cv::rectangle(img, cv::Rect(lx - 6, ly - 2, width + 54, 18 * count + 6), cv::Scalar(255, 255, 255), cv::FILLED);
-    cv::rectangle(img, cv::Rect(lx - 6, ly - 2, width + 54, 18 * count + 6), cv::Scalar(180, 180, 180), 1);
+    cv::rectangle(img, legend_box, cv::Scalar(255, 255, 255), cv::FILLED);
+    cv::rectangle(img, legend_box, cv::Scalar(180, 180, 180), 1);
     for (const Series& s : ax.series) {
       if (s.label.empty()) continue;
       if (s.dashed) DashedLine(img, {lx, ly + 9}, {lx + 36, ly + 9}, ToCv(s.color), s.thickness);
@@ -278,16 +402,22 @@ Figure::Figure(int rows, int cols, int panel_width_px, int panel_height_px)
   if (rows < 1 || cols < 1) throw std::invalid_argument("Figure: needs at least one panel");
 }
 
-std::vector<unsigned char> Figure::EncodePng() const {
+std::vector<unsigned char> Figure::EncodePng(std::vector<PlacedLabel>* labels) const {
+  if (labels) labels->clear();
   const int title_h = title.empty() ? 0 : 34;
   cv::Mat img(rows_ * panel_h_ + title_h, cols_ * panel_w_, CV_8UC3, cv::Scalar(255, 255, 255));
   if (!title.empty()) {
-    const cv::Size sz = TextSize(title, 0.7, 2);
-    PutText(img, title, {img.cols / 2 - sz.width / 2, 24}, 0.7, kBlack, 2);
+    // A title wider than the figure is set smaller (down to the size of a
+    // panel's title) rather than cut at both ends.
+    double scale = 0.7;
+    while (scale > 0.5 && TextSize(title, scale, 2).width > img.cols - 16) scale -= 0.025;
+    const cv::Size sz = TextSize(title, scale, 2);
+    PutText(img, title, {std::max(4, img.cols / 2 - sz.width / 2), 24}, scale, kBlack, 2);
   }
   for (int r = 0; r < rows_; ++r) {
     for (int c = 0; c < cols_; ++c) {
-      RenderAxes(img, axes_[r * cols_ + c], cv::Rect(c * panel_w_, title_h + r * panel_h_, panel_w_, panel_h_));
+      RenderAxes(img, axes_[r * cols_ + c], cv::Rect(c * panel_w_, title_h + r * panel_h_, panel_w_, panel_h_),
+                 r * cols_ + c, labels);
     }
   }
   std::vector<unsigned char> png;

@@ -2,7 +2,11 @@
 # runs the tool and checks its exit code, its stderr and the row's checks;
 # reports every row that fails, then fails if any did.
 #   cmake -DSRC=<source tree> -DBIN=<folder of the tools> -DWORK=<scratch folder>
-#         -DTABLE=<checklist> [-DONLY=<row name regex>] -P first_hour_checklist.cmake
+#         -DTABLE=<checklist> [-DONLY=<row name regex>]
+#         [-DPYTHON=<interpreter> -DPYTHONPATH=<folder of the robomach module>]
+#         -P first_hour_checklist.cmake
+# A row whose tool is `python` runs PYTHON with PYTHONPATH; without them
+# (no Python module built) such rows are skipped and listed.
 # The inputs are made here from shipped files, so the test needs nothing
 # outside the source tree.
 cmake_minimum_required(VERSION 3.16)  # CMP0053: "@SRC@" below is literal text
@@ -33,6 +37,17 @@ file(WRITE ${WORK}/rad_as_deg.csv
 file(WRITE ${WORK}/deg_as_rad.csv
      "pose_id,q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad\nP1,0,-90,90,0,45,0\n")
 
+# Python: the demo posture in degrees passed where radians are expected;
+# the glog level the module leaves (Ceres's log lines silenced).
+file(WRITE ${WORK}/evaluate_degrees.py
+     "import sys, numpy, robomach\n"
+     "model = robomach.RobotConfig(sys.argv[1]).build()\n"
+     "robomach.PostureEvaluator(model).evaluate(numpy.array([0.0, -90, 90, 0, 45, 0]))\n")
+file(WRITE ${WORK}/glog_level.py
+     "import ctypes, robomach\n"
+     "path = next(l.split()[-1] for l in open('/proc/self/maps') if 'libglog' in l)\n"
+     "print('minloglevel', ctypes.c_int.in_dll(ctypes.CDLL(path), '_ZN3fLI17FLAGS_minloglevelE').value)\n")
+
 file(STRINGS ${TABLE} lines ENCODING UTF-8)
 set(failed "")
 set(count 0)
@@ -57,6 +72,16 @@ foreach(line IN LISTS lines)
   math(EXPR count "${count} + 1")
   separate_arguments(args UNIX_COMMAND "${command}")
   list(POP_FRONT args tool)
+  if(tool STREQUAL "python")
+    if(NOT PYTHON OR NOT PYTHONPATH)
+      message(STATUS "skip ${name}: no Python module (python rows need -DPYTHON and -DPYTHONPATH)")
+      math(EXPR count "${count} - 1")
+      continue()
+    endif()
+    set(exe ${CMAKE_COMMAND} -E env --unset=GLOG_minloglevel PYTHONPATH=${PYTHONPATH} ${PYTHON})
+  else()
+    set(exe ${BIN}/${tool})
+  endif()
   set(problems "")
   string(REPLACE "," ";" checks "${checks}")
   foreach(c IN LISTS checks)
@@ -64,7 +89,7 @@ foreach(line IN LISTS lines)
       file(REMOVE ${CMAKE_MATCH_1})
     endif()
   endforeach()
-  execute_process(COMMAND ${BIN}/${tool} ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err
+  execute_process(COMMAND ${exe} ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err
                   TIMEOUT 300)
   if(NOT rc STREQUAL rc_expected)
     list(APPEND problems "exit code ${rc}, expected ${rc_expected}")
@@ -86,6 +111,23 @@ foreach(line IN LISTS lines)
     elseif(c MATCHES "^no=(.+)$")
       if(EXISTS ${CMAKE_MATCH_1})
         list(APPEND problems "${CMAKE_MATCH_1} was written")
+      endif()
+    elseif(c MATCHES "^file=([^~]+)~(.+)$")
+      # file=PATH~REGEX: the file exists and its text matches (. matches
+      # newlines in CMake's regex, so A.*B checks that A comes before B).
+      set(f "${CMAKE_MATCH_1}")
+      set(want "${CMAKE_MATCH_2}")
+      if(NOT EXISTS ${f})
+        list(APPEND problems "${f} was not written")
+      else()
+        file(READ ${f} text)
+        if(NOT text MATCHES "${want}")
+          list(APPEND problems "${f} does not match '${want}'")
+        endif()
+      endif()
+    elseif(c MATCHES "^stderr_not=(.+)$")
+      if(err MATCHES "${CMAKE_MATCH_1}")
+        list(APPEND problems "stderr matches '${CMAKE_MATCH_1}'")
       endif()
     elseif(c STREQUAL "short_numbers")
       if(err MATCHES "[0-9]\\.[0-9][0-9][0-9][0-9][0-9][0-9][0-9][0-9][0-9]")

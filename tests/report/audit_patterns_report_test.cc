@@ -116,5 +116,18 @@ TEST(AuditPatternsReport, CsvRowsAndPngs) {
   EXPECT_NE(r.html.find("mode_error_map.png"), std::string::npos);
 }
 
+// trends.png draws only descriptors that vary over the postures (issue #35:
+// ten near-identical panels): reach has no spread here (r undefined), so
+// one row with q2; no candidate, so one column (620 x 300 px + the title).
+TEST(AuditPatternsReport, TrendsPngDrawsOnlyDescriptorsThatVary) {
+  const AuditPatternsReport r = MakeAuditPatternsReport(Sample(), 0.05, "test");
+  EXPECT_EQ(r.trends_png_descriptors, std::vector<std::string>{"q2"});
+  const cv::Mat img = cv::imdecode(r.trends_png, cv::IMREAD_COLOR);
+  EXPECT_EQ(img.cols, 620);
+  EXPECT_EQ(img.rows, 300 + 34);
+  EXPECT_NE(r.html.find("against q2 (the strongest correlations; the table has them all)"), std::string::npos)
+      << r.html;
+}
+
 }  // namespace
 }  // namespace robomach::report

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "robomach/report/frf_plot.h"
@@ -38,6 +39,109 @@ TEST(Figure, WritesADecodablePngOfTheRequestedSize) {
   EXPECT_EQ(img.rows, 2 * 300 + 34);
   cv::Scalar mean = cv::mean(img);
   EXPECT_LT(mean[0], 254.0);  // something was drawn
+}
+
+
+// Coloured pixels in a box of the image: a curve (Okabe-Ito colours, their
+// antialiased edges blended with white) has channels that differ by tens;
+// the grey labels, grey marker lines, black text and the light grey grid
+// have r = g = b. A spread of 25 is far above the 0-1 of a grey pixel and
+// below the ~40 that a curve's edge pixel still has at a quarter of its colour.
+int ColouredPixels(const cv::Mat& img, const PlacedLabel& l) {
+  int n = 0;
+  for (int y = l.y; y < l.y + l.height; ++y) {
+    for (int x = l.x; x < l.x + l.width; ++x) {
+      const cv::Vec3b p = img.at<cv::Vec3b>(y, x);
+      const int hi = std::max({p[0], p[1], p[2]}), lo = std::min({p[0], p[1], p[2]});
+      n += hi - lo > 25;
+    }
+  }
+  return n;
+}
+
+// Three direct FRFs with the modes of frf-predict's posture P3 (issue #35:
+// labels overlapped there, and on model-audit's worst FRF "10.4 Hz" read
+// "1.4 Hz" under a curve): two modes 0.4 Hz apart near 10 Hz, peaks that
+// reach the top of the panel under the labels' old fixed rows.
+FrfCurve ThreeModeCurve(const std::string& label, int colour, const std::vector<double>& f_hz,
+                        const std::vector<double>& k_N_per_m) {
+  FrfCurve c;
+  c.freq_hz = Eigen::VectorXd::LinSpaced(2000, 0.5, 500.0);
+  c.receptance = Eigen::VectorXcd::Zero(c.freq_hz.size());
+  for (size_t m = 0; m < f_hz.size(); ++m) {
+    const Eigen::ArrayXd r = c.freq_hz.array() / f_hz[m];
+    c.receptance.array() += (1.0 / k_N_per_m[m]) / (1.0 - r.square() + std::complex<double>(0, 0.04) * r);
+  }
+  c.label = label;
+  c.color = PaletteColor(colour);
+  return c;
+}
+
+std::vector<FrfCurve> P3LikeCurves() {
+  return {ThreeModeCurve("Hxx", 0, {10.5, 39.1, 88.7}, {5e6, 4e6, 5e6}),
+          ThreeModeCurve("Hyy", 1, {10.1, 53.3, 250.9}, {1.5e6, 3e6, 8e7}),
+          ThreeModeCurve("Hzz", 2, {10.1, 39.1}, {2e6, 2e6})};
+}
+
+TEST(Figure, MarkerLabelsCrossNoCurveNoOtherLabelAndNoOtherMarkerLine) {
+  const std::vector<double> modes_hz = {10.1, 10.5, 39.1, 53.3, 88.7, 250.9};
+  for (const auto [w, h] : {std::pair{760, 380}, std::pair{600, 300}, std::pair{900, 380}}) {
+    Figure fig(1, 2, w, h);
+    FillFrfPanels(P3LikeCurves(), modes_hz, "P3", &fig.at(0, 0), &fig.at(0, 1));
+    std::vector<PlacedLabel> labels;
+    const cv::Mat img = cv::imdecode(fig.EncodePng(&labels), cv::IMREAD_COLOR);
+    ASSERT_FALSE(img.empty());
+    // Every mode labelled once, in the magnitude panel (the phase panel's
+    // markers carry no text).
+    ASSERT_EQ(labels.size(), modes_hz.size()) << w << "x" << h;
+    PlacedLabel whole_panel;
+    whole_panel.width = w, whole_panel.height = h;
+    ASSERT_GT(ColouredPixels(img, whole_panel), 1000) << "the check sees the curves";
+    for (size_t i = 0; i < labels.size(); ++i) {
+      const PlacedLabel& a = labels[i];
+      SCOPED_TRACE(a.text + " in " + std::to_string(w) + "x" + std::to_string(h));
+      EXPECT_EQ(a.panel, 0);
+      EXPECT_TRUE(a.clear);
+      EXPECT_EQ(ColouredPixels(img, a), 0) << "a curve crosses the label's box";
+      // Beside its own line, 3 px away, left or right.
+      EXPECT_TRUE(a.x == a.line_x + 3 || a.x + a.width == a.line_x - 3) << a.x << " " << a.line_x;
+      for (size_t j = 0; j < labels.size(); ++j) {
+        if (j == i) continue;
+        const PlacedLabel& b = labels[j];
+        const cv::Rect ra(a.x, a.y, a.width, a.height), rb(b.x, b.y, b.width, b.height);
+        EXPECT_TRUE((ra & rb).empty()) << "overlaps " << b.text;
+        // Another mode's line may cross the label only where the lines are
+        // closer than a label is wide (53.3 and 88.7 Hz are 49 px apart on
+        // the 760 px panel, the label 55 px wide); then it is flagged and
+        // drawn on white. With 900 px there is room for every label.
+        if (b.line_x >= a.x && b.line_x < a.x + a.width) {
+          EXPECT_TRUE(a.over_marker_line) << "crosses the line of " << b.text << " unflagged";
+          EXPECT_NE(w, 900) << "crosses the line of " << b.text;
+        }
+      }
+    }
+  }
+}
+
+// A panel filled by a curve has no clear place: the label is still drawn,
+// flagged, on a white ground that no curve crosses.
+TEST(Figure, LabelWithoutAClearPlaceIsFlaggedAndDrawnOnWhite) {
+  Figure fig(1, 1, 500, 300);
+  Axes& ax = fig.at(0, 0);
+  Series zigzag;
+  zigzag.color = PaletteColor(0);
+  zigzag.thickness = 3;
+  for (int i = 0; i <= 400; ++i) {
+    zigzag.x.push_back(i);
+    zigzag.y.push_back(i % 2);
+  }
+  ax.series.push_back(zigzag);
+  ax.markers.push_back({200.0, "123.4 Hz"});
+  std::vector<PlacedLabel> labels;
+  const cv::Mat img = cv::imdecode(fig.EncodePng(&labels), cv::IMREAD_COLOR);
+  ASSERT_EQ(labels.size(), 1u);
+  EXPECT_FALSE(labels[0].clear);
+  EXPECT_EQ(ColouredPixels(img, labels[0]), 0);
 }
 
 }  // namespace

@@ -39,7 +39,12 @@ struct AuditPatternsReport {
   std::string mode_errors_csv;
   std::string posture_descriptors_csv;
   std::string unmatched_modes_csv;
+  /// The error per posture against the descriptors with the strongest
+  /// correlation (at most 4; significant ones first; those that do not vary
+  /// over the postures never), before and, with an accepted candidate,
+  /// after it, each panel on its own error scale with its least-squares line.
   std::vector<unsigned char> trends_png;
+  std::vector<std::string> trends_png_descriptors;  // the descriptors drawn, top to bottom
   /// Empty if no mode was matched anywhere (nothing to map).
   std::vector<unsigned char> mode_error_map_png;
   /// index.html sections (<h2> …), self-contained but for the PNGs above.

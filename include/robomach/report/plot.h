@@ -51,6 +51,24 @@ struct Axes {
   LegendPosition legend{LegendPosition::kTopRight};
 };
 
+/// Where a marker's label was drawn, in pixels of the PNG (origin top left).
+/// Labels go beside their marker line, left or right of it, where their box
+/// crosses no curve, no legend and no other label, and, where there is room,
+/// no other marker line (see over_marker_line).
+struct PlacedLabel {
+  int panel{0};             // row * cols + col
+  std::string text;
+  double marker_x{0.0};     // the marker's x, in data units
+  int x{0}, y{0}, width{0}, height{0};  // the label's box [px]
+  int line_x{0};            // the marker line's pixel column
+  /// false: no clear place in the panel; the label is drawn on a white box
+  /// over the curves (it hides a piece of a curve rather than being crossed).
+  bool clear{true};
+  /// true: marker lines closer than the label is wide; the box crosses
+  /// another marker line and is drawn on a white ground that interrupts it.
+  bool over_marker_line{false};
+};
+
 /// A figure of rows × cols panels rendered to PNG.
 class Figure {
  public:
@@ -60,8 +78,9 @@ class Figure {
   /// Renders and writes atomically (formats.md §4).
   /// @throws OutputError if the file cannot be written.
   void SavePng(const std::string& path) const;
-  /// Encoded PNG bytes.
-  std::vector<unsigned char> EncodePng() const;
+  /// Encoded PNG bytes; `labels`, if given, receives where each marker
+  /// label was drawn (for tests and callers that annotate further).
+  std::vector<unsigned char> EncodePng(std::vector<PlacedLabel>* labels = nullptr) const;
 
  private:
   int rows_, cols_, panel_w_, panel_h_;
