@@ -14,9 +14,9 @@ constexpr double kOneTurn = 2.0 * kPi;
 
 std::string ImplausibleMessage(const YamlDoc& node, const std::string& value, const PlausibleRange& r, bool low) {
   // The value as typed; the limits in plain digits (100000, not 1e+05).
-  return "implausible (unit mistake?): " + node.location().ToString() + ": " + node.key_path() + " " + value + " " +
-         r.unit + " is outside the " + FormatNumber(r.lo, 7) + " to " + FormatNumber(r.hi, 7) + " " + r.unit +
-         " of " + r.practice + ": " + (low ? r.low_hint : r.high_hint);
+  const std::string unit = r.unit.empty() ? "" : " " + r.unit;
+  return "implausible (unit mistake?): " + node.location().ToString() + ": " + node.key_path() + " " + value + unit +
+         " is outside the " + FormatNumber(r.lo, 7) + " to " + FormatNumber(r.hi, 7) + unit + " of " + r.practice + ": " + (low ? r.low_hint : r.high_hint);
 }
 
 void CheckPlausible(const YamlDoc& node, double v, const PlausibleRange& r, std::vector<std::string>* out) {

@@ -17,6 +17,9 @@
 
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
+#include "robomach/io/cut_file.h"
+#include "robomach/io/drilling_files.h"
+#include "robomach/io/polishing_files.h"
 #include "robomach/io/robot_config.h"
 #include "test_support.h"
 
@@ -45,6 +48,15 @@ struct NamedReader {
 const std::vector<NamedReader>& Readers() {
   static const std::vector<NamedReader> readers = {
       {"robot_config", [](const std::string& p) { return LoadRobotConfig(p).implausible; }},
+      {"flexible_robot", [](const std::string& p) { return ReadFlexibleRobotFile(p).implausible; }},
+      {"drill_file", [](const std::string& p) { return ReadDrillFile(p).implausible; }},
+      {"cut_file", [](const std::string& p) { return ReadCutFile(p).implausible; }},
+      {"polish_process",
+       [](const std::string& p) {
+         std::vector<std::string> w;
+         ReadPolishingProcess(p, &w);
+         return w;
+       }},
   };
   return readers;
 }
@@ -89,6 +101,30 @@ const std::vector<WrongUnitCase>& Cases() {
       {"robot_config", "config/kr210.yaml", "d6_m", 0, 1000, Expect::kRefused, "a value in mm typed in the m field"},
       {"robot_config", "config/kr210_dh.yaml", "a_prev_m", 1, 1000, Expect::kFlagged, "a_prev_m 330 m .*a length in mm typed in the m field"},
       {"robot_config", "config/kr210_dh.yaml", "d_m", 0, 1000, Expect::kFlagged, "d_m -645 m .*a length in mm typed in the m field"},
+      // drill-sim's flexible-joint robot (config/drilling/planar3r.yaml)
+      {"flexible_robot", "config/drilling/planar3r.yaml", "mass_kg", 0, 1000, Expect::kFlagged, "mass_kg 6000 kg .*a mass in g typed in the kg field"},
+      {"flexible_robot", "config/drilling/planar3r.yaml", "a_prev_m", 1, 1000, Expect::kFlagged, "a_prev_m 600 m .*a length in mm typed in the m field"},
+      {"flexible_robot", "config/drilling/planar3r.yaml", "stiffness_Nm_per_rad", -1, 1e-3, Expect::kFlagged, "stiffness_Nm_per_rad 60 N·m/rad .*a stiffness in kN·m/rad"},
+      {"flexible_robot", "config/drilling/planar3r.yaml", "rotor_inertia_kgm2", 0, 1e4, Expect::kFlagged, "rotor_inertia_kgm2 1.98 kg·m² .*kg·cm²"},
+      {"flexible_robot", "config/drilling/planar3r.yaml", "alpha_prev_deg|base_rpy_deg|tip_rpy_deg", -1, kRadPerDeg, Expect::kFlagged, "radians typed in _deg fields"},
+      // drill file (config/drilling/drill_5mm.yaml)
+      {"drill_file", "config/drilling/drill_5mm.yaml", "point_angle_deg", 0, kRadPerDeg, Expect::kRefused, "point_angle_deg: expected an angle in \\(60, 180\\) deg, got 2.0594.*radians typed in a _deg field"},
+      {"drill_file", "config/drilling/drill_5mm.yaml", "initial_posture_deg", 0, kRadPerDeg, Expect::kFlagged, "initial_posture_deg.*radians typed in _deg fields"},
+      // cut file (config/cut_demo.yaml; checks of commit 648cfe0)
+      {"cut_file", "config/cut_demo.yaml", "diameter_mm", 0, 1000, Expect::kFlagged, "diameter_mm 20000 mm .*a diameter in um"},
+      {"cut_file", "config/cut_demo.yaml", "diameter_mm", 0, 1e-3, Expect::kFlagged, "diameter_mm 0.02 mm .*a diameter in m"},
+      {"cut_file", "config/cut_demo.yaml", "ktc_N_per_mm2", 0, 1000, Expect::kFlagged, "ktc_N_per_mm2 .*N/m² \\(Pa\\) or kN/m²"},
+      {"cut_file", "config/cut_demo.yaml", "ktc_N_per_mm2", 0, 1e-3, Expect::kFlagged, "ktc_N_per_mm2 .*kN/mm²"},
+      // polishing process (config/polishing/belt_2N.yaml)
+      {"polish_process", "config/polishing/belt_2N.yaml", "force_N", 0, 1e-3, Expect::kFlagged, "force_N 0.002 N .*a force in kN typed in the N field"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "force_N", 0, 1e4, Expect::kFlagged, "force_N 20000 N .*a force in mN"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "wheel_radius_mm", 0, 1e-3, Expect::kFlagged, "wheel_radius_mm 0.05 mm .*a length in m typed in the mm field"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "belt_width_mm", 0, 1000, Expect::kFlagged, "belt_width_mm 20000 mm .*a length in um"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "pad_modulus_MPa", 0, 1000, Expect::kFlagged, "pad_modulus_MPa 10000 MPa .*kPa or Pa"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "belt_speed_m_per_s", 0, 1000, Expect::kFlagged, "belt_speed_m_per_s 3000 m/s .*mm/s"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "modulus_GPa", 0, 1000, Expect::kFlagged, "modulus_GPa 200000 GPa .*MPa or Pa"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "preston_coefficient_m2_per_N", 0, 1e6, Expect::kFlagged, "preston_coefficient_m2_per_N .*mm²/N"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "max_speed_mm_per_s", 0, 1e-3, Expect::kFlagged, "max_speed_mm_per_s 0.05 mm/s .*m/s typed in the mm/s field"},
       {"robot_config", "config/kr210_dh.yaml", "alpha_prev_deg|theta_offset_deg|lower_deg|upper_deg|base_rpy_deg|tip_rpy_deg", -1, kRadPerDeg, Expect::kRefused, "radians typed in _deg fields"},
   };
   return cases;
@@ -104,7 +140,8 @@ std::string Scaled(const std::string& text, const WrongUnitCase& c, const std::s
     key = m[1];
     element = std::stoi(m[2]);
   }
-  const std::regex line_re("^(\\s*-?\\s*(?:" + key + "):\\s*)(\\[[^\\]]*\\]|[-+0-9.eE]+)(.*)$");
+  // The key at the start of a line, or inside a flow map ({a: 1, key: 2}).
+  const std::regex line_re("^(.*?(?:^|[\\s{,-])(?:" + key + "):\\s*)(\\[[^\\]]*\\]|[-+0-9.eE]+)(.*)$");
   std::istringstream in(text);
   std::string line, out;
   int seen = 0, changed = 0;
