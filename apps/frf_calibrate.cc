@@ -96,7 +96,7 @@ int Run(int argc, char** argv) {
     opt.modal_fit.fmin_hz = opt.fmin_hz;
     opt.modal_fit.fmax_hz = opt.fmax_hz;
 
-    io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
+    io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     ApplyAddsAndSets(adds, sets, &cfg);
     for (const std::string& name : opt.free_parameters) {
       if (!cfg.parameters.Has(name)) {
@@ -189,6 +189,7 @@ int Run(int argc, char** argv) {
     const calibration::CalibrationVerdict verdict = calibration::JudgeCalibration(result, measured, opt);
     std::vector<std::string> flags = measured_read.unit_findings;  // implausible units, warned when read
     flags.insert(flags.end(), holdout_read.unit_findings.begin(), holdout_read.unit_findings.end());
+    flags.insert(flags.end(), cfg.implausible.begin(), cfg.implausible.end());  // warned when read
     for (const std::string& w : posture_units) {
       Warn(kTool, w);
       flags.push_back(w);

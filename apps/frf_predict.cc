@@ -129,7 +129,7 @@ int Run(int argc, char** argv) {
       freq_hz = Eigen::VectorXd::LinSpaced(n, fmin_hz, fmin_hz + (n - 1) * df_hz);
     }
 
-    io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
+    io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     ApplyAddsAndSets(adds, sets, &cfg);
     if (verbose) {
       for (const auto& s : cfg.parameters.specs()) {
@@ -221,7 +221,7 @@ int Run(int argc, char** argv) {
             .SavePng((std::filesystem::path(plot_dir) / (preds[p].pose_id + ".png")).string());
       }
     }
-    return posture_units.empty() ? ExitCodeFor(result.status()) : kExitFlagged;
+    return posture_units.empty() && cfg.implausible.empty() ? ExitCodeFor(result.status()) : kExitFlagged;
   });
 }
 

@@ -105,7 +105,7 @@ int Run(int argc, char** argv) {
     for (const auto& [r, e] : FromOption("--directions", [&] { return io::ParseDirectionPairs(directions); })) {
       o.directions.emplace_back(static_cast<Axis>(r), static_cast<Axis>(e));
     }
-    io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
+    io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     ApplyAddsAndSets(adds, sets, &cfg);
     o.sample_rate_hz = std::isfinite(fs_hz) ? fs_hz : calibration::ConfiguredSampleRateHz(cfg.description);
     calibration::CheckValid(o);
@@ -175,7 +175,7 @@ int Run(int argc, char** argv) {
         << " lines to " << out_path << '\n';
     std::cerr << msg.str();
     for (const std::string& w : implausible) Warn(kTool, w);
-    return implausible.empty() && posture_units.empty() ? kExitOk : kExitFlagged;
+    return implausible.empty() && posture_units.empty() && cfg.implausible.empty() ? kExitOk : kExitFlagged;
   });
 }
 

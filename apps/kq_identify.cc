@@ -238,13 +238,14 @@ int Run(int argc, char** argv) {
     CheckDistinctPaths({{"--robot", robot_path}, {"--tracker", tracker_path}},
                        {{"--out", out_path}, {"--residuals", residuals_path}, {"--plot", plot_path},
                         {"--summary", json_path}});
-    const io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
+    const io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     if (plan_n != 0) {
       if (plan_n < 1) throw UsageError("--plan: expected a number of postures >= 1");
       if (merge) throw UsageError("--merge cannot be combined with --plan");
-      return RunPlan(cfg, plan_n, noise_mm, seed, ParsePointMm("--load-point-mm", load_point),
-                     ParsePointMm("--target-mm", target), ParsePositiveList("--masses-kg", masses), rope_angle_deg,
-                     out_path);
+      const int rc = RunPlan(cfg, plan_n, noise_mm, seed, ParsePointMm("--load-point-mm", load_point),
+                             ParsePointMm("--target-mm", target), ParsePositiveList("--masses-kg", masses),
+                             rope_angle_deg, out_path);
+      return rc == kExitOk && !cfg.implausible.empty() ? kExitFlagged : rc;
     }
     if (tracker_path.empty()) throw UsageError("--tracker is required (or --plan N)");
     if (merge && out_path.empty()) throw UsageError("--merge needs --out for the merged config");
@@ -300,7 +301,7 @@ int Run(int argc, char** argv) {
     }
     if (!json_path.empty()) io::WriteFileAtomically(json_path, report::DumpJson(io::KqSummaryJson(r)));
     PrintReport(r, std::cerr);
-    return r.flagged() ? kExitFlagged : kExitOk;
+    return r.flagged() || !cfg.implausible.empty() ? kExitFlagged : kExitOk;
   });
 }
 

@@ -158,7 +158,7 @@ int Run(int argc, char** argv) {
     json previous;
     if (!compare_dir.empty()) previous = ReadPreviousSummary(compare_dir);
 
-    io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
+    io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     for (const std::string& name : adds) {
       std::tie(cfg.description, cfg.parameters) =
           FromOption("--add " + name, [&] { return audit::WithEffect(cfg.description, cfg.parameters, name); });
@@ -269,7 +269,8 @@ int Run(int argc, char** argv) {
     io::WriteFileAtomically("-", yaml);
     if (summary_path == "-") io::WriteFileAtomically("-", report::DumpJson(j));
     // measured_read.unit_findings: receptances outside the plausible range, warned when read.
-    return verdict.flagged() || !measured_read.unit_findings.empty() ? kExitFlagged : kExitOk;
+    return verdict.flagged() || !measured_read.unit_findings.empty() || !cfg.implausible.empty() ? kExitFlagged
+                                                                                                  : kExitOk;
   });
 }
 

@@ -211,7 +211,9 @@ int Run(int argc, char** argv) {
     if (list_faces) return ListFaces(surface_path, process_path, list_out, choice, pattern, radius_mm, sample_mm, offset_mm,
                                      pitch_mm, row_step_mm);
     if (!list_out.empty()) throw UsageError("--out goes with --list-faces");
-    const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
+    std::vector<std::string> implausible;  // unit findings of the process file
+    const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path, &implausible);
+    for (const std::string& w : implausible) Warn(kTool, w);
     const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
     {
       polishing::PathParameters p;
@@ -248,7 +250,7 @@ int Run(int argc, char** argv) {
     params = outcome.params;
     const polishing::EvaluatedPlan& e = outcome.plan;
     for (const Finding& f : outcome.findings) Warn(kTool, f.message);
-    bool flagged = outcome.flagged();
+    bool flagged = outcome.flagged() || !implausible.empty();
     if (outcome.optimisation && outcome.optimisation->status == "max_time") {
       Note(kTool, "the optimiser stopped at --max-time-s " + io::FormatDouble(max_time_s) +
                       " before its local searches converged; the best plan so far is written");

@@ -70,7 +70,9 @@ int Run(int argc, char** argv) {
                        outs);
 
     const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
-    const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path);
+    std::vector<std::string> implausible;  // unit findings of the process file
+    const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path, &implausible);
+    for (const std::string& w : implausible) Warn(kTool, w);
     io::PolishSimulation sim =
         io::SimulatePolishPathFile(surface, process, path_in, MmToM(sample_mm), surface_path, process_path);
     io::PolishPathFile& file = sim.file;
@@ -78,7 +80,7 @@ int Run(int argc, char** argv) {
     const std::vector<double>& removal = sim.removal;
     const polishing::RemovalStats& stats = sim.stats;
     for (const Finding& f : sim.findings) Warn(kTool, f.message);
-    bool flagged = sim.flagged();
+    bool flagged = sim.flagged() || !implausible.empty();
     const std::string unpolished = polishing::DescribeUnpolished(stats, grid.region_area());
     if (!unpolished.empty()) Warn(kTool, unpolished);
     nlohmann::json summary = io::PolishSimSummaryJson(sim, process, sample_mm);

@@ -209,9 +209,12 @@ int Run(int argc, char** argv) {
     for (const std::string& w : cut.implausible) Warn(kTool, w);
 
     std::vector<stability::TipDynamics> tips;
+    bool config_implausible = false;
     const std::string axis_source = "--tool-axis " + tool_axis_text;
     if (!robot_path.empty()) {
-      tips = io::TipsFromRobotPostures(io::LoadRobotConfig(robot_path).Build(), postures_path, pose_ids, cut, Tell);
+      const io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
+      config_implausible = !cfg.implausible.empty();
+      tips = io::TipsFromRobotPostures(cfg.Build(), postures_path, pose_ids, cut, Tell);
     } else if (!frf_path.empty()) {
       stability::MeasuredTipOptions mo;
       mo.frf_path = frf_path;
@@ -296,7 +299,7 @@ int Run(int argc, char** argv) {
       io::WriteModalTableCsv(modes_out_path, ids, modes);
     }
     if (!fit_plot_path.empty()) PlotFits(fit_plot_path, frf_path, tips);
-    const bool flagged = lobes.flagged() || !cut.implausible.empty();
+    const bool flagged = lobes.flagged() || !cut.implausible.empty() || config_implausible;
     if (!summary_path.empty()) {
       nlohmann::json j = io::LobesSummaryJson(tips, lobes);
       j["tool"] = kTool;

@@ -72,8 +72,10 @@ int Run(int argc, char** argv) {
     CheckDistinctPaths({{"--robot", robot_path}, {"--cut", cut_path}, {"--region", region_path}, {"--path", path_path}},
                        {{"--out", out_path}, {"--plot", plot_path}, {"--summary", summary_path}});
     if (!path_path.empty()) RequireReadableFile(path_path, "tool-path file");
-    const auto model = io::LoadRobotConfig(robot_path).Build();
+    const io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
+    const auto model = cfg.Build();
     const io::CutSpec cut = io::ReadCutFile(cut_path);
+    const bool implausible = !cut.implausible.empty() || !cfg.implausible.empty();
     for (const std::string& w : cut.implausible) Warn(kTool, w);
     const io::RegionSpec region = io::ReadRegionFile(region_path, model->num_joints());
 
@@ -147,11 +149,11 @@ int Run(int argc, char** argv) {
       if (!region_path.empty()) j["region"] = region_path;
       if (!path_path.empty()) j["path"] = path_path;
       j["points_csv"] = out_path.empty() ? "-" : out_path;
-      j["exit_code"] = cut.implausible.empty() ? ExitCodeFor(map.status()) : kExitFlagged;
+      j["exit_code"] = !implausible ? ExitCodeFor(map.status()) : kExitFlagged;
       io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }
     for (const Finding& f : map.findings) Warn(kTool, f.message);
-    return cut.implausible.empty() ? ExitCodeFor(map.status()) : kExitFlagged;
+    return !implausible ? ExitCodeFor(map.status()) : kExitFlagged;
   });
 }
 

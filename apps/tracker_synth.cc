@@ -25,6 +25,9 @@
 namespace robomach::apps {
 namespace {
 
+constexpr double kMinPlausibleTrackerNoiseMm = 1e-4;  // --noise-mm, flagged outside (0 allowed)
+constexpr double kMaxPlausibleTrackerNoiseMm = 1.0;
+
 constexpr char kTool[] = "tracker-synth";
 
 int Run(int argc, char** argv) {
@@ -89,7 +92,18 @@ int Run(int argc, char** argv) {
     if (!plan_path.empty() && !postures_path.empty()) {
       throw UsageError("--plan-file and --postures exclude each other");
     }
-    io::RobotConfig cfg = io::LoadRobotConfig(robot_path);
+    // Laser trackers measure to 0.005 - 0.05 mm (1 sigma, Leica AT960 and
+    // API Radian data sheets): a noise over 1 mm is um typed in the mm
+    // option, one under 0.1 um is m (docs/plausibility.md).
+    std::vector<std::string> implausible;
+    if (noise_mm > kMaxPlausibleTrackerNoiseMm || (noise_mm > 0.0 && noise_mm < kMinPlausibleTrackerNoiseMm)) {
+      implausible.push_back("implausible (unit mistake?): --noise-mm " + io::FormatDouble(noise_mm) +
+                            " is outside the 0.0001 to 1 mm of laser trackers (0.005 to 0.05 mm): " +
+                            (noise_mm > kMaxPlausibleTrackerNoiseMm ? "a noise in um typed in the mm option?"
+                                                                    : "a noise in m typed in the mm option?"));
+    }
+    for (const std::string& w : implausible) Warn(kTool, w);
+    io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     for (const std::string& s : sets) {
       const auto [name, value] = ParseAssignment("--set", s);
       cfg.parameters.Set(name, value);
@@ -205,7 +219,7 @@ int Run(int argc, char** argv) {
     std::cerr << kTool << ": " << ms.size() << " load cases (" << ids.size() << " postures x "
               << (plan_pulleys.empty() ? o.pulleys.size() : plan_pulleys[0].size()) << " rope directions x " << o.masses_kg.size() << " masses)"
               << (bad.empty() ? "" : "; outliers: " + bad_ids) << "\n";
-    return kExitOk;
+    return cfg.implausible.empty() && implausible.empty() ? kExitOk : kExitFlagged;
   });
 }
 

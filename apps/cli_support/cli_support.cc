@@ -145,6 +145,12 @@ void Warn(const std::string& tool, const std::string& message) {
   WarningsList().push_back(message);
 }
 
+io::RobotConfig LoadRobotConfigWarned(const std::string& tool, const std::string& path) {
+  io::RobotConfig cfg = io::LoadRobotConfig(path);
+  for (const std::string& w : cfg.implausible) Warn(tool, w);
+  return cfg;
+}
+
 std::vector<std::string> WarningsGiven() {
   std::lock_guard<std::mutex> lock(WarningsMutex());
   return WarningsList();

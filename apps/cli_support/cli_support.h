@@ -124,6 +124,10 @@ void Warn(const std::string& tool, const std::string& message);
 /// put them in their summary and report (every warning a tool prints is
 /// also there).
 std::vector<std::string> WarningsGiven();
+/// LoadRobotConfig with its unit findings (RobotConfig::implausible,
+/// docs/plausibility.md) given to Warn(): the tool flags its result (exit 3)
+/// when the returned config's `implausible` is not empty.
+io::RobotConfig LoadRobotConfigWarned(const std::string& tool, const std::string& path);
 /// "tool: note: message" on stderr: what a reader inferred or skipped; not
 /// a warning, and no reason for exit 3.
 void Note(const std::string& tool, const std::string& message);

@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "plausible.h"
 #include "robomach/common/solver_status.h"
 #include "robomach/common/units.h"
 #include "robomach/drilling/plausibility.h"
@@ -123,11 +124,12 @@ DrillFile ReadDrillFile(const std::string& path) {
   const YamlDoc d = doc["drill"];
   g.diameter = MmToM(d["diameter_mm"].PositiveNumber());
   g.lips = d["lips"].IntInRange(1, 8);
-  g.point_angle = DegToRad(d["point_angle_deg"].NumberInRange(60.0, 180.0, false, false));
-  g.helix_angle = DegToRad(d["helix_angle_deg"].NumberInRange(0.0, 60.0, true, false));
+  // A refused angle says when it is an angle of the range in radians.
+  g.point_angle = DegToRad(DegreesInRange(d["point_angle_deg"], 60.0, 180.0, false, false));
+  g.helix_angle = DegToRad(DegreesInRange(d["helix_angle_deg"], 0.0, 60.0, true, false));
   g.web_thickness_ratio = d["web_thickness_ratio"].NumberInRange(0.0, 0.5, true, false);
-  g.chisel_edge_angle = DegToRad(d["chisel_edge_angle_deg"].NumberInRange(90.0, 180.0, false, false));
-  g.lip_relief_angle = DegToRad(d["lip_relief_angle_deg"].NumberInRange(0.0, 45.0, true, false));
+  g.chisel_edge_angle = DegToRad(DegreesInRange(d["chisel_edge_angle_deg"], 90.0, 180.0, false, false));
+  g.lip_relief_angle = DegToRad(DegreesInRange(d["lip_relief_angle_deg"], 0.0, 45.0, true, false));
   d.RejectUnknownKeys();
   try {
     drilling::CheckValid(g);
@@ -144,6 +146,9 @@ DrillFile ReadDrillFile(const std::string& path) {
     const YamlDoc q0 = pr["initial_posture_deg"];
     const auto q = q0.Numbers();
     if (q.empty()) throw q0.Error("expected one angle per joint");
+    std::vector<TypedAngle> angles;
+    for (size_t j = 0; j < q.size(); ++j) angles.push_back({q0.at(static_cast<int>(j)), q[j]});
+    CheckDegreesNotRadians(angles, &out.implausible);
     p.initial_posture.resize(static_cast<int>(q.size()));
     for (size_t j = 0; j < q.size(); ++j) p.initial_posture(j) = DegToRad(q[j]);
     out.initial_posture_at = q0.location();
@@ -267,7 +272,7 @@ FlexibleRobotFile ReadFlexibleRobotFile(const std::string& path) {
   if (!doc.IsMap()) throw doc.Error("expected a robot config (a YAML map)");
   FlexibleRobotFile out;
   out.path = path;
-  out.chain = ReadRobotChain(doc["robot"], path);
+  out.chain = ReadRobotChain(doc["robot"], path, &out.implausible);
   const int n = out.chain.num_joints();
   const auto& names = out.chain.joint_names();
   const YamlDoc list = doc["flexible_joints"];
@@ -294,14 +299,29 @@ FlexibleRobotFile ReadFlexibleRobotFile(const std::string& path) {
     const YamlDoc k = e["stiffness_Nm_per_rad"];
     d.stiffness = k.Number();
     if (!(d.stiffness > 0.0)) throw k.Error("expected a joint stiffness > 0, got " + FormatDouble(d.stiffness));
+    CheckPlausible(k, d.stiffness,
+                   {kMinPlausibleJointStiffnessNmPerRad, kMaxPlausibleJointStiffnessNmPerRad, "N·m/rad",
+                    "robot joints (1e3 for a small wrist to 1e7 for a heavy robot's base)",
+                    "a stiffness in kN·m/rad typed in the N·m/rad field?",
+                    "a stiffness in N·mm/rad typed in the N·m/rad field?"},
+                   &out.implausible);
     const YamlDoc g = e["gear_ratio"];
     d.gear_ratio = g.Number();
     if (!(d.gear_ratio > 0.0)) throw g.Error("expected a gear ratio > 0, got " + FormatDouble(d.gear_ratio));
+    CheckPlausible(g, d.gear_ratio,
+                   {kMinPlausibleGearRatio, kMaxPlausibleGearRatio, "", "robot gearboxes (30 to 300)",
+                    "the inverse ratio (output/input) typed?", "a typo (an extra zero)?"},
+                   &out.implausible);
     const YamlDoc jm = e["rotor_inertia_kgm2"];
     d.rotor_inertia = jm.Number();
     if (!(d.rotor_inertia > 0.0)) {
       throw jm.Error("expected a rotor inertia > 0, got " + FormatDouble(d.rotor_inertia));
     }
+    CheckPlausible(jm, d.rotor_inertia,
+                   {kMinPlausibleRotorInertiaKgM2, kMaxPlausibleRotorInertiaKgM2, "kg·m²",
+                    "servo motor rotors (1e-6 to 1e-2 kg·m²)", "a value in t·m² or kg·km²? (x1e-3)",
+                    "a value in kg·cm² (x1e4) or g·cm² (x1e7) typed in the kg·m² field?"},
+                   &out.implausible);
     if (e.Has("damping_Nms_per_rad")) {
       const YamlDoc c = e["damping_Nms_per_rad"];
       d.damping = c.Number();

@@ -34,6 +34,13 @@ DrillingSetup LoadDrillingSetup(const std::string& robot_path, const std::string
                      "(--motor-torque-limit-Nm)");
   }
   s.unit_findings = drilling::ToolingFindings(s.drill.drill, &s.drill.process);
+  // The readers' own findings carry the prefix the verdict adds again.
+  for (const auto* list : {&s.robot_file.implausible, &s.drill.implausible}) {
+    for (const std::string& f : *list) {
+      const std::string prefix = "implausible (unit mistake?): ";
+      s.unit_findings.push_back(f.rfind(prefix, 0) == 0 ? f.substr(prefix.size()) : f);
+    }
+  }
   for (const std::string& f : drilling::MaterialFindings(s.material)) s.unit_findings.push_back(material_path + ": " + f);
   return s;
 }

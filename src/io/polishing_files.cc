@@ -1,5 +1,7 @@
 #include "robomach/io/polishing_files.h"
 
+#include "plausible.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -87,24 +89,51 @@ polishing::NurbsSurface ReadNurbsYaml(const std::string& path) {
   }
 }
 
-polishing::PolishingProcess ReadPolishingProcess(const std::string& path) {
+polishing::PolishingProcess ReadPolishingProcess(const std::string& path, std::vector<std::string>* implausible) {
   const YamlDoc doc = YamlDoc::LoadFile(path);
   polishing::PolishingProcess p;
   const YamlDoc tool = doc["tool"], work = doc["workpiece"], proc = doc["process"];
-  p.wheel_radius = MmToM(tool["wheel_radius_mm"].PositiveNumber());
-  p.crown_radius = MmToM(tool["crown_radius_mm"].PositiveNumber());
-  p.belt_width = MmToM(tool["belt_width_mm"].PositiveNumber());
-  p.pad_modulus = tool["pad_modulus_MPa"].PositiveNumber() * 1e6;
+  // A positive value checked against its plausible range (plausibility.md).
+  const auto value = [&](const YamlDoc& node, const PlausibleRange& r) {
+    const double v = node.PositiveNumber();
+    CheckPlausible(node, v, r, implausible);
+    return v;
+  };
+  const std::string m_in_mm = "a length in m typed in the mm field?", um_in_mm = "a length in um typed in the mm field?";
+  p.wheel_radius = MmToM(value(tool["wheel_radius_mm"], {kMinPlausibleWheelRadiusMm, kMaxPlausibleWheelRadiusMm,
+                                                         "mm", "contact wheels (25 to 250 mm)", m_in_mm, um_in_mm}));
+  p.crown_radius = MmToM(value(tool["crown_radius_mm"], {kMinPlausibleCrownRadiusMm, kMaxPlausibleCrownRadiusMm,
+                                                         "mm", "wheel crowns", m_in_mm, um_in_mm}));
+  p.belt_width = MmToM(value(tool["belt_width_mm"], {kMinPlausibleBeltWidthMm, kMaxPlausibleBeltWidthMm, "mm",
+                                                     "abrasive belts (10 to 300 mm)", m_in_mm, um_in_mm}));
+  p.pad_modulus = value(tool["pad_modulus_MPa"], {kMinPlausiblePadModulusMPa, kMaxPlausiblePadModulusMPa, "MPa",
+                                                  "pad rubbers (1 to 100 MPa)", "a modulus in GPa typed in the MPa field?",
+                                                  "a modulus in kPa or Pa typed in the MPa field?"}) *
+                  1e6;
   p.pad_poisson = tool["pad_poisson"].NumberInRange(0.0, 0.5, true, false);
-  p.belt_speed = tool["belt_speed_m_per_s"].PositiveNumber();
+  p.belt_speed = value(tool["belt_speed_m_per_s"],
+                       {kMinPlausibleBeltSpeedMPerS, kMaxPlausibleBeltSpeedMPerS, "m/s", "belt grinding (5 to 35 m/s)",
+                        "a speed in km/s?", "a speed in mm/s or m/min typed in the m/s field?"});
   tool.RejectUnknownKeys();
-  p.work_modulus = work["modulus_GPa"].PositiveNumber() * 1e9;
+  p.work_modulus = value(work["modulus_GPa"], {kMinPlausibleWorkModulusGPa, kMaxPlausibleWorkModulusGPa, "GPa",
+                                               "engineering solids (1 GPa polymers to 400 GPa carbides)",
+                                               "a modulus in TPa typed in the GPa field?",
+                                               "a modulus in MPa or Pa typed in the GPa field?"}) *
+                   1e9;
   p.work_poisson = work["poisson"].NumberInRange(0.0, 0.5, true, false);
-  p.preston_coefficient = work["preston_coefficient_m2_per_N"].PositiveNumber();
+  p.preston_coefficient = value(work["preston_coefficient_m2_per_N"],
+                                {kMinPlausiblePrestonM2PerN, kMaxPlausiblePrestonM2PerN, "m²/N",
+                                 "Preston coefficients (1e-14 to 1e-10 m²/N)", "a value in m²/kN or m²/MN?",
+                                 "a value in mm²/N (x1e6) typed in the m²/N field?"});
   work.RejectUnknownKeys();
-  p.force = proc["force_N"].PositiveNumber();
+  p.force = value(proc["force_N"], {kMinPlausiblePolishForceN, kMaxPlausiblePolishForceN, "N",
+                                    "robotic polishing contact forces (1 to 100 N)",
+                                    "a force in kN typed in the N field?", "a force in mN typed in the N field?"});
   p.margin = MmToM(proc["margin_mm"].NumberInRange(0.0, 1e6));
-  p.max_speed = MmToM(proc["max_speed_mm_per_s"].PositiveNumber());
+  p.max_speed = MmToM(value(proc["max_speed_mm_per_s"],
+                            {kMinPlausiblePolishSpeedMmPerS, kMaxPlausiblePolishSpeedMmPerS, "mm/s",
+                             "robot polishing feeds (5 to 200 mm/s)", "a speed in m/s typed in the mm/s field?",
+                             "a speed in mm/min or um/s typed in the mm/s field?"}));
   p.flip_normal = proc.Has("flip_normal") ? proc["flip_normal"].Bool() : false;
   proc.MarkUsed("flip_normal");
   proc.RejectUnknownKeys();

@@ -6,9 +6,12 @@
 #include <regex>
 #include <fstream>
 #include <sstream>
+#include <tuple>
 
+#include "plausible.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/effect.h"
+#include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/io/file_kind.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/urdf_loader.h"
@@ -33,15 +36,42 @@ Eigen::Matrix3d Inertia6(const YamlDoc& node) {
   return I;
 }
 
-Inertial ReadInertial(const YamlDoc& node) {
+const PlausibleRange& BodyMassRange() {
+  static const PlausibleRange r{0.0, kMaxPlausibleBodyMassKg, "kg",
+                                "robot links and end-effector bodies (a 1000 kg-payload robot's heaviest link is "
+                                "about 1 t)",
+                                "", "a mass in g typed in the kg field?"};
+  return r;
+}
+
+const PlausibleRange& LengthRange() {
+  static const PlausibleRange r{0.0, kMaxPlausibleRobotLengthM, "m",
+                                "robot geometry (the longest industrial arms reach 4 m)", "",
+                                "a length in mm typed in the m field?"};
+  return r;
+}
+
+// Each component of a length vector (com_m, tcp_m, xyz): |v| within LengthRange.
+void CheckLengths(const YamlDoc& node, const Eigen::Vector3d& v, std::vector<std::string>* implausible) {
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(v(i)) > kMaxPlausibleRobotLengthM) {
+      CheckPlausible(node.at(i), std::abs(v(i)), LengthRange(), implausible);
+      return;  // one finding per vector
+    }
+  }
+}
+
+Inertial ReadInertial(const YamlDoc& node, std::vector<std::string>* implausible) {
   Inertial b;
   {
     // A negative mass is reported on its own line, not on inertia_kgm2's.
     const YamlDoc m = node["mass_kg"];
     b.mass = m.Number();
     if (b.mass < 0.0) throw m.Error("expected a mass >= 0 kg, got " + m.String() + " (a link's mass cannot be negative)");
+    CheckPlausible(m, b.mass, BodyMassRange(), implausible);
   }
   b.com = Vec3(node["com_m"]);
+  CheckLengths(node["com_m"], b.com, implausible);
   const YamlDoc inertia = node["inertia_kgm2"];
   b.inertia_com = Inertia6(inertia);
   if (auto problem = kinematics::CheckInertial(b)) throw inertia.Error(*problem);
@@ -49,12 +79,19 @@ Inertial ReadInertial(const YamlDoc& node) {
 }
 
 Eigen::Isometry3d ReadPose(const YamlDoc& node, const std::string& xyz_key,
-                           const std::string& rpy_key) {
+                           const std::string& rpy_key, std::vector<TypedAngle>* angles,
+                           std::vector<std::string>* implausible) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  if (node.Has(xyz_key)) X.translation() = Vec3(node[xyz_key]);
-  else node.MarkUsed(xyz_key);
+  if (node.Has(xyz_key)) {
+    X.translation() = Vec3(node[xyz_key]);
+    CheckLengths(node[xyz_key], X.translation(), implausible);
+  } else {
+    node.MarkUsed(xyz_key);
+  }
   if (node.Has(rpy_key)) {
-    const Eigen::Vector3d rpy = Vec3(node[rpy_key]);
+    const YamlDoc rpy_node = node[rpy_key];
+    const Eigen::Vector3d rpy = Vec3(rpy_node);
+    for (int i = 0; i < 3; ++i) angles->push_back({rpy_node.at(i), rpy(i)});
     // URDF convention: fixed-axis roll, pitch, yaw: R = Rz(y) Ry(p) Rx(r).
     X.linear() = (Eigen::AngleAxisd(DegToRad(rpy(2)), Eigen::Vector3d::UnitZ()) *
                   Eigen::AngleAxisd(DegToRad(rpy(1)), Eigen::Vector3d::UnitY()) *
@@ -66,35 +103,49 @@ Eigen::Isometry3d ReadPose(const YamlDoc& node, const std::string& xyz_key,
   return X;
 }
 
-kinematics::SerialChain ReadDh(const YamlDoc& dh) {
+kinematics::SerialChain ReadDh(const YamlDoc& dh, std::vector<std::string>* implausible) {
   std::vector<kinematics::ModifiedDhRow> rows;
+  std::vector<TypedAngle> angles;  // every _deg value of the table, for the unit check
+  const auto angle = [&](const YamlDoc& node) {
+    const double v = node.Number();
+    angles.push_back({node, v});
+    return DegToRad(v);
+  };
+  const auto length = [&](const YamlDoc& node) {
+    const double v = node.Number();
+    CheckPlausible(node, std::abs(v), LengthRange(), implausible);
+    return v;
+  };
   const YamlDoc links = dh["links"];
   for (int i = 0; i < links.size(); ++i) {
     const YamlDoc l = links.at(i);
     kinematics::ModifiedDhRow r;
     r.joint_name = l.Has("joint") ? l["joint"].String() : "joint_" + std::to_string(i + 1);
     l.MarkUsed("joint");
-    r.alpha_prev = DegToRad(l["alpha_prev_deg"].Number());
-    r.a_prev = l["a_prev_m"].Number();
-    r.d = l["d_m"].Number();
-    r.theta_offset = l.Has("theta_offset_deg") ? DegToRad(l["theta_offset_deg"].Number()) : 0.0;
+    r.alpha_prev = angle(l["alpha_prev_deg"]);
+    r.a_prev = length(l["a_prev_m"]);
+    r.d = length(l["d_m"]);
+    r.theta_offset = l.Has("theta_offset_deg") ? angle(l["theta_offset_deg"]) : 0.0;
     l.MarkUsed("theta_offset_deg");
     if (l.Has("lower_deg") || l.Has("upper_deg")) {
-      r.limits.lower = DegToRad(l["lower_deg"].Number());
+      r.limits.lower = angle(l["lower_deg"]);
       const YamlDoc up = l["upper_deg"];
-      r.limits.upper = DegToRad(up.Number());
+      r.limits.upper = angle(up);
       if (!(r.limits.lower < r.limits.upper)) throw up.Error("expected upper_deg > lower_deg");
       r.limits.bounded = true;
     }
     l.MarkUsed("lower_deg");
     l.MarkUsed("upper_deg");
-    r.inertial = ReadInertial(l);
+    r.inertial = ReadInertial(l, implausible);
     l.RejectUnknownKeys();
     rows.push_back(r);
   }
   if (rows.empty()) throw links.Error("expected at least one link");
-  const Eigen::Isometry3d X_B0 = ReadPose(dh, "base_xyz_m", "base_rpy_deg");
-  const Eigen::Isometry3d X_nT = ReadPose(dh, "tip_xyz_m", "tip_rpy_deg");
+  const Eigen::Isometry3d X_B0 = ReadPose(dh, "base_xyz_m", "base_rpy_deg", &angles, implausible);
+  const Eigen::Isometry3d X_nT = ReadPose(dh, "tip_xyz_m", "tip_rpy_deg", &angles, implausible);
+  // Radians in the _deg fields: the twists of a real arm are 0 and +-90 deg,
+  // +-1.5708 in radians (issue #35: named whatever the joint limits).
+  CheckDegreesNotRadians(angles, implausible);
   dh.RejectUnknownKeys();
   return kinematics::BuildModifiedDhChain(rows, X_B0, X_nT, "base", "tip");
 }
@@ -110,12 +161,108 @@ void ReadNumericSection(const YamlDoc& section, const std::string& prefix,
 
 std::string FormatNumber(double v) { return FormatDouble(v); }
 
+// ": 29050 is 1000 x 29.05: a value in g typed in the kg field?" when value
+// and reference differ by a factor within 20 % of 1000 (or 1/1000).
+std::string ThousandHint(double value, double reference, const std::string& small_unit, const std::string& unit) {
+  if (!(reference != 0.0) || !std::isfinite(value)) return "";
+  const double r = value / reference;
+  if (r > 800.0 && r < 1250.0) {
+    return "; " + FormatDouble(value) + " is 1000 x " + FormatDouble(reference) + ": a value in " + small_unit +
+           " typed in the " + unit + " field?";
+  }
+  if (r > 0.0008 && r < 0.00125) {
+    return "; " + FormatDouble(value) + " is " + FormatDouble(reference) + " / 1000: a value in k" + unit +
+           " typed in the " + unit + " field?";
+  }
+  return "";
+}
+
+// The findings so far, for a refusal they may explain (a body mass in g
+// makes m6_kg disagree with the bodies).
+std::string Also(const std::vector<std::string>& findings) {
+  std::string s;
+  for (const std::string& f : findings) s += "; the likely cause, " + f;
+  return s;
+}
+
+// The decoupled frequency of each joint, f_j = sqrt(kq_j / M_q(j,j)) / 2 pi,
+// at q = 0 (the middle of the limits where they exclude 0), and the damping
+// ratio zeta_j = (alpha w_j + beta / w_j) / 2 it gets: a stiffness or a mass
+// 1000 times off moves f_j by a factor of 31.6, out of what robots have
+// (docs/plausibility.md). Named per joint, with the likely mistakes.
+void CheckJointFrequencies(RobotConfig& cfg, const YamlDoc& doc, const YamlDoc& kq, const YamlDoc& damping) {
+  const kinematics::SerialChain& arm = cfg.description.arm;
+  const int n = arm.num_joints();
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
+  for (int j = 0; j < n; ++j) {
+    const auto& lim = arm.limits()[j];
+    if (lim.bounded && (lim.lower > 0.0 || lim.upper < 0.0)) q(j) = 0.5 * (lim.lower + lim.upper);
+  }
+  Eigen::MatrixXd M;
+  double alpha = 0.0, beta = 0.0;
+  Eigen::VectorXd k(n);
+  try {
+    const auto model = cfg.Build();
+    M = dynamics::EvaluatePosture(model, q).M_q();
+    for (int j = 0; j < n; ++j) k(j) = model->joint_stiffness()(j);
+    alpha = model->alpha();
+    beta = model->beta();
+  } catch (const std::exception&) {
+    return;  // a model that does not build is reported by the tool that builds it
+  }
+  (void)doc;
+  // Whole hertz from 10 Hz up (7895 Hz, not 7.9e+03), 3 digits below.
+  const auto hz = [](double f) {
+    return f >= 10.0 ? std::to_string(std::lround(f)) : robomach::FormatNumber(f, 3);
+  };
+  const bool have_damping = alpha > 0.0 || beta > 0.0;
+  bool frequency_found = false;
+  double zeta_max = 0.0;
+  int zeta_joint = -1;
+  for (int j = 0; j < n; ++j) {
+    if (!(M(j, j) > 0.0)) continue;
+    const double w = std::sqrt(k(j) / M(j, j));
+    const double f_hz = w / (2.0 * kPi);
+    if (f_hz < kMinPlausibleJointFrequencyHz || f_hz > kMaxPlausibleJointFrequencyHz) {
+      const bool low = f_hz < kMinPlausibleJointFrequencyHz;
+      frequency_found = true;
+      cfg.implausible.push_back(
+          "implausible (unit mistake?): " + kq.at(j).location().ToString() + ": joint " + std::to_string(j + 1) +
+          " (" + arm.joint_names()[j] + "): its stiffness " + FormatNumber(k(j)) + " N·m/rad on the inertia " +
+          robomach::FormatNumber(M(j, j), 4) + " kg·m² it moves at q = 0 makes a joint frequency sqrt(kq/M)/2pi of " +
+          hz(f_hz) + " Hz, outside the " + robomach::FormatNumber(kMinPlausibleJointFrequencyHz, 4) +
+          " to " + robomach::FormatNumber(kMaxPlausibleJointFrequencyHz, 4) + " Hz of robots: " +
+          (low ? "a stiffness in kN·m/rad, or masses in g (x1000)?" : "a stiffness in N·mm/rad (x1000)?"));
+    }
+    if (have_damping) {
+      const double zeta = 0.5 * (alpha * w + beta / w);
+      if (zeta > zeta_max) {
+        zeta_max = zeta;
+        zeta_joint = j;
+      }
+    }
+  }
+  // A joint frequency off by 31.6 explains any damping ratio: say it once.
+  if (!frequency_found && zeta_joint >= 0 && zeta_max > kMaxPlausibleDampingRatio) {
+    const double w = std::sqrt(k(zeta_joint) / M(zeta_joint, zeta_joint));
+    const bool alpha_term = alpha * w > beta / w;
+    cfg.implausible.push_back(
+        "implausible (unit mistake?): " + damping.location().ToString() + ": damping: alpha_s " +
+        FormatNumber(alpha) + " s and beta_per_s " + FormatNumber(beta) + " /s give joint " +
+        std::to_string(zeta_joint + 1) + " a damping ratio of " + robomach::FormatNumber(zeta_max, 3) +
+        " at its frequency " + hz(w / (2.0 * kPi)) + " Hz, more than the " +
+        robomach::FormatNumber(kMaxPlausibleDampingRatio, 3) + " robots have (0.01 to 0.1 measured): " +
+        (alpha_term ? "alpha_s in ms typed in the s field?" : "beta_per_s 1000 times too large?"));
+  }
+}
+
 }  // namespace
 
-kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& path) {
+kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& path,
+                                       std::vector<std::string>* implausible) {
   kinematics::SerialChain arm;
   if (robot.Has("dh")) {
-    arm = ReadDh(robot["dh"]);
+    arm = ReadDh(robot["dh"], implausible);
   } else {
     const YamlDoc urdf = robot["urdf"];
     const std::string urdf_path = ResolveRelative(path, urdf.String());
@@ -162,7 +309,7 @@ RobotConfig LoadRobotConfig(const std::string& path) {
   dynamics::RobotDescription& d = cfg.description;
   d.source = path;
 
-  d.arm = ReadRobotChain(doc["robot"], path);
+  d.arm = ReadRobotChain(doc["robot"], path, &cfg.implausible);
   const int n = d.arm.num_joints();
 
   const YamlDoc kq = doc["joint_stiffness_Nm_per_rad"];
@@ -170,11 +317,33 @@ RobotConfig LoadRobotConfig(const std::string& path) {
   d.joint_stiffness = Eigen::Map<const Eigen::VectorXd>(kv.data(), n);
   for (int j = 0; j < n; ++j) {
     if (!(kv[j] > 0.0)) throw kq.at(j).Error("expected a joint stiffness > 0");
+    CheckPlausible(kq.at(j), kv[j],
+                   {kMinPlausibleJointStiffnessNmPerRad, kMaxPlausibleJointStiffnessNmPerRad, "N·m/rad",
+                    "robot joints (1e3 for a small wrist to 1e7 for a heavy robot's base)",
+                    "a stiffness in kN·m/rad typed in the N·m/rad field?",
+                    "a stiffness in N·mm/rad typed in the N·m/rad field?"},
+                   &cfg.implausible);
   }
 
   const YamlDoc damping = doc["damping"];
-  d.alpha = damping["alpha_s"].NumberInRange(0.0, 0.1);
-  d.beta = damping["beta_per_s"].NumberInRange(0.0, 1e3);
+  {
+    // alpha_s and beta_per_s swapped is the likely mistake behind an alpha
+    // beyond 0.1 s (the seed's are 1e-4 s and 5 /s): say so when refusing.
+    const YamlDoc a = damping["alpha_s"];
+    const YamlDoc b = damping["beta_per_s"];
+    const double av = a.Number(), bv = b.Number();
+    const bool swapped = av > 0.1 && bv >= 0.0 && bv <= 0.1 && av <= 1e3;
+    const std::string hint = swapped ? " (alpha_s and beta_per_s swapped? C = alpha K + beta M: alpha is a time of "
+                                       "about 1e-4 s, beta a rate of about 1-10 /s)"
+                                     : "";
+    if (!(av >= 0.0 && av <= 0.1)) {
+      throw a.Error("expected a number in [0, 0.1] s, got " + a.String() + hint +
+                    (swapped || av < 0.0 ? "" : " (alpha_s in ms? x1000)"));
+    }
+    if (!(bv >= 0.0 && bv <= 1e3)) throw b.Error("expected a number in [0, 1000] /s, got " + b.String() + hint);
+    d.alpha = av;
+    d.beta = bv;
+  }
   damping.RejectUnknownKeys();
 
   const YamlDoc ee = doc["end_effector"];
@@ -184,15 +353,20 @@ RobotConfig LoadRobotConfig(const std::string& path) {
       const YamlDoc b = bodies.at(i);
       dynamics::EndEffectorBody body;
       body.name = b["name"].String();
-      body.inertial = ReadInertial(b);
+      body.inertial = ReadInertial(b, &cfg.implausible);
       b.RejectUnknownKeys();
       d.end_effector.bodies.push_back(body);
     }
   }
   ee.MarkUsed("bodies");
   d.end_effector.p_tcp = Vec3(ee["tcp_m"]);
-  if (ee.Has("spindle_nose_m")) d.end_effector.p_spindle_nose = Vec3(ee["spindle_nose_m"]);
-  else d.end_effector.p_spindle_nose = d.end_effector.p_tcp;
+  CheckLengths(ee["tcp_m"], d.end_effector.p_tcp, &cfg.implausible);
+  if (ee.Has("spindle_nose_m")) {
+    d.end_effector.p_spindle_nose = Vec3(ee["spindle_nose_m"]);
+    CheckLengths(ee["spindle_nose_m"], d.end_effector.p_spindle_nose, &cfg.implausible);
+  } else {
+    d.end_effector.p_spindle_nose = d.end_effector.p_tcp;
+  }
   ee.MarkUsed("spindle_nose_m");
   // m6_kg and d6_m document the reference values; they must match the
   // geometry (a calibrated value goes under `parameters:` instead).
@@ -203,7 +377,7 @@ RobotConfig LoadRobotConfig(const std::string& path) {
     if (std::abs(node.Number() - m6) > 1e-6 * std::max(1.0, m6)) {
       throw node.Error("the last link and the end-effector bodies weigh " + FormatNumber(m6) +
                        " kg; m6_kg must state that reference (put a calibrated m6 under "
-                       "'parameters: m6_kg')");
+                       "'parameters: m6_kg')" + ThousandHint(node.Number(), m6, "g", "kg") + Also(cfg.implausible));
     }
   }
   if (ee.Has("d6_m")) {
@@ -211,7 +385,8 @@ RobotConfig LoadRobotConfig(const std::string& path) {
     if (std::abs(node.Number() - d6) > 1e-6) {
       throw node.Error("the geometry puts the tool tip " + FormatNumber(d6) +
                        " m from the wrist centre along the last joint axis; d6_m must state "
-                       "that reference (put a calibrated d6 under 'parameters: d6_m')");
+                       "that reference (put a calibrated d6 under 'parameters: d6_m')" +
+                       ThousandHint(node.Number(), d6, "mm", "m") + Also(cfg.implausible));
     }
   }
   ee.MarkUsed("m6_kg");
@@ -258,12 +433,26 @@ RobotConfig LoadRobotConfig(const std::string& path) {
       try {
         cfg.parameters.Set(key, v.Number());
       } catch (const std::invalid_argument& ex) {
-        throw v.Error(ex.what());
+        // A value 1000 times the configured one is a unit mistake more
+        // often than a calibration (g for kg, mm for m, N·mm for N·m).
+        const double reference = cfg.parameters.Has(key) ? cfg.parameters.Get(key) : 0.0;
+        std::string unit = "", small = "";
+        for (const auto& [suffix, u, su] : {std::tuple{"_Nm_per_rad", "N·m/rad", "N·mm/rad"}, {"_kg", "kg", "g"},
+                                            {"_per_s", "1/s", "1/ms"}, {"_m", "m", "mm"}, {"_s", "s", "ms"}}) {
+          const std::string sfx = suffix;
+          if (key.size() > sfx.size() && key.compare(key.size() - sfx.size(), sfx.size(), sfx) == 0) {
+            unit = u;
+            small = su;
+            break;
+          }
+        }
+        throw v.Error(ex.what() + (unit.empty() ? "" : ThousandHint(v.Number(), reference, small, unit)));
       }
     }
   }
   doc.MarkUsed("parameters");
   doc.RejectUnknownKeys();
+  CheckJointFrequencies(cfg, doc, kq, damping);
   return cfg;
 }
 

@@ -22,6 +22,14 @@ file(READ ${SRC}/config/kr210.yaml cfg)
 string(REPLACE "urdf: kr210_r2700_2.urdf" "urdf: ${SRC}/config/kr210_r2700_2.urdf" cfg "${cfg}")
 string(REPLACE "mass_kg: 22.0" "mass_kg: -22.0" cfg "${cfg}")
 file(WRITE ${WORK}/neg_mass.yaml "${cfg}")
+# The joint stiffnesses in N·mm/rad (x1000), a drilling robot's rotor inertias in kg·cm².
+string(REPLACE "mass_kg: -22.0" "mass_kg: 22.0" cfg "${cfg}")
+string(REPLACE "[3.3479e+6, 3.1318e+6, 4.2895e+6, 2.4787e+5, 6.4292e+5, 1.8847e+5]"
+               "[3.3479e+9, 3.1318e+9, 4.2895e+9, 2.4787e+8, 6.4292e+8, 1.8847e+8]" cfg "${cfg}")
+file(WRITE ${WORK}/kq_Nmm.yaml "${cfg}")
+file(READ ${SRC}/config/drilling/planar3r.yaml cfg)
+string(REPLACE "rotor_inertia_kgm2: 1.98e-4" "rotor_inertia_kgm2: 1.98" cfg "${cfg}")
+file(WRITE ${WORK}/planar3r_kgcm2.yaml "${cfg}")
 # Cut files: a count beyond the limit, a diameter in um, ktc x1000.
 file(READ ${SRC}/tests/data/stability/cut_benchmark_slot.yaml cut)
 string(REPLACE "spindle_speed_count: 400" "spindle_speed_count: 2000000000" c "${cut}")

@@ -38,6 +38,9 @@ struct DrillFile {
   drilling::DrillingProcess process;       // defaults where absent
   SourceLocation hole_axis_at;             // for errors found later (feeding)
   SourceLocation initial_posture_at;
+  /// "implausible (unit mistake?): file:line:col: ..." (docs/plausibility.md):
+  /// drill and posture angles that all look like radians under _deg keys.
+  std::vector<std::string> implausible;
 };
 /// @throws InputError with file:line:col for any problem (unknown keys too).
 DrillFile ReadDrillFile(const std::string& path);
@@ -62,10 +65,24 @@ struct FlexibleRobotFile {
   kinematics::SerialChain chain;
   std::vector<drilling::JointDrive> drives;   // in chain order
   std::vector<std::string> unused_sections;
+  /// "implausible (unit mistake?): file:line:col: ..." (docs/plausibility.md):
+  /// the `dh:` table's masses, lengths and angles (robot_config.h's ranges),
+  /// joint stiffnesses, gear ratios and rotor inertias outside their ranges.
+  std::vector<std::string> implausible;
 };
 /// @throws InputError with file:line:col: a joint without an entry, an
 ///   unknown or repeated joint name, a stiffness, gear ratio or rotor inertia
 ///   not > 0, a negative damping, unknown keys.
 FlexibleRobotFile ReadFlexibleRobotFile(const std::string& path);
+
+// Plausible ranges of a flexible joint's drive (docs/plausibility.md).
+// Sources: harmonic-drive and cycloidal robot gearboxes have ratios of 30 to
+// 300 (Harmonic Drive AG, CSG catalogue; Nabtesco RV catalogue); servo
+// motor rotor inertias are 1e-6 kg·m² (100 W) to 1e-2 kg·m² (15 kW)
+// (Siemens 1FK7, Yaskawa Sigma-7 data sheets).
+inline constexpr double kMinPlausibleGearRatio = 1.0;
+inline constexpr double kMaxPlausibleGearRatio = 3000.0;
+inline constexpr double kMinPlausibleRotorInertiaKgM2 = 1e-8;
+inline constexpr double kMaxPlausibleRotorInertiaKgM2 = 1.0;
 
 }  // namespace robomach::io

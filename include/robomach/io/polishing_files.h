@@ -21,8 +21,30 @@ namespace robomach::io {
 /// knot vector that does not match the control points, a weight <= 0, ...
 polishing::NurbsSurface ReadNurbsYaml(const std::string& path);
 
-/// formats.md §7 process file. Unknown keys are rejected.
-polishing::PolishingProcess ReadPolishingProcess(const std::string& path);
+// Plausible ranges of a process file's values (docs/plausibility.md), about
+// 10 to 100 times wider than practice. Sources: 3M and VSM belt-grinding
+// guides (contact wheels of 25 to 250 mm radius, belts 10 to 300 mm wide,
+// belt speeds 5 to 35 m/s); robotic belt polishing forces 5 to 100 N (Zhang
+// et al., Robot. CIM 2020; the shipped example 2 N); pad rubber moduli 1 to
+// 100 MPa; Young's moduli of metals 45 to 400 GPa, of polymers 1 to 3 GPa;
+// Preston coefficients 1e-14 to 1e-10 m²/N (Preston 1927; Tam and Cheng,
+// J. Mater. Process. Technol. 2007); robot polishing feeds 5 to 200 mm/s.
+inline constexpr double kMinPlausibleWheelRadiusMm = 1.0, kMaxPlausibleWheelRadiusMm = 2000.0;
+inline constexpr double kMinPlausibleCrownRadiusMm = 1.0, kMaxPlausibleCrownRadiusMm = 1e5;
+inline constexpr double kMinPlausibleBeltWidthMm = 1.0, kMaxPlausibleBeltWidthMm = 2000.0;
+inline constexpr double kMinPlausiblePadModulusMPa = 0.1, kMaxPlausiblePadModulusMPa = 5000.0;
+inline constexpr double kMinPlausibleBeltSpeedMPerS = 0.1, kMaxPlausibleBeltSpeedMPerS = 100.0;
+inline constexpr double kMinPlausibleWorkModulusGPa = 0.1, kMaxPlausibleWorkModulusGPa = 1000.0;
+inline constexpr double kMinPlausiblePrestonM2PerN = 1e-16, kMaxPlausiblePrestonM2PerN = 1e-8;
+inline constexpr double kMinPlausiblePolishForceN = 0.01, kMaxPlausiblePolishForceN = 5000.0;
+inline constexpr double kMinPlausiblePolishSpeedMmPerS = 0.1, kMaxPlausiblePolishSpeedMmPerS = 2000.0;
+
+/// formats.md §7 process file. Unknown keys are rejected. When `implausible`
+/// is given, it receives "implausible (unit mistake?): file:line:col: ..."
+/// for each value outside its plausible range above (the tools flag their
+/// result, exit 3).
+polishing::PolishingProcess ReadPolishingProcess(const std::string& path,
+                                                 std::vector<std::string>* implausible = nullptr);
 
 /// A tool path CSV as read (formats.md §6), SI.
 struct PolishPathFile {

@@ -15,10 +15,37 @@ struct RobotConfig {
   dynamics::RobotDescription description;
   dynamics::ParameterSet parameters;   // defaults, then the file's `parameters:` overrides
   std::string path;
+  /// "implausible (unit mistake?): file:line:col: ..." for each value outside
+  /// its plausible range below (docs/plausibility.md): a tool prints them and
+  /// flags its result (exit 3).
+  std::vector<std::string> implausible;
   std::shared_ptr<const dynamics::RobotModel> Build() const {
     return dynamics::RobotModel::Build(description, parameters);
   }
 };
+
+// Plausible ranges of a robot config's values (docs/plausibility.md): wide,
+// so that no real robot is flagged, and each names the likely unit mistake.
+// Sources: manufacturers' data sheets (KUKA KR 1000 titan: 4.7 t in all, a
+// reach of 3.2 m; the longest arms reach about 4 m); joint stiffnesses of
+// industrial robots 1e4 to 1e7 N·m/rad (Dumas, Caro, Garnier and Furet,
+// Robot. CIM 27 (2011); the seed's KR 210: 1.9e5 to 4.3e6), of small arms
+// down to 1e3; first modes of robots 5 to 50 Hz and wrist modes to a few
+// hundred Hz, damping ratios 0.01 to 0.1 (Cordes, Hintze and Altintas,
+// Robot. CIM 55 (2019); Tunc and Stoddart, IJAMT 89 (2017)).
+inline constexpr double kMaxPlausibleBodyMassKg = 5000.0;      // a link or end-effector body
+inline constexpr double kMaxPlausibleRobotLengthM = 10.0;      // |each component| of a length
+inline constexpr double kMinPlausibleJointStiffnessNmPerRad = 100.0;
+inline constexpr double kMaxPlausibleJointStiffnessNmPerRad = 1e9;
+/// sqrt(kq_j / M_q(j,j)) / 2 pi at q = 0 (mid-limits where they exclude 0):
+/// x1000 in kq or /1000 in the masses moves it by 31.6 (the KR 210's are
+/// 10 to 250 Hz). Below 1 Hz a joint that carries its links' weight would
+/// let them sag by g / w² = 25 cm (a link of mass m at radius r: torque
+/// m g r over kq = m r² w² turns it by g / (w² r)).
+inline constexpr double kMinPlausibleJointFrequencyHz = 1.0;
+inline constexpr double kMaxPlausibleJointFrequencyHz = 2000.0;
+/// Rayleigh damping ratio (alpha w + beta / w) / 2 at each joint frequency.
+inline constexpr double kMaxPlausibleDampingRatio = 0.5;
 
 /// Reads a robot config (see config/kr210.yaml for the documented schema):
 /// `robot:` with `urdf`, `base_link`, `tip_frame` (and optional
@@ -29,14 +56,22 @@ struct RobotConfig {
 /// `spindle_toolholder_interface`, `hammer_test`, `effects` and
 /// `parameters` (values by parameter name, as calibration writes them).
 /// Unknown keys are rejected. Paths are relative to the config's folder.
-/// @throws InputError with `file:line:col` for any problem.
+/// Values outside the plausible ranges above (masses, lengths, joint
+/// stiffnesses, joint frequencies, damping ratios; DH angles that look like
+/// radians) are listed in RobotConfig::implausible.
+/// @throws InputError with `file:line:col` for any problem; a refused value
+///   1000 times its reference (m6_kg, d6_m, a `parameters:` value) names the
+///   unit mistake.
 RobotConfig LoadRobotConfig(const std::string& path);
 
 /// The kinematic chain of a config's `robot:` section (URDF or `dh:`, as
 /// LoadRobotConfig reads it); `path` is the config file, for relative paths.
 /// Used by readers of other robot files (drilling's flexible-joint robot).
+/// When `implausible` is given, it receives the unit findings of a `dh:`
+/// table (masses, lengths, angles that look like radians).
 /// @throws InputError with `file:line:col` for any problem.
-kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& path);
+kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& path,
+                                       std::vector<std::string>* implausible = nullptr);
 
 /// The `parameters:` block that reproduces `parameters` where they differ
 /// from the description's defaults (all of them if `all`), as YAML text.

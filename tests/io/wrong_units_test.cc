@@ -1,0 +1,238 @@
+// Wrong units on purpose (issue #35 acceptance): for every reader that takes
+// a dimensional quantity a user types, a valid shipped input with one
+// quantity scaled as a user gets it wrong (x1000, /1000, deg <-> rad,
+// N <-> kN, mm <-> m) must be flagged (a finding) or refused (InputError)
+// with words naming the unit mistake; the unmodified input must give no
+// finding, so a check that flags everything fails here too.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "robomach/common/errors.h"
+#include "robomach/common/units.h"
+#include "robomach/io/cut_file.h"
+#include "robomach/io/drilling_files.h"
+#include "robomach/io/polishing_files.h"
+#include "robomach/io/robot_config.h"
+#include "test_support.h"
+
+namespace robomach::io {
+namespace {
+
+using robomach::testing::SourcePath;
+using robomach::testing::TempDir;
+using robomach::testing::WriteText;
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// A reader under test: the findings it returns for a file (it may throw).
+using Reader = std::function<std::vector<std::string>(const std::string& path)>;
+
+struct NamedReader {
+  const char* name;
+  Reader read;
+};
+
+const std::vector<NamedReader>& Readers() {
+  static const std::vector<NamedReader> readers = {
+      {"robot_config", [](const std::string& p) { return LoadRobotConfig(p).implausible; }},
+      {"flexible_robot", [](const std::string& p) { return ReadFlexibleRobotFile(p).implausible; }},
+      {"drill_file", [](const std::string& p) { return ReadDrillFile(p).implausible; }},
+      {"cut_file", [](const std::string& p) { return ReadCutFile(p).implausible; }},
+      {"polish_process",
+       [](const std::string& p) {
+         std::vector<std::string> w;
+         ReadPolishingProcess(p, &w);
+         return w;
+       }},
+  };
+  return readers;
+}
+
+const Reader& FindReader(const std::string& name) {
+  for (const auto& r : Readers()) {
+    if (name == r.name) return r.read;
+  }
+  throw std::logic_error("no reader " + name);
+}
+
+enum class Expect { kFlagged, kRefused };
+
+struct WrongUnitCase {
+  const char* reader;
+  const char* file;     // shipped or test input, relative to the source tree
+  const char* key;      // `key` (a scalar or every number of a flow list), `key[i]` (element i of a
+                        // flow list), or `key|key2|...` (each of them)
+  int occurrence;       // which line with the key (0 = the first)
+  double factor;        // the mistake: the value times this
+  Expect expect;
+  const char* words;    // regex the finding or the error must match
+};
+
+constexpr double kDegPerRad = 180.0 / kPi;
+constexpr double kRadPerDeg = kPi / 180.0;
+
+// One row per quantity and mistake.
+const std::vector<WrongUnitCase>& Cases() {
+  static const std::vector<WrongUnitCase> cases = {
+      // robot config (config/kr210.yaml; DH table config/kr210_dh.yaml)
+      {"robot_config", "config/kr210.yaml", "mass_kg", 0, 1000, Expect::kRefused, "m6_kg must state .*the likely cause, .*mass_kg 22000 kg .*a mass in g typed in the kg field"},
+      {"robot_config", "config/kr210_dh.yaml", "mass_kg", 0, 1000, Expect::kFlagged, "mass_kg 363070 kg .*a mass in g typed in the kg field"},
+      {"robot_config", "config/kr210.yaml", "com_m[2]", 0, 1000, Expect::kFlagged, "com_m\\[2\\] 110 m .*a length in mm typed in the m field"},
+      {"robot_config", "config/kr210.yaml", "tcp_m[2]", 0, 1000, Expect::kRefused, "tcp_m\\[2\\] 335 m .*a length in mm typed in the m field"},
+      {"robot_config", "config/kr210.yaml", "joint_stiffness_Nm_per_rad[0]", 0, 1000, Expect::kFlagged, "joint_stiffness_Nm_per_rad\\[0\\] 3347900000 N·m/rad .*a stiffness in N·mm/rad"},
+      {"robot_config", "config/kr210.yaml", "joint_stiffness_Nm_per_rad", 0, 1000, Expect::kFlagged, "joint 6 \\(joint_6\\).* 7\\d\\d\\d Hz.*a stiffness in N·mm/rad"},
+      {"robot_config", "config/kr210.yaml", "joint_stiffness_Nm_per_rad", 0, 1e-3, Expect::kFlagged, "joint 2 \\(joint_2\\).* 0.328 Hz.*a stiffness in kN·m/rad"},
+      {"robot_config", "config/kr210.yaml", "alpha_s", 0, 1000, Expect::kFlagged, "alpha_s in ms"},
+      {"robot_config", "config/kr210.yaml", "beta_per_s", 0, 1000, Expect::kRefused, "beta_per_s: expected a number in \\[0, 1000\\] /s"},
+      {"robot_config", "config/kr210.yaml", "m6_kg", 0, 1000, Expect::kRefused, "1000 x 29.05: a value in g typed in the kg field"},
+      {"robot_config", "config/kr210.yaml", "d6_m", 0, 1000, Expect::kRefused, "a value in mm typed in the m field"},
+      {"robot_config", "config/kr210_dh.yaml", "a_prev_m", 1, 1000, Expect::kFlagged, "a_prev_m 330 m .*a length in mm typed in the m field"},
+      {"robot_config", "config/kr210_dh.yaml", "d_m", 0, 1000, Expect::kFlagged, "d_m -645 m .*a length in mm typed in the m field"},
+      // drill-sim's flexible-joint robot (config/drilling/planar3r.yaml)
+      {"flexible_robot", "config/drilling/planar3r.yaml", "mass_kg", 0, 1000, Expect::kFlagged, "mass_kg 6000 kg .*a mass in g typed in the kg field"},
+      {"flexible_robot", "config/drilling/planar3r.yaml", "a_prev_m", 1, 1000, Expect::kFlagged, "a_prev_m 600 m .*a length in mm typed in the m field"},
+      {"flexible_robot", "config/drilling/planar3r.yaml", "stiffness_Nm_per_rad", -1, 1e-3, Expect::kFlagged, "stiffness_Nm_per_rad 60 N·m/rad .*a stiffness in kN·m/rad"},
+      {"flexible_robot", "config/drilling/planar3r.yaml", "rotor_inertia_kgm2", 0, 1e4, Expect::kFlagged, "rotor_inertia_kgm2 1.98 kg·m² .*kg·cm²"},
+      {"flexible_robot", "config/drilling/planar3r.yaml", "alpha_prev_deg|base_rpy_deg|tip_rpy_deg", -1, kRadPerDeg, Expect::kFlagged, "radians typed in _deg fields"},
+      // drill file (config/drilling/drill_5mm.yaml)
+      {"drill_file", "config/drilling/drill_5mm.yaml", "point_angle_deg", 0, kRadPerDeg, Expect::kRefused, "point_angle_deg: expected an angle in \\(60, 180\\) deg, got 2.0594.*radians typed in a _deg field"},
+      {"drill_file", "config/drilling/drill_5mm.yaml", "initial_posture_deg", 0, kRadPerDeg, Expect::kFlagged, "initial_posture_deg.*radians typed in _deg fields"},
+      // cut file (config/cut_demo.yaml; checks of commit 648cfe0)
+      {"cut_file", "config/cut_demo.yaml", "diameter_mm", 0, 1000, Expect::kFlagged, "diameter_mm 20000 mm .*a diameter in um"},
+      {"cut_file", "config/cut_demo.yaml", "diameter_mm", 0, 1e-3, Expect::kFlagged, "diameter_mm 0.02 mm .*a diameter in m"},
+      {"cut_file", "config/cut_demo.yaml", "ktc_N_per_mm2", 0, 1000, Expect::kFlagged, "ktc_N_per_mm2 .*N/m² \\(Pa\\) or kN/m²"},
+      {"cut_file", "config/cut_demo.yaml", "ktc_N_per_mm2", 0, 1e-3, Expect::kFlagged, "ktc_N_per_mm2 .*kN/mm²"},
+      // polishing process (config/polishing/belt_2N.yaml)
+      {"polish_process", "config/polishing/belt_2N.yaml", "force_N", 0, 1e-3, Expect::kFlagged, "force_N 0.002 N .*a force in kN typed in the N field"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "force_N", 0, 1e4, Expect::kFlagged, "force_N 20000 N .*a force in mN"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "wheel_radius_mm", 0, 1e-3, Expect::kFlagged, "wheel_radius_mm 0.05 mm .*a length in m typed in the mm field"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "belt_width_mm", 0, 1000, Expect::kFlagged, "belt_width_mm 20000 mm .*a length in um"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "pad_modulus_MPa", 0, 1000, Expect::kFlagged, "pad_modulus_MPa 10000 MPa .*kPa or Pa"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "belt_speed_m_per_s", 0, 1000, Expect::kFlagged, "belt_speed_m_per_s 3000 m/s .*mm/s"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "modulus_GPa", 0, 1000, Expect::kFlagged, "modulus_GPa 200000 GPa .*MPa or Pa"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "preston_coefficient_m2_per_N", 0, 1e6, Expect::kFlagged, "preston_coefficient_m2_per_N .*mm²/N"},
+      {"polish_process", "config/polishing/belt_2N.yaml", "max_speed_mm_per_s", 0, 1e-3, Expect::kFlagged, "max_speed_mm_per_s 0.05 mm/s .*m/s typed in the mm/s field"},
+      {"robot_config", "config/kr210_dh.yaml", "alpha_prev_deg|theta_offset_deg|lower_deg|upper_deg|base_rpy_deg|tip_rpy_deg", -1, kRadPerDeg, Expect::kRefused, "radians typed in _deg fields"},
+  };
+  return cases;
+}
+
+// The file's text with the case's value scaled; -1 as occurrence scales
+// every line with the key (all angles of a table typed in radians).
+std::string Scaled(const std::string& text, const WrongUnitCase& c, const std::string& folder) {
+  std::string key = c.key;
+  int element = -1;
+  std::smatch m;
+  if (std::regex_match(key, m, std::regex(R"((\w+)\[(\d+)\])"))) {
+    key = m[1];
+    element = std::stoi(m[2]);
+  }
+  // The key at the start of a line, or inside a flow map ({a: 1, key: 2}).
+  const std::regex line_re("^(.*?(?:^|[\\s{,-])(?:" + key + "):\\s*)(\\[[^\\]]*\\]|[-+0-9.eE]+)(.*)$");
+  std::istringstream in(text);
+  std::string line, out;
+  int seen = 0, changed = 0;
+  const auto scale = [&](const std::string& v) {
+    std::ostringstream s;
+    s.precision(12);
+    s << std::stod(v) * c.factor;
+    return s.str();
+  };
+  while (std::getline(in, line)) {
+    if (std::regex_match(line, m, line_re) && (c.occurrence < 0 || seen++ == c.occurrence)) {
+      std::string value = m[2];
+      if (value[0] == '[') {
+        std::vector<std::string> items;
+        std::stringstream list(value.substr(1, value.size() - 2));
+        for (std::string item; std::getline(list, item, ',');) items.push_back(item);
+        for (size_t i = 0; i < items.size(); ++i) {
+          if (element < 0 || static_cast<int>(i) == element) items[i] = scale(items[i]);
+        }
+        value = "[";
+        for (size_t i = 0; i < items.size(); ++i) value += (i ? ", " : "") + items[i];
+        value += "]";
+      } else {
+        value = scale(value);
+      }
+      line = m[1].str() + value + m[3].str();
+      ++changed;
+    }
+    // A relative file reference made absolute: the copy lives elsewhere.
+    if (std::regex_match(line, m, std::regex(R"(^(\s*urdf:\s*)(\S+)(.*)$)"))) {
+      line = m[1].str() + folder + "/" + m[2].str() + m[3].str();
+    }
+    out += line + "\n";
+  }
+  if (changed == 0) throw std::logic_error(std::string("no ") + c.key + " in the file");
+  return out;
+}
+
+std::string CaseName(const WrongUnitCase& c) {
+  std::ostringstream s;
+  s << c.reader << " " << c.file << " " << c.key << "#" << c.occurrence << " x" << c.factor;
+  return s.str();
+}
+
+// The shipped inputs give no finding: a check that flags them would make
+// every row below pass for the wrong reason.
+TEST(WrongUnits, ShippedInputsAreNotFlagged) {
+  std::vector<std::pair<std::string, std::string>> done;
+  for (const WrongUnitCase& c : Cases()) {
+    const std::pair<std::string, std::string> k{c.reader, c.file};
+    if (std::find(done.begin(), done.end(), k) != done.end()) continue;
+    done.push_back(k);
+    std::vector<std::string> findings;
+    ASSERT_NO_THROW(findings = FindReader(c.reader)(SourcePath(c.file))) << c.reader << " " << c.file;
+    std::string all;
+    for (const auto& f : findings) all += "\n  " + f;
+    EXPECT_TRUE(findings.empty()) << c.reader << " " << c.file << ":" << all;
+  }
+}
+
+// Every case: flagged or refused with the words naming the mistake.
+TEST(WrongUnits, EachMistakeIsNamed) {
+  const std::string dir = TempDir("wrong_units");
+  int n = 0;
+  for (const WrongUnitCase& c : Cases()) {
+    SCOPED_TRACE(CaseName(c));
+    const std::string src = SourcePath(c.file);
+    const std::string folder = std::filesystem::path(src).parent_path().string();
+    const std::string path = dir + "/case" + std::to_string(n++) + "_" + std::filesystem::path(c.file).filename().string();
+    WriteText(path, Scaled(ReadText(src), c, folder));
+    std::vector<std::string> findings;
+    std::string error;
+    try {
+      findings = FindReader(c.reader)(path);
+    } catch (const InputError& e) {
+      error = e.what();
+    }
+    if (c.expect == Expect::kRefused) {
+      EXPECT_TRUE(std::regex_search(error, std::regex(c.words))) << "refusal: '" << error << "'";
+      continue;
+    }
+    EXPECT_EQ(error, "");
+    if (!error.empty()) continue;
+    std::string all;
+    for (const auto& f : findings) all += "\n  " + f;
+    bool named = false;
+    for (const auto& f : findings) named = named || std::regex_search(f, std::regex(c.words));
+    EXPECT_TRUE(named) << "findings:" << all;
+    for (const auto& f : findings) EXPECT_EQ(f.rfind("implausible (unit mistake?): ", 0), 0u) << f;
+  }
+}
+
+}  // namespace
+}  // namespace robomach::io
