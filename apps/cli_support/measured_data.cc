@@ -39,6 +39,9 @@ MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::s
       all.frfs.Insert(key, frf);
       all.averages[key] = r.averages;
       all.file[key] = path;
+      all.file_power[key] = r.file_quantity == io::FrfQuantity::kReceptance  ? 0
+                            : r.file_quantity == io::FrfQuantity::kMobility ? 1
+                                                                            : 2;
     }
   };
   for (const std::string& f : files) add(f, "");

@@ -24,6 +24,9 @@ struct MeasuredData {
   dynamics::FrfSet frfs;
   std::map<dynamics::FrfKey, int> averages;
   std::map<dynamics::FrfKey, std::string> file;
+  /// Power of iω of the quantity each FRF's file holds (0 receptance,
+  /// 1 mobility, 2 accelerance): misfits are reported in it.
+  std::map<dynamics::FrfKey, int> file_power;
   /// FRFs whose receptance on its usable band is outside the plausible
   /// range (calibration::ReceptanceUnitFindings; printed as warnings): a
   /// unit mistake, which the tools flag (exit 3).

@@ -533,6 +533,8 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     return result;
   }
   result.orders_tried = nmax - o.min_order + 1;
+  result.min_order = o.min_order;
+  result.max_order = nmax;
   result.lscf_power = FlattestPower(frfs);
   const auto by_order = LscfPoles(frfs, result.lscf_power, o.min_order, nmax, result.fmin_hz, result.fmax_hz, o);
   for (const auto& poles : by_order)

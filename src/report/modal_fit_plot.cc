@@ -66,3 +66,76 @@ void FillModalFitPanels(const dynamics::Frf& measured, const calibration::FrfNoi
 }
 
 }  // namespace robomach::report
+
+namespace robomach::report {
+
+void WriteModalAnalysisPng(const std::string& path, const calibration::PoseModes& pose,
+                           const dynamics::FrfSet& measured, const calibration::NoiseModels& noise) {
+  int frf_rows = 0;
+  for (const calibration::ModalGroup& g : pose.groups) frf_rows += 2 * static_cast<int>(g.keys.size());
+  const int rows = static_cast<int>(pose.groups.size()) + frf_rows;
+  Figure fig(std::max(1, rows), 1, 1000, 320);
+  fig.title = "robomach frf-modes: posture " + pose.pose_id;
+  int row = 0;
+  for (const calibration::ModalGroup& g : pose.groups) {
+    Axes& ax = fig.at(row++, 0);
+    std::string which;
+    for (const auto& k : g.keys) which += std::string(which.empty() ? "H" : ", H") + AxisName(k.response) + AxisName(k.excitation);
+    char head[200];
+    std::snprintf(head, sizeof(head), "stabilisation diagram of %s: %zu modes, orders %d..%d", which.c_str(),
+                  g.fit.modes.size(), g.fit.min_order, g.fit.max_order);
+    ax.title = head;
+    ax.x_label = "frequency [Hz]";
+    ax.y_label = "model order";
+    ax.log_x = g.fit.fmin_hz > 0.0 && g.fit.fmax_hz / g.fit.fmin_hz > 100.0;
+    ax.x_min = ax.log_x ? g.fit.fmin_hz : 0.0;
+    ax.x_max = g.fit.fmax_hz > 0.0 ? g.fit.fmax_hz : NAN;
+    Series unstable, stable;
+    unstable.markers = stable.markers = true;
+    unstable.label = "pole";
+    stable.label = "stable pole";
+    unstable.color = {180, 180, 180};
+    stable.color = PaletteColor(2);
+    for (const auto& p : g.fit.stabilisation) {
+      Series& s = p.stable ? stable : unstable;
+      s.x.push_back(p.freq_hz);
+      s.y.push_back(p.order);
+    }
+    ax.series.push_back(std::move(unstable));
+    ax.series.push_back(std::move(stable));
+    for (const auto& m : g.fit.modes) {
+      char l[32];
+      std::snprintf(l, sizeof(l), "%.1f Hz", m.freq_hz);
+      ax.markers.push_back({m.freq_hz, l});
+    }
+    for (size_t i = 0; i < g.keys.size(); ++i) {
+      const dynamics::Frf& frf = measured.at(g.keys[i]);
+      calibration::FrfNoise nz;
+      const auto it = noise.find(g.keys[i]);
+      if (it != noise.end()) {
+        nz = it->second;
+      } else {
+        nz.usable.assign(frf.size(), 1);
+        nz.floor_m_per_N = Eigen::VectorXd::Constant(frf.size(), NAN);
+      }
+      calibration::ModalFitResult fit;
+      if (i < g.fit.per_frf.size()) fit = g.fit.per_frf[i];
+      char title[240];
+      const double noise_units = i < g.fit.misfit_in_noise.size() ? g.fit.misfit_in_noise[i] : NAN;
+      const double rel = i < g.misfit.size() ? g.misfit[i] : NAN;
+      if (std::isfinite(noise_units)) {
+        std::snprintf(title, sizeof(title), "H%c%c: %zu modes, misfit %.3g (%.2f x the noise)",
+                      AxisName(g.keys[i].response), AxisName(g.keys[i].excitation), fit.modes.size(), rel,
+                      noise_units);
+      } else {
+        std::snprintf(title, sizeof(title), "H%c%c: %zu modes, misfit %.3g", AxisName(g.keys[i].response),
+                      AxisName(g.keys[i].excitation), fit.modes.size(), rel);
+      }
+      FillModalFitPanels(frf, nz, fit, title, &fig.at(row, 0), &fig.at(row + 1, 0));
+      row += 2;
+    }
+  }
+  fig.SavePng(path);
+}
+
+}  // namespace robomach::report

@@ -5,7 +5,6 @@
 // on real files other software wrote (../shared/external, read where they
 // lie, skipped when absent).
 
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cmath>
@@ -273,10 +272,7 @@ TEST(GlobalModalFitRealFiles, Dataset58ModesAtTheFilesPeaks) {
   const io::FrfReadResult read = io::ReadFrfFile(path);
   ASSERT_EQ(read.frfs.size(), 1);
   const dynamics::Frf frf = WithNoiseModels({read.frfs.begin()->second}).front();
-  const auto t0 = std::chrono::steady_clock::now();
   const GlobalModalFitResult fit = FitModesGlobal({frf});
-  std::printf("fit %.2f s (CPU contended; bench_modal measures it)\n",
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   ASSERT_EQ(fit.status, ModalFitStatus::kOk) << fit.message;
   if (std::getenv("ROBOMACH_DUMP_FIT")) DumpFit(fit, {frf}, 1);
   // The peaks of the file (SOURCES.md, 0.5 Hz grid): 175, 376.5, 464,

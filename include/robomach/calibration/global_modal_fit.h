@@ -83,6 +83,7 @@ struct GlobalModalFitResult {
   /// receptance, mobility or accelerance), the one with the flattest
   /// magnitude; the poles do not depend on it.
   int lscf_power{0};
+  int min_order{0}, max_order{0};  // orders of the stabilisation diagram
   int orders_tried{0};
   double fmin_hz{0.0}, fmax_hz{0.0};
   std::vector<StabilisationPole> stabilisation;

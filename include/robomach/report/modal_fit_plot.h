@@ -22,3 +22,17 @@ void FillModalFitPanels(const dynamics::Frf& measured, const calibration::FrfNoi
                         Axes* phase);
 
 }  // namespace robomach::report
+
+#include "robomach/calibration/modal_analysis.h"
+
+namespace robomach::report {
+
+/// frf-modes' picture of one posture: the stabilisation diagram of each fit
+/// (poles per model order, stable ones in colour, the modes as lines), then
+/// magnitude and phase of each FRF with its fit, the noise floor and the
+/// usable band (FillModalFitPanels). `noise` may lack an FRF (drawn without
+/// floor, every line usable).
+void WriteModalAnalysisPng(const std::string& path, const calibration::PoseModes& pose,
+                           const dynamics::FrfSet& measured, const calibration::NoiseModels& noise);
+
+}  // namespace robomach::report

@@ -1,0 +1,73 @@
+#pragma once
+
+// Modal analysis of measured FRFs, posture by posture (frf-modes' work,
+// issue #34 §3): the FRFs of one posture share their poles and are fitted
+// together (global_modal_fit.h) on the lines every one of them can use (the
+// noise models' usable bands); from the residues of the direct FRFs comes
+// the tool-tip modal model of formats.md §4 (modal mass and unit shape), the
+// table stability-lobes --modal-table reads.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/calibration/frf_noise.h"
+#include "robomach/calibration/global_modal_fit.h"
+#include "robomach/dynamics/measured_frf.h"
+
+namespace robomach::calibration {
+
+struct ModalAnalysisOptions {
+  GlobalModalFitOptions fit;
+  /// Fit each FRF alone (its own poles) instead of one set of poles per
+  /// posture.
+  bool per_frf{false};
+  /// A posture's FRFs are fitted together only if at least this many lines
+  /// are usable in all of them; else each alone, with a warning.
+  int min_common_lines{40};
+};
+
+/// One tool-tip mode of a posture from the direct FRFs' modal constants:
+/// A_dd = u_d² / m for each measured direction d, so 1/m = Σ_d A_dd and
+/// u_d = sqrt(A_dd m), the signs of the cross FRFs' A_de giving the relative
+/// signs (formats.md §4: modal_mass_kg and a unit shape ux, uy, uz).
+struct TipMode {
+  double freq_hz{0.0};
+  double damping_ratio{0.0};
+  double modal_mass_kg{NAN};    // NaN if no direct FRF has a positive A_dd
+  Eigen::Vector3d shape{Eigen::Vector3d::Zero()};  // unit, in the FRFs' frame
+  /// Directions that entered (a subset of "xyz"): the mass is that of the
+  /// mode as seen in those directions only.
+  std::string directions;
+};
+
+/// One fit: the FRFs of a posture fitted together (or one FRF alone).
+struct ModalGroup {
+  std::string pose_id;
+  std::vector<dynamics::FrfKey> keys;  // the FRFs, in the order of fit.per_frf
+  std::vector<dynamics::Frf> data;     // the lines fitted, with σ when a noise model was given
+  GlobalModalFitResult fit;
+  /// Per FRF: the relative rms misfit in the file's quantity (receptance,
+  /// mobility or accelerance: see file_power).
+  std::vector<double> misfit;
+};
+
+struct PoseModes {
+  std::string pose_id;
+  std::vector<ModalGroup> groups;  // one per posture, or one per FRF with per_frf
+  std::vector<TipMode> tip_modes;  // from the first group (ascending frequency)
+  std::vector<std::string> warnings;
+};
+
+/// The modal analysis of every posture of `measured` (all lines),
+/// `noise` its noise models (may be empty: every line, weights 1/|H|).
+/// `file_power` is the power of iω of the file's quantity (0 receptance,
+/// 1 mobility, 2 accelerance), used for the misfit only.
+std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const NoiseModels& noise,
+                                    const ModalAnalysisOptions& options = {}, int file_power = 0);
+
+/// The tool-tip modes from one fit's direct and cross FRFs (see TipMode).
+std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>* warnings = nullptr);
+
+}  // namespace robomach::calibration

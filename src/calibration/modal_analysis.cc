@@ -1,0 +1,178 @@
+#include "robomach/calibration/modal_analysis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "robomach/common/frames.h"
+
+namespace robomach::calibration {
+namespace {
+
+int AxisIndex(Axis a) { return static_cast<int>(a); }
+
+// The lines of `frf` usable under its noise model (all without one).
+std::vector<char> UsableMask(const dynamics::Frf& frf, const FrfNoise* noise) {
+  std::vector<char> mask(frf.size(), 1);
+  if (noise && static_cast<int>(noise->usable.size()) == frf.size()) mask = noise->usable;
+  for (int k = 0; k < frf.size(); ++k) {
+    if (!(frf.freq_hz()(k) > 0.0)) mask[k] = 0;
+  }
+  return mask;
+}
+
+dynamics::Frf Prepared(const dynamics::Frf& frf, const FrfNoise* noise, const std::vector<int>& lines) {
+  dynamics::Frf f = frf;
+  if (noise && noise->sigma_m_per_N.size() == frf.size()) f = frf.WithNoise(noise->sigma_m_per_N);
+  return f.Select(lines);
+}
+
+}  // namespace
+
+std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>* warnings) {
+  std::vector<TipMode> out;
+  const Eigen::MatrixXcd A = group.fit.ModalConstants();
+  for (size_t r = 0; r < group.fit.modes.size(); ++r) {
+    TipMode t;
+    t.freq_hz = group.fit.modes[r].freq_hz;
+    t.damping_ratio = group.fit.modes[r].damping_ratio;
+    Eigen::Vector3d a_dd = Eigen::Vector3d::Constant(NAN);
+    Eigen::Matrix3d a_de = Eigen::Matrix3d::Constant(NAN);
+    for (size_t i = 0; i < group.keys.size(); ++i) {
+      const int d = AxisIndex(group.keys[i].response), e = AxisIndex(group.keys[i].excitation);
+      // Proportional damping: A is real; its real part carries the sign.
+      if (d == e) a_dd(d) = A(i, r).real();
+      else a_de(d, e) = A(i, r).real();
+    }
+    double inv_m = 0.0;
+    for (int d = 0; d < 3; ++d) {
+      if (std::isfinite(a_dd(d)) && a_dd(d) > 0.0) {
+        inv_m += a_dd(d);
+        t.directions += "xyz"[d];
+      }
+    }
+    if (inv_m > 0.0) {
+      t.modal_mass_kg = 1.0 / inv_m;
+      for (int d = 0; d < 3; ++d) {
+        if (std::isfinite(a_dd(d)) && a_dd(d) > 0.0) t.shape(d) = std::sqrt(a_dd(d) * t.modal_mass_kg);
+      }
+      // Signs relative to the strongest direction, from a cross FRF.
+      int ref = 0;
+      t.shape.cwiseAbs().maxCoeff(&ref);
+      for (int d = 0; d < 3; ++d) {
+        if (d == ref || t.shape(d) == 0.0) continue;
+        const double c = std::isfinite(a_de(d, ref)) ? a_de(d, ref) : a_de(ref, d);
+        if (std::isfinite(c) && c < 0.0) t.shape(d) = -t.shape(d);
+      }
+    } else if (warnings) {
+      warnings->push_back("posture " + group.pose_id + ", mode at " + std::to_string(t.freq_hz) +
+                          " Hz: no direct FRF has a positive modal constant, so it has no modal mass (left out of the "
+                          "modal table)");
+    }
+    out.push_back(t);
+  }
+  return out;
+}
+
+std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const NoiseModels& noise,
+                                    const ModalAnalysisOptions& options, int file_power) {
+  std::vector<PoseModes> out;
+  for (const std::string& pose : measured.pose_ids()) {
+    PoseModes pm;
+    pm.pose_id = pose;
+    const dynamics::FrfSet set = measured.ForPose(pose);
+    std::vector<dynamics::FrfKey> keys;
+    std::vector<const FrfNoise*> noises;
+    for (const auto& [key, frf] : set) {
+      keys.push_back(key);
+      const auto it = noise.find(key);
+      noises.push_back(it == noise.end() ? nullptr : &it->second);
+    }
+    // The lines usable in every FRF of the posture (same grid required).
+    bool same_grid = true;
+    const dynamics::Frf& first = set.at(keys.front());
+    for (const auto& key : keys) {
+      const dynamics::Frf& f = set.at(key);
+      same_grid = same_grid && f.size() == first.size() &&
+                  (f.freq_hz() - first.freq_hz()).cwiseAbs().maxCoeff() <= 1e-9 * first.freq_hz().maxCoeff();
+    }
+    std::vector<int> common;
+    if (same_grid) {
+      std::vector<char> all(first.size(), 1);
+      for (size_t i = 0; i < keys.size(); ++i) {
+        const std::vector<char> m = UsableMask(set.at(keys[i]), noises[i]);
+        for (int k = 0; k < first.size(); ++k) all[k] = all[k] && m[k];
+      }
+      for (int k = 0; k < first.size(); ++k) {
+        const double f = first.freq_hz()(k);
+        if (all[k] && f >= options.fit.fmin_hz && f <= options.fit.fmax_hz) common.push_back(k);
+      }
+    }
+    bool together = !options.per_frf && keys.size() > 1;
+    if (together && (!same_grid || static_cast<int>(common.size()) < options.min_common_lines)) {
+      pm.warnings.push_back("posture " + pose + ": its FRFs " +
+                            (same_grid ? "have only " + std::to_string(common.size()) +
+                                             " lines usable in all of them"
+                                       : std::string("are on different frequency lines")) +
+                            ", so each is fitted alone (its own poles)");
+      together = false;
+    }
+    auto fit_group = [&](const std::vector<size_t>& members, const std::vector<int>& lines_all) {
+      ModalGroup g;
+      g.pose_id = pose;
+      for (size_t i : members) {
+        std::vector<int> lines = lines_all;
+        if (lines.empty()) {
+          const std::vector<char> m = UsableMask(set.at(keys[i]), noises[i]);
+          const dynamics::Frf& f = set.at(keys[i]);
+          for (int k = 0; k < f.size(); ++k) {
+            if (m[k] && f.freq_hz()(k) >= options.fit.fmin_hz && f.freq_hz()(k) <= options.fit.fmax_hz) {
+              lines.push_back(k);
+            }
+          }
+        }
+        g.keys.push_back(keys[i]);
+        g.data.push_back(Prepared(set.at(keys[i]), noises[i], lines));
+      }
+      for (const dynamics::Frf& f : g.data) {
+        if (f.size() == 0) {
+          g.fit.message = "no usable line in the band";
+          return g;
+        }
+      }
+      GlobalModalFitOptions o = options.fit;
+      o.fmin_hz = 0.0;
+      o.fmax_hz = std::numeric_limits<double>::infinity();
+      g.fit = FitModesGlobal(g.data, o);
+      for (size_t i = 0; i < g.data.size(); ++i) {
+        g.misfit.push_back(i < g.fit.per_frf.size() ? RelativeMisfit(g.fit.per_frf[i], g.data[i], file_power) : NAN);
+      }
+      if (g.fit.status != ModalFitStatus::kOk) {
+        std::string which;
+        for (const auto& k : g.keys) which += (which.empty() ? "" : ", ") + k.ToString();
+        pm.warnings.push_back(which + ": " + g.fit.message);
+      }
+      return g;
+    };
+    if (together) {
+      std::vector<size_t> all(keys.size());
+      for (size_t i = 0; i < keys.size(); ++i) all[i] = i;
+      pm.groups.push_back(fit_group(all, common));
+    } else {
+      for (size_t i = 0; i < keys.size(); ++i) pm.groups.push_back(fit_group({i}, {}));
+    }
+    // Fitted together: the tool-tip modes of the one set of poles. Each FRF
+    // alone: the modes of each direct FRF, each a mode in its direction.
+    for (const ModalGroup& g : pm.groups) {
+      if (g.fit.status != ModalFitStatus::kOk) continue;
+      if (g.keys.size() == 1 && g.keys[0].response != g.keys[0].excitation) continue;
+      for (const TipMode& t : TipModes(g, &pm.warnings)) pm.tip_modes.push_back(t);
+    }
+    std::sort(pm.tip_modes.begin(), pm.tip_modes.end(),
+              [](const TipMode& a, const TipMode& b) { return a.freq_hz < b.freq_hz; });
+    out.push_back(std::move(pm));
+  }
+  return out;
+}
+
+}  // namespace robomach::calibration
