@@ -48,6 +48,12 @@ int Run(int argc, char** argv) {
   app.add_option("--max-order", opt.fit.max_order,
                  "highest LSCF order of the stabilisation diagram (number of poles)")
       ->capture_default_str();
+  std::string weights = "noise";
+  app.add_option("--weights", weights,
+                 "noise: 1/sigma of the noise model (the fit to within the noise); quantity: every line of the file's "
+                 "quantity alike (the unweighted least squares of modal software, which favours the peaks)")
+      ->check(CLI::IsMember({"noise", "quantity"}))
+      ->capture_default_str();
   app.add_flag("--per-frf", opt.per_frf, "fit each FRF alone (its own poles) instead of one set per posture");
   AddNoiseOptions(app, &noise_opt);
   app.add_option("--out", out_path,
@@ -64,6 +70,7 @@ int Run(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   return RunGuarded(kTool, [&]() -> int {
+    opt.weights_in_file_quantity = weights == "quantity";
     if (measured_files.empty() && pose_files.empty()) throw UsageError("give at least one --measured or --pose file");
     CheckOptionRange("--fmin-hz", opt.fit.fmin_hz, 0.0, 1e7);
     if (!std::isinf(opt.fit.fmax_hz)) CheckOptionRange("--fmax-hz", opt.fit.fmax_hz, opt.fit.fmin_hz, 1e7);

@@ -37,7 +37,7 @@ def misfit(h_fit, h):
 def run_robomach(csv_path, fmin, fmax, out_dir):
     summary = os.path.join(out_dir, 'summary.json')
     t0 = time.time()
-    subprocess.run([FRF_MODES, '--measured', csv_path, '--fmin-hz', str(fmin), '--fmax-hz', str(fmax),
+    subprocess.run([FRF_MODES, '--measured', csv_path, '--weights', os.environ.get('ROBOMACH_WEIGHTS', 'quantity'), '--fmin-hz', str(fmin), '--fmax-hz', str(fmax),
                     '--out', os.path.join(out_dir, 'modes.csv'), '--summary', summary, '--noise-model', 'scatter'],
                    check=False, capture_output=True)
     t = time.time() - t0

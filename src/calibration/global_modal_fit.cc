@@ -238,8 +238,24 @@ struct SetFit {
 
 class GlobalProblem {
  public:
-  GlobalProblem(const std::vector<dynamics::Frf>& frfs, double fmin_hz) : frfs_(frfs), fmin_hz_(fmin_hz) {
-    for (const dynamics::Frf& f : frfs_) weights_.push_back(ModalFitWeights(f));
+  // `uniform_power` >= 0: weights |ω|^p / rms|(iω)^p H| (every line of
+  // (iω)^p H alike, every FRF alike) instead of ModalFitWeights.
+  GlobalProblem(const std::vector<dynamics::Frf>& frfs, double fmin_hz, int uniform_power = -1)
+      : frfs_(frfs), fmin_hz_(fmin_hz) {
+    for (const dynamics::Frf& f : frfs_) {
+      if (uniform_power < 0) {
+        weights_.push_back(ModalFitWeights(f));
+        continue;
+      }
+      Eigen::VectorXd w(f.size());
+      double ss = 0.0;
+      for (int k = 0; k < f.size(); ++k) {
+        w(k) = std::pow(HzToRadPerSec(f.freq_hz()(k)), uniform_power);
+        ss += std::norm(w(k) * f.receptance()(k));
+      }
+      const double rms = std::sqrt(ss / std::max(1, f.size()));
+      weights_.push_back(rms > 0.0 ? Eigen::VectorXd(w / rms) : w);
+    }
   }
 
   bool LowerResidual(const std::vector<cd>& poles) const {
@@ -543,7 +559,7 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
                                   static_cast<int>(std::ceil(o.min_cluster_fraction * result.orders_tried)));
   std::vector<Cluster> clusters = ClusterStablePoles(by_order, min_orders, o.cluster_freq_tol);
 
-  const GlobalProblem problem(frfs, result.fmin_hz);
+  const GlobalProblem problem(frfs, result.fmin_hz, o.uniform_weights_power);
   std::vector<cd> poles;
   std::vector<int> support;
   for (const Cluster& c : clusters) {

@@ -243,18 +243,27 @@ void DumpFit(const GlobalModalFitResult& fit, const std::vector<dynamics::Frf>& 
     std::printf("  FRF %zu misfit %.4f noise %.2f\n", i + 1, RelativeMisfit(fit.per_frf[i], frfs[i], power), fit.misfit_in_noise[i]);
 }
 
-TEST(GlobalModalFitRealFiles, PyuffBeamEveryPeakFoundWithCommonPoles) {
+TEST(GlobalModalFitRealFiles, PyuffBeamEveryPeakFoundAndMisfitAtMostThePeers) {
   if (!std::filesystem::exists(Shared("pyuff/meas_point_1.txt"))) {
     GTEST_SKIP() << "../shared/external/frf_uff58/pyuff is absent (a clone without ../shared)";
   }
   const auto frfs = WithNoiseModels(PyuffBeam());
-  const GlobalModalFitResult fit = FitModesGlobal(frfs);
+  // The peer's criterion: least squares of the accelerance as measured,
+  // every line alike (frf-modes --weights quantity).
+  GlobalModalFitOptions o;
+  o.uniform_weights_power = 2;
+  const GlobalModalFitResult fit = FitModesGlobal(frfs, o);
   ASSERT_EQ(fit.status, ModalFitStatus::kOk) << fit.message;
   if (std::getenv("ROBOMACH_DUMP_FIT")) DumpFit(fit, frfs, 2);
+  // sdypy-EMA 0.31 (LSCF/LSFD, the three FRFs jointly) on the same files:
+  // misfit 0.026 / 0.045 / 0.029 as accelerance (issue #34; rerun by
+  // bench/peer_modal_sdypy.sh: 0.027 / 0.050 / 0.027).
+  const double peer[3] = {0.026, 0.045, 0.029};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LE(RelativeMisfit(fit.per_frf[i], frfs[i], 2), peer[i]) << "FRF " << i + 1 << ": " << fit.message;
+  }
   // The peaks the files show (SOURCES.md, read on the 1 Hz grid): 52, 142,
-  // 279, 460, 687, 959 Hz; a mode within one line of each. (Misfit against
-  // sdypy-EMA's 0.026 / 0.045 / 0.029: measured 0.056 / 0.083 / 0.053, not
-  // yet at the peer's, see docs/testing.md; not asserted.)
+  // 279, 460, 687, 959 Hz; a mode within one line of each.
   for (double f : {52.0, 142.0, 279.0, 460.0, 687.0, 959.0}) {
     double nearest = 1e300;
     for (const GlobalMode& m : fit.modes) nearest = std::min(nearest, std::abs(m.freq_hz - f));

@@ -51,6 +51,13 @@ struct GlobalModalFitOptions {
   /// At most this many modes added where the residual of the FRFs together
   /// is structured rather than noise; kept if the BIC falls.
   int max_added_modes{4};
+  /// Weights of the residues and the refinement: −1 (default) those of
+  /// ModalFitWeights, 1/σ with a noise model (the maximum-likelihood fit for
+  /// the noise measured), else 1/|H|; p = 0, 1, 2: every line of the
+  /// receptance, mobility or accelerance alike (each FRF scaled to unit
+  /// rms), the least-squares fit of that quantity without weights, as
+  /// modal software does, which favours the peaks.
+  int uniform_weights_power{-1};
   /// Index of the driving-point FRF (response = reference) among the FRFs,
   /// or −1: with it the mode shapes are mass-normalised
   /// (φ_j = A_j / sqrt(A_driving)); without it they are unit-normalised.

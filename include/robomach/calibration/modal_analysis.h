@@ -23,6 +23,14 @@ struct ModalAnalysisOptions {
   /// Fit each FRF alone (its own poles) instead of one set of poles per
   /// posture.
   bool per_frf{false};
+  /// Weights of the fit: false (the default) the noise model's 1/σ (the
+  /// maximum-likelihood fit for the noise measured, a fit to within the
+  /// noise over the whole band); true every line of the FRF in the file's
+  /// quantity alike (receptance, mobility or accelerance: the unweighted
+  /// least squares of modal software, which the relative misfit measures
+  /// and which favours the peaks). See
+  /// GlobalModalFitOptions::uniform_weights_power.
+  bool weights_in_file_quantity{false};
   /// A posture's FRFs are fitted together only if at least this many lines
   /// are usable in all of them; else each alone, with a warning.
   int min_common_lines{40};
