@@ -93,7 +93,7 @@ int Run(int argc, char** argv) {
       "frf-estimate: tool-tip FRFs from raw impact-hammer time records (docs/frf-estimate.md).\n"
       "Input CSV: time_s, force_N, one or more responses named by unit (<name>_m displacement,\n"
       "<name>_m_per_s velocity, <name>_m_per_s2 acceleration), and an optional hit column (else one\n"
-      "file per hit). Per response: H1 = Gfx/Gff (or H2 = Gxx/Gxf) averaged over the accepted hits,\n"
+      "file per hit), or UFF58 time records. Per response: H1 = Gfx/Gff (or H2 = Gxx/Gxf) averaged over the accepted hits,\n"
       "with the coherence, written as the FRF CSV of docs/formats.md section 3 (re-readable by\n"
       "frf-calibrate and model-audit) with '# averages: N' and the windows as metadata.\n"
       "Hits with a second force pulse (double hit) or a clipped/over-range channel (overload) are\n"
@@ -107,7 +107,9 @@ int Run(int argc, char** argv) {
                                                  estimator = "h1";
   calibration::FrfEstimateOptions o;
   int min_hits = 3;
-  app.add_option("records", records, "hammer record CSV file(s)")->required();
+  app.add_option("records", records,
+                 "hammer record file(s): CSV, or UFF58 time records (function type 1: per hit the force record, "
+                 "then its response records; docs/formats.md section 10.1)")->required();
   app.add_option("--out", out_path, "output FRF CSV (docs/formats.md section 3); '-' = stdout")->required();
   app.add_option("--pose-id", pose_id, "pose id written in the FRF file")->capture_default_str();
   app.add_option("--excitation", excitation, "hammer direction at the tool tip: x, y or z")->capture_default_str();

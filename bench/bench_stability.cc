@@ -185,6 +185,39 @@ void BM_SdLobesKr210Posture60Speeds(benchmark::State& state) {
 }
 BENCHMARK(BM_SdLobesKr210Posture60Speeds)->Arg(30)->Arg(0)->Unit(benchmark::kMillisecond)->Iterations(3);
 
+// The SD of a measured tap test as `stability-lobes --frf --method sd
+// --threads 1` runs it (issue #34: 30 s of its 44 s): the modes of
+// tests/tap_test_synth.h (1074, 1961, 2617 Hz, zeta 0.03, modal masses
+// 0.439, 0.198, 0.185 kg) fitted along x and y of a symmetric tool (6 modes,
+// automatic steps: capped at a 400-row monodromy matrix), the cut of
+// tests/data/stability/cut_tap_lobe0.yaml (4 teeth, a/D 0.5, down-milling,
+// Ktc 1800, Krc 650 N/mm^2), 60 speeds over 22000-32000 rpm, one thread.
+void BM_SdLobesTapTest60Speeds(benchmark::State& state) {
+  const double f[3] = {1074.0, 1961.0, 2617.0}, mass[3] = {0.4393, 0.1976, 0.1850};
+  stability::TipModalModel m;
+  m.omega_rad_s.resize(6);
+  m.zeta = Eigen::VectorXd::Constant(6, 0.03);
+  m.p = Matrix3Xd::Zero(3, 6);
+  for (int d = 0; d < 2; ++d) {
+    for (int k = 0; k < 3; ++k) {
+      m.omega_rad_s(3 * d + k) = HzToRadPerSec(f[k]);
+      m.p(d, 3 * d + k) = 1.0 / std::sqrt(mass[k]);
+    }
+  }
+  stability::MillingProcess p;
+  p.teeth = 4;
+  p.radial_immersion = 0.5;
+  p.direction = stability::MillingDirection::kDown;
+  p.coefficients = {1800e6, 650e6, 300e6};
+  const stability::SdOptions o;
+  const Eigen::VectorXd speeds = Eigen::VectorXd::LinSpaced(60, RpmToRadPerSec(22000.0), RpmToRadPerSec(32000.0));
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(stability::SdLobes(m, p, speeds, o, 1).data());
+  }
+  state.counters["steps_at_min_speed"] = stability::SdStepsPerPeriod(m, p, speeds(0), o);
+}
+BENCHMARK(BM_SdLobesTapTest60Speeds)->Unit(benchmark::kSecond)->Iterations(1);
+
 }  // namespace
 
 BENCHMARK_MAIN();

@@ -74,11 +74,15 @@ void BindCalibration(py::module_& m) {
           d["damping_ratio"] = mm.fit.damping_ratio;
           d["peak_freq_hz"] = mm.peak_freq_hz;
           d["peak_magnitude_m_per_N"] = mm.peak_magnitude;
+          d["peak_kind"] = mm.peak_kind == calibration::PeakKind::kShoulder ? "shoulder" : "maximum";
           out.push_back(d);
         }
         return out;
       }, "list of dicts: key (pose_id, response, excitation), freq_hz [Hz], damping_ratio [-], "
-         "peak_freq_hz [Hz], peak_magnitude_m_per_N [m/N]")
+         "peak_freq_hz [Hz], peak_magnitude_m_per_N [m/N] (the maximum of the fitted curve within the mode's "
+         "own half-power band, cut at the midpoints to the other modes of the FRF), peak_kind 'maximum' or "
+         "'shoulder' (no maximum of its own in that window, on a stronger neighbour's flank: the peak is then "
+         "|H| at the mode's own resonance f_n sqrt(1 - 2 zeta^2))")
       .def_property_readonly("fit_status", [](const MeasuredFeatures& f) {
         std::map<std::tuple<std::string, std::string, std::string>, std::string> out;
         for (const auto& [k, r] : f.fits) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -12,6 +13,7 @@
 #include "robomach/common/number_format.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
+#include "robomach/io/uff58.h"
 
 namespace robomach::io {
 namespace {
@@ -157,6 +159,255 @@ FileHits ReadOne(const std::string& path, bool prefix_ids) {
   return out;
 }
 
+// ------------------------------------------------------------ UFF58 --
+//
+// Time records (dataset 58, function type 1) as data acquisition systems
+// export a hammer test: per hit one force record and the response records
+// of that hit, in file order. A hit starts at each force record; the
+// response records after it, up to the next force record, are its
+// responses. A record is a force if record 9 says excitation or reaction
+// force (specific data type 13 or 9) or its unit is a force; a response if
+// it says displacement, velocity or acceleration (8, 11, 12) or its unit is
+// a length, m/s or m/s². Units: the record 9 label (e.g. "g", "mm/s^2",
+// "lbf"), else dataset 164 with record 9's exponents, else SI. A response
+// channel is named by its node and direction, "n<node>_<axis>" (a negative
+// direction is read with its sign flipped, along +axis), so that its
+// direction comes from the name (ChannelKeys); a force record with a
+// negative direction is likewise read along +axis.
+
+struct UffTimeRecord {
+  const Uff58Record* r;
+  bool force{false};
+  ResponseQuantity quantity{ResponseQuantity::kAcceleration};
+  double factor{1.0};  // SI = factor × stored
+  std::string name;     // response channel name
+};
+
+UnitDimension LabelAt(const std::string& path, const UffAxis& a, const std::string& record) {
+  try {
+    return ParseUnitLabel(a.units);
+  } catch (const std::invalid_argument& e) {
+    throw InputError({path, a.line, 48}, record + " units label: " + e.what());
+  }
+}
+
+UffTimeRecord ClassifyTimeRecord(const std::string& path, const Uff58Record& r, const UffUnits* units) {
+  UffTimeRecord out;
+  out.r = &r;
+  const int spec = r.ordinate.specific_type;
+  std::optional<bool> force_by_code;
+  std::optional<ResponseQuantity> q_by_code;
+  switch (spec) {
+    case 13: case 9: force_by_code = true; break;
+    case 8: q_by_code = ResponseQuantity::kDisplacement; break;
+    case 11: q_by_code = ResponseQuantity::kVelocity; break;
+    case 12: q_by_code = ResponseQuantity::kAcceleration; break;
+    case 0: case 1: break;
+    default:
+      throw InputError({path, r.ordinate.line, 1},
+                       "record 9: ordinate specific data type " + std::to_string(spec) +
+                           " is not a hammer force (13 excitation force, 9 reaction force) or a response (8 "
+                           "displacement, 11 velocity, 12 acceleration)");
+  }
+  const UnitDimension u = LabelAt(path, r.ordinate, "record 9");
+  std::optional<bool> force_by_unit;
+  std::optional<ResponseQuantity> q_by_unit;
+  if (u.given) {
+    if (u.force == 1 && u.length == 0 && u.time == 0) force_by_unit = true;
+    else if (u.force == 0 && u.length == 1 && u.time == 0) q_by_unit = ResponseQuantity::kDisplacement;
+    else if (u.force == 0 && u.length == 1 && u.time == -1) q_by_unit = ResponseQuantity::kVelocity;
+    else if (u.force == 0 && u.length == 1 && u.time == -2) q_by_unit = ResponseQuantity::kAcceleration;
+    else {
+      throw InputError({path, r.ordinate.line, 48},
+                       "record 9 unit \"" + r.ordinate.units + "\" is m^" + std::to_string(u.length) + " N^" +
+                           std::to_string(u.force) + " s^" + std::to_string(u.time) +
+                           ", neither a force (N) nor a displacement, velocity or acceleration (m, m/s, m/s^2)");
+    }
+  }
+  const bool is_force = force_by_code.value_or(false) || force_by_unit.value_or(false);
+  const bool is_response = q_by_code.has_value() || q_by_unit.has_value();
+  if (is_force && is_response) {
+    throw InputError({path, r.ordinate.line, 1},
+                     "record 9: specific data type " + std::to_string(spec) + " and unit \"" + r.ordinate.units +
+                         "\" disagree on whether this is the force or a response; correct one of them in the export");
+  }
+  if (!is_force && !is_response) {
+    throw InputError({path, r.ordinate.line, 1},
+                     "record 9 gives neither a specific data type (" + std::to_string(spec) +
+                         ") nor a unit, so the force cannot be told from the responses: export the force with "
+                         "type 13 (or unit N) and the responses with 8, 11 or 12 (or m, m/s, m/s^2)");
+  }
+  if (q_by_code && q_by_unit && *q_by_code != *q_by_unit) {
+    throw InputError({path, r.ordinate.line, 1},
+                     "record 9: specific data type " + std::to_string(spec) + " and unit \"" + r.ordinate.units +
+                         "\" name different quantities; correct one of them in the export");
+  }
+  out.force = is_force;
+  if (!is_force) out.quantity = q_by_unit ? *q_by_unit : *q_by_code;
+  if (u.given) {
+    out.factor = u.factor;
+  } else if (units && (r.ordinate.length_exponent || r.ordinate.force_exponent)) {
+    out.factor = std::pow(units->length, -r.ordinate.length_exponent) * std::pow(units->force, -r.ordinate.force_exponent);
+  }
+  if (out.force) {
+    // The hammer along -axis (a negative direction code): read along +axis,
+    // as the responses are.
+    if (r.response_direction < 0) out.factor = -out.factor;
+  } else {
+    const int d = r.response_direction;
+    if (std::abs(d) >= 4) {
+      throw InputError({path, r.record6_line, 52},
+                       "record 6: response direction " + std::to_string(d) +
+                           " is not translational (1/-1 x, 2/-2 y, 3/-3 z, 0 scalar)");
+    }
+    out.name = "n" + std::to_string(r.response_node);
+    if (d != 0) {
+      out.name += std::string("_") + "xyz"[std::abs(d) - 1];
+      if (d < 0) out.factor = -out.factor;
+    }
+  }
+  return out;
+}
+
+// Seconds per stored abscissa unit of a time record.
+double AbscissaToSeconds(const std::string& path, const Uff58Record& r) {
+  const int spec = r.abscissa.specific_type;
+  if (spec != 0 && spec != 1 && spec != 17) {
+    throw InputError({path, r.abscissa.line, 1}, "record 8: abscissa specific data type " + std::to_string(spec) +
+                                                     " is not time (17): a time record is a function of time");
+  }
+  const UnitDimension d = LabelAt(path, r.abscissa, "record 8");
+  if (!d.given) return 1.0;
+  if (d.time != 1 || d.length || d.force) {
+    throw InputError({path, r.abscissa.line, 48}, "record 8: abscissa unit \"" + r.abscissa.units + "\" is not a time");
+  }
+  return d.factor;
+}
+
+FileHits ReadOneUff(const std::string& path, bool prefix_ids) {
+  const UffFile file = ReadUffFile(path);
+  const std::string stem = std::filesystem::path(path).stem().string();
+  if (file.records.empty()) {
+    throw InputError({path, 0, 0}, "no dataset 58 record: a UFF hammer record file holds the time records "
+                                   "(dataset 58, function type 1) of the force and responses of each hit");
+  }
+  std::vector<UffTimeRecord> recs;
+  for (size_t i = 0; i < file.records.size(); ++i) {
+    const Uff58Record& r = file.records[i];
+    if (r.function_type != 1) {
+      throw InputError({path, r.record6_line, 1},
+                       "record 6: function type " + std::to_string(r.function_type) + " (" +
+                           UffFunctionTypeName(r.function_type) +
+                           "); frf-estimate reads time responses (function type 1), the raw records of each hit" +
+                           (r.function_type == 4 ? " (an FRF file is read by frf-calibrate, model-audit, stability-lobes)"
+                                                 : ""));
+    }
+    if (r.complex()) {
+      throw InputError({path, r.record7_line, 1}, "record 7: ordinate data type " + std::to_string(r.ordinate_type) +
+                                                      " is complex; a time record is real (2 or 4)");
+    }
+    const UffUnits* units = file.record_units[i] >= 0 ? &file.units[file.record_units[i]] : nullptr;
+    recs.push_back(ClassifyTimeRecord(path, r, units));
+  }
+  if (!recs.front().force) {
+    throw InputError({path, recs.front().r->line, 0},
+                     "the first record is a response (" + recs.front().name +
+                         "); each hit starts with its force record, followed by its response records");
+  }
+  // Groups: a force record and the responses after it.
+  std::vector<std::vector<const UffTimeRecord*>> groups;
+  for (const UffTimeRecord& t : recs) {
+    if (t.force) groups.emplace_back();
+    groups.back().push_back(&t);
+  }
+  // Load cases as hit ids when every hit has its own.
+  std::set<int> cases;
+  for (const auto& g : groups) cases.insert(g.front()->r->load_case);
+  const bool by_case = cases.size() == groups.size() && groups.size() > 1;
+  FileHits out;
+  std::vector<std::string> names;  // channel names of the first hit, in order
+  for (size_t h = 0; h < groups.size(); ++h) {
+    const auto& g = groups[h];
+    const Uff58Record& f = *g.front()->r;
+    const std::string hid = by_case ? std::to_string(f.load_case) : std::to_string(h + 1);
+    const std::string where = path + ":" + std::to_string(f.line);
+    if (g.size() < 2) throw InputError({path, f.line, 0}, "hit " + hid + ": a force record without response records");
+    std::vector<std::string> mine;
+    for (size_t k = 1; k < g.size(); ++k) {
+      const UffTimeRecord& t = *g[k];
+      if (t.r->load_case != f.load_case && by_case) {
+        throw InputError({path, t.r->line, 0}, "response record of load case " + std::to_string(t.r->load_case) +
+                                                   " after the force record of load case " + std::to_string(f.load_case) +
+                                                   " (line " + std::to_string(f.line) + "); each hit's responses follow its force");
+      }
+      if (std::find(mine.begin(), mine.end(), t.name) != mine.end()) {
+        throw InputError({path, t.r->line, 0}, "hit " + hid + ": a second response record of " + t.name +
+                                                   " (node " + std::to_string(t.r->response_node) + ", direction " +
+                                                   std::to_string(t.r->response_direction) + ")");
+      }
+      mine.push_back(t.name);
+    }
+    if (h == 0) {
+      names = mine;
+      for (size_t k = 1; k < g.size(); ++k) {
+        const char* suffix = g[k]->quantity == ResponseQuantity::kDisplacement ? "_m"
+                             : g[k]->quantity == ResponseQuantity::kVelocity   ? "_m_per_s"
+                                                                               : "_m_per_s2";
+        out.channel_columns.push_back(g[k]->name + suffix);
+      }
+    } else if (std::set<std::string>(mine.begin(), mine.end()) != std::set<std::string>(names.begin(), names.end())) {
+      std::string a, b;
+      for (const auto& c : names) a += (a.empty() ? "" : ", ") + c;
+      for (const auto& c : mine) b += (b.empty() ? "" : ", ") + c;
+      throw InputError({path, f.line, 0}, "hit " + hid + " has the responses " + b + ", the first hit " + a +
+                                              "; every hit must have the same responses");
+    }
+    // One time grid per hit, the same for its force and responses.
+    const double s_per_unit = AbscissaToSeconds(path, f);
+    for (const UffTimeRecord* t : g) {
+      const Uff58Record& r = *t->r;
+      if (!r.even) {
+        throw InputError({path, r.record7_line, 21}, "record 7: uneven abscissa; a time record must be evenly "
+                                                         "sampled (record 7 field 3 = 1, with x_min and dx)");
+      }
+      if (!(r.dx > 0.0)) {
+        throw InputError({path, r.record7_line, 44}, "record 7: dx " + FormatNumber(r.dx, 10) + " is not > 0");
+      }
+      if (r.num_points != f.num_points || std::abs(r.dx - f.dx) > 1e-9 * f.dx ||
+          std::abs(r.x_min - f.x_min) > 1e-6 * f.dx * f.num_points ||
+          std::abs(AbscissaToSeconds(path, r) - s_per_unit) > 1e-12 * s_per_unit) {
+        throw InputError({path, r.line, 0}, "hit " + hid + ": this record's time grid (" + std::to_string(r.num_points) +
+                                                " points, x_min " + FormatNumber(r.x_min, 10) + ", dx " +
+                                                FormatNumber(r.dx, 10) + ") differs from its force record's (" +
+                                                std::to_string(f.num_points) + " points, x_min " +
+                                                FormatNumber(f.x_min, 10) + ", dx " + FormatNumber(f.dx, 10) +
+                                                ", line " + std::to_string(f.line) + ")");
+      }
+    }
+    const long n = f.num_points;
+    if (n < 16) {
+      throw InputError({path, f.line, 0}, "hit " + hid + " has " + std::to_string(n) + " samples; at least 16 are needed");
+    }
+    ImpactRecord rec;
+    rec.id = prefix_ids ? stem + "#" + hid : hid;
+    rec.source = where;
+    rec.start_time_s = f.x_min * s_per_unit;
+    rec.sample_rate_hz = 1.0 / (f.dx * s_per_unit);
+    // dx is written with 6 significant digits (E13.5): a rate within that
+    // rounding of a whole number of hertz is that number (as for the CSV).
+    const double whole = std::round(rec.sample_rate_hz);
+    if (whole > 0.0 && std::abs(whole - rec.sample_rate_hz) <= 5e-6 * rec.sample_rate_hz) rec.sample_rate_hz = whole;
+    rec.force_N = g.front()->factor * f.y.real();
+    rec.response.resize(n, static_cast<Eigen::Index>(names.size()));
+    for (size_t k = 1; k < g.size(); ++k) {
+      const auto c = std::find(names.begin(), names.end(), g[k]->name) - names.begin();
+      rec.response.col(c) = g[k]->factor * g[k]->r->y.real();
+    }
+    out.hits.push_back(std::move(rec));
+  }
+  return out;
+}
+
 }  // namespace
 
 bool ParseResponseColumn(const std::string& column, ResponseQuantity* quantity, std::string* name) {
@@ -180,7 +431,7 @@ HammerRecords ReadHammerRecords(const std::vector<std::string>& paths) {
   HammerRecords out;
   std::map<std::string, std::string> where;  // hit id -> source
   for (size_t f = 0; f < paths.size(); ++f) {
-    FileHits fh = ReadOne(paths[f], paths.size() > 1);
+    FileHits fh = LooksLikeUff(paths[f]) ? ReadOneUff(paths[f], paths.size() > 1) : ReadOne(paths[f], paths.size() > 1);
     if (f == 0) {
       out.channel_columns = fh.channel_columns;
       for (const std::string& c : fh.channel_columns) {

@@ -43,8 +43,65 @@ nlohmann::json LobesSummaryJson(const std::vector<stability::TipDynamics>& tips,
     }
     results.push_back(r);
   }
+  // Every number stability-lobes tells on stderr is here too (issue #34
+  // item 6): the fit reports, the band the ZOA uses, the SD's
+  // discretisation and the comparison of the two methods.
+  nlohmann::json tip_list = nlohmann::json::array();
+  for (const stability::TipDynamics& t : tips) {
+    nlohmann::json tj;
+    tj["pose_id"] = t.id;
+    if (t.freq_hz.size() > 0) tj["zoa_band_hz"] = {t.freq_hz(0), t.freq_hz(t.freq_hz.size() - 1)};
+    if (!t.fits.empty()) {
+      nlohmann::json fits = nlohmann::json::array();
+      for (const stability::DirectionFit& d : t.fits) {
+        nlohmann::json fj;
+        fj["frf"] = d.label;
+        if (!d.same_as.empty()) fj["same_as"] = d.same_as;
+        fj["noise"] = d.fit.noise.description;
+        if (!d.fit.noise.usable_bands.empty()) {
+          fj["usable_band_hz"] = {d.fit.noise.usable_bands.front().first, d.fit.noise.usable_bands.back().second};
+        }
+        fj["usable_lines"] = d.fit.noise.usable_lines;
+        nlohmann::json modes = nlohmann::json::array();
+        for (const calibration::FittedMode& m : d.fit.fit.modes) {
+          nlohmann::json mj;
+          mj["freq_hz"] = m.freq_hz;
+          mj["damping_ratio"] = m.damping_ratio;
+          // 1 / Re A: the modal mass of a driving-point mode; none for Re A <= 0 (left out of the SD).
+          if (m.modal_constant.real() > 0.0) mj["modal_mass_kg"] = 1.0 / m.modal_constant.real();
+          modes.push_back(mj);
+        }
+        fj["modes"] = modes;
+        if (std::isfinite(d.fit.noise_rms)) fj["rms_misfit_noise_units"] = d.fit.noise_rms;
+        fj["poor"] = d.fit.poor;
+        fits.push_back(fj);
+      }
+      tj["fits"] = fits;
+    }
+    for (const stability::SdDiscretisation& s : lobes.sd_discretisation) {
+      if (s.id != t.id) continue;
+      tj["sd_modes"] = s.modes;
+      tj["sd_highest_mode_hz"] = s.highest_mode_hz;
+      tj["sd_steps_per_tooth_period_min"] = s.min_steps_per_period;
+      tj["sd_steps_per_tooth_period_max"] = s.max_steps_per_period;
+      tj["sd_steps_capped"] = s.capped;
+    }
+    for (const stability::ZoaSdComparison& c : lobes.comparisons) {
+      if (c.id != t.id) continue;
+      nlohmann::json cj;
+      cj["sd_min_critical_depth_mm"] = MToMm(c.sd_min_depth);
+      cj["sd_min_critical_depth_speed_rpm"] = LobeSpeedRpm(c.sd_min_depth_speed_rad_s);
+      cj["zoa_min_critical_depth_mm"] = MToMm(c.zoa_min_depth);
+      cj["zoa_min_critical_depth_speed_rpm"] = LobeSpeedRpm(c.zoa_min_depth_speed_rad_s);
+      cj["difference_percent"] = 100.0 * c.relative_difference;
+      cj["agree"] = c.agree;
+      tj["zoa_sd_comparison"] = cj;
+    }
+    tip_list.push_back(tj);
+  }
   nlohmann::json j;
   j["lobes"] = results;
+  j["tips"] = tip_list;
   j["no_boundary_at_some_speeds"] = lobes.no_boundary;
   j["flagged"] = lobes.flagged();
   return j;

@@ -13,12 +13,13 @@
 namespace robomach::stability {
 namespace {
 
-// The smallest critical depth [m] of one method over its ok points.
-double MinDepth(const std::vector<LobeRow>& rows, const std::string& id, const std::string& method) {
-  double m = INFINITY;
+// The smallest critical depth [m] of one method over its ok points, and its
+// speed [rad/s].
+std::pair<double, double> MinDepth(const std::vector<LobeRow>& rows, const std::string& id, const std::string& method) {
+  std::pair<double, double> m{INFINITY, NAN};
   for (const LobeRow& r : rows) {
-    if (r.id == id && r.method == method && r.point.status == LobeStatus::kOk) {
-      m = std::min(m, r.point.critical_depth);
+    if (r.id == id && r.method == method && r.point.status == LobeStatus::kOk && r.point.critical_depth < m.first) {
+      m = {r.point.critical_depth, r.point.spindle_speed_rad_s};
     }
   }
   return m;
@@ -40,11 +41,11 @@ TipModalModel SdModel(const TipDynamics& t, int sd_modes) {
 // not (on issue #18's tap test, 0.886 mm at lobe 0 and 0.971 mm at lobe 2
 // against the ZOA's 0.896 mm). A disagreement is a finding.
 void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<LobeRow>& rows, const LobesOptions& o,
-                     const TipMessageSink& tell, RunFindings* findings) {
+                     const TipMessageSink& tell, LobesResult* findings) {
   if (o.process.radial_immersion < 0.3) return;
   for (const TipDynamics& t : tips) {
-    double sd = MinDepth(rows, t.id, "sd");
-    const double zoa = MinDepth(rows, t.id, "zoa");
+    auto [sd, sd_speed] = MinDepth(rows, t.id, "sd");
+    const auto [zoa, zoa_speed] = MinDepth(rows, t.id, "zoa");
     if (!std::isfinite(sd) || !std::isfinite(zoa)) continue;
     std::map<int, const LobeRow*> bottom;  // lowest ZOA point of each lobe
     for (const LobeRow& r : rows) {
@@ -65,10 +66,14 @@ void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
       if (!(hi > lo)) continue;
       for (const LobePoint& p :
            SdLobes(SdModel(t, o.sd_modes), o.process, Eigen::VectorXd::LinSpaced(7, lo, hi), o.sd, o.threads)) {
-        if (p.status == LobeStatus::kOk) sd = std::min(sd, p.critical_depth);
+        if (p.status == LobeStatus::kOk && p.critical_depth < sd) {
+          sd = p.critical_depth;
+          sd_speed = p.spindle_speed_rad_s;
+        }
       }
     }
     const double diff = std::abs(sd - zoa) / std::min(sd, zoa);
+    findings->comparisons.push_back({t.id, sd, sd_speed, zoa, zoa_speed, diff, diff <= 0.10});
     std::ostringstream m;
     m << t.id << ": smallest critical depth SD " << FormatNumber(MToMm(sd)) << " mm, ZOA " << FormatNumber(MToMm(zoa))
       << " mm";
@@ -92,6 +97,7 @@ std::vector<std::string> TipFitWarnings(const TipDynamics& t, bool sd) {
   std::vector<std::string> w;
   if (!t.unit_finding.empty()) w.push_back("implausible (unit mistake?): " + t.unit_finding);
   for (const DirectionFit& d : t.fits) {
+    if (!d.same_as.empty()) continue;  // the same FRF as an earlier fit: its warnings are said once
     if (d.fit.not_driving_point) {
       w.push_back(d.label + ": Im H > 0 (beyond twice the noise) on " +
                   FormatDouble(std::round(d.fit.active_fraction * 1000.0) / 10.0) +
@@ -162,6 +168,8 @@ LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOption
             << o.sd.min_steps_per_period << ")";
       }
       tell(TipMessage::Kind::kFit, msg.str());
+      result.sd_discretisation.push_back(
+          {t.id, static_cast<int>(m.num_modes()), RadPerSecToHz(m.omega_rad_s.maxCoeff()), k_lo, k_hi, capped});
       if (capped) {
         tell(TipMessage::Kind::kWarning,
              "SD of " + t.id + ": at the lowest speeds the automatic steps per tooth period were capped at " +

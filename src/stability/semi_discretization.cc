@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <unsupported/Eigen/MatrixFunctions>
@@ -11,6 +12,55 @@
 #include "robomach/common/units.h"
 
 namespace robomach::stability {
+
+namespace {
+
+// The dominant eigenvalue of the monodromy matrix Φ (D × D), given only
+// its product with vectors, by Arnoldi's method [Saad 2011, §6.3]: the
+// eigenvalues of the Hessenberg matrix H_K of the Krylov space of dimension
+// K (Ritz values) approximate the outermost eigenvalues of Φ first. The
+// monodromy of a semi-discretised delay equation has few such eigenvalues
+// (about two per mode) and D − O(d) crowded near zero (the delay line), so
+// K of a few d captures the dominant one. It is accepted only when its Ritz
+// residual |h_{K+1,K} s_K| is below 1e-12 of |θ| (then θ is an eigenvalue of
+// a matrix within that of Φ); otherwise K doubles, and at K = D the Krylov
+// space is the whole space and H_K is similar to Φ: the dense answer.
+template <class Apply>
+std::complex<double> DominantEigenvalue(int D, int d, const Apply& apply) {
+  int K = std::min(D, std::max(40, 4 * d));
+  for (;;) {
+    Eigen::MatrixXd V(D, K + 1), H = Eigen::MatrixXd::Zero(K + 1, K);
+    // A fixed start with every component non-zero (reproducible results).
+    for (int i = 0; i < D; ++i) V(i, 0) = 1.0 + 0.5 * std::sin(1.0 + 0.7 * i);
+    V.col(0).normalize();
+    int k_used = K;
+    Eigen::VectorXd w(D);
+    for (int j = 0; j < K; ++j) {
+      apply(V.col(j), &w);
+      for (int pass = 0; pass < 2; ++pass) {  // Gram-Schmidt twice: orthogonal to rounding
+        const Eigen::VectorXd h = V.leftCols(j + 1).transpose() * w;
+        w.noalias() -= V.leftCols(j + 1) * h;
+        H.col(j).head(j + 1) += h;
+      }
+      H(j + 1, j) = w.norm();
+      if (H(j + 1, j) <= 1e-14 * H.col(j).head(j + 1).norm()) {  // invariant subspace: exact
+        k_used = j + 1;
+        break;
+      }
+      V.col(j + 1) = w / H(j + 1, j);
+    }
+    Eigen::EigenSolver<Eigen::MatrixXd> es(H.topLeftCorner(k_used, k_used), true);
+    const Eigen::VectorXcd theta = es.eigenvalues();
+    Eigen::Index imax = 0;
+    theta.cwiseAbs().maxCoeff(&imax);
+    const Eigen::VectorXcd s = es.eigenvectors().col(imax);
+    const double residual = k_used < K || k_used == D ? 0.0 : H(k_used, k_used - 1) * std::abs(s(k_used - 1)) / s.norm();
+    if (residual <= 1e-12 * std::max(std::abs(theta(imax)), 1e-300) || K >= D) return theta(imax);
+    K = std::min(D, 2 * K);
+  }
+}
+
+}  // namespace
 
 SdMonodromy FirstOrderSdMonodromy(int d, int n_u, double period, double delay, int steps,
                                   const SdStepCoefficients& coefficients) {
@@ -22,47 +72,53 @@ SdMonodromy FirstOrderSdMonodromy(int d, int n_u, double period, double delay, i
   if (m < 1) throw std::invalid_argument("semi-discretization: the delay is shorter than half a step");
   const int D = d + m * n_u;
 
-  // Z holds the product of the step matrices applied so far, as rows of
-  // z = [y (d); u_{i-1}; ...; u_{i-m}] (block l at row d + (l-1) n_u).
-  Eigen::MatrixXd Z = Eigen::MatrixXd::Identity(D, D);
-  Eigen::MatrixXd A(d, d), B(d, n_u), E(3 * d, 3 * d), top(d, D);
+  // The step matrices: y_{i+1} = P_i y_i + R1_i u_{i-m+1} + R0_i u_{i-m},
+  // u_j = the first n_u entries of y_j.
+  std::vector<Eigen::MatrixXd> P(steps), R1(steps), R0(steps);
+  Eigen::MatrixXd A(d, d), B(d, n_u), E(d + 2 * n_u, d + 2 * n_u);
   for (int i = 0; i < steps; ++i) {
     A.setZero();
     B.setZero();
     coefficients(i, i * dt, (i + 1) * dt, &A, &B);
-    // Van Loan: exp([[A, I, 0], [0, 0, I], [0, 0, 0]] Δt) has blocks
-    // (1,1) = e^{AΔt}, (1,2) = Γ0, (1,3) = Γ1.
+    // Van Loan: with u' = v, v' = 0 appended to y' = A y + B u, the flow
+    // over Δt, exp([[A, B, 0], [0, 0, I], [0, 0, 0]] Δt), has the blocks
+    // (1,1) = e^{AΔt}, (1,2) = Γ0 B (from u = I, v = 0) and (1,3) = Γ1 B
+    // (from u = 0, v = I: u grows as s). Of size d + 2 n_u, not the 3d of
+    // Γ0 and Γ1 themselves: (24/36)³ of the work for six modes.
     E.setZero();
-    E.block(0, 0, d, d) = A * dt;
-    E.block(0, d, d, d) = Eigen::MatrixXd::Identity(d, d) * dt;
-    E.block(d, 2 * d, d, d) = Eigen::MatrixXd::Identity(d, d) * dt;
+    E.topLeftCorner(d, d) = A * dt;
+    E.block(0, d, d, n_u) = B * dt;
+    E.block(d, d + n_u, n_u, n_u) = Eigen::MatrixXd::Identity(n_u, n_u) * dt;
     const Eigen::MatrixXd X = E.exp();
-    // With u' = v, v' = 0 appended to y' = A y + u, the flow over Δt from
-    // (0, I, 0) is Γ0 and from (0, 0, I) is Γ1 (u grows as s).
-    const Eigen::MatrixXd P = X.block(0, 0, d, d);
-    const Eigen::MatrixXd G0 = X.block(0, d, d, d);
-    const Eigen::MatrixXd G1 = X.block(0, 2 * d, d, d);
-    const Eigen::MatrixXd R1 = (G1 / dt) * B;        // weight of u_{i-m+1}
-    const Eigen::MatrixXd R0 = (G0 - G1 / dt) * B;   // weight of u_{i-m}
-    auto u_rows = [&](int l) {  // rows of u_{i-l} in Z, l = 0..m
-      return l == 0 ? Z.middleRows(0, n_u) : Z.middleRows(d + (l - 1) * n_u, n_u);
-    };
-    top.noalias() = P * Z.topRows(d);
-    top.noalias() += R1 * u_rows(m - 1);
-    top.noalias() += R0 * u_rows(m);
-    // Shift the delay line down by one block, then insert u_i and y_{i+1}.
-    for (int l = m; l >= 2; --l) Z.middleRows(d + (l - 1) * n_u, n_u) = Z.middleRows(d + (l - 2) * n_u, n_u);
-    Z.middleRows(d, n_u) = Z.topRows(n_u);
-    Z.topRows(d) = top;
+    P[i] = X.topLeftCorner(d, d);
+    const Eigen::MatrixXd G1B = X.block(0, d + n_u, d, n_u) / dt;
+    R1[i] = G1B;                               // weight of u_{i-m+1}
+    R0[i] = X.block(0, d, d, n_u) - G1B;       // weight of u_{i-m}
   }
+  // Φ z for z = [y_0; u_{-1}; ...; u_{-m}]: the k steps, the delay line as
+  // one array U of u_j, j = -m .. k-1 (U.col(j + m)); Φ z = [y_k; u_{k-1};
+  // ...; u_{k-m}]. O(k d (d + n_u)) per product, against O(k d² D) to form
+  // Φ and O(D³) for its dense eigenvalues (issue #34: the SD of a tap test
+  // took 30 s in those, at D = 396).
+  Eigen::MatrixXd U(n_u, m + steps);
+  Eigen::VectorXd y(d), y_next(d);
+  auto apply = [&](const Eigen::Ref<const Eigen::VectorXd>& z, Eigen::VectorXd* out) {
+    y = z.head(d);
+    for (int l = 1; l <= m; ++l) U.col(m - l) = z.segment(d + (l - 1) * n_u, n_u);
+    for (int i = 0; i < steps; ++i) {
+      U.col(m + i) = y.head(n_u);
+      y_next.noalias() = P[i] * y;
+      y_next.noalias() += R1[i] * U.col(i + 1);  // u_{i-m+1}
+      y_next.noalias() += R0[i] * U.col(i);      // u_{i-m}
+      y.swap(y_next);
+    }
+    out->head(d) = y;
+    for (int l = 1; l <= m; ++l) out->segment(d + (l - 1) * n_u, n_u) = U.col(m + steps - l);
+  };
   SdMonodromy out;
   out.dimension = D;
-  Eigen::EigenSolver<Eigen::MatrixXd> es(Z, false);
-  const Eigen::VectorXcd ev = es.eigenvalues();
-  Eigen::Index imax = 0;
-  ev.cwiseAbs().maxCoeff(&imax);
-  out.critical_multiplier = ev(imax);
-  out.spectral_radius = std::abs(ev(imax));
+  out.critical_multiplier = DominantEigenvalue(D, d, apply);
+  out.spectral_radius = std::abs(out.critical_multiplier);
   return out;
 }
 

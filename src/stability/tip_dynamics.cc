@@ -58,6 +58,25 @@ DirectionFit FitOne(const std::string& label, const dynamics::Frf& frf, const Ti
   return d;
 }
 
+// FitOne, unless an earlier fit of the tip (`fits`) is of an identical FRF
+// (the same lines, every value equal): each distinct FRF is fitted once
+// (issue #34 item 6), its result reused under the new label.
+DirectionFit FitOrReuse(const std::string& label, const dynamics::Frf& frf, const std::vector<DirectionFit>& fits,
+                        const TipMessageSink& on_message) {
+  for (const DirectionFit& d : fits) {
+    if (!d.same_as.empty()) continue;
+    const dynamics::Frf& m = d.fit.measured;
+    if (m.size() == frf.size() && m.freq_hz() == frf.freq_hz() && m.receptance() == frf.receptance()) {
+      if (on_message) {
+        on_message({TipMessage::Kind::kFit, label + ": the same FRF as " + d.label + " (every line equal): its noise "
+                                                "model and modal fit are reused"});
+      }
+      return DirectionFit{label, d.fit, d.label};
+    }
+  }
+  return FitOne(label, frf, on_message);
+}
+
 // The band [lo, hi] usable in every fitted direction (±inf where none says).
 std::pair<double, double> CommonUsableBand(const std::vector<DirectionFit>& fits) {
   double lo = -INFINITY, hi = INFINITY;
@@ -173,7 +192,8 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
       diagonal(hx.receptance(), hy.receptance());
       if (o.fit) {
         t.fits.push_back(FitOne(id + " " + Hname(a, a) + " (feed, x of the cut)", hx, on_message));
-        t.fits.push_back(FitOne(id + " " + Hname(b, b) + " (normal to the feed, y of the cut)", hy, on_message));
+        t.fits.push_back(FitOrReuse(id + " " + Hname(b, b) + " (normal to the feed, y of the cut)", hy, t.fits,
+                                    on_message));
         t.modes_C = Concatenate({DominantModes(ModesAlong(t.fits[0].fit.fit, ex), o.sd_modes),
                                  DominantModes(ModesAlong(t.fits[1].fit.fit, ey), o.sd_modes)});
       }
@@ -231,7 +251,7 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
       if (o.fit) {
         std::vector<TipModalModel> parts;
         for (int a : dirs) {
-          t.fits.push_back(FitOne(id + " " + Hname(a, a), DirectFrf(s, a), on_message));
+          t.fits.push_back(FitOrReuse(id + " " + Hname(a, a), DirectFrf(s, a), t.fits, on_message));
           parts.push_back(
               DominantModes(ModesAlong(t.fits.back().fit.fit, Eigen::Vector3d::Unit(a)).Rotated(R), o.sd_modes));
         }

@@ -61,6 +61,28 @@ def main():
             at = [float(x["spindle_speed_rpm"]) for x in mine if x["critical_depth_mm"] and float(x["critical_depth_mm"]) == lo]
             expect(e["min_critical_depth_speed_rpm"] in at, f"speed at the min {e['min_critical_depth_speed_rpm']} in {at}")
         expect(total == len(r), f"every CSV row counted ({total} of {len(r)})")
+        # Issue #34 item 6: the numbers told on stderr are in the summary.
+        for t in s.get("tips", []):
+            pid = t["pose_id"]
+            c = t.get("zoa_sd_comparison")
+            if c is not None:
+                zoa = [float(x["critical_depth_mm"]) for x in r
+                       if x["pose_id"] == pid and x["method"] == "zoa" and x["critical_depth_mm"]]
+                sd = [float(x["critical_depth_mm"]) for x in r
+                      if x["pose_id"] == pid and x["method"] == "sd" and x["critical_depth_mm"]]
+                expect(c["zoa_min_critical_depth_mm"] == min(zoa), f"{pid}: comparison's ZOA min == CSV ZOA min")
+                # The SD's minimum also searches speeds near the ZOA's lobe
+                # bottoms that are in no CSV row: at most the CSV's.
+                expect(c["sd_min_critical_depth_mm"] <= min(sd), f"{pid}: comparison's SD min <= CSV SD min")
+                a, b = c["sd_min_critical_depth_mm"], c["zoa_min_critical_depth_mm"]
+                expect(math.isclose(c["difference_percent"], 100 * abs(a - b) / min(a, b), rel_tol=1e-9),
+                       f"{pid}: difference_percent {c['difference_percent']}")
+                expect(c["agree"] == (c["difference_percent"] <= 10.0), f"{pid}: agree")
+            labels = {f["frf"]: f for f in t.get("fits", [])}
+            for f in t.get("fits", []):
+                if "same_as" in f:
+                    expect(f["same_as"] in labels and labels[f["same_as"]]["modes"] == f["modes"],
+                           f"{f['frf']}: the modes of {f['same_as']}, whose fit it reuses")
     elif kind == "map":
         expect(s["points"] == len(r), f"points {s['points']} == {len(r)} CSV rows")
         depths = [float(x["critical_depth_mm"]) for x in r if x["critical_depth_mm"]]

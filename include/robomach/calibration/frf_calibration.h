@@ -29,15 +29,33 @@ namespace robomach::calibration {
 
 // ------------------------------------------------------ measured features --
 
+/// How the peak feature of a mode is taken (issue #34 item 6).
+enum class PeakKind {
+  /// |H| has its maximum inside the mode's peak search window: the peak is
+  /// that maximum (a stationary value, insensitive to the window's ends).
+  kMaximum,
+  /// |H| grows through the window's end towards a stronger neighbour: the
+  /// mode makes a shoulder on that neighbour's flank, not a peak of its own.
+  /// The feature is |H| at the mode's own resonance f_n √(1 − 2ζ²)
+  /// (OwnResonanceHz); the flank's value at the window's end would move with
+  /// the estimated ζ by about 13 % per 1 % of frequency 8 % from the
+  /// neighbour.
+  kShoulder,
+};
+
 /// One mode identified in one measured FRF.
 struct MeasuredMode {
   dynamics::FrfKey key;
   FittedMode fit;
-  /// The maximum of |H_fit| within f_n (1 ± 3ζ): the peak amplitude of the
-  /// seed's Table 3, taken from the fitted curve so that noise on single
-  /// lines does not bias it upwards [m/N], and where it occurs [Hz].
+  /// The maximum of |H_fit| within the mode's own peak search window
+  /// (PeakSearchWindow: its half-power band, cut at the midpoints to the
+  /// other fitted modes of the FRF): the peak amplitude of the seed's
+  /// Table 3, taken from the fitted curve so that noise on single lines
+  /// does not bias it upwards [m/N], and where it occurs [Hz]. For a
+  /// shoulder (peak_kind), |H_fit| at the mode's own resonance instead.
   double peak_freq_hz{0.0};
   double peak_magnitude{0.0};
+  PeakKind peak_kind{PeakKind::kMaximum};
 };
 
 struct MeasuredFeatures {
@@ -47,6 +65,20 @@ struct MeasuredFeatures {
   std::map<dynamics::FrfKey, std::vector<PeakEstimate>> peaks;
   std::vector<MeasuredMode> modes;
 };
+
+/// Where the peak of a mode is searched (issue #34 item 6): its own
+/// half-power band f_n (1 ± ζ) (the lower end at least 0.05 f_n), cut at
+/// the midpoint between f_n and each other mode's natural frequency
+/// `other_freqs_hz`, whichever is narrower. The peak of one mode's
+/// receptance, f_n √(1 − 2ζ²), lies in its half-power band for ζ <= 2/3;
+/// the former f_n (1 ± 3ζ) reached the peak of a stronger neighbour 5-10 %
+/// away (ζ = 3 %) and gave it to the weaker mode. [lo, hi] in Hz.
+std::pair<double, double> PeakSearchWindow(double freq_hz, double damping_ratio,
+                                           const std::vector<double>& other_freqs_hz);
+
+/// The resonance of one mode's receptance, f_n √(1 − 2ζ²) [Hz] (f_n for
+/// ζ >= 1/√2 would be 0: the receptance of such a mode has no peak).
+double OwnResonanceHz(double freq_hz, double damping_ratio);
 
 /// Fits every FRF of `measured` with FitModes and collects its modes.
 /// FRFs whose fit has no stable mode contribute none (their status is in
@@ -77,6 +109,8 @@ struct ModeMatch {
   double model_freq_hz{0.0};
   double measured_peak{0.0};  // [m/N]
   double model_peak{0.0};     // [m/N]
+  /// The measured mode's PeakKind; model_peak is taken the same way.
+  PeakKind peak_kind{PeakKind::kMaximum};
   double measured_damping{0.0};
   double model_damping{0.0};
   Eigen::Vector3d model_shape_T{Eigen::Vector3d::Zero()};
@@ -93,9 +127,15 @@ using PostureMap = std::map<std::string, Eigen::VectorXd>;  // q [rad]
 double ModelModeVisibility(const dynamics::Mode& mode, const dynamics::FrfKey& key);
 
 /// Peak of |H_model| for the FRF `key` near a model mode, on the same
-/// definition as MeasuredMode::peak_magnitude (window f_n (1 ± 3ζ)).
+/// definition as MeasuredMode::peak_magnitude: the maximum within
+/// PeakSearchWindow, whose neighbours are the other modes of the posture
+/// that show in this FRF (peak contribution at least 1e-3 of the largest;
+/// the measurement's neighbours are the modes its fit found), or, with
+/// `kind` kShoulder (the measured mode's kind: both sides of a match use one
+/// definition), |H_model| at the mode's own resonance OwnResonanceHz.
+/// Returns {frequency [Hz], |H| [m/N]}.
 std::pair<double, double> ModelPeak(const dynamics::PostureDynamics& d, const dynamics::FrfKey& key,
-                                    int model_mode);
+                                    int model_mode, PeakKind kind = PeakKind::kMaximum);
 
 /// Matches measured modes to model modes by frequency and tool-tip direction
 /// (greedy on the cost |ln f ratio| + w |ln visibility ratio|, one-to-one

@@ -13,6 +13,17 @@
 // read together; they must have the same response columns. The sample rate
 // is 1/(mean time step), snapped to a whole number of hertz when that is
 // within the rounding of the written times.
+//
+// Or a UFF file (docs/formats.md §10.1; issue #34 item 7) of dataset 58
+// time records (function type 1), as acquisition systems export them: per
+// hit its force record (record 9 specific data type 13 or 9, or a force
+// unit) followed by its response records (8, 11, 12, or a length, m/s or
+// m/s² unit), all on one even time grid per hit. A hit starts at each force
+// record; its id is its load case when every hit has its own, else its
+// number in the file. A response channel is named n<node>_<axis> from
+// record 6 (a negative direction read with its sign flipped), its column
+// n<node>_<axis>_m_per_s2 (or _m, _m_per_s). Units as the label of record 9
+// says ("g", "mm/s^2", "lbf"), else dataset 164, else SI.
 
 #include <map>
 #include <string>
@@ -43,7 +54,11 @@ bool ParseResponseColumn(const std::string& column, calibration::ResponseQuantit
 /// Reads hammer records from one or more files (format above). Hit ids are
 /// the `hit` cells, or the file stem; with several files the stem is put in
 /// front of a hit cell ("run2#3") so that ids stay unique.
-/// @throws InputError "file:line:column: ..." for a missing or unknown
+/// A file that starts with the UFF delimiter is read as UFF58 time records
+/// (above), any other as CSV; the two may be mixed if their responses agree.
+/// @throws InputError "file:line:column: ..." for a UFF record that is not
+///   a time record or cannot be told force or response, hits whose time
+///   grids or responses differ, a missing or unknown
 ///   column, a bad number (with a hint for a decimal comma, nan, inf), a
 ///   time that does not increase or is not evenly spaced (a step more than
 ///   1 % off the hit's median step), a hit whose rows are split, fewer than 16 samples in a

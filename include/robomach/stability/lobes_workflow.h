@@ -50,6 +50,29 @@ struct SdProgress {
 };
 using SdProgressSink = std::function<void(const SdProgress&)>;
 
+/// The SD's discretisation of one tip, as ComputeLobes tells it before the
+/// work: the modes kept, the highest of them, and the steps per tooth
+/// period over the speeds (SdStepsPerPeriod).
+struct SdDiscretisation {
+  std::string id;
+  int modes{0};
+  double highest_mode_hz{NAN};                          // [Hz]
+  int min_steps_per_period{0}, max_steps_per_period{0};
+  bool capped{false};  // automatic steps capped by SdOptions::max_monodromy_dimension at some speed
+};
+
+/// The comparison of the two methods' smallest critical depths for one tip
+/// (both methods, radial immersion 0.3 or more). The SD's minimum is over
+/// its speeds and the extra speeds near the ZOA's lobe bottoms, which are in
+/// no lobes row: this is where that number is kept.
+struct ZoaSdComparison {
+  std::string id;
+  double sd_min_depth{NAN}, sd_min_depth_speed_rad_s{NAN};    // [m], [rad/s]
+  double zoa_min_depth{NAN}, zoa_min_depth_speed_rad_s{NAN};  // [m], [rad/s]
+  double relative_difference{NAN};  // |SD − ZOA| / min(SD, ZOA)
+  bool agree{true};                 // relative_difference <= 0.10
+};
+
 /// Flagged (RunFindings; stability-lobes' exit 3), one finding each, for a
 /// modal fit that does not describe a tool tip (TipFitWarnings: an
 /// implausible unit, not a driving point, a mode at the edge of the usable
@@ -61,6 +84,8 @@ struct LobesResult : RunFindings {
   /// Some speeds have no boundary (a ZOA point that is not ok, an SD point
   /// unstable at depth zero).
   bool no_boundary{false};
+  std::vector<SdDiscretisation> sd_discretisation;  // per tip the SD was run on
+  std::vector<ZoaSdComparison> comparisons;         // per tip compared (see ComputeLobes)
 };
 
 /// The warnings about one tip's measured FRFs (empty for a model tip): its

@@ -34,6 +34,11 @@ struct TipFrfs {
 struct DirectionFit {
   std::string label;  // "P1 Hxx", for messages and the plot
   DirectFrfFit fit;
+  /// The label of an earlier fit of the same tip whose FRF is identical
+  /// (every line equal, e.g. a file that gives one measurement as both Hxx
+  /// and Hyy): that fit is reused, not repeated (issue #34 item 6), and its
+  /// warnings are not repeated either. Empty for a fit of its own.
+  std::string same_as;
 };
 
 /// The tool-tip dynamics of one source, oriented into the cutting frame.
