@@ -3,6 +3,7 @@
 // (identification/joint_stiffness.h, io/tracker_file.h) and its D-optimal
 // test plan (identification/test_plan.h, io/kq_files.h). Results are plain
 // objects with read-only attributes.
+#include <cmath>
 #include <limits>
 
 #include <optional>
@@ -14,6 +15,7 @@
 #include "robomach/calibration/virtual_hammer_test.h"
 #include "robomach/calibration/frf_calibration.h"
 #include "robomach/calibration/modal_fit.h"
+#include "robomach/calibration/modal_analysis.h"
 #include "robomach/identification/joint_stiffness.h"
 #include "robomach/identification/load_case.h"
 #include "robomach/identification/test_plan.h"
@@ -61,6 +63,86 @@ MeasuredFeatures Features(const dynamics::FrfSet& measured, double fmin_hz, doub
 }  // namespace
 
 void BindCalibration(py::module_& m) {
+  // frf-modes' call (calibration::AnalyseModes, issue #34 §3).
+  m.def(
+      "analyse_modes",
+      [](const dynamics::FrfSet& frfs, const std::map<KeyTuple, calibration::FrfNoise>& noise, double fmin_hz,
+         double fmax_hz, int max_order, bool per_frf, const std::string& weights, int file_power) {
+        if (weights != "noise" && weights != "quantity") {
+          throw py::value_error("weights: expected 'noise' or 'quantity', got '" + weights + "'");
+        }
+        if (file_power < 0 || file_power > 2) throw py::value_error("file_power: expected 0, 1 or 2");
+        calibration::NoiseModels n;
+        for (const auto& [k, v] : noise) n.emplace(ToKey(k), v);
+        calibration::ModalAnalysisOptions o;
+        o.fit.fmin_hz = fmin_hz;
+        o.fit.fmax_hz = fmax_hz;
+        o.fit.max_order = max_order;
+        o.per_frf = per_frf;
+        o.weights_in_file_quantity = weights == "quantity";
+        const auto poses = calibration::AnalyseModes(frfs, n, o, file_power);
+        py::list out;
+        for (const calibration::PoseModes& p : poses) {
+          py::list fits;
+          for (const calibration::ModalGroup& g : p.groups) {
+            py::list frf_list, modes;
+            for (size_t i = 0; i < g.keys.size(); ++i) {
+              py::dict f;
+              f["frf"] = FromKey(g.keys[i]);
+              f["misfit_relative"] = i < g.misfit.size() ? g.misfit[i] : NAN;
+              f["misfit_noise_sigmas"] = i < g.fit.misfit_in_noise.size() ? g.fit.misfit_in_noise[i] : NAN;
+              py::list constants;
+              if (i < g.fit.per_frf.size()) {
+                for (const auto& md : g.fit.per_frf[i].modes) constants.append(md.modal_constant);
+              }
+              f["modal_constants"] = constants;
+              frf_list.append(f);
+            }
+            for (const auto& md : g.fit.modes) {
+              py::dict d;
+              d["freq_hz"] = md.freq_hz;
+              d["damping_ratio"] = md.damping_ratio;
+              d["stable_orders"] = md.stable_orders;
+              modes.append(d);
+            }
+            py::dict gd;
+            gd["frfs"] = frf_list;
+            gd["modes"] = modes;
+            gd["ok"] = g.fit.status == calibration::ModalFitStatus::kOk;
+            gd["message"] = g.fit.message;
+            fits.append(gd);
+          }
+          py::list tips;
+          for (const calibration::TipMode& t : p.tip_modes) {
+            py::dict d;
+            d["freq_hz"] = t.freq_hz;
+            d["damping_ratio"] = t.damping_ratio;
+            d["modal_mass_kg"] = t.modal_mass_kg;
+            d["shape"] = Eigen::Vector3d(t.shape);
+            d["directions"] = t.directions;
+            tips.append(d);
+          }
+          py::dict pd;
+          pd["pose_id"] = p.pose_id;
+          pd["fits"] = fits;
+          pd["tip_modes"] = tips;
+          pd["warnings"] = p.warnings;
+          out.append(pd);
+        }
+        return out;
+      },
+      py::arg("frfs"), py::arg("noise") = std::map<KeyTuple, calibration::FrfNoise>{}, py::arg("fmin_hz") = 0.0,
+      py::arg("fmax_hz") = std::numeric_limits<double>::infinity(), py::arg("max_order") = 100,
+      py::arg("per_frf") = false, py::arg("weights") = "noise", py::arg("file_power") = 0,
+      "frf-modes' modal analysis: per posture, its FRFs fitted with common poles; returns a list of "
+      "{pose_id, fits: [{frfs: [{frf, misfit_relative, misfit_noise_sigmas, modal_constants}], modes: "
+      "[{freq_hz, damping_ratio, stable_orders}], ok, message}], tip_modes: [{freq_hz, damping_ratio, "
+      "modal_mass_kg, shape, directions}], warnings}. noise: estimate_noise(frfs) (the fit's weights and usable "
+      "lines); weights 'noise' or 'quantity' (every line of the file's quantity alike, file_power 0 "
+      "receptance, 1 mobility, 2 accelerance).");
+  m.def("modal_assurance_criterion", &calibration::ModalAssuranceCriterion, py::arg("a"), py::arg("b"),
+        "MAC matrix between the columns of two complex shape matrices (same rows), in [0, 1].");
+
   // ------------------------------------------------------ calibration --
   py::class_<MeasuredFeatures>(m, "MeasuredFeatures",
                                "Modal fits of every measured FRF (extract_features): the modes the "

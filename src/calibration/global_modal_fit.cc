@@ -361,7 +361,8 @@ class GlobalProblem {
   // matrix's columns).
   // `free_from`: only the poles from this index on move (the others are
   // held), for a trial pole added to a refined set.
-  std::vector<cd> Refine(std::vector<cd> poles, int free_from = 0) const {
+  std::vector<cd> Refine(std::vector<cd> poles, int free_from = 0, int max_iterations = 30,
+                         double rel_tol = 1e-7) const {
     const int nm = static_cast<int>(poles.size());
     const int np = 2 * (nm - free_from);
     if (np <= 0) return poles;
@@ -406,7 +407,7 @@ class GlobalProblem {
     double cost = evaluate(poles, &e, &J);
     if (!(cost < 1e300)) return poles;
     double mu = 1e-3;
-    for (int it = 0; it < 30; ++it) {
+    for (int it = 0; it < max_iterations; ++it) {
       const Eigen::MatrixXd JtJ = J.transpose() * J;
       const Eigen::VectorXd grad = J.transpose() * e;
       bool improved = false;
@@ -436,7 +437,7 @@ class GlobalProblem {
           cost = c2;
           mu = std::max(mu / 10.0, 1e-12);
           improved = true;
-          if (rel < 1e-7) it = 1000;
+          if (rel < rel_tol) it = 1000;
           break;
         }
         mu *= 10.0;
@@ -681,7 +682,9 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     for (double shift : {0.0, -2.0, 2.0}) {
       std::vector<cd> p = poles;
       p.push_back(PoleFrom(f_peak * (1.0 + shift * z0), z0));
-      if (o.refine) p = problem.Refine(p, static_cast<int>(poles.size()));
+      // A trial only needs to be good enough to be judged: a few
+      // iterations; the kept one is refined fully below.
+      if (o.refine) p = problem.Refine(p, static_cast<int>(poles.size()), 8, 1e-4);
       const SetFit fit = problem.Fit(p);
       if (fit.cost < trial_best.cost) {
         trial_best = fit;
