@@ -53,6 +53,8 @@ RobotConfig LoadConfig(const std::string& path, const std::vector<std::string>& 
     py::gil_scoped_release release;
     cfg = io::LoadRobotConfig(path);
   }
+  // The tools' exit 3 (docs/plausibility.md): a UnitWarning per finding.
+  for (const std::string& w : cfg.implausible) WarnUnit(w);
   for (const auto& a : add) AddEffect(&cfg, a);
   for (const auto& [k, v] : set) cfg.parameters.Set(k, v);
   return cfg;

@@ -96,8 +96,13 @@ void BindPolishing(py::module_& m) {
       .def_property_readonly("belt_speed_m_per_s", [](const PolishingProcess& p) { return p.belt_speed; });
   m.def("read_polishing_process", [](const std::string& path) {
     RequireReadableFile(path);
-    return io::ReadPolishingProcess(path);
-  }, py::arg("path"), "Reads a process YAML. Raises InputError naming file, line and column.");
+    std::vector<std::string> implausible;
+    PolishingProcess p = io::ReadPolishingProcess(path, &implausible);
+    for (const std::string& w : implausible) WarnUnit(w);
+    return p;
+  }, py::arg("path"),
+     "Reads a process YAML. Raises InputError naming file, line and column; a UnitWarning per value outside its "
+     "plausible range (docs/plausibility.md), where polish-plan exits 3.");
 
   m.def("path_patterns", [] {
     std::vector<std::string> n;

@@ -96,8 +96,12 @@ void BindStability(py::module_& m) {
       });
   m.def("read_cut_file", [](const std::string& path) {
     RequireReadableFile(path);
-    return io::ReadCutFile(path);
-  }, py::arg("path"), "Reads a cut file (YAML). Raises InputError naming file, line and column.");
+    io::CutSpec cut = io::ReadCutFile(path);
+    for (const std::string& w : cut.implausible) WarnUnit(w);
+    return cut;
+  }, py::arg("path"),
+     "Reads a cut file (YAML). Raises InputError naming file, line and column; a UnitWarning per value outside "
+     "its plausible range (docs/plausibility.md), where stability-lobes exits 3.");
 
   py::class_<TipDynamics>(m, "TipDynamics",
                           "The tool tip of one source, oriented into the cutting frame C (x along the feed, z "

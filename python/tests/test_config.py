@@ -3,6 +3,7 @@ frf-predict tool's --summary JSON for the same config, adds and sets (the
 parameters it used), and its stderr for a bad config (the same message)."""
 import json
 import os
+import warnings
 
 import pytest
 
@@ -111,3 +112,20 @@ def glog_minloglevel(env_value):
 def test_import_silences_ceres_log_lines_unless_asked():
     assert glog_minloglevel(None) == 3
     assert glog_minloglevel('0') == 0
+
+
+def test_stiffness_in_n_mm_per_rad_gives_the_tools_unit_warning(tmp):
+    # The same finding as frf-predict's exit 3 (docs/plausibility.md):
+    # joint stiffnesses typed in N mm/rad, 1000 x too stiff.
+    text = open(KR210).read()
+    text = text.replace('urdf: kr210_r2700_2.urdf', 'urdf: ' + os.path.join(os.path.dirname(KR210), 'kr210_r2700_2.urdf'))
+    text = text.replace('[3.3479e+6, 3.1318e+6, 4.2895e+6, 2.4787e+5, 6.4292e+5, 1.8847e+5]',
+                        '[3.3479e+9, 3.1318e+9, 4.2895e+9, 2.4787e+8, 6.4292e+8, 1.8847e+8]')
+    path = tmp / 'kq_Nmm.yaml'
+    path.write_text(text)
+    with pytest.warns(rm.UnitWarning, match=r'implausible \(unit mistake\?\).*N.mm/rad'):
+        rm.RobotConfig(str(path))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        rm.RobotConfig(KR210)
+    assert not [w for w in caught if issubclass(w.category, rm.UnitWarning)]
