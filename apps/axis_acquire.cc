@@ -82,6 +82,8 @@ int Run(int argc, char** argv) {
     const std::vector<machine::TemperatureCompensation>& temps = in.temperatures;
     const std::optional<machine::ProgrammedPath>& path = in.program;
     const machine::CountsRecord& rec = in.counts;
+    const std::vector<std::string> implausible = in.implausible();
+    for (const std::string& w : implausible) Warn(kTool, w);
 
     machine::Acquisition acq(mf.machine, in.applied());
     std::optional<machine::ContourTracker> tracker;
@@ -136,9 +138,9 @@ int Run(int argc, char** argv) {
                 << j["axis_error_deg"]["max"].get<double>() << " deg\n";
       const RunFindings verdict = machine::JudgeContour(contour, *path);
       for (const Finding& f : verdict.findings) Warn(kTool, f.message);
-      return ExitCodeFor(verdict.status());
+      return implausible.empty() ? ExitCodeFor(verdict.status()) : kExitFlagged;
     }
-    return kExitOk;
+    return implausible.empty() ? kExitOk : kExitFlagged;
   });
 }
 

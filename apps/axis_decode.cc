@@ -53,7 +53,14 @@ int Run(int argc, char** argv) {
     RequireReadableFile(capture_path, "capture");
     CheckDistinctPaths({{"--machine", machine_path}, {"--capture", capture_path}},
                        {{"--out", out_path}, {"--summary", summary_path}});
+    // Capture cards sample quadrature at 1 kHz - 100 MHz (docs/plausibility.md).
+    const std::string rate_w = ImplausibleOption("--sample-rate-hz", rate_hz, 1000.0, 1e8, "Hz",
+                                                 "quadrature captures (1 kHz - 100 MHz)",
+                                                 "a rate in kHz or MHz typed in the Hz option?",
+                                                 "a rate in mHz typed in the Hz option?");
+    if (!rate_w.empty()) Warn(kTool, rate_w);
     const io::MachineFile mf = io::ReadMachineFile(machine_path);
+    for (const std::string& w : mf.implausible) Warn(kTool, w);
     const auto& axes = mf.machine.axes;
     ProgressLine progress(kTool, "samples", static_cast<long>(std::filesystem::file_size(capture_path) / 2));
     io::CaptureDecoding d;
@@ -72,7 +79,7 @@ int Run(int argc, char** argv) {
     const nlohmann::json j = io::CaptureDecodingSummaryJson(d, axes, rate_hz, every, filter);
     if (!summary_path.empty()) io::WriteFileAtomically(summary_path, report::DumpJson(j));
     for (const Finding& f : d.findings) Warn(kTool, f.message);
-    return ExitCodeFor(d.status());
+    return mf.implausible.empty() && rate_w.empty() ? ExitCodeFor(d.status()) : kExitFlagged;
   });
 }
 

@@ -70,6 +70,21 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--glitch-probability", glitch_p, 0.0, 1.0);
     if (capture_every < 1 || capture_every > 100000) throw UsageError("--capture-every: expected 1..100000");
     if (settle < 0 || settle >= capture_every) throw UsageError("--capture-settle: expected 0 <= settle < --capture-every");
+    // Plausible ranges (docs/plausibility.md): feeds of machine tools 10 -
+    // 100 000 mm/min (HSC rapids to 100 m/min), controller traces 100 Hz -
+    // 100 kHz (840D sl servo trace: 8 kHz at most in the IPO/servo cycle).
+    std::vector<std::string> implausible;
+    for (const std::string& w :
+         {ImplausibleOption("--feed-mm-min", feed_mm_min, 10.0, 100000.0, "mm/min",
+                            "machine tool feeds (up to 100 m/min rapids)", "a feed in m/min typed in the mm/min option?",
+                            "a feed in um/min typed in the mm/min option?"),
+          ImplausibleOption("--sample-rate-hz", rate_hz, 10.0, 1e6, "Hz", "position traces (100 Hz - 100 kHz)",
+                            "a rate in kHz typed in the Hz option?", "a rate in mHz typed in the Hz option?"),
+          ImplausibleOption("--dwell-s", dwell_s, 0.0, 600.0, "s", "dwells before a measured move (under a minute)", "",
+                            "a dwell in ms typed in the s option?")}) {
+      if (!w.empty()) implausible.push_back(w);
+    }
+    for (const std::string& w : implausible) Warn(kTool, w);
     RequireReadableFile(machine_path, "machine file");
     RequireReadableFile(program_path, "programmed path");
     if (!comp_path.empty()) RequireReadableFile(comp_path, "compensation file");
@@ -83,6 +98,10 @@ int Run(int argc, char** argv) {
     if (!comp_path.empty()) tables = io::ReadCompensationFile(comp_path, mf);
     std::vector<machine::TemperatureCompensation> temps;
     if (!temp_path.empty()) temps = io::ReadTemperatureLog(temp_path, mf);
+    for (const std::string& w : mf.implausible) Warn(kTool, w);
+    for (const std::string& w : tables.implausible) Warn(kTool, w);
+    implausible.insert(implausible.end(), mf.implausible.begin(), mf.implausible.end());
+    implausible.insert(implausible.end(), tables.implausible.begin(), tables.implausible.end());
     const machine::Compensation comp(static_cast<int>(mf.machine.axes.size()), tables.encoder, tables.cross_axis, temps);
     const machine::Compensation* comp_ptr = comp.empty() ? nullptr : &comp;
 
@@ -155,7 +174,7 @@ int Run(int argc, char** argv) {
       for (long r = 0; r < rec.rows(); ++r) w.Row(rec.t_s[r], rec.counts.data() + r * n);
     });
     std::cerr << kTool << ": " << rec.rows() << " rows, " << io::FormatDouble(rec.t_s.back()) << " s\n";
-    return kExitOk;
+    return implausible.empty() ? kExitOk : kExitFlagged;
   });
 }
 

@@ -27,6 +27,20 @@ constexpr char kTool[] = "frf-synth";
 // 0.1 to 10 %; above 50 % it is flagged (a percentage typed for a fraction:
 // --noise-rel 2 for 2 %), above 1000 % nothing of the FRF is left: refused.
 constexpr double kMaxPlausibleRelativeNoise = 0.5;
+// Plausible ranges of the other options (docs/plausibility.md). Hammer tests
+// of robots and machine tools: lines to 0.1 - 10 kHz, sampled at 1 - 200 kHz
+// (Schmitz and Smith, "Machining Dynamics", ch. 2; the seed's 5120 Hz); hammer
+// tips cut off at 0.5 kHz (soft) to 10 kHz and more (steel; PCB 086 series
+// data sheets). Noise floors: tool-tip receptances are 1e-8 - 1e-5 m/N, a
+// floor 1e-4 - 1e-2 of the peak (Ewins, "Modal Testing", §3); accelerometers
+// resolve 1e-4 - 1e-2 m/s² under 10 - 1000 N impacts.
+constexpr double kMinPlausibleFmaxHz = 1.0, kMaxPlausibleFmaxHz = 50000.0;
+constexpr double kMinPlausibleSampleRateHz = 100.0, kMaxPlausibleSampleRateHz = 1e6;
+constexpr double kMinPlausibleHammerCutoffHz = 50.0, kMaxPlausibleHammerCutoffHz = 50000.0;
+constexpr double kMaxPlausibleNoiseMPerN = 1e-6;        // receptance floor
+constexpr double kMaxPlausibleNoiseMPerSPerN = 1e-3;    // mobility floor
+constexpr double kMaxPlausibleNoiseMPerS2PerN = 10.0;   // accelerance floor
+constexpr double kMaxFrequencyHz = 1e9;                 // refused above (exit 64)
 constexpr double kMaxRelativeNoise = 10.0;
 
 int Run(int argc, char** argv) {
@@ -97,6 +111,45 @@ int Run(int argc, char** argv) {
                             " % of the FRF; hammer tests have 0.1 to 10 % (plausible up to 50 %): a percentage typed "
                             "for a fraction? 2 % is --noise-rel 0.02");
     }
+    // Impossible values (exit 64), then implausible ones (exit 3).
+    for (const auto& [name, v] : {std::pair{"--fmax-hz", o.fmax_hz}, std::pair{"--hammer-cutoff-hz", o.hammer_cutoff_hz}}) {
+      if (!(v >= 0.0 && v <= kMaxFrequencyHz)) {
+        throw UsageError(std::string(name) + " " + FormatNumber(v, 7) + ": expected a frequency in [0, 1e9] Hz");
+      }
+    }
+    if (std::isfinite(fs_hz) && !(fs_hz > 0.0 && fs_hz <= kMaxFrequencyHz)) {
+      throw UsageError("--sample-rate-hz " + FormatNumber(fs_hz, 7) + ": expected a rate in (0, 1e9] Hz");
+    }
+    for (const auto& [name, v] : {std::pair{"--noise-abs-m-per-N", o.absolute_noise_m_per_N},
+                                  std::pair{"--noise-abs-m-per-s-per-N", o.absolute_noise_m_per_s_per_N},
+                                  std::pair{"--noise-abs-m-per-s2-per-N", o.absolute_noise_m_per_s2_per_N}}) {
+      if (!(v >= 0.0) || !std::isfinite(v)) throw UsageError(std::string(name) + " " + FormatNumber(v, 7) + ": expected a noise rms >= 0");
+    }
+    const auto flag = [&](const std::string& m) {
+      if (!m.empty()) implausible.push_back(m);
+    };
+    flag(ImplausibleOption("--fmax-hz", o.fmax_hz, kMinPlausibleFmaxHz, kMaxPlausibleFmaxHz, "Hz",
+                           "hammer tests (lines to 0.1 - 10 kHz)", "a frequency in kHz typed in the Hz option?",
+                           "a frequency in mHz typed in the Hz option, or a line count?"));
+    if (std::isfinite(fs_hz)) {
+      flag(ImplausibleOption("--sample-rate-hz", fs_hz, kMinPlausibleSampleRateHz, kMaxPlausibleSampleRateHz, "Hz",
+                             "hammer-test acquisition (1 - 200 kHz)", "a rate in kHz typed in the Hz option?",
+                             "a rate in mHz typed in the Hz option?"));
+    }
+    if (o.hammer_cutoff_hz > 0.0) {
+      flag(ImplausibleOption("--hammer-cutoff-hz", o.hammer_cutoff_hz, kMinPlausibleHammerCutoffHz,
+                             kMaxPlausibleHammerCutoffHz, "Hz", "hammer tips (0.5 - 10 kHz; 0: flat)",
+                             "a frequency in kHz typed in the Hz option?", "a frequency in mHz typed in the Hz option?"));
+    }
+    flag(ImplausibleOption("--noise-abs-m-per-N", o.absolute_noise_m_per_N, 0.0, kMaxPlausibleNoiseMPerN, "m/N",
+                           "receptance noise floors (tool tips are 1e-8 - 1e-5 m/N)", "",
+                           "a noise in mm/N or um/N typed in the m/N option?"));
+    flag(ImplausibleOption("--noise-abs-m-per-s-per-N", o.absolute_noise_m_per_s_per_N, 0.0, kMaxPlausibleNoiseMPerSPerN,
+                           "(m/s)/N", "mobility noise floors", "", "a noise in (mm/s)/N typed in the (m/s)/N option?"));
+    flag(ImplausibleOption("--noise-abs-m-per-s2-per-N", o.absolute_noise_m_per_s2_per_N, 0.0,
+                           kMaxPlausibleNoiseMPerS2PerN, "(m/s²)/N",
+                           "accelerance noise floors (accelerometers resolve 1e-4 - 1e-2 m/s² under 10 - 1000 N)", "",
+                           "a noise in (mm/s²)/N typed in the (m/s²)/N option?"));
     RequireInputFile("--robot", robot_path, "robot config", {io::FileKind::kYaml}, io::kRobotConfigFormat);
     RequireInputFile("--postures", postures_path, "posture file", {io::FileKind::kCsv}, io::kPostureCsvFormat);
     CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}},

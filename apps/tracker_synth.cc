@@ -27,6 +27,10 @@ namespace {
 
 constexpr double kMinPlausibleTrackerNoiseMm = 1e-4;  // --noise-mm, flagged outside (0 allowed)
 constexpr double kMaxPlausibleTrackerNoiseMm = 1.0;
+// Load tests hang 5 - 300 kg (up to the robot's payload; the seed's KR 210:
+// 10 - 30 kg) over pulleys 0.5 - 5 m from the base (docs/plausibility.md).
+constexpr double kMinPlausibleLoadMassKg = 0.5, kMaxPlausibleLoadMassKg = 500.0;
+constexpr double kMinPlausiblePulleyDistanceMm = 100.0, kMaxPlausiblePulleyDistanceMm = 20000.0;
 
 constexpr char kTool[] = "tracker-synth";
 
@@ -114,7 +118,19 @@ int Run(int argc, char** argv) {
     o.masses_kg = ParseNumberList("--masses-kg", masses);
     // Load tests hang tens of kilograms; beyond a tonne the linear model and
     // the static equilibrium of the simulation are meaningless.
-    for (double m : o.masses_kg) CheckOptionRange("--masses-kg", m, 1e-3, 1e3);
+    for (double m : o.masses_kg) {
+      if (!(m >= 1e-3 && m <= 1e3)) {
+        throw UsageError("--masses-kg " + io::FormatDouble(m) + ": expected masses in [0.001, 1000] kg" +
+                         (m > 1e3 ? ": a mass in g typed in the kg option?" : ""));
+      }
+      const std::string w = ImplausibleOption("--masses-kg", m, kMinPlausibleLoadMassKg, kMaxPlausibleLoadMassKg, "kg",
+                                              "load-test masses (5 - 300 kg)", "a mass in t typed in the kg option?",
+                                              "a mass in g typed in the kg option, or a weight in N?");
+      if (!w.empty()) {
+        Warn(kTool, w);
+        implausible.push_back(w);
+      }
+    }
     for (double m : o.masses_kg) {
       if (!(m > 0.0)) throw UsageError("--masses-kg: expected masses > 0 kg");
     }
@@ -122,6 +138,15 @@ int Run(int argc, char** argv) {
     for (const auto& p : pulleys) {
       const auto v = ParsePointMm("--pulley-mm", p);
       if (!v) throw UsageError("--pulley-mm: expected x,y,z in mm");
+      const std::string w = ImplausibleOption("--pulley-mm " + p + ": a distance from the base of", MToMm(v->norm()),
+                                              kMinPlausiblePulleyDistanceMm, kMaxPlausiblePulleyDistanceMm, "mm",
+                                              "load-test pulleys (0.5 - 5 m from the base)",
+                                              "a position in m typed in the mm option?",
+                                              "a position in um typed in the mm option?");
+      if (!w.empty()) {
+        Warn(kTool, w);
+        implausible.push_back(w);
+      }
       o.pulleys.push_back(*v);
     }
     o.p_load_tip = ParsePointMm("--load-point-mm", load_point);

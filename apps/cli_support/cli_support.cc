@@ -1,5 +1,7 @@
 #include "cli_support.h"
 
+#include "robomach/common/number_format.h"
+
 #include <CLI/CLI.hpp>
 #include <glog/logging.h>
 
@@ -238,6 +240,15 @@ void CheckOptionRange(const std::string& option, double value, double lo, double
     s << option << ": expected a value in [" << lo << ", " << hi << "], got " << value;
     throw UsageError(s.str());
   }
+}
+
+std::string ImplausibleOption(const std::string& option, double value, double lo, double hi, const std::string& unit,
+                              const std::string& practice, const std::string& low_hint, const std::string& high_hint) {
+  if (value >= lo && value <= hi) return "";
+  const std::string u = unit.empty() ? "" : " " + unit;
+  return "implausible (unit mistake?): " + option + " " + FormatNumber(value, 7) + u + " is outside the " +
+         FormatNumber(lo, 7) + " to " + FormatNumber(hi, 7) + u + " of " + practice + ": " +
+         (value < lo ? low_hint : high_hint);
 }
 
 std::vector<double> ParseNumberList(const std::string& option, const std::string& text) {

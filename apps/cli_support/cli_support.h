@@ -158,6 +158,13 @@ void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& 
 /// @throws UsageError unless lo <= value <= hi (and finite).
 void CheckOptionRange(const std::string& option, double value, double lo, double hi);
 
+/// Sense check of a typed option (docs/plausibility.md): "" when lo <= value
+/// <= hi, else "implausible (unit mistake?): OPTION VALUE UNIT is outside
+/// the LO to HI UNIT of PRACTICE: HINT" (low_hint below lo, high_hint above
+/// hi) for the tool to Warn() and flag its result (exit 3).
+std::string ImplausibleOption(const std::string& option, double value, double lo, double hi, const std::string& unit,
+                              const std::string& practice, const std::string& low_hint, const std::string& high_hint);
+
 /// "1,2.5,3" -> numbers; @throws UsageError naming the option.
 std::vector<double> ParseNumberList(const std::string& option, const std::string& text);
 /// "x,y,z" in millimetres -> metres, or nullopt for "tcp" (or empty).

@@ -210,6 +210,34 @@ CompensationTables ReadCompensationFile(const std::string& path, const MachineFi
     }
   }
 
+  // Values in the output axis's unit: refused when impossible, one finding
+  // per table (its largest value) when implausible.
+  std::vector<std::string> out_implausible;
+  auto check_values = [&](const PendingTable& t, const std::string& what, const AxisScale& out_axis) {
+    const bool mm = out_axis.kind == machine::AxisKind::kLinear;
+    const std::string unit = mm ? "mm" : "deg";
+    const std::pair<double, int>* largest = nullptr;
+    for (const auto& [i, v] : t.points) {
+      if (!largest || std::abs(v.first) > std::abs(largest->first)) largest = &v;
+    }
+    if (!largest) return;
+    const double m = std::abs(largest->first);
+    if (m > (mm ? kMaxCompensationMm : kMaxCompensationDeg)) {
+      throw err(largest->second, what + ": value " + FormatDouble(largest->first) + " " + unit + " is beyond the " +
+                                     FormatDouble(mm ? kMaxCompensationMm : kMaxCompensationDeg) + " " + unit +
+                                     " any compensation table corrects: " +
+                                     (mm ? "values in um or nm typed in the mm table?" : "values in arc-seconds typed in the deg table?"));
+    }
+    if (m > (mm ? kMaxPlausibleCompensationMm : kMaxPlausibleCompensationDeg)) {
+      out_implausible.push_back("implausible (unit mistake?): " + path + ":" + std::to_string(largest->second) + ": " +
+                                what + ": value " + FormatDouble(largest->first) + " " + unit + " is outside the +-" +
+                                FormatDouble(mm ? kMaxPlausibleCompensationMm : kMaxPlausibleCompensationDeg) + " " + unit +
+                                " of compensation tables (a few um; $MA_CEC_MAX_SUM is 1 mm by default): " +
+                                (mm ? "values in um typed in the mm table?"
+                                    : "values in arc-seconds or millidegrees typed in the deg table?"));
+    }
+  };
+
   // Assemble and check each table (formats.md §8.4: MAX = MIN + (n - 1) STEP).
   auto build = [&](const PendingTable& t, const std::string& what, const AxisScale& input_axis) {
     if (t.points.empty()) throw err(t.first_line, what + ": the table has no points");
@@ -231,6 +259,17 @@ CompensationTables ReadCompensationFile(const std::string& path, const MachineFi
                                    FormatDouble(t.min->first) + " + " + std::to_string(n - 1) + " * " +
                                    FormatDouble(t.step->first) + " = " + FormatDouble(expected_max));
     }
+    // Positions of a linear input axis within machine travels (um typed
+    // for mm moves them x1000).
+    if (input_axis.kind == machine::AxisKind::kLinear) {
+      const auto& far = std::abs(t.min->first) > std::abs(t.max->first) ? *t.min : *t.max;
+      if (std::abs(far.first) > kMaxPlausibleMachineLengthMm) {
+        out_implausible.push_back("implausible (unit mistake?): " + path + ":" + std::to_string(far.second) + ": " + what +
+                                  ": position " + FormatDouble(far.first) + " mm is outside the +-" +
+                                  FormatDouble(kMaxPlausibleMachineLengthMm) +
+                                  " mm of machine tool travels: positions in um typed in the mm table?");
+      }
+    }
     machine::CompensationTable table;
     table.min = ToSi(input_axis, t.min->first);
     table.step = ToSi(input_axis, t.step->first);
@@ -240,6 +279,7 @@ CompensationTables ReadCompensationFile(const std::string& path, const MachineFi
   for (const auto& [key, t] : enc) {
     const AxisScale& ax = mf.machine.axes[key.first];
     auto [table, n] = build(t, "$AA_ENC_COMP table of axis " + ax.name, ax);
+    check_values(t, "$AA_ENC_COMP table of axis " + ax.name, ax);
     for (const auto& [i, v] : t.points) table.values.push_back(ToSi(ax, v.first));
     out.encoder.push_back({key.first, table});
   }
@@ -250,9 +290,11 @@ CompensationTables ReadCompensationFile(const std::string& path, const MachineFi
     const int in_axis = mf.controller_axes.at(t.input->first);
     const int out_axis = mf.controller_axes.at(t.output->first);
     auto [table, n] = build(t, what, mf.machine.axes[in_axis]);
+    check_values(t, what, mf.machine.axes[out_axis]);
     for (const auto& [i, v] : t.points) table.values.push_back(ToSi(mf.machine.axes[out_axis], v.first));
     out.cross_axis.push_back({in_axis, out_axis, table});
   }
+  out.implausible = std::move(out_implausible);
   return out;
 }
 

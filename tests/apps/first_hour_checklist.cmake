@@ -38,6 +38,10 @@ string(REPLACE "diameter_mm: 20" "diameter_mm: 20000" c "${cut}")
 file(WRITE ${WORK}/cut_diameter.yaml "${c}")
 string(REPLACE "ktc_N_per_mm2: 600" "ktc_N_per_mm2: 1.8e6" c "${cut}")
 file(WRITE ${WORK}/cut_ktc.yaml "${c}")
+# A machine file with the linear encoder resolutions in um (x1000).
+file(READ ${SRC}/config/machine/dmu80p.yaml mach)
+string(REPLACE "resolution_mm: 0.0005" "resolution_mm: 0.5" mach "${mach}")
+file(WRITE ${WORK}/dmu80p_um.yaml "${mach}")
 # Postures: an absurd angle, radians under _deg headers, degrees under _rad.
 file(WRITE ${WORK}/huge.csv "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\nP1,1e308,-90,90,0,45,0\n")
 file(WRITE ${WORK}/rad_as_deg.csv

@@ -17,8 +17,10 @@
 
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
+#include "robomach/io/compensation_file.h"
 #include "robomach/io/cut_file.h"
 #include "robomach/io/drilling_files.h"
+#include "robomach/io/machine_file.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/io/robot_config.h"
 #include "test_support.h"
@@ -57,6 +59,11 @@ const std::vector<NamedReader>& Readers() {
          ReadPolishingProcess(p, &w);
          return w;
        }},
+      {"machine_file", [](const std::string& p) { return ReadMachineFile(p).implausible; }},
+      {"compensation",
+       [](const std::string& p) {
+         return ReadCompensationFile(p, ReadMachineFile(SourcePath("config/machine/dmu80p.yaml"))).implausible;
+       }},
   };
   return readers;
 }
@@ -74,7 +81,8 @@ struct WrongUnitCase {
   const char* reader;
   const char* file;     // shipped or test input, relative to the source tree
   const char* key;      // `key` (a scalar or every number of a flow list), `key[i]` (element i of a
-                        // flow list), or `key|key2|...` (each of them)
+                        // flow list), or `key|key2|...` (each of them); `$NAME[...]` a controller
+                        // assignment `$NAME[...]=value` (compensation tables)
   int occurrence;       // which line with the key (0 = the first)
   double factor;        // the mistake: the value times this
   Expect expect;
@@ -126,6 +134,23 @@ const std::vector<WrongUnitCase>& Cases() {
       {"polish_process", "config/polishing/belt_2N.yaml", "preston_coefficient_m2_per_N", 0, 1e6, Expect::kFlagged, "preston_coefficient_m2_per_N .*mm²/N"},
       {"polish_process", "config/polishing/belt_2N.yaml", "max_speed_mm_per_s", 0, 1e-3, Expect::kFlagged, "max_speed_mm_per_s 0.05 mm/s .*m/s typed in the mm/s field"},
       {"robot_config", "config/kr210_dh.yaml", "alpha_prev_deg|theta_offset_deg|lower_deg|upper_deg|base_rpy_deg|tip_rpy_deg", -1, kRadPerDeg, Expect::kRefused, "radians typed in _deg fields"},
+      // five-axis machine file (config/machine/dmu80p.yaml)
+      {"machine_file", "config/machine/dmu80p.yaml", "resolution_mm", -1, 1000, Expect::kFlagged, "resolution_mm 0.5 mm .*a resolution in um typed in the mm field"},
+      {"machine_file", "config/machine/dmu80p.yaml", "resolution_mm", -1, 1e-3, Expect::kFlagged, "resolution_mm 5e-07 mm .*a resolution in m typed in the mm field"},
+      {"machine_file", "config/machine/dmu80p.yaml", "resolution_deg", -1, 1000, Expect::kFlagged, "resolution_deg 0.1 deg .*arc-seconds or millidegrees"},
+      {"machine_file", "config/machine/dmu80p.yaml", "resolution_deg", -1, 1e7, Expect::kRefused, "resolution_deg: expected a resolution of at most 360 deg .*arc-seconds"},
+      {"machine_file", "config/machine/dmu80p.yaml", "nutation_deg", 0, kRadPerDeg, Expect::kFlagged, "nutation_deg 0.785398163397 deg .*45 deg; radians typed in a _deg field"},
+      {"machine_file", "config/machine/dmu80p.yaml", "pivot_length_mm", 0, 1e-3, Expect::kFlagged, "pivot_length_mm 0.3 mm .*a length in m typed in the mm field"},
+      {"machine_file", "config/machine/dmu80p.yaml", "pivot_length_mm", 0, 1000, Expect::kFlagged, "pivot_length_mm 300000 mm .*a length in um typed in the mm field"},
+      {"machine_file", "config/machine/dmu80p.yaml", "tool_length_mm", 0, 1e-3, Expect::kFlagged, "tool_length_mm 0.12 mm .*a length in m typed in the mm field"},
+      {"machine_file", "config/machine/dmu80p.yaml", "zero_offset_mm", 0, 1000, Expect::kFlagged, "zero_offset_mm\\[0\\] 350000 mm .*a length in um typed in the mm field"},
+      {"machine_file", "config/machine/dmu80p.yaml", "c_centre_mm", 0, 1000, Expect::kFlagged, "c_centre_mm\\[0\\] 400000 mm .*a length in um"},
+      {"machine_file", "config/machine/dmu80p.yaml", "zero_offset_mm", 0, 1e7, Expect::kRefused, "expected a length within \\+-1000000 mm \\(1 km\\).*um or nm typed in the mm field"},
+      {"machine_file", "config/machine/dmu80p.yaml", "b_eccentricity_mm", 0, 1000, Expect::kFlagged, "b_eccentricity_mm\\[0\\] 4 mm .*an error in um typed in the mm field"},
+      {"machine_file", "config/machine/dmu80p.yaml", "pivot_length_error_mm", 0, 1000, Expect::kFlagged, "pivot_length_error_mm 6 mm .*an error in um"},
+      // Siemens compensation tables (config/machine/dmu80p_comp.mpf)
+      {"compensation", "config/machine/dmu80p_comp.mpf", "$AA_ENC_COMP[0,6,AX1]", 0, 1000, Expect::kFlagged, "dmu80p_comp.mpf:\\d+: \\$AA_ENC_COMP table of axis X: value 2.827 mm .*values in um typed in the mm table"},
+      {"compensation", "config/machine/dmu80p_comp.mpf", "$AA_ENC_COMP[0,6,AX1]", 0, 1e6, Expect::kRefused, "dmu80p_comp.mpf:\\d+: \\$AA_ENC_COMP table of axis X: value 2827 mm is beyond the 100 mm.*um or nm typed"},
   };
   return cases;
 }
@@ -140,8 +165,15 @@ std::string Scaled(const std::string& text, const WrongUnitCase& c, const std::s
     key = m[1];
     element = std::stoi(m[2]);
   }
-  // The key at the start of a line, or inside a flow map ({a: 1, key: 2}).
-  const std::regex line_re("^(.*?(?:^|[\\s{,-])(?:" + key + "):\\s*)(\\[[^\\]]*\\]|[-+0-9.eE]+)(.*)$");
+  // The key at the start of a line, or inside a flow map ({a: 1, key: 2});
+  // a controller assignment `$NAME[...]=value` taken literally.
+  const bool assignment = c.key[0] == '$';
+  if (assignment) {
+    key = std::regex_replace(std::string(c.key), std::regex(R"([$\[\]\\.^*+?(){}|])"), "\\$&");
+    element = -1;
+  }
+  const std::regex line_re(assignment ? "^(" + key + "\\s*=\\s*)([-+0-9.eE]+)(.*)$"
+                                      : "^(.*?(?:^|[\\s{,-])(?:" + key + "):\\s*)(\\[[^\\]]*\\]|[-+0-9.eE]+)(.*)$");
   std::istringstream in(text);
   std::string line, out;
   int seen = 0, changed = 0;

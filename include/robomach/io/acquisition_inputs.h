@@ -27,6 +27,13 @@ struct AcquisitionInputs {
   const machine::Compensation* applied() const {
     return compensation && !compensation->empty() ? compensation.get() : nullptr;
   }
+  /// The machine file's and the compensation tables' unit findings
+  /// (docs/plausibility.md): the tool flags its result (exit 3) on any.
+  std::vector<std::string> implausible() const {
+    std::vector<std::string> all = machine.implausible;
+    all.insert(all.end(), tables.implausible.begin(), tables.implausible.end());
+    return all;
+  }
 };
 
 /// Reads every input before any work (an empty path: not given).

@@ -14,12 +14,30 @@ namespace robomach::io {
 struct CompensationTables {
   std::vector<machine::EncoderCompensation> encoder;
   std::vector<machine::CrossAxisCompensation> cross_axis;
+  /// "implausible (unit mistake?): file:line: ..." for a table whose largest
+  /// value or whose positions are outside the plausible ranges below
+  /// (docs/plausibility.md); one per table. The axis tools flag (exit 3).
+  std::vector<std::string> implausible;
 };
+
+// Compensation values are mm (deg for rotary axes), like the control's. The
+// 840D sl caps the summed compensation of an axis by MD32720
+// $MA_CEC_MAX_SUM, 1 mm by default; real pitch and sag tables hold a few um
+// to tens of um (Siemens 840D sl function manual "Extended functions",
+// K3 compensation). A larger value is um typed for mm (x1000).
+inline constexpr double kMaxPlausibleCompensationMm = 1.0;
+inline constexpr double kMaxPlausibleCompensationDeg = 0.1;  // 360 arc-seconds
+/// Refused (exit 65): no table corrects an axis by 10 cm or 10 deg.
+inline constexpr double kMaxCompensationMm = 100.0;
+inline constexpr double kMaxCompensationDeg = 10.0;
 /// Reads the controller's table assignments (formats.md §8.4).
 /// @throws InputError "file:line: ..." for a malformed assignment, MAX not
 ///   equal to MIN + (n - 1) STEP, a modulo table, a measuring system other
 ///   than 0, $AN_CEC_DIRECTION != 0, $AN_CEC_MULT_BY_TABLE != 0, an axis not
-///   in controller_axes, a gap in the points or a duplicated assignment.
+///   in controller_axes, a gap in the points or a duplicated assignment, a
+///   value over kMaxCompensationMm (kMaxCompensationDeg for rotary axes).
+///   Table positions (_MIN, _MAX) are checked against the machine file's
+///   plausible lengths (kMaxPlausibleMachineLengthMm).
 CompensationTables ReadCompensationFile(const std::string& path, const MachineFile& machine);
 
 }  // namespace robomach::io
