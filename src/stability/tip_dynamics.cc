@@ -42,7 +42,7 @@ std::string Hname(int a, int b) { return std::string("H") + "xyz"[a] + "xyz"[b];
 
 // Noise model and modal fit of one direct FRF, told to `on_message`.
 DirectionFit FitOne(const std::string& label, const dynamics::Frf& frf, const TipMessageSink& on_message) {
-  DirectionFit d{label, FitDirectFrf(frf)};
+  DirectionFit d{label, FitDirectFrf(frf), ""};
   std::ostringstream m;
   m << label << ": noise " << d.fit.noise.description << "\n" << label << ": modal fit: " << d.fit.fit.message;
   for (const calibration::FittedMode& fm : d.fit.fit.modes) {
