@@ -161,7 +161,10 @@ std::string Scaled(const std::string& text, const WrongUnitCase& c, const std::s
   std::string key = c.key;
   int element = -1;
   std::smatch m;
-  if (std::regex_match(key, m, std::regex(R"((\w+)\[(\d+)\])"))) {
+  // Matched on the case's own string: `m` points into it, so `key` may be
+  // reassigned (matching `key` and then assigning it left m[2] dangling).
+  const std::string full_key = c.key;
+  if (std::regex_match(full_key, m, std::regex(R"((\w+)\[(\d+)\])"))) {
     key = m[1];
     element = std::stoi(m[2]);
   }
