@@ -9,19 +9,14 @@
 #include <Eigen/Eigenvalues>
 
 #include "robomach/common/units.h"
+#include "internal/lscf_poles.h"
 
 namespace robomach::calibration {
 namespace {
 
 using cd = std::complex<double>;
 
-// 1/z as conj(z)/|z|²: std::complex's division (__divdc3, with its care for
-// infinities and scaling) was a sixth of the modal fit's time; the poles
-// and frequencies here are far from overflow.
-inline cd Reciprocal(cd z) {
-  const double n = z.real() * z.real() + z.imag() * z.imag();
-  return cd(z.real() / n, -z.imag() / n);
-}
+using internal::Reciprocal;
 
 cd PowerOf(cd s, int p) {
   cd v = 1.0;
@@ -156,24 +151,9 @@ std::vector<std::vector<OrderPole>> LscfPoles(const std::vector<dynamics::Frf>& 
       const Eigen::MatrixXd Y = llt.matrixL().solve(Sm);
       M.noalias() -= Y.transpose() * Y;
     }
-    const Eigen::VectorXd a = M.topLeftCorner(n, n).ldlt().solve(-M.col(n).head(n));
-    if (!a.allFinite()) continue;
-    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
-    for (int i = 1; i < n; ++i) C(i, i - 1) = 1.0;
-    for (int i = 0; i < n; ++i) C(i, n - 1) = -a(i);
-    const Eigen::EigenSolver<Eigen::MatrixXd> es(C, false);
-    if (es.info() != Eigen::Success) continue;
-    for (int i = 0; i < n; ++i) {
-      const cd z = es.eigenvalues()(i);
-      if (std::abs(z) == 0.0) continue;
-      const cd lambda = std::log(z) / dt;
-      if (!(lambda.imag() > 0.0)) continue;
-      const double wn = std::abs(lambda);
-      const double zeta = -lambda.real() / wn;
-      const double f_hz = RadPerSecToHz(wn);
-      if (!(zeta > 0.0 && zeta < o.max_damping_ratio)) continue;
-      if (f_hz < fmin_hz || f_hz > fmax_hz) continue;
-      OrderPole p{f_hz, zeta, lambda, n, false};
+    for (const internal::LscfPole& pole : internal::PolesOfOrder(M, n, dt, o.max_damping_ratio, fmin_hz, fmax_hz)) {
+      const double f_hz = pole.f_hz, zeta = pole.zeta;
+      OrderPole p{pole.f_hz, pole.zeta, pole.lambda, n, false};
       if (n > nmin) {
         for (const OrderPole& q : by_order[n - 1]) {
           if (std::abs(q.f_hz - f_hz) / f_hz < o.stable_freq_tol &&

@@ -10,19 +10,14 @@
 
 #include "robomach/common/golden_section.h"
 #include "robomach/common/units.h"
+#include "internal/lscf_poles.h"
 
 namespace robomach::calibration {
 namespace {
 
 using cd = std::complex<double>;
 
-// 1/z as conj(z)/|z|²: std::complex's division (__divdc3, with its care for
-// infinities and scaling) was a sixth of the modal fit's time; the poles
-// and frequencies here are far from overflow.
-inline cd Reciprocal(cd z) {
-  const double n = z.real() * z.real() + z.imag() * z.imag();
-  return cd(z.real() / n, -z.imag() / n);
-}
+using internal::Reciprocal;
 
 // |H|² at a fractional position between lines i and i+1 crossing `level`.
 double CrossingFreq(const Eigen::VectorXd& f, const Eigen::VectorXd& p2, int i, int j, double level) {
@@ -383,26 +378,9 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(Rm);
     if (ldlt.info() != Eigen::Success) continue;
     const Eigen::MatrixXd M = Tm - Sm.transpose() * ldlt.solve(Sm);
-    // a_n = 1: M[0:n,0:n] a = −M[0:n, n].
-    const Eigen::VectorXd a = M.topLeftCorner(n, n).ldlt().solve(-M.col(n).head(n));
-    if (!a.allFinite()) continue;
-    // Companion matrix of z^n + a_{n−1} z^{n−1} + ... + a_0.
-    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
-    for (int i = 1; i < n; ++i) C(i, i - 1) = 1.0;
-    for (int i = 0; i < n; ++i) C(i, n - 1) = -a(i);
-    const Eigen::EigenSolver<Eigen::MatrixXd> es(C, false);
-    if (es.info() != Eigen::Success) continue;
-    for (int i = 0; i < n; ++i) {
-      const cd z = es.eigenvalues()(i);
-      if (std::abs(z) == 0.0) continue;
-      const cd lambda = std::log(z) / dt;
-      if (!(lambda.imag() > 0.0)) continue;
-      const double wn = std::abs(lambda);
-      const double zeta = -lambda.real() / wn;
-      const double f_hz = RadPerSecToHz(wn);
-      if (!(zeta > 0.0 && zeta < o.max_damping_ratio)) continue;
-      if (f_hz < result.fmin_hz || f_hz > result.fmax_hz) continue;
-      OrderPole p{f_hz, zeta, lambda, 1};
+    for (const internal::LscfPole& pole : internal::PolesOfOrder(M, n, dt, o.max_damping_ratio, result.fmin_hz, result.fmax_hz)) {
+      const double f_hz = pole.f_hz, zeta = pole.zeta;
+      OrderPole p{pole.f_hz, pole.zeta, pole.lambda, 1};
       bool stable = false;
       if (n > o.min_order) {
         const OrderPole* best = nullptr;
