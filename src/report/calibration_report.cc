@@ -9,6 +9,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/frf_plot.h"
+#include "robomach/report/modal_fit_plot.h"
 #include "robomach/report/plot.h"
 
 namespace robomach::report {
@@ -225,25 +226,9 @@ void WriteStabilisationPng(const std::string& path, const std::string& pose_id,
     Axes& ax = fig.at(static_cast<int>(r), 0);
     ax.title = "H" + Dir(key) + ": " + std::to_string(fit.modes.size()) + " modes, LSCF order " +
                std::to_string(fit.order_used) + ", relative rms misfit " + Fixed(fit.relative_rms_error, 4);
-    ax.x_label = "frequency [Hz]";
-    ax.y_label = "model order";
-    ax.log_x = fit.fmin_hz > 0.0 && fit.fmax_hz / fit.fmin_hz > 100.0;
-    ax.x_min = ax.log_x ? fit.fmin_hz : 0.0;
-    ax.x_max = fit.fmax_hz;
-    Series unstable, stable;
-    unstable.markers = stable.markers = true;
-    unstable.label = "pole";
-    stable.label = "stable pole";
-    unstable.color = {180, 180, 180};
-    stable.color = PaletteColor(2);
-    for (const auto& p : fit.stabilisation) {
-      Series& s = p.stable ? stable : unstable;
-      s.x.push_back(p.freq_hz);
-      s.y.push_back(p.order);
-    }
-    ax.series.push_back(std::move(unstable));
-    ax.series.push_back(std::move(stable));
-    for (const auto& m : fit.modes) ax.markers.push_back({m.freq_hz, Fixed(m.freq_hz, 1) + " Hz"});
+    std::vector<double> modes;
+    for (const auto& m : fit.modes) modes.push_back(m.freq_hz);
+    FillStabilisationPanel(fit.stabilisation, modes, fit.fmin_hz, fit.fmax_hz, &ax);
   }
   fig.SavePng(path);
 }

@@ -69,6 +69,33 @@ void FillModalFitPanels(const dynamics::Frf& measured, const calibration::FrfNoi
 
 namespace robomach::report {
 
+void FillStabilisationPanel(const std::vector<calibration::StabilisationPole>& poles,
+                            const std::vector<double>& mode_freq_hz, double fmin_hz, double fmax_hz, Axes* ax) {
+  ax->x_label = "frequency [Hz]";
+  ax->y_label = "model order";
+  ax->log_x = fmin_hz > 0.0 && fmax_hz / fmin_hz > 100.0;
+  ax->x_min = ax->log_x ? fmin_hz : 0.0;
+  ax->x_max = fmax_hz > 0.0 ? fmax_hz : NAN;
+  Series unstable, stable;
+  unstable.markers = stable.markers = true;
+  unstable.label = "pole";
+  stable.label = "stable pole";
+  unstable.color = {180, 180, 180};
+  stable.color = PaletteColor(2);
+  for (const auto& p : poles) {
+    Series& s = p.stable ? stable : unstable;
+    s.x.push_back(p.freq_hz);
+    s.y.push_back(p.order);
+  }
+  ax->series.push_back(std::move(unstable));
+  ax->series.push_back(std::move(stable));
+  for (double f : mode_freq_hz) {
+    char l[32];
+    std::snprintf(l, sizeof(l), "%.1f Hz", f);
+    ax->markers.push_back({f, l});
+  }
+}
+
 void WriteModalAnalysisPng(const std::string& path, const calibration::PoseModes& pose,
                            const dynamics::FrfSet& measured, const calibration::NoiseModels& noise) {
   int frf_rows = 0;
@@ -85,29 +112,9 @@ void WriteModalAnalysisPng(const std::string& path, const calibration::PoseModes
     std::snprintf(head, sizeof(head), "stabilisation diagram of %s: %zu modes, orders %d..%d", which.c_str(),
                   g.fit.modes.size(), g.fit.min_order, g.fit.max_order);
     ax.title = head;
-    ax.x_label = "frequency [Hz]";
-    ax.y_label = "model order";
-    ax.log_x = g.fit.fmin_hz > 0.0 && g.fit.fmax_hz / g.fit.fmin_hz > 100.0;
-    ax.x_min = ax.log_x ? g.fit.fmin_hz : 0.0;
-    ax.x_max = g.fit.fmax_hz > 0.0 ? g.fit.fmax_hz : NAN;
-    Series unstable, stable;
-    unstable.markers = stable.markers = true;
-    unstable.label = "pole";
-    stable.label = "stable pole";
-    unstable.color = {180, 180, 180};
-    stable.color = PaletteColor(2);
-    for (const auto& p : g.fit.stabilisation) {
-      Series& s = p.stable ? stable : unstable;
-      s.x.push_back(p.freq_hz);
-      s.y.push_back(p.order);
-    }
-    ax.series.push_back(std::move(unstable));
-    ax.series.push_back(std::move(stable));
-    for (const auto& m : g.fit.modes) {
-      char l[32];
-      std::snprintf(l, sizeof(l), "%.1f Hz", m.freq_hz);
-      ax.markers.push_back({m.freq_hz, l});
-    }
+    std::vector<double> modes;
+    for (const auto& m : g.fit.modes) modes.push_back(m.freq_hz);
+    FillStabilisationPanel(g.fit.stabilisation, modes, g.fit.fmin_hz, g.fit.fmax_hz, &ax);
     for (size_t i = 0; i < g.keys.size(); ++i) {
       const dynamics::Frf& frf = measured.at(g.keys[i]);
       calibration::FrfNoise nz;

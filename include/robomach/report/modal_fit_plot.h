@@ -27,6 +27,13 @@ void FillModalFitPanels(const dynamics::Frf& measured, const calibration::FrfNoi
 
 namespace robomach::report {
 
+/// A stabilisation diagram in `ax`: the poles per model order against
+/// frequency (grey, the stable ones in colour) and the selected modes as
+/// labelled lines; a log frequency axis when [fmin_hz, fmax_hz] spans more
+/// than two decades.
+void FillStabilisationPanel(const std::vector<calibration::StabilisationPole>& poles,
+                            const std::vector<double>& mode_freq_hz, double fmin_hz, double fmax_hz, Axes* ax);
+
 /// frf-modes' picture of one posture: the stabilisation diagram of each fit
 /// (poles per model order, stable ones in colour, the modes as lines), then
 /// magnitude and phase of each FRF with its fit, the noise floor and the
