@@ -41,7 +41,8 @@ int Run(int argc, char** argv) {
   std::string out_path, constants_path, summary_path, plot_dir;
   calibration::ModalAnalysisOptions opt;
   NoiseCliOptions noise_opt;
-  app.add_option("--measured", measured_files, "measured FRF file (CSV or UFF58); repeatable");
+  app.add_option("--measured", measured_files,
+                 "measured FRF file (CSV or UFF58; UFF records that name no posture are posture P1); repeatable");
   app.add_option("--pose", pose_files, "ID=file.uff: a UFF58 file whose records name no posture; repeatable");
   app.add_option("--fmin-hz", opt.fit.fmin_hz, "lower end of the band to fit [Hz]")->capture_default_str();
   app.add_option("--fmax-hz", opt.fit.fmax_hz, "upper end of the band to fit [Hz] (default: the whole FRF)");
@@ -94,19 +95,11 @@ int Run(int argc, char** argv) {
       }
       for (const auto& u : one.unit_findings) all.unit_findings.push_back(u);
     };
-    for (const std::string& f : measured_files) {
-      // A file without posture names (a UFF export) is posture P1 here:
-      // frf-modes needs none.
-      MeasuredData one;
-      try {
-        one = ReadMeasuredFiles(kTool, {f}, {}, "measured FRF file");
-      } catch (const InputError& e) {
-        if (std::string(e.what()).find("name no posture") == std::string::npos) throw;
-        one = ReadMeasuredFiles(kTool, {}, {"P1=" + f}, "measured FRF file");
-        Note(kTool, f + ": no posture named in the file; its FRFs are posture P1");
-      }
-      merge(one);
-    }
+    // A UFF record that names no posture is posture P1 here (frf-modes needs
+    // none); a posture the file names wins, and a CSV always names its own.
+    // Read once: retrying after the reader's "no posture" error printed its
+    // warnings twice.
+    for (const std::string& f : measured_files) merge(ReadMeasuredFiles(kTool, {}, {"P1=" + f}, "measured FRF file"));
     const calibration::NoiseModels noise = EstimateNoiseModels(kTool, all, noise_opt);
     int power = 0;
     std::string quantity = "receptance";
