@@ -38,7 +38,7 @@ int Run(int argc, char** argv) {
              "3 x its noise, a measured receptance is outside the plausible range, or the FRFs of a posture "
              "could not be fitted together (see the warnings, also in the summary).");
   std::vector<std::string> measured_files, pose_files;
-  std::string out_path, constants_path, summary_path, plot_dir;
+  std::string out_path, constants_path, shapes_path, summary_path, plot_dir;
   calibration::ModalAnalysisOptions opt;
   NoiseCliOptions noise_opt;
   app.add_option("--measured", measured_files,
@@ -63,6 +63,10 @@ int Run(int argc, char** argv) {
       ->required();
   app.add_option("--modal-constants", constants_path,
                  "CSV of every FRF's modal constant and mode-shape component per mode");
+  app.add_option("--mode-shapes", shapes_path,
+                 "CSV of the mode shapes of a roving test (FRFs numbered by point: UFF nodes, or the "
+                 "response_point/excitation_point columns of formats.md §3), mass-normalised if the test has a "
+                 "driving point");
   app.add_option("--summary", summary_path, "JSON summary (modes, misfit per FRF, warnings)");
   app.add_option("--plot-dir", plot_dir, "folder for modes_<pose>.png (stabilisation diagram and fits)");
   try {
@@ -78,10 +82,10 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--max-order", opt.fit.max_order, 8, 400);
     std::vector<std::pair<std::string, std::string>> inputs;
     for (const auto& f : measured_files) inputs.push_back({"--measured", f});
-    CheckDistinctPaths(inputs, {{"--out", out_path}, {"--modal-constants", constants_path}, {"--summary", summary_path}});
+    CheckDistinctPaths(inputs, {{"--out", out_path}, {"--modal-constants", constants_path}, {"--mode-shapes", shapes_path}, {"--summary", summary_path}});
     // A UFF file without posture names is one posture, "P1", here: frf-modes
     // needs none (frf-calibrate's --pose P1=file.uff still works).
-    MeasuredData all = ReadMeasuredFiles(kTool, {}, pose_files, "measured FRF file");
+    MeasuredData all = ReadMeasuredFiles(kTool, {}, pose_files, "measured FRF file", "--pose", true);
     auto merge = [&](const MeasuredData& one) {
       for (const auto& [key, frf] : one.frfs) {
         if (all.frfs.contains(key)) {
@@ -99,7 +103,7 @@ int Run(int argc, char** argv) {
     // none); a posture the file names wins, and a CSV always names its own.
     // Read once: retrying after the reader's "no posture" error printed its
     // warnings twice.
-    for (const std::string& f : measured_files) merge(ReadMeasuredFiles(kTool, {}, {"P1=" + f}, "measured FRF file"));
+    for (const std::string& f : measured_files) merge(ReadMeasuredFiles(kTool, {}, {"P1=" + f}, "measured FRF file", "--pose", true));
     const calibration::NoiseModels noise = EstimateNoiseModels(kTool, all, noise_opt);
     int power = 0;
     std::string quantity = "receptance";
@@ -135,14 +139,14 @@ int Run(int argc, char** argv) {
         std::ostringstream line;
         line << "posture " << p.pose_id << ": ";
         for (size_t i = 0; i < g.keys.size(); ++i) {
-          line << (i ? ", H" : "H") << AxisName(g.keys[i].response) << AxisName(g.keys[i].excitation);
+          line << (i ? ", " : "") << g.keys[i].Label();
         }
         line << ": " << g.fit.message;
         Note(kTool, line.str());
         for (size_t i = 0; i < g.keys.size(); ++i) {
           const double ns = i < g.fit.misfit_in_noise.size() ? g.fit.misfit_in_noise[i] : NAN;
           if (std::isfinite(ns) && ns > 3.0) {
-            Warn(kTool, "posture " + p.pose_id + ", H" + AxisName(g.keys[i].response) + AxisName(g.keys[i].excitation) +
+            Warn(kTool, "posture " + p.pose_id + ", " + g.keys[i].Label() +
                             ": the fit leaves " + FormatNumber(ns, 3) +
                             " x the noise (more than 3): a mode or a residual effect is missing, or the noise model is "
                             "too optimistic (see the picture)");
@@ -154,11 +158,17 @@ int Run(int argc, char** argv) {
         std::fprintf(stderr, "%s: posture %s: %.6g Hz, zeta %.4g, modal mass %s kg (%s)\n", kTool, p.pose_id.c_str(),
                      t.freq_hz, t.damping_ratio,
                      std::isfinite(t.modal_mass_kg) ? FormatNumber(t.modal_mass_kg, 4).c_str() : "-",
-                     t.directions.empty() ? "no direct FRF" : t.directions.c_str());
+                     t.directions.empty() ? "no driving-point FRF with a positive modal constant" : t.directions.c_str());
       }
     }
     io::WriteFileAtomically(out_path, io::ModalTableCsv(poses));
     if (!constants_path.empty()) io::WriteFileAtomically(constants_path, io::ModalConstantsCsv(poses));
+    if (!shapes_path.empty()) {
+      std::vector<std::string> why;
+      const std::string csv = io::ModeShapesCsv(poses, &why);
+      for (const std::string& w : why) Note(kTool, w);
+      io::WriteFileAtomically(shapes_path, csv);
+    }
     if (!plot_dir.empty()) {
       io::EnsureDirectory(plot_dir);
       for (const calibration::PoseModes& p : poses) {

@@ -14,11 +14,11 @@ namespace robomach::apps {
 
 MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::string>& files,
                                const std::vector<std::string>& pose_files, const std::string& what,
-                               const std::string& pose_option) {
+                               const std::string& pose_option, bool keep_points) {
   MeasuredData all;
   auto add = [&](const std::string& path, const std::string& pose) {
     RequireReadableFile(path, what);
-    const io::FrfReadResult r = io::ReadFrfFile(path, pose);
+    const io::FrfReadResult r = io::ReadFrfFile(path, pose, keep_points);
     for (const std::string& w : r.warnings) Warn(tool, w);
     for (const std::string& n : r.notes) Note(tool, n);
     // On each FRF's usable band only (issue #34 item 5): a tap test's drift

@@ -37,10 +37,11 @@ struct MeasuredData {
 /// set; warnings and notes go to stderr under `tool`. @throws InputError for
 /// an FRF read twice or one without a posture (the message suggests
 /// --pose, so every tool that calls this has that option),
-/// UsageError for a malformed ID=file.
+/// UsageError for a malformed ID=file. `keep_points`: the point numbers of
+/// a roving test stay in the keys (io::ReadFrfFile).
 MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::string>& files,
                                const std::vector<std::string>& pose_files, const std::string& what,
-                               const std::string& pose_option = "--pose");
+                               const std::string& pose_option = "--pose", bool keep_points = false);
 
 /// The noise options of the command line.
 struct NoiseCliOptions {

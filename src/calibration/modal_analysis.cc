@@ -29,9 +29,71 @@ dynamics::Frf Prepared(const dynamics::Frf& frf, const FrfNoise* noise, const st
 
 }  // namespace
 
+std::optional<RovingShapes> ShapesOfRovingTest(const ModalGroup& group, std::string* why) {
+  auto fail = [&](const std::string& reason) {
+    if (why) *why = reason;
+    return std::nullopt;
+  };
+  const auto& keys = group.keys;
+  if (keys.size() < 2) return fail("one FRF: no shape to compare across points");
+  bool same_response = true, same_excitation = true;
+  for (const auto& k : keys) {
+    same_response = same_response && k.response_point == keys[0].response_point && k.response == keys[0].response;
+    same_excitation =
+        same_excitation && k.excitation_point == keys[0].excitation_point && k.excitation == keys[0].excitation;
+  }
+  RovingShapes s;
+  if (same_response && !same_excitation) {
+    s.roving = "excitation";
+    s.fixed_point = keys[0].response_point;
+    s.fixed_direction = keys[0].response;
+  } else if (same_excitation && !same_response) {
+    s.roving = "response";
+    s.fixed_point = keys[0].excitation_point;
+    s.fixed_direction = keys[0].excitation;
+  } else {
+    return fail("the FRFs share no end (a roving test keeps the response or the excitation at one point and "
+                "direction)");
+  }
+  int driving = -1;
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const bool hammer = s.roving == "excitation";
+    s.points.push_back(hammer ? keys[i].excitation_point : keys[i].response_point);
+    s.directions.push_back(hammer ? keys[i].excitation : keys[i].response);
+    if (keys[i].IsDrivingPoint() && driving < 0) driving = static_cast<int>(i);
+  }
+  s.shapes = group.fit.ModeShapes(driving);
+  s.mass_normalised = driving >= 0;
+  return s;
+}
+
 std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>* warnings) {
   std::vector<TipMode> out;
   const Eigen::MatrixXcd A = group.fit.ModalConstants();
+  // The tool tip of a roving test is its driving point: the FRFs between
+  // that point and itself give the mass and shape; a test without one has
+  // no modal mass.
+  int tip = -1;
+  for (const auto& k : group.keys) {
+    if (k.response_point == k.excitation_point) {
+      tip = k.response_point;
+      break;
+    }
+  }
+  if (tip < 0) {
+    if (warnings && !group.fit.modes.empty()) {
+      warnings->push_back("posture " + group.pose_id + ": no FRF has its response and excitation at one point (" +
+                          group.keys[0].ToString() + ", ...), so no mode has a modal mass: the modal table (--out) "
+                          "is empty; the modes and shapes are in the summary and --modal-constants / --mode-shapes");
+    }
+    for (const GlobalMode& m : group.fit.modes) {
+      TipMode t;
+      t.freq_hz = m.freq_hz;
+      t.damping_ratio = m.damping_ratio;
+      out.push_back(t);
+    }
+    return out;
+  }
   for (size_t r = 0; r < group.fit.modes.size(); ++r) {
     TipMode t;
     t.freq_hz = group.fit.modes[r].freq_hz;
@@ -39,6 +101,7 @@ std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>*
     Eigen::Vector3d a_dd = Eigen::Vector3d::Constant(NAN);
     Eigen::Matrix3d a_de = Eigen::Matrix3d::Constant(NAN);
     for (size_t i = 0; i < group.keys.size(); ++i) {
+      if (group.keys[i].response_point != tip || group.keys[i].excitation_point != tip) continue;
       const int d = AxisIndex(group.keys[i].response), e = AxisIndex(group.keys[i].excitation);
       // Proportional damping: A is real; its real part carries the sign.
       if (d == e) a_dd(d) = A(i, r).real();
@@ -66,7 +129,7 @@ std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>*
       }
     } else if (warnings) {
       warnings->push_back("posture " + group.pose_id + ", mode at " + std::to_string(t.freq_hz) +
-                          " Hz: no direct FRF has a positive modal constant, so it has no modal mass (left out of the "
+                          " Hz: no driving-point FRF has a positive modal constant, so it has no modal mass (left out of the "
                           "modal table)");
     }
     out.push_back(t);
@@ -166,7 +229,7 @@ std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const Nois
     // alone: the modes of each direct FRF, each a mode in its direction.
     for (const ModalGroup& g : pm.groups) {
       if (g.fit.status != ModalFitStatus::kOk) continue;
-      if (g.keys.size() == 1 && g.keys[0].response != g.keys[0].excitation) continue;
+      if (g.keys.size() == 1 && !g.keys[0].IsDrivingPoint()) continue;
       for (const TipMode& t : TipModes(g, &pm.warnings)) pm.tip_modes.push_back(t);
     }
     std::sort(pm.tip_modes.begin(), pm.tip_modes.end(),

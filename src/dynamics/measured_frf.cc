@@ -120,8 +120,21 @@ Frf Frf::Select(const std::vector<int>& lines) const {
 std::string FrfKey::ToString() const {
   // A posture-free FRF (a tap test on a machine tool, a UFF record that
   // names no posture) has an empty pose id.
+  const bool points = response_point != 0 || excitation_point != 0;
+  auto at = [&](int p) { return points ? " at point " + std::to_string(p) : std::string(); };
   return (pose_id.empty() ? std::string() : "pose " + pose_id + ", ") + "response " + AxisName(response) +
-         ", excitation " + AxisName(excitation);
+         at(response_point) + ", excitation " + AxisName(excitation) + at(excitation_point);
+}
+
+std::string FrfKey::Label() const {
+  if (response_point == 0 && excitation_point == 0) return std::string("H") + AxisName(response) + AxisName(excitation);
+  std::string s = "H";
+  s += std::to_string(response_point);
+  s += AxisName(response);
+  s += ',';
+  s += std::to_string(excitation_point);
+  s += AxisName(excitation);
+  return s;
 }
 
 void FrfSet::Insert(FrfKey key, Frf frf) {

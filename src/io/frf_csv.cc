@@ -1,6 +1,7 @@
 #include "robomach/io/frf_csv.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 
@@ -19,7 +20,7 @@ using frf_text::CheckLowFrequencyTrend;
 using frf_text::Fmt;
 using frf_text::ParseAxis;
 
-FrfReadResult ReadFrfCsv(const std::string& path) {
+FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
   const CsvTable t = CsvTable::ReadFile(path, kFrfFileFormat);
   FrfReadResult out;
   if (auto it = t.metadata().find("quantity"); it != t.metadata().end()) {
@@ -40,6 +41,26 @@ FrfReadResult ReadFrfCsv(const std::string& path) {
   }
   for (const char* c : {"pose_id", "response", "excitation", "freq_hz", "re", "im"}) t.RequireColumn(c);
   const bool has_coherence = t.HasColumn("coherence");
+  // Point numbers of a roving test (formats.md §3): `point` is the roving
+  // transducer's point, read as the response point (by reciprocity a
+  // roving hammer's point may go there too).
+  if (t.HasColumn("point") && t.HasColumn("response_point")) {
+    throw InputError({path, t.header_line(), 0},
+                     "columns 'point' and 'response_point' are the same thing: give one of them");
+  }
+  const char* response_point_col = t.HasColumn("response_point") ? "response_point"
+                                   : t.HasColumn("point")         ? "point"
+                                                                  : nullptr;
+  const bool has_excitation_point = t.HasColumn("excitation_point");
+  auto point_at = [&](int r, const char* col) {
+    const std::string text = t.Text(r, col);
+    int v = -1;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc() || end != text.data() + text.size() || v < 0) {
+      throw t.ErrorAt(r, col, "expected a point number (a whole number >= 0), got \"" + text + "\"");
+    }
+    return v;
+  };
   if (t.num_rows() == 0) throw InputError({path, t.header_line(), 0}, "no FRF lines after the header");
 
   struct Block {
@@ -88,6 +109,8 @@ FrfReadResult ReadFrfCsv(const std::string& path) {
     if (!ParseAxis(t.Text(r, "excitation"), &key.excitation)) {
       throw t.ErrorAt(r, "excitation", "expected x, y or z, got \"" + t.Text(r, "excitation") + "\"");
     }
+    if (response_point_col) key.response_point = point_at(r, response_point_col);
+    if (has_excitation_point) key.excitation_point = point_at(r, "excitation_point");
     if (!open || !(key == cur.key)) {
       finish();
       if (auto it = seen.find(key); it != seen.end()) {
@@ -146,6 +169,7 @@ FrfReadResult ReadFrfCsv(const std::string& path) {
     if (has_coherence) cur.coh.push_back(coh);
   }
   finish();
+  if (!keep_points) DropPointNumbers(path, &out);
   return out;
 }
 
@@ -155,7 +179,10 @@ void WriteFrfCsv(std::ostream& os, const FrfSet& frfs, FrfQuantity quantity, int
   os << "# quantity: " << QuantityName(quantity) << '\n';
   if (averages > 0) os << "# averages: " << averages << '\n';
   os << "# written by robomach; tool-tip FRFs in the robot base frame B, SI units\n";
-  os << "pose_id,response,excitation,freq_hz,re,im" << (coherence ? ",coherence" : "") << '\n';
+  bool points = false;
+  for (const auto& [k, f] : frfs) points = points || k.response_point != 0 || k.excitation_point != 0;
+  os << "pose_id,response,excitation,freq_hz,re,im" << (coherence ? ",coherence" : "")
+     << (points ? ",response_point,excitation_point" : "") << '\n';
   for (const auto& [k, frf] : frfs) {
     for (int i = 0; i < frf.size(); ++i) {
       const double f = frf.freq_hz()(i);
@@ -164,6 +191,7 @@ void WriteFrfCsv(std::ostream& os, const FrfSet& frfs, FrfQuantity quantity, int
       os << k.pose_id << ',' << AxisName(k.response) << ',' << AxisName(k.excitation) << ','
          << FormatDouble(f) << ',' << FormatDouble(v.real()) << ',' << FormatDouble(v.imag());
       if (coherence) os << ',' << FormatDouble((*frf.coherence())(i));
+      if (points) os << ',' << k.response_point << ',' << k.excitation_point;
       os << '\n';
     }
   }

@@ -6,19 +6,19 @@
 
 #include "text.h"
 
+
 namespace robomach::io {
 
-
-FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_pose_id) {
+FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_pose_id, bool keep_points) {
   std::string ext;
   if (auto dot = path.find_last_of('.'); dot != std::string::npos) ext = Lower(path.substr(dot + 1));
   // A YAML config, a picture or a spreadsheet is named before either parser
   // sees it (io/file_kind.h).
   RequireFileKind(path, {FileKind::kCsv, FileKind::kUff58}, kFrfFileFormat);
   if (ext == "uff" || ext == "unv" || ext == "uf" || ext == "ufb" || LooksLikeUff(path)) {
-    return ReadUff58(path, default_pose_id);
+    return ReadUff58(path, default_pose_id, keep_points);
   }
-  return ReadFrfCsv(path);
+  return ReadFrfCsv(path, keep_points);
 }
 
 }  // namespace robomach::io

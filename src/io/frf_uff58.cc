@@ -272,7 +272,7 @@ std::string NodeText(int resp_node, Axis ra, int ref_node, Axis ea) {
 
 }  // namespace
 
-FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose_id) {
+FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose_id, bool keep_points) {
   const UffFile file = ReadUffFile(path);
   FrfReadResult out;
   bool quantity_set = false;
@@ -313,12 +313,6 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
     }
     const int resp_node = r.response_node != 0 ? r.response_node : rd.node;
     const int ref_node = r.reference_node != 0 ? r.reference_node : ed.node;
-    if (r.function_type == 4 && resp_node != 0 && ref_node != 0 && resp_node != ref_node) {
-      out.warnings.push_back(where + ": a transfer FRF between two points (response node " + std::to_string(resp_node) +
-                             ", reference node " + std::to_string(ref_node) +
-                             "); a tool-tip FRF is a driving-point FRF (hammer and sensor at the tool tip), so the "
-                             "tools read it as one only if the export numbered one point twice");
-    }
     const double hz = AbscissaToHz(path, r);
     if (r.trailing_values > 0) {
       (r.trailing_all_zero ? out.notes : out.warnings)
@@ -348,14 +342,14 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
     key.pose_id = pose;
     key.response = ra;
     key.excitation = ea;
+    key.response_point = resp_node;
+    key.excitation_point = ref_node;
     for (const FrfRecord& o : frf_records) {
       if (o.key == key) {
         throw InputError({path, r.line, 0},
                          "this FRF (" + NodeText(resp_node, ra, ref_node, ea) + ") and the one at line " +
-                             std::to_string(o.line) + " (" + NodeText(o.resp_node, ra, o.ref_node, ea) +
-                             ") are both " + key.ToString() +
-                             "; a file for robomach holds the FRFs of one tool-tip point per posture: split the "
-                             "export, or name the postures with pose=ID in ID line 1");
+                             std::to_string(o.line) + " are both " + key.ToString() +
+                             ": the same FRF twice; name the postures (or runs) with pose=ID in ID line 1");
       }
     }
     const double sign = rd.sign * ed.sign;
@@ -465,6 +459,7 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
       throw InputError({path, r.line, 0}, "coherence record for " + match->key.ToString() + ": " + e.what());
     }
   }
+  if (!keep_points) DropPointNumbers(path, &out);
   return out;
 }
 

@@ -1,6 +1,7 @@
 #include "robomach/io/modal_analysis_files.h"
 
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "robomach/common/frames.h"
@@ -33,7 +34,7 @@ std::string ModalTableCsv(const std::vector<calibration::PoseModes>& poses) {
 std::string ModalConstantsCsv(const std::vector<calibration::PoseModes>& poses) {
   std::ostringstream os;
   os << "pose_id,fit,mode,freq_hz,damping_ratio,response,excitation,modal_constant_re,modal_constant_im,"
-        "peak_contribution_m_per_N,shape_re,shape_im\n";
+        "peak_contribution_m_per_N,shape_re,shape_im,response_point,excitation_point\n";
   for (const calibration::PoseModes& p : poses) {
     for (size_t g = 0; g < p.groups.size(); ++g) {
       const calibration::ModalGroup& grp = p.groups[g];
@@ -46,7 +47,36 @@ std::string ModalConstantsCsv(const std::vector<calibration::PoseModes>& poses) 
              << FormatDouble(m.damping_ratio) << ',' << AxisName(grp.keys[i].response) << ','
              << AxisName(grp.keys[i].excitation) << ',' << FormatDouble(m.modal_constant.real()) << ','
              << FormatDouble(m.modal_constant.imag()) << ',' << FormatDouble(m.peak_contribution) << ','
-             << FormatDouble(shapes(i, r).real()) << ',' << FormatDouble(shapes(i, r).imag()) << '\n';
+             << FormatDouble(shapes(i, r).real()) << ',' << FormatDouble(shapes(i, r).imag()) << ','
+             << grp.keys[i].response_point << ',' << grp.keys[i].excitation_point << '\n';
+        }
+      }
+    }
+  }
+  return os.str();
+}
+
+std::string ModeShapesCsv(const std::vector<calibration::PoseModes>& poses, std::vector<std::string>* notes) {
+  std::ostringstream os;
+  os << "pose_id,fit,mode,freq_hz,damping_ratio,point,direction,shape_re,shape_im,shape_unit,roving,fixed_point,"
+        "fixed_direction\n";
+  for (const calibration::PoseModes& p : poses) {
+    for (size_t g = 0; g < p.groups.size(); ++g) {
+      const calibration::ModalGroup& grp = p.groups[g];
+      if (grp.fit.status != calibration::ModalFitStatus::kOk) continue;
+      std::string why;
+      const std::optional<calibration::RovingShapes> rs = calibration::ShapesOfRovingTest(grp, &why);
+      if (!rs) {
+        if (notes) notes->push_back("posture " + p.pose_id + ", fit " + std::to_string(g + 1) + ": no mode shapes: " + why);
+        continue;
+      }
+      for (size_t r = 0; r < grp.fit.modes.size(); ++r) {
+        for (size_t i = 0; i < rs->points.size(); ++i) {
+          os << p.pose_id << ',' << g + 1 << ',' << r + 1 << ',' << FormatDouble(grp.fit.modes[r].freq_hz) << ','
+             << FormatDouble(grp.fit.modes[r].damping_ratio) << ',' << rs->points[i] << ','
+             << AxisName(rs->directions[i]) << ',' << FormatDouble(rs->shapes(i, r).real()) << ','
+             << FormatDouble(rs->shapes(i, r).imag()) << ',' << (rs->mass_normalised ? "1/sqrt(kg)" : "1") << ','
+             << rs->roving << ',' << rs->fixed_point << ',' << AxisName(rs->fixed_direction) << '\n';
         }
       }
     }
@@ -70,6 +100,10 @@ nlohmann::json ModalAnalysisSummaryJson(const std::vector<calibration::PoseModes
       for (size_t i = 0; i < g.keys.size(); ++i) {
         json jf;
         jf["frf"] = Dir(g.keys[i]);
+        if (g.keys[i].response_point != 0 || g.keys[i].excitation_point != 0) {
+          jf["response_point"] = g.keys[i].response_point;
+          jf["excitation_point"] = g.keys[i].excitation_point;
+        }
         jf["lines"] = g.data[i].size();
         jf["misfit_relative"] = NumberOrNull(i < g.misfit.size() ? g.misfit[i] : NAN);
         jf["misfit_noise_sigmas"] =

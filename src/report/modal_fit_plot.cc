@@ -1,9 +1,12 @@
 #include "robomach/report/modal_fit_plot.h"
 
+#include <algorithm>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <vector>
 
+#include "robomach/common/frames.h"
 #include "robomach/report/frf_plot.h"
 
 namespace robomach::report {
@@ -96,26 +99,106 @@ void FillStabilisationPanel(const std::vector<calibration::StabilisationPole>& p
   }
 }
 
+namespace {
+
+constexpr size_t kMaxFrfsDrawn = 4;
+
+// The FRFs of a fit that are drawn: all up to kMaxFrfsDrawn; of a larger
+// (roving) test the driving point and then the worst fits in units of the
+// noise (the ones a user must look at).
+std::vector<size_t> FrfsDrawn(const calibration::ModalGroup& g) {
+  std::vector<size_t> all(g.keys.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  if (all.size() <= kMaxFrfsDrawn) return all;
+  auto badness = [&](size_t i) {
+    const double ns = i < g.fit.misfit_in_noise.size() ? g.fit.misfit_in_noise[i] : NAN;
+    if (std::isfinite(ns)) return ns;
+    return i < g.misfit.size() && std::isfinite(g.misfit[i]) ? g.misfit[i] : 0.0;
+  };
+  std::vector<size_t> out;
+  for (size_t i : all) {
+    if (g.keys[i].IsDrivingPoint()) {
+      out.push_back(i);
+      break;
+    }
+  }
+  std::vector<size_t> rest;
+  for (size_t i : all) {
+    if (out.empty() || i != out[0]) rest.push_back(i);
+  }
+  std::stable_sort(rest.begin(), rest.end(), [&](size_t a, size_t b) { return badness(a) > badness(b); });
+  for (size_t i : rest) {
+    if (out.size() == kMaxFrfsDrawn) break;
+    out.push_back(i);
+  }
+  return out;
+}
+
+}  // namespace
+
 void WriteModalAnalysisPng(const std::string& path, const calibration::PoseModes& pose,
                            const dynamics::FrfSet& measured, const calibration::NoiseModels& noise) {
-  int frf_rows = 0;
-  for (const calibration::ModalGroup& g : pose.groups) frf_rows += 2 * static_cast<int>(g.keys.size());
-  const int rows = static_cast<int>(pose.groups.size()) + frf_rows;
+  int rows = 0;
+  for (const calibration::ModalGroup& g : pose.groups) {
+    rows += 1 + 2 * static_cast<int>(FrfsDrawn(g).size());
+    if (g.fit.status == calibration::ModalFitStatus::kOk && calibration::ShapesOfRovingTest(g)) ++rows;
+  }
   Figure fig(std::max(1, rows), 1, 1000, 320);
   fig.title = "robomach frf-modes: posture " + pose.pose_id;
   int row = 0;
   for (const calibration::ModalGroup& g : pose.groups) {
     Axes& ax = fig.at(row++, 0);
     std::string which;
-    for (const auto& k : g.keys) which += std::string(which.empty() ? "H" : ", H") + AxisName(k.response) + AxisName(k.excitation);
-    char head[200];
+    if (g.keys.size() <= kMaxFrfsDrawn) {
+      for (const auto& k : g.keys) which += (which.empty() ? "" : ", ") + k.Label();
+    } else {
+      which = std::to_string(g.keys.size()) + " FRFs (" + g.keys.front().Label() + " .. " + g.keys.back().Label() +
+              "; drawn below: the driving point and the worst fits)";
+    }
+    char head[240];
     std::snprintf(head, sizeof(head), "stabilisation diagram of %s: %zu modes, orders %d..%d", which.c_str(),
                   g.fit.modes.size(), g.fit.min_order, g.fit.max_order);
     ax.title = head;
     std::vector<double> modes;
     for (const auto& m : g.fit.modes) modes.push_back(m.freq_hz);
     FillStabilisationPanel(g.fit.stabilisation, modes, g.fit.fmin_hz, g.fit.fmax_hz, &ax);
-    for (size_t i = 0; i < g.keys.size(); ++i) {
+    if (g.fit.status == calibration::ModalFitStatus::kOk) {
+      if (const auto rs = calibration::ShapesOfRovingTest(g)) {
+        // The shapes over the roving points: the component in phase with
+        // the mode's largest, scaled so that the largest is 1.
+        Axes& sx = fig.at(row++, 0);
+        sx.title = std::string("mode shapes over the ") + (rs->roving == "excitation" ? "hammer" : "sensor") +
+                   " points (real part, largest 1; fixed " + (rs->roving == "excitation" ? "sensor" : "hammer") +
+                   " at point " + std::to_string(rs->fixed_point) + AxisName(rs->fixed_direction) + ")";
+        sx.x_label = "point";
+        sx.y_label = "shape";
+        std::vector<size_t> order(rs->points.size());
+        for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return rs->points[a] < rs->points[b]; });
+        for (int r = 0; r < rs->shapes.cols(); ++r) {
+          int imax = 0;
+          rs->shapes.col(r).cwiseAbs().maxCoeff(&imax);
+          const std::complex<double> pivot = rs->shapes(imax, r);
+          Series se;
+          char lab[64];
+          std::snprintf(lab, sizeof(lab), "%.4g Hz", g.fit.modes[r].freq_hz);
+          se.label = lab;
+          se.color = PaletteColor(r);
+          for (size_t i : order) {
+            se.x.push_back(rs->points[i]);
+            se.y.push_back(std::abs(pivot) > 0.0 ? (rs->shapes(i, r) / pivot).real() : 0.0);
+          }
+          sx.series.push_back(se);
+          Series dots = se;
+          dots.label.clear();
+          dots.markers = true;
+          sx.series.push_back(dots);
+        }
+      }
+    }
+    const std::vector<size_t> drawn = FrfsDrawn(g);
+    for (size_t n = 0; n < drawn.size(); ++n) {
+      const size_t i = drawn[n];
       const dynamics::Frf& frf = measured.at(g.keys[i]);
       calibration::FrfNoise nz;
       const auto it = noise.find(g.keys[i]);
@@ -127,16 +210,18 @@ void WriteModalAnalysisPng(const std::string& path, const calibration::PoseModes
       }
       calibration::ModalFitResult fit;
       if (i < g.fit.per_frf.size()) fit = g.fit.per_frf[i];
-      char title[240];
+      char title[300];
       const double noise_units = i < g.fit.misfit_in_noise.size() ? g.fit.misfit_in_noise[i] : NAN;
       const double rel = i < g.misfit.size() ? g.misfit[i] : NAN;
+      std::string label = g.keys[i].Label();
+      if (g.keys[i].IsDrivingPoint() && (g.keys[i].response_point != 0 || drawn.size() < g.keys.size())) {
+        label += " (driving point)";
+      }
       if (std::isfinite(noise_units)) {
-        std::snprintf(title, sizeof(title), "H%c%c: %zu modes, misfit %.3g (%.2f x the noise)",
-                      AxisName(g.keys[i].response), AxisName(g.keys[i].excitation), fit.modes.size(), rel,
-                      noise_units);
+        std::snprintf(title, sizeof(title), "%s: %zu modes, misfit %.3g (%.2f x the noise)", label.c_str(),
+                      fit.modes.size(), rel, noise_units);
       } else {
-        std::snprintf(title, sizeof(title), "H%c%c: %zu modes, misfit %.3g", AxisName(g.keys[i].response),
-                      AxisName(g.keys[i].excitation), fit.modes.size(), rel);
+        std::snprintf(title, sizeof(title), "%s: %zu modes, misfit %.3g", label.c_str(), fit.modes.size(), rel);
       }
       FillModalFitPanels(frf, nz, fit, title, &fig.at(row, 0), &fig.at(row + 1, 0));
       row += 2;

@@ -267,6 +267,49 @@ TEST(FrfCsv, RejectsMixedGridsInsideOneFrf) {
                         "excitation x: step 1 Hz from line 2, then 0.5 Hz here"));
 }
 
+// A roving test in the CSV of formats.md §3: point columns, read with the
+// points kept (frf-modes), written back with them, refused by the tool-tip
+// read with what to do; one point pair per posture is read as the tool tip.
+TEST(FrfCsv, PointColumnsOfARovingTest) {
+  const std::string dir = TempDir("frf_csv_points");
+  std::string text = "pose_id,response,excitation,freq_hz,re,im,response_point,excitation_point\n";
+  for (int p : {1, 2, 3}) {
+    for (int k = 1; k <= 8; ++k) {
+      text += "B,z,z," + std::to_string(10 * k) + "," + std::to_string(p) + "e-6,-" + std::to_string(k) + "e-8,1," +
+              std::to_string(p) + "\n";
+    }
+  }
+  const std::string path = WriteText(dir + "/roving.csv", text);
+  const FrfReadResult kept = ReadFrfFile(path, "", true);
+  ASSERT_EQ(kept.frfs.size(), 3);
+  const FrfKey k3{"B", Axis::kZ, Axis::kZ, 1, 3};
+  ASSERT_TRUE(kept.frfs.contains(k3));
+  EXPECT_DOUBLE_EQ(kept.frfs.at(k3).receptance()(1).real(), 3e-6);
+  EXPECT_DOUBLE_EQ(kept.frfs.at(k3).receptance()(1).imag(), -2e-8);
+  EXPECT_THAT(CaptureError([&] { ReadFrfFile(path); }),
+              HasSubstr("posture B hold 3 measurement-point pairs (response->excitation 1->1, 1->2, 1->3): a "
+                        "roving test. The tool-tip tools read one point per posture: give frf-modes this file"));
+  // Written back with its points, read back equal.
+  WriteFrfCsv(dir + "/back.csv", kept.frfs, FrfQuantity::kReceptance);
+  const FrfReadResult back = ReadFrfFile(dir + "/back.csv", "", true);
+  EXPECT_EQ(back.frfs.keys(), kept.frfs.keys());
+  // `point` is the response point; one pair per posture is the tool tip
+  // (numbers dropped), a transfer pair with a warning.
+  const std::string one = WriteText(dir + "/one.csv",
+                                    "pose_id,response,excitation,freq_hz,re,im,point,excitation_point\n"
+                                    "P1,x,x,10,1e-7,0,7,2\nP1,x,x,20,1e-7,0,7,2\nP1,x,x,30,1e-7,0,7,2\n");
+  const FrfReadResult tip = ReadFrfFile(one);
+  EXPECT_EQ(tip.frfs.keys(), (std::vector<FrfKey>{FrfKey{"P1", Axis::kX, Axis::kX}}));
+  ASSERT_EQ(tip.warnings.size(), 1u);
+  EXPECT_THAT(tip.warnings[0], HasSubstr("a transfer FRF between two points (response point 7, excitation point 2)"));
+  EXPECT_EQ(ReadFrfFile(one, "", true).frfs.keys().at(0), (FrfKey{"P1", Axis::kX, Axis::kX, 7, 2}));
+  const std::string bad = WriteText(dir + "/bad.csv",
+                                    "pose_id,response,excitation,freq_hz,re,im,response_point\n"
+                                    "P1,x,x,10,1e-7,0,1.5\n");
+  EXPECT_THAT(CaptureError([&] { ReadFrfFile(bad); }),
+              HasSubstr("bad.csv:2: column response_point: expected a point number (a whole number >= 0), got \"1.5\""));
+}
+
 TEST(FrfCsv, RejectsNanAndBadDirectionAndQuantity) {
   const std::string dir = TempDir("frf_csv_nan");
   const std::string nan = WriteText(dir + "/nan.csv",

@@ -456,9 +456,25 @@ TEST(Uff58, BadInputIsNamed) {
   Header h1 = h2;
   h1.r6 = Record6(4, "NONE", 1, 3, "NONE", 1, 3);
   WriteText(dir + "/two.uff", AsciiRecord(h1, v) + AsciiRecord(h2, v));
+  // A roving test: the tool-tip read refuses it and says what to do; with
+  // the points kept (frf-modes) both FRFs are there, numbered.
   EXPECT_THAT(CaptureError([&] { ReadFrfFile(dir + "/two.uff"); }),
-              HasSubstr("this FRF (response 2z, reference 1z) and the one at line 2 (response 1z, reference 1z) are "
-                        "both response z, excitation z"));
+              HasSubstr("the FRFs hold 2 measurement-point pairs (response->excitation 1->1, 2->1): a roving test"));
+  {
+    const FrfReadResult kept = ReadFrfFile(dir + "/two.uff", "", true);
+    ASSERT_EQ(kept.frfs.size(), 2);
+    const FrfKey k1{"", Axis::kZ, Axis::kZ, 1, 1}, k2{"", Axis::kZ, Axis::kZ, 2, 1};
+    EXPECT_EQ(kept.frfs.keys(), (std::vector<FrfKey>{k1, k2}));
+    EXPECT_TRUE(k1.IsDrivingPoint());
+    EXPECT_FALSE(k2.IsDrivingPoint());
+    EXPECT_EQ(k2.ToString(), "response z at point 2, excitation z at point 1");
+    EXPECT_EQ(k2.Label(), "H2z,1z");
+  }
+  // The same record twice (same nodes and directions) is an error at the
+  // second.
+  WriteText(dir + "/twice.uff", AsciiRecord(h1, v) + AsciiRecord(h1, v));
+  EXPECT_THAT(CaptureError([&] { ReadFrfFile(dir + "/twice.uff", "", true); }),
+              HasSubstr("are both response z at point 1, excitation z at point 1: the same FRF twice"));
   // Not UFF at all, by extension.
   WriteText(dir + "/csv.uff", "pose_id,response\n");
   EXPECT_THAT(CaptureError([&] { ReadFrfFile(dir + "/csv.uff"); }),
@@ -539,9 +555,12 @@ TEST(Uff58External, MeasuredMobilityFrf) {
   EXPECT_THAT(notes, HasSubstr("directions from the entity names \".1.Z-\" and \".56.Z\""));
   EXPECT_THAT(notes, HasSubstr("4 padding zeros after the 1600 points"));
   EXPECT_THAT(notes, HasSubstr("record 9 gives no physical ordinate type (0); its unit (m/s)/N makes it a mobility"));
-  // Points 1 and 56 (from the entity names): not a tool-tip (driving-point) FRF.
+  // Points 1 and 56 (from the entity names): not a tool-tip (driving-point)
+  // FRF; frf-modes keeps the numbers.
   ASSERT_EQ(r.warnings.size(), 1u);
-  EXPECT_THAT(r.warnings[0], HasSubstr("a transfer FRF between two points (response node 1, reference node 56)"));
+  EXPECT_THAT(r.warnings[0], HasSubstr("a transfer FRF between two points (response point 1, excitation point 56)"));
+  const FrfKey numbered{"", Axis::kZ, Axis::kZ, 1, 56};
+  EXPECT_EQ(ReadFrfFile(path, "", true).frfs.keys(), std::vector<FrfKey>{numbered});
 }
 
 TEST(Uff58External, CoherenceTimeAndSpectrumAreNamedNotMisread) {

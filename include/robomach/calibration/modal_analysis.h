@@ -7,6 +7,7 @@
 // the tool-tip modal model of formats.md §4 (modal mass and unit shape), the
 // table stability-lobes --modal-table reads.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -75,7 +76,30 @@ struct PoseModes {
 std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const NoiseModels& noise,
                                     const ModalAnalysisOptions& options = {}, int file_power = 0);
 
+/// The mode shapes of a roving test from one fit (issue #34 §2): the FRFs
+/// share one fixed end (the response point and direction of a roving-hammer
+/// test, the excitation's of a roving sensor) and the other end roves over
+/// the points. The shape at a point is its FRF's modal constant A_j, scaled
+/// by 1/sqrt(A_dd) of the driving-point FRF (fixed end = roving end), if the
+/// test has one: φ_j = A_j/sqrt(A_dd), mass-normalised [1/sqrt(kg)], as
+/// A_j = φ_fixed φ_j. Without a driving point the largest component is 1.
+struct RovingShapes {
+  std::string roving;   // "excitation" (roving hammer) or "response" (roving sensor)
+  int fixed_point{0};
+  Axis fixed_direction{Axis::kX};
+  std::vector<int> points;        // the roving end of each FRF (rows of shapes)
+  std::vector<Axis> directions;   // its direction
+  Eigen::MatrixXcd shapes;        // rows: the fit's FRFs, columns: modes
+  bool mass_normalised{false};    // false: unit-normalised (largest component 1)
+};
+
+/// The shapes of `group` if it is a roving test (several FRFs with one end
+/// in common); otherwise nullopt with the reason in `why`.
+std::optional<RovingShapes> ShapesOfRovingTest(const ModalGroup& group, std::string* why = nullptr);
+
 /// The tool-tip modes from one fit's direct and cross FRFs (see TipMode).
+/// With point numbers, only the FRFs between the driving point's point and
+/// itself enter (the tool tip of a roving test is its driving point).
 std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>* warnings = nullptr);
 
 }  // namespace robomach::calibration

@@ -66,13 +66,26 @@ class Frf {
 
 /// Which FRF of a test campaign: posture, response and excitation direction
 /// at the tool tip (in B). (pose, x, x) is the direct FRF Hxx.
+///
+/// A roving test (several measurement points on the structure, for mode
+/// shapes: formats.md §3's `response_point`/`excitation_point` columns, UFF
+/// node numbers) also numbers the points; 0 is "not numbered", the tool tip
+/// of the tool-tip workflows. Readers strip the numbers of a file that holds
+/// one point pair per posture, so every tool-tip tool sees 0 (io::ReadFrfFile).
 struct FrfKey {
   std::string pose_id;
   Axis response{Axis::kX};
   Axis excitation{Axis::kX};
+  int response_point{0};
+  int excitation_point{0};
   auto operator<=>(const FrfKey&) const = default;
-  /// "pose P1, response x, excitation y".
+  /// "pose P1, response x, excitation y"; with points
+  /// "pose P1, response z at point 1, excitation z at point 56".
   std::string ToString() const;
+  /// "Hxy"; with points "H1z,56z" (response first), for labels.
+  std::string Label() const;
+  /// Response and excitation at the same point in the same direction.
+  bool IsDrivingPoint() const { return response == excitation && response_point == excitation_point; }
 };
 
 /// All FRFs of one test campaign, keyed by posture and direction pair,

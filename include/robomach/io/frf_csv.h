@@ -22,7 +22,7 @@ namespace robomach::io {
 ///   cells, a non-increasing frequency, mixed grids inside one FRF (the rows
 ///   of one FRF split into blocks, or an even grid whose step changes),
 ///   a duplicate FRF, an unknown quantity.
-FrfReadResult ReadFrfCsv(const std::string& path);
+FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points = false);
 
 /// Writes `frfs` in the format of formats.md §3 as `quantity`, with a
 /// coherence column if every FRF has coherence, and `# averages: N` if

@@ -17,6 +17,14 @@ namespace robomach::io {
 /// Reads a measured-FRF file: UFF for the extensions `.uff`, `.unv`, `.uf`,
 /// `.ufb` or a file that starts with the UFF delimiter "-1", else CSV.
 /// `default_pose_id` applies to UFF only.
-FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_pose_id = "");
+///
+/// Point numbers (formats.md §3 `response_point`/`excitation_point`, UFF
+/// nodes): with `keep_points` they stay in the keys (a roving test for mode
+/// shapes, frf-modes). Without it (the tool-tip tools) a posture must hold
+/// one point pair, whose numbers are dropped (0); a transfer FRF between two
+/// points is read with a warning; several pairs are an InputError that says
+/// which pairs the posture holds and what to do.
+FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_pose_id = "",
+                          bool keep_points = false);
 
 }  // namespace robomach::io

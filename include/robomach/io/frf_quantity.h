@@ -42,4 +42,10 @@ struct FrfReadResult {
   std::vector<std::string> notes;
 };
 
+/// What the readers do without `keep_points` (io::ReadFrfFile): a posture
+/// must hold one measurement-point pair, whose numbers are dropped (the tool
+/// tip); a transfer pair is kept with a warning. @throws InputError naming
+/// the pairs of a posture that holds several (a roving test) and what to do.
+void DropPointNumbers(const std::string& path, FrfReadResult* r);
+
 }  // namespace robomach::io

@@ -44,7 +44,7 @@ namespace robomach::io {
 /// - Two FRF records of the same posture and directions (other nodes) are
 ///   an error: a file holds the FRFs of one tool-tip point per posture.
 /// @throws InputError "file:line[:col]: ..." naming the record and field.
-FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose_id = "");
+FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose_id = "", bool keep_points = false);
 
 /// Writes one dataset 58 record per FRF (complex double, format 4E20.12;
 /// even spacing when the grid is even, else E13.5,2E20.12), `pose=ID` in

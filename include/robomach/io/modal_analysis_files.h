@@ -25,6 +25,14 @@ std::string ModalTableCsv(const std::vector<calibration::PoseModes>& poses);
 /// that the largest of the fit's FRFs is 1 (the mode shape over the FRFs).
 std::string ModalConstantsCsv(const std::vector<calibration::PoseModes>& poses);
 
+/// `pose_id,fit,mode,freq_hz,damping_ratio,point,direction,shape_re,
+/// shape_im,shape_unit,roving,fixed_point,fixed_direction`: the mode shape
+/// of every fit that is a roving test (calibration::ShapesOfRovingTest), one
+/// row per mode and point; shape_unit `1/sqrt(kg)` (mass-normalised, the
+/// test has a driving point) or `1` (largest component 1). A fit that is no
+/// roving test gets a note in `notes` and no rows.
+std::string ModeShapesCsv(const std::vector<calibration::PoseModes>& poses, std::vector<std::string>* notes = nullptr);
+
 /// The summary (formats.md §4.2).
 nlohmann::json ModalAnalysisSummaryJson(const std::vector<calibration::PoseModes>& poses,
                                         const std::string& quantity);
