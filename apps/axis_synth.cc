@@ -97,11 +97,12 @@ int Run(int argc, char** argv) {
     io::CompensationTables tables;
     if (!comp_path.empty()) tables = io::ReadCompensationFile(comp_path, mf);
     std::vector<machine::TemperatureCompensation> temps;
-    if (!temp_path.empty()) temps = io::ReadTemperatureLog(temp_path, mf);
-    for (const std::string& w : mf.implausible) Warn(kTool, w);
-    for (const std::string& w : tables.implausible) Warn(kTool, w);
-    implausible.insert(implausible.end(), mf.implausible.begin(), mf.implausible.end());
-    implausible.insert(implausible.end(), tables.implausible.begin(), tables.implausible.end());
+    std::vector<std::string> temp_implausible;
+    if (!temp_path.empty()) temps = io::ReadTemperatureLog(temp_path, mf, &temp_implausible);
+    for (const auto* found : {&mf.implausible, &tables.implausible, &temp_implausible}) {
+      for (const std::string& w : *found) Warn(kTool, w);
+      implausible.insert(implausible.end(), found->begin(), found->end());
+    }
     const machine::Compensation comp(static_cast<int>(mf.machine.axes.size()), tables.encoder, tables.cross_axis, temps);
     const machine::Compensation* comp_ptr = comp.empty() ? nullptr : &comp;
 
