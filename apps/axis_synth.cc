@@ -4,10 +4,12 @@
 #include <CLI/CLI.hpp>
 
 #include <bit>
+#include <cmath>
 #include <fstream>
 
 #include "cli_support.h"
 #include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/machine_files.h"
@@ -43,7 +45,8 @@ int Run(int argc, char** argv) {
   app.add_option("--sample-rate-hz", rate_hz, "counts rows per second [Hz]")->capture_default_str();
   app.add_option("--dwell-s", dwell_s, "time at the first point before moving [s]")->capture_default_str();
   app.add_option("--start-b-deg", start_b_deg,
-                 "B near which the first point's inverse kinematics is chosen (then: nearest previous) [deg]")
+                 "B near which the first point's inverse kinematics is chosen (then: nearest previous) [deg]; "
+                 "radians or more than a turn are flagged (exit 3)")
       ->capture_default_str();
   app.add_option("--machine-out", machine_out, "write the machine file with origins = measured start position");
   app.add_option("--capture", capture_path, "also write the raw quadrature capture (docs/formats.md §8.2)");
@@ -84,6 +87,22 @@ int Run(int argc, char** argv) {
                             "a dwell in ms typed in the s option?")}) {
       if (!w.empty()) implausible.push_back(w);
     }
+    // --start-b-deg, the only angle option: a nutating head's B within a
+    // turn either way (the inverse kinematics repeats every turn); within
+    // 2 pi and not whole it is radians (-1.5708 for -90 deg), the rule of
+    // the _deg fields (CheckDegreesNotRadians, src/io/plausible.h).
+    if (start_b_deg != 0.0 && std::abs(start_b_deg) <= 2.0 * kPi && start_b_deg != std::floor(start_b_deg)) {
+      implausible.push_back("implausible (unit mistake?): --start-b-deg " + FormatNumber(start_b_deg, 7) +
+                            " deg is within 2 pi = 6.28 and not whole, as radians are: radians typed in the deg "
+                            "option? (" + FormatNumber(start_b_deg, 7) + " rad is " +
+                            FormatNumber(RadToDeg(start_b_deg), 4) + " deg)");
+    } else if (const std::string w = ImplausibleOption(
+                   "--start-b-deg", start_b_deg, -360.0, 360.0, "deg", "a nutating head's B (within a turn of 0)",
+                   "an angle in gradians (400 a turn) or a turn too many typed?",
+                   "an angle in gradians (400 a turn) or a turn too many typed?");
+               !w.empty()) {
+      implausible.push_back(w);
+    }
     for (const std::string& w : implausible) Warn(kTool, w);
     RequireReadableFile(machine_path, "machine file");
     RequireReadableFile(program_path, "programmed path");
@@ -97,11 +116,12 @@ int Run(int argc, char** argv) {
     io::CompensationTables tables;
     if (!comp_path.empty()) tables = io::ReadCompensationFile(comp_path, mf);
     std::vector<machine::TemperatureCompensation> temps;
-    if (!temp_path.empty()) temps = io::ReadTemperatureLog(temp_path, mf);
-    for (const std::string& w : mf.implausible) Warn(kTool, w);
-    for (const std::string& w : tables.implausible) Warn(kTool, w);
-    implausible.insert(implausible.end(), mf.implausible.begin(), mf.implausible.end());
-    implausible.insert(implausible.end(), tables.implausible.begin(), tables.implausible.end());
+    std::vector<std::string> temp_implausible;
+    if (!temp_path.empty()) temps = io::ReadTemperatureLog(temp_path, mf, &temp_implausible);
+    for (const auto* found : {&mf.implausible, &tables.implausible, &temp_implausible}) {
+      for (const std::string& w : *found) Warn(kTool, w);
+      implausible.insert(implausible.end(), found->begin(), found->end());
+    }
     const machine::Compensation comp(static_cast<int>(mf.machine.axes.size()), tables.encoder, tables.cross_axis, temps);
     const machine::Compensation* comp_ptr = comp.empty() ? nullptr : &comp;
 

@@ -31,6 +31,9 @@ void BindMachine(py::module_& m) {
     }
     const io::AcquisitionInputs in = io::ReadAcquisitionInputs(machine_path, counts_path, compensation.value_or(""),
                                                                 temperature.value_or(""), program.value_or(""));
+    // axis-acquire's exit 3 (docs/plausibility.md): a UnitWarning per finding
+    // of the machine file, the tables, the temperature log and the counts.
+    for (const std::string& w : in.implausible()) WarnUnit(w);
     const io::MachineFile& mf = in.machine;
     const std::optional<machine::ProgrammedPath>& path = in.program;
     const machine::CountsRecord& rec = in.counts;
@@ -86,7 +89,8 @@ void BindMachine(py::module_& m) {
      "axis-acquire's call: encoder counts (docs/formats.md §8.1) through the machine file's scales, the controller's "
      "compensation tables and temperature log, to compensated axis positions [m, rad] and the tool tip and axis in "
      "workpiece coordinates; with a programmed path, the contour error of every sample (and axis-acquire's unit "
-     "findings). out: also write axis-acquire's --out file. Returns a dict of arrays (rows first): axes_si holds "
+     "findings). A UnitWarning per value of the input files outside its plausible range (docs/plausibility.md), "
+     "where axis-acquire exits 3. out: also write axis-acquire's --out file. Returns a dict of arrays (rows first): axes_si holds "
      "each axis in SI (m or rad). The GIL is "
      "released while it runs.");
 
@@ -100,6 +104,8 @@ void BindMachine(py::module_& m) {
                                   "glitch_filter in [0, 1000000]");
     }
     const io::MachineFile mf = io::ReadMachineFile(machine_path);
+    // axis-decode's exit 3: a UnitWarning per finding of the machine file.
+    for (const std::string& w : mf.implausible) WarnUnit(w);
     const int n = static_cast<int>(mf.machine.axes.size());
     std::vector<double> t;
     std::vector<std::int64_t> counts;
@@ -142,9 +148,10 @@ void BindMachine(py::module_& m) {
   }, py::arg("machine"), py::arg("capture"), py::arg("sample_rate_hz"), py::arg("every") = 1, py::arg("glitch_filter") = 0,
      py::arg("out") = py::none(),
      "axis-decode's call: a raw quadrature capture (docs/formats.md §8.2) decoded to counts at samples 0, every, "
-     "2 every, ... Returns a dict: t_s, counts (rows × axes, int64), samples, error_events and final_counts per "
-     "axis, status ('flagged' with error events: axis-decode's exit 3) and findings; out: also write "
-     "axis-decode's --out file. The GIL is released while it runs.");
+     "2 every, ... A UnitWarning per machine-file value outside its plausible range (axis-decode's exit 3). "
+     "Returns a dict: t_s, counts (rows × axes, int64), samples, error_events and final_counts per axis, status "
+     "('flagged' with error events: axis-decode's exit 3) and findings; out: also write axis-decode's --out file. "
+     "The GIL is released while it runs.");
 
   m.def("iso230_evaluate", [](const std::string& runs_path) {
     RequireReadableFile(runs_path);

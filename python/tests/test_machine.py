@@ -5,6 +5,8 @@ statistics, and iso230_evaluate equals axis-accuracy's JSON to 1e-12. Then
 bad input."""
 import json
 import os
+import re
+import warnings
 
 import numpy as np
 import pytest
@@ -95,3 +97,35 @@ def test_bad_input(tmp):
         rm.decode_capture(MACHINE, str(odd), 1000.0)
     with pytest.raises(rm.InputError, match='axis'):
         rm.iso230_evaluate(os.path.join(DATA, 'machine', 'x_runs_no_down.csv'))
+
+
+def test_machine_file_findings_are_unit_warnings(tmp):
+    # The machine file's X resolution in um (0.5 under resolution_mm) and a
+    # temperature log's K0 in um (x1000): axis-acquire prints one finding per
+    # mistake and exits 3; acquire gives the same text as one UnitWarning
+    # each, and decode_capture the machine file's. The shipped files give
+    # none (the tools' reference: exit 0 and no finding).
+    text = open(MACHINE).read()
+    assert 'X: {resolution_mm: 0.0005,' in text
+    (tmp / 'um.yaml').write_text(text.replace('X: {resolution_mm: 0.0005,', 'X: {resolution_mm: 0.5,'))
+    log = open(TEMP).read()
+    assert '4,X,0.0018,' in log
+    (tmp / 'temp_um.csv').write_text(log.replace('4,X,0.0018,', '4,X,1.8,'))
+    counts = os.path.join(DATA, 'machine', 'counts_tiny.csv')
+    r = run_tool('axis-acquire', '--machine', tmp / 'um.yaml', '--counts', counts, '--temperature', tmp / 'temp_um.csv',
+                 '--out', tmp / 'tool.csv', expect_rc=3)
+    tool = [line.split('warning: ', 1)[1] for line in r.stderr.splitlines() if 'implausible (unit mistake?)' in line]
+    assert len(tool) == 2
+    with pytest.warns(rm.UnitWarning) as caught:
+        rm.acquire(str(tmp / 'um.yaml'), counts, temperature=str(tmp / 'temp_um.csv'))
+    got = [str(w.message) for w in caught if issubclass(w.category, rm.UnitWarning)]
+    assert got == tool
+    assert re.search(r'um\.yaml:10:\d+: axes\.X\.resolution_mm 0\.5 mm .*a resolution in um typed in the mm field', got[0])
+    assert re.search(r'temp_um\.csv:5: column K0_mm: 1\.8 mm .*an offset in um typed in the mm column', got[1])
+    (tmp / 'zeros.bin').write_bytes(bytes(8))
+    with pytest.warns(rm.UnitWarning, match=r'axes\.X\.resolution_mm 0\.5 mm'):
+        rm.decode_capture(str(tmp / 'um.yaml'), str(tmp / 'zeros.bin'), 10000.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter('error', rm.UnitWarning)
+        rm.acquire(MACHINE, counts, temperature=TEMP)
+        rm.decode_capture(MACHINE, str(tmp / 'zeros.bin'), 10000.0)

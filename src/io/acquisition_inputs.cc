@@ -12,11 +12,11 @@ AcquisitionInputs ReadAcquisitionInputs(const std::string& machine_path, const s
   AcquisitionInputs in;
   in.machine = ReadMachineFile(machine_path);
   if (!compensation_path.empty()) in.tables = ReadCompensationFile(compensation_path, in.machine);
-  if (!temperature_path.empty()) in.temperatures = ReadTemperatureLog(temperature_path, in.machine);
+  if (!temperature_path.empty()) in.temperatures = ReadTemperatureLog(temperature_path, in.machine, &in.temperature_implausible);
   in.compensation = std::make_unique<machine::Compensation>(static_cast<int>(in.machine.machine.axes.size()),
                                                             in.tables.encoder, in.tables.cross_axis, in.temperatures);
   if (!program_path.empty()) in.program = ReadProgramFile(program_path);
-  in.counts = ReadCountsFile(counts_path, in.machine);
+  in.counts = ReadCountsFile(counts_path, in.machine, &in.counts_implausible);
   return in;
 }
 

@@ -232,7 +232,7 @@ CompensationTables ReadCompensationFile(const std::string& path, const MachineFi
       out_implausible.push_back("implausible (unit mistake?): " + path + ":" + std::to_string(largest->second) + ": " +
                                 what + ": value " + FormatDouble(largest->first) + " " + unit + " is outside the +-" +
                                 FormatDouble(mm ? kMaxPlausibleCompensationMm : kMaxPlausibleCompensationDeg) + " " + unit +
-                                " of compensation tables (a few um; $MA_CEC_MAX_SUM is 1 mm by default): " +
+                                " of compensation tables (they hold a few um to tens of um): " +
                                 (mm ? "values in um typed in the mm table?"
                                     : "values in arc-seconds or millidegrees typed in the deg table?"));
     }

@@ -7,6 +7,7 @@
 
 #include "machine_text.h"
 #include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/number_format.h"
 
@@ -15,7 +16,7 @@ namespace robomach::io {
 using machine::AxisScale;
 using machine_text::ReadWholeFile;
 
-machine::CountsRecord ReadCountsFile(const std::string& path, const MachineFile& mf) {
+machine::CountsRecord ReadCountsFile(const std::string& path, const MachineFile& mf, std::vector<std::string>* implausible) {
   // A dedicated reader: a 60 s record at 8 kHz has 480,000 rows, and
   // axis-acquire must finish in under a second (CsvTable keeps every cell as
   // a string). Same rules as CsvTable: '#' comments, header by name, unknown
@@ -30,10 +31,12 @@ machine::CountsRecord ReadCountsFile(const std::string& path, const MachineFile&
   int line = 0;
   std::vector<std::string_view> cells;
   std::vector<std::string> header;
+  std::vector<int> row_line;  // the file line of each row, for the step finding
   {
     const size_t lines = static_cast<size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
     rec.t_s.reserve(lines);
     rec.counts.reserve(lines * n_axes);
+    row_line.reserve(lines);
   }
   const char* const text_end = text.data() + text.size();
   while (pos < text.size()) {
@@ -87,11 +90,17 @@ machine::CountsRecord ReadCountsFile(const std::string& path, const MachineFile&
         throw InputError({path, line, 0}, "column t_s: expected a number, got \"" + std::string(s) + "\"");
       }
     }
+    if (t < 0.0) {
+      throw InputError({path, line, 0}, "column t_s: expected a time >= 0 s on the clock the first row (the "
+                                        "reference position, formats.md §8.1) starts, got " + std::string(cell_at(t_col)) +
+                                        " s");
+    }
     if (!rec.t_s.empty() && !(t > rec.t_s.back())) {
       throw InputError({path, line, 0}, "column t_s: time must increase, got " + FormatDouble(t) + " s after " +
                                             FormatDouble(rec.t_s.back()) + " s");
     }
     rec.t_s.push_back(t);
+    row_line.push_back(line);
     for (size_t ax = 0; ax < n_axes; ++ax) {
       const std::string_view s = cell_at(col_of_axis[ax]);
       std::int64_t v = 0;
@@ -110,6 +119,24 @@ machine::CountsRecord ReadCountsFile(const std::string& path, const MachineFile&
   }
   if (header_line == 0) throw InputError({path, 0, 0}, "no header row");
   if (rec.t_s.empty()) throw InputError({path, header_line, 0}, "no data rows after the header");
+  // The median step (a pause or a dropped row does not count): rows slower
+  // than kMaxPlausibleCountsStepS are a time in ms typed in the s column.
+  if (implausible && rec.t_s.size() >= 2) {
+    std::vector<double> steps(rec.t_s.size() - 1);
+    for (size_t i = 1; i < rec.t_s.size(); ++i) steps[i - 1] = rec.t_s[i] - rec.t_s[i - 1];
+    std::vector<double> sorted = steps;
+    auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+    std::nth_element(sorted.begin(), mid, sorted.end());
+    const double median = *mid;
+    if (median > kMaxPlausibleCountsStepS) {
+      const size_t i = static_cast<size_t>(std::find(steps.begin(), steps.end(), median) - steps.begin()) + 1;
+      implausible->push_back("implausible (unit mistake?): " + path + ":" + std::to_string(row_line[i]) +
+                             ": column t_s: the rows are " + FormatDouble(median) + " s apart (the median step; " +
+                             FormatNumber(1.0 / median, 4) + " Hz), more than the " +
+                             FormatNumber(kMaxPlausibleCountsStepS, 7) + " s (10 Hz) of position traces (100 Hz - "
+                             "100 kHz): a time in ms typed in the s column?");
+    }
+  }
   return rec;
 }
 

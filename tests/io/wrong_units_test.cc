@@ -18,11 +18,13 @@
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/io/compensation_file.h"
+#include "robomach/io/counts_file.h"
 #include "robomach/io/cut_file.h"
 #include "robomach/io/drilling_files.h"
 #include "robomach/io/machine_file.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/io/temperature_log.h"
 #include "test_support.h"
 
 namespace robomach::io {
@@ -64,6 +66,18 @@ const std::vector<NamedReader>& Readers() {
        [](const std::string& p) {
          return ReadCompensationFile(p, ReadMachineFile(SourcePath("config/machine/dmu80p.yaml"))).implausible;
        }},
+      {"temperature_log",
+       [](const std::string& p) {
+         std::vector<std::string> w;
+         ReadTemperatureLog(p, ReadMachineFile(SourcePath("config/machine/dmu80p.yaml")), &w);
+         return w;
+       }},
+      {"counts_file",
+       [](const std::string& p) {
+         std::vector<std::string> w;
+         ReadCountsFile(p, ReadMachineFile(SourcePath("config/machine/dmu80p.yaml")), &w);
+         return w;
+       }},
   };
   return readers;
 }
@@ -82,7 +96,8 @@ struct WrongUnitCase {
   const char* file;     // shipped or test input, relative to the source tree
   const char* key;      // `key` (a scalar or every number of a flow list), `key[i]` (element i of a
                         // flow list), or `key|key2|...` (each of them); `$NAME[...]` a controller
-                        // assignment `$NAME[...]=value` (compensation tables)
+                        // assignment `$NAME[...]=value` (compensation tables); `csv:NAME` the
+                        // column NAME of a CSV file (occurrence: its data row, -1 every row)
   int occurrence;       // which line with the key (0 = the first)
   double factor;        // the mistake: the value times this
   Expect expect;
@@ -151,8 +166,53 @@ const std::vector<WrongUnitCase>& Cases() {
       // Siemens compensation tables (config/machine/dmu80p_comp.mpf)
       {"compensation", "config/machine/dmu80p_comp.mpf", "$AA_ENC_COMP[0,6,AX1]", 0, 1000, Expect::kFlagged, "dmu80p_comp.mpf:\\d+: \\$AA_ENC_COMP table of axis X: value 2.827 mm .*values in um typed in the mm table"},
       {"compensation", "config/machine/dmu80p_comp.mpf", "$AA_ENC_COMP[0,6,AX1]", 0, 1e6, Expect::kRefused, "dmu80p_comp.mpf:\\d+: \\$AA_ENC_COMP table of axis X: value 2827 mm is beyond the 100 mm.*um or nm typed"},
+      // temperature log (config/machine/dmu80p_temperature.csv; largest K0 0.0018 mm, tan_beta 1.5e-05, P0 -600 mm)
+      {"temperature_log", "config/machine/dmu80p_temperature.csv", "csv:K0_mm", -1, 1000, Expect::kFlagged, "dmu80p_temperature.csv:5: column K0_mm: 1.8 mm is outside the \\+-1 mm .*an offset in um typed in the mm column"},
+      {"temperature_log", "config/machine/dmu80p_temperature.csv", "csv:K0_mm", -1, 1e6, Expect::kRefused, "dmu80p_temperature.csv:3: column K0_mm: expected a thermal offset within \\+-100 mm, got 1000 mm: an offset in um or nm"},
+      {"temperature_log", "config/machine/dmu80p_temperature.csv", "csv:tan_beta", -1, 1000, Expect::kFlagged, "dmu80p_temperature.csv:5: column tan_beta: 0.015 is outside the \\+-0.001 .*um/m \\(ppm\\), mm/m or percent"},
+      {"temperature_log", "config/machine/dmu80p_temperature.csv", "csv:tan_beta", -1, 1e6, Expect::kRefused, "dmu80p_temperature.csv:3: column tan_beta: expected a thermal slope within \\+-0.1 .*got 12: a slope in um/m \\(ppm\\)"},
+      {"temperature_log", "config/machine/dmu80p_temperature.csv", "csv:P0_mm", -1, 1000, Expect::kFlagged, "dmu80p_temperature.csv:4: column P0_mm: -600000 mm is outside the \\+-50000 mm .*a position in um typed in the mm column"},
+      // encoder counts (tests/data/machine/counts_tiny.csv: 8 kHz, a step of 0.000125 s)
+      {"counts_file", "tests/data/machine/counts_tiny.csv", "csv:t_s", -1, 1000, Expect::kFlagged, "counts_tiny.csv:3: column t_s: the rows are 0.125 s apart .*more than the 0.1 s .*a time in ms typed in the s column"},
   };
   return cases;
+}
+
+std::string ScaleNumber(const std::string& v, double factor) {
+  std::ostringstream s;
+  s.precision(12);
+  s << std::stod(v) * factor;
+  return s.str();
+}
+
+// A CSV file (formats.md: `#` comments, one header row) with the cells of
+// `column` scaled: in data row c.occurrence, or every row for -1.
+std::string ScaledCsv(const std::string& text, const WrongUnitCase& c, const std::string& column) {
+  std::istringstream in(text);
+  std::string line, out;
+  int col = -1, row = 0, changed = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') {
+      out += line + "\n";
+      continue;
+    }
+    std::vector<std::string> cells;
+    std::stringstream cs(line);
+    for (std::string cell; std::getline(cs, cell, ',');) cells.push_back(cell);
+    if (col < 0) {
+      for (size_t i = 0; i < cells.size(); ++i) {
+        if (cells[i] == column) col = static_cast<int>(i);
+      }
+      if (col < 0) throw std::logic_error("no column " + column + " in the file");
+    } else if ((c.occurrence < 0 || row++ == c.occurrence) && col < static_cast<int>(cells.size())) {
+      cells[col] = ScaleNumber(cells[col], c.factor);
+      ++changed;
+    }
+    for (size_t i = 0; i < cells.size(); ++i) out += (i ? "," : "") + cells[i];
+    out += "\n";
+  }
+  if (changed == 0) throw std::logic_error("no row with column " + column + " in the file");
+  return out;
 }
 
 // The file's text with the case's value scaled; -1 as occurrence scales
@@ -168,6 +228,8 @@ std::string Scaled(const std::string& text, const WrongUnitCase& c, const std::s
     key = m[1];
     element = std::stoi(m[2]);
   }
+  // A CSV column: the cells of that column in the data rows.
+  if (key.rfind("csv:", 0) == 0) return ScaledCsv(text, c, key.substr(4));
   // The key at the start of a line, or inside a flow map ({a: 1, key: 2});
   // a controller assignment `$NAME[...]=value` taken literally.
   const bool assignment = c.key[0] == '$';

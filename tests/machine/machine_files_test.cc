@@ -182,6 +182,35 @@ TEST(CountsFile, RejectsBadInputWithFileAndLine) {
   EXPECT_THAT(CountsError("counts_nan", h + "nan,0,0,0,0,0\n"), HasSubstr("c.csv:2: column t_s: expected a number"));
 }
 
+// A time before the reference row's clock is refused; the median step
+// decides the ms finding, so one pause in an 8 kHz record does not flag it
+// and ms typed for s (a step of 0.125 "s") does. References: the steps as
+// written, against kMaxPlausibleCountsStepS = 0.1 s.
+TEST(CountsFile, NegativeTimeIsRefusedAndAMillisecondStepIsFlagged) {
+  const std::string h = "t_s,X_count,Y_count,Z_count,B_count,C_count\n";
+  EXPECT_THAT(CountsError("counts_negative", h + "-0.5,0,0,0,0,0\n0,1,0,0,0,0\n"),
+              HasSubstr("c.csv:2: column t_s: expected a time >= 0 s on the clock the first row"));
+  const MachineFile m = DefaultMachine();
+  const std::string dir = TempDir("counts_step");
+  std::vector<std::string> w;
+  // 8 kHz with one pause of 5 s: the median step is 0.000125 s.
+  ReadCountsFile(WriteText(dir + "/pause.csv", h + "0,0,0,0,0,0\n0.000125,1,0,0,0,0\n0.00025,2,0,0,0,0\n"
+                                                   "5.00025,3,0,0,0,0\n5.000375,4,0,0,0,0\n"),
+                 m, &w);
+  EXPECT_TRUE(w.empty()) << w.front();
+  // 10 Hz, the slowest plausible rate: not flagged.
+  ReadCountsFile(WriteText(dir + "/ten.csv", h + "0,0,0,0,0,0\n0.1,1,0,0,0,0\n0.2,2,0,0,0,0\n"), m, &w);
+  EXPECT_TRUE(w.empty()) << w.front();
+  // The same 8 kHz in ms: the median step of 0.125 is flagged at the row
+  // where that step ends (line 3).
+  ReadCountsFile(WriteText(dir + "/ms.csv", h + "0,0,0,0,0,0\n0.125,1,0,0,0,0\n0.25,2,0,0,0,0\n5000.25,3,0,0,0,0\n"), m,
+                 &w);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_THAT(w[0], HasSubstr("implausible (unit mistake?): " + dir + "/ms.csv:3: column t_s: the rows are 0.125 s apart "
+                              "(the median step; 8 Hz), more than the 0.1 s (10 Hz)"));
+  EXPECT_THAT(w[0], HasSubstr("a time in ms typed in the s column?"));
+}
+
 TEST(CountsFile, WriterOutputReadsBack) {
   const MachineFile m = DefaultMachine();
   std::ostringstream out;
@@ -210,6 +239,22 @@ TEST(TemperatureLog, ReadsPerAxisAndRejectsBadRows) {
               HasSubstr("b.csv:3: column t_s: time must increase for axis X"));
   EXPECT_THAT(CaptureError([&] { ReadTemperatureLog(WriteText(dir + "/c.csv", h + "5,C,0,0,0\n"), m); }),
               HasSubstr("c.csv:2: column axis: axis C is rotary"));
+}
+
+// The shipped log gives no finding; a row a day after the counts' clock
+// started (86 400 s) is a time in ms, named at its line.
+TEST(TemperatureLog, TimeBeyondADayIsFlaggedAsMilliseconds) {
+  const MachineFile m = DefaultMachine();
+  std::vector<std::string> w;
+  ReadTemperatureLog(SourcePath("config/machine/dmu80p_temperature.csv"), m, &w);
+  EXPECT_TRUE(w.empty()) << w.front();
+  const std::string h = "t_s,axis,K0_mm,tan_beta,P0_mm\n";
+  ReadTemperatureLog(WriteText(TempDir("temp_ms") + "/ms.csv", h + "0,X,0.001,1e-05,0\n86400,X,0.002,1e-05,0\n"
+                                                                  "90000,X,0.002,1e-05,0\n"),
+                     m, &w);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_THAT(w[0], HasSubstr("ms.csv:4: column t_s: 90000 s is after the 86400 s (a day) of counts records"));
+  EXPECT_THAT(w[0], HasSubstr("a time in ms typed in the s column?"));
 }
 
 TEST(IsoRuns, ReadsAndWrapsRotaryDeviations) {

@@ -277,7 +277,7 @@ struct AuditResult {
   double noise_floor{0.0};
   double baseline_bic{0.0};
   bool significant_failure{false};
-  /// Best first (by BIC); the greedy pairs follow the single candidates.
+  /// Singles best first (by BIC), then the pairs "a+b" (greedy effect and parameter pairs) best first.
   std::vector<CandidateResult> candidates;
   /// Index in `candidates` of the accepted candidate, -1 if none: the best
   /// plausible one that lowers the BIC (the explanation when the grade is

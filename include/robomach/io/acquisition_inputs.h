@@ -23,15 +23,20 @@ struct AcquisitionInputs {
   std::unique_ptr<machine::Compensation> compensation;       // all of them; empty() when none
   std::optional<machine::ProgrammedPath> program;
   machine::CountsRecord counts;
+  /// The temperature log's and the counts file's unit findings.
+  std::vector<std::string> temperature_implausible, counts_implausible;
   /// The compensation the acquisition applies (null when there is none).
   const machine::Compensation* applied() const {
     return compensation && !compensation->empty() ? compensation.get() : nullptr;
   }
-  /// The machine file's and the compensation tables' unit findings
-  /// (docs/plausibility.md): the tool flags its result (exit 3) on any.
+  /// The unit findings of the machine file, the compensation tables, the
+  /// temperature log and the counts (docs/plausibility.md), in that order:
+  /// the tool flags its result (exit 3) on any.
   std::vector<std::string> implausible() const {
     std::vector<std::string> all = machine.implausible;
     all.insert(all.end(), tables.implausible.begin(), tables.implausible.end());
+    all.insert(all.end(), temperature_implausible.begin(), temperature_implausible.end());
+    all.insert(all.end(), counts_implausible.begin(), counts_implausible.end());
     return all;
   }
 };

@@ -20,11 +20,13 @@ struct CompensationTables {
   std::vector<std::string> implausible;
 };
 
-// Compensation values are mm (deg for rotary axes), like the control's. The
-// 840D sl caps the summed compensation of an axis by MD32720
-// $MA_CEC_MAX_SUM, 1 mm by default; real pitch and sag tables hold a few um
-// to tens of um (Siemens 840D sl function manual "Extended functions",
-// K3 compensation). A larger value is um typed for mm (x1000).
+// Compensation values are mm (deg for rotary axes), like the control's.
+// Real pitch and sag tables hold a few um to tens of um (the example pitch
+// table of the SINUMERIK 840D sl Function Manual Extended Functions, K3
+// Compensations, 03/2013, §4.4.2.3: +3, +10, +12 um). A larger value than
+// 1 mm is um typed for mm (x1000). This limit is a judgement from practice,
+// not a control's limit: MD32720 $MA_CEC_MAX_SUM, once cited here as "1 mm
+// by default", could not be verified (docs/plausibility.md).
 inline constexpr double kMaxPlausibleCompensationMm = 1.0;
 inline constexpr double kMaxPlausibleCompensationDeg = 0.1;  // 360 arc-seconds
 /// Refused (exit 65): no table corrects an axis by 10 cm or 10 deg.
