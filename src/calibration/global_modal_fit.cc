@@ -547,6 +547,46 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     poles.push_back(PoleFrom(c.f_hz, c.zeta));
     support.push_back(c.orders);
   }
+  // A dense FRF: band by band (GlobalModalFitOptions::max_modes_per_band).
+  std::vector<cd> band_poles;
+  std::vector<int> band_support;
+  if (o.max_modes_per_band > 0 && static_cast<int>(clusters.size()) > o.max_modes_per_band) {
+    std::vector<double> fc;
+    for (const Cluster& c : clusters) fc.push_back(c.f_hz);
+    std::sort(fc.begin(), fc.end());
+    const int n = static_cast<int>(fc.size());
+    const int groups = (n + o.max_modes_per_band - 1) / o.max_modes_per_band;
+    const int per = (n + groups - 1) / groups;
+    std::vector<int> first;  // index of each group's first cluster
+    for (int g = 0; g < groups; ++g) first.push_back(g * per);
+    first.push_back(n);
+    GlobalModalFitOptions sub = o;
+    sub.max_modes_per_band = 0;
+    sub.driving_point = -1;
+    for (int g = 0; g < groups && first[g] < n; ++g) {
+      const int a = first[g], b = std::min(n, first[g + 1]) - 1;  // this group's clusters
+      // Core: from the gap below to the gap above (geometric means); band:
+      // widened to take in the neighbour mode on each side with its flanks.
+      const double core_lo = a == 0 ? result.fmin_hz : std::sqrt(fc[a - 1] * fc[a]);
+      const double core_hi = b == n - 1 ? result.fmax_hz : std::sqrt(fc[b] * fc[b + 1]);
+      sub.fmin_hz = a == 0 ? result.fmin_hz : std::max(result.fmin_hz, 0.97 * fc[a - 1]);
+      sub.fmax_hz = b == n - 1 ? result.fmax_hz : std::min(result.fmax_hz, 1.03 * fc[b + 1]);
+      const GlobalModalFitResult part = FitModesGlobal(all, sub);
+      if (part.status != ModalFitStatus::kOk) continue;
+      for (const GlobalMode& m : part.modes) {
+        const bool in_core = m.freq_hz >= core_lo && (m.freq_hz < core_hi || (g == groups - 1 && m.freq_hz <= core_hi));
+        if (!in_core) continue;
+        band_poles.push_back(m.pole);
+        band_support.push_back(m.stable_orders);
+      }
+    }
+    result.bands = groups;
+  }
+  const bool banded = !band_poles.empty();
+  if (banded) {
+    poles = band_poles;
+    support = band_support;
+  }
   bool from_peaks = false;
   if (poles.empty()) {
     // No stable cluster: the peaks of the summed |H| start the refinement,
@@ -614,7 +654,10 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
   };
 
   SetFit best;
-  if (!poles.empty()) std::tie(poles, support) = settle(poles, support, &best);
+  // Banded: the poles were refined, added and dropped in their bands; here
+  // only the residues of every mode over the whole band (and the pruning of
+  // a mode two bands both found).
+  if (!poles.empty()) std::tie(poles, support) = settle(poles, support, &best, /*refine=*/!banded);
   if (poles.empty()) {
     result.status = ModalFitStatus::kNoStableModes;
     result.message = "no cluster of stable poles over " + std::to_string(min_orders) + " of the orders " +
@@ -624,7 +667,7 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
   }
   // Residual-driven additions on the summed weighted residual of all FRFs.
   int added = 0;
-  for (int attempt = 0; attempt < o.max_added_modes; ++attempt) {
+  for (int attempt = 0; attempt < (banded ? 0 : o.max_added_modes); ++attempt) {
     Eigen::VectorXd e2 = Eigen::VectorXd::Zero(N);
     for (size_t i = 0; i < frfs.size(); ++i) {
       for (int k = 0; k < N; ++k) {
@@ -688,7 +731,7 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     }
   }
   // Backward elimination: drop the weakest mode while that lowers the BIC.
-  for (int attempt = 0; attempt < 8 && poles.size() > 1; ++attempt) {
+  for (int attempt = 0; attempt < 8 && poles.size() > 1 && !banded; ++attempt) {
     size_t weakest = 0;
     double weakest_s = 1e300;
     for (size_t r = 0; r < poles.size(); ++r) {
@@ -763,9 +806,29 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
                    (from_peaks ? std::string("no cluster of stable poles, poles from the peaks of |H|")
                                : std::to_string(clusters.size()) + " clusters of stable poles over orders " +
                                      std::to_string(o.min_order) + ".." + std::to_string(nmax)) +
+                   (banded ? ", a dense FRF fitted in " + std::to_string(result.bands) + " bands" : "") +
                    (o.refine ? ", refined" : "") +
                    (added > 0 ? ", " + std::to_string(added) + " added from the residual" : "");
   return result;
+}
+
+ModalFitResult FitOneFrf(const dynamics::Frf& frf, const ModalFitOptions& options) {
+  GlobalModalFitOptions o;
+  o.fmin_hz = options.fmin_hz;
+  o.fmax_hz = options.fmax_hz;
+  o.max_damping_ratio = options.max_damping_ratio;
+  o.min_relative_contribution = options.min_relative_contribution;
+  o.max_added_modes = options.max_added_modes;
+  const GlobalModalFitResult g = FitModesGlobal({frf}, o);
+  ModalFitResult r;
+  if (g.status == ModalFitStatus::kOk && !g.per_frf.empty()) r = g.per_frf[0];
+  r.status = g.status;
+  r.message = g.message;
+  r.fmin_hz = g.fmin_hz;
+  r.fmax_hz = g.fmax_hz;
+  r.order_used = g.max_order;
+  r.stabilisation = g.stabilisation;
+  return r;
 }
 
 }  // namespace robomach::calibration

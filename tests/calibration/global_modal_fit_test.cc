@@ -284,18 +284,17 @@ TEST(GlobalModalFitRealFiles, Dataset58ModesAtTheFilesPeaks) {
   const GlobalModalFitResult fit = FitModesGlobal({frf});
   ASSERT_EQ(fit.status, ModalFitStatus::kOk) << fit.message;
   if (std::getenv("ROBOMACH_DUMP_FIT")) DumpFit(fit, {frf}, 1);
-  // The peaks of the file (SOURCES.md, 0.5 Hz grid): 175, 376.5, 464,
-  // 544 Hz, each within 0.5 %. The fifth, 81.5 Hz, is split by this fit
-  // into 81.0 Hz (zeta 5 %) and 82.5 Hz (zeta 9.6 %): a known gap of issue
-  // #34, checked here only to within 1 %.
-  for (double f : {175.0, 376.5, 464.0, 544.0}) {
+  // The peaks of the file (SOURCES.md, 0.5 Hz grid): 81.5, 175, 376.5, 464,
+  // 544 Hz, each within 0.5 % (issue #34's acceptance). About 30 modes in
+  // 5-800 Hz: a dense FRF, fitted band by band; in one band at order 100 the
+  // clusters of the lowest modes were too short to count and the 81.5 Hz
+  // mode came out at 80.1 Hz, 1.7 % off.
+  EXPECT_GT(fit.bands, 1) << fit.message;
+  for (double f : {81.5, 175.0, 376.5, 464.0, 544.0}) {
     double nearest = 1e300;
     for (const GlobalMode& m : fit.modes) nearest = std::min(nearest, std::abs(m.freq_hz - f));
     EXPECT_LT(nearest, 0.005 * f) << "mode near " << f << " Hz: " << fit.message;
   }
-  double nearest = 1e300;
-  for (const GlobalMode& m : fit.modes) nearest = std::min(nearest, std::abs(m.freq_hz - 81.5));
-  EXPECT_LT(nearest, 0.01 * 81.5) << fit.message;
 }
 
 }  // namespace

@@ -58,6 +58,15 @@ struct GlobalModalFitOptions {
   /// rms), the least-squares fit of that quantity without weights, as
   /// modal software does, which favours the peaks.
   int uniform_weights_power{-1};
+  /// A dense FRF (more clusters of stable poles over the band than this) is
+  /// fitted band by band: the clusters are split into groups of at most
+  /// this many modes at the gaps between them, each group fitted (LSCF,
+  /// clustering, refinement, BIC) on its own band widened to its neighbour
+  /// modes, the modes of each band's core kept, and the residues of all
+  /// modes fitted over the whole band. Modal software leaves the bands to
+  /// the user; a fit of 30 modes at once took 13 s on 1600 lines and placed
+  /// modes 1.5 % off where the order limit cut the clusters short. 0: never.
+  int max_modes_per_band{8};
   /// Index of the driving-point FRF (response = reference) among the FRFs,
   /// or −1: with it the mode shapes are mass-normalised
   /// (φ_j = A_j / sqrt(A_driving)); without it they are unit-normalised.
@@ -92,6 +101,9 @@ struct GlobalModalFitResult {
   int lscf_power{0};
   int min_order{0}, max_order{0};  // orders of the stabilisation diagram
   int orders_tried{0};
+  /// Bands the fit was made in (1 unless the FRFs were dense: see
+  /// GlobalModalFitOptions::max_modes_per_band).
+  int bands{1};
   double fmin_hz{0.0}, fmax_hz{0.0};
   std::vector<StabilisationPole> stabilisation;
 
@@ -122,6 +134,13 @@ struct GlobalModalFitResult {
 ///   the band differ.
 GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& frfs,
                                     const GlobalModalFitOptions& options = {});
+
+/// One FRF through the global fitter (the fit frf-modes makes), as a
+/// ModalFitResult with its stabilisation diagram: what the tools that take
+/// one FRF at a time use (stability-lobes --frf). From `options` it takes
+/// the band, max_damping_ratio, min_relative_contribution and
+/// max_added_modes; the orders are the global fit's (to 100).
+ModalFitResult FitOneFrf(const dynamics::Frf& frf, const ModalFitOptions& options = {});
 
 /// Modal assurance criterion between the columns of two shape matrices
 /// (same number of rows): MAC_ij = |a_iᴴ b_j|² / ((a_iᴴ a_i)(b_jᴴ b_j)),
