@@ -128,7 +128,9 @@ calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const Meas
     } catch (const std::invalid_argument& e) {
       throw InputError({data.file.at(key), 0, 0}, key.ToString() + ": " + e.what());
     }
-    std::cerr << tool << ": " << key.pose_id << " " << AxisName(key.response) << AxisName(key.excitation) << ": "
+    const bool points = key.response_point != 0 || key.excitation_point != 0;
+    std::cerr << tool << ": " << key.pose_id << " "
+              << (points ? key.Label() : std::string{AxisName(key.response), AxisName(key.excitation)}) << ": "
               << n.description << '\n';
     if (n.usable_lines == 0) {
       ++none_usable;

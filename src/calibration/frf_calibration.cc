@@ -13,6 +13,7 @@
 #include <ceres/ceres.h>
 
 #include "robomach/calibration/frf_noise.h"
+#include "robomach/calibration/global_modal_fit.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/golden_section.h"
 #include "robomach/common/units.h"
@@ -127,7 +128,7 @@ constexpr double kNeighbourVisibility = 1e-3;
 MeasuredFeatures ExtractFeatures(const dynamics::FrfSet& measured, const ModalFitOptions& options) {
   MeasuredFeatures out;
   for (const auto& [key, frf] : measured) {
-    ModalFitResult fit = FitModes(frf, options);
+    ModalFitResult fit = FitOneFrf(frf, options);
     if (fit.status == ModalFitStatus::kOk) {
       for (size_t i = 0; i < fit.modes.size(); ++i) {
         const FittedMode& m = fit.modes[i];

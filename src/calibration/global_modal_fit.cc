@@ -550,7 +550,7 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
   // A dense FRF: band by band (GlobalModalFitOptions::max_modes_per_band).
   std::vector<cd> band_poles;
   std::vector<int> band_support;
-  if (o.max_modes_per_band > 0 && static_cast<int>(clusters.size()) > o.max_modes_per_band) {
+  if (o.max_modes_per_band > 0 && static_cast<int>(clusters.size()) > std::max(o.dense_modes, o.max_modes_per_band)) {
     std::vector<double> fc;
     for (const Cluster& c : clusters) fc.push_back(c.f_hz);
     std::sort(fc.begin(), fc.end());
