@@ -7,6 +7,9 @@
 // shape.
 
 #include <cmath>
+#include <random>
+
+#include <Eigen/Eigenvalues>
 
 #include <gtest/gtest.h>
 
@@ -22,6 +25,7 @@ namespace robomach::calibration {
 namespace {
 
 using robomach::testing::SourcePath;
+constexpr double kPi = 3.14159265358979323846;
 
 TEST(ModalAnalysis, Kr210HammerTestGivesTheModelsModes) {
   const io::RobotConfig cfg = io::LoadRobotConfig(SourcePath("config/kr210.yaml"));
@@ -95,6 +99,83 @@ TEST(ModalAnalysis, FrfsOnDifferentGridsAreFittedAloneWithAWarning) {
   EXPECT_EQ(poses[0].groups.size(), 2u);
   ASSERT_FALSE(poses[0].warnings.empty());
   EXPECT_NE(poses[0].warnings[0].find("different frequency lines"), std::string::npos) << poses[0].warnings[0];
+}
+
+// A roving-sensor test of a 4-DOF chain (ground-k-m-k-m-k-m-k-m, masses
+// and stiffnesses unequal, Rayleigh damping): the hammer stays at mass 2,
+// the sensor roves over masses 1-4, with 1 % noise. The reference is the
+// chain's own generalized eigenproblem K φ = ω² M φ (Eigen), mass-normalised
+// φᵀ M φ = 1: AnalyseModes and ShapesOfRovingTest must find the roving end
+// (the response), the four frequencies, and the mass-normalised shapes
+// (the driving point 2 -> 2 is among the FRFs), MAC >= 0.999 and the scale
+// within 2 %; the tool-tip modal mass is that of the driving point,
+// 1/φ_2².
+TEST(ModalAnalysis, RovingSensorOnAChainGivesItsMassNormalisedShapes) {
+  const Eigen::Vector4d m(2.0, 1.5, 1.0, 0.8), k(4e5, 3e5, 2.5e5, 1.5e5);
+  Eigen::Matrix4d M = m.asDiagonal(), K = Eigen::Matrix4d::Zero();
+  for (int i = 0; i < 4; ++i) {
+    K(i, i) += k(i);
+    if (i + 1 < 4) {
+      K(i, i) += k(i + 1);
+      K(i, i + 1) -= k(i + 1);
+      K(i + 1, i) -= k(i + 1);
+    }
+  }
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix4d> eig(K, M);
+  const Eigen::Vector4d w2 = eig.eigenvalues();
+  const Eigen::Matrix4d phi = eig.eigenvectors();  // φᵀ M φ = I
+  const Eigen::Matrix4d C = 2e-4 * K + 2.0 * M;     // Rayleigh
+  const double fmax = 1.3 * std::sqrt(w2(3)) / (2.0 * kPi);
+  const int n = 3000;
+  Eigen::VectorXd f(n);
+  for (int i = 0; i < n; ++i) f(i) = (i + 1) * fmax / n;
+  std::mt19937 rng(3407);
+  std::normal_distribution<double> g(0.0, 1.0);
+  dynamics::FrfSet set;
+  const int hammer = 1;  // mass 2 (points are numbered from 1)
+  for (int j = 0; j < 4; ++j) {
+    Eigen::VectorXcd h(n);
+    for (int i = 0; i < n; ++i) {
+      const double w = 2.0 * kPi * f(i);
+      const Eigen::Matrix4cd D = K.cast<std::complex<double>>() - w * w * M.cast<std::complex<double>>() +
+                                 std::complex<double>(0.0, w) * C.cast<std::complex<double>>();
+      Eigen::Vector4cd e = Eigen::Vector4cd::Zero();
+      e(hammer) = 1.0;
+      const std::complex<double> x = D.partialPivLu().solve(e)(j);
+      h(i) = x * (1.0 + 0.01 / std::sqrt(2.0) * std::complex<double>(g(rng), g(rng)));
+    }
+    set.Insert({"R", Axis::kZ, Axis::kZ, j + 1, hammer + 1}, dynamics::Frf::FromSamples(f, h));
+  }
+  const auto poses = AnalyseModes(set, EstimateNoise(set));
+  ASSERT_EQ(poses.size(), 1u);
+  ASSERT_EQ(poses[0].groups.size(), 1u);
+  const ModalGroup& grp = poses[0].groups[0];
+  ASSERT_EQ(grp.fit.status, ModalFitStatus::kOk) << grp.fit.message;
+  ASSERT_EQ(grp.fit.modes.size(), 4u) << grp.fit.message;
+  std::string why;
+  const auto rs = ShapesOfRovingTest(grp, &why);
+  ASSERT_TRUE(rs.has_value()) << why;
+  EXPECT_EQ(rs->roving, "response");
+  EXPECT_EQ(rs->fixed_point, hammer + 1);
+  EXPECT_TRUE(rs->mass_normalised);
+  for (int r = 0; r < 4; ++r) {
+    const double fn = std::sqrt(w2(r)) / (2.0 * kPi);
+    EXPECT_NEAR(grp.fit.modes[r].freq_hz, fn, 0.002 * fn) << "mode " << r + 1;
+    Eigen::Vector4cd fitted;
+    for (int j = 0; j < 4; ++j) fitted(rs->points[j] - 1) = rs->shapes(j, r);
+    const Eigen::Vector4cd ref = phi.col(r).cast<std::complex<double>>();
+    const double mac = std::norm(ref.dot(fitted)) / (ref.squaredNorm() * fitted.squaredNorm());
+    EXPECT_GE(mac, 0.999) << "mode " << r + 1;
+    const double scale = std::abs(ref.dot(fitted)) / ref.squaredNorm();
+    EXPECT_NEAR(scale, 1.0, 0.02) << "mode " << r + 1;
+  }
+  // The modal table's mass: the driving point's, 1/φ_2².
+  ASSERT_EQ(poses[0].tip_modes.size(), 4u);
+  for (int r = 0; r < 4; ++r) {
+    EXPECT_NEAR(poses[0].tip_modes[r].modal_mass_kg, 1.0 / std::pow(phi(hammer, r), 2),
+                0.03 / std::pow(phi(hammer, r), 2))
+        << "mode " << r + 1;
+  }
 }
 
 }  // namespace
