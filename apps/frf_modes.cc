@@ -76,6 +76,9 @@ int Run(int argc, char** argv) {
   }
   return RunGuarded(kTool, [&]() -> int {
     opt.weights_in_file_quantity = weights == "quantity";
+    // The noise model's pass about a modal fit uses this tool's own fitter
+    // (calibration::NoiseOptions::global_modal_fit).
+    noise_opt.global_modal_fit = true;
     if (measured_files.empty() && pose_files.empty()) throw UsageError("give at least one --measured or --pose file");
     CheckOptionRange("--fmin-hz", opt.fit.fmin_hz, 0.0, 1e7);
     if (!std::isinf(opt.fit.fmax_hz)) CheckOptionRange("--fmax-hz", opt.fit.fmax_hz, opt.fit.fmin_hz, 1e7);

@@ -106,6 +106,7 @@ calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const Meas
     no.averages = o.averages > 0 ? o.averages : data.averages.at(key);
     no.use_coherence = o.model != "scatter";
     no.wide_floor = o.drift_floor;
+    no.global_modal_fit = o.global_modal_fit;
     if (o.model == "coherence") {
       if (!frf.coherence()) {
         throw UsageError("--noise-model coherence: " + key.ToString() + " (" + data.file.at(key) +

@@ -52,6 +52,7 @@ struct NoiseCliOptions {
   double min_snr{calibration::NoiseOptions{}.min_snr};
   int averages{0};  // 0: from the file
   bool drift_floor{false};  // calibration::NoiseOptions::wide_floor
+  bool global_modal_fit{false};  // calibration::NoiseOptions::global_modal_fit (frf-modes)
 };
 
 /// --noise-model, --min-snr, --averages, --drift-floor.
