@@ -257,6 +257,13 @@ int Run(int argc, char** argv) {
                   "theirs");
     }
     const io::TrackerFile tf = io::ReadTrackerFile(tracker_path, model->num_joints());
+    // Unit mistakes in the file and in --noise-mm: said, flagged, and kept
+    // with the advice (summary and report).
+    std::vector<std::string> implausible = tf.unit_warnings;
+    if (const std::string w = io::TrackerNoiseUnitFinding("--noise-mm", noise_mm); !w.empty()) {
+      implausible.push_back(w);
+    }
+    for (const std::string& w : implausible) Warn(kTool, w);
     if (verbose && !tf.unknown_columns.empty()) {
       std::string cols;
       for (const auto& c : tf.unknown_columns) cols += (cols.empty() ? "" : ", ") + c;
@@ -264,20 +271,30 @@ int Run(int argc, char** argv) {
     }
     std::vector<identification::LoadCase> cases;
     for (const auto& m : tf.measurements) cases.push_back(identification::ToLoadCase(m));
+    // Joints outside their limits: the first three cases named, the rest
+    // counted (radians under _deg put every case outside: one line, not 72).
+    int outside = 0;
     for (const auto& c : cases) {
       for (int j : model->chain().JointsOutsideLimits(c.q)) {
-        Warn(kTool, tracker_path + ":" + std::to_string(c.line) + ": case " + c.case_id + ": joint " +
-                        std::to_string(j + 1) + " is outside its limits");
+        if (++outside <= 3) {
+          Warn(kTool, tracker_path + ":" + std::to_string(c.line) + ": case " + c.case_id + ": joint " +
+                          std::to_string(j + 1) + " is outside its limits");
+        }
       }
+    }
+    if (outside > 3) {
+      Warn(kTool, tracker_path + ": " + std::to_string(outside - 3) + " more joints outside their limits (" +
+                      std::to_string(outside) + " in all)");
     }
     identification::IdentificationOptions opt;
     opt.tracker_noise = MmToM(noise_mm);
     if (robust == "cauchy") opt.loss = identification::RobustLoss::kCauchy;
     if (robust == "huber") opt.loss = identification::RobustLoss::kHuber;
     ProgressLine progress(kTool, "load cases", static_cast<long>(cases.size()));
-    const identification::JointStiffnessResult r = identification::IdentifyJointStiffness(
+    identification::JointStiffnessResult r = identification::IdentifyJointStiffness(
         *model, cases, opt, [&](long done, long) { progress.Update(done); });
     progress.Finish();
+    r.advice.insert(r.advice.begin(), implausible.begin(), implausible.end());
 
     // Outputs, each complete or absent (docs/formats.md §4).
     const std::vector<std::string> header{
@@ -301,7 +318,7 @@ int Run(int argc, char** argv) {
     }
     if (!json_path.empty()) io::WriteFileAtomically(json_path, report::DumpJson(io::KqSummaryJson(r)));
     PrintReport(r, std::cerr);
-    return r.flagged() || !cfg.implausible.empty() ? kExitFlagged : kExitOk;
+    return r.flagged() || !cfg.implausible.empty() || !implausible.empty() ? kExitFlagged : kExitOk;
   });
 }
 

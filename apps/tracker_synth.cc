@@ -25,11 +25,9 @@
 namespace robomach::apps {
 namespace {
 
-constexpr double kMinPlausibleTrackerNoiseMm = 1e-4;  // --noise-mm, flagged outside (0 allowed)
-constexpr double kMaxPlausibleTrackerNoiseMm = 1.0;
-// Load tests hang 5 - 300 kg (up to the robot's payload; the seed's KR 210:
-// 10 - 30 kg) over pulleys 0.5 - 5 m from the base (docs/plausibility.md).
-constexpr double kMinPlausibleLoadMassKg = 0.5, kMaxPlausibleLoadMassKg = 500.0;
+using io::kMaxPlausibleLoadMassKg;  // load masses and tracker noise: the ranges kq-identify
+using io::kMinPlausibleLoadMassKg;  // checks a tracker file with (io/tracker_file.h)
+// Pulleys 0.5 - 5 m from the base (docs/plausibility.md).
 constexpr double kMinPlausiblePulleyDistanceMm = 100.0, kMaxPlausiblePulleyDistanceMm = 20000.0;
 
 constexpr char kTool[] = "tracker-synth";
@@ -100,11 +98,8 @@ int Run(int argc, char** argv) {
     // API Radian data sheets): a noise over 1 mm is um typed in the mm
     // option, one under 0.1 um is m (docs/plausibility.md).
     std::vector<std::string> implausible;
-    if (noise_mm > kMaxPlausibleTrackerNoiseMm || (noise_mm > 0.0 && noise_mm < kMinPlausibleTrackerNoiseMm)) {
-      implausible.push_back("implausible (unit mistake?): --noise-mm " + io::FormatDouble(noise_mm) +
-                            " is outside the 0.0001 to 1 mm of laser trackers (0.005 to 0.05 mm): " +
-                            (noise_mm > kMaxPlausibleTrackerNoiseMm ? "a noise in um typed in the mm option?"
-                                                                    : "a noise in m typed in the mm option?"));
+    if (const std::string w = io::TrackerNoiseUnitFinding("--noise-mm", noise_mm); !w.empty()) {
+      implausible.push_back(w);
     }
     for (const std::string& w : implausible) Warn(kTool, w);
     io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);

@@ -95,6 +95,7 @@ std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>*
     }
     return out;
   }
+  std::vector<double> unsplit;  // modes seen in two directions with no cross FRF between them
   for (size_t r = 0; r < group.fit.modes.size(); ++r) {
     TipMode t;
     t.freq_hz = group.fit.modes[r].freq_hz;
@@ -123,10 +124,30 @@ std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>*
       // Signs relative to the strongest direction, from a cross FRF.
       int ref = 0;
       t.shape.cwiseAbs().maxCoeff(&ref);
+      std::string unsigned_dirs;
       for (int d = 0; d < 3; ++d) {
         if (d == ref || t.shape(d) == 0.0) continue;
         const double c = std::isfinite(a_de(d, ref)) ? a_de(d, ref) : a_de(ref, d);
         if (std::isfinite(c) && c < 0.0) t.shape(d) = -t.shape(d);
+        if (!std::isfinite(c)) unsigned_dirs += "xyz"[d];
+      }
+      if (!unsigned_dirs.empty()) {
+        // No cross FRF gives the sign of these components against the
+        // strongest one's: either sign fits the direct FRFs, and the two
+        // couple the directions oppositely (a chatter model from a wrong
+        // sign is wrong). The mode is written once per direction, each with
+        // the modal mass its direct FRF gives and no coupling (H_de = 0, as
+        // stability-lobes --frf takes direct FRFs without a cross FRF).
+        unsplit.push_back(t.freq_hz);
+        for (int d = 0; d < 3; ++d) {
+          if (!(std::isfinite(a_dd(d)) && a_dd(d) > 0.0)) continue;
+          TipMode one = t;
+          one.modal_mass_kg = 1.0 / a_dd(d);
+          one.shape = Eigen::Vector3d::Unit(d);
+          one.directions = std::string(1, "xyz"[d]);
+          out.push_back(one);
+        }
+        continue;
       }
     } else if (warnings) {
       std::ostringstream w;
@@ -137,6 +158,18 @@ std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>*
       warnings->push_back(w.str());
     }
     out.push_back(t);
+  }
+  if (warnings && !unsplit.empty()) {
+    std::ostringstream w;
+    w.precision(4);
+    w << "posture " << group.pose_id << ": " << unsplit.size() << " mode" << (unsplit.size() > 1 ? "s" : "")
+      << " (at";
+    for (double f : unsplit) w << " " << f;
+    w << " Hz) appear in two direct FRFs but no cross FRF between their directions gives the relative sign of the "
+         "shape's components (either sign fits the direct FRFs, and they couple the directions oppositely); each "
+         "is written once per direction with no coupling, as stability-lobes --frf takes direct FRFs alone; "
+         "measure the cross FRF (e.g. xy) to get the coupled mode";
+    warnings->push_back(w.str());
   }
   return out;
 }
@@ -253,10 +286,23 @@ std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const Nois
     }
     // Fitted together: the tool-tip modes of the one set of poles. Each FRF
     // alone: the modes of each direct FRF, each a mode in its direction.
+    std::vector<std::string> transfer;
     for (const ModalGroup& g : pm.groups) {
       if (g.fit.status != ModalFitStatus::kOk) continue;
-      if (g.keys.size() == 1 && !g.keys[0].IsDrivingPoint()) continue;
+      if (g.keys.size() == 1 && !g.keys[0].IsDrivingPoint()) {
+        transfer.push_back(g.keys[0].ToString());
+        continue;
+      }
       for (const TipMode& t : TipModes(g, &pm.warnings)) pm.tip_modes.push_back(t);
+    }
+    if (pm.tip_modes.empty() && !transfer.empty()) {
+      std::string which;
+      for (const std::string& k : transfer) which += (which.empty() ? "" : ", ") + k;
+      pm.warnings.push_back("posture " + pose + ": no driving-point FRF (" + which +
+                            (transfer.size() > 1 ? " are transfer FRFs" : " is a transfer FRF") +
+                            ": response and excitation at different points or in different directions), so no "
+                            "mode has a modal mass: the modal table (--out) is empty; the modes are in the summary "
+                            "and their constants in --modal-constants");
     }
     std::sort(pm.tip_modes.begin(), pm.tip_modes.end(),
               [](const TipMode& a, const TipMode& b) { return a.freq_hz < b.freq_hz; });

@@ -97,6 +97,15 @@ nlohmann::json LobesSummaryJson(const std::vector<stability::TipDynamics>& tips,
       cj["agree"] = c.agree;
       tj["zoa_sd_comparison"] = cj;
     }
+    for (const stability::ZoaFitCheck& c : lobes.zoa_fit_checks) {
+      if (c.id != t.id) continue;
+      nlohmann::json cj;
+      cj["measured_min_critical_depth_mm"] = MToMm(c.measured_min_depth);
+      cj["fit_min_critical_depth_mm"] = MToMm(c.fit_min_depth);
+      cj["difference_percent"] = 100.0 * c.relative_difference;
+      cj["agree"] = c.agree;
+      tj["zoa_measured_vs_fit"] = cj;
+    }
     tip_list.push_back(tj);
   }
   nlohmann::json j;

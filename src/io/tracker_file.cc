@@ -1,16 +1,20 @@
 #include "robomach/io/tracker_file.h"
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <map>
 #include <regex>
 #include <sstream>
 #include <stdexcept>
 
 #include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/number_format.h"
+#include "robomach/io/posture_file.h"
 
 namespace robomach::io {
 namespace {
@@ -67,6 +71,63 @@ void CheckTriple(const CsvTable& t, const std::vector<std::string>& cols, const 
                                         ", " + cols[2] + "; " + c + " is missing");
     }
   }
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// The unit checks of ReadTrackerFile (TrackerFile::unit_warnings): medians,
+// so that one odd row is not taken for a unit.
+std::vector<std::string> TrackerUnitWarnings(const TrackerFile& f, const CsvTable& t,
+                                             const std::vector<std::string>& qcols, const std::vector<bool>& is_deg) {
+  std::vector<std::vector<double>> written;
+  for (int r = 0; r < t.num_rows(); ++r) {
+    std::vector<double> row;
+    for (const std::string& c : qcols) row.push_back(t.Number(r, c));
+    written.push_back(row);
+  }
+  std::vector<std::string> out = PostureUnitWarnings(f.path, written, is_deg);
+  const std::string head = "implausible (unit mistake?): " + f.path + ": ";
+  std::vector<double> dist_mm, mass_kg, force_n;
+  for (const auto& m : f.measurements) {
+    dist_mm.push_back(MToMm(m.p0.norm()));
+    if (m.force) force_n.push_back(m.force->norm());
+    if (f.rope_form) mass_kg.push_back(m.mass_kg);
+  }
+  const double d = Median(dist_mm);
+  if (d < kMinPlausibleTargetDistanceMm) {
+    out.push_back(head + "the unloaded target (x0_mm, y0_mm, z0_mm) is a median " + FormatNumber(d) +
+                  " mm from the robot base, closer than the " + FormatDouble(kMinPlausibleTargetDistanceMm) +
+                  " mm a robot's tool can be: the positions look like metres under the _mm headers (the tracker "
+                  "frame is the base frame, formats.md §2); convert them to mm");
+  } else if (d > kMaxPlausibleTargetDistanceMm) {
+    out.push_back(head + "the unloaded target (x0_mm, y0_mm, z0_mm) is a median " + FormatNumber(d) +
+                  " mm from the robot base, farther than the " + FormatDouble(kMaxPlausibleTargetDistanceMm) +
+                  " mm of any industrial robot: the positions look like micrometres under the _mm headers; "
+                  "convert them to mm");
+  }
+  const double m = Median(mass_kg);
+  if (m > kMaxPlausibleLoadMassKg) {
+    out.push_back(head + "the median load mass_kg " + FormatNumber(m) + " is above the " +
+                  FormatDouble(kMaxPlausibleLoadMassKg) + " kg a load test hangs (5 - 300 kg): grams under mass_kg?");
+  } else if (m < kMinPlausibleLoadMassKg) {
+    out.push_back(head + "the median load mass_kg " + FormatNumber(m) + " is below the " +
+                  FormatDouble(kMinPlausibleLoadMassKg) + " kg that deflect a robot measurably: tonnes under "
+                  "mass_kg?");
+  }
+  const double F = Median(force_n);
+  if (F < kMinPlausibleLoadN) {
+    out.push_back(head + "the median load |(fx_N, fy_N, fz_N)| " + FormatNumber(F) + " N is below the " +
+                  FormatDouble(kMinPlausibleLoadN) + " N that deflect a robot measurably: kN under the _N headers?");
+  } else if (F > kMaxPlausibleLoadN) {
+    out.push_back(head + "the median load |(fx_N, fy_N, fz_N)| " + FormatNumber(F) + " N is above the " +
+                  FormatDouble(kMaxPlausibleLoadN) + " N of a robot load test: a mass in g, or a force in "
+                  "another unit, under the _N headers?");
+  }
+  return out;
 }
 
 }  // namespace
@@ -190,7 +251,18 @@ TrackerFile ReadTrackerFile(const std::string& path, int num_joints) {
     f.measurements.push_back(std::move(m));
   }
   if (f.measurements.empty()) throw InputError({path, 0, 0}, "no load cases (the file has a header only)");
+  f.unit_warnings = TrackerUnitWarnings(f, t, qcols, is_deg);
   return f;
+}
+
+std::string TrackerNoiseUnitFinding(const std::string& option, double noise_mm) {
+  if (!(noise_mm > kMaxPlausibleTrackerNoiseMm || (noise_mm > 0.0 && noise_mm < kMinPlausibleTrackerNoiseMm))) {
+    return "";
+  }
+  return "implausible (unit mistake?): " + option + " " + FormatDouble(noise_mm) +
+         " mm is outside the 0.0001 to 1 mm of laser trackers (0.005 to 0.05 mm): " +
+         (noise_mm > kMaxPlausibleTrackerNoiseMm ? "a noise in um typed in the mm option?"
+                                                 : "a noise in m typed in the mm option?");
 }
 
 void WriteTrackerFile(std::ostream& os,

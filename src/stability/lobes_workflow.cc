@@ -9,6 +9,7 @@
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
+#include "robomach/stability/tool_tip_model.h"
 
 namespace robomach::stability {
 namespace {
@@ -91,6 +92,40 @@ void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
   }
 }
 
+// A measured tip: the ZOA's smallest depth on the measured FRF against the
+// ZOA on the modes fitted to it (see ZoaFitCheck).
+void CheckZoaAgainstFit(const TipDynamics& t, const LobesOptions& o, const ZoaOptions& zo, double measured_min,
+                        const std::function<void(TipMessage::Kind, const std::string&)>& tell, LobesResult* result) {
+  const Eigen::VectorXd f = LobeFrequencyGrid(t.fit_C, o.process.teeth, o.max_speed_rad_s, kLobeGridLines);
+  const auto fit_lobes = ComputeZoaLobes(f, InPlaneModalReceptance(t.fit_C, f), o.process, zo);
+  double fit_min = INFINITY;
+  for (const LobePoint& p : fit_lobes.At(o.zoa_speeds_rad_s)) {
+    if (p.status == LobeStatus::kOk) fit_min = std::min(fit_min, p.critical_depth);
+  }
+  if (!std::isfinite(fit_min)) return;
+  ZoaFitCheck c;
+  c.id = t.id;
+  c.measured_min_depth = measured_min;
+  c.fit_min_depth = fit_min;
+  c.relative_difference = std::abs(measured_min - fit_min) / std::min(measured_min, fit_min);
+  c.agree = c.relative_difference <= 0.10;
+  result->zoa_fit_checks.push_back(c);
+  std::ostringstream m;
+  m << t.id << ": the ZOA's smallest critical depth is " << FormatNumber(MToMm(measured_min))
+    << " mm on the measured FRF and " << FormatNumber(MToMm(fit_min)) << " mm on its fitted modes";
+  if (c.agree) {
+    tell(TipMessage::Kind::kFit, m.str() + " (they agree within 10 %)");
+    return;
+  }
+  const std::string w =
+      m.str() + ": they differ by " + FormatDouble(std::round(c.relative_difference * 1000.0) / 10.0) +
+      " %, so the lobes hang on something the fit and the measured lines disagree on: a mode the fit left out or "
+      "misplaced (see --fit-plot), or a resonance too narrow for the line spacing (a longer record gives finer "
+      "lines); compare --method sd, which uses the fitted modes";
+  tell(TipMessage::Kind::kWarning, w);
+  result->Flag(w);
+}
+
 }  // namespace
 
 std::vector<std::string> TipFitWarnings(const TipDynamics& t, bool sd) {
@@ -139,9 +174,14 @@ LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOption
       zo.max_lobe_index = o.max_lobe_index;
       zo.min_spindle_speed_rad_s = o.min_speed_rad_s;
       const auto lobes = ComputeZoaLobes(t.freq_hz, t.Phi_C, o.process, zo);
+      double measured_min = INFINITY;
       for (const auto& p : lobes.At(o.zoa_speeds_rad_s)) {
         result.rows.push_back({t.id, "zoa", p});
         result.no_boundary |= p.status != LobeStatus::kOk;
+        if (p.status == LobeStatus::kOk) measured_min = std::min(measured_min, p.critical_depth);
+      }
+      if (t.modes_fitted && t.fit_C.num_modes() > 0 && !t.fit_lacks_cross && std::isfinite(measured_min)) {
+        CheckZoaAgainstFit(t, o, zo, measured_min, tell, &result);
       }
     }
     if (do_sd && t.modes_C.num_modes() > 0) {

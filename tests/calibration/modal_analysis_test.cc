@@ -82,6 +82,90 @@ TEST(ModalAnalysis, Kr210HammerTestGivesTheModelsModes) {
   for (double ns : pm.groups[0].fit.misfit_in_noise) EXPECT_LT(ns, 1.5);
 }
 
+// The same hammer test without its cross FRF (xx and yy only): a mode seen
+// in both directions has a shape whose relative sign no FRF gives, and
+// either sign couples the directions oppositely in a chatter model. The
+// modal table gives such a mode once per direction (no coupling), each
+// with the modal mass of its direction, 1/p_x² and 1/p_y² of the model's
+// eigen-solution, and a warning names the modes and the cross FRF that
+// would resolve them. (Before, both components came out positive,
+// silently: stability-lobes from such a table was off by a factor 5.)
+TEST(ModalAnalysis, ModeInTwoDirectionsWithoutACrossFrfIsOneModePerDirection) {
+  const io::RobotConfig cfg = io::LoadRobotConfig(SourcePath("config/kr210.yaml"));
+  const auto model = dynamics::RobotModel::Build(cfg.description, cfg.parameters);
+  Eigen::VectorXd q(6);
+  q << DegToRad(10), DegToRad(-60), DegToRad(90), DegToRad(15), DegToRad(45), DegToRad(-20);
+  VirtualHammerOptions o;
+  o.directions = {{Axis::kX, Axis::kX}, {Axis::kY, Axis::kY}};
+  o.relative_noise = 0.01;
+  o.seed = 3442;
+  const dynamics::FrfSet measured = SynthesizeHammerTest(model, {{"P", q}}, o);
+  const std::vector<PoseModes> poses = AnalyseModes(measured, EstimateNoise(measured));
+  ASSERT_EQ(poses.size(), 1u);
+  const PoseModes& pm = poses.front();
+  bool warned = false;
+  for (const std::string& w : pm.warnings) warned |= w.find("no cross FRF") != std::string::npos;
+  EXPECT_TRUE(warned);
+  dynamics::PostureEvaluator ev(model);
+  const dynamics::PostureDynamics d = ev.Evaluate(q);
+  int checked = 0;
+  for (const dynamics::Mode& m : d.modes) {
+    const double w = HzToRadPerSec(m.freq_hz);
+    // Both directions clearly visible: each direction's peak |p_a|²/(2ζω²)
+    // at least 5e-8 m/N (a few % of the largest).
+    bool both = true;
+    for (int a = 0; a < 2; ++a) both = both && m.p_T(a) * m.p_T(a) / (2 * m.damping_ratio * w * w) > 5e-8;
+    if (!both) continue;
+    for (int a = 0; a < 2; ++a) {
+      const TipMode* found = nullptr;
+      for (const TipMode& t : pm.tip_modes) {
+        if (std::abs(t.freq_hz - m.freq_hz) < 0.01 * m.freq_hz && t.directions == std::string(1, "xy"[a])) found = &t;
+      }
+      ASSERT_NE(found, nullptr) << m.freq_hz << " Hz in " << "xy"[a];
+      EXPECT_DOUBLE_EQ(found->shape(a), 1.0);
+      EXPECT_EQ(found->shape.norm(), 1.0);
+      const double mass = 1.0 / (m.p_T(a) * m.p_T(a));
+      EXPECT_NEAR(found->modal_mass_kg, mass, 0.05 * mass) << m.freq_hz << " Hz in " << "xy"[a];
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 1);
+  for (const TipMode& t : pm.tip_modes) EXPECT_EQ(t.directions.size(), 1u) << t.freq_hz << " Hz";
+}
+
+// One transfer FRF (response at point 1, excitation at point 56, as
+// ufffiles_jl's dataset58_FRF.unv is): its modes are fitted, but none has
+// a modal mass, so the modal table is empty; a warning says why and where
+// the modes are (before, the table came out empty without a word).
+TEST(ModalAnalysis, OneTransferFrfGivesNoModalTableAndSaysWhy) {
+  const io::RobotConfig cfg = io::LoadRobotConfig(SourcePath("config/kr210.yaml"));
+  const auto model = dynamics::RobotModel::Build(cfg.description, cfg.parameters);
+  Eigen::VectorXd q(6);
+  q << 0.2, -1.0, 1.5, 0.2, 0.8, -0.3;
+  VirtualHammerOptions o;
+  o.directions = {{Axis::kX, Axis::kX}};
+  o.relative_noise = 0.01;
+  const dynamics::FrfSet one = SynthesizeHammerTest(model, {{"P", q}}, o);
+  dynamics::FrfSet transfer;
+  for (const auto& [key, frf] : one) {
+    dynamics::FrfKey k = key;
+    k.response_point = 1;
+    k.excitation_point = 56;
+    transfer.Insert(k, frf);
+  }
+  const auto poses = AnalyseModes(transfer, EstimateNoise(transfer));
+  ASSERT_EQ(poses.size(), 1u);
+  ASSERT_EQ(poses[0].groups.size(), 1u);
+  EXPECT_FALSE(poses[0].groups[0].fit.modes.empty());
+  EXPECT_TRUE(poses[0].tip_modes.empty());
+  bool said = false;
+  for (const std::string& w : poses[0].warnings) {
+    said |= w.find("no driving-point FRF") != std::string::npos && w.find("at point 56") != std::string::npos &&
+            w.find("--modal-constants") != std::string::npos;
+  }
+  EXPECT_TRUE(said);
+}
+
 TEST(ModalAnalysis, FrfsOnDifferentGridsAreFittedAloneWithAWarning) {
   const io::RobotConfig cfg = io::LoadRobotConfig(SourcePath("config/kr210.yaml"));
   const auto model = dynamics::RobotModel::Build(cfg.description, cfg.parameters);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -72,6 +73,50 @@ TEST(TrackerFile, ReadsRopeFormAndOptionalTipFramePoints) {
   const auto c = identification::ToLoadCase(m);
   EXPECT_NEAR(c.force.x(), 20 * 9.80665 * 0.6, 1e-9);
   EXPECT_NEAR(c.force.z(), -20 * 9.80665 * 0.8, 1e-9);
+}
+
+// Numbers that fit another unit far better than the header's: a KR210
+// load test (targets 1.5-2.5 m from the base, 20 kg on a rope, degrees)
+// reads without a unit warning; the same file with the positions in m, the
+// masses in g, or the angles in radians under the same headers gives one
+// warning each, naming the column and the likely unit; a force in kN under
+// _N likewise.
+TEST(TrackerFile, UnitMistakesAreNamed) {
+  const std::string dir = TempDir("tracker_units");
+  auto rope_file = [&](const std::string& name, double pos_scale, double mass, bool radians) {
+    std::string text = kRopeHeader;
+    const double q[3][6] = {{0, -90, 90, 0, 45, 0}, {30.5, -60, 100, 10, 30, 20}, {-40, -110, 80, 5, 60, -30}};
+    const double p0[3][3] = {{1938.9, 0, 1521.1}, {1500.2, 866.1, 1200.4}, {1700.7, -1400.3, 900.8}};
+    for (int r = 0; r < 3; ++r) {
+      std::ostringstream row;
+      row.precision(10);
+      row << "C" << r + 1 << ",P" << r + 1;
+      for (double a : q[r]) row << "," << (radians ? DegToRad(a) : a);
+      for (int k = 0; k < 3; ++k) row << "," << p0[r][k] * pos_scale;
+      for (int k = 0; k < 3; ++k) row << "," << (p0[r][k] + (k == 2 ? -0.4 : 0.0)) * pos_scale;
+      row << "," << mass << "," << 1000 * pos_scale << ",0,0," << 1300 * pos_scale << ",0," << -400 * pos_scale;
+      text += row.str() + "\n";
+    }
+    return File(dir, name, text);
+  };
+  EXPECT_TRUE(ReadTrackerFile(rope_file("ok.csv", 1.0, 20.0, false), 6).unit_warnings.empty());
+  auto one_warning = [&](const std::string& path, const std::string& what) {
+    const TrackerFile f = ReadTrackerFile(path, 6);
+    ASSERT_EQ(f.unit_warnings.size(), 1u) << path;
+    EXPECT_THAT(f.unit_warnings[0], HasSubstr("implausible (unit mistake?)"));
+    EXPECT_THAT(f.unit_warnings[0], HasSubstr(what));
+  };
+  one_warning(rope_file("metres.csv", 1e-3, 20.0, false), "look like metres under the _mm headers");
+  one_warning(rope_file("grams.csv", 1.0, 20000.0, false), "grams under mass_kg");
+  one_warning(rope_file("radians.csv", 1.0, 20.0, true), "these look like radians");
+  const std::string kn = File(dir, "kn.csv", kForceHeader +
+                                                 "C1,P1,0,-90,90,0,45,0,1938.9,0,1521.1,1938.9,0.02,1520.6,0,0,-0.294\n"
+                                                 "C2,P1,0,-90,90,0,45,0,1938.9,0,1521.1,1938.9,0.02,1520.6,0.2,0,0\n");
+  one_warning(kn, "kN under the _N headers");
+  EXPECT_THAT(TrackerNoiseUnitFinding("--noise-mm", 10.0), HasSubstr("um typed in the mm option"));
+  EXPECT_THAT(TrackerNoiseUnitFinding("--noise-mm", 1e-5), HasSubstr("m typed in the mm option"));
+  EXPECT_EQ(TrackerNoiseUnitFinding("--noise-mm", 0.01), "");
+  EXPECT_EQ(TrackerNoiseUnitFinding("--noise-mm", 0.0), "");
 }
 
 TEST(TrackerFile, WriteReadRoundTrip) {

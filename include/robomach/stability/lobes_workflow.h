@@ -73,6 +73,18 @@ struct ZoaSdComparison {
   bool agree{true};                 // relative_difference <= 0.10
 };
 
+/// A measured tip's ZOA on its measured FRF against the ZOA on the modes
+/// fitted to it (TipDynamics::fit_C, on the model grid): the smallest
+/// critical depths over the ZOA's speeds. They differ when the fit misses
+/// what the lines show (a mode left out, a poor fit) or the lines miss what
+/// the fit shows (a resonance narrower than the line spacing).
+struct ZoaFitCheck {
+  std::string id;
+  double measured_min_depth{NAN}, fit_min_depth{NAN};  // [m]
+  double relative_difference{NAN};                     // |measured − fit| / min of the two
+  bool agree{true};                                    // relative_difference <= 0.10
+};
+
 /// Flagged (RunFindings; stability-lobes' exit 3), one finding each, for a
 /// modal fit that does not describe a tool tip (TipFitWarnings: an
 /// implausible unit, not a driving point, a mode at the edge of the usable
@@ -86,6 +98,7 @@ struct LobesResult : RunFindings {
   bool no_boundary{false};
   std::vector<SdDiscretisation> sd_discretisation;  // per tip the SD was run on
   std::vector<ZoaSdComparison> comparisons;         // per tip compared (see ComputeLobes)
+  std::vector<ZoaFitCheck> zoa_fit_checks;          // per measured tip with the ZOA
 };
 
 /// The warnings about one tip's measured FRFs (empty for a model tip): its
@@ -99,7 +112,8 @@ std::vector<std::string> TipFitWarnings(const TipDynamics& tip, bool sd);
 /// kept). With both methods at a radial immersion of 0.3 or more the
 /// smallest critical depths must agree within 10 %: the SD's minimum is
 /// also searched on 7 speeds within ±4 % of the bottom of each of the (at
-/// most 4) lowest ZOA lobes.
+/// most 4) lowest ZOA lobes. A measured tip's ZOA is checked against the
+/// ZOA on its fitted modes (ZoaFitCheck; flagged beyond 10 %).
 LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOptions& options,
                          const TipMessageSink& on_message = {}, const SdProgressSink& on_progress = {});
 

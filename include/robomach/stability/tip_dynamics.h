@@ -47,6 +47,11 @@ struct TipDynamics {
   Eigen::VectorXd freq_hz;              // grid of the FRF [Hz], > 0
   std::vector<Eigen::Matrix2cd> Phi_C;  // in-plane oriented FRF [m/N]: the ZOA's input
   TipModalModel modes_C;                // p in C [1/√kg]: the semi-discretization's input
+  /// Measured tips: every fitted mode in C (modes_C keeps the dominant
+  /// ones), the shape the ZOA follows between the measured lines and its
+  /// cross-check (ComputeLobes); empty for a model's tip.
+  TipModalModel fit_C;
+  bool fit_lacks_cross{false};  // the file's cross FRFs are in Phi_C but fit_C does not model them
   bool modes_fitted{false};             // fitted to an FRF (not given)
   bool no_modes{false};                 // fitted, but no mode: no SD
   std::vector<DirectionFit> fits;       // measured FRFs: one per direct FRF fitted
