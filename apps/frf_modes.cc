@@ -86,27 +86,11 @@ int Run(int argc, char** argv) {
     std::vector<std::pair<std::string, std::string>> inputs;
     for (const auto& f : measured_files) inputs.push_back({"--measured", f});
     CheckDistinctPaths(inputs, {{"--out", out_path}, {"--modal-constants", constants_path}, {"--mode-shapes", shapes_path}, {"--summary", summary_path}});
-    // A UFF file without posture names is one posture, "P1", here: frf-modes
-    // needs none (frf-calibrate's --pose P1=file.uff still works).
-    MeasuredData all = ReadMeasuredFiles(kTool, {}, pose_files, "measured FRF file", "--pose", true);
-    auto merge = [&](const MeasuredData& one) {
-      for (const auto& [key, frf] : one.frfs) {
-        if (all.frfs.contains(key)) {
-          throw InputError({one.file.at(key), 0, 0},
-                           "FRF " + key.ToString() + " was already read from " + all.file.at(key));
-        }
-        all.frfs.Insert(key, frf);
-        all.averages[key] = one.averages.at(key);
-        all.file[key] = one.file.at(key);
-        all.file_power[key] = one.file_power.at(key);
-      }
-      for (const auto& u : one.unit_findings) all.unit_findings.push_back(u);
-    };
-    // A UFF record that names no posture is posture P1 here (frf-modes needs
-    // none); a posture the file names wins, and a CSV always names its own.
-    // Read once: retrying after the reader's "no posture" error printed its
-    // warnings twice.
-    for (const std::string& f : measured_files) merge(ReadMeasuredFiles(kTool, {}, {"P1=" + f}, "measured FRF file", "--pose", true));
+    // A UFF record that names no posture is posture P1 here (frf-modes
+    // needs none; frf-calibrate's --pose P1=file.uff still works); a
+    // posture the file names wins, and a CSV always names its own.
+    const MeasuredData all =
+        ReadMeasuredFiles(kTool, measured_files, pose_files, "measured FRF file", "--pose", true, "P1");
     const calibration::NoiseModels noise = EstimateNoiseModels(kTool, all, noise_opt);
     int power = 0;
     std::string quantity = "receptance";

@@ -13,6 +13,9 @@ set(allowed_polishing "common;polishing")
 set(allowed_drilling "common;kinematics;drilling")
 set(allowed_machine "common;machine")
 set(allowed_io "common;kinematics;dynamics;identification;calibration;audit;stability;polishing;drilling;machine;io")
+# workflows (issue #36) sits above io and every domain module; it does not
+# draw (report) and nothing below it may include it.
+set(allowed_workflows "common;kinematics;dynamics;identification;calibration;audit;stability;polishing;drilling;machine;io;io_base;workflows")
 # report has two parts (issue #21): report itself draws and may include only
 # common, io_base and report; report_fits (the reports of calibration and
 # audit results, whose files sit in include/robomach/report/ and src/report/)
@@ -26,7 +29,7 @@ set(allowed_report_fits "common;kinematics;dynamics;calibration;audit;report;rep
 set(io_base_names atomic_file csv_table yaml_doc file_kind parallel_rows number_format text)
 set(allowed_io_base "common;io_base")
 set(violations "")
-foreach(module common kinematics dynamics identification calibration audit stability polishing drilling machine io io_base report report_fits)
+foreach(module common kinematics dynamics identification calibration audit stability polishing drilling machine io io_base workflows report report_fits)
   if(module STREQUAL "report_fits" OR module STREQUAL "report")
     set(files "")
     file(GLOB candidates ${ROOT}/include/robomach/report/*.h ${ROOT}/src/report/*.cc ${ROOT}/src/report/*.h)

@@ -6,14 +6,15 @@
 # LINKS is a file of "target=link|link|..." lines written by
 # tests/CMakeLists.txt at generate time.
 cmake_minimum_required(VERSION 3.16)
-set(forbidden_report robomach::io robomach::kinematics robomach::dynamics
+set(forbidden_io robomach::workflows robomach::report robomach::report_fits)
+set(forbidden_report robomach::workflows robomach::io robomach::kinematics robomach::dynamics
     robomach::identification robomach::calibration robomach::audit robomach::stability robomach::polishing
     robomach::drilling robomach::machine robomach::io_cad robomach::report_fits)
 set(forbidden_report_fits robomach::io robomach::identification robomach::stability robomach::polishing
     robomach::drilling robomach::machine robomach::io_cad)
 set(forbidden_io_base robomach::io robomach::kinematics robomach::dynamics robomach::identification
     robomach::calibration robomach::audit robomach::stability robomach::polishing robomach::drilling
-    robomach::machine robomach::io_cad robomach::report)
+    robomach::machine robomach::io_cad robomach::report robomach::workflows)
 file(STRINGS ${LINKS} lines)
 set(violations "")
 set(seen "")
@@ -28,8 +29,8 @@ foreach(line ${lines})
     endif()
   endforeach()
 endforeach()
-if(NOT "report" IN_LIST seen OR NOT "report_fits" IN_LIST seen OR NOT "io_base" IN_LIST seen)
-  message(FATAL_ERROR "link rules: ${LINKS} does not list report, report_fits and io_base")
+if(NOT "report" IN_LIST seen OR NOT "report_fits" IN_LIST seen OR NOT "io_base" IN_LIST seen OR NOT "io" IN_LIST seen)
+  message(FATAL_ERROR "link rules: ${LINKS} does not list report, report_fits, io_base and io")
 endif()
 if(violations)
   string(REPLACE ";" "\n" msg "${violations}")

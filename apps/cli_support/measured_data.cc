@@ -8,68 +8,54 @@
 #include "cli_support.h"
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/common/errors.h"
-#include "robomach/io/frf_files.h"
+#include "robomach/common/messages.h"
 
 namespace robomach::apps {
 
-MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::string>& files,
-                               const std::vector<std::string>& pose_files, const std::string& what,
-                               const std::string& pose_option, bool keep_points) {
-  MeasuredData all;
-  auto add = [&](const std::string& path, const std::string& pose) {
-    RequireReadableFile(path, what);
-    const io::FrfReadResult r = io::ReadFrfFile(path, pose, keep_points);
-    for (const std::string& w : r.warnings) Warn(tool, w);
-    for (const std::string& n : r.notes) Note(tool, n);
-    // On each FRF's usable band only (issue #34 item 5): a tap test's drift
-    // lines are no measure of the unit.
-    for (const std::string& f : calibration::ReceptanceUnitFindings(r.frfs, path, r.averages)) {
-      Warn(tool, "implausible (unit mistake?): " + f);
-      all.unit_findings.push_back(f);
-    }
-    for (const auto& [key, frf] : r.frfs) {
-      if (key.pose_id.empty()) {
-        throw InputError({path, 0, 0}, "the FRFs of this file name no posture: give it as " + pose_option + " P1=" + path +
-                                           " (P1 a pose_id of the posture file), or put pose=P1 in ID line 1 of "
-                                           "each UFF58 record");
-      }
-      if (all.frfs.contains(key)) {
-        throw InputError({path, 0, 0}, "FRF " + key.ToString() + " was already read from " + all.file.at(key));
-      }
-      all.frfs.Insert(key, frf);
-      all.averages[key] = r.averages;
-      all.file[key] = path;
-      all.file_power[key] = r.file_quantity == io::FrfQuantity::kReceptance  ? 0
-                            : r.file_quantity == io::FrfQuantity::kMobility ? 1
-                                                                            : 2;
+namespace {
+
+// The library's messages on stderr under the tool's name.
+MessageSink Printer(const std::string& tool) {
+  return [tool](const Message& m) {
+    switch (m.kind) {
+      case Message::Kind::kWarning: Warn(tool, m.text); break;
+      case Message::Kind::kNote: Note(tool, m.text); break;
+      case Message::Kind::kInfo: std::cerr << tool << ": " << m.text << '\n'; break;
     }
   };
-  for (const std::string& f : files) add(f, "");
+}
+
+workflows::MeasuredFrfOptions LibraryOptions(const NoiseCliOptions& o) {
+  CheckOptionRange("--min-snr", o.min_snr, 1e-3, 1e6);
+  CheckOptionRange("--averages", o.averages, 0, 1e6);
+  workflows::MeasuredFrfOptions w;
+  w.noise_model = workflows::ParseNoiseModelChoice(o.model);  // CLI11 checked the name
+  w.min_snr = o.min_snr;
+  w.averages = o.averages;
+  w.drift_floor = o.drift_floor;
+  w.global_modal_fit = o.global_modal_fit;
+  return w;
+}
+
+}  // namespace
+
+MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::string>& files,
+                               const std::vector<std::string>& pose_files, const std::string& what,
+                               const std::string& pose_option, bool keep_points, const std::string& default_pose) {
+  workflows::MeasuredFrfOptions o;
+  o.files = files;
   for (const std::string& a : pose_files) {
     const auto eq = a.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == a.size()) {
       throw UsageError(pose_option + " '" + a + "': expected ID=file.uff, e.g. " + pose_option + " P1=p1.uff");
     }
-    add(a.substr(eq + 1), a.substr(0, eq));
+    o.posed_files.push_back({a.substr(0, eq), a.substr(eq + 1)});
   }
-  // Files were given and read, but none held an FRF (a UFF with only other
-  // datasets, a CSV with a header and no lines): bad input data, exit 65,
-  // not a command-line error.
-  if (all.frfs.empty() && !(files.empty() && pose_files.empty())) {
-    std::string names;
-    std::string first;
-    for (const std::string& f : files) {
-      names += (names.empty() ? "" : ", ") + f;
-      if (first.empty()) first = f;
-    }
-    for (const std::string& a : pose_files) {
-      const std::string f = a.substr(a.find('=') + 1);
-      names += (names.empty() ? "" : ", ") + f;
-      if (first.empty()) first = f;
-    }
-    throw InputError({first, 0, 0}, "no " + what + " holds an FRF (read: " + names + ")");
-  }
-  return all;
+  o.default_pose = default_pose;
+  o.what = what;
+  o.pose_option = pose_option;
+  o.keep_points = keep_points;
+  return workflows::ReadMeasuredFrfFiles(o, Printer(tool));
 }
 
 void AddNoiseOptions(CLI::App& app, NoiseCliOptions* o) {
@@ -93,64 +79,15 @@ void AddNoiseOptions(CLI::App& app, NoiseCliOptions* o) {
 
 calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const MeasuredData& data,
                                              const NoiseCliOptions& o) {
-  CheckOptionRange("--min-snr", o.min_snr, 1e-3, 1e6);
-  CheckOptionRange("--averages", o.averages, 0, 1e6);
-  calibration::NoiseModels out;
-  if (o.model == "none") return out;
-  std::cerr << tool << ": noise model of " << data.frfs.size() << " FRFs (usable where |H| >= " << o.min_snr
-            << " x floor)\n";
-  int none_usable = 0;
-  for (const auto& [key, frf] : data.frfs) {
-    calibration::NoiseOptions no;
-    no.min_snr = o.min_snr;
-    no.averages = o.averages > 0 ? o.averages : data.averages.at(key);
-    no.use_coherence = o.model != "scatter";
-    no.wide_floor = o.drift_floor;
-    no.global_modal_fit = o.global_modal_fit;
-    if (o.model == "coherence") {
-      if (!frf.coherence()) {
-        throw UsageError("--noise-model coherence: " + key.ToString() + " (" + data.file.at(key) +
-                         ") has no coherence; use --noise-model scatter or auto");
-      }
-      if (no.averages == 0) {
-        throw UsageError("--noise-model coherence: " + data.file.at(key) +
-                         " does not say how many averages are behind its coherence ('# averages: N'); "
-                         "give --averages N");
-      }
-    }
-    if (o.model == "auto" && frf.coherence() && no.averages == 0) {
-      Warn(tool, key.ToString() + ": the coherence is not used because " + data.file.at(key) +
-                     " does not give the number of averages ('# averages: N'; or --averages N); the noise is "
-                     "estimated from the scatter");
-    }
-    calibration::FrfNoise n;
-    try {
-      n = calibration::EstimateFrfNoise(frf, no);
-    } catch (const std::invalid_argument& e) {
-      throw InputError({data.file.at(key), 0, 0}, key.ToString() + ": " + e.what());
-    }
-    const bool points = key.response_point != 0 || key.excitation_point != 0;
-    std::cerr << tool << ": " << key.pose_id << " "
-              << (points ? key.Label() : std::string{AxisName(key.response), AxisName(key.excitation)}) << ": "
-              << n.description << '\n';
-    if (n.usable_lines == 0) {
-      ++none_usable;
-      Warn(tool, key.ToString() + ": no line reaches the signal-to-noise ratio " + std::to_string(o.min_snr) +
-                     "; this FRF is not used");
-    }
-    out.emplace(key, std::move(n));
+  const workflows::MeasuredFrfOptions w = LibraryOptions(o);
+  try {
+    return workflows::EstimateNoiseModels(data, w, Printer(tool));
+  } catch (const OptionError& e) {
+    // The data cannot meet an option: the option, and what to give.
+    throw UsageError((e.field() == "averages" ? "--noise-model " + o.model + " needs --averages N: "
+                                              : "--noise-model " + o.model + ": ") +
+                     std::string(e.what()));
   }
-  return out;
-}
-
-dynamics::FrfSet FitData(const MeasuredData& data, const calibration::NoiseModels& noise) {
-  if (noise.empty()) return data.frfs;
-  dynamics::FrfSet out = calibration::UsableData(data.frfs, noise);
-  if (out.empty()) {
-    throw InputError({data.file.begin()->second, 0, 0},
-                     "no measured FRF has a usable line (signal-to-noise ratio below --min-snr everywhere)");
-  }
-  return out;
 }
 
 }  // namespace robomach::apps

@@ -14,6 +14,7 @@
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/io/frf_files.h"
 #include "robomach/io/hammer_records.h"
+#include "robomach/workflows/measured_frfs.h"
 
 namespace robomach::python {
 namespace {
@@ -283,6 +284,86 @@ void BindFrf(py::module_& m) {
   }, py::arg("frfs"), py::arg("noise"),
      "The usable lines of every FRF with their sigma attached: what the calibration fits. FRFs "
      "with no usable line are left out; ValueError if an FRF has no noise model.");
+
+  // The measured-FRF route of the tools (workflows/measured_frfs.h): the
+  // same reading, unit checks, noise model and usable lines as
+  // frf-calibrate, model-audit and frf-modes.
+  py::class_<workflows::MeasuredFrfs>(
+      m, "MeasuredFrfs",
+      "Measured FRFs read the way the tools read them: frfs (all lines, receptance), the file, "
+      "'# averages: N' and quantity power (0 receptance, 1 mobility, 2 accelerance) of each, the "
+      "unit findings, the noise model of each FRF and fit_data (its usable lines with sigma).")
+      .def_readonly("frfs", &workflows::MeasuredFrfs::frfs)
+      .def_property_readonly("file", [](const workflows::MeasuredFrfs& d) {
+        std::map<KeyTuple, std::string> out;
+        for (const auto& [k, v] : d.file) out.emplace(FromKey(k), v);
+        return out;
+      })
+      .def_property_readonly("averages", [](const workflows::MeasuredFrfs& d) {
+        std::map<KeyTuple, int> out;
+        for (const auto& [k, v] : d.averages) out.emplace(FromKey(k), v);
+        return out;
+      })
+      .def_property_readonly("file_power", [](const workflows::MeasuredFrfs& d) {
+        std::map<KeyTuple, int> out;
+        for (const auto& [k, v] : d.file_power) out.emplace(FromKey(k), v);
+        return out;
+      })
+      .def_readonly("unit_findings", &workflows::MeasuredFrfs::unit_findings)
+      .def_property_readonly("noise", [](const workflows::MeasuredFrfs& d) {
+        std::map<KeyTuple, FrfNoise> out;
+        for (const auto& [k, v] : d.noise) out.emplace(FromKey(k), v);
+        return out;
+      }, "{(pose_id, response, excitation): FrfNoise}; empty for noise_model='none'")
+      .def_property_readonly("fit_data", &workflows::MeasuredFrfs::FitData,
+                             "the usable lines with sigma (all lines without a noise model): what the fits use")
+      .def("__repr__", [](const workflows::MeasuredFrfs& d) {
+        return "<MeasuredFrfs " + std::to_string(d.frfs.size()) + " FRFs, " + std::to_string(d.noise.size()) +
+               " noise models>";
+      });
+  m.def("read_measured_frfs",
+        [](const std::vector<std::string>& files, const std::map<std::string, std::string>& posed_files,
+           const std::string& default_pose, const std::string& noise_model, double min_snr, int averages,
+           bool drift_floor) {
+          for (const std::string& f : files) RequireReadableFile(f);
+          for (const auto& [pose, f] : posed_files) RequireReadableFile(f);
+          workflows::MeasuredFrfOptions o;
+          o.files = files;
+          for (const auto& [pose, f] : posed_files) o.posed_files.push_back({pose, f});
+          o.default_pose = default_pose;
+          o.pose_option = "posed_files";
+          o.noise_model = workflows::ParseNoiseModelChoice(noise_model);
+          o.min_snr = min_snr;
+          o.averages = averages;
+          o.drift_floor = drift_floor;
+          std::vector<std::pair<std::string, std::string>> said;
+          workflows::MeasuredFrfs out;
+          {
+            py::gil_scoped_release release;
+            out = workflows::ReadMeasuredFrfs(o, [&](const Message& msg) {
+              if (msg.kind == Message::Kind::kWarning) said.push_back({"warning", msg.text});
+            });
+          }
+          // The readers' and the noise model's warnings as Python warnings
+          // (a unit mistake as UnitWarning), as the tools print them.
+          for (const auto& [kind, text] : said) {
+            if (text.rfind("implausible (unit mistake?)", 0) == 0) {
+              WarnUnit(text);
+            } else if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) {
+              throw py::error_already_set();
+            }
+          }
+          return out;
+        },
+        py::arg("files"), py::arg("posed_files") = std::map<std::string, std::string>{},
+        py::arg("default_pose") = "", py::arg("noise_model") = "auto", py::arg("min_snr") = 3.0,
+        py::arg("averages") = 0, py::arg("drift_floor") = false,
+        "Reads hammer-test files (CSV of docs/formats.md §3 or UFF58) as frf-calibrate, model-audit and "
+        "frf-modes do: posed_files {pose_id: file.uff} for UFF records without a posture (default_pose "
+        "for every such file instead); noise_model 'auto', 'coherence', 'scatter' or 'none'; min_snr and "
+        "averages as --min-snr and --averages; drift_floor as --drift-floor. Returns MeasuredFrfs; "
+        "warnings (unit mistakes as UnitWarning) as the tools print them. FileNotFoundError for a missing "
+        "file, InputError for a bad one, ValueError for a bad option.");
 
   // The library's defaults, so that Python and frf-estimate cannot drift apart.
   const calibration::FrfEstimateOptions kEstimate;

@@ -179,3 +179,41 @@ def test_non_utf8_header_of_another_programs_uff_is_read():
     assert r['quantity'] == 'accelerance'
     assert len(r['frfs']) == 1
     assert any('\ufffd' in n and 'accelerance' in n for n in r['notes'])
+
+
+def test_read_measured_frfs_is_the_tools_route(tmp):
+    """read_measured_frfs (workflows/measured_frfs.h) against the same work
+    done call by call: the file read by read_frf_file, the noise model of
+    each FRF by estimate_noise with the file's averages, the usable lines by
+    usable_data."""
+    path = os.path.join(DATA, 'kr210_P1_receptance.csv')
+    m = rm.read_measured_frfs([path])
+    r = rm.read_frf_file(path)
+    assert sorted(m.frfs.keys()) == sorted(r['frfs'].keys())
+    assert all(f == path for f in m.file.values())
+    assert all(p == 0 for p in m.file_power.values()) and m.unit_findings == []
+    noise = rm.estimate_noise(r['frfs'], rm.NoiseOptions(averages=r['averages']))
+    assert set(m.noise) == set(noise)
+    for key, n in noise.items():
+        np.testing.assert_array_equal(m.noise[key].sigma_m_per_N, n.sigma_m_per_N)
+    u = rm.usable_data(r['frfs'], noise)
+    fit = m.fit_data
+    for key in u:
+        np.testing.assert_array_equal(fit[key].freq_hz, u[key].freq_hz)
+    # No noise model: every line.
+    none = rm.read_measured_frfs([path], noise_model='none')
+    assert none.noise == {} and all(len(none.fit_data[k]) == len(r['frfs'][k]) for k in r['frfs'].keys())
+    with pytest.raises(ValueError, match='min_snr'):
+        rm.read_measured_frfs([path], min_snr=0)
+    with pytest.raises(ValueError, match='noise model'):
+        rm.read_measured_frfs([path], noise_model='coherent')
+    with pytest.raises(FileNotFoundError):
+        rm.read_measured_frfs([str(tmp / 'absent.csv')])
+    # A response in mm under the m/N receptance: a UnitWarning, as the tools' exit 3.
+    mm_set = rm.FrfSet()
+    for k, f in r['frfs'].items():
+        mm_set[k] = rm.Frf(f.freq_hz, 1e3 * f.receptance)
+    rm.write_frf_csv(str(tmp / 'mm.csv'), mm_set)
+    with pytest.warns(rm.UnitWarning, match='implausible'):
+        mm = rm.read_measured_frfs([str(tmp / 'mm.csv')])
+    assert mm.unit_findings

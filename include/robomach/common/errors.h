@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace robomach {
 
@@ -43,6 +44,21 @@ class OutputError : public std::runtime_error {
 class NumericalError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+/// An option of a workflow (a field of an options struct) out of its
+/// bounds, or one the data cannot meet (issue #36: the validators name the
+/// field, its value and the bound). what() is the message; field() the
+/// struct's field, which a tool maps to its option (exit 64) and Python
+/// to its keyword argument (ValueError).
+class OptionError : public std::invalid_argument {
+ public:
+  OptionError(std::string field, const std::string& message)
+      : std::invalid_argument(message), field_(std::move(field)) {}
+  const std::string& field() const { return field_; }
+
+ private:
+  std::string field_;
 };
 
 }  // namespace robomach
