@@ -15,6 +15,9 @@
 // (defaults: config/kr210.yaml and config/postures_demo.csv of the source
 // tree). The model-audit tool runs this loop on measured files
 // (docs/model-audit.md); scripts/demo.sh runs it on the shipped demo data.
+// Ceres may log a line about a rank-deficient covariance on stderr (through
+// glog; the tools and the Python module silence it): the fits report their
+// own status.
 #include <cstdio>
 #include <exception>
 #include <limits>
@@ -87,12 +90,15 @@ int main(int argc, char** argv) try {
   }
 
   // 4. Add the named effect to the model and refit. The audit has done this
-  // fit already (audit.candidates[audit.best].fit); doing it by hand shows
-  // the calls a user makes with the next measurement campaign: switch the
-  // effect on, free its fittable parameters with the calibration ones, and
-  // fit the whole curve (log magnitude and phase, weighted by the noise).
-  // The measured modes (audit.features, from a modal fit of every FRF) are
-  // what a modal objective would match; the audit has them already.
+  // fit already (audit::CandidateModel(config.description,
+  // audit.candidates[audit.best]) is that model in one call); doing it by
+  // hand shows the calls a user makes with the next measurement campaign:
+  // switch the effect on, free its fittable parameters with the calibration
+  // ones, and fit the whole curve (log magnitude and phase, weighted by the
+  // noise). The fit starts from the calibrated model, whose m6 has taken up
+  // part of the missing tip mass; it gives it back. The measured modes
+  // (audit.features, a modal fit of every FRF) are what a modal objective
+  // would match; the audit has them already.
   const std::string effect = audit.missing_effects.front();
   auto [description, start] =
       rm::dynamics::WithEffect(config.description, audit.baseline_fit.parameters, effect);
@@ -109,12 +115,16 @@ int main(int argc, char** argv) try {
     std::printf("  %-22s %.4g %s (start %.4g)\n", e.name.c_str(), e.value, e.unit.c_str(), e.initial);
   }
 
-  // The errors over all lines of all FRFs, before (the configured model
+  // The rms log-magnitude errors over all lines of all FRFs (and per FRF
+  // in `curves`, per band in their `bands`), before (the configured model,
   // calibrated) and after (with the effect), in units of the noise.
   const double inf = std::numeric_limits<double>::infinity();
+  const rm::audit::ModelErrors before = rm::audit::ComputeErrors(
+      rm::dynamics::RobotModel::Build(config.description, audit.baseline_fit.parameters), postures, measured, 0.0,
+      inf, 8);
   const rm::audit::ModelErrors after = rm::audit::ComputeErrors(
       rm::dynamics::RobotModel::Build(description, refit.parameters), postures, measured, 0.0, inf, 8);
-  std::printf("error before: %.2f x the noise\n", audit.errors_before.total_rms_log_mag / audit.noise_floor);
+  std::printf("error before: %.2f x the noise\n", before.total_rms_log_mag / audit.noise_floor);
   std::printf("error after:  %.2f x the noise (with %s)\n", after.total_rms_log_mag / audit.noise_floor,
               effect.c_str());
   return 0;
