@@ -52,7 +52,7 @@ int main(int argc, char** argv) try {
   // At these defaults the cycloid's overlapping loops leave a removal about
   // twice as even (cv, the coefficient of variation) as the zig-zag's rows;
   // options.optimise = "nlopt" searches the spacing that makes either most
-  // even (seconds to a minute; polish-plan --optimise).
+  // even (up to options.max_time_s, 50 s by default; polish-plan --optimise).
   for (const char* pattern : {"cycloid", "parallel"}) {
     rm::polishing::PlanOptions options;
     options.pattern = pattern;         // "parallel" is the zig-zag, rows one contact width apart

@@ -85,6 +85,9 @@ int main(int argc, char** argv) try {
   zoa.min_spindle_speed_rad_s = cut.spindle_speed_min_rad_s;  // skip lobes that cannot reach the range
   const rm::stability::ZoaLobes lobes = rm::stability::ComputeZoaLobes(tip.freq_hz, tip.Phi_C, cut.process, zoa);
   // The lowest boundary over all lobes, sampled at the cut's speeds.
+  // stability::ComputeLobes (lobes_workflow.h) wraps this for many tips,
+  // adds the semi-discretization and its checks, and SummarizeLobes finds
+  // the extremes: what the stability-lobes tool calls.
   const std::vector<rm::stability::LobePoint> points = lobes.At(cut.SpeedGrid());
   const rm::stability::LobePoint* lowest = nullptr;
   for (const rm::stability::LobePoint& p : points) {
