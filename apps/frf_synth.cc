@@ -65,7 +65,7 @@ int Run(int argc, char** argv) {
   double fs_hz = NAN;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
-  app.add_option("--out", out_path, "output file: .csv (docs/formats.md §3) or .uff/.unv (UFF58 ASCII); '-' = stdout (CSV)")->required();
+  app.add_option("--out", out_path, "output file: .csv (docs/formats.md §3) or .uff/.unv (UFF58 ASCII); '-' = stdout (CSV); another extension is refused (exit 64)")->required();
   app.add_option("--summary", summary_path,
                  "summary JSON (docs/formats.md §4.1): inputs, grid, noise, per FRF its peak; '-' = stdout");
   app.add_option("--set", sets, "override a model parameter, NAME=VALUE in its unit (e.g. m6_kg=31.5)");
@@ -98,6 +98,15 @@ int Run(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   return RunGuarded(kTool, [&]() -> int {
+    // The format follows --out's extension: refuse one we do not write (a
+    // .png would get CSV text).
+    std::string ext = std::filesystem::path(out_path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const bool uff = ext == ".uff" || ext == ".unv" || ext == ".uf";
+    if (out_path != "-" && !uff && ext != ".csv") {
+      throw UsageError("--out " + out_path + ": expected a file name ending in .csv (the FRF CSV of docs/formats.md "
+                       "§3) or .uff, .unv (UFF58), or '-' for standard output (CSV)");
+    }
     CheckOptionRange("--block-samples", static_cast<double>(o.block_samples), 2, 1 << 22);
     CheckOptionRange("--averages", o.averages, o.coherence ? 2 : 1, 100000);
     if (o.relative_noise > kMaxRelativeNoise) {
@@ -198,9 +207,6 @@ int Run(int argc, char** argv) {
     for (const std::string& w : posture_units) Warn(kTool, w);
     const dynamics::FrfSet frfs = calibration::SynthesizeHammerTest(model, postures, o);
     const io::FrfQuantity q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
-    std::string ext = std::filesystem::path(out_path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    const bool uff = ext == ".uff" || ext == ".unv" || ext == ".uf";
     if (uff && out_path != "-") {
       if (o.coherence && o.averages > 1) {
         Warn(kTool, "UFF58 has no field for the number of averages: give --averages " +
