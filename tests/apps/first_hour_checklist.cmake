@@ -29,7 +29,10 @@ string(REPLACE "[3.3479e+6, 3.1318e+6, 4.2895e+6, 2.4787e+5, 6.4292e+5, 1.8847e+
 file(WRITE ${WORK}/kq_Nmm.yaml "${cfg}")
 # The spindle_toolholder_interface section with a taper diameter in mm, a
 # drawbar force in kN, a zero diameter, a billion elements; hammer_test's
-# sample rate in kHz.
+# sample rate in kHz. Each from the shipped config with one mistake (the
+# URDF by absolute path).
+file(READ ${SRC}/config/kr210.yaml cfg)
+string(REPLACE "urdf: kr210_r2700_2.urdf" "urdf: ${SRC}/config/kr210_r2700_2.urdf" cfg "${cfg}")
 string(REPLACE "taper_large_diameter_m: 0.024007" "taper_large_diameter_m: 24.007" c "${cfg}")
 file(WRITE ${WORK}/taper_mm.yaml "${c}")
 string(REPLACE "taper_large_diameter_m: 0.024007" "taper_large_diameter_m: 0" c "${cfg}")
