@@ -13,6 +13,7 @@
 
 #include "cli_support.h"
 #include "robomach/calibration/frf_estimate.h"
+#include "robomach/common/units.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/frf_files.h"
 #include "robomach/io/hammer_records.h"
@@ -122,7 +123,8 @@ int Run(int argc, char** argv) {
   app.add_option("--estimator", estimator, "h1 (noise on the response) or h2 (noise on the force)")
       ->check(CLI::IsMember({"h1", "h2"}))
       ->capture_default_str();
-  app.add_option("--fmax-hz", o.fmax_hz, "highest line written [Hz]; 0: sample rate / 2.56")->capture_default_str();
+  app.add_option("--fmax-hz", o.fmax_hz, "highest line written [Hz]; 0: sample rate / 2.56; above the Nyquist frequency (sample rate / 2): "
+                 "exit 64, as frf-synth")->capture_default_str();
   app.add_option("--force-window-s", o.force_window_s,
                  "force window length after the hit [s]; 0: automatic (3 pulse lengths + 32 samples); "
                  "negative: no force window")
@@ -133,7 +135,8 @@ int Run(int argc, char** argv) {
                  "cosine taper at each end of the force window [s]; 0: automatic (8 samples)")->capture_default_str();
   app.add_option("--exp-window-tau-s", o.exponential_tau_s,
                  "exponential window exp(-t/tau) from the hit on force and responses [s]; 0: none. Adds "
-                 "1/(tau*omega_n) to every damping ratio (recorded in the output; see the docs)")
+                 "1/(tau*omega_n) to every damping ratio (recorded in the output; see the docs); under 4 sample periods: "
+                 "exit 64")
       ->capture_default_str();
   app.add_option("--double-hit-fraction", o.double_hit_fraction,
                  "a force sample outside the main pulse above this fraction of its peak is a double hit [-]")
@@ -160,7 +163,13 @@ int Run(int argc, char** argv) {
   }
   return RunGuarded(kTool, [&]() -> int {
     CheckOptionRange("--min-hits", min_hits, 1, 1e6);
-    calibration::CheckValid(o);
+    const std::vector<FieldSource> fields = {
+        {"force_window_s", "--force-window-s"},       {"force_window_pre_s", "--force-window-pre-s"},
+        {"force_window_taper_s", "--force-window-taper-s"}, {"exponential_tau_s", "--exp-window-tau-s"},
+        {"fmax_hz", "--fmax-hz"},                     {"trigger_fraction", "--trigger-fraction"},
+        {"double_hit_fraction", "--double-hit-fraction"}, {"flat_top_samples", "--flat-top-samples"},
+        {"force_range_N", "--force-range-N"},         {"response_range", "--response-range"}};
+    ValidateOptions(fields, [&] { calibration::CheckValid(o); });
     const Axis exc = ParseAxisOption("--excitation", excitation);
     std::map<std::string, std::string> dir_given;
     for (const std::string& d : directions) {
@@ -194,6 +203,24 @@ int Run(int argc, char** argv) {
       o.response_range = io::ResponseRanges(rec, ranges);
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--response-range ") + e.what());
+    }
+    // Options that the records' sample rate decides (docs/frf-estimate.md).
+    const double fs = rec.hits.front().sample_rate_hz;
+    if (o.fmax_hz > 0.5 * fs) {
+      throw UsageError("--fmax-hz " + FormatNumber(o.fmax_hz, 7) + ": above the Nyquist frequency " +
+                       FormatNumber(0.5 * fs, 7) + " Hz of the records (sample rate " + FormatNumber(fs, 7) +
+                       " Hz): the highest line is at most fs/2 (0, the default: fs/2.56 = " +
+                       FormatNumber(fs / 2.56, 7) + " Hz)");
+    }
+    if (o.exponential_tau_s > 0.0 && o.exponential_tau_s < calibration::kMinExponentialWindowSamples / fs) {
+      const double f_hi = o.fmax_hz > 0.0 ? o.fmax_hz : fs / 2.56;
+      throw UsageError("--exp-window-tau-s " + FormatNumber(o.exponential_tau_s, 7) + ": shorter than " +
+                       FormatNumber(calibration::kMinExponentialWindowSamples, 3) + " sample periods (" +
+                       FormatNumber(calibration::kMinExponentialWindowSamples / fs, 3) + " s at " +
+                       FormatNumber(fs, 7) + " Hz): the window would add a damping ratio 1/(tau omega) of " +
+                       FormatNumber(1.0 / (o.exponential_tau_s * 2.0 * kPi * f_hi), 3) + " even at " +
+                       FormatNumber(f_hi, 6) + " Hz, more at lower lines; "
+                       "choose tau near the record length / 4.6 (docs/frf-estimate.md)");
     }
     std::cerr << kTool << ": " << rec.hits.size() << " hit(s) at " << FormatNumber(rec.hits.front().sample_rate_hz, 7)
               << " Hz; pose " << pose_id << ", excitation " << AxisName(exc) << ", responses";

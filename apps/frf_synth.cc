@@ -7,6 +7,7 @@
 #include <cctype>
 
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 
 #include "cli_support.h"
@@ -64,7 +65,7 @@ int Run(int argc, char** argv) {
   double fs_hz = NAN;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
-  app.add_option("--out", out_path, "output file: .csv (docs/formats.md §3) or .uff/.unv (UFF58 ASCII); '-' = stdout (CSV)")->required();
+  app.add_option("--out", out_path, "output file: .csv (docs/formats.md §3) or .uff/.unv (UFF58 ASCII); '-' = stdout (CSV); another extension is refused (exit 64)")->required();
   app.add_option("--summary", summary_path,
                  "summary JSON (docs/formats.md §4.1): inputs, grid, noise, per FRF its peak; '-' = stdout");
   app.add_option("--set", sets, "override a model parameter, NAME=VALUE in its unit (e.g. m6_kg=31.5)");
@@ -73,7 +74,7 @@ int Run(int argc, char** argv) {
   app.add_option("--sample-rate-hz", fs_hz, "sampling frequency [Hz]; default: the config's hammer_test.sample_rate_hz, else 5120");
   app.add_option("--block-samples", o.block_samples, "samples per record N; line spacing fs/N [Hz]")->capture_default_str();
   app.add_option("--fmin-hz", o.fmin_hz, "lowest line kept [Hz], > 0")->capture_default_str();
-  app.add_option("--fmax-hz", o.fmax_hz, "highest line kept [Hz]")->capture_default_str();
+  app.add_option("--fmax-hz", o.fmax_hz, "highest line kept [Hz], at most the Nyquist frequency fs/2 (above: exit 64)")->capture_default_str();
   app.add_option("--noise-rel", o.relative_noise, "relative noise, rms of complex Gaussian [-] (0.02 = 2 %)")->capture_default_str();
   app.add_option("--noise-abs-m-per-N", o.absolute_noise_m_per_N,
                  "additive noise floor flat in receptance, rms [m/N]")->capture_default_str();
@@ -97,6 +98,15 @@ int Run(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   return RunGuarded(kTool, [&]() -> int {
+    // The format follows --out's extension: refuse one we do not write (a
+    // .png would get CSV text).
+    std::string ext = std::filesystem::path(out_path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const bool uff = ext == ".uff" || ext == ".unv" || ext == ".uf";
+    if (out_path != "-" && !uff && ext != ".csv") {
+      throw UsageError("--out " + out_path + ": expected a file name ending in .csv (the FRF CSV of docs/formats.md "
+                       "§3) or .uff, .unv (UFF58), or '-' for standard output (CSV)");
+    }
     CheckOptionRange("--block-samples", static_cast<double>(o.block_samples), 2, 1 << 22);
     CheckOptionRange("--averages", o.averages, o.coherence ? 2 : 1, 100000);
     if (o.relative_noise > kMaxRelativeNoise) {
@@ -161,7 +171,33 @@ int Run(int argc, char** argv) {
     io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     ApplyAddsAndSets(adds, sets, &cfg);
     o.sample_rate_hz = std::isfinite(fs_hz) ? fs_hz : calibration::ConfiguredSampleRateHz(cfg.description);
-    calibration::CheckValid(o);
+    // The options through the library's check, named as the user gave them:
+    // the sample rate from the config is named with its file:line:col, and a
+    // band the config's rate cannot hold (--fmax-hz not given) is the
+    // config's mistake (65), not the command line's.
+    std::vector<FieldSource> fields = {
+        {"sample_rate_hz", "--sample-rate-hz"}, {"block_samples", "--block-samples"}, {"fmin_hz", "--fmin-hz"},
+        {"fmax_hz", "--fmax-hz"}, {"relative_noise", "--noise-rel"}, {"absolute_noise_m_per_N", "--noise-abs-m-per-N"},
+        {"absolute_noise_m_per_s_per_N", "--noise-abs-m-per-s-per-N"},
+        {"absolute_noise_m_per_s2_per_N", "--noise-abs-m-per-s2-per-N"}, {"hammer_cutoff_hz", "--hammer-cutoff-hz"},
+        {"averages", "--averages"}, {"directions", "--directions"}};
+    const auto fs_where = cfg.extra_value_locations.find("hammer_test.sample_rate_hz");
+    if (!std::isfinite(fs_hz) && fs_where != cfg.extra_value_locations.end()) {
+      fields[0] = {"sample_rate_hz", fs_where->second.ToString() + ": hammer_test.sample_rate_hz", true};
+      for (FieldSource& f : fields) {
+        if ((f.field == "fmax_hz" || f.field == "block_samples") && app.count(f.name) == 0) f.from_input = true;
+      }
+    }
+    try {
+      ValidateOptions(fields, [&] { calibration::CheckValid(o); });
+    } catch (const std::invalid_argument& e) {
+      // An implausible option (a rate in kHz) is the likely cause: say so.
+      std::string why;
+      for (const std::string& w : implausible) why += "; the likely cause, " + w;
+      if (why.empty()) throw;
+      if (dynamic_cast<const UsageError*>(&e)) throw UsageError(e.what() + why);
+      throw std::invalid_argument(e.what() + why);
+    }
     const auto model = cfg.Build();
     std::vector<calibration::NamedPosture> postures;
     std::vector<std::string> posture_units;  // radians under _deg headers, ...
@@ -171,9 +207,7 @@ int Run(int argc, char** argv) {
     for (const std::string& w : posture_units) Warn(kTool, w);
     const dynamics::FrfSet frfs = calibration::SynthesizeHammerTest(model, postures, o);
     const io::FrfQuantity q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
-    std::string ext = out_path.substr(out_path.find_last_of('.') + 1);
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == "uff" || ext == "unv" || ext == "uf") {
+    if (uff && out_path != "-") {
       if (o.coherence && o.averages > 1) {
         Warn(kTool, "UFF58 has no field for the number of averages: give --averages " +
                         std::to_string(o.averages) + " to the tools that read " + out_path);
@@ -190,7 +224,7 @@ int Run(int argc, char** argv) {
       j["sets"] = sets;
       j["adds"] = adds;
       j["out"] = out_path;
-      j["format"] = out_path != "-" && (ext == "uff" || ext == "unv" || ext == "uf") ? "uff58" : "csv";
+      j["format"] = out_path != "-" && uff ? "uff58" : "csv";
       j["quantity"] = quantity;
       j["sample_rate_hz"] = o.sample_rate_hz;
       j["block_samples"] = o.block_samples;

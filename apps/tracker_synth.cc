@@ -178,7 +178,8 @@ int Run(int argc, char** argv) {
         qs.push_back(p.q);
       }
     } else {
-      qs = identification::CampaignPostures(*model, num_postures, o, seed);
+      ValidateOptions({{"count", "--num-postures"}},
+                      [&] { qs = identification::CampaignPostures(*model, num_postures, o, seed); });
       for (size_t p = 0; p < qs.size(); ++p) ids.push_back("P" + std::to_string(p + 1));
     }
     std::vector<int> bad;

@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <filesystem>
 #include <mutex>
 #include <fstream>
@@ -231,6 +232,54 @@ void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& 
     if (::access(probe.c_str(), W_OK | X_OK) != 0) {
       throw OutputError(opt + " " + path + ": cannot be written: the folder " + probe.string() + " is not writable");
     }
+  }
+}
+
+void ValidateOptions(const std::vector<FieldSource>& fields, const std::function<void()>& check) {
+  try {
+    check();
+  } catch (const UsageError&) {
+    throw;
+  } catch (const std::invalid_argument& e) {
+    std::string msg = e.what();
+    // "VirtualHammerOptions: fmax_hz ..." or "FrfEstimateOptions::fmax_hz = ...": drop the C++ name.
+    size_t start = 0;
+    if (!msg.empty() && std::isupper(static_cast<unsigned char>(msg[0]))) {
+      size_t i = 0;
+      while (i < msg.size() && (std::isalnum(static_cast<unsigned char>(msg[i])) || msg[i] == '_')) ++i;
+      if (msg.compare(i, 2, "::") == 0) start = i + 2;
+      else if (msg.compare(i, 2, ": ") == 0) start = i + 2;
+    }
+    const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+    std::string out;
+    const FieldSource* first = nullptr;
+    for (size_t i = start; i < msg.size();) {
+      const FieldSource* hit = nullptr;
+      if (i == start || !word(msg[i - 1])) {
+        for (const FieldSource& f : fields) {
+          const size_t n = f.field.size();
+          if (msg.compare(i, n, f.field) == 0 && (i + n == msg.size() || !word(msg[i + n])) &&
+              (!hit || n > hit->field.size())) {
+            hit = &f;
+          }
+        }
+      }
+      if (!hit) {
+        out += msg[i++];
+        continue;
+      }
+      const bool leading = i == start;
+      if (!first) first = hit;
+      out += hit->name;
+      i += hit->field.size();
+      if (leading && msg.compare(i, 3, " = ") == 0) {  // "field = value: ..." -> "--option value: ..."
+        out += ' ';
+        i += 3;
+      }
+    }
+    if (!first) throw;
+    if (first->from_input) throw std::invalid_argument(out);
+    throw UsageError(out);
   }
 }
 

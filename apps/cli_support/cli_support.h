@@ -58,6 +58,27 @@ auto FromOption(const std::string& option, F&& parse) -> decltype(parse()) {
   }
 }
 
+/// Where a field of a library options struct got its value, for
+/// ValidateOptions: the command-line option ("--fmax-hz"), or an input file's
+/// key with its place ("kr210.yaml:70:19: hammer_test.sample_rate_hz").
+struct FieldSource {
+  std::string field;         // as the library's messages name it: "fmax_hz"
+  std::string name;          // what the user typed: "--fmax-hz"
+  bool from_input{false};    // the value came from an input file, not the command line
+};
+
+/// Runs a library options check (`calibration::CheckValid(o)`, ...): the
+/// one mechanism by which the tools validate their options. The library's
+/// std::invalid_argument names the failing field first ("VirtualHammerOptions:
+/// fmax_hz 500000: above the Nyquist frequency 2560 Hz of sample_rate_hz
+/// 5120"); the struct's name is dropped and every field of `fields` is
+/// written as its option ("--fmax-hz 500000: above the Nyquist frequency
+/// 2560 Hz of --sample-rate-hz 5120"). The first field named decides: an
+/// option makes it a UsageError (exit 64), an input file's key a
+/// std::invalid_argument (bad input, 65, with the file's place). A message
+/// that names none of `fields` is passed on as it came.
+void ValidateOptions(const std::vector<FieldSource>& fields, const std::function<void()>& check);
+
 /// Runs `body` and maps exceptions to exit codes with one message on stderr
 /// prefixed by the tool name: UsageError -> 64, NoInputError -> 66,
 /// InputError -> 65, OutputError -> 73, anything else -> 70. A library's

@@ -88,7 +88,7 @@ void CheckValid(const FrfEstimateOptions& o) {
   Require(o.trigger_fraction > 0.0 && o.trigger_fraction < 1.0, "trigger_fraction", o.trigger_fraction,
           "in (0, 1)");
   Require(o.double_hit_fraction >= o.trigger_fraction && o.double_hit_fraction < 1.0, "double_hit_fraction",
-          o.double_hit_fraction, "in [trigger_fraction, 1)");
+          o.double_hit_fraction, "in [trigger_fraction " + FormatNumber(o.trigger_fraction, 6) + ", 1)");
   Require(o.flat_top_samples >= 2, "flat_top_samples", o.flat_top_samples, ">= 2");
   Require(o.force_range_N >= 0.0 && std::isfinite(o.force_range_N), "force_range_N", o.force_range_N,
           ">= 0 [N] (0 = unknown)");
@@ -205,7 +205,15 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
   result.block_samples = n;
   const double df = fs / n;
   const double fmax = o.fmax_hz > 0.0 ? o.fmax_hz : fs / 2.56;
-  const int lines = std::min(n / 2, static_cast<int>(std::floor(fmax / df + 1e-9)));
+  // The line count in double before it becomes an int: fmax / df of 1e12 Hz
+  // would overflow one (seen: "fmax_hz 1e+12 is below the line spacing").
+  const double lines_wanted = std::floor(fmax / df + 1e-9);
+  const int lines = lines_wanted >= n / 2 ? n / 2 : static_cast<int>(lines_wanted);
+  if (fmax > 0.5 * fs * (1.0 + 1e-12)) {
+    result.warnings.push_back("fmax_hz " + FormatNumber(fmax, 6) + " is above the Nyquist frequency " +
+                              FormatNumber(0.5 * fs, 6) + " Hz of the records (sample rate " + FormatNumber(fs, 6) +
+                              " Hz): the lines stop there");
+  }
   if (lines < 1) throw std::invalid_argument("EstimateFrf: fmax_hz " + FormatNumber(fmax) + " is below the line spacing " + FormatNumber(df) + " Hz");
 
   // Pass 1: pulses, double hits and overloads.

@@ -6,6 +6,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -22,21 +23,45 @@ double Round13(double v) {
 
 }  // namespace
 
+// Each message starts with the field and its value, so that a tool can put
+// its option's name in the field's place (apps' ValidateOptions).
 void CheckValid(const VirtualHammerOptions& o) {
   auto fail = [](const std::string& m) { throw std::invalid_argument("VirtualHammerOptions: " + m); };
-  if (!(o.sample_rate_hz > 0.0)) fail("sample_rate_hz must be > 0");
-  if (o.block_samples < 2) fail("block_samples must be >= 2");
-  if (!(o.fmin_hz > 0.0)) fail("fmin_hz must be > 0 (the 0 Hz line is not measured)");
-  if (!(o.fmax_hz > o.fmin_hz)) fail("fmax_hz must be > fmin_hz");
-  if (o.fmax_hz > 0.5 * o.sample_rate_hz) fail("fmax_hz must not exceed the Nyquist frequency sample_rate_hz/2");
-  if (!(o.relative_noise >= 0.0) || !(o.absolute_noise_m_per_N >= 0.0) ||
-      !(o.absolute_noise_m_per_s_per_N >= 0.0) || !(o.absolute_noise_m_per_s2_per_N >= 0.0)) {
-    fail("noise levels must be >= 0");
+  const auto num = [](double v) { return FormatNumber(v, 7); };
+  if (!(o.sample_rate_hz > 0.0) || !std::isfinite(o.sample_rate_hz)) {
+    fail("sample_rate_hz " + num(o.sample_rate_hz) + ": expected a rate > 0 Hz");
   }
-  if (!(o.hammer_cutoff_hz >= 0.0) || !std::isfinite(o.hammer_cutoff_hz)) fail("hammer_cutoff_hz must be >= 0");
-  if (o.averages < 1) fail("averages must be >= 1");
-  if (o.coherence && o.averages < 2) fail("a coherence needs averages >= 2 (one impact's coherence is 1)");
-  if (o.directions.empty()) fail("no direction pairs");
+  if (o.block_samples < 2) fail("block_samples " + std::to_string(o.block_samples) + ": expected at least 2 samples");
+  if (!(o.fmin_hz > 0.0) || !std::isfinite(o.fmin_hz)) {
+    fail("fmin_hz " + num(o.fmin_hz) + ": expected a frequency > 0 Hz (the 0 Hz line is not measured)");
+  }
+  if (!(o.fmax_hz > o.fmin_hz) || !std::isfinite(o.fmax_hz)) {
+    fail("fmax_hz " + num(o.fmax_hz) + ": expected a frequency above fmin_hz " + num(o.fmin_hz) + " Hz");
+  }
+  if (o.fmax_hz > 0.5 * o.sample_rate_hz) {
+    fail("fmax_hz " + num(o.fmax_hz) + ": above the Nyquist frequency " + num(0.5 * o.sample_rate_hz) +
+         " Hz of sample_rate_hz " + num(o.sample_rate_hz));
+  }
+  const double df = o.sample_rate_hz / o.block_samples;
+  if (std::floor(o.fmax_hz / df + 1e-9) < std::ceil(o.fmin_hz / df - 1e-9)) {
+    fail("block_samples " + std::to_string(o.block_samples) + ": the line spacing sample_rate_hz / block_samples = " +
+         num(df) + " Hz leaves no line between fmin_hz " + num(o.fmin_hz) + " and fmax_hz " + num(o.fmax_hz) +
+         " Hz");
+  }
+  for (const auto& [name, v] : {std::pair{"relative_noise", o.relative_noise},
+                                std::pair{"absolute_noise_m_per_N", o.absolute_noise_m_per_N},
+                                std::pair{"absolute_noise_m_per_s_per_N", o.absolute_noise_m_per_s_per_N},
+                                std::pair{"absolute_noise_m_per_s2_per_N", o.absolute_noise_m_per_s2_per_N}}) {
+    if (!(v >= 0.0) || !std::isfinite(v)) fail(std::string(name) + " " + num(v) + ": expected a finite noise rms >= 0");
+  }
+  if (!(o.hammer_cutoff_hz >= 0.0) || !std::isfinite(o.hammer_cutoff_hz)) {
+    fail("hammer_cutoff_hz " + num(o.hammer_cutoff_hz) + ": expected a frequency >= 0 Hz (0: a flat force spectrum)");
+  }
+  if (o.averages < 1) fail("averages " + std::to_string(o.averages) + ": expected at least 1");
+  if (o.coherence && o.averages < 2) {
+    fail("averages " + std::to_string(o.averages) + ": a coherence needs at least 2 (one impact's coherence is 1)");
+  }
+  if (o.directions.empty()) fail("directions: no direction pair given");
 }
 
 double ConfiguredSampleRateHz(const dynamics::RobotDescription& description, double fallback) {

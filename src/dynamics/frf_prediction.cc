@@ -53,6 +53,21 @@ FrfPredictionResult PredictFrfs(const std::shared_ptr<const RobotModel>& model,
           << "); the FRF is computed in joint space and stays valid, but the Cartesian M, K, C are not reported";
       result.Flag(msg.str(), static_cast<int>(p));
     }
+    {
+      int rigid = 0;
+      for (const Mode& m : out.dynamics.modes) {
+        if (!(m.freq_hz >= kMinPredictedModeHz)) ++rigid;
+      }
+      if (rigid > 0) {
+        std::ostringstream msg;
+        msg << "posture " << pose.id << ": " << rigid << " mode(s) at " << out.dynamics.modes.front().freq_hz
+            << " Hz (below " << kMinPredictedModeHz
+            << " Hz): the stiffness matrix is singular, a part of the model is held by no spring (an effect's "
+               "stiffness made negligible, e.g. by a unit mistake in its config section); the FRF is that of a "
+               "free body";
+        result.Flag(msg.str(), static_cast<int>(p));
+      }
+    }
     out.H = ReceptanceBy(options.method, out.dynamics, freq_hz);
     for (const auto& h : out.H) {
       if (!h.allFinite()) throw std::runtime_error("non-finite receptance at posture " + pose.id);

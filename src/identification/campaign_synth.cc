@@ -30,7 +30,9 @@ std::vector<Eigen::VectorXd> CampaignPostures(const dynamics::RobotModel& model,
   std::mt19937 rng(seed);
   std::vector<Eigen::VectorXd> out;
   const double margin = DegToRad(5.0);
-  for (int tries = 0; tries < 100000 && static_cast<int>(out.size()) < count; ++tries) {
+  constexpr int kTries = 100000;
+  int tries = 0;
+  for (; tries < kTries && static_cast<int>(out.size()) < count; ++tries) {
     Eigen::VectorXd q(n);
     for (int j = 0; j < n; ++j) {
       double lo = -kPi, hi = kPi;
@@ -59,8 +61,11 @@ std::vector<Eigen::VectorXd> CampaignPostures(const dynamics::RobotModel& model,
     if (ok) out.push_back(q);
   }
   if (static_cast<int>(out.size()) < count) {
-    throw std::invalid_argument("CampaignPostures: found only " + std::to_string(out.size()) +
-                                " postures that reach every pulley within 60 degrees of vertical");
+    // The count first, so that a tool can name its option in its place.
+    throw std::invalid_argument("count " + std::to_string(count) + ": only " + std::to_string(out.size()) + " of " +
+                                std::to_string(tries) +
+                                " random postures reach every pulley within 60 degrees of vertical; ask for at most " +
+                                std::to_string(out.size()) + ", or place the pulleys elsewhere");
   }
   return out;
 }

@@ -151,11 +151,12 @@ kinematics::SerialChain ReadDh(const YamlDoc& dh, std::vector<std::string>* impl
 }
 
 void ReadNumericSection(const YamlDoc& section, const std::string& prefix,
-                        std::map<std::string, double>* out) {
+                        std::map<std::string, double>* out, std::map<std::string, SourceLocation>* where) {
   for (const std::string& key : section.Keys()) {
     const YamlDoc v = section[key];
     if (v.IsSequence()) continue;  // lists such as hammer_test.directions are informational
     (*out)[prefix + "." + key] = v.Number();
+    (*where)[prefix + "." + key] = v.location();
   }
 }
 
@@ -183,6 +184,87 @@ std::string Also(const std::vector<std::string>& findings) {
   std::string s;
   for (const std::string& f : findings) s += "; the likely cause, " + f;
   return s;
+}
+
+// The keys of `spindle_toolholder_interface` (docs/plausibility.md): a value
+// no holder can have is refused here, with file:line:col (the library's
+// check would name neither the place nor, for a zero diameter, the key); a
+// value outside the plausible range of holders (a diameter in mm under an
+// `_m` key, a drawbar force in kN) is a finding: the tool flags its result.
+void CheckSpindleInterface(const YamlDoc& section, std::vector<std::string>* implausible) {
+  struct Rule {
+    const char* key;
+    double impossible_below;  // refused at or below (or below, see `strict`)
+    bool strict;              // true: value <= bound refused; false: value < bound
+    const char* expected;
+    PlausibleRange range;
+  };
+  const Rule rules[] = {
+      {"friction_coefficient", 0.0, false, "a friction coefficient >= 0",
+       {0.0, kMaxPlausibleFrictionCoefficient, "", "holder-spindle contacts (dry steel on steel 0.1 - 0.8)", "",
+        "a percentage typed for a coefficient (15 for 0.15)?"}},
+      {"alpha_prime", 0.0, true, "Yoshimura's alpha' > 0 (k_n = alpha' p^beta', p in Pa, k_n in N/m³)",
+       {kMinPlausibleYoshimuraAlpha, kMaxPlausibleYoshimuraAlpha, "", "Yoshimura's alpha' with p in Pa (the seed's 3.26e6)",
+        "alpha' for a pressure in MPa or k_n in N/mm³?", "alpha' for a pressure in kPa or k_n per mm²?"}},
+      {"beta_prime", 0.0, false, "Yoshimura's exponent beta' >= 0",
+       {kMinPlausibleYoshimuraBeta, kMaxPlausibleYoshimuraBeta, "", "Yoshimura's exponent of machined joints (0.3 - 1)",
+        "the exponent of another law?", "alpha' and beta' swapped, or a percentage?"}},
+      {"tangential_to_normal", 0.0, true, "a ratio > 0",
+       {kMinPlausibleTangentialToNormal, kMaxPlausibleTangentialToNormal, "", "contact stiffness ratios (the seed's 0.5)",
+        "a ratio inverted?", "a percentage typed for a ratio (50 for 0.5)?"}},
+      {"drawbar_force_N", 0.0, true, "a clamping force > 0 N",
+       {kMinPlausibleDrawbarForceN, kMaxPlausibleDrawbarForceN, "N",
+        "spindle drawbars (3 kN for HSK-E25 to 60 kN for SK/BT 50)", "a force in kN typed in the N field?",
+        "a force in mN, or in N x 1000?"}},
+      {"taper_large_diameter_m", 0.0, true, "a diameter > 0 m",
+       {kMinPlausibleTaperDiameterM, kMaxPlausibleTaperDiameterM, "m",
+        "HSK, SK and BT holders (19 - 120 mm: HSK-25 to HSK-160, SK/BT 30 - 60)", "a radius, or a diameter in km?",
+        "a diameter in mm typed in the m field?"}},
+      {"taper_length_m", 0.0, true, "a length > 0 m",
+       {kMinPlausibleTaperLengthM, kMaxPlausibleTaperLengthM, "m", "holder tapers (10 - 170 mm)", "",
+        "a length in mm typed in the m field?"}},
+      {"taper_ratio", 0.0, true, "a diameter change per length > 0 (HSK 1:10 = 0.1, SK/BT 7:24 = 0.29)",
+       {kMinPlausibleTaperRatio, kMaxPlausibleTaperRatio, "", "holder tapers (HSK 0.1, SK/BT 7:24 = 0.29)",
+        "a ratio in percent of a percent?", "the ratio inverted (10 for 1:10) or an angle in degrees?"}},
+  };
+  for (const Rule& r : rules) {
+    if (!section.Has(r.key)) continue;
+    const YamlDoc node = section[r.key];
+    const double v = node.Number();
+    if (r.strict ? !(v > r.impossible_below) : !(v >= r.impossible_below)) {
+      throw node.Error(std::string("expected ") + r.expected + ", got " + node.String());
+    }
+    CheckPlausible(node, v, r.range, implausible);
+  }
+  if (section.Has("elements")) {
+    const YamlDoc node = section["elements"];
+    const double v = node.Number();
+    if (!(v >= 1.0 && v <= kMaxTaperElements) || v != std::floor(v)) {
+      throw node.Error("expected a whole number of taper rings in [1, " + std::to_string(kMaxTaperElements) +
+                       "] (the seed: 6), got " + node.String());
+    }
+  }
+  // The taper must keep a small diameter: D - ratio L > 0.
+  if (section.Has("taper_ratio") && section.Has("taper_length_m") && section.Has("taper_large_diameter_m")) {
+    const YamlDoc ratio = section["taper_ratio"];
+    const double L = section["taper_length_m"].Number(), D = section["taper_large_diameter_m"].Number();
+    if (!(ratio.Number() * L < D)) {
+      throw ratio.Error("the taper's small diameter taper_large_diameter_m - taper_ratio x taper_length_m = " +
+                        FormatDouble(D) + " - " + ratio.String() + " x " + FormatDouble(L) + " m is not > 0" +
+                        Also(*implausible));
+    }
+  }
+}
+
+void CheckHammerTest(const YamlDoc& section, std::vector<std::string>* implausible) {
+  if (!section.Has("sample_rate_hz")) return;
+  const YamlDoc node = section["sample_rate_hz"];
+  if (!(node.Number() > 0.0)) throw node.Error("expected a sample rate > 0 Hz, got " + node.String());
+  CheckPlausible(node, node.Number(),
+                 {kMinPlausibleHammerSampleRateHz, kMaxPlausibleHammerSampleRateHz, "Hz",
+                  "hammer-test acquisition (1 - 200 kHz; the seed's 5120 Hz)", "a rate in kHz typed in the Hz field?",
+                  "a rate in mHz typed in the Hz field?"},
+                 implausible);
 }
 
 // The decoupled frequency of each joint, f_j = sqrt(kq_j / M_q(j,j)) / 2 pi,
@@ -394,9 +476,13 @@ RobotConfig LoadRobotConfig(const std::string& path) {
   ee.RejectUnknownKeys();
 
   for (const char* section : {"spindle_toolholder_interface", "hammer_test"}) {
-    if (doc.Has(section)) ReadNumericSection(doc[section], section, &d.extra_values);
+    if (doc.Has(section)) ReadNumericSection(doc[section], section, &d.extra_values, &cfg.extra_value_locations);
     doc.MarkUsed(section);
   }
+  if (doc.Has("spindle_toolholder_interface")) {
+    CheckSpindleInterface(doc["spindle_toolholder_interface"], &cfg.implausible);
+  }
+  if (doc.Has("hammer_test")) CheckHammerTest(doc["hammer_test"], &cfg.implausible);
 
   if (doc.Has("effects")) {
     const YamlDoc effects = doc["effects"];

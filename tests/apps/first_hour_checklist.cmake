@@ -27,6 +27,22 @@ string(REPLACE "mass_kg: -22.0" "mass_kg: 22.0" cfg "${cfg}")
 string(REPLACE "[3.3479e+6, 3.1318e+6, 4.2895e+6, 2.4787e+5, 6.4292e+5, 1.8847e+5]"
                "[3.3479e+9, 3.1318e+9, 4.2895e+9, 2.4787e+8, 6.4292e+8, 1.8847e+8]" cfg "${cfg}")
 file(WRITE ${WORK}/kq_Nmm.yaml "${cfg}")
+# The spindle_toolholder_interface section with a taper diameter in mm, a
+# drawbar force in kN, a zero diameter, a billion elements; hammer_test's
+# sample rate in kHz. Each from the shipped config with one mistake (the
+# URDF by absolute path).
+file(READ ${SRC}/config/kr210.yaml cfg)
+string(REPLACE "urdf: kr210_r2700_2.urdf" "urdf: ${SRC}/config/kr210_r2700_2.urdf" cfg "${cfg}")
+string(REPLACE "taper_large_diameter_m: 0.024007" "taper_large_diameter_m: 24.007" c "${cfg}")
+file(WRITE ${WORK}/taper_mm.yaml "${c}")
+string(REPLACE "taper_large_diameter_m: 0.024007" "taper_large_diameter_m: 0" c "${cfg}")
+file(WRITE ${WORK}/taper_zero.yaml "${c}")
+string(REPLACE "drawbar_force_N: 5000 " "drawbar_force_N: 5 " c "${cfg}")
+file(WRITE ${WORK}/drawbar_kN.yaml "${c}")
+string(REPLACE "elements: 6 " "elements: 1000000000 " c "${cfg}")
+file(WRITE ${WORK}/elements_huge.yaml "${c}")
+string(REPLACE "sample_rate_hz: 5120" "sample_rate_hz: 5.12" c "${cfg}")
+file(WRITE ${WORK}/fs_kHz.yaml "${c}")
 file(READ ${SRC}/config/drilling/planar3r.yaml cfg)
 string(REPLACE "rotor_inertia_kgm2: 1.98e-4" "rotor_inertia_kgm2: 1.98" cfg "${cfg}")
 file(WRITE ${WORK}/planar3r_kgcm2.yaml "${cfg}")

@@ -66,3 +66,26 @@ set_tests_properties(frf_estimate.leakage frf_estimate.exponential_window
                      frf_estimate.defaults frf_estimate.too_few_hits frf_estimate.all_rejected
                      frf_estimate.bad_number frf_estimate.missing_file frf_estimate.unknown_direction
                      PROPERTIES FIXTURES_REQUIRED frf_estimate_records)
+# Bad option values are bad command lines (64) named by their option, not
+# "bad input: FrfEstimateOptions::..."; an fmax above the records' Nyquist
+# frequency is refused as frf-synth refuses it (1e12 once overflowed the
+# line count: "is below the line spacing"); an exponential window shorter
+# than 4 sample periods is refused with the damping bias it would add.
+set(est_option_tests "")
+function(est_option_test name words)
+  robomach_app_test(frf_estimate.option_${name} RC 64
+    CMD $<TARGET_FILE:frf-estimate> ${EST_TMP}/records/hits.csv --out ${EST_TMP}/opt_${name}.csv ${ARGN}
+    NO_FILES ${EST_TMP}/opt_${name}.csv
+    STDERR "frf-estimate: ${words}")
+  set(est_option_tests ${est_option_tests} frf_estimate.option_${name} PARENT_SCOPE)
+endfunction()
+est_option_test(fmax_1e12 "--fmax-hz 1e\\+12: above the Nyquist frequency 512 Hz of the records" --fmax-hz 1e12)
+est_option_test(fmax_1e308 "--fmax-hz 1e\\+308: above the Nyquist frequency 512 Hz" --fmax-hz 1e308)
+est_option_test(fmax_1e6 "--fmax-hz 1000000: above the Nyquist frequency 512 Hz" --fmax-hz 1e6)
+est_option_test(fmax_negative "--fmax-hz -5: expected >= 0" --fmax-hz -5)
+est_option_test(double_hit_fraction "--double-hit-fraction 10: expected in .--trigger-fraction" --double-hit-fraction 10)
+est_option_test(tau_negative "--exp-window-tau-s -1: expected >= 0" --exp-window-tau-s -1)
+est_option_test(tau_below_a_sample
+  "--exp-window-tau-s 1e-09: shorter than 4 sample periods .*damping ratio 1/.tau omega. of [0-9.e+]+ even at 400 Hz"
+  --exp-window-tau-s 1e-9)
+set_tests_properties(${est_option_tests} PROPERTIES FIXTURES_REQUIRED frf_estimate_records)

@@ -25,6 +25,7 @@ using testing::HammerSimulator;
 using testing::HitSpec;
 using testing::ThreeDofChain;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // Six good hits of different strength and timing, then a double hit (a
 // rebound 12 ms later at 45 % of the peak) and a hit that clips the
@@ -386,6 +387,35 @@ TEST(FrfEstimate, PrimeLengthIsCutToAFastLength) {
     worst = std::max(worst, std::abs(r.channels[0].h1(k) - h) / std::abs(h));
   }
   EXPECT_LT(worst, 0.02);
+}
+
+// An fmax far above the Nyquist frequency (1e12, 1e20, 1e308 Hz) once
+// overflowed the int line count into "fmax_hz 1e+12 is below the line
+// spacing": the lines stop at fs/2 and the result says why.
+TEST(FrfEstimate, HugeFmaxStopsAtNyquistWithAWarning) {
+  const ThreeDofChain sys = ThreeDofChain::Default();
+  AcquisitionSpec acq;
+  acq.samples = 4096;
+  acq.force_noise_N = acq.disp_noise_m = acq.acc_noise_m_per_s2 = 0.0;
+  std::mt19937 rng(5);
+  HammerSimulator sim(sys, acq);
+  std::vector<ImpactRecord> hits;
+  for (int i = 0; i < 3; ++i) hits.push_back(sim.Simulate(HitSpec{}, &rng, std::to_string(i + 1)));
+  for (const double fmax : {1e6, 1e12, 1e20, 1e308}) {
+    FrfEstimateOptions o;
+    o.fmax_hz = fmax;
+    const FrfEstimateResult r = EstimateFrf(hits, testing::SimulatedChannels(), o);
+    ASSERT_EQ(r.freq_hz.size(), 2048) << fmax;  // 1 .. 2048 Hz = fs/2
+    EXPECT_DOUBLE_EQ(r.freq_hz(r.freq_hz.size() - 1), 2048.0);
+    bool named = false;
+    for (const std::string& w : r.warnings) named |= w.find("above the Nyquist frequency 2048 Hz") != std::string::npos;
+    EXPECT_TRUE(named) << fmax;
+  }
+  FrfEstimateOptions o;
+  o.fmax_hz = 2048.0;  // exactly Nyquist: no warning
+  for (const std::string& w : EstimateFrf(hits, testing::SimulatedChannels(), o).warnings) {
+    EXPECT_THAT(w, Not(HasSubstr("Nyquist")));
+  }
 }
 
 // One or two averaged hits: the coherence cannot mean much, and the result

@@ -124,6 +124,12 @@ const std::vector<WrongUnitCase>& Cases() {
       {"robot_config", "config/kr210.yaml", "d6_m", 0, 1000, Expect::kRefused, "a value in mm typed in the m field"},
       {"robot_config", "config/kr210_dh.yaml", "a_prev_m", 1, 1000, Expect::kFlagged, "a_prev_m 330 m .*a length in mm typed in the m field"},
       {"robot_config", "config/kr210_dh.yaml", "d_m", 0, 1000, Expect::kFlagged, "d_m -645 m .*a length in mm typed in the m field"},
+      // its spindle_toolholder_interface (the spindle_interface effect) and hammer_test sections
+      {"robot_config", "config/kr210.yaml", "taper_large_diameter_m", 0, 1000, Expect::kFlagged, "kr210.yaml:\\d+:\\d+: spindle_toolholder_interface.taper_large_diameter_m 24.007 m .*a diameter in mm typed in the m field"},
+      {"robot_config", "config/kr210.yaml", "taper_length_m", 0, 1000, Expect::kRefused, "taper_ratio.*small diameter.*not > 0.*the likely cause.*taper_length_m 16 m .*a length in mm typed in the m field"},
+      {"robot_config", "config/kr210.yaml", "drawbar_force_N", 0, 1e-3, Expect::kFlagged, "drawbar_force_N 5 N .*a force in kN typed in the N field"},
+      {"robot_config", "config/kr210.yaml", "friction_coefficient", 0, 100, Expect::kFlagged, "friction_coefficient 15 .*a percentage typed"},
+      {"robot_config", "config/kr210.yaml", "sample_rate_hz", 0, 1e-3, Expect::kFlagged, "hammer_test.sample_rate_hz 5.12 Hz .*a rate in kHz typed in the Hz field"},
       // drill-sim's flexible-joint robot (config/drilling/planar3r.yaml)
       {"flexible_robot", "config/drilling/planar3r.yaml", "mass_kg", 0, 1000, Expect::kFlagged, "mass_kg 6000 kg .*a mass in g typed in the kg field"},
       {"flexible_robot", "config/drilling/planar3r.yaml", "a_prev_m", 1, 1000, Expect::kFlagged, "a_prev_m 600 m .*a length in mm typed in the m field"},

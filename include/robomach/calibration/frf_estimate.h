@@ -46,6 +46,12 @@
 
 namespace robomach::calibration {
 
+/// The shortest exponential window frf-estimate accepts, in sample periods:
+/// below, the window is gone within a few samples of the hit and the FRF is
+/// that of the pulse alone; its damping bias 1/(τ ω) is 0.16 x fs / f, at
+/// least 0.32 (= 1/(2 pi x 0.5 x 4)) at the Nyquist frequency.
+inline constexpr double kMinExponentialWindowSamples = 4.0;
+
 struct FrfEstimateOptions {
   /// Force window: 1 on [t_hit − pre, t_hit + width], cosine tapers of
   /// `force_window_taper_s` on both sides, 0 elsewhere. t_hit is the first
@@ -60,8 +66,12 @@ struct FrfEstimateOptions {
   double force_window_pre_s{0.0};      // [s]
   double force_window_taper_s{0.0};    // [s]
   /// Exponential window time constant τ [s]; 0 = no exponential window.
+  /// It adds ≈ 1/(τ ω) to the damping ratio of a mode at ω: frf-estimate
+  /// refuses τ under kMinExponentialWindowSamples sample periods (exit 64).
   double exponential_tau_s{0.0};
   /// Highest line written [Hz]; 0 = fs / 2.56 (the usual anti-aliasing ratio).
+  /// Above the Nyquist frequency fs / 2 the lines stop at fs / 2 and the
+  /// result has a warning (frf-estimate refuses such a --fmax-hz, exit 64).
   double fmax_hz{0.0};
   /// The pulse starts and ends where |force| crosses this fraction of the
   /// peak.

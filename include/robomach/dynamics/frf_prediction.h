@@ -44,6 +44,10 @@ struct PosturePredictionResult {
   std::vector<int> joints_outside_limits;  // 0-based
 };
 
+/// A mode below this is a rigid-body mode: no robot-held tool has one (robot
+/// modes start at a few Hz; docs/plausibility.md's joint frequencies >= 1 Hz).
+inline constexpr double kMinPredictedModeHz = 0.01;
+
 struct FrfPredictionResult : RunFindings {
   std::vector<PosturePredictionResult> postures;  // in the order given
 };
@@ -51,7 +55,10 @@ struct FrfPredictionResult : RunFindings {
 /// Evaluates `model` at each posture and its receptance at `freq_hz`
 /// (finite, >= 0). Findings (input_index = the posture's index): each joint
 /// outside its limits, each posture near a singularity (the FRF, in joint
-/// space, stays valid; the Cartesian M, K, C do not).
+/// space, stays valid; the Cartesian M, K, C do not), each posture with a
+/// mode below kMinPredictedModeHz (a singular stiffness: a spring of the
+/// model that holds nothing, e.g. an interface stiffness made negligible by
+/// a unit mistake; its FRF is that of a free body).
 /// @throws std::invalid_argument for a non-finite frequency or a posture of
 ///   the wrong size; std::runtime_error for a non-finite receptance.
 FrfPredictionResult PredictFrfs(const std::shared_ptr<const RobotModel>& model,

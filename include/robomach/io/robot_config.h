@@ -1,9 +1,11 @@
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "robomach/common/errors.h"
 #include "robomach/dynamics/parameters.h"
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/io/yaml_doc.h"
@@ -19,6 +21,10 @@ struct RobotConfig {
   /// its plausible range below (docs/plausibility.md): a tool prints them and
   /// flags its result (exit 3).
   std::vector<std::string> implausible;
+  /// Where each of `description.extra_values` was typed (the numbers of
+  /// `spindle_toolholder_interface` and `hammer_test`), so that a tool that
+  /// refuses one of them can name its file:line:col.
+  std::map<std::string, SourceLocation> extra_value_locations;
   std::shared_ptr<const dynamics::RobotModel> Build() const {
     return dynamics::RobotModel::Build(description, parameters);
   }
@@ -46,6 +52,44 @@ inline constexpr double kMinPlausibleJointFrequencyHz = 1.0;
 inline constexpr double kMaxPlausibleJointFrequencyHz = 2000.0;
 /// Rayleigh damping ratio (alpha w + beta / w) / 2 at each joint frequency.
 inline constexpr double kMaxPlausibleDampingRatio = 0.5;
+
+// Plausible ranges of the `spindle_toolholder_interface` section (the
+// spindle_interface effect, docs/model.md) and of `hammer_test`. Practice:
+// hollow-taper holders HSK-25 to HSK-160 (ISO 12164-1, DIN 69893: taper
+// large diameters 19 - 120 mm, taper lengths about 10 - 80 mm, taper 1:10)
+// and steep-taper holders SK/BT/CAT 30 - 60 (ISO 7388-1, JIS B 6339: large
+// diameters 31.75 - 107.95 mm, tapers up to about 170 mm long, taper 7:24 =
+// 0.29); drawbar (clamping) forces of spindles from about 3 kN (HSK-E25) to
+// 45 kN (HSK-A100) and 25 - 60 kN (SK/BT 50) by clamping-unit catalogues
+// (OTT-JAKOB, Roehm; figures recalled, not re-checked); Yoshimura's
+// unit-area law k_n = alpha' p^beta' (p in Pa, k_n in N/m³): beta' 0.3 - 1
+// for machined steel joints, the seed's alpha' 3.3e6 with beta' 0.604
+// (Yoshimura, "Computer-aided design improvement of machine tool structure
+// incorporating joint dynamics data", CIRP Annals 28/1 (1979)); dry steel
+// on steel friction 0.1 - 0.8 (Machinery's Handbook, 30th ed., friction
+// tables); hammer-test acquisition at 1 - 200 kHz (the seed's 5120 Hz).
+// A taper diameter or length in mm under its `_m` key is 1000 times the
+// range, a drawbar force in kN 1000 times below it.
+inline constexpr double kMinPlausibleTaperDiameterM = 0.01;
+inline constexpr double kMaxPlausibleTaperDiameterM = 0.2;
+inline constexpr double kMinPlausibleTaperLengthM = 0.005;
+inline constexpr double kMaxPlausibleTaperLengthM = 0.2;
+/// Diameter change per length: 1:50 to 1:1 (HSK 0.1, SK/BT 7:24 = 0.29).
+inline constexpr double kMinPlausibleTaperRatio = 0.02;
+inline constexpr double kMaxPlausibleTaperRatio = 1.0;
+inline constexpr double kMinPlausibleDrawbarForceN = 500.0;
+inline constexpr double kMaxPlausibleDrawbarForceN = 1e6;
+inline constexpr double kMaxPlausibleFrictionCoefficient = 2.0;
+inline constexpr double kMinPlausibleYoshimuraAlpha = 1e3;   // alpha' [N/m³ per Pa^beta']
+inline constexpr double kMaxPlausibleYoshimuraAlpha = 1e10;
+inline constexpr double kMinPlausibleYoshimuraBeta = 0.1;
+inline constexpr double kMaxPlausibleYoshimuraBeta = 1.5;
+inline constexpr double kMinPlausibleTangentialToNormal = 0.05;
+inline constexpr double kMaxPlausibleTangentialToNormal = 2.0;
+/// `elements` (rings of the taper): refused outside [1, kMaxTaperElements].
+inline constexpr int kMaxTaperElements = 1000;
+inline constexpr double kMinPlausibleHammerSampleRateHz = 100.0;
+inline constexpr double kMaxPlausibleHammerSampleRateHz = 1e6;
 
 /// Reads a robot config (see config/kr210.yaml for the documented schema):
 /// `robot:` with `urdf`, `base_link`, `tip_frame` (and optional
