@@ -11,7 +11,7 @@ AcquisitionInputs ReadAcquisitionInputs(const std::string& machine_path, const s
                                         const std::string& program_path) {
   AcquisitionInputs in;
   in.machine = ReadMachineFile(machine_path);
-  if (!compensation_path.empty()) in.tables = ReadCompensationFile(compensation_path, in.machine);
+  if (!compensation_path.empty()) in.tables = ReadCompensationFile(compensation_path, in.machine, "--compensation");
   if (!temperature_path.empty()) in.temperatures = ReadTemperatureLog(temperature_path, in.machine, &in.temperature_implausible);
   in.compensation = std::make_unique<machine::Compensation>(static_cast<int>(in.machine.machine.axes.size()),
                                                             in.tables.encoder, in.tables.cross_axis, in.temperatures);

@@ -101,6 +101,35 @@ TEST(CompensationFile, TheDefaultFileReads) {
   EXPECT_EQ(t.cross_axis.size(), 2u);
 }
 
+// A file of another kind given as the tables was read as "no assignments"
+// and the acquisition ran uncompensated with exit 0. Each is now named as
+// what it is (io::SniffFileKind), and a text without a single table
+// assignment is refused: it holds nothing to compensate with.
+TEST(CompensationFile, AFileOfAnotherKindOrWithoutTablesIsNamedNotIgnored) {
+  const MachineFile m = DefaultMachine();
+  const auto error = [&](const std::string& path, const std::string& option = "") {
+    return CaptureError([&] { ReadCompensationFile(path, m, option); });
+  };
+  const std::string temperature = error(SourcePath("config/machine/dmu80p_temperature.csv"), "--compensation");
+  EXPECT_THAT(temperature, HasSubstr("dmu80p_temperature.csv: this is a CSV table; --compensation expects the Siemens "
+                                     "compensation tables"));
+  EXPECT_THAT(temperature, HasSubstr("docs/formats.md §8.4"));
+  EXPECT_THAT(temperature, HasSubstr("(its columns are those of the temperature log of docs/formats.md §8.4)"));
+  EXPECT_THAT(error(SourcePath("docs/img/stability-map.png")), HasSubstr("stability-map.png: this is a PNG image; expected "
+                                                                         "the Siemens compensation tables"));
+  EXPECT_THAT(error(SourcePath("config/machine/dmu80p.yaml")), HasSubstr("this is a YAML file"));
+  const std::string dir = TempDir("comp_other_kinds");
+  EXPECT_THAT(error(WriteText(dir + "/hello.txt", "\nhello world\n"), "--compensation"),
+              HasSubstr("hello.txt:2: this is a text file without a single $AA_ENC_COMP or $AN_CEC table assignment; "
+                        "--compensation expects the Siemens compensation tables"));
+  EXPECT_THAT(error(WriteText(dir + "/hello.txt", "\nhello world\n")), HasSubstr("(this line is \"hello world\")"));
+  // A part program of other variables is an MPF, but holds no table.
+  EXPECT_THAT(error(WriteText(dir + "/other.mpf", "%_N_OTHER_MPF\n$MA_SOMETHING[AX1]=3\nM30\n")),
+              HasSubstr("other.mpf:1: this is a Siemens MPF file (a part program or table archive of the control) "
+                        "without a single $AA_ENC_COMP or $AN_CEC table assignment"));
+  EXPECT_THAT(error(WriteText(dir + "/empty.mpf", "")), HasSubstr("this is an empty file without a single"));
+}
+
 std::string Replace(std::string s, const std::string& from, const std::string& to) {
   const size_t i = s.find(from);
   EXPECT_NE(i, std::string::npos) << from;
@@ -239,6 +268,22 @@ TEST(TemperatureLog, ReadsPerAxisAndRejectsBadRows) {
               HasSubstr("b.csv:3: column t_s: time must increase for axis X"));
   EXPECT_THAT(CaptureError([&] { ReadTemperatureLog(WriteText(dir + "/c.csv", h + "5,C,0,0,0\n"), m); }),
               HasSubstr("c.csv:2: column axis: axis C is rotary"));
+}
+
+// The compensation tables given as the log failed on a "decimal comma";
+// now the MPF is named as what it is, as are other kinds.
+TEST(TemperatureLog, ACompensationFileOrAnotherKindIsNamed) {
+  const MachineFile m = DefaultMachine();
+  const auto error = [&](const std::string& path) { return CaptureError([&] { ReadTemperatureLog(path, m); }); };
+  EXPECT_THAT(error(SourcePath("config/machine/dmu80p_comp.mpf")),
+              HasSubstr("dmu80p_comp.mpf: this is a Siemens MPF file (a part program or table archive of the control); "
+                        "expected the temperature log CSV t_s,axis,K0_mm,tan_beta,P0_mm of docs/formats.md §8.4"));
+  const std::string dir = TempDir("temp_other_kinds");
+  // An MPF without the %_N_ header line, comments first.
+  EXPECT_THAT(error(WriteText(dir + "/t.mpf", "; tables, exported\nN10 $AA_ENC_COMP[0,0,AX1]=0.0\n")),
+              HasSubstr("this is a Siemens MPF file"));
+  EXPECT_THAT(error(SourcePath("docs/img/stability-map.png")), HasSubstr("this is a PNG image; expected the temperature log"));
+  EXPECT_THAT(error(SourcePath("config/machine/dmu80p.yaml")), HasSubstr("this is a YAML file; expected the temperature log"));
 }
 
 // The shipped log gives no finding; a row a day after the counts' clock
