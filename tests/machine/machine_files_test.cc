@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "robomach/common/units.h"
+#include "robomach/io/capture_decoding.h"
 #include "robomach/io/iso_runs_file.h"
 #include "test_support.h"
 
@@ -284,6 +285,32 @@ TEST(TemperatureLog, ACompensationFileOrAnotherKindIsNamed) {
               HasSubstr("this is a Siemens MPF file"));
   EXPECT_THAT(error(SourcePath("docs/img/stability-map.png")), HasSubstr("this is a PNG image; expected the temperature log"));
   EXPECT_THAT(error(SourcePath("config/machine/dmu80p.yaml")), HasSubstr("this is a YAML file; expected the temperature log"));
+}
+
+// A text file or a PNG given as the raw capture decoded to a million error
+// events (exit 3, "raise the sample rate"); it is named instead.
+TEST(CaptureFile, TextOrAKnownBinaryKindIsNamedNotDecoded) {
+  const MachineFile m = DefaultMachine();
+  const auto error = [&](const std::string& path) {
+    return CaptureError([&] { DecodeCaptureFile(path, m, 2e6, 250, 0, [](double, const std::int64_t*) {}); });
+  };
+  const std::string counts = error(SourcePath("tests/data/machine/counts_tiny.csv"));
+  EXPECT_THAT(counts, HasSubstr("counts_tiny.csv: this is a CSV table; expected the raw binary capture"));
+  EXPECT_THAT(counts, HasSubstr("docs/formats.md §8.2"));
+  EXPECT_THAT(counts, HasSubstr("(its columns are those of the encoder counts of docs/formats.md §8.1)"));
+  EXPECT_THAT(error(SourcePath("docs/img/stability-map.png")), HasSubstr("this is a PNG image; expected the raw binary capture"));
+  const std::string dir = TempDir("capture_other_kinds");
+  EXPECT_THAT(error(WriteText(dir + "/hello.bin", "hello world\n")), HasSubstr("this is a text file, not binary"));
+  EXPECT_THAT(error(WriteText(dir + "/blank.bin", " \n")), HasSubstr("this is a text file of white space only"));
+  EXPECT_THAT(error(WriteText(dir + "/pdf.bin", "%PDF-1.7\n")), HasSubstr("this is a PDF document"));
+  EXPECT_THAT(error(WriteText(dir + "/gz.bin", std::string("\x1f\x8b\x08\0", 4))), HasSubstr("gzip"));
+  // A real capture (every word's high byte below 0x04 for five axes) is
+  // binary and decodes; an empty one keeps its own message.
+  long rows = 0;
+  DecodeCaptureFile(WriteText(dir + "/ok.bin", std::string("\x00\x00\x01\x00\x03\x00\x02\x00", 8)), m, 1e6, 1, 0,
+                    [&](double, const std::int64_t*) { ++rows; });
+  EXPECT_EQ(rows, 4);
+  EXPECT_THAT(error(WriteText(dir + "/empty.bin", "")), HasSubstr("the capture is empty"));
 }
 
 // The shipped log gives no finding; a row a day after the counts' clock
