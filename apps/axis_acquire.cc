@@ -80,7 +80,7 @@ int Run(int argc, char** argv) {
                        {{"--out", out_path}, {"--summary", summary_path}, {"--plot", plot_path}});
     // Read and check every input before writing anything.
     const io::AcquisitionInputs in =
-        io::ReadAcquisitionInputs(machine_path, counts_path, comp_path, temp_path, program_path);
+        io::ReadAcquisitionInputs(machine_path, counts_path, comp_path, temp_path, program_path, "--compensation");
     const io::MachineFile& mf = in.machine;
     const io::CompensationTables& tables = in.tables;
     const std::vector<machine::TemperatureCompensation>& temps = in.temperatures;
