@@ -68,15 +68,19 @@ int Run(int argc, char** argv) {
     if (!plot_path.empty() && program_path.empty()) throw UsageError("--plot needs --program");
     RequireReadableFile(machine_path, "machine file");
     RequireReadableFile(counts_path, "counts file");
-    if (!comp_path.empty()) RequireReadableFile(comp_path, "compensation file");
-    if (!temp_path.empty()) RequireReadableFile(temp_path, "temperature log");
+    if (!comp_path.empty()) {
+      RequireInputFile("--compensation", comp_path, "compensation file", {io::FileKind::kMpf}, io::kCompensationFileFormat);
+    }
+    if (!temp_path.empty()) {
+      RequireInputFile("--temperature", temp_path, "temperature log", {io::FileKind::kCsv}, io::kTemperatureLogFormat);
+    }
     if (!program_path.empty()) RequireReadableFile(program_path, "programmed path");
     CheckDistinctPaths({{"--machine", machine_path}, {"--counts", counts_path}, {"--compensation", comp_path},
                         {"--temperature", temp_path}, {"--program", program_path}},
                        {{"--out", out_path}, {"--summary", summary_path}, {"--plot", plot_path}});
     // Read and check every input before writing anything.
     const io::AcquisitionInputs in =
-        io::ReadAcquisitionInputs(machine_path, counts_path, comp_path, temp_path, program_path);
+        io::ReadAcquisitionInputs(machine_path, counts_path, comp_path, temp_path, program_path, "--compensation");
     const io::MachineFile& mf = in.machine;
     const io::CompensationTables& tables = in.tables;
     const std::vector<machine::TemperatureCompensation>& temps = in.temperatures;

@@ -51,6 +51,9 @@ int Run(int argc, char** argv) {
     if (filter < 0 || filter > 1000000) throw UsageError("--glitch-filter: expected 0..1000000 samples");
     RequireReadableFile(machine_path, "machine file");
     RequireReadableFile(capture_path, "capture");
+    // A counts CSV or a PNG given as the capture: named, not decoded to
+    // millions of error events.
+    io::RequireBinaryFile(capture_path, io::kCaptureFileFormat, "--capture");
     CheckDistinctPaths({{"--machine", machine_path}, {"--capture", capture_path}},
                        {{"--out", out_path}, {"--summary", summary_path}});
     // Capture cards sample quadrature at 1 kHz - 100 MHz (docs/plausibility.md).

@@ -106,15 +106,19 @@ int Run(int argc, char** argv) {
     for (const std::string& w : implausible) Warn(kTool, w);
     RequireReadableFile(machine_path, "machine file");
     RequireReadableFile(program_path, "programmed path");
-    if (!comp_path.empty()) RequireReadableFile(comp_path, "compensation file");
-    if (!temp_path.empty()) RequireReadableFile(temp_path, "temperature log");
+    if (!comp_path.empty()) {
+      RequireInputFile("--compensation", comp_path, "compensation file", {io::FileKind::kMpf}, io::kCompensationFileFormat);
+    }
+    if (!temp_path.empty()) {
+      RequireInputFile("--temperature", temp_path, "temperature log", {io::FileKind::kCsv}, io::kTemperatureLogFormat);
+    }
     CheckDistinctPaths({{"--machine", machine_path}, {"--program", program_path}, {"--compensation", comp_path},
                         {"--temperature", temp_path}},
                        {{"--out", out_path}, {"--machine-out", machine_out}, {"--capture", capture_path}});
     io::MachineFile mf = io::ReadMachineFile(machine_path);
     const machine::ProgrammedPath path = io::ReadProgramFile(program_path);
     io::CompensationTables tables;
-    if (!comp_path.empty()) tables = io::ReadCompensationFile(comp_path, mf);
+    if (!comp_path.empty()) tables = io::ReadCompensationFile(comp_path, mf, "--compensation");
     std::vector<machine::TemperatureCompensation> temps;
     std::vector<std::string> temp_implausible;
     if (!temp_path.empty()) temps = io::ReadTemperatureLog(temp_path, mf, &temp_implausible);

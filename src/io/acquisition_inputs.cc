@@ -8,10 +8,10 @@ namespace robomach::io {
 
 AcquisitionInputs ReadAcquisitionInputs(const std::string& machine_path, const std::string& counts_path,
                                         const std::string& compensation_path, const std::string& temperature_path,
-                                        const std::string& program_path) {
+                                        const std::string& program_path, const std::string& compensation_option) {
   AcquisitionInputs in;
   in.machine = ReadMachineFile(machine_path);
-  if (!compensation_path.empty()) in.tables = ReadCompensationFile(compensation_path, in.machine);
+  if (!compensation_path.empty()) in.tables = ReadCompensationFile(compensation_path, in.machine, compensation_option);
   if (!temperature_path.empty()) in.temperatures = ReadTemperatureLog(temperature_path, in.machine, &in.temperature_implausible);
   in.compensation = std::make_unique<machine::Compensation>(static_cast<int>(in.machine.machine.axes.size()),
                                                             in.tables.encoder, in.tables.cross_axis, in.temperatures);

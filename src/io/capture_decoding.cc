@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "robomach/common/errors.h"
+#include "robomach/io/file_kind.h"
 #include "robomach/machine/quadrature_decoder.h"
 
 namespace robomach::io {
@@ -20,6 +21,9 @@ CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const Machine
   std::error_code ec;
   const auto bytes = std::filesystem::file_size(capture_path, ec);
   if (ec) throw InputError({capture_path, 0, 0}, "cannot open file for reading");
+  // Text (a counts CSV given as the capture) or a PNG decodes to millions
+  // of error events; name what the file is instead (file_kind.h).
+  RequireBinaryFile(capture_path, kCaptureFileFormat);
   if (bytes % 2 != 0) {
     throw InputError({capture_path, 0, 0}, "size " + std::to_string(bytes) +
                                                " bytes is not a whole number of 16-bit words (truncated capture?)");

@@ -11,6 +11,7 @@
 #include "machine_text.h"
 #include "robomach/common/errors.h"
 #include "robomach/io/csv_table.h"
+#include "robomach/io/file_kind.h"
 #include "robomach/io/number_format.h"
 
 #include "text.h"
@@ -78,7 +79,11 @@ std::optional<Assignment> ParseAssignment(const std::string& raw, int line) {
 
 }  // namespace
 
-CompensationTables ReadCompensationFile(const std::string& path, const MachineFile& mf) {
+CompensationTables ReadCompensationFile(const std::string& path, const MachineFile& mf, const std::string& option) {
+  // A PNG, a YAML, a CSV (the temperature log given as the tables) is named
+  // as what it is before the lines are read as assignments.
+  const FileSniff sniff = SniffFileKind(path);
+  RequireFileKind(path, {FileKind::kMpf}, kCompensationFileFormat, option);
   const std::string text = ReadWholeFile(path);
   std::map<std::pair<int, int>, PendingTable> enc;  // (axis index, system) -> table
   std::map<int, PendingTable> cec;                  // table number -> table
@@ -88,14 +93,25 @@ CompensationTables ReadCompensationFile(const std::string& path, const MachineFi
   std::string raw;
   int line = 0;
   auto err = [&](int l, const std::string& m) { return InputError({path, l, 0}, m); };
+  int table_assignments = 0;
+  int first_line = 0;      // the first line that is neither blank nor a comment
+  std::string first_text;  // and its text, for the message of a file without tables
   while (std::getline(in, raw)) {
     ++line;
+    if (first_line == 0) {
+      const std::string t = Trim(raw);
+      if (!t.empty() && t[0] != ';' && t[0] != '#') {
+        first_line = line;
+        first_text = t.size() > 60 ? t.substr(0, 60) + "..." : t;
+      }
+    }
     const auto oa = ParseAssignment(raw, line);
     if (!oa) continue;
     const Assignment& a = *oa;
     const bool enc_var = a.name.rfind("AA_ENC_COMP", 0) == 0;
     const bool cec_var = a.name.rfind("AN_CEC", 0) == 0;
     if (!enc_var && !cec_var) continue;  // some other variable: not a table assignment
+    ++table_assignments;
     if (!a.index.empty() && a.index[0] == "<unclosed>") throw err(line, "$" + a.name + ": unclosed '['");
     std::string key = a.name + "[";
     for (const auto& i : a.index) key += i + ",";
@@ -208,6 +224,19 @@ CompensationTables ReadCompensationFile(const std::string& path, const MachineFi
       throw err(line, "$" + a.name + ": not supported (expected $AN_CEC, _INPUT_AXIS, _OUTPUT_AXIS, _STEP, _MIN, "
                       "_MAX, _IS_MODULO, _DIRECTION, _MULT_BY_TABLE)");
     }
+  }
+
+  // A file without a single table assignment holds nothing to compensate
+  // with: applying none would give the uncompensated path without a word
+  // (docs/conventions.md: a file the tool cannot use is bad data, 65).
+  if (table_assignments == 0) {
+    FileSniff what = sniff;
+    what.description += " without a single $AA_ENC_COMP or $AN_CEC table assignment";
+    if (first_line > 0) {
+      throw err(first_line, WrongFileKindMessage(what, kCompensationFileFormat, option) + " (this line is \"" + first_text +
+                                "\")");
+    }
+    throw err(0, WrongFileKindMessage(what, kCompensationFileFormat, option));
   }
 
   // Values in the output axis's unit: refused when impossible, one finding

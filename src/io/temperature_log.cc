@@ -6,6 +6,7 @@
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 #include "robomach/io/csv_table.h"
+#include "robomach/io/file_kind.h"
 #include "robomach/io/number_format.h"
 
 namespace robomach::io {
@@ -30,7 +31,9 @@ struct Largest {
 
 std::vector<machine::TemperatureCompensation> ReadTemperatureLog(const std::string& path, const MachineFile& mf,
                                                                  std::vector<std::string>* implausible) {
-  const CsvTable t = CsvTable::ReadFile(path);
+  // An MPF (the compensation tables given as the log), a PNG, a YAML is
+  // named as what it is (file_kind.h) before any cell is read.
+  const CsvTable t = CsvTable::ReadFile(path, kTemperatureLogFormat);
   for (const char* c : {"t_s", "axis", "K0_mm", "tan_beta", "P0_mm"}) t.RequireColumn(c);
   std::map<int, machine::TemperatureCompensation> by_axis;
   std::map<int, int> last_line;

@@ -39,6 +39,31 @@ TEST(FileKind, RecognisesEachKindFromItsFirstBytes) {
   EXPECT_EQ(SniffText("\xEF\xBB\xBF# quantity: receptance\npose_id,q1_deg\nP1,0\n").kind, FileKind::kCsv);
   EXPECT_EQ(SniffText("freq_hz\n1\n2\n").kind, FileKind::kText);  // one column: not refused
   EXPECT_EQ(SniffText("\n  \n").kind, FileKind::kEmpty);
+  // Siemens part programs and table archives (formats.md §8.4): the header
+  // line, an assignment (also after a block number and ';' comments, some
+  // holding commas), CHANDATA.
+  EXPECT_EQ(SniffText("%_N_COMP_MPF\n;$PATH=/_N_MPF_DIR\n").kind, FileKind::kMpf);
+  EXPECT_EQ(SniffText("; tables, exported\n$AA_ENC_COMP[0,0,AX1]=0.0\n").kind, FileKind::kMpf);
+  EXPECT_EQ(SniffText("N10 $AN_CEC[0,0]=0.0\n").kind, FileKind::kMpf);
+  EXPECT_EQ(SniffText("CHANDATA(1)\n").kind, FileKind::kMpf);
+  EXPECT_EQ(SniffText("%YAML 1.2\n---\na: 1\n").kind, FileKind::kYaml);
+  EXPECT_EQ(SniffText("\xff\xfeh\0").kind, FileKind::kUtf16);
+}
+
+// A CSV is named by its header when it is one of formats.md's tables, so a
+// CSV given to the wrong option says which table it is.
+TEST(FileKind, NamesTheTableOfAKnownCsvHeader) {
+  const FileSniff t = SniffText("# log\nt_s,axis,K0_mm,tan_beta,P0_mm\n0,X,0,0,0\n");
+  EXPECT_EQ(t.kind, FileKind::kCsv);
+  EXPECT_EQ(t.description, "a CSV table");
+  EXPECT_EQ(t.table, "the temperature log of docs/formats.md §8.4");
+  EXPECT_EQ(WrongFileKindMessage(t, "X", "--compensation"),
+            "this is a CSV table; --compensation expects X (its columns are those of the temperature log of "
+            "docs/formats.md §8.4)");
+  EXPECT_EQ(SniffText("t_s,X_count,Y_count\n").table, "the encoder counts of docs/formats.md §8.1");
+  EXPECT_EQ(SniffText("pose_id,q1_deg,q2_deg\n").table, "the posture CSV of docs/formats.md §1");
+  EXPECT_EQ(SniffText("a,b\n1,2\n").table, "");
+  EXPECT_EQ(WrongFileKindMessage(SniffText("a,b\n"), "X"), "this is a CSV table; expected X");
 }
 
 TEST(FileKind, ShippedInputsAreWhatTheirReadersExpect) {
@@ -70,6 +95,8 @@ TEST(FileKind, EveryShippedFileIsSniffedAsItsExtensionSays) {
         EXPECT_TRUE(s.kind == FileKind::kYaml || text) << e.path() << ": " << s.description;
       } else if (ext == ".uff" || ext == ".unv") {
         EXPECT_EQ(s.kind, FileKind::kUff58) << e.path();
+      } else if (ext == ".mpf") {
+        EXPECT_EQ(s.kind, FileKind::kMpf) << e.path() << ": " << s.description;
       } else {
         continue;
       }

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "robomach/common/units.h"
+#include "robomach/io/capture_decoding.h"
 #include "robomach/io/iso_runs_file.h"
 #include "test_support.h"
 
@@ -99,6 +100,35 @@ TEST(CompensationFile, TheDefaultFileReads) {
   const CompensationTables t = ReadCompensationFile(SourcePath("config/machine/dmu80p_comp.mpf"), m);
   EXPECT_EQ(t.encoder.size(), 4u);
   EXPECT_EQ(t.cross_axis.size(), 2u);
+}
+
+// A file of another kind given as the tables was read as "no assignments"
+// and the acquisition ran uncompensated with exit 0. Each is now named as
+// what it is (io::SniffFileKind), and a text without a single table
+// assignment is refused: it holds nothing to compensate with.
+TEST(CompensationFile, AFileOfAnotherKindOrWithoutTablesIsNamedNotIgnored) {
+  const MachineFile m = DefaultMachine();
+  const auto error = [&](const std::string& path, const std::string& option = "") {
+    return CaptureError([&] { ReadCompensationFile(path, m, option); });
+  };
+  const std::string temperature = error(SourcePath("config/machine/dmu80p_temperature.csv"), "--compensation");
+  EXPECT_THAT(temperature, HasSubstr("dmu80p_temperature.csv: this is a CSV table; --compensation expects the Siemens "
+                                     "compensation tables"));
+  EXPECT_THAT(temperature, HasSubstr("docs/formats.md §8.4"));
+  EXPECT_THAT(temperature, HasSubstr("(its columns are those of the temperature log of docs/formats.md §8.4)"));
+  EXPECT_THAT(error(SourcePath("docs/img/stability-map.png")), HasSubstr("stability-map.png: this is a PNG image; expected "
+                                                                         "the Siemens compensation tables"));
+  EXPECT_THAT(error(SourcePath("config/machine/dmu80p.yaml")), HasSubstr("this is a YAML file"));
+  const std::string dir = TempDir("comp_other_kinds");
+  EXPECT_THAT(error(WriteText(dir + "/hello.txt", "\nhello world\n"), "--compensation"),
+              HasSubstr("hello.txt:2: this is a text file without a single $AA_ENC_COMP or $AN_CEC table assignment; "
+                        "--compensation expects the Siemens compensation tables"));
+  EXPECT_THAT(error(WriteText(dir + "/hello.txt", "\nhello world\n")), HasSubstr("(this line is \"hello world\")"));
+  // A part program of other variables is an MPF, but holds no table.
+  EXPECT_THAT(error(WriteText(dir + "/other.mpf", "%_N_OTHER_MPF\n$MA_SOMETHING[AX1]=3\nM30\n")),
+              HasSubstr("other.mpf:1: this is a Siemens MPF file (a part program or table archive of the control) "
+                        "without a single $AA_ENC_COMP or $AN_CEC table assignment"));
+  EXPECT_THAT(error(WriteText(dir + "/empty.mpf", "")), HasSubstr("this is an empty file without a single"));
 }
 
 std::string Replace(std::string s, const std::string& from, const std::string& to) {
@@ -239,6 +269,48 @@ TEST(TemperatureLog, ReadsPerAxisAndRejectsBadRows) {
               HasSubstr("b.csv:3: column t_s: time must increase for axis X"));
   EXPECT_THAT(CaptureError([&] { ReadTemperatureLog(WriteText(dir + "/c.csv", h + "5,C,0,0,0\n"), m); }),
               HasSubstr("c.csv:2: column axis: axis C is rotary"));
+}
+
+// The compensation tables given as the log failed on a "decimal comma";
+// now the MPF is named as what it is, as are other kinds.
+TEST(TemperatureLog, ACompensationFileOrAnotherKindIsNamed) {
+  const MachineFile m = DefaultMachine();
+  const auto error = [&](const std::string& path) { return CaptureError([&] { ReadTemperatureLog(path, m); }); };
+  EXPECT_THAT(error(SourcePath("config/machine/dmu80p_comp.mpf")),
+              HasSubstr("dmu80p_comp.mpf: this is a Siemens MPF file (a part program or table archive of the control); "
+                        "expected the temperature log CSV t_s,axis,K0_mm,tan_beta,P0_mm of docs/formats.md §8.4"));
+  const std::string dir = TempDir("temp_other_kinds");
+  // An MPF without the %_N_ header line, comments first.
+  EXPECT_THAT(error(WriteText(dir + "/t.mpf", "; tables, exported\nN10 $AA_ENC_COMP[0,0,AX1]=0.0\n")),
+              HasSubstr("this is a Siemens MPF file"));
+  EXPECT_THAT(error(SourcePath("docs/img/stability-map.png")), HasSubstr("this is a PNG image; expected the temperature log"));
+  EXPECT_THAT(error(SourcePath("config/machine/dmu80p.yaml")), HasSubstr("this is a YAML file; expected the temperature log"));
+}
+
+// A text file or a PNG given as the raw capture decoded to a million error
+// events (exit 3, "raise the sample rate"); it is named instead.
+TEST(CaptureFile, TextOrAKnownBinaryKindIsNamedNotDecoded) {
+  const MachineFile m = DefaultMachine();
+  const auto error = [&](const std::string& path) {
+    return CaptureError([&] { DecodeCaptureFile(path, m, 2e6, 250, 0, [](double, const std::int64_t*) {}); });
+  };
+  const std::string counts = error(SourcePath("tests/data/machine/counts_tiny.csv"));
+  EXPECT_THAT(counts, HasSubstr("counts_tiny.csv: this is a CSV table; expected the raw binary capture"));
+  EXPECT_THAT(counts, HasSubstr("docs/formats.md §8.2"));
+  EXPECT_THAT(counts, HasSubstr("(its columns are those of the encoder counts of docs/formats.md §8.1)"));
+  EXPECT_THAT(error(SourcePath("docs/img/stability-map.png")), HasSubstr("this is a PNG image; expected the raw binary capture"));
+  const std::string dir = TempDir("capture_other_kinds");
+  EXPECT_THAT(error(WriteText(dir + "/hello.bin", "hello world\n")), HasSubstr("this is a text file, not binary"));
+  EXPECT_THAT(error(WriteText(dir + "/blank.bin", " \n")), HasSubstr("this is a text file of white space only"));
+  EXPECT_THAT(error(WriteText(dir + "/pdf.bin", "%PDF-1.7\n")), HasSubstr("this is a PDF document"));
+  EXPECT_THAT(error(WriteText(dir + "/gz.bin", std::string("\x1f\x8b\x08\0", 4))), HasSubstr("gzip"));
+  // A real capture (every word's high byte below 0x04 for five axes) is
+  // binary and decodes; an empty one keeps its own message.
+  long rows = 0;
+  DecodeCaptureFile(WriteText(dir + "/ok.bin", std::string("\x00\x00\x01\x00\x03\x00\x02\x00", 8)), m, 1e6, 1, 0,
+                    [&](double, const std::int64_t*) { ++rows; });
+  EXPECT_EQ(rows, 4);
+  EXPECT_THAT(error(WriteText(dir + "/empty.bin", "")), HasSubstr("the capture is empty"));
 }
 
 // The shipped log gives no finding; a row a day after the counts' clock

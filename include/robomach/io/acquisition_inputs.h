@@ -42,10 +42,13 @@ struct AcquisitionInputs {
 };
 
 /// Reads every input before any work (an empty path: not given).
+/// `compensation_option` names the compensation file in a message about
+/// what it is (the tool's "--compensation"; "" for a library caller).
 /// @throws InputError naming the file, line and column of the first problem.
 AcquisitionInputs ReadAcquisitionInputs(const std::string& machine_path, const std::string& counts_path,
                                         const std::string& compensation_path = "",
                                         const std::string& temperature_path = "",
-                                        const std::string& program_path = "");
+                                        const std::string& program_path = "",
+                                        const std::string& compensation_option = "");
 
 }  // namespace robomach::io

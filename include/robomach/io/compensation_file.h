@@ -40,6 +40,13 @@ inline constexpr double kMaxCompensationDeg = 10.0;
 ///   value over kMaxCompensationMm (kMaxCompensationDeg for rotary axes).
 ///   Table positions (_MIN, _MAX) are checked against the machine file's
 ///   plausible lengths (kMaxPlausibleMachineLengthMm).
-CompensationTables ReadCompensationFile(const std::string& path, const MachineFile& machine);
+///   A file of another kind (a PNG, a YAML, a CSV such as the temperature
+///   log: io::SniffFileKind) and a file without a single $AA_ENC_COMP or
+///   $AN_CEC assignment (nothing to compensate with) are refused, named as
+///   what they are: "this is a CSV table (the temperature log ...);
+///   --compensation expects the Siemens compensation tables ...", with
+///   `option` (the tool's option, "" for none) in the message.
+CompensationTables ReadCompensationFile(const std::string& path, const MachineFile& machine,
+                                        const std::string& option = "");
 
 }  // namespace robomach::io
