@@ -18,6 +18,9 @@ enum class FrfQuantity { kReceptance, kMobility, kAccelerance };
 
 /// "receptance", "mobility", "accelerance".
 std::string QuantityName(FrfQuantity q);
+/// The name with its article, for messages: "a receptance", "a mobility",
+/// "an accelerance".
+std::string QuantityWithArticle(FrfQuantity q);
 /// @throws std::invalid_argument for anything else.
 FrfQuantity ParseQuantity(const std::string& name);
 
