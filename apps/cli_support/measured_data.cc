@@ -23,7 +23,7 @@ MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::s
     for (const std::string& n : r.notes) Note(tool, n);
     // On each FRF's usable band only (issue #34 item 5): a tap test's drift
     // lines are no measure of the unit.
-    for (const std::string& f : calibration::ReceptanceUnitFindings(r.frfs, path, r.averages)) {
+    for (const std::string& f : calibration::ReceptanceUnitFindings(r.frfs, path, r.averages, r.file_format)) {
       Warn(tool, "implausible (unit mistake?): " + f);
       all.unit_findings.push_back(f);
     }
