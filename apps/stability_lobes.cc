@@ -287,6 +287,37 @@ int Run(int argc, char** argv) {
           ax.series.push_back(std::move(s));
         }
       }
+      // The depth axis shows the lobes' bottoms, the depths a user can cut:
+      // between lobes the critical depth rises to tens or hundreds of mm,
+      // and a linear axis up to that squashes the sub-mm bottoms flat. It
+      // ends at 5 x the smallest critical depth of all curves (the first
+      // lobes above the bottom and the stable pockets between them), raised
+      // to 1.5 x the largest of the curves' own smallest depths so that every
+      // posture's bottom is in the picture. The full range is in the CSV.
+      double smallest = INFINITY, largest_bottom = 0.0, largest = 0.0;
+      for (const report::Series& s : ax.series) {
+        double bottom = INFINITY;
+        for (double d : s.y) {
+          if (!std::isfinite(d) || d <= 0.0) continue;
+          bottom = std::min(bottom, d);
+          largest = std::max(largest, d);
+        }
+        if (!std::isfinite(bottom)) continue;
+        smallest = std::min(smallest, bottom);
+        largest_bottom = std::max(largest_bottom, bottom);
+      }
+      if (std::isfinite(smallest)) {
+        const double clip_mm = std::max(5.0 * smallest, 1.5 * largest_bottom);
+        if (largest > 1.05 * clip_mm) {
+          ax.y_max = clip_mm;
+          char clip_text[96];
+          std::snprintf(clip_text, sizeof(clip_text), "; depth axis clipped at %.3g mm (full range in ", clip_mm);
+          ax.title += clip_text +
+                      (out_path.empty() || out_path == "-" ? std::string("the CSV")
+                                                           : std::filesystem::path(out_path).filename().string()) +
+                      ")";
+        }
+      }
       fig.SavePng(plot_path);
     }
     if (!modes_out_path.empty()) {

@@ -51,28 +51,30 @@ int RunGuarded(const std::string& tool, const std::function<int()>& body) {
     }
     return rc;
   } catch (const NoInputError& e) {
-    std::cerr << tool << ": " << e.what() << '\n';
+    // Every message escapes bytes that are not UTF-8 (a path or a header
+    // quoted from a Latin-1 file): the terminal gets valid text.
+    std::cerr << tool << ": " << EscapeInvalidUtf8(e.what()) << '\n';
     return kExitNoInput;
   } catch (const io::MissingFileError& e) {
     // A file named inside an input (a config's urdf:) that is not there.
-    std::cerr << tool << ": " << e.what() << '\n';
+    std::cerr << tool << ": " << EscapeInvalidUtf8(e.what()) << '\n';
     return kExitNoInput;
   } catch (const InputError& e) {
-    std::cerr << tool << ": " << e.what() << '\n';
+    std::cerr << tool << ": " << EscapeInvalidUtf8(e.what()) << '\n';
     return kExitDataError;
   } catch (const OutputError& e) {
-    std::cerr << tool << ": " << e.what() << '\n';
+    std::cerr << tool << ": " << EscapeInvalidUtf8(e.what()) << '\n';
     return kExitCantCreate;
   } catch (const UsageError& e) {
-    std::cerr << tool << ": " << e.what() << '\n';
+    std::cerr << tool << ": " << EscapeInvalidUtf8(e.what()) << '\n';
     return kExitUsage;
   } catch (const std::invalid_argument& e) {
     // The library refused a value the app passed on unchecked: every option
     // is checked by the app (UsageError), so this value came from the input.
-    std::cerr << tool << ": bad input: " << e.what() << '\n';
+    std::cerr << tool << ": bad input: " << EscapeInvalidUtf8(e.what()) << '\n';
     return kExitDataError;
   } catch (const std::exception& e) {
-    std::cerr << tool << ": internal error: " << e.what() << '\n';
+    std::cerr << tool << ": internal error: " << EscapeInvalidUtf8(e.what()) << '\n';
     return kExitSoftware;
   }
 }
@@ -142,7 +144,10 @@ std::vector<std::string>& WarningsList() {
 }
 }  // namespace
 
-void Warn(const std::string& tool, const std::string& message) {
+void Warn(const std::string& tool, const std::string& raw_message) {
+  // Text quoted from a file header may hold Latin-1 bytes: escaped, so that
+  // the terminal and the JSON summary (which lists every warning) get UTF-8.
+  const std::string message = EscapeInvalidUtf8(raw_message);
   std::cerr << tool << ": warning: " << message << '\n';
   std::lock_guard<std::mutex> lock(WarningsMutex());
   WarningsList().push_back(message);
@@ -179,7 +184,7 @@ void AddVersionFlag(CLI::App& app, const std::string& tool) {
 }
 
 void Note(const std::string& tool, const std::string& message) {
-  std::cerr << tool << ": note: " << message << '\n';
+  std::cerr << tool << ": note: " << EscapeInvalidUtf8(message) << '\n';
 }
 
 std::pair<std::string, double> ParseAssignment(const std::string& option, const std::string& text) {

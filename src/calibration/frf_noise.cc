@@ -890,8 +890,8 @@ UsableBandPeak PeakReceptanceInUsableBand(const dynamics::Frf& frf, int averages
   return out;
 }
 
-std::string UsableBandUnitFinding(const std::string& what, const UsableBandPeak& p) {
-  std::string f = dynamics::ReceptancePeakFinding(what, p.peak_m_per_N);
+std::string UsableBandUnitFinding(const std::string& what, const UsableBandPeak& p, dynamics::FrfFileFormat format) {
+  std::string f = dynamics::ReceptancePeakFinding(what, p.peak_m_per_N, format);
   if (f.empty()) return f;
   return f + (p.on_usable_band ? " (the largest on the usable band " + Sci(p.fmin_hz) + "-" + Sci(p.fmax_hz) +
                                      " Hz of the noise model)"
@@ -899,10 +899,11 @@ std::string UsableBandUnitFinding(const std::string& what, const UsableBandPeak&
 }
 
 std::vector<std::string> ReceptanceUnitFindings(const dynamics::FrfSet& frfs, const std::string& source,
-                                                int averages) {
+                                                int averages, dynamics::FrfFileFormat format) {
   std::vector<std::string> out;
   for (const auto& [key, frf] : frfs) {
-    std::string f = UsableBandUnitFinding(source + ": " + key.ToString(), PeakReceptanceInUsableBand(frf, averages));
+    std::string f =
+        UsableBandUnitFinding(source + ": " + key.ToString(), PeakReceptanceInUsableBand(frf, averages), format);
     if (!f.empty()) out.push_back(std::move(f));
   }
   return out;

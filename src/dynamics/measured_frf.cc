@@ -174,17 +174,39 @@ void FrfSet::Merge(const FrfSet& other) {
   for (const auto& [k, f] : other.frfs_) Insert(k, f);
 }
 
-std::string ReceptancePeakFinding(const std::string& what, double peak) {
+std::string ReceptancePeakFinding(const std::string& what, double peak, FrfFileFormat format) {
   if (!(peak > kMaxPlausibleReceptance || (peak > 0.0 && peak < kMinPlausibleReceptance))) return "";
   char b[160];
   std::snprintf(b, sizeof b, ": the largest receptance is %.3g m/N, outside the plausible %.0e to %.0e m/N of a machine structure: ",
                 peak, kMinPlausibleReceptance, kMaxPlausibleReceptance);
-  return what + b +
-         (peak > kMaxPlausibleReceptance
-              ? "the response was probably recorded in mm or um (or the force in kN) under a column named in m (and "
-                "N), or a mobility or accelerance was read as receptance (the file's quantity or unit labels)"
-              : "the force was probably recorded in mN, or the response in km") +
-         "; check the units in the column names";
+  // A UFF58 file has no columns: its units are in record 8 (abscissa),
+  // record 9 (ordinate, the response, with its data type: displacement,
+  // velocity, acceleration) and record 10 (denominator, the force).
+  const bool high = peak > kMaxPlausibleReceptance;
+  std::string mistake, check;
+  switch (format) {
+    case FrfFileFormat::kUff58:
+      mistake = high ? "the response was probably recorded in mm or um (or the force in kN) under a unit line of m (and "
+                       "N), or a mobility or accelerance was read as receptance"
+                     : "the force was probably recorded in mN, or the response in km";
+      check = "; check the unit lines and the ordinate data type of records 9 (response) and 10 (force), and record 8 "
+              "(abscissa, Hz)";
+      break;
+    case FrfFileFormat::kCsv:
+      mistake = high ? "the response was probably recorded in mm or um (or the force in kN) under a column named in m "
+                       "(and N), or a mobility or accelerance was read as receptance (the file's quantity or unit labels)"
+                     : "the force was probably recorded in mN, or the response in km";
+      check = "; check the units in the column names";
+      break;
+    case FrfFileFormat::kUnknown:
+      mistake = high ? "the response was probably recorded in mm or um (or the force in kN) under a unit of m (and N), "
+                       "or a mobility or accelerance was read as receptance (the file's quantity or unit labels)"
+                     : "the force was probably recorded in mN, or the response in km";
+      check = "; check the units in the column names (CSV), or the unit lines and ordinate data type of records 9 "
+              "and 10 (UFF58)";
+      break;
+  }
+  return what + b + mistake + check;
 }
 
 namespace {
@@ -213,10 +235,10 @@ double PeakReceptance(const Frf& frf) {
   return RobustPeak(m);
 }
 
-std::vector<std::string> ReceptanceUnitFindings(const FrfSet& frfs, const std::string& source) {
+std::vector<std::string> ReceptanceUnitFindings(const FrfSet& frfs, const std::string& source, FrfFileFormat format) {
   std::vector<std::string> out;
   for (const auto& [key, frf] : frfs) {
-    const std::string f = ReceptancePeakFinding(source + ": " + key.ToString(), PeakReceptance(frf));
+    const std::string f = ReceptancePeakFinding(source + ": " + key.ToString(), PeakReceptance(frf), format);
     if (!f.empty()) out.push_back(f);
   }
   return out;

@@ -159,8 +159,8 @@ FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
       if (coh < 0.0 || coh > 1.0) throw t.ErrorAt(r, "coherence", "expected a value in [0, 1], got " + t.Text(r, "coherence"));
     }
     if (f == 0.0 && out.file_quantity != FrfQuantity::kReceptance) {
-      out.warnings.push_back(path + ":" + std::to_string(t.line(r)) + ": the 0 Hz line of a " +
-                             QuantityName(out.file_quantity) +
+      out.warnings.push_back(path + ":" + std::to_string(t.line(r)) + ": the 0 Hz line of " +
+                             QuantityWithArticle(out.file_quantity) +
                              " FRF has no receptance equivalent; it is skipped");
       continue;
     }

@@ -16,9 +16,13 @@ FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_po
   // sees it (io/file_kind.h).
   RequireFileKind(path, {FileKind::kCsv, FileKind::kUff58}, kFrfFileFormat);
   if (ext == "uff" || ext == "unv" || ext == "uf" || ext == "ufb" || LooksLikeUff(path)) {
-    return ReadUff58(path, default_pose_id, keep_points);
+    FrfReadResult r = ReadUff58(path, default_pose_id, keep_points);
+    r.file_format = dynamics::FrfFileFormat::kUff58;
+    return r;
   }
-  return ReadFrfCsv(path, keep_points);
+  FrfReadResult r = ReadFrfCsv(path, keep_points);
+  r.file_format = dynamics::FrfFileFormat::kCsv;
+  return r;
 }
 
 }  // namespace robomach::io

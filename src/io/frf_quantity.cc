@@ -21,6 +21,10 @@ std::string QuantityName(FrfQuantity q) {
   return "?";
 }
 
+std::string QuantityWithArticle(FrfQuantity q) {
+  return (q == FrfQuantity::kAccelerance ? "an " : "a ") + QuantityName(q);
+}
+
 FrfQuantity ParseQuantity(const std::string& name) {
   const std::string n = Lower(Trim(name));
   if (n == "receptance") return FrfQuantity::kReceptance;

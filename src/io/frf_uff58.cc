@@ -213,7 +213,7 @@ RecordUnits FrfRecordUnits(const std::string& path, const Uff58Record& r, const 
       }
       n += "its unit " + (by_unit ? r.ordinate.units + (de.given ? " per " + r.denominator.units : "")
                                   : std::string("(specific data type)")) +
-           " makes it a " + QuantityName(out.quantity);
+           " makes it " + QuantityWithArticle(out.quantity);
       if (word_differs) n += ", although its axis label says \"" + r.ordinate.label + "\"";
       notes->push_back(n + "; read as " + QuantityName(out.quantity));
     }
@@ -366,8 +366,7 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
       hk.push_back(sign * ToReceptance(u.quantity, f, u.factor * r.y(p)));
     }
     if (zero_lines > 0) {
-      out.notes.push_back(where + ": the 0 Hz line of " +
-                          (u.quantity == FrfQuantity::kAccelerance ? "an " : "a ") + QuantityName(u.quantity) +
+      out.notes.push_back(where + ": the 0 Hz line of " + QuantityWithArticle(u.quantity) +
                           " FRF has no receptance equivalent; it is skipped");
     }
     try {
@@ -393,10 +392,20 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
     }
     std::string others;
     for (const auto& [n, lines] : file.skipped) others += (others.empty() ? "" : ", ") + n;
+    // Time records are what a hammer test records; frf-estimate reads them
+    // as UFF58 function type 1 (per hit the force record, then its response
+    // records: docs/formats.md §10.1) and writes the FRF CSV read here.
+    const bool time_records = std::any_of(file.records.begin(), file.records.end(),
+                                          [](const Uff58Record& r) { return r.function_type == 1; });
     throw InputError({path, 0, 0}, "no frequency response function (dataset 58, function type 4) in the file" +
                                        (held.empty() ? std::string() : ": it holds a " + held) +
                                        (others.empty() ? std::string() : (held.empty() ? ": " : "; ") +
-                                                                             std::string("datasets ") + others));
+                                                                             std::string("datasets ") + others) +
+                                       (time_records ? std::string("; to turn impact-hammer time records (per hit the "
+                                                                   "force record, then its response records) into an "
+                                                                   "FRF file, run frf-estimate on them "
+                                                                   "(docs/frf-estimate.md)")
+                                                     : std::string()));
   }
   for (const auto& [name, lines] : not_frf) {
     out.notes.push_back(path + ": skipped " + std::to_string(lines.size()) + " record" + (lines.size() > 1 ? "s" : "") +

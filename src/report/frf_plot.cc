@@ -8,7 +8,7 @@
 namespace robomach::report {
 
 void FillFrfPanels(const std::vector<FrfCurve>& curves, const std::vector<double>& mode_freq_hz,
-                   const std::string& title, Axes* mag, Axes* phase) {
+                   const std::string& title, Axes* mag, Axes* phase, const std::vector<double>& mode_strength) {
   double fmin = INFINITY, fmax = 0.0;
   for (const auto& c : curves) {
     for (Eigen::Index i = 0; i < c.freq_hz.size(); ++i) {
@@ -54,7 +54,9 @@ void FillFrfPanels(const std::vector<FrfCurve>& curves, const std::vector<double
     if (!(mode_freq_hz[k] > 0.0) || (fmax > 0 && mode_freq_hz[k] > fmax)) continue;
     char buf[32];
     std::snprintf(buf, sizeof(buf), "%.1f Hz", mode_freq_hz[k]);
-    mag->markers.push_back({mode_freq_hz[k], buf});
+    VerticalMarker marker{mode_freq_hz[k], buf};
+    if (k < mode_strength.size() && std::isfinite(mode_strength[k])) marker.priority = mode_strength[k];
+    mag->markers.push_back(marker);
     phase->markers.push_back({mode_freq_hz[k], ""});
   }
   if (std::isfinite(fmin)) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <complex>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include "robomach/common/frames.h"
@@ -47,9 +48,28 @@ void FillModalFitPanels(const dynamics::Frf& measured, const calibration::FrfNoi
   FrfCurve fl{f, floor, "noise floor", PaletteColor(3), true, 1};
   fl.magnitude_only = true;
   curves.push_back(fl);
-  std::vector<double> modes;
-  for (const calibration::FittedMode& m : fit.modes) modes.push_back(m.freq_hz);
-  FillFrfPanels(curves, modes, title, mag, phase);
+  std::vector<double> modes, strength;
+  for (const calibration::FittedMode& m : fit.modes) {
+    modes.push_back(m.freq_hz);
+    strength.push_back(m.peak_contribution);
+  }
+  FillFrfPanels(curves, modes, title, mag, phase, strength);
+  // The magnitude axis goes down to 1e-3 x the smallest measured |H| (three
+  // decades below the data are room for the antiresonances and the floor
+  // where it matters); a floor of, say, 1e-16 m/N under data of 1e-6 m/N
+  // would otherwise squash the FRF into the top third of the panel. What
+  // lies lower is cut off at the axis.
+  double h_min = std::numeric_limits<double>::infinity(), lowest = h_min;
+  for (int k = 0; k < n; ++k) {
+    const double h = std::abs(measured.receptance()(lines[k]));
+    if (std::isfinite(h) && h > 0.0) h_min = std::min(h_min, h);
+  }
+  for (const Series& s : mag->series) {
+    for (double v : s.y) {
+      if (std::isfinite(v) && v > 0.0) lowest = std::min(lowest, v);
+    }
+  }
+  if (std::isfinite(h_min) && lowest < 1e-3 * h_min) mag->y_min = 1e-3 * h_min;
   // The edges of the usable stretches; only the outer two are labelled,
   // and an edge at the end of the FRF is not marked.
   const double f_first = n > 0 ? f(0) : 0.0, f_last = n > 0 ? f(n - 1) : 0.0;
@@ -60,9 +80,11 @@ void FillModalFitPanels(const dynamics::Frf& measured, const calibration::FrfNoi
     std::snprintf(c, sizeof(c), "usable to %.4g Hz", hi);
     for (Axes* ax : {mag, phase}) {
       const bool label = ax == mag;
-      if (lo > f_first) ax->markers.push_back({lo, label && b == 0 ? a : "", PaletteColor(2)});
+      // The band's edges keep their labels before any mode's.
+      constexpr double kFirst = std::numeric_limits<double>::infinity();
+      if (lo > f_first) ax->markers.push_back({lo, label && b == 0 ? a : "", PaletteColor(2), kFirst});
       if (hi < f_last) {
-        ax->markers.push_back({hi, label && b + 1 == noise.usable_bands.size() ? c : "", PaletteColor(2)});
+        ax->markers.push_back({hi, label && b + 1 == noise.usable_bands.size() ? c : "", PaletteColor(2), kFirst});
       }
     }
   }
@@ -73,7 +95,8 @@ void FillModalFitPanels(const dynamics::Frf& measured, const calibration::FrfNoi
 namespace robomach::report {
 
 void FillStabilisationPanel(const std::vector<calibration::StabilisationPole>& poles,
-                            const std::vector<double>& mode_freq_hz, double fmin_hz, double fmax_hz, Axes* ax) {
+                            const std::vector<double>& mode_freq_hz, double fmin_hz, double fmax_hz, Axes* ax,
+                            const std::vector<double>& mode_strength) {
   ax->x_label = "frequency [Hz]";
   ax->y_label = "model order";
   ax->log_x = fmin_hz > 0.0 && fmax_hz / fmin_hz > 100.0;
@@ -92,10 +115,12 @@ void FillStabilisationPanel(const std::vector<calibration::StabilisationPole>& p
   }
   ax->series.push_back(std::move(unstable));
   ax->series.push_back(std::move(stable));
-  for (double f : mode_freq_hz) {
+  for (size_t k = 0; k < mode_freq_hz.size(); ++k) {
     char l[32];
-    std::snprintf(l, sizeof(l), "%.1f Hz", f);
-    ax->markers.push_back({f, l});
+    std::snprintf(l, sizeof(l), "%.1f Hz", mode_freq_hz[k]);
+    VerticalMarker m{mode_freq_hz[k], l};
+    if (k < mode_strength.size() && std::isfinite(mode_strength[k])) m.priority = mode_strength[k];
+    ax->markers.push_back(m);
   }
 }
 
@@ -159,9 +184,18 @@ void WriteModalAnalysisPng(const std::string& path, const calibration::PoseModes
     std::snprintf(head, sizeof(head), "stabilisation diagram of %s: %zu modes, orders %d..%d", which.c_str(),
                   g.fit.modes.size(), g.fit.min_order, g.fit.max_order);
     ax.title = head;
-    std::vector<double> modes;
-    for (const auto& m : g.fit.modes) modes.push_back(m.freq_hz);
-    FillStabilisationPanel(g.fit.stabilisation, modes, g.fit.fmin_hz, g.fit.fmax_hz, &ax);
+    // A mode's strength: its largest peak receptance over the FRFs fitted
+    // (the labels of the strongest are kept where not all fit).
+    std::vector<double> modes, strength;
+    for (size_t r = 0; r < g.fit.modes.size(); ++r) {
+      modes.push_back(g.fit.modes[r].freq_hz);
+      double s = 0.0;
+      for (const calibration::ModalFitResult& f : g.fit.per_frf) {
+        if (r < f.modes.size() && std::isfinite(f.modes[r].peak_contribution)) s = std::max(s, f.modes[r].peak_contribution);
+      }
+      strength.push_back(s);
+    }
+    FillStabilisationPanel(g.fit.stabilisation, modes, g.fit.fmin_hz, g.fit.fmax_hz, &ax, strength);
     if (g.fit.status == calibration::ModalFitStatus::kOk) {
       if (const auto rs = calibration::ShapesOfRovingTest(g)) {
         // The shapes over the roving points: the component in phase with

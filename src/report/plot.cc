@@ -134,9 +134,11 @@ struct MarkerLabel {
   double data_x;
   int line_x;        // the marker line's column in the plot area [px]
   cv::Scalar color;
+  double priority;   // VerticalMarker::priority
   cv::Rect box;      // in the plot area, set by PlaceLabels
   bool clear;        // set by PlaceLabels
   bool over_line;    // set by PlaceLabels: the box crosses another marker line
+  bool placed;       // set by PlaceLabels: false = left out, no room
 };
 
 // Places each label beside its marker line, left or right of it, as high in
@@ -146,21 +148,33 @@ struct MarkerLabel {
 // wide, it may cross other marker lines (over_line = true; it is drawn on a
 // white ground that interrupts them, so that a dashed line through "10.4"
 // cannot read "1.4"). A label that finds no place free of curves goes where
-// it covers the fewest curve pixels, with clear = false. Exhaustive over the
+// it covers the fewest curve pixels, with clear = false; one that finds no
+// place clear of the labels before it is left out (placed = false): with
+// thirty modes in a panel, overlapping labels are unreadable. Labels are
+// placed by descending priority, so the strongest modes keep theirs.
+// Exhaustive over the
 // plot's rows: a few hundred candidate boxes per label, each checked with
 // the summed-area table in constant time.
-void PlaceLabels(const cv::Mat1b& ink, const std::vector<int>& line_x, std::vector<MarkerLabel>* labels) {
+void PlaceLabels(const cv::Mat1b& ink, const cv::Rect& legend, const std::vector<int>& line_x,
+                 std::vector<MarkerLabel>* labels) {
   const int W = ink.cols, H = ink.rows;
+  // The legend is drawn over everything: no label goes under it, not even
+  // one without a clear place.
   cv::Mat1b taken(ink.size(), static_cast<unsigned char>(0));
+  taken(legend & cv::Rect(0, 0, W, H)).setTo(255);
   cv::Mat1i ink_sum;
   cv::integral(ink / 255, ink_sum, CV_32S);
   auto sum_of = [](const cv::Mat1i& s, const cv::Rect& r) {
     return s(r.y + r.height, r.x + r.width) - s(r.y, r.x + r.width) - s(r.y + r.height, r.x) + s(r.y, r.x);
   };
-  // Left to right: the label of the lower frequency takes its place first.
+  // By priority, then left to right: the label of the lower frequency takes
+  // its place first.
   std::vector<MarkerLabel*> order;
   for (auto& l : *labels) order.push_back(&l);
-  std::stable_sort(order.begin(), order.end(), [](auto* a, auto* b) { return a->line_x < b->line_x; });
+  std::stable_sort(order.begin(), order.end(), [](auto* a, auto* b) {
+    if (a->priority != b->priority) return a->priority > b->priority;
+    return a->line_x < b->line_x;
+  });
   for (MarkerLabel* l : order) {
     const cv::Size sz = TextSize(l->text, kLabelScale);
     const int bw = sz.width + 2 * kLabelPad;
@@ -197,17 +211,24 @@ void PlaceLabels(const cv::Mat1b& ink, const std::vector<int>& line_x, std::vect
       }
     }
     if (!found) {
-      // No clear place: the fewest curve pixels, then the highest.
+      // No clear place: the fewest curve pixels, then the highest, but
+      // never over another label.
       long fewest = std::numeric_limits<long>::max();
       for (int side = 0; side < 2; ++side) {
         const int bx = std::clamp(side == 0 ? l->line_x + kLabelGap : l->line_x - kLabelGap - bw, 0, std::max(0, W - bw));
         for (int by = 0; by + bh <= H; ++by) {
           const cv::Rect r(bx, by, std::min(bw, W), bh);
-          const long c = 1000L * (sum_of(ink_sum, r) + sum_of(taken_sum, r)) + by;
+          if (sum_of(taken_sum, r) > 0) continue;
+          const long c = 1000L * sum_of(ink_sum, r) + by;
           if (c < fewest) fewest = c, best = r;
         }
       }
+      if (fewest == std::numeric_limits<long>::max()) {
+        l->placed = false;
+        continue;
+      }
     }
+    l->placed = true;
     l->box = best;
     l->clear = found;
     l->over_line = over_line || (!found && crosses_other_line(best));
@@ -218,7 +239,8 @@ void PlaceLabels(const cv::Mat1b& ink, const std::vector<int>& line_x, std::vect
   }
 }
 
-void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vector<PlacedLabel>* placed) {
+void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vector<PlacedLabel>* placed,
+                std::vector<PlacedLegend>* legends) {
   const int left = 80, right = 20, top = 28, bottom = 48;
   const cv::Rect plot(area.x + left, area.y + top, area.width - left - right,
                       area.height - top - bottom);
@@ -294,19 +316,46 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
     }
     flush();
   }
-  // The legend's box, top right inside the plot (drawn last, reserved now
-  // so that no label is put under it).
+  // The legend's box in a corner inside the plot (drawn last, reserved now
+  // so that no label is put under it): the preferred corner unless it hides
+  // curves or points, else the corner that hides the fewest. Only series
+  // with a point to draw are listed ("measured, not used" when every line
+  // was used would name a curve that is not there).
+  std::vector<const Series*> listed;
+  for (const Series& s : ax.series) {
+    if (s.label.empty()) continue;
+    bool any = false;
+    for (size_t i = 0; i < std::min(s.x.size(), s.y.size()) && !any; ++i) {
+      any = std::isfinite(s.x[i]) && std::isfinite(s.y[i]) && (!ax.log_x || s.x[i] > 0) && (!ax.log_y || s.y[i] > 0);
+    }
+    if (any) listed.push_back(&s);
+  }
   int legend_width = 0;
-  for (const Series& s : ax.series) legend_width = std::max(legend_width, TextSize(s.label).width);
-  int count = 0;
-  for (const Series& s : ax.series) count += !s.label.empty();
+  for (const Series* s : listed) legend_width = std::max(legend_width, TextSize(s->label).width);
+  const int count = static_cast<int>(listed.size());
   using LP = Axes::LegendPosition;
-  const bool at_right = ax.legend == LP::kTopRight || ax.legend == LP::kBottomRight;
-  const bool at_top = ax.legend == LP::kTopRight || ax.legend == LP::kTopLeft;
-  const int legend_x = at_right ? plot.x + plot.width - legend_width - 50 : plot.x + 14;
-  const int legend_y = at_top ? plot.y + 8 : plot.y + plot.height - 18 * count - 10;
-  const cv::Rect legend_box(legend_x - 6, legend_y - 2, legend_width + 54, 18 * count + 6);
-  if (count > 0) cv::rectangle(ink, legend_box - plot.tl(), cv::Scalar(255), cv::FILLED);
+  const auto legend_box_at = [&](LP corner) {
+    const bool at_right = corner == LP::kTopRight || corner == LP::kBottomRight;
+    const bool at_top = corner == LP::kTopRight || corner == LP::kTopLeft;
+    const int x = at_right ? plot.x + plot.width - legend_width - 50 : plot.x + 14;
+    const int y = at_top ? plot.y + 8 : plot.y + plot.height - 18 * count - 10;
+    return cv::Rect(x - 6, y - 2, legend_width + 54, 18 * count + 6);
+  };
+  cv::Rect legend_box = legend_box_at(ax.legend);
+  if (count > 0) {
+    const auto hidden = [&](const cv::Rect& box) {
+      const cv::Rect r = (box - plot.tl()) & cv::Rect(0, 0, ink.cols, ink.rows);
+      return r.empty() ? 0 : cv::countNonZero(ink(r));
+    };
+    int fewest = hidden(legend_box);
+    for (LP corner : {LP::kTopRight, LP::kTopLeft, LP::kBottomLeft, LP::kBottomRight}) {
+      const cv::Rect box = legend_box_at(corner);
+      const int n = hidden(box);
+      if (n < fewest) fewest = n, legend_box = box;
+    }
+    cv::rectangle(ink, legend_box - plot.tl(), cv::Scalar(255), cv::FILLED);
+  }
+  const int legend_x = legend_box.x + 6, legend_y = legend_box.y + 2;
   // Vertical markers: the dashed lines, then their labels where they cross
   // no curve, no other label and, if possible, no other marker line.
   std::vector<MarkerLabel> labels;
@@ -316,10 +365,15 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
     const int x = static_cast<int>(std::lround(tx(m.x)));
     DashedLine(img, {x, plot.y}, {x, plot.y + plot.height}, ToCv(m.color), 1);
     line_x.push_back(x - plot.x);
-    if (!m.label.empty()) labels.push_back({m.label, m.x, x - plot.x, ToCv(m.color), {}, true, false});
+    if (!m.label.empty()) labels.push_back({m.label, m.x, x - plot.x, ToCv(m.color), m.priority, {}, true, false, true});
   }
-  PlaceLabels(ink, line_x, &labels);
+  PlaceLabels(ink, count > 0 ? legend_box - plot.tl() : cv::Rect(), line_x, &labels);
+  int left_out = 0;
   for (MarkerLabel& l : labels) {
+    if (!l.placed) {
+      ++left_out;
+      continue;
+    }
     const cv::Rect box = l.box + plot.tl();
     // Over another marker line, or without a clear place, the label gets a
     // white ground: it then hides a piece of that line or curve instead of
@@ -335,16 +389,26 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
   const cv::Size xs = TextSize(ax.x_label);
   PutText(img, ax.x_label, {plot.x + plot.width / 2 - xs.width / 2, area.y + area.height - 8});
   PutVerticalText(img, ax.y_label, {area.x + 14, plot.y + plot.height / 2});
-  if (!ax.title.empty()) {
-    PutText(img, ax.title, {plot.x, area.y + 19}, 0.55, kBlack, 1);
+  std::string title = ax.title;
+  if (left_out > 0) {
+    title += std::string(title.empty() ? "" : " ") + "(" + std::to_string(left_out) + " of " +
+             std::to_string(labels.size()) + " line labels left out: no room)";
+  }
+  if (!title.empty()) {
+    PutText(img, title, {plot.x, area.y + 19}, 0.55, kBlack, 1);
   }
   // Legend.
   int lx = legend_x, ly = legend_y;
   if (count > 0) {
+    if (legends) {
+      PlacedLegend pl{panel, {}, legend_box.x, legend_box.y, legend_box.width, legend_box.height};
+      for (const Series* s : listed) pl.entries.push_back(s->label);
+      legends->push_back(std::move(pl));
+    }
     cv::rectangle(img, legend_box, cv::Scalar(255, 255, 255), cv::FILLED);
     cv::rectangle(img, legend_box, cv::Scalar(180, 180, 180), 1);
-    for (const Series& s : ax.series) {
-      if (s.label.empty()) continue;
+    for (const Series* sp : listed) {
+      const Series& s = *sp;
       if (s.dashed) DashedLine(img, {lx, ly + 9}, {lx + 36, ly + 9}, ToCv(s.color), s.thickness);
       else if (s.markers) cv::circle(img, {lx + 18, ly + 9}, 3, ToCv(s.color), cv::FILLED);
       else cv::line(img, {lx, ly + 9}, {lx + 36, ly + 9}, ToCv(s.color), s.thickness, cv::LINE_AA);
@@ -402,8 +466,10 @@ Figure::Figure(int rows, int cols, int panel_width_px, int panel_height_px)
   if (rows < 1 || cols < 1) throw std::invalid_argument("Figure: needs at least one panel");
 }
 
-std::vector<unsigned char> Figure::EncodePng(std::vector<PlacedLabel>* labels) const {
+std::vector<unsigned char> Figure::EncodePng(std::vector<PlacedLabel>* labels,
+                                             std::vector<PlacedLegend>* legends) const {
   if (labels) labels->clear();
+  if (legends) legends->clear();
   const int title_h = title.empty() ? 0 : 34;
   cv::Mat img(rows_ * panel_h_ + title_h, cols_ * panel_w_, CV_8UC3, cv::Scalar(255, 255, 255));
   if (!title.empty()) {
@@ -417,7 +483,7 @@ std::vector<unsigned char> Figure::EncodePng(std::vector<PlacedLabel>* labels) c
   for (int r = 0; r < rows_; ++r) {
     for (int c = 0; c < cols_; ++c) {
       RenderAxes(img, axes_[r * cols_ + c], cv::Rect(c * panel_w_, title_h + r * panel_h_, panel_w_, panel_h_),
-                 r * cols_ + c, labels);
+                 r * cols_ + c, labels, legends);
     }
   }
   std::vector<unsigned char> png;

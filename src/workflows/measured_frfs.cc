@@ -81,7 +81,7 @@ MeasuredFrfs ReadMeasuredFrfFiles(const MeasuredFrfOptions& o, const MessageSink
     for (const std::string& n : r.notes) Tell(on_message, Message::Kind::kNote, n);
     // On each FRF's usable band only (issue #34 item 5): a tap test's drift
     // lines are no measure of the unit.
-    for (const std::string& f : calibration::ReceptanceUnitFindings(r.frfs, path, r.averages)) {
+    for (const std::string& f : calibration::ReceptanceUnitFindings(r.frfs, path, r.averages, r.file_format)) {
       Tell(on_message, Message::Kind::kWarning, "implausible (unit mistake?): " + f);
       all.unit_findings.push_back(f);
     }

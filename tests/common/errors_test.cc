@@ -13,6 +13,25 @@ TEST(InputError, MessageStartsWithTheLocation) {
   EXPECT_EQ(InputError({"r.urdf", 0, 0}, "x").message(), "x");
 }
 
+// A Latin-1 header byte (0xE9 "é", 0xB2 "²") is not UTF-8 and is written
+// \xHH; valid UTF-8 ("²" = C2 B2, "µ" = C2 B5, a 4-byte emoji) is kept.
+// The ill-formed sequences of the Unicode Standard's Table 3-7: a cut
+// sequence, an overlong "/" (C0 AF), a surrogate (ED A0 80) and a code
+// point above U+10FFFF (F4 90 80 80) are escaped byte by byte.
+TEST(EscapeInvalidUtf8, EscapesLatin1AndIllFormedBytesAndKeepsUtf8) {
+  EXPECT_EQ(EscapeInvalidUtf8("caf\xE9 m/s\xB2"), "caf\\xE9 m/s\\xB2");
+  EXPECT_EQ(EscapeInvalidUtf8("m/s\xC2\xB2, \xC2\xB5m, \xF0\x9F\x94\xA8"), "m/s\xC2\xB2, \xC2\xB5m, \xF0\x9F\x94\xA8");
+  EXPECT_EQ(EscapeInvalidUtf8("a\xC2"), "a\\xC2");
+  EXPECT_EQ(EscapeInvalidUtf8("\xC0\xAF"), "\\xC0\\xAF");
+  EXPECT_EQ(EscapeInvalidUtf8("\xED\xA0\x80"), "\\xED\\xA0\\x80");
+  EXPECT_EQ(EscapeInvalidUtf8("\xF4\x90\x80\x80"), "\\xF4\\x90\\x80\\x80");
+  EXPECT_EQ(EscapeInvalidUtf8(""), "");
+  // An InputError quoting a header escapes it in what() and message().
+  const InputError e({"h.uff", 11, 0}, "unit \"m/s\xB2\"");
+  EXPECT_STREQ(e.what(), "h.uff:11: unit \"m/s\\xB2\"");
+  EXPECT_EQ(e.message(), "unit \"m/s\\xB2\"");
+}
+
 TEST(Units, ConversionsAreExactInverses) {
   EXPECT_DOUBLE_EQ(DegToRad(180.0), kPi);
   EXPECT_DOUBLE_EQ(RpmToRadPerSec(60.0), 2 * kPi);

@@ -25,6 +25,7 @@ using dynamics::Frf;
 using dynamics::FrfKey;
 using dynamics::FrfSet;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using robomach::testing::CaptureError;
 using robomach::testing::SourcePath;
 using robomach::testing::TempDir;
@@ -206,6 +207,19 @@ TEST(FrfUff58, MobilityReadAsReceptanceIsFlagged) {
   EXPECT_THAT(f[0], HasSubstr("m.uff: pose P1, response x, excitation x: the largest receptance is 0.00133 m/N, "
                               "outside the plausible 1e-12 to 1e-03 m/N"));
   EXPECT_THAT(f[0], HasSubstr("a mobility or accelerance was read as receptance"));
+  // Where to look depends on the format: a UFF58 file has no columns.
+  EXPECT_THAT(f[0], HasSubstr("check the units in the column names (CSV), or the unit lines and ordinate data type "
+                              "of records 9 and 10 (UFF58)"));
+  const auto fu = dynamics::ReceptanceUnitFindings(mobility, "m.uff", dynamics::FrfFileFormat::kUff58);
+  ASSERT_EQ(fu.size(), 2u);
+  EXPECT_THAT(fu[0], HasSubstr("check the unit lines and the ordinate data type of records 9 (response) and 10 "
+                               "(force), and record 8 (abscissa, Hz)"));
+  EXPECT_THAT(fu[0], Not(HasSubstr("column")));
+  const auto fc = dynamics::ReceptanceUnitFindings(mm, "mm.csv", dynamics::FrfFileFormat::kCsv);
+  ASSERT_EQ(fc.size(), 2u);
+  EXPECT_THAT(fc[0], HasSubstr("under a column named in m (and N)"));
+  EXPECT_THAT(fc[0], HasSubstr("; check the units in the column names"));
+  EXPECT_THAT(fc[0], Not(HasSubstr("records 9")));
   EXPECT_EQ(dynamics::ReceptanceUnitFindings(mm, "mm.csv").size(), 2u);
   const std::string dir = TempDir("frf_units");
   WriteUff58(dir + "/mobility.uff", mobility);

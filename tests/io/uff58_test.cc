@@ -29,6 +29,7 @@ namespace {
 using dynamics::Frf;
 using dynamics::FrfKey;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using robomach::testing::CaptureError;
 using robomach::testing::SourcePath;
 using robomach::testing::TempDir;
@@ -380,6 +381,25 @@ TEST(Uff58, BinaryRecordsEqualTheirAsciiTwins) {
   }
 }
 
+// A unit that makes the record an accelerance is named with its article
+// ("an accelerance", not "a accelerance"), and so is its 0 Hz line.
+TEST(Uff58, NamesAnAccelerancePerItsUnitWithTheRightArticle) {
+  const std::string dir = TempDir("uff58_article");
+  Header h;
+  h.r6 = Record6(4, "NONE", 1, 3, "NONE", 1, 3);
+  h.n = 3;
+  h.dx = 1.0;
+  h.r9 = Axis(0, 0, 0, "Accelerance", "m/s^2");
+  WriteText(dir + "/a.uff", AsciiRecord(h, {1e-3, 0, 2e-3, 0, 3e-3, 0}));
+  const FrfReadResult r = ReadFrfFile(dir + "/a.uff");
+  std::string notes;
+  for (const auto& s : r.notes) notes += s + "\n";
+  for (const auto& s : r.warnings) notes += s + "\n";
+  EXPECT_THAT(notes, HasSubstr("makes it an accelerance"));
+  EXPECT_THAT(notes, HasSubstr("the 0 Hz line of an accelerance FRF"));
+  EXPECT_THAT(notes, Not(HasSubstr("a accelerance")));
+}
+
 TEST(Uff58, SaysWhatARecordIsWhenItIsNotAnFrf) {
   const std::string dir = TempDir("uff58_not_frf");
   Header h;
@@ -395,6 +415,11 @@ TEST(Uff58, SaysWhatARecordIsWhenItIsNotAnFrf) {
   EXPECT_THAT(CaptureError([&] { ReadFrfFile(dir + "/t.uff"); }),
               HasSubstr("t.uff: no frequency response function (dataset 58, function type 4) in the file: it holds a "
                         "time response (function type 1) at line 2"));
+  // Time records are a hammer test's raw data: the message names the tool
+  // that turns them into FRFs (frf-estimate reads UFF58 function type 1).
+  EXPECT_THAT(CaptureError([&] { ReadFrfFile(dir + "/t.uff"); }),
+              HasSubstr("; to turn impact-hammer time records (per hit the force record, then its response records) "
+                        "into an FRF file, run frf-estimate on them (docs/frf-estimate.md)"));
   // Beside an FRF the time record is skipped with a note.
   Header hf;
   hf.r6 = Record6(4, "NONE", 1, 3, "NONE", 1, 3);

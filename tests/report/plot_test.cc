@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include <opencv2/core.hpp>
@@ -142,6 +144,82 @@ TEST(Figure, LabelWithoutAClearPlaceIsFlaggedAndDrawnOnWhite) {
   ASSERT_EQ(labels.size(), 1u);
   EXPECT_FALSE(labels[0].clear);
   EXPECT_EQ(ColouredPixels(img, labels[0]), 0);
+}
+
+// 120 modes 3 Hz apart on a 600 x 200 px panel (frf-modes on
+// dataset58_FRF.unv: 31 modes, the labels were drawn over each other): no
+// two labels overlap, labels that find no room are left out, and the
+// strongest keep theirs.
+TEST(Figure, CrowdedMarkerLabelsNeverOverlapAndTheStrongestAreKept) {
+  Figure fig(1, 1, 600, 200);
+  Axes& ax = fig.at(0, 0);
+  Series line;
+  line.color = PaletteColor(0);
+  for (int i = 0; i <= 100; ++i) {
+    line.x.push_back(300.0 + 4.0 * i);
+    line.y.push_back(std::sin(0.3 * i));
+  }
+  ax.series.push_back(line);
+  ax.x_min = 300.0;
+  ax.x_max = 700.0;
+  const int n = 120;
+  for (int k = 0; k < n; ++k) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.1f Hz", 310.0 + 3.0 * k);
+    // Priorities in a scrambled order; mode 17 (361 Hz) is the strongest.
+    ax.markers.push_back({310.0 + 3.0 * k, text, {120, 120, 120}, k == 17 ? 100.0 : static_cast<double>((k * 7) % 11)});
+  }
+  std::vector<PlacedLabel> labels;
+  fig.EncodePng(&labels);
+  ASSERT_GT(labels.size(), 0u);
+  EXPECT_LT(labels.size(), static_cast<size_t>(n)) << "120 labels in ~10 rows of ~8 cannot all be placed";
+  bool strongest = false;
+  for (size_t i = 0; i < labels.size(); ++i) {
+    strongest = strongest || labels[i].text == "361.0 Hz";
+    for (size_t j = i + 1; j < labels.size(); ++j) {
+      const cv::Rect a(labels[i].x, labels[i].y, labels[i].width, labels[i].height);
+      const cv::Rect b(labels[j].x, labels[j].y, labels[j].width, labels[j].height);
+      EXPECT_TRUE((a & b).empty()) << labels[i].text << " overlaps " << labels[j].text;
+    }
+  }
+  EXPECT_TRUE(strongest) << "the label of the strongest mode (361.0 Hz) was left out";
+}
+
+// The legend lists only series with a point to draw ("measured, not used"
+// with every line used has none), and leaves the preferred corner for the
+// one that hides the fewest curve pixels when the preferred one hides some.
+TEST(Figure, LegendListsSeriesWithPointsAndAvoidsTheData) {
+  Figure fig(1, 1, 500, 300);
+  Axes& ax = fig.at(0, 0);
+  Series unused, used;
+  unused.label = "measured, not used";
+  used.label = "measured, usable";
+  used.color = PaletteColor(0);
+  used.thickness = 3;
+  // A curve through the top right corner (the default legend corner) only:
+  // y rises steeply at the right end.
+  for (int i = 0; i <= 100; ++i) {
+    unused.x.push_back(i);
+    unused.y.push_back(NAN);
+    used.x.push_back(i);
+    used.y.push_back(i < 70 ? 0.0 : (i - 70) / 30.0);
+  }
+  ax.series = {unused, used};
+  ax.y_min = 0.0;
+  ax.y_max = 1.0;
+  std::vector<PlacedLegend> legends;
+  fig.EncodePng(nullptr, &legends);
+  ASSERT_EQ(legends.size(), 1u);
+  EXPECT_EQ(legends[0].entries, std::vector<std::string>{"measured, usable"});
+  // Not top right any more: the box starts in the left half or the lower half.
+  const bool left = legends[0].x < 200, low = legends[0].y > 150;
+  EXPECT_TRUE(left || low) << legends[0].x << "," << legends[0].y;
+  // With no curve in the top right corner the legend stays there.
+  ax.series[1].y.assign(ax.series[1].y.size(), 0.0);
+  fig.EncodePng(nullptr, &legends);
+  ASSERT_EQ(legends.size(), 1u);
+  EXPECT_GT(legends[0].x, 250);
+  EXPECT_LT(legends[0].y, 150);
 }
 
 }  // namespace

@@ -271,13 +271,16 @@ struct UsableBandPeak {
 UsableBandPeak PeakReceptanceInUsableBand(const dynamics::Frf& frf, int averages = 0);
 
 /// dynamics::ReceptancePeakFinding of PeakReceptanceInUsableBand, naming
-/// the band: "" when plausible. `what` starts the sentence.
-std::string UsableBandUnitFinding(const std::string& what, const UsableBandPeak& peak);
+/// the band: "" when plausible. `what` starts the sentence; `format` says
+/// where the message tells the user to look for the units.
+std::string UsableBandUnitFinding(const std::string& what, const UsableBandPeak& peak,
+                                  dynamics::FrfFileFormat format = dynamics::FrfFileFormat::kUnknown);
 
 /// UsableBandUnitFinding of PeakReceptanceInUsableBand of every FRF of the
 /// set (`averages` behind each, 0 unknown): one finding per FRF out of
 /// range, each starting with `source` and the FRF's key.
 std::vector<std::string> ReceptanceUnitFindings(const dynamics::FrfSet& frfs, const std::string& source,
-                                                int averages = 0);
+                                                int averages = 0,
+                                                dynamics::FrfFileFormat format = dynamics::FrfFileFormat::kUnknown);
 
 }  // namespace robomach::calibration

@@ -2,9 +2,16 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 
 namespace robomach {
+
+/// `text` with every byte that is not part of valid UTF-8 written as \xHH
+/// (e.g. a Latin-1 "é" from a file header as \xE9), for messages: a raw
+/// byte would garble the terminal and make a JSON summary invalid. Valid
+/// UTF-8 (ASCII, "²", "µ") is kept as it is.
+std::string EscapeInvalidUtf8(std::string_view text);
 
 /// Where in a user's file something was found. Lines and columns are 1-based;
 /// 0 means unknown.
@@ -17,6 +24,8 @@ struct SourceLocation {
 };
 
 /// Malformed or out-of-range user data. what() == "path:line[:col]: message".
+/// Bytes of the path or message that are not UTF-8 are escaped
+/// (EscapeInvalidUtf8): the message quotes text from the user's file.
 class InputError : public std::runtime_error {
  public:
   InputError(SourceLocation where, const std::string& message);

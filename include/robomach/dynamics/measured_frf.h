@@ -129,8 +129,12 @@ inline constexpr double kMinPlausibleReceptance = 1e-12;
 /// [kMinPlausibleReceptance, kMaxPlausibleReceptance]: "" if plausible, else
 /// a sentence starting with `what` that names the value, the range and the
 /// likely unit mistakes (mm or um under an _m column, kN under force_N, a
-/// mobility or accelerance read as receptance; or mN, km).
-std::string ReceptancePeakFinding(const std::string& what, double peak_m_per_N);
+/// mobility or accelerance read as receptance; or mN, km), and where to
+/// look: the column names of a CSV, records 8-10 of a UFF58 file (its unit
+/// lines and ordinate data type), either when `format` is kUnknown.
+enum class FrfFileFormat { kUnknown, kCsv, kUff58 };
+std::string ReceptancePeakFinding(const std::string& what, double peak_m_per_N,
+                                  FrfFileFormat format = FrfFileFormat::kUnknown);
 
 /// The largest median of three neighbouring |H| (a resonance spans several
 /// lines; a lone line is noise) of `frf` on its lines above 0 Hz with
@@ -143,6 +147,7 @@ double PeakReceptance(const Frf& frf);
 
 /// ReceptancePeakFinding of every FRF of the set: one finding per FRF out of
 /// range, each starting with `source` and the FRF's key.
-std::vector<std::string> ReceptanceUnitFindings(const FrfSet& frfs, const std::string& source);
+std::vector<std::string> ReceptanceUnitFindings(const FrfSet& frfs, const std::string& source,
+                                                FrfFileFormat format = FrfFileFormat::kUnknown);
 
 }  // namespace robomach::dynamics

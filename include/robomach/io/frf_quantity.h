@@ -18,6 +18,9 @@ enum class FrfQuantity { kReceptance, kMobility, kAccelerance };
 
 /// "receptance", "mobility", "accelerance".
 std::string QuantityName(FrfQuantity q);
+/// The name with its article, for messages: "a receptance", "a mobility",
+/// "an accelerance".
+std::string QuantityWithArticle(FrfQuantity q);
 /// @throws std::invalid_argument for anything else.
 FrfQuantity ParseQuantity(const std::string& name);
 
@@ -40,6 +43,9 @@ struct FrfReadResult {
   /// entity names, a quantity from unit labels, padding, datasets and
   /// records that are not FRFs. Tools print them as notes, not warnings.
   std::vector<std::string> notes;
+  /// The file's format (set by io::ReadFrfFile), for messages that say
+  /// where its units are: CSV column names or UFF58 records 8-10.
+  dynamics::FrfFileFormat file_format{dynamics::FrfFileFormat::kUnknown};
 };
 
 /// What the readers do without `keep_points` (io::ReadFrfFile): a posture

@@ -23,9 +23,12 @@ struct FrfCurve {
 };
 
 /// Fills a magnitude panel (log |H| in m/N) and a phase panel (degrees, -180..180)
-/// with `curves` and marks `mode_freq_hz` as labelled vertical lines.
+/// with `curves` and marks `mode_freq_hz` as labelled vertical lines;
+/// `mode_strength` (e.g. each mode's peak receptance; empty: all equal) says
+/// whose labels are kept where they cannot all be placed.
 /// The frequency axis is logarithmic when it spans more than two decades.
 void FillFrfPanels(const std::vector<FrfCurve>& curves, const std::vector<double>& mode_freq_hz,
-                   const std::string& title, Axes* magnitude, Axes* phase);
+                   const std::string& title, Axes* magnitude, Axes* phase,
+                   const std::vector<double>& mode_strength = {});
 
 }  // namespace robomach::report

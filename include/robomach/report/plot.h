@@ -31,6 +31,11 @@ struct VerticalMarker {
   double x{0.0};
   std::string label;
   Rgb color{120, 120, 120};
+  /// Which labels are kept when they cannot all be placed (a mode's peak
+  /// receptance, say): labels are placed in descending priority, and one
+  /// that finds no place clear of the labels placed before it is left out
+  /// (its line is still drawn). Equal priorities: left to right.
+  double priority{0.0};
 };
 
 /// One panel: axes with labelled ticks, grid, curves, legend. Units belong
@@ -47,6 +52,10 @@ struct Axes {
   std::vector<VerticalMarker> markers;
   /// Fixed y ticks (e.g. every 90° for phase); empty = automatic.
   std::vector<double> y_ticks;
+  /// The preferred corner of the legend. Where its box would hide a curve
+  /// or points, the legend goes to the corner where it hides the fewest
+  /// (the preferred one on a tie). Series without a finite point to draw
+  /// get no legend entry.
   enum class LegendPosition { kTopRight, kTopLeft, kBottomLeft, kBottomRight };
   LegendPosition legend{LegendPosition::kTopRight};
 };
@@ -54,7 +63,9 @@ struct Axes {
 /// Where a marker's label was drawn, in pixels of the PNG (origin top left).
 /// Labels go beside their marker line, left or right of it, where their box
 /// crosses no curve, no legend and no other label, and, where there is room,
-/// no other marker line (see over_marker_line).
+/// no other marker line (see over_marker_line). Labels never overlap each
+/// other: one without room is left out (VerticalMarker::priority says which)
+/// and the panel's title says how many were.
 struct PlacedLabel {
   int panel{0};             // row * cols + col
   std::string text;
@@ -69,6 +80,13 @@ struct PlacedLabel {
   bool over_marker_line{false};
 };
 
+/// Where a panel's legend was drawn and what it lists.
+struct PlacedLegend {
+  int panel{0};
+  std::vector<std::string> entries;     // the series' labels, in order
+  int x{0}, y{0}, width{0}, height{0};  // the box [px]
+};
+
 /// A figure of rows × cols panels rendered to PNG.
 class Figure {
  public:
@@ -79,8 +97,10 @@ class Figure {
   /// @throws OutputError if the file cannot be written.
   void SavePng(const std::string& path) const;
   /// Encoded PNG bytes; `labels`, if given, receives where each marker
-  /// label was drawn (for tests and callers that annotate further).
-  std::vector<unsigned char> EncodePng(std::vector<PlacedLabel>* labels = nullptr) const;
+  /// label was drawn, `legends` where each legend was (for tests and callers
+  /// that annotate further).
+  std::vector<unsigned char> EncodePng(std::vector<PlacedLabel>* labels = nullptr,
+                                       std::vector<PlacedLegend>* legends = nullptr) const;
 
  private:
   int rows_, cols_, panel_w_, panel_h_;
