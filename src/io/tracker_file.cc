@@ -260,7 +260,7 @@ std::string TrackerNoiseUnitFinding(const std::string& option, double noise_mm) 
     return "";
   }
   return "implausible (unit mistake?): " + option + " " + FormatDouble(noise_mm) +
-         " mm is outside the 0.0001 to 1 mm of laser trackers (0.005 to 0.05 mm): " +
+         " is outside the 0.0001 to 1 mm of laser trackers (0.005 to 0.05 mm): " +
          (noise_mm > kMaxPlausibleTrackerNoiseMm ? "a noise in um typed in the mm option?"
                                                  : "a noise in m typed in the mm option?");
 }
