@@ -80,7 +80,9 @@ int Run(int argc, char** argv) {
                                                                  {"--postures", postures_path}};
       for (const auto& f : measured_files) inputs.emplace_back("--measured", f);
       for (const auto& f : validate_files) inputs.emplace_back("--validate", f);
-      CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}});
+      for (const auto& f : pose_files) inputs.emplace_back("--pose", f.substr(f.find('=') + 1));
+      for (const auto& f : validate_pose_files) inputs.emplace_back("--validate-pose", f.substr(f.find('=') + 1));
+      CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}}, {{"--report", report_dir}});
     }
     if (measured_files.empty() && pose_files.empty()) {
       throw UsageError("no measured FRFs: give --measured FILE or --pose ID=file.uff");

@@ -85,7 +85,11 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--max-order", opt.fit.max_order, 8, 400);
     std::vector<std::pair<std::string, std::string>> inputs;
     for (const auto& f : measured_files) inputs.push_back({"--measured", f});
-    CheckDistinctPaths(inputs, {{"--out", out_path}, {"--modal-constants", constants_path}, {"--mode-shapes", shapes_path}, {"--summary", summary_path}});
+    for (const auto& f : pose_files) inputs.push_back({"--pose", f.substr(f.find('=') + 1)});
+    CheckDistinctPaths(inputs,
+                       {{"--out", out_path}, {"--modal-constants", constants_path}, {"--mode-shapes", shapes_path},
+                        {"--summary", summary_path}},
+                       {{"--plot-dir", plot_dir}});
     // A UFF file without posture names is one posture, "P1", here: frf-modes
     // needs none (frf-calibrate's --pose P1=file.uff still works).
     MeasuredData all = ReadMeasuredFiles(kTool, {}, pose_files, "measured FRF file", "--pose", true);

@@ -112,7 +112,8 @@ int Run(int argc, char** argv) {
     if (!freq_file.empty()) RequireReadableFile(freq_file, "frequency file");
     CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}, {"--freq-file", freq_file}},
                        {{"--out", out_path}, {"--modes", modes_path}, {"--summary", details_path},
-                        {"--plot", plot_path}});
+                        {"--plot", plot_path}},
+                       {{"--plot-dir", plot_dir}});
     const io::DirectionPairs pairs = FromOption("--directions", [&] { return io::ParseDirectionPairs(directions); });
     Eigen::VectorXd freq_hz;
     if (!freq_file.empty()) {
