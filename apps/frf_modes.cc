@@ -178,9 +178,13 @@ int Run(int argc, char** argv) {
     }
     if (!plot_dir.empty()) {
       io::EnsureDirectory(plot_dir);
+      std::vector<std::string> ids;
+      for (const calibration::PoseModes& p : poses) ids.push_back(p.pose_id);
+      const std::map<std::string, std::string> stems = FileStemsForIds(kTool, "--plot-dir", ids);
       for (const calibration::PoseModes& p : poses) {
-        report::WriteModalAnalysisPng((std::filesystem::path(plot_dir) / ("modes_" + p.pose_id + ".png")).string(), p,
-                                      all.frfs, noise);
+        report::WriteModalAnalysisPng(
+            (std::filesystem::path(plot_dir) / ("modes_" + stems.at(p.pose_id) + ".png")).string(), p, all.frfs,
+            noise);
       }
     }
     if (!summary_path.empty()) {

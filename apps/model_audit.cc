@@ -252,6 +252,7 @@ int Run(int argc, char** argv) {
     }
     for (const audit::BoundFlag& f : r.baseline_on_bound) Warn(kTool, f.message);
     ro.input_warnings = WarningsGiven();
+    FileStemsForIds(kTool, "--report", measured.pose_ids());  // notes: the overlays' file names
     const report::AuditReport rep = report::WriteAuditReport(report_dir, r, cfg.description, postures, measured,
                                                              measured_read.frfs, noise, ro);
     const json& j = rep.summary;

@@ -19,6 +19,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/file_kind.h"
+#include "robomach/io/file_names.h"
 
 namespace robomach::apps {
 
@@ -250,6 +251,18 @@ void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& 
       throw OutputError(opt + " " + path + ": cannot be written: the folder " + probe.string() + " is not writable");
     }
   }
+}
+
+std::map<std::string, std::string> FileStemsForIds(const std::string& tool, const std::string& option,
+                                                   const std::vector<std::string>& ids) {
+  std::map<std::string, std::string> stems = io::SafeFileStems(ids);
+  for (const auto& [id, stem] : stems) {
+    if (stem != id) {
+      Note(tool, option + ": posture \"" + id + "\" is not a safe file name; its files are named with \"" + stem +
+                     "\" (docs/conventions.md, file names made from IDs)");
+    }
+  }
+  return stems;
 }
 
 void CheckOptionRange(const std::string& option, double value, double lo, double hi) {

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <functional>
+#include <map>
 #include <optional>
 
 #include <Eigen/Core>
@@ -160,6 +161,12 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
 void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& inputs,
                         const std::vector<std::pair<std::string, std::string>>& outputs,
                         const std::vector<std::pair<std::string, std::string>>& folders = {});
+
+/// File-name stems for IDs used as file names in a folder output
+/// (io::SafeFileStems): "tool: note: ..." on stderr for each ID whose file
+/// name differs from it, naming `option` and the name used.
+std::map<std::string, std::string> FileStemsForIds(const std::string& tool, const std::string& option,
+                                                   const std::vector<std::string>& ids);
 
 /// @throws UsageError unless lo <= value <= hi (and finite).
 void CheckOptionRange(const std::string& option, double value, double lo, double hi);
