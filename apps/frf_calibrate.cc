@@ -80,7 +80,9 @@ int Run(int argc, char** argv) {
                                                                  {"--postures", postures_path}};
       for (const auto& f : measured_files) inputs.emplace_back("--measured", f);
       for (const auto& f : validate_files) inputs.emplace_back("--validate", f);
-      CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}});
+      for (const auto& f : pose_files) inputs.emplace_back("--pose", f.substr(f.find('=') + 1));
+      for (const auto& f : validate_pose_files) inputs.emplace_back("--validate-pose", f.substr(f.find('=') + 1));
+      CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}}, {{"--report", report_dir}});
     }
     if (measured_files.empty() && pose_files.empty()) {
       throw UsageError("no measured FRFs: give --measured FILE or --pose ID=file.uff");
@@ -218,22 +220,26 @@ int Run(int argc, char** argv) {
       if (!all.contains(k)) all.Insert(k, f);
     }
     for (const auto& [k, n] : holdout_noise) all_noise.emplace(k, n);
+    std::vector<std::string> ids = all.pose_ids();
+    for (const std::string& pose : holdout.pose_ids()) ids.push_back(pose);
+    const std::map<std::string, std::string> stems = FileStemsForIds(kTool, "--report", ids);
     for (const std::string& pose : all.pose_ids()) {
       const auto db = eb.Evaluate(postures.at(pose));
       const auto da = ea.Evaluate(postures.at(pose));
       const bool held = !measured_read.frfs.ForPose(pose).size();
       report::PostureOverlay overlay = report::MakePostureOverlay(pose, all, db, da);
       report::AddNoise(all_noise, &overlay);
-      report::WriteOverlayPng((dir / (pose + ".png")).string(), overlay,
+      report::WriteOverlayPng((dir / (stems.at(pose) + ".png")).string(), overlay,
                               "frf-calibrate: posture " + pose + (held ? " (held out)" : "") +
                                   ", measured vs model before and after calibration");
     }
     for (const std::string& pose : measured.pose_ids()) {
-      report::WriteStabilisationPng((dir / ("stabilisation_" + pose + ".png")).string(), pose, features);
+      report::WriteStabilisationPng((dir / ("stabilisation_" + stems.at(pose) + ".png")).string(), pose, features);
     }
     for (const std::string& pose : holdout.pose_ids()) {
       if (measured.ForPose(pose).empty()) {
-        report::WriteStabilisationPng((dir / ("stabilisation_" + pose + ".png")).string(), pose, holdout_features);
+        report::WriteStabilisationPng((dir / ("stabilisation_" + stems.at(pose) + ".png")).string(), pose,
+                                      holdout_features);
       }
     }
     if (!summary_path.empty()) io::WriteFileAtomically(summary_path, report::DumpJson(summary));

@@ -85,7 +85,11 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--max-order", opt.fit.max_order, 8, 400);
     std::vector<std::pair<std::string, std::string>> inputs;
     for (const auto& f : measured_files) inputs.push_back({"--measured", f});
-    CheckDistinctPaths(inputs, {{"--out", out_path}, {"--modal-constants", constants_path}, {"--mode-shapes", shapes_path}, {"--summary", summary_path}});
+    for (const auto& f : pose_files) inputs.push_back({"--pose", f.substr(f.find('=') + 1)});
+    CheckDistinctPaths(inputs,
+                       {{"--out", out_path}, {"--modal-constants", constants_path}, {"--mode-shapes", shapes_path},
+                        {"--summary", summary_path}},
+                       {{"--plot-dir", plot_dir}});
     // A UFF record that names no posture is posture P1 here (frf-modes
     // needs none; frf-calibrate's --pose P1=file.uff still works); a
     // posture the file names wins, and a CSV always names its own.
@@ -158,9 +162,13 @@ int Run(int argc, char** argv) {
     }
     if (!plot_dir.empty()) {
       io::EnsureDirectory(plot_dir);
+      std::vector<std::string> ids;
+      for (const calibration::PoseModes& p : poses) ids.push_back(p.pose_id);
+      const std::map<std::string, std::string> stems = FileStemsForIds(kTool, "--plot-dir", ids);
       for (const calibration::PoseModes& p : poses) {
-        report::WriteModalAnalysisPng((std::filesystem::path(plot_dir) / ("modes_" + p.pose_id + ".png")).string(), p,
-                                      all.frfs, noise);
+        report::WriteModalAnalysisPng(
+            (std::filesystem::path(plot_dir) / ("modes_" + stems.at(p.pose_id) + ".png")).string(), p, all.frfs,
+            noise);
       }
     }
     if (!summary_path.empty()) {

@@ -112,7 +112,8 @@ int Run(int argc, char** argv) {
     if (!freq_file.empty()) RequireReadableFile(freq_file, "frequency file");
     CheckDistinctPaths({{"--robot", robot_path}, {"--postures", postures_path}, {"--freq-file", freq_file}},
                        {{"--out", out_path}, {"--modes", modes_path}, {"--summary", details_path},
-                        {"--plot", plot_path}});
+                        {"--plot", plot_path}},
+                       {{"--plot-dir", plot_dir}});
     const io::DirectionPairs pairs = FromOption("--directions", [&] { return io::ParseDirectionPairs(directions); });
     Eigen::VectorXd freq_hz;
     if (!freq_file.empty()) {
@@ -216,9 +217,12 @@ int Run(int argc, char** argv) {
     }
     if (!plot_dir.empty()) {
       io::EnsureDirectory(plot_dir);
+      std::vector<std::string> ids;
+      for (const auto& pred : preds) ids.push_back(pred.pose_id);
+      const std::map<std::string, std::string> stems = FileStemsForIds(kTool, "--plot-dir", ids);
       for (size_t p = 0; p < preds.size(); ++p) {
         PostureFigure({&preds[p]}, {&dyns[p]}, title)
-            .SavePng((std::filesystem::path(plot_dir) / (preds[p].pose_id + ".png")).string());
+            .SavePng((std::filesystem::path(plot_dir) / (stems.at(preds[p].pose_id) + ".png")).string());
       }
     }
     return posture_units.empty() && cfg.implausible.empty() ? ExitCodeFor(result.status()) : kExitFlagged;

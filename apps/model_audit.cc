@@ -134,15 +134,13 @@ int Run(int argc, char** argv) {
       }
     }
     RequireFolderOption("--compare", compare_dir);
-    if (fs::exists(report_dir) && !fs::is_directory(report_dir)) {
-      throw UsageError("--report " + report_dir + " exists and is not a folder");
-    }
     {
       std::vector<std::pair<std::string, std::string>> inputs = {{"--robot", robot_path},
                                                                   {"--postures", postures_path}};
       for (const auto& f : measured_files) inputs.push_back({"--measured", f});
       for (const auto& f : pose_files) inputs.push_back({"--pose", f.substr(f.find('=') + 1)});
-      CheckDistinctPaths(inputs, {{"--report", report_dir}, {"--summary", summary_path}, {"--write-config", write_config}});
+      CheckDistinctPaths(inputs, {{"--summary", summary_path}, {"--write-config", write_config}},
+                         {{"--report", report_dir}});
     }
     if (measured_files.empty() && pose_files.empty()) {
       throw UsageError("no measured FRFs: give --measured FILE or --pose ID=file.uff");
@@ -254,6 +252,7 @@ int Run(int argc, char** argv) {
     }
     for (const audit::BoundFlag& f : r.baseline_on_bound) Warn(kTool, f.message);
     ro.input_warnings = WarningsGiven();
+    FileStemsForIds(kTool, "--report", measured.pose_ids());  // notes: the overlays' file names
     const report::AuditReport rep = report::WriteAuditReport(report_dir, r, cfg.description, postures, measured,
                                                              measured_read.frfs, noise, ro);
     const json& j = rep.summary;

@@ -201,7 +201,7 @@ int Run(int argc, char** argv) {
     if (process_path.empty() && !list_faces) throw UsageError("--process is required (except with --list-faces)");
     if (!process_path.empty()) RequireReadableFile(process_path, "process file");
     std::vector<std::pair<std::string, std::string>> outs = {
-        {"--path", path_out}, {"--removal", removal_out}, {"--summary", summary_out}};
+        {"--path", path_out}, {"--removal", removal_out}, {"--summary", summary_out}, {"--out", list_out}};
     robot.Prepare(&outs);
     if (!plot_out.empty()) {
       for (const auto& p : PicturePaths(plot_out, optimise != "none")) outs.push_back({"--plot", p});

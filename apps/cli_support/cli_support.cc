@@ -20,6 +20,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/file_kind.h"
+#include "robomach/io/file_names.h"
 
 namespace robomach::apps {
 
@@ -197,38 +198,56 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
 }
 
 void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& inputs,
-                        const std::vector<std::pair<std::string, std::string>>& outputs) {
+                        const std::vector<std::pair<std::string, std::string>>& outputs,
+                        const std::vector<std::pair<std::string, std::string>>& folders) {
   namespace fs = std::filesystem;
   auto key = [](const std::string& p) {
     std::error_code ec;
     const fs::path c = fs::weakly_canonical(fs::path(p), ec);
     return ec ? fs::absolute(p).lexically_normal().string() : c.string();
   };
-  for (size_t i = 0; i < outputs.size(); ++i) {
-    const auto& [opt, path] = outputs[i];
+  // "-" is standard output, which takes single files only.
+  for (const auto& [opt, path] : folders) RequireFolderOption(opt, path);
+  // Files and folders alike: none may be an input or another output.
+  struct Out {
+    std::string opt, path;
+    bool folder;
+  };
+  std::vector<Out> all;
+  for (const auto& [opt, path] : outputs) all.push_back({opt, path, false});
+  for (const auto& [opt, path] : folders) all.push_back({opt, path, true});
+  for (size_t i = 0; i < all.size(); ++i) {
+    const auto& [opt, path, folder] = all[i];
     if (path.empty() || path == "-") continue;
     for (const auto& [in_opt, in_path] : inputs) {
-      if (!in_path.empty() && key(in_path) == key(path)) {
+      if (!in_path.empty() && in_path != "-" && key(in_path) == key(path)) {
         throw UsageError(opt + " " + path + " is also the input of " + in_opt +
                          "; writing it would destroy the input");
       }
     }
     for (size_t j = 0; j < i; ++j) {
-      if (!outputs[j].second.empty() && key(outputs[j].second) == key(path)) {
-        throw UsageError(opt + " and " + outputs[j].first + " name the same file " + path);
+      if (!all[j].path.empty() && all[j].path != "-" && key(all[j].path) == key(path)) {
+        throw UsageError(opt + " and " + all[j].opt + " name the same " + (folder || all[j].folder ? "path " : "file ") +
+                         path);
       }
     }
   }
   // Writable before any work: the nearest existing ancestor of each output
   // (its folder, or the first folder to be created) must be a folder we may
-  // write in. An existing output that is a folder is the output itself (a
-  // report folder), checked the same way.
-  for (const auto& [opt, path] : outputs) {
+  // write in. A file output that is an existing folder, and a folder output
+  // that is an existing file, cannot be written either.
+  for (const auto& [opt, path, folder] : all) {
     if (path.empty() || path == "-") continue;
     std::error_code ec;
-    fs::path p = fs::absolute(fs::path(path), ec).lexically_normal();
+    const fs::path p = fs::absolute(fs::path(path), ec).lexically_normal();
     if (ec) continue;
-    fs::path probe = fs::is_directory(p, ec) ? p : p.parent_path();
+    const std::string what = folder ? "folder" : "file";
+    if (fs::exists(p, ec) && fs::is_directory(p, ec) != folder) {
+      throw OutputError(opt + " " + path + ": cannot be written: it is " +
+                        (folder ? "a file; expected a folder (it is created if it does not exist)"
+                                : "a folder; expected a file name"));
+    }
+    fs::path probe = folder && fs::is_directory(p, ec) ? p : p.parent_path();
     while (!probe.empty() && !fs::exists(probe, ec) && probe != probe.root_path()) probe = probe.parent_path();
     if (probe.empty()) continue;
     if (!fs::is_directory(probe, ec)) {
@@ -286,6 +305,18 @@ void ValidateOptions(const std::vector<FieldSource>& fields, const std::function
     if (first->from_input) throw std::invalid_argument(out);
     throw UsageError(out);
   }
+}
+
+std::map<std::string, std::string> FileStemsForIds(const std::string& tool, const std::string& option,
+                                                   const std::vector<std::string>& ids) {
+  std::map<std::string, std::string> stems = io::SafeFileStems(ids);
+  for (const auto& [id, stem] : stems) {
+    if (stem != id) {
+      Note(tool, option + ": posture \"" + id + "\" is not a safe file name; its files are named with \"" + stem +
+                     "\" (docs/conventions.md, file names made from IDs)");
+    }
+  }
+  return stems;
 }
 
 void CheckOptionRange(const std::string& option, double value, double lo, double hi) {

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <functional>
+#include <map>
 #include <optional>
 
 #include <Eigen/Core>
@@ -169,12 +170,24 @@ std::pair<std::string, double> ParseAssignment(const std::string& option, const 
 /// Refuses an output path that is also an input or another output (a user
 /// typo that would silently destroy data). Empty paths are ignored; "-"
 /// means stdout. @throws UsageError naming both options.
+/// `folders` are the folder outputs (--report, --plot-dir): "-" is a bad
+/// command line (UsageError), and they are checked against the inputs and
+/// the other outputs as the files are.
 /// Then, before any work, checks that every output can be written: the
 /// nearest existing folder on its path must be a writable folder (a file in
-/// the way, a read-only folder). @throws OutputError (exit 73) naming the
-/// option, so a long run does not fail at its end.
+/// the way, a read-only folder); a file output must not be an existing
+/// folder, nor a folder output an existing file. @throws OutputError (exit
+/// 73) naming the option and the path, so a long run does not fail at its
+/// end.
 void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& inputs,
-                        const std::vector<std::pair<std::string, std::string>>& outputs);
+                        const std::vector<std::pair<std::string, std::string>>& outputs,
+                        const std::vector<std::pair<std::string, std::string>>& folders = {});
+
+/// File-name stems for IDs used as file names in a folder output
+/// (io::SafeFileStems): "tool: note: ..." on stderr for each ID whose file
+/// name differs from it, naming `option` and the name used.
+std::map<std::string, std::string> FileStemsForIds(const std::string& tool, const std::string& option,
+                                                   const std::vector<std::string>& ids);
 
 /// @throws UsageError unless lo <= value <= hi (and finite).
 void CheckOptionRange(const std::string& option, double value, double lo, double hi);

@@ -12,6 +12,7 @@
 #include "robomach/common/number_format.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/io/atomic_file.h"
+#include "robomach/io/file_names.h"
 #include "robomach/report/audit_patterns_report.h"
 #include "robomach/report/calibration_report.h"
 #include "robomach/report/html.h"
@@ -424,8 +425,12 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
   h << "<h2>Overlays per posture</h2><p>Measured FRFs (wide band), the " << HtmlEscape(before_label) << " (dashed)"
     << (shown ? " and the model " + HtmlEscape(after_label) + " (thin line)" : std::string())
     << "; vertical lines: the natural frequencies of the " << (shown ? "latter" : "model") << ".</p>\n";
+  // Posture IDs become file names through io::SafeFileStems (no path
+  // separators, no ".."; docs/conventions.md); the tool notes the changed ones.
+  const std::map<std::string, std::string> stems = io::SafeFileStems(measured_fit.pose_ids());
   for (const auto& id : measured_fit.pose_ids()) {
-    h << "<p><img src=\"overlay_" << HtmlEscape(id) << ".png\" alt=\"overlay " << HtmlEscape(id) << "\"></p>\n";
+    h << "<p><img src=\"overlay_" << HtmlEscape(stems.at(id)) << ".png\" alt=\"overlay " << HtmlEscape(id)
+      << "\"></p>\n";
   }
   h << "</body></html>\n";
 
@@ -468,7 +473,7 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
                                     (shown ? " and " + after_label : std::string()),
                                 before_label, after_label);
       }
-      WriteOverlayPng((dir / ("overlay_" + pose + ".png")).string(), o,
+      WriteOverlayPng((dir / ("overlay_" + stems.at(pose) + ".png")).string(), o,
                               "model-audit: posture " + pose + ", measured vs " + before_label +
                                   (shown ? " and " + after_label : std::string()),
                               before_label, after_label);
@@ -478,8 +483,8 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
   // rewrite would be taken for its results: remove them.
   {
     std::vector<fs::path> stale;
-    const std::vector<std::string> ids = measured_fit.pose_ids();
-    const std::set<std::string> poses(ids.begin(), ids.end());
+    std::set<std::string> poses;  // the file-name stems of this run's postures
+    for (const auto& [id, stem] : stems) poses.insert(stem);
     if (yaml.empty()) stale.push_back(dir / "effects.yaml");
     if (pr.mode_error_map_png.empty()) stale.push_back(dir / names.mode_error_map_png);
     for (const auto& entry : fs::directory_iterator(dir)) {
