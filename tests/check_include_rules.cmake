@@ -26,7 +26,7 @@ set(allowed_report_fits "common;kinematics;dynamics;calibration;audit;report;rep
 # io has two layers (issue #21). io_base (the generic tools below, whose
 # headers sit in include/robomach/io/ with the formats) may include only
 # common and io_base; report may include io_base but no format of io.
-set(io_base_names atomic_file csv_table yaml_doc file_kind parallel_rows number_format text)
+set(io_base_names atomic_file csv_table yaml_doc file_kind parallel_rows number_format text file_names)
 set(allowed_io_base "common;io_base")
 set(violations "")
 foreach(module common kinematics dynamics identification calibration audit stability polishing drilling machine io io_base workflows report report_fits)
