@@ -137,7 +137,7 @@ void BindCalibration(py::module_& m) {
       "frf-modes' modal analysis: per posture, its FRFs fitted with common poles; returns a list of "
       "{pose_id, fits: [{frfs: [{frf, misfit_relative, misfit_noise_sigmas, modal_constants}], modes: "
       "[{freq_hz, damping_ratio, stable_orders}], ok, message}], tip_modes: [{freq_hz, damping_ratio, "
-      "modal_mass_kg, shape, directions}], warnings}. noise: estimate_noise(frfs) (the fit's weights and usable "
+      "modal_mass_kg, shape, directions}], warnings}. noise: estimate_noise(frfs, NoiseOptions(global_modal_fit=True)), as the tool takes it (the fit's weights and usable "
       "lines); weights 'noise' or 'quantity' (every line of the file's quantity alike, file_power 0 "
       "receptance, 1 mobility, 2 accelerance).");
   m.def("modal_assurance_criterion", &calibration::ModalAssuranceCriterion, py::arg("a"), py::arg("b"),

@@ -69,7 +69,8 @@ constexpr char kReadResultDoc[] =
     "the GIL.";
 
 NoiseOptions MakeNoiseOptions(double min_snr, int averages, bool use_coherence, double knots_per_octave,
-                              int max_gap_lines, int min_run_lines, bool refine_with_modal_fit, bool wide_floor) {
+                              int max_gap_lines, int min_run_lines, bool refine_with_modal_fit, bool wide_floor,
+                              bool global_modal_fit) {
   NoiseOptions o;
   o.min_snr = min_snr;
   o.averages = averages;
@@ -79,6 +80,7 @@ NoiseOptions MakeNoiseOptions(double min_snr, int averages, bool use_coherence, 
   o.min_run_lines = min_run_lines;
   o.refine_with_modal_fit = refine_with_modal_fit;
   o.wide_floor = wide_floor;
+  o.global_modal_fit = global_modal_fit;
   calibration::CheckValid(o);
   return o;
 }
@@ -224,10 +226,13 @@ void BindFrf(py::module_& m) {
       .def(py::init(&MakeNoiseOptions), py::arg("min_snr") = 3.0, py::arg("averages") = 0,
            py::arg("use_coherence") = true, py::arg("knots_per_octave") = 1.0, py::arg("max_gap_lines") = 3,
            py::arg("min_run_lines") = 8, py::arg("refine_with_modal_fit") = true, py::arg("wide_floor") = false,
+           py::arg("global_modal_fit") = false,
            "min_snr: a line is usable where |H|/floor reaches it; averages: number of averages "
            "behind the coherence (0 = unknown: the scatter is used); wide_floor: also take the "
-           "floor from wide second differences (integrated-accelerometer drift). ValueError naming "
-           "the field for a bad value.")
+           "floor from wide second differences (integrated-accelerometer drift); global_modal_fit: "
+           "the pass about a modal fit uses the common-pole fitter, as frf-modes does (analyse_modes "
+           "gives the tool's result with this noise model); the other tools use the single-FRF "
+           "fitter. ValueError naming the field for a bad value.")
       .def_readonly("min_snr", &NoiseOptions::min_snr)
       .def_readonly("averages", &NoiseOptions::averages)
       .def_readonly("use_coherence", &NoiseOptions::use_coherence)
@@ -235,7 +240,8 @@ void BindFrf(py::module_& m) {
       .def_readonly("max_gap_lines", &NoiseOptions::max_gap_lines)
       .def_readonly("min_run_lines", &NoiseOptions::min_run_lines)
       .def_readonly("refine_with_modal_fit", &NoiseOptions::refine_with_modal_fit)
-      .def_readonly("wide_floor", &NoiseOptions::wide_floor);
+      .def_readonly("wide_floor", &NoiseOptions::wide_floor)
+      .def_readonly("global_modal_fit", &NoiseOptions::global_modal_fit);
 
   py::class_<FrfNoise>(m, "FrfNoise",
                        "The noise model of one FRF, sigma(f)^2 = (rel |H|)^2 + floor(f)^2 [m/N]^2, per line.")
@@ -324,7 +330,7 @@ void BindFrf(py::module_& m) {
   m.def("read_measured_frfs",
         [](const std::vector<std::string>& files, const std::map<std::string, std::string>& posed_files,
            const std::string& default_pose, const std::string& noise_model, double min_snr, int averages,
-           bool drift_floor) {
+           bool drift_floor, bool global_modal_fit) {
           for (const std::string& f : files) RequireReadableFile(f);
           for (const auto& [pose, f] : posed_files) RequireReadableFile(f);
           workflows::MeasuredFrfOptions o;
@@ -336,6 +342,7 @@ void BindFrf(py::module_& m) {
           o.min_snr = min_snr;
           o.averages = averages;
           o.drift_floor = drift_floor;
+          o.global_modal_fit = global_modal_fit;
           std::vector<std::pair<std::string, std::string>> said;
           workflows::MeasuredFrfs out;
           {
@@ -357,7 +364,7 @@ void BindFrf(py::module_& m) {
         },
         py::arg("files"), py::arg("posed_files") = std::map<std::string, std::string>{},
         py::arg("default_pose") = "", py::arg("noise_model") = "auto", py::arg("min_snr") = 3.0,
-        py::arg("averages") = 0, py::arg("drift_floor") = false,
+        py::arg("averages") = 0, py::arg("drift_floor") = false, py::arg("global_modal_fit") = false,
         "Reads hammer-test files (CSV of docs/formats.md §3 or UFF58) as frf-calibrate, model-audit and "
         "frf-modes do: posed_files {pose_id: file.uff} for UFF records without a posture (default_pose "
         "for every such file instead); noise_model 'auto', 'coherence', 'scatter' or 'none'; min_snr and "

@@ -27,7 +27,7 @@ def tap(tmp_path_factory):
 
 def test_analyse_modes_equals_the_tool_and_the_model(tap):
     frfs = rm.read_frf_file(str(tap / 'tap.csv'))['frfs']
-    poses = rm.analyse_modes(frfs, rm.estimate_noise(frfs))
+    poses = rm.analyse_modes(frfs, rm.estimate_noise(frfs, rm.NoiseOptions(global_modal_fit=True)))
     summary = json.loads((tap / 's.json').read_text())
     assert [p['pose_id'] for p in poses] == [p['pose_id'] for p in summary['postures']]
     model = {}
