@@ -26,13 +26,14 @@
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/lobes_file.h"
-#include "robomach/io/tip_sources.h"
+#include "robomach/report/lobes_plot.h"
 #include "robomach/report/modal_fit_plot.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/json.h"
 #include "robomach/stability/semi_discretization.h"
 #include "robomach/stability/lobes_workflow.h"
 #include "robomach/stability/tip_dynamics.h"
+#include "robomach/workflows/stability_lobes.h"
 
 namespace robomach::apps {
 namespace {
@@ -167,31 +168,36 @@ int Run(int argc, char** argv) {
   }
 
   return RunGuarded(kTool, [&]() -> int {
-    const int sources = (!robot_path.empty()) + (!frf_path.empty()) + (!modal_path.empty());
-    if (sources != 1) {
-      throw UsageError("give exactly one tool-tip source: --robot (with --postures), --frf or --modal-table");
-    }
-    if (!robot_path.empty() && postures_path.empty()) throw UsageError("--robot needs --postures");
+    workflows::StabilityLobesOptions o;
+    o.cut_path = cut_path;
+    o.robot_path = robot_path;
+    o.postures_path = postures_path;
+    o.frf_path = frf_path;
+    o.frf_y_path = frf_y_path;
+    o.modal_table_path = modal_path;
+    o.pose_ids = pose_ids;
+    o.tool_axis = ParseVector("--tool-axis", tool_axis_text);
+    o.tool_axis_source = "--tool-axis " + tool_axis_text;
+    o.method = stability::ParseLobeMethod(method);
+    o.speeds = speeds;
+    o.max_lobe = max_lobe;
+    o.sd_speeds = sd_speeds;
+    o.sd_steps = sd_steps;
+    o.sd_steps_per_mode_period = sd_steps_per_mode;
+    o.sd_modes = sd_modes;
+    o.sd_max_depth_mm = sd_max_depth_mm;
+    o.threads = threads;
+    ValidateOptions({{"robot_path", "--robot"}, {"postures_path", "--postures"}, {"frf_y_path", "--frf-y"},
+                     {"frf_path", "--frf"}, {"modal_table_path", "--modal-table"}, {"tool_axis", "--tool-axis"},
+                     {"speeds", "--speeds"}, {"max_lobe", "--max-lobe"}, {"sd_speeds", "--sd-speeds"},
+                     {"sd_steps", "--sd-steps"}, {"sd_steps_per_mode_period", "--sd-steps-per-mode-period"},
+                     {"sd_modes", "--sd-modes"}, {"sd_max_depth_mm", "--sd-max-depth-mm"}, {"threads", "--threads"}},
+                    [&] { o.Validate(); });
     if (frf_path.empty()) {
-      for (const auto& [o, v] : {std::pair{"--frf-y", &frf_y_path}, {"--fit-plot", &fit_plot_path},
-                                 {"--modes-out", &modes_out_path}}) {
-        if (!v->empty()) throw UsageError(std::string(o) + " needs --frf");
+      for (const auto& [opt, v] : {std::pair{"--fit-plot", &fit_plot_path}, {"--modes-out", &modes_out_path}}) {
+        if (!v->empty()) throw UsageError(std::string(opt) + " needs --frf");
       }
     }
-    if ((sd_steps != 0 && sd_steps < 2) || sd_speeds < 1 || sd_modes < 1 || !(sd_max_depth_mm > 0.0) || speeds < 0 ||
-        max_lobe < 0) {
-      throw UsageError(
-          "expected --sd-steps 0 (automatic) or >= 2, --sd-speeds >= 1, --sd-modes >= 1, --sd-max-depth-mm > 0");
-    }
-    // Bounds that keep a typo from hours of work or an allocation failure.
-    CheckOptionRange("--speeds", speeds, 0, 100000);
-    CheckOptionRange("--sd-speeds", sd_speeds, 1, 10000);
-    CheckOptionRange("--sd-steps", sd_steps, 0, 1000);
-    CheckOptionRange("--sd-steps-per-mode-period", sd_steps_per_mode, 4.0, 1000.0);
-    CheckOptionRange("--sd-modes", sd_modes, 1, 200);
-    CheckOptionRange("--sd-max-depth-mm", sd_max_depth_mm, 1e-6, 1e4);
-    CheckOptionRange("--threads", threads, 0, 256);
-    CheckOptionRange("--max-lobe", max_lobe, 0, 1000);
     RequireInputFile("--cut", cut_path, "cut file", {io::FileKind::kYaml}, io::kCutFileFormat);
     CheckDistinctPaths({{"--cut", cut_path}, {"--robot", robot_path}, {"--postures", postures_path},
                         {"--frf", frf_path}, {"--frf-y", frf_y_path}, {"--modal-table", modal_path}},
@@ -205,50 +211,9 @@ int Run(int argc, char** argv) {
     if (!frf_path.empty()) {
       RequireInputFile("--frf", frf_path, "FRF file", {io::FileKind::kCsv, io::FileKind::kUff58}, io::kFrfFileFormat);
     }
-    const io::CutSpec cut = io::ReadCutFile(cut_path);
-    for (const std::string& w : cut.implausible) Warn(kTool, w);
-
-    std::vector<stability::TipDynamics> tips;
-    bool config_implausible = false;
-    const std::string axis_source = "--tool-axis " + tool_axis_text;
-    if (!robot_path.empty()) {
-      const io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
-      config_implausible = !cfg.implausible.empty();
-      tips = io::TipsFromRobotPostures(cfg.Build(), postures_path, pose_ids, cut, Tell);
-    } else if (!frf_path.empty()) {
-      stability::MeasuredTipOptions mo;
-      mo.frf_path = frf_path;
-      mo.frf_y_path = frf_y_path;
-      mo.pose_ids = pose_ids;
-      // The cutting frame only when the FRFs need orienting.
-      mo.cutting_frame = [&] { return io::CutFrame(cut, ParseVector("--tool-axis", tool_axis_text), axis_source); };
-      mo.tool_axis_source = axis_source;
-      mo.fit = true;  // always: the noise model's usable band serves the ZOA too
-      mo.sd_modes = sd_modes;
-      tips = io::TipsFromFrfFiles(mo, Tell);
-    } else {
-      const Eigen::Matrix3d R = io::CutFrame(cut, ParseVector("--tool-axis", tool_axis_text), axis_source);
-      tips = io::TipsFromModalTableFile(modal_path, pose_ids, R, cut);
-    }
-
-    stability::LobesOptions lo;
-    lo.method = method == "zoa" ? stability::LobeMethod::kZoa
-                : method == "sd" ? stability::LobeMethod::kSd
-                                 : stability::LobeMethod::kBoth;
-    lo.process = cut.process;
-    lo.min_speed_rad_s = cut.spindle_speed_min_rad_s;
-    lo.max_speed_rad_s = cut.spindle_speed_max_rad_s;
-    lo.zoa_speeds_rad_s = cut.SpeedRange(speeds);
-    lo.sd_speeds_rad_s = cut.SpeedRange(sd_speeds);
-    lo.max_lobe_index = max_lobe;
-    lo.sd.steps_per_period = sd_steps;
-    lo.sd.steps_per_mode_period = sd_steps_per_mode;
-    lo.sd.max_depth = MmToM(sd_max_depth_mm);
-    lo.sd_modes = sd_modes;
-    lo.threads = threads;
     std::optional<ProgressLine> progress;
-    const stability::LobesResult lobes =
-        stability::ComputeLobes(tips, lo, Tell, [&](const stability::SdProgress& p) {
+    const workflows::StabilityLobesRun run =
+        workflows::RunStabilityLobes(o, Tell, [&](const stability::SdProgress& p) {
           // Counts the speeds themselves ("12/60"), from 20 speeds on.
           if (p.done == 0 && !p.finished) progress.emplace(kTool, "SD speeds of " + p.id, p.total, 20);
           if (!progress) return;
@@ -259,93 +224,47 @@ int Run(int argc, char** argv) {
             progress->Update(p.done);
           }
         });
-    const std::vector<stability::LobeRow>& rows = lobes.rows;
+    const std::vector<stability::LobeRow>& rows = run.lobes.rows;
 
     io::WriteLobesCsv(out_path.empty() ? "-" : out_path, rows);
     if (!plot_path.empty()) {
-      report::Figure fig(1, 1, 1000, 560);
-      fig.title = "robomach stability-lobes: " + cut_path;
-      report::Axes& ax = fig.at(0, 0);
-      ax.title = std::to_string(cut.process.teeth) + " teeth, a_e/D = " + io::FormatDouble(cut.process.radial_immersion) +
-                 (cut.process.direction == stability::MillingDirection::kUp ? ", up-milling" : ", down-milling");
-      ax.x_label = "spindle speed [rpm]";
-      ax.y_label = "critical axial depth [mm]";
-      ax.y_min = 0.0;
-      int color = 0;
-      for (const stability::TipDynamics& t : tips) {
-        for (const char* m : {"zoa", "sd"}) {
-          report::Series s;
+      std::vector<report::LobeCurve> curves;
+      for (const stability::TipDynamics& t : run.tips) {
+        for (const std::string m : {"zoa", "sd"}) {
+          report::LobeCurve c;
           for (const stability::LobeRow& r : rows) {
             if (r.id != t.id || r.method != m) continue;
-            s.x.push_back(RadPerSecToRpm(r.point.spindle_speed_rad_s));
-            s.y.push_back(r.point.status == stability::LobeStatus::kOk ? MToMm(r.point.critical_depth) : NAN);
+            c.speed_rpm.push_back(RadPerSecToRpm(r.point.spindle_speed_rad_s));
+            c.depth_mm.push_back(r.point.status == stability::LobeStatus::kOk ? MToMm(r.point.critical_depth) : NAN);
           }
-          if (s.x.empty()) continue;
-          s.label = t.id + " " + (std::string(m) == "zoa" ? "ZOA" : "SD");
-          s.color = report::PaletteColor(color++);
-          s.markers = std::string(m) == "sd";
-          ax.series.push_back(std::move(s));
+          if (c.speed_rpm.empty()) continue;
+          c.label = t.id + " " + (m == "zoa" ? "ZOA" : "SD");
+          c.markers = m == "sd";
+          curves.push_back(std::move(c));
         }
       }
-      // The depth axis shows the lobes' bottoms, the depths a user can cut:
-      // between lobes the critical depth rises to tens or hundreds of mm,
-      // and a linear axis up to that squashes the sub-mm bottoms flat. It
-      // ends at 5 x the smallest critical depth of all curves (the first
-      // lobes above the bottom and the stable pockets between them), raised
-      // to 1.5 x the largest of the curves' own smallest depths so that every
-      // posture's bottom is in the picture. The full range is in the CSV.
-      double smallest = INFINITY, largest_bottom = 0.0, largest = 0.0;
-      for (const report::Series& s : ax.series) {
-        double bottom = INFINITY;
-        for (double d : s.y) {
-          if (!std::isfinite(d) || d <= 0.0) continue;
-          bottom = std::min(bottom, d);
-          largest = std::max(largest, d);
-        }
-        if (!std::isfinite(bottom)) continue;
-        smallest = std::min(smallest, bottom);
-        largest_bottom = std::max(largest_bottom, bottom);
-      }
-      if (std::isfinite(smallest)) {
-        const double clip_mm = std::max(5.0 * smallest, 1.5 * largest_bottom);
-        if (largest > 1.05 * clip_mm) {
-          ax.y_max = clip_mm;
-          char clip_text[96];
-          std::snprintf(clip_text, sizeof(clip_text), "; depth axis clipped at %.3g mm (full range in ", clip_mm);
-          ax.title += clip_text +
-                      (out_path.empty() || out_path == "-" ? std::string("the CSV")
-                                                           : std::filesystem::path(out_path).filename().string()) +
-                      ")";
-        }
-      }
-      fig.SavePng(plot_path);
+      const stability::MillingProcess& mp = run.cut.process;
+      report::SaveLobesPlot(plot_path, "robomach stability-lobes: " + cut_path,
+                            std::to_string(mp.teeth) + " teeth, a_e/D = " + io::FormatDouble(mp.radial_immersion) +
+                                (mp.direction == stability::MillingDirection::kUp ? ", up-milling" : ", down-milling"),
+                            curves,
+                            out_path.empty() || out_path == "-" ? std::string("the CSV")
+                                                                : std::filesystem::path(out_path).filename().string());
     }
     if (!modes_out_path.empty()) {
       std::vector<std::string> ids;
       std::vector<std::vector<dynamics::Mode>> modes;
-      for (const stability::TipDynamics& t : tips) {
+      for (const stability::TipDynamics& t : run.tips) {
         ids.push_back(t.id);
         modes.push_back(stability::ModesInSourceFrame(t));
       }
       io::WriteModalTableCsv(modes_out_path, ids, modes);
     }
-    if (!fit_plot_path.empty()) PlotFits(fit_plot_path, frf_path, tips);
-    const bool flagged = lobes.flagged() || !cut.implausible.empty() || config_implausible;
+    if (!fit_plot_path.empty()) PlotFits(fit_plot_path, frf_path, run.tips);
+    const bool flagged = run.flagged();
     if (!summary_path.empty()) {
-      nlohmann::json j = io::LobesSummaryJson(tips, lobes);
+      nlohmann::json j = run.Summary(o);
       j["tool"] = kTool;
-      j["cut"] = cut_path;
-      j["source"] = !robot_path.empty() ? "robot" : !frf_path.empty() ? "frf" : "modal_table";
-      if (!robot_path.empty()) {
-        j["robot"] = robot_path;
-        j["postures"] = postures_path;
-      }
-      if (!frf_path.empty()) j["frf"] = frf_path;
-      if (!frf_y_path.empty()) j["frf_y"] = frf_y_path;
-      if (!modal_path.empty()) j["modal_table"] = modal_path;
-      j["method"] = method;
-      j["teeth"] = cut.process.teeth;
-      j["radial_immersion"] = cut.process.radial_immersion;
       j["lobes_csv"] = out_path.empty() ? "-" : out_path;
       j["exit_code"] = flagged ? kExitFlagged : kExitOk;
       io::WriteFileAtomically(summary_path, report::DumpJson(j));

@@ -16,7 +16,8 @@
 #include "robomach/io/lobes_file.h"
 #include "robomach/io/region_file.h"
 #include "robomach/io/tip_dynamics_files.h"
-#include "robomach/io/tip_sources.h"
+#include "robomach/workflows/stability_lobes.h"
+#include "robomach/workflows/tip_sources.h"
 #include "robomach/stability/lobes_workflow.h"
 #include "robomach/stability/stability_map.h"
 #include "robomach/stability/tip_dynamics.h"
@@ -34,7 +35,7 @@ std::string AxisText(const Eigen::Vector3d& a) {
 // makes it (an InputError naming the cut file's feed_direction).
 Eigen::Matrix3d FrameOf(const io::CutSpec& cut, const Eigen::Vector3d& tool_axis) {
   if (!(tool_axis.norm() > 0.0)) throw std::invalid_argument("tool_axis: expected a non-zero vector");
-  return io::CutFrame(cut, tool_axis, AxisText(tool_axis));
+  return workflows::CutFrame(cut, tool_axis, AxisText(tool_axis));
 }
 
 py::dict MessageDict(const stability::TipMessage& m) {
@@ -146,7 +147,7 @@ void BindStability(py::module_& m) {
   m.def("tips_from_modal_table", [](const std::string& path, const io::CutSpec& cut, const Eigen::Vector3d& tool_axis,
                                     const std::vector<std::string>& poses) {
     RequireReadableFile(path);
-    return io::TipsFromModalTableFile(path, poses, FrameOf(cut, tool_axis), cut);
+    return workflows::TipsFromModalTableFile(path, poses, FrameOf(cut, tool_axis), cut);
   }, py::arg("path"), py::arg("cut"), py::arg("tool_axis") = Eigen::Vector3d::UnitZ(),
      py::arg("poses") = std::vector<std::string>{},
      "The tool tips of a modal table (docs/formats.md §4), as stability-lobes --modal-table makes them.");
@@ -168,7 +169,7 @@ void BindStability(py::module_& m) {
     std::vector<TipDynamics> tips;
     {
       py::gil_scoped_release release;
-      tips = io::TipsFromFrfFiles(o, said.Sink());
+      tips = workflows::TipsFromFrfFiles(o, said.Sink());
     }
     return py::make_tuple(tips, said.List());
   }, py::arg("path"), py::arg("cut"), py::arg("tool_axis") = Eigen::Vector3d::UnitZ(), py::arg("frf_y") = py::none(),
@@ -181,33 +182,19 @@ void BindStability(py::module_& m) {
   m.def("stability_lobes", [](const std::vector<TipDynamics>& tips, const io::CutSpec& cut, const std::string& method,
                               int speeds, int sd_speeds, int sd_steps, double sd_steps_per_mode_period, int sd_modes,
                               double sd_max_depth_mm, int max_lobe, int threads) {
-    if (method != "zoa" && method != "sd" && method != "both") {
-      throw std::invalid_argument("method: expected zoa, sd or both, got " + method);
-    }
-    if (speeds < 0 || sd_speeds < 1 || (sd_steps != 0 && sd_steps < 2) || sd_modes < 1 || !(sd_max_depth_mm > 0.0) ||
-        max_lobe < 0 || threads < 0 || !(sd_steps_per_mode_period >= 4.0) || speeds > 100000 || sd_speeds > 10000 ||
-        sd_steps > 1000 || sd_modes > 200 || !(sd_max_depth_mm <= 1e4) || threads > 256 || max_lobe > 1000 ||
-        !(sd_steps_per_mode_period <= 1000.0)) {
-      throw std::invalid_argument(
-          "expected (stability-lobes' ranges) speeds in [0, 100000], sd_speeds in [1, 10000], sd_steps 0 or in [2, "
-          "1000], sd_steps_per_mode_period in [4, 1000], sd_modes in [1, 200], sd_max_depth_mm in (0, 1e4], max_lobe "
-          "in [0, 1000], threads in [0, 256]");
-    }
-    stability::LobesOptions o;
-    o.method = method == "zoa" ? stability::LobeMethod::kZoa
-               : method == "sd" ? stability::LobeMethod::kSd
-                                : stability::LobeMethod::kBoth;
-    o.process = cut.process;
-    o.min_speed_rad_s = cut.spindle_speed_min_rad_s;
-    o.max_speed_rad_s = cut.spindle_speed_max_rad_s;
-    o.zoa_speeds_rad_s = cut.SpeedRange(speeds);
-    o.sd_speeds_rad_s = cut.SpeedRange(sd_speeds);
-    o.max_lobe_index = max_lobe;
-    o.sd.steps_per_period = sd_steps;
-    o.sd.steps_per_mode_period = sd_steps_per_mode_period;
-    o.sd.max_depth = MmToM(sd_max_depth_mm);
-    o.sd_modes = sd_modes;
-    o.threads = threads;
+    // The tool's options and their checks (workflows::StabilityLobesOptions).
+    workflows::StabilityLobesOptions wo;
+    wo.method = stability::ParseLobeMethod(method);
+    wo.speeds = speeds;
+    wo.sd_speeds = sd_speeds;
+    wo.sd_steps = sd_steps;
+    wo.sd_steps_per_mode_period = sd_steps_per_mode_period;
+    wo.sd_modes = sd_modes;
+    wo.sd_max_depth_mm = sd_max_depth_mm;
+    wo.max_lobe = max_lobe;
+    wo.threads = threads;
+    wo.ValidateSettings();
+    const stability::LobesOptions o = workflows::MakeLobesOptions(cut, wo);
     Collected said;
     stability::LobesResult r;
     {
@@ -221,6 +208,66 @@ void BindStability(py::module_& m) {
      "Stability lobes of the tool tips, as stability-lobes computes them (the same options, the same defaults): "
      "method 'zoa', 'sd' or 'both'; speeds = ZOA speeds in the cut's range (0: the cut's count). Returns "
      "(Lobes, messages). The GIL is released while it runs.");
+
+  const workflows::StabilityLobesOptions kLobes;  // the tool's defaults
+  m.def("run_stability_lobes",
+        [](const std::string& cut, const std::optional<std::string>& robot, const std::optional<std::string>& postures,
+           const std::optional<std::string>& frf, const std::optional<std::string>& frf_y,
+           const std::optional<std::string>& modal_table, const std::vector<std::string>& poses,
+           const Eigen::Vector3d& tool_axis, const std::string& method, int speeds, int max_lobe, int sd_speeds,
+           int sd_steps, double sd_steps_per_mode_period, int sd_modes, double sd_max_depth_mm, int threads) {
+          workflows::StabilityLobesOptions o;
+          o.cut_path = cut;
+          o.robot_path = robot.value_or("");
+          o.postures_path = postures.value_or("");
+          o.frf_path = frf.value_or("");
+          o.frf_y_path = frf_y.value_or("");
+          o.modal_table_path = modal_table.value_or("");
+          o.pose_ids = poses;
+          o.tool_axis = tool_axis;
+          o.method = stability::ParseLobeMethod(method);
+          o.speeds = speeds;
+          o.max_lobe = max_lobe;
+          o.sd_speeds = sd_speeds;
+          o.sd_steps = sd_steps;
+          o.sd_steps_per_mode_period = sd_steps_per_mode_period;
+          o.sd_modes = sd_modes;
+          o.sd_max_depth_mm = sd_max_depth_mm;
+          o.threads = threads;
+          o.Validate();
+          for (const std::string* p : {&o.cut_path, &o.robot_path, &o.postures_path, &o.frf_path, &o.frf_y_path,
+                                       &o.modal_table_path}) {
+            if (!p->empty()) RequireReadableFile(*p);
+          }
+          Collected said;
+          workflows::StabilityLobesRun run;
+          {
+            py::gil_scoped_release release;
+            run = workflows::RunStabilityLobes(o, said.Sink());
+          }
+          for (const std::string& f : run.input_findings) WarnUnit(f);
+          py::dict d;
+          d["lobes"] = run.lobes;
+          d["tips"] = run.tips;
+          d["messages"] = said.List();
+          d["input_findings"] = run.input_findings;
+          d["flagged"] = run.flagged();
+          d["summary"] = py::module_::import("json").attr("loads")(run.Summary(o).dump());
+          return d;
+        },
+        py::arg("cut"), py::arg("robot") = py::none(), py::arg("postures") = py::none(), py::arg("frf") = py::none(),
+        py::arg("frf_y") = py::none(), py::arg("modal_table") = py::none(),
+        py::arg("poses") = std::vector<std::string>{}, py::arg("tool_axis") = Eigen::Vector3d::UnitZ(),
+        py::arg("method") = "zoa", py::arg("speeds") = kLobes.speeds, py::arg("max_lobe") = kLobes.max_lobe,
+        py::arg("sd_speeds") = kLobes.sd_speeds, py::arg("sd_steps") = kLobes.sd_steps,
+        py::arg("sd_steps_per_mode_period") = kLobes.sd_steps_per_mode_period, py::arg("sd_modes") = kLobes.sd_modes,
+        py::arg("sd_max_depth_mm") = kLobes.sd_max_depth_mm, py::arg("threads") = kLobes.threads,
+        "stability-lobes as one call (workflows::RunStabilityLobes): the cut file and one tool-tip source (robot "
+        "with postures, frf (and frf_y), or modal_table), the tool's options under their names without dashes. "
+        "Returns a dict: lobes (Lobes), tips, messages (dicts {kind, text}, what the tool prints), input_findings "
+        "(the cut's and robot config's unit findings, also as UnitWarning), flagged (the tool's exit 3) and "
+        "summary (the tool's --summary JSON but for tool, lobes_csv and exit_code). ValueError naming the "
+        "option for a bad value; FileNotFoundError, InputError for files. Releases the GIL.");
 
   py::class_<stability::LobesResult>(m, "Lobes", "The lobes of every tool tip: one row per speed, tip and method.")
       .def_property_readonly("flagged", &stability::LobesResult::flagged,

@@ -3,6 +3,7 @@ and its lobes reproduce the tool's --out file byte for byte (the same
 library call, ComputeLobes), and stability-map's points from a region file
 reproduce the tool's map CSV to 1e-12. Then bad input."""
 import csv
+import json
 import math
 import os
 
@@ -123,7 +124,7 @@ def test_bad_input():
     tips = rm.tips_from_modal_table(MODAL, cut)
     with pytest.raises(ValueError, match='method'):
         rm.stability_lobes(tips, cut, method='fast')
-    with pytest.raises(ValueError, match=r'sd_speeds in \[1, 10000\]'):
+    with pytest.raises(ValueError, match=r'sd_speeds 0 is outside \[1, 10000\]'):
         rm.stability_lobes(tips, cut, sd_speeds=0)
     with pytest.raises(rm.InputError, match='none of the requested postures'):
         rm.tips_from_modal_table(MODAL, cut, poses=['nope'])
@@ -131,3 +132,39 @@ def test_bad_input():
     with pytest.raises(rm.InputError) as e:
         rm.tips_from_modal_table(MODAL, cut, tool_axis=np.array(cut.feed_direction))
     assert e.value.path == CUT and 'feed_direction' in e.value.message
+
+
+@pytest.mark.parametrize('source', ['robot', 'frf'])
+def test_run_stability_lobes_equals_the_tools_summary(tmp, source):
+    """Issue #36 acceptance: the tool's JSON summary and the Python call's
+    result on the shipped defaults (the README's robot, postures and cut; a
+    measured FRF file), the same library call (workflows::RunStabilityLobes)."""
+    args = {'robot': ['--robot', KR210, '--postures', os.path.join(SOURCE_DIR, 'config', 'postures_demo.csv')],
+            'frf': ['--frf', FRF]}[source]
+    r = run_tool('stability-lobes', *args, '--cut', CUT, '--method', 'both', '--sd-speeds', 4, '--out',
+                 tmp / 'tool.csv', '--summary', tmp / 'tool.json', expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool = json.loads((tmp / 'tool.json').read_text())
+    kw = {'robot': dict(robot=KR210, postures=os.path.join(SOURCE_DIR, 'config', 'postures_demo.csv')),
+          'frf': dict(frf=FRF)}[source]
+    run = rm.run_stability_lobes(CUT, method='both', sd_speeds=4, **kw)
+    assert run['flagged'] == (r.returncode == 3)
+    assert tool['exit_code'] == r.returncode
+    for key in ('tool', 'lobes_csv', 'exit_code', 'robomach_version'):  # what only the tool writes
+        del tool[key]
+    assert run['summary'] == tool
+    rm.write_lobes_csv(str(tmp / 'py.csv'), run['lobes'])
+    assert (tmp / 'py.csv').read_text() == (tmp / 'tool.csv').read_text()
+    # What the tool printed as warnings, the call returns as messages.
+    printed = [line.split('warning: ', 1)[1] for line in r.stderr.splitlines() if ': warning: ' in line]
+    said = [m['text'] for m in run['messages'] if m['kind'] == 'warning']
+    assert [w.splitlines()[0] for w in said] == printed
+
+
+def test_run_stability_lobes_names_the_option():
+    with pytest.raises(ValueError, match=r'sd_speeds 0 is outside \[1, 10000\]'):
+        rm.run_stability_lobes(CUT, modal_table=MODAL, sd_speeds=0)
+    with pytest.raises(ValueError, match='exactly one tool-tip source'):
+        rm.run_stability_lobes(CUT, modal_table=MODAL, frf=FRF)
+    with pytest.raises(ValueError, match="method 'zo': expected zoa, sd or both"):
+        rm.run_stability_lobes(CUT, modal_table=MODAL, method='zo')

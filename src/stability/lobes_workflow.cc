@@ -7,11 +7,32 @@
 #include <sstream>
 
 #include "robomach/calibration/frf_noise.h"
+#include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 #include "robomach/stability/tool_tip_model.h"
 
 namespace robomach::stability {
+
+const char* ToString(LobeMethod m) {
+  switch (m) {
+    case LobeMethod::kZoa:
+      return "zoa";
+    case LobeMethod::kSd:
+      return "sd";
+    case LobeMethod::kBoth:
+      return "both";
+  }
+  return "?";
+}
+
+LobeMethod ParseLobeMethod(const std::string& name) {
+  for (LobeMethod m : {LobeMethod::kZoa, LobeMethod::kSd, LobeMethod::kBoth}) {
+    if (name == ToString(m)) return m;
+  }
+  throw OptionError("method", "method '" + name + "': expected zoa, sd or both");
+}
+
 namespace {
 
 // The smallest critical depth [m] of one method over its ok points, and its

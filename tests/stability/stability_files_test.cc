@@ -11,7 +11,7 @@
 #include "robomach/io/region_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/tip_dynamics_files.h"
-#include "robomach/io/tip_sources.h"
+#include "robomach/workflows/tip_sources.h"
 #include "test_support.h"
 
 namespace robomach::io {
@@ -22,6 +22,9 @@ using robomach::testing::CaptureError;
 using robomach::testing::SourcePath;
 using robomach::testing::TempDir;
 using robomach::testing::WriteText;
+using workflows::CutFrame;
+using workflows::TipsFromModalTableFile;
+using workflows::TipsFromRobotPostures;
 
 constexpr char kCut[] =
     "diameter_mm: 20\n"

@@ -19,6 +19,11 @@
 namespace robomach::stability {
 
 enum class LobeMethod { kZoa, kSd, kBoth };
+/// "zoa", "sd", "both" (stability-lobes --method).
+const char* ToString(LobeMethod m);
+/// The inverse of ToString.
+/// @throws OptionError (field method) naming the accepted names.
+LobeMethod ParseLobeMethod(const std::string& name);
 
 /// One point of the lobes of one tool tip by one method.
 struct LobeRow {

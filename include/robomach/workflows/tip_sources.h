@@ -14,13 +14,13 @@
 #include "robomach/io/cut_file.h"
 #include "robomach/stability/tip_dynamics.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
 /// R_BC of `cut` for a tool axis (from the tip to the spindle) in the
 /// source's frame (stability::CuttingFrame). A feed along the axis is an
 /// InputError at the cut file's feed_direction that names `axis_source`
 /// (how the caller gave the axis, e.g. "--tool-axis 0,0,1").
-Eigen::Matrix3d CutFrame(const CutSpec& cut, const Eigen::Vector3d& tool_axis, const std::string& axis_source);
+Eigen::Matrix3d CutFrame(const io::CutSpec& cut, const Eigen::Vector3d& tool_axis, const std::string& axis_source);
 
 /// The tool tips of `model` at the postures `pose_ids` of the posture file
 /// (in that order; every posture of the file, in its order, when empty). A
@@ -31,11 +31,11 @@ Eigen::Matrix3d CutFrame(const CutSpec& cut, const Eigen::Vector3d& tool_axis, c
 ///   axis at a posture.
 std::vector<stability::TipDynamics> TipsFromRobotPostures(const std::shared_ptr<const dynamics::RobotModel>& model,
                                                           const std::string& postures_path,
-                                                          const std::vector<std::string>& pose_ids, const CutSpec& cut,
+                                                          const std::vector<std::string>& pose_ids, const io::CutSpec& cut,
                                                           const stability::TipMessageSink& tell = {});
 
 /// The tool tips of the measured FRFs of options.frf_path (and
-/// options.frf_y_path): ReadTipFrfs, its warnings told, then
+/// options.frf_y_path): io::ReadTipFrfs, its warnings told, then
 /// stability::TipsFromMeasuredFrfs.
 std::vector<stability::TipDynamics> TipsFromFrfFiles(const stability::MeasuredTipOptions& options,
                                                      const stability::TipMessageSink& tell = {});
@@ -45,6 +45,6 @@ std::vector<stability::TipDynamics> TipsFromFrfFiles(const stability::MeasuredTi
 /// @throws InputError naming the file when none of the postures is in it.
 std::vector<stability::TipDynamics> TipsFromModalTableFile(const std::string& path,
                                                            const std::vector<std::string>& pose_ids,
-                                                           const Eigen::Matrix3d& R_BC, const CutSpec& cut);
+                                                           const Eigen::Matrix3d& R_BC, const io::CutSpec& cut);
 
-}  // namespace robomach::io
+}  // namespace robomach::workflows

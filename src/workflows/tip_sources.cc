@@ -1,4 +1,4 @@
-#include "robomach/io/tip_sources.h"
+#include "robomach/workflows/tip_sources.h"
 
 #include <algorithm>
 #include <sstream>
@@ -10,9 +10,9 @@
 #include "robomach/io/tip_dynamics_files.h"
 #include "robomach/stability/tool_tip_model.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
-Eigen::Matrix3d CutFrame(const CutSpec& cut, const Eigen::Vector3d& tool_axis, const std::string& axis_source) {
+Eigen::Matrix3d CutFrame(const io::CutSpec& cut, const Eigen::Vector3d& tool_axis, const std::string& axis_source) {
   try {
     return stability::CuttingFrame(tool_axis, cut.feed_direction_B);
   } catch (const std::invalid_argument& e) {
@@ -23,25 +23,25 @@ Eigen::Matrix3d CutFrame(const CutSpec& cut, const Eigen::Vector3d& tool_axis, c
 
 std::vector<stability::TipDynamics> TipsFromRobotPostures(const std::shared_ptr<const dynamics::RobotModel>& model,
                                                           const std::string& postures_path,
-                                                          const std::vector<std::string>& pose_ids, const CutSpec& cut,
+                                                          const std::vector<std::string>& pose_ids, const io::CutSpec& cut,
                                                           const stability::TipMessageSink& tell) {
-  const std::vector<Posture> postures = ReadPostureFile(postures_path, model->num_joints());
-  std::vector<const Posture*> chosen;
+  const std::vector<io::Posture> postures = io::ReadPostureFile(postures_path, model->num_joints());
+  std::vector<const io::Posture*> chosen;
   for (const std::string& id : pose_ids) {
-    auto it = std::find_if(postures.begin(), postures.end(), [&](const Posture& p) { return p.id == id; });
+    auto it = std::find_if(postures.begin(), postures.end(), [&](const io::Posture& p) { return p.id == id; });
     if (it == postures.end()) {
       std::string known;
-      for (const Posture& p : postures) known += (known.empty() ? "" : ", ") + p.id;
+      for (const io::Posture& p : postures) known += (known.empty() ? "" : ", ") + p.id;
       throw InputError({postures_path, 0, 0}, "no posture \"" + id + "\" in the file; it has " + known);
     }
     chosen.push_back(&*it);
   }
   if (chosen.empty()) {
-    for (const Posture& p : postures) chosen.push_back(&p);
+    for (const io::Posture& p : postures) chosen.push_back(&p);
   }
   std::vector<stability::TipDynamics> tips;
   dynamics::PostureEvaluator ev(model);
-  for (const Posture* p : chosen) {
+  for (const io::Posture* p : chosen) {
     const dynamics::PostureDynamics d = ev.Evaluate(p->q);
     if (d.near_singular && tell) {
       tell({stability::TipMessage::Kind::kWarning, postures_path + ":" + std::to_string(p->line) + ": posture " +
@@ -64,23 +64,23 @@ std::vector<stability::TipDynamics> TipsFromFrfFiles(const stability::MeasuredTi
   // Each file's reader warnings as it is read, before the fits speak.
   auto read = [&](const std::string& path) {
     std::vector<std::string> warnings;
-    std::vector<FrfSetOfPose> sets = ReadTipFrfs(path, "", &warnings);
+    std::vector<io::FrfSetOfPose> sets = io::ReadTipFrfs(path, "", &warnings);
     if (tell) {
       for (const std::string& w : warnings) tell({stability::TipMessage::Kind::kWarning, w});
     }
     return sets;
   };
-  const std::vector<FrfSetOfPose> sets = read(options.frf_path);
-  std::vector<FrfSetOfPose> ysets;
+  const std::vector<io::FrfSetOfPose> sets = read(options.frf_path);
+  std::vector<io::FrfSetOfPose> ysets;
   if (!options.frf_y_path.empty()) ysets = read(options.frf_y_path);
   return stability::TipsFromMeasuredFrfs(sets, ysets, options, tell);
 }
 
 std::vector<stability::TipDynamics> TipsFromModalTableFile(const std::string& path,
                                                            const std::vector<std::string>& pose_ids,
-                                                           const Eigen::Matrix3d& R_BC, const CutSpec& cut) {
+                                                           const Eigen::Matrix3d& R_BC, const io::CutSpec& cut) {
   std::vector<stability::TipDynamics> tips;
-  for (const ModalTableEntry& e : ReadModalTable(path)) {
+  for (const io::ModalTableEntry& e : io::ReadModalTable(path)) {
     if (!pose_ids.empty() && std::find(pose_ids.begin(), pose_ids.end(), e.pose_id) == pose_ids.end()) continue;
     tips.push_back(stability::TipFromModes(e.pose_id, e.modes, R_BC, cut.process.teeth, cut.spindle_speed_max_rad_s));
   }
@@ -88,4 +88,4 @@ std::vector<stability::TipDynamics> TipsFromModalTableFile(const std::string& pa
   return tips;
 }
 
-}  // namespace robomach::io
+}  // namespace robomach::workflows

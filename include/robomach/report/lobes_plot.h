@@ -1,0 +1,34 @@
+#pragma once
+// The lobe diagram of stability-lobes --plot: critical axial depth against
+// spindle speed, one curve per tool tip and method.
+
+#include <string>
+#include <vector>
+
+namespace robomach::report {
+
+/// One curve of the diagram: NaN depths (no boundary) leave a gap.
+struct LobeCurve {
+  std::string label;              // e.g. "P1 ZOA"
+  std::vector<double> speed_rpm;  // [rpm]
+  std::vector<double> depth_mm;   // [mm]
+  bool markers{false};            // SD's points (a coarser grid) as markers
+};
+
+/// Where the depth axis ends, or NaN when it shows the curves' full range.
+/// The axis shows the lobes' bottoms, the depths a user can cut: between
+/// lobes the critical depth rises to tens or hundreds of mm, and a linear
+/// axis up to that squashes the sub-mm bottoms flat. It ends at 5 x the
+/// smallest critical depth of all curves (the first lobes above the bottom
+/// and the stable pockets between them), raised to 1.5 x the largest of the
+/// curves' own smallest depths so that every curve's bottom is in the
+/// picture; NaN when the largest depth is within 5 % of that.
+double LobesDepthAxisClipMm(const std::vector<LobeCurve>& curves);
+
+/// Draws the diagram to a PNG: `title` above, `subtitle` on the panel
+/// (teeth, immersion, milling direction). A clipped depth axis is said in
+/// the panel's title, naming `csv_name` as where the full range is.
+void SaveLobesPlot(const std::string& path, const std::string& title, const std::string& subtitle,
+                   const std::vector<LobeCurve>& curves, const std::string& csv_name);
+
+}  // namespace robomach::report

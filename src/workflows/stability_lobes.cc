@@ -1,0 +1,137 @@
+#include "robomach/workflows/stability_lobes.h"
+
+#include <string>
+
+#include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
+#include "robomach/common/units.h"
+#include "robomach/io/lobes_file.h"
+#include "robomach/io/robot_config.h"
+#include "robomach/workflows/tip_sources.h"
+
+namespace robomach::workflows {
+namespace {
+
+template <typename T>
+void CheckRange(const char* field, T value, T lo, T hi) {
+  if (!(value >= lo && value <= hi)) {
+    throw OptionError(field, std::string(field) + " " + FormatNumber(static_cast<double>(value), 6) +
+                                 " is outside [" + FormatNumber(static_cast<double>(lo), 6) + ", " +
+                                 FormatNumber(static_cast<double>(hi), 6) + "]");
+  }
+}
+
+std::string AxisSource(const StabilityLobesOptions& o) {
+  if (!o.tool_axis_source.empty()) return o.tool_axis_source;
+  return "tool_axis " + FormatNumber(o.tool_axis(0), 6) + "," + FormatNumber(o.tool_axis(1), 6) + "," +
+         FormatNumber(o.tool_axis(2), 6);
+}
+
+void Say(const stability::TipMessageSink& tell, stability::TipMessage::Kind kind, const std::string& text) {
+  if (tell) tell({kind, text});
+}
+
+}  // namespace
+
+void StabilityLobesOptions::Validate() const {
+  const int sources = !robot_path.empty() + !frf_path.empty() + !modal_table_path.empty();
+  if (sources != 1) {
+    throw OptionError("robot_path",
+                      "give exactly one tool-tip source: robot_path (with postures_path), frf_path or modal_table_path");
+  }
+  if (!robot_path.empty() && postures_path.empty()) throw OptionError("postures_path", "robot_path needs postures_path");
+  if (!frf_y_path.empty() && frf_path.empty()) throw OptionError("frf_y_path", "frf_y_path needs frf_path");
+  if (!(tool_axis.allFinite() && tool_axis.norm() > 0.0)) {
+    throw OptionError("tool_axis", AxisSource(*this) + ": expected a non-zero vector x,y,z");
+  }
+  ValidateSettings();
+}
+
+void StabilityLobesOptions::ValidateSettings() const {
+  CheckRange("speeds", speeds, 0, 100000);
+  CheckRange("max_lobe", max_lobe, 0, 1000);
+  CheckRange("sd_speeds", sd_speeds, 1, 10000);
+  if (sd_steps != 0) CheckRange("sd_steps", sd_steps, 2, 1000);
+  CheckRange("sd_steps_per_mode_period", sd_steps_per_mode_period, 4.0, 1000.0);
+  CheckRange("sd_modes", sd_modes, 1, 200);
+  CheckRange("sd_max_depth_mm", sd_max_depth_mm, 1e-6, 1e4);
+  CheckRange("threads", threads, 0, 256);
+}
+
+std::string StabilityLobesOptions::Source() const {
+  return !robot_path.empty() ? "robot" : !frf_path.empty() ? "frf" : "modal_table";
+}
+
+stability::LobesOptions MakeLobesOptions(const io::CutSpec& cut, const StabilityLobesOptions& o) {
+  stability::LobesOptions lo;
+  lo.method = o.method;
+  lo.process = cut.process;
+  lo.min_speed_rad_s = cut.spindle_speed_min_rad_s;
+  lo.max_speed_rad_s = cut.spindle_speed_max_rad_s;
+  lo.zoa_speeds_rad_s = cut.SpeedRange(o.speeds);
+  lo.sd_speeds_rad_s = cut.SpeedRange(o.sd_speeds);
+  lo.max_lobe_index = o.max_lobe;
+  lo.sd.steps_per_period = o.sd_steps;
+  lo.sd.steps_per_mode_period = o.sd_steps_per_mode_period;
+  lo.sd.max_depth = MmToM(o.sd_max_depth_mm);
+  lo.sd_modes = o.sd_modes;
+  lo.threads = o.threads;
+  return lo;
+}
+
+StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const stability::TipMessageSink& tell,
+                                    const stability::SdProgressSink& progress) {
+  o.Validate();
+  StabilityLobesRun run;
+  run.cut = io::ReadCutFile(o.cut_path);
+  for (const std::string& w : run.cut.implausible) {
+    Say(tell, stability::TipMessage::Kind::kWarning, w);
+    run.input_findings.push_back(w);
+  }
+  const std::string axis_source = AxisSource(o);
+  if (!o.robot_path.empty()) {
+    const io::RobotConfig cfg = io::LoadRobotConfig(o.robot_path);
+    for (const std::string& w : cfg.implausible) {
+      Say(tell, stability::TipMessage::Kind::kWarning, w);
+      run.input_findings.push_back(w);
+    }
+    run.tips = TipsFromRobotPostures(cfg.Build(), o.postures_path, o.pose_ids, run.cut, tell);
+  } else if (!o.frf_path.empty()) {
+    stability::MeasuredTipOptions mo;
+    mo.frf_path = o.frf_path;
+    mo.frf_y_path = o.frf_y_path;
+    mo.pose_ids = o.pose_ids;
+    // The cutting frame only when the FRFs need orienting.
+    const io::CutSpec& cut = run.cut;
+    mo.cutting_frame = [&cut, &o, axis_source] { return CutFrame(cut, o.tool_axis, axis_source); };
+    mo.tool_axis_source = axis_source;
+    mo.fit = true;  // always: the noise model's usable band serves the ZOA too
+    mo.sd_modes = o.sd_modes;
+    run.tips = TipsFromFrfFiles(mo, tell);
+  } else {
+    const Eigen::Matrix3d R = CutFrame(run.cut, o.tool_axis, axis_source);
+    run.tips = TipsFromModalTableFile(o.modal_table_path, o.pose_ids, R, run.cut);
+  }
+  run.lobes = stability::ComputeLobes(run.tips, MakeLobesOptions(run.cut, o), tell, progress);
+  return run;
+}
+
+nlohmann::json StabilityLobesRun::Summary(const StabilityLobesOptions& o) const {
+  nlohmann::json j = io::LobesSummaryJson(tips, lobes);
+  j["cut"] = o.cut_path;
+  j["source"] = o.Source();
+  if (!o.robot_path.empty()) {
+    j["robot"] = o.robot_path;
+    j["postures"] = o.postures_path;
+  }
+  if (!o.frf_path.empty()) j["frf"] = o.frf_path;
+  if (!o.frf_y_path.empty()) j["frf_y"] = o.frf_y_path;
+  if (!o.modal_table_path.empty()) j["modal_table"] = o.modal_table_path;
+  j["method"] = stability::ToString(o.method);
+  j["teeth"] = cut.process.teeth;
+  j["radial_immersion"] = cut.process.radial_immersion;
+  j["input_findings"] = input_findings;
+  return j;
+}
+
+}  // namespace robomach::workflows
