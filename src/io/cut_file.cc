@@ -100,6 +100,11 @@ CutSpec ReadCutFile(const std::string& path) {
     constexpr double kNPerMm2 = 1e6;  // N/mm² -> N/m²
     const bool has_t = k.Has("ktc_N_per_mm2"), has_s = k.Has("Ks_N_per_mm2");
     if (has_t == has_s) {
+      // A coefficient mistyped (ktc_N_per_m2) is named with the key meant.
+      for (const char* key : {"ktc_N_per_mm2", "krc_N_per_mm2", "kac_N_per_mm2", "Ks_N_per_mm2", "beta_deg"}) {
+        k.MarkUsed(key);
+      }
+      k.RejectUnknownKeys();
       throw k.Error("give either ktc_N_per_mm2 and krc_N_per_mm2 (optional kac_N_per_mm2), or Ks_N_per_mm2 and beta_deg");
     }
     const std::string practice = "metal-cutting coefficients (300 to 4000 N/mm² for aluminium to nickel alloys)";

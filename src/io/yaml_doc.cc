@@ -6,6 +6,7 @@
 #include <fstream>
 #include <map>
 
+#include "robomach/common/closest_name.h"
 #include "robomach/io/csv_table.h"
 
 namespace robomach::io {
@@ -60,7 +61,34 @@ void RejectDuplicateKeys(const YAML::Node& node, const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+// YAML indents with spaces only; yaml-cpp's answer to a tab ("illegal tab
+// when looking for indentation", or a key silently taken into the value
+// before it) does not lead to the fix (issue #35). A line whose indentation
+// holds a tab is refused at the tab, except comment lines.
+void RejectTabIndentation(const std::string& text, const std::string& path) {
+  size_t line = 1;
+  for (size_t pos = 0; pos < text.size();) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    const size_t first = text.find_first_not_of(" \t", pos);
+    if (first < end && text[first] != '#' && text[first] != '\r') {
+      const size_t tab = text.find('\t', pos);
+      if (tab < first) {
+        throw InputError({path, static_cast<int>(line), static_cast<int>(tab - pos + 1)},
+                         "a tab in the indentation: YAML is indented with spaces only; indent with spaces");
+      }
+    }
+    pos = end + 1;
+    ++line;
+  }
+}
+
+}  // namespace
+
 YamlDoc YamlDoc::LoadString(const std::string& text, const std::string& path) {
+  RejectTabIndentation(text, path);
   try {
     YAML::Node root = YAML::Load(text);
     RejectDuplicateKeys(root, path);
@@ -91,6 +119,23 @@ YamlDoc YamlDoc::operator[](const std::string& key) const {
   used_keys_->push_back(key);
   YAML::Node child = node_[key];
   if (!child) {
+    // A key of the map that is close to the one missing is most likely it,
+    // mistyped: that key's place and name (issue #35).
+    std::vector<std::string> present;
+    for (const auto& kv : node_) {
+      if (kv.first.IsScalar()) present.push_back(kv.first.Scalar());
+    }
+    const std::string closest = ClosestName(key, present);
+    if (!closest.empty()) {
+      for (const auto& kv : node_) {
+        if (kv.first.IsScalar() && kv.first.Scalar() == closest) {
+          const YAML::Mark km = kv.first.Mark();
+          throw InputError({*path_, km.line + 1, km.column + 1},
+                           "missing key '" + key + "'" + (key_path_.empty() ? "" : " in '" + key_path_ + "'") +
+                               "; the file has '" + closest + "' here: mistyped?");
+        }
+      }
+    }
     throw InputError(location(), "missing key '" + key + "'" +
                                      (key_path_.empty() ? "" : " in '" + key_path_ + "'"));
   }
@@ -210,11 +255,13 @@ void YamlDoc::RejectUnknownKeys() const {
     std::sort(sorted.begin(), sorted.end());
     sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
     for (const auto& k : sorted) known += (known.empty() ? "" : ", ") + k;
+    const std::string closest = ClosestName(key, sorted);
     const YAML::Mark m = kv.first.Mark();
     throw InputError({*path_, m.line + 1, m.column + 1},
                      "unknown key '" + key + "'" +
                          (key_path_.empty() ? "" : " in '" + key_path_ + "'") +
-                         "; known keys: " + known);
+                         (closest.empty() ? "; known keys: " : "; did you mean '" + closest + "'? Known keys: ") +
+                         known);
   }
 }
 

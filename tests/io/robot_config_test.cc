@@ -44,6 +44,13 @@ TEST(RobotConfig, UnknownKeysAreRejectedWithLineColumnAndTheKnownKeys) {
               HasSubstr("robot.yaml:31:3: unknown key 'gamma' in 'damping'; known keys: alpha_s, beta_per_s"));
 }
 
+TEST(RobotConfig, AMistypedKeyIsAnsweredWithTheKeyMeant) {
+  const std::string p = Variant("typo", "  alpha_s: 1.0e-4", "  alpha_s: 1.0e-4\n  beta_per_ss: 3");
+  EXPECT_THAT(CaptureError([&] { LoadRobotConfig(p); }),
+              HasSubstr("robot.yaml:31:3: unknown key 'beta_per_ss' in 'damping'; did you mean 'beta_per_s'? "
+                        "Known keys: alpha_s, beta_per_s"));
+}
+
 TEST(RobotConfig, BadValuesAreLocated) {
   EXPECT_THAT(CaptureError([&] {
                 LoadRobotConfig(Variant("kq", "[3.3479e+6, 3.1318e+6,", "[3.3479e+6, abc,"));
