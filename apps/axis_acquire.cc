@@ -135,7 +135,7 @@ int Run(int argc, char** argv) {
         fig.SavePng(plot_path);
       }
     }
-    if (!summary_path.empty()) io::WriteFileAtomically(summary_path, report::DumpJson(j));
+    if (!summary_path.empty()) io::WriteFileAtomically(summary_path, SummaryText(j));
     if (path) {
       std::cerr << kTool << ": " << rec.rows() << " samples; contour error max " << j["contour_error_um"]["max"].get<double>()
                 << " um, rms " << j["contour_error_um"]["rms"].get<double>() << " um; axis error max "

@@ -91,11 +91,8 @@ int Run(int argc, char** argv) {
     // turn either way (the inverse kinematics repeats every turn); within
     // 2 pi and not whole it is radians (-1.5708 for -90 deg), the rule of
     // the _deg fields (CheckDegreesNotRadians, src/io/plausible.h).
-    if (start_b_deg != 0.0 && std::abs(start_b_deg) <= 2.0 * kPi && start_b_deg != std::floor(start_b_deg)) {
-      implausible.push_back("implausible (unit mistake?): --start-b-deg " + FormatNumber(start_b_deg, 7) +
-                            " deg is within 2 pi = 6.28 and not whole, as radians are: radians typed in the deg "
-                            "option? (" + FormatNumber(start_b_deg, 7) + " rad is " +
-                            FormatNumber(RadToDeg(start_b_deg), 4) + " deg)");
+    if (const std::string w = RadiansInDegreeOption("--start-b-deg", start_b_deg); !w.empty()) {
+      implausible.push_back(w);
     } else if (const std::string w = ImplausibleOption(
                    "--start-b-deg", start_b_deg, -360.0, 360.0, "deg", "a nutating head's B (within a turn of 0)",
                    "an angle in gradians (400 a turn) or a turn too many typed?",

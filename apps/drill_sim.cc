@@ -198,9 +198,9 @@ int RunDrillSim(int argc, char** argv) {
       const nlohmann::json j = io::DrillRunSummaryJson(run, *sc, limit);
       if (!out_path.empty()) io::WriteFileAtomically(WithSuffix(out_path, kind, several), io::DrillSeriesCsv(run.result));
       if (!summary_path.empty()) {
-        io::WriteFileAtomically(WithSuffix(summary_path, kind, several), report::DumpJson(j));
+        io::WriteFileAtomically(WithSuffix(summary_path, kind, several), SummaryText(j));
       } else if (out_path.empty()) {
-        io::WriteFileAtomically("-", report::DumpJson(j));
+        io::WriteFileAtomically("-", SummaryText(j));
       }
     }
     if (!plot_path.empty()) Plot(plot_path, runs, n);

@@ -211,7 +211,7 @@ int Run(int argc, char** argv) {
     if (!holdout_noise.empty()) summary["holdout_noise"] = report::NoiseSummaryJson(holdout_noise, noise_opt.model, noise_opt.min_snr);
     summary["robot"] = robot_path;
     summary["calibrated_config"] = out_path;
-    io::WriteFileAtomically((dir / "summary.json").string(), report::DumpJson(summary));
+    io::WriteFileAtomically((dir / "summary.json").string(), SummaryText(summary));
     dynamics::PostureEvaluator eb(model_before), ea(model_after);
     // Overlays show every measured line with the noise model, not only the usable ones.
     dynamics::FrfSet all = measured_read.frfs;
@@ -242,7 +242,7 @@ int Run(int argc, char** argv) {
                                       holdout_features);
       }
     }
-    if (!summary_path.empty()) io::WriteFileAtomically(summary_path, report::DumpJson(summary));
+    if (!summary_path.empty()) io::WriteFileAtomically(summary_path, SummaryText(summary));
     // Matching and errors on stderr, briefly.
     for (const auto& s : sets_out) {
       std::ostringstream m;

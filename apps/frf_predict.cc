@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli_support.h"
+#include "robomach/common/number_format.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/frf_prediction.h"
@@ -121,7 +122,9 @@ int Run(int argc, char** argv) {
     } else {
       if (!(fmin_hz >= 0.0) || !(fmax_hz > fmin_hz) || !(df_hz > 0.0) || !std::isfinite(fmax_hz) ||
           !std::isfinite(df_hz)) {
-        throw UsageError("expected finite 0 <= --fmin-hz < --fmax-hz and --df-hz > 0");
+        throw UsageError("expected finite 0 <= --fmin-hz < --fmax-hz and --df-hz > 0, got --fmin-hz " +
+                         FormatNumber(fmin_hz, 7) + ", --fmax-hz " + FormatNumber(fmax_hz, 7) + ", --df-hz " +
+                         FormatNumber(df_hz, 7));
       }
       // Count in double first: a tiny step would overflow the integer.
       const double lines = std::floor((fmax_hz - fmin_hz) / df_hz + 1e-9) + 1.0;
@@ -197,7 +200,7 @@ int Run(int argc, char** argv) {
       j["parameters"] = params;
       j["postures"] = nlohmann::json::array();
       for (size_t p = 0; p < postures.size(); ++p) j["postures"].push_back(io::PostureToJson(ids[p], dyns[p]));
-      io::WriteFileAtomically(details_path, report::DumpJson(j));
+      io::WriteFileAtomically(details_path, SummaryText(j));
     }
     std::string title = "robomach frf-predict: " + robot_path;
     for (const auto& e : model->effects()) title += " + " + e.effect->name();

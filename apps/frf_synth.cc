@@ -109,6 +109,10 @@ int Run(int argc, char** argv) {
     }
     CheckOptionRange("--block-samples", static_cast<double>(o.block_samples), 2, 1 << 22);
     CheckOptionRange("--averages", o.averages, o.coherence ? 2 : 1, 100000);
+    if (std::isinf(o.relative_noise)) {  // "1e400" reads as infinity
+      throw UsageError("--noise-rel " + FormatNumber(o.relative_noise, 7) +
+                       ": expected a finite noise rms >= 0, as a fraction of the FRF (0.02 = 2 %)");
+    }
     if (o.relative_noise > kMaxRelativeNoise) {
       throw UsageError("--noise-rel " + FormatNumber(o.relative_noise, 7) +
                        ": expected the noise as a fraction of the FRF (0.02 = 2 %), at most 10; the noise would bury "
@@ -255,7 +259,7 @@ int Run(int argc, char** argv) {
                         {"peak_receptance_m_per_N", peak}});
       }
       j["frfs"] = list;
-      io::WriteFileAtomically(summary_path, report::DumpJson(j));
+      io::WriteFileAtomically(summary_path, SummaryText(j));
     }
     std::ostringstream msg;
     msg << kTool << ": wrote " << frfs.size() << " FRFs of " << calibration::HammerTestGrid(o).size()

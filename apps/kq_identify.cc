@@ -234,6 +234,24 @@ int Run(int argc, char** argv) {
       throw UsageError("--noise-mm: expected a finite noise > 0 mm");
     }
     CheckOptionRange("--plan", plan_n, 0, 500);  // 500 postures: ~15 s of planning
+    // The two modes' options are not mixed silently (issue #35: --plan with
+    // --tracker planned and ignored the file).
+    if (plan_n != 0) {
+      for (const char* name : {"--tracker", "--residuals", "--plot", "--summary", "--robust", "--merge",
+                               "--as-parameters"}) {
+        if (app.count(name) > 0) {
+          throw UsageError(std::string(name) + " is for identifying from a tracker file, and --plan " +
+                           std::to_string(plan_n) + " plans a test instead (no file is read): give one of the two");
+        }
+      }
+    } else {
+      for (const char* name : {"--load-point-mm", "--target-mm", "--masses-kg", "--max-rope-angle-deg", "--seed"}) {
+        if (app.count(name) > 0) {
+          throw UsageError(std::string(name) + " is an option of --plan N (planning a test); without --plan, "
+                           "kq-identify identifies from --tracker and does not use it");
+        }
+      }
+    }
     RequireInputFile("--robot", robot_path, "robot config", {io::FileKind::kYaml}, io::kRobotConfigFormat);
     CheckDistinctPaths({{"--robot", robot_path}, {"--tracker", tracker_path}},
                        {{"--out", out_path}, {"--residuals", residuals_path}, {"--plot", plot_path},
@@ -241,7 +259,6 @@ int Run(int argc, char** argv) {
     const io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     if (plan_n != 0) {
       if (plan_n < 1) throw UsageError("--plan: expected a number of postures >= 1");
-      if (merge) throw UsageError("--merge cannot be combined with --plan");
       const int rc = RunPlan(cfg, plan_n, noise_mm, seed, ParsePointMm("--load-point-mm", load_point),
                              ParsePointMm("--target-mm", target), ParsePositiveList("--masses-kg", masses),
                              rope_angle_deg, out_path);
@@ -316,7 +333,7 @@ int Run(int argc, char** argv) {
     if (!plot_path.empty()) {
       PlotResiduals(plot_path, r, r.outlier_threshold, "kq-identify: " + tracker_path);
     }
-    if (!json_path.empty()) io::WriteFileAtomically(json_path, report::DumpJson(io::KqSummaryJson(r)));
+    if (!json_path.empty()) io::WriteFileAtomically(json_path, SummaryText(io::KqSummaryJson(r)));
     PrintReport(r, std::cerr);
     return r.flagged() || !cfg.implausible.empty() || !implausible.empty() ? kExitFlagged : kExitOk;
   });

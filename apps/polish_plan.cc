@@ -213,6 +213,10 @@ int Run(int argc, char** argv) {
     if (!list_out.empty()) throw UsageError("--out goes with --list-faces");
     std::vector<std::string> implausible;  // unit findings of the process file
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path, &implausible);
+    // The one angle option: radians typed under _deg (1.5708 for 90 deg).
+    if (const std::string w = RadiansInDegreeOption("--line-angle-deg", po.line_angle_deg); !w.empty()) {
+      implausible.push_back(w);
+    }
     for (const std::string& w : implausible) Warn(kTool, w);
     const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
     {
@@ -277,7 +281,7 @@ int Run(int argc, char** argv) {
       WritePictures(plot_out, grid, e.removal, e.path.rows, e.path.guide_lines_st, outcome.history_best, pattern,
                     outcome.history_cv);
     }
-    io::WriteFileAtomically(summary_out.empty() ? "-" : summary_out, report::DumpJson(summary));
+    io::WriteFileAtomically(summary_out.empty() ? "-" : summary_out, SummaryText(summary));
     return flagged ? kExitFlagged : kExitOk;
   });
 }

@@ -88,7 +88,7 @@ int Run(int argc, char** argv) {
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, removal);
     robot.WriteJoints(file.rows);
     if (!plot_out.empty()) WritePictures(plot_out, grid, removal, file.rows, {}, {}, "polish-sim");
-    const std::string text = report::DumpJson(summary);
+    const std::string text = SummaryText(summary);
     io::WriteFileAtomically(summary_out.empty() ? "-" : summary_out, text);
     return flagged ? kExitFlagged : kExitOk;
   });

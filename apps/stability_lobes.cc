@@ -267,7 +267,7 @@ int Run(int argc, char** argv) {
       j["tool"] = kTool;
       j["lobes_csv"] = out_path.empty() ? "-" : out_path;
       j["exit_code"] = flagged ? kExitFlagged : kExitOk;
-      io::WriteFileAtomically(summary_path, report::DumpJson(j));
+      io::WriteFileAtomically(summary_path, SummaryText(j));
     }
     return flagged ? kExitFlagged : kExitOk;
   });

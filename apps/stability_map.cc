@@ -150,7 +150,7 @@ int Run(int argc, char** argv) {
       if (!path_path.empty()) j["path"] = path_path;
       j["points_csv"] = out_path.empty() ? "-" : out_path;
       j["exit_code"] = !implausible ? ExitCodeFor(map.status()) : kExitFlagged;
-      io::WriteFileAtomically(summary_path, report::DumpJson(j));
+      io::WriteFileAtomically(summary_path, SummaryText(j));
     }
     for (const Finding& f : map.findings) Warn(kTool, f.message);
     return !implausible ? ExitCodeFor(map.status()) : kExitFlagged;

@@ -235,7 +235,7 @@ int Run(int argc, char** argv) {
         j["deflection_min_mm"] = dmin;
         j["deflection_max_mm"] = dmax;
       }
-      io::WriteFileAtomically(summary_path, report::DumpJson(j));
+      io::WriteFileAtomically(summary_path, SummaryText(j));
     }
     std::cerr << kTool << ": " << ms.size() << " load cases (" << ids.size() << " postures x "
               << (plan_pulleys.empty() ? o.pulleys.size() : plan_pulleys[0].size()) << " rope directions x " << o.masses_kg.size() << " masses)"

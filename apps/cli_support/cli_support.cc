@@ -1,13 +1,16 @@
 #include "cli_support.h"
 
+#include "robomach/common/closest_name.h"
 #include "robomach/common/number_format.h"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <glog/logging.h>
 
 #include <unistd.h>
 
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <mutex>
 #include <fstream>
@@ -21,6 +24,7 @@
 #include "robomach/io/csv_table.h"
 #include "robomach/io/file_kind.h"
 #include "robomach/io/file_names.h"
+#include "robomach/report/json.h"
 
 namespace robomach::apps {
 
@@ -154,6 +158,12 @@ void Warn(const std::string& tool, const std::string& raw_message) {
   WarningsList().push_back(message);
 }
 
+std::string SummaryText(const nlohmann::json& summary) {
+  nlohmann::json j = summary;
+  if (j.is_object() && !j.contains("warnings")) j["warnings"] = WarningsGiven();
+  return report::DumpJson(j);
+}
+
 io::RobotConfig LoadRobotConfigWarned(const std::string& tool, const std::string& path) {
   io::RobotConfig cfg = io::LoadRobotConfig(path);
   for (const std::string& w : cfg.implausible) Warn(tool, w);
@@ -175,12 +185,43 @@ std::function<std::string(const std::string&)> PngFileName() {
   };
 }
 
+std::string SuggestOption(const std::string& given, const std::vector<std::string>& long_names) {
+  if (given.size() < 3 || given.rfind("--", 0) != 0) return "";
+  const std::string name = given.substr(2, given.find('=') == std::string::npos ? std::string::npos : given.find('=') - 2);
+  const std::string best = ClosestName(name, long_names);
+  return best.empty() ? "" : "--" + best;
+}
+
 void AddVersionFlag(CLI::App& app, const std::string& tool) {
   app.set_version_flag("--version", tool + " " + Version(), "print the version (and git commit) and exit");
   // Command-line errors CLI11 reports (a --plot x.jpg, an unknown option)
-  // start with the tool's name like every other message (issue #35).
+  // start with the tool's name like every other message (issue #35); an
+  // unknown option is answered with the closest known one.
   app.failure_message([tool](const CLI::App* a, const CLI::Error& e) {
-    return tool + ": " + CLI::FailureMessage::simple(a, e);
+    std::string message = tool + ": " + e.what() + "\n";
+    std::vector<std::string> extras;
+    if (dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr) {
+      // The unknown arguments as CLI11 lists them ("... not expected: 5 --fmax-hzz").
+      const std::string what = e.what();
+      const size_t colon = what.find(": ");
+      std::istringstream words(colon == std::string::npos ? "" : what.substr(colon + 2));
+      for (std::string w; words >> w;) extras.push_back(w);
+    } else {
+      // Another error found first ("--postures is required" for --postres):
+      // the arguments left over so far.
+      extras = a->remaining();
+    }
+    if (!extras.empty()) {
+      std::vector<std::string> names;
+      for (const CLI::Option* opt : a->get_options()) {
+        for (const std::string& n : opt->get_lnames()) names.push_back(n);
+      }
+      for (const std::string& extra : extras) {
+        const std::string hint = SuggestOption(extra, names);
+        if (!hint.empty()) message += tool + ": " + extra.substr(0, extra.find('=')) + ": did you mean " + hint + "?\n";
+      }
+    }
+    return message + "Run with --help for more information.\n";
   });
 }
 
@@ -334,6 +375,14 @@ std::string ImplausibleOption(const std::string& option, double value, double lo
   return "implausible (unit mistake?): " + option + " " + FormatNumber(value, 7) + u + " is outside the " +
          FormatNumber(lo, 7) + " to " + FormatNumber(hi, 7) + u + " of " + practice + ": " +
          (value < lo ? low_hint : high_hint);
+}
+
+std::string RadiansInDegreeOption(const std::string& option, double value_deg) {
+  constexpr double kTurnRad = 6.283185307179586;
+  if (value_deg == 0.0 || !(std::abs(value_deg) <= kTurnRad) || value_deg == std::floor(value_deg)) return "";
+  return "implausible (unit mistake?): " + option + " " + FormatNumber(value_deg, 7) +
+         " deg is within 2 pi = 6.28 and not whole, as radians are: radians typed in the deg option? (" +
+         FormatNumber(value_deg, 7) + " rad is " + FormatNumber(value_deg * 180.0 / 3.141592653589793, 4) + " deg)";
 }
 
 std::vector<double> ParseNumberList(const std::string& option, const std::string& text) {

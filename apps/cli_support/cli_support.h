@@ -10,6 +10,7 @@
 #include <optional>
 
 #include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
 
 #include "robomach/common/run_status.h"
 #include "robomach/io/file_kind.h"
@@ -146,6 +147,11 @@ void Warn(const std::string& tool, const std::string& message);
 /// put them in their summary and report (every warning a tool prints is
 /// also there).
 std::vector<std::string> WarningsGiven();
+/// A tool's JSON summary as written (report::DumpJson) with `warnings`:
+/// every message given to Warn() before it is written (WarningsGiven), so
+/// that every warning printed is also in the summary (formats.md §4.1). A
+/// summary that has its own `warnings` keeps them.
+std::string SummaryText(const nlohmann::json& summary);
 /// LoadRobotConfig with its unit findings (RobotConfig::implausible,
 /// docs/plausibility.md) given to Warn(): the tool flags its result (exit 3)
 /// when the returned config's `implausible` is not empty.
@@ -153,6 +159,10 @@ io::RobotConfig LoadRobotConfigWarned(const std::string& tool, const std::string
 /// "tool: note: message" on stderr: what a reader inferred or skipped; not
 /// a warning, and no reason for exit 3.
 void Note(const std::string& tool, const std::string& message);
+
+/// The known long option closest to `given` ("--fmax-hzz", "--fmax_hz",
+/// "--depth-m=3"), with its dashes, or "" when none is close (ClosestName).
+std::string SuggestOption(const std::string& given, const std::vector<std::string>& long_names);
 
 /// Adds --version to `app`: prints "tool 0.1.0 (git <commit>)" and exits 0.
 /// Also prefixes CLI11's command-line error messages with the tool's name.
@@ -198,6 +208,13 @@ void CheckOptionRange(const std::string& option, double value, double lo, double
 /// hi) for the tool to Warn() and flag its result (exit 3).
 std::string ImplausibleOption(const std::string& option, double value, double lo, double hi, const std::string& unit,
                               const std::string& practice, const std::string& low_hint, const std::string& high_hint);
+
+/// Sense check of a typed angle option in degrees: "" unless the value
+/// looks like radians, i.e. is within one turn in radians (|v| <= 2 pi =
+/// 6.28) and not whole (-1.5708 for -90 deg; 5 deg is degrees), the rule of
+/// the files' _deg fields (io::CheckDegreesNotRadians). The finding names
+/// the angle the value is in degrees, for the tool to Warn() and flag.
+std::string RadiansInDegreeOption(const std::string& option, double value_deg);
 
 /// "1,2.5,3" -> numbers; @throws UsageError naming the option.
 std::vector<double> ParseNumberList(const std::string& option, const std::string& text);

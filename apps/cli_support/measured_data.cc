@@ -74,7 +74,19 @@ void AddNoiseOptions(CLI::App& app, NoiseCliOptions* o) {
                "second differences over 8 and 16 lines of the residual about the modal fit, so that no mode is "
                "fitted in the drift (off by default: it can also count a smooth model misfit as noise)");
   app.add_option("--averages", o->averages,
-                 "number of averaged impacts behind the coherence, for files without '# averages: N' (UFF58)");
+                 "number of averaged impacts behind the coherence, for files without '# averages: N' (UFF58)")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            // 0 is the library's "not known"; typed, it is a mistake (issue #35).
+            long n = 0;
+            std::istringstream in(text);
+            if (!(in >> n) || !in.eof() || n < 1 || n > 1000000) {
+              return "expected the number of averaged impacts, a whole number from 1 to 1000000, got " + text +
+                     " (leave --averages out when the file gives '# averages: N' or the number is not known)";
+            }
+            return "";
+          },
+          "N >= 1"));
 }
 
 calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const MeasuredData& data,

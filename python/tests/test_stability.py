@@ -150,6 +150,7 @@ def test_run_stability_lobes_equals_the_tools_summary(tmp, source):
     run = rm.run_stability_lobes(CUT, method='both', sd_speeds=4, **kw)
     assert run['flagged'] == (r.returncode == 3)
     assert tool['exit_code'] == r.returncode
+    tool_warnings = tool.pop('warnings')  # every warning printed (formats.md §4.1)
     for key in ('tool', 'lobes_csv', 'exit_code', 'robomach_version'):  # what only the tool writes
         del tool[key]
     assert run['summary'] == tool
@@ -159,6 +160,7 @@ def test_run_stability_lobes_equals_the_tools_summary(tmp, source):
     printed = [line.split('warning: ', 1)[1] for line in r.stderr.splitlines() if ': warning: ' in line]
     said = [m['text'] for m in run['messages'] if m['kind'] == 'warning']
     assert [w.splitlines()[0] for w in said] == printed
+    assert [w.splitlines()[0] for w in tool_warnings] == printed
 
 
 def test_run_stability_lobes_names_the_option():

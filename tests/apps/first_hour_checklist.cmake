@@ -54,6 +54,12 @@ string(REPLACE "diameter_mm: 20" "diameter_mm: 20000" c "${cut}")
 file(WRITE ${WORK}/cut_diameter.yaml "${c}")
 string(REPLACE "ktc_N_per_mm2: 600" "ktc_N_per_mm2: 1.8e6" c "${cut}")
 file(WRITE ${WORK}/cut_ktc.yaml "${c}")
+# A key mistyped (mm2 -> m2), and a cut file indented with a tab.
+string(REPLACE "ktc_N_per_mm2: 600" "ktc_N_per_m2: 600" c "${cut}")
+file(WRITE ${WORK}/cut_typo.yaml "${c}")
+file(READ ${SRC}/config/cut_demo.yaml cut_demo)
+string(REPLACE "\n  ktc_N_per_mm2:" "\n\tktc_N_per_mm2:" c "${cut_demo}")
+file(WRITE ${WORK}/cut_tab.yaml "${c}")
 # A machine file with the linear encoder resolutions in um (x1000).
 file(READ ${SRC}/config/machine/dmu80p.yaml mach)
 string(REPLACE "resolution_mm: 0.0005" "resolution_mm: 0.5" mach "${mach}")
