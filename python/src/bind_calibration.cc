@@ -110,6 +110,25 @@ void BindCalibration(py::module_& m) {
             gd["modes"] = modes;
             gd["ok"] = g.fit.status == calibration::ModalFitStatus::kOk;
             gd["message"] = g.fit.message;
+            // A roving test's shapes (frf-modes --mode-shapes): None with the
+            // reason otherwise.
+            std::string why;
+            if (const auto rs = calibration::ShapesOfRovingTest(g, &why)) {
+              py::dict sd;
+              sd["roving"] = rs->roving;
+              sd["fixed_point"] = rs->fixed_point;
+              sd["fixed_direction"] = AxisString(rs->fixed_direction);
+              sd["points"] = rs->points;
+              std::vector<std::string> dirs;
+              for (Axis a : rs->directions) dirs.push_back(AxisString(a));
+              sd["directions"] = dirs;
+              sd["shapes"] = Eigen::MatrixXcd(rs->shapes);
+              sd["mass_normalised"] = rs->mass_normalised;
+              gd["shapes"] = sd;
+            } else {
+              gd["shapes"] = py::none();
+              gd["shapes_why_not"] = why;
+            }
             fits.append(gd);
           }
           py::list tips;
@@ -136,10 +155,14 @@ void BindCalibration(py::module_& m) {
       py::arg("per_frf") = false, py::arg("weights") = "noise", py::arg("file_power") = 0,
       "frf-modes' modal analysis: per posture, its FRFs fitted with common poles; returns a list of "
       "{pose_id, fits: [{frfs: [{frf, misfit_relative, misfit_noise_sigmas, modal_constants}], modes: "
-      "[{freq_hz, damping_ratio, stable_orders}], ok, message}], tip_modes: [{freq_hz, damping_ratio, "
+      "[{freq_hz, damping_ratio, stable_orders}], ok, message, shapes}], tip_modes: [{freq_hz, damping_ratio, "
       "modal_mass_kg, shape, directions}], warnings}. noise: estimate_noise(frfs, NoiseOptions(global_modal_fit=True)), as the tool takes it (the fit's weights and usable "
       "lines); weights 'noise' or 'quantity' (every line of the file's quantity alike, file_power 0 "
-      "receptance, 1 mobility, 2 accelerance).");
+      "receptance, 1 mobility, 2 accelerance). shapes: for a roving test (FRFs read with "
+      "read_frf_file(..., keep_points=True) sharing one end) {roving: 'excitation' or 'response', fixed_point, "
+      "fixed_direction, points, directions, shapes (complex, rows the FRFs, columns the modes; mass-normalised "
+      "[1/sqrt(kg)] when the driving point is among them), mass_normalised}, as frf-modes --mode-shapes; "
+      "else None and shapes_why_not.");
   m.def("modal_assurance_criterion", &calibration::ModalAssuranceCriterion, py::arg("a"), py::arg("b"),
         "MAC matrix between the columns of two complex shape matrices (same rows), in [0, 1].");
 
@@ -166,7 +189,7 @@ void BindCalibration(py::module_& m) {
          "'shoulder' (no maximum of its own in that window, on a stronger neighbour's flank: the peak is then "
          "|H| at the mode's own resonance f_n sqrt(1 - 2 zeta^2))")
       .def_property_readonly("fit_status", [](const MeasuredFeatures& f) {
-        std::map<std::tuple<std::string, std::string, std::string>, std::string> out;
+        std::map<KeyTuple, std::string> out;
         for (const auto& [k, r] : f.fits) {
           out[FromKey(k)] = r.status == calibration::ModalFitStatus::kOk            ? "ok"
                              : r.status == calibration::ModalFitStatus::kNoStableModes ? "no stable modes"

@@ -197,10 +197,14 @@ void BindFrf(py::module_& m) {
      (std::string("Reads the FRFs of a Universal File Format file (dataset 58/58b; 164 units). "
                   "default_pose_id is the posture of records without 'pose=ID' (the tools' --pose ID=file.uff).") +
       kReadResultDoc).c_str());
-  m.def("read_frf_file", [](const std::string& path, const std::string& default_pose_id) {
-    return ReadFrfs(path, [&] { return io::ReadFrfFile(path, default_pose_id); });
-  }, py::arg("path"), py::arg("default_pose_id") = "",
-     (std::string("Reads a measured-FRF file: UFF58 by extension (.uff .unv .uf .ufb) or content, else CSV.") +
+  m.def("read_frf_file", [](const std::string& path, const std::string& default_pose_id, bool keep_points) {
+    return ReadFrfs(path, [&] { return io::ReadFrfFile(path, default_pose_id, keep_points); });
+  }, py::arg("path"), py::arg("default_pose_id") = "", py::arg("keep_points") = false,
+     (std::string("Reads a measured-FRF file: UFF58 by extension (.uff .unv .uf .ufb) or content, else CSV. "
+                  "keep_points=True keeps the point numbers (UFF nodes, the CSV's response_point/"
+                  "excitation_point): the keys of numbered FRFs are then (pose_id, response, excitation, "
+                  "response_point, excitation_point), a roving test for analyse_modes' mode shapes, as "
+                  "frf-modes reads it; without it a posture must hold one point pair (the tool-tip tools).") +
       kReadResultDoc).c_str());
   m.def("write_frf_csv", [](const std::string& path, const FrfSet& frfs, const std::string& quantity, int averages) {
     const io::FrfQuantity q = io::ParseQuantity(quantity);

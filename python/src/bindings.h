@@ -46,10 +46,14 @@ Axis ParseAxis(const std::string& name);
 std::string AxisString(Axis a);
 
 /// Python spells an FRF key as a tuple (pose_id, response, excitation), e.g.
-/// ("P1", "x", "x") for the direct FRF Hxx of posture P1.
-using KeyTuple = std::tuple<std::string, std::string, std::string>;
-dynamics::FrfKey ToKey(const KeyTuple& t);
-KeyTuple FromKey(const dynamics::FrfKey& k);
+/// ("P1", "x", "x") for the direct FRF Hxx of posture P1, and, when the file
+/// numbers its points (a roving test read with keep_points=True), as
+/// (pose_id, response, excitation, response_point, excitation_point), e.g.
+/// ("P1", "z", "z", 1, 7). The type caster below converts both ways; a key
+/// whose points are 0 is the 3-tuple.
+using KeyTuple = dynamics::FrfKey;
+inline const dynamics::FrfKey& ToKey(const KeyTuple& t) { return t; }
+inline const KeyTuple& FromKey(const dynamics::FrfKey& k) { return k; }
 
 /// Joint angles as the library takes them [rad], from the `q_rad` or the
 /// `q_deg` of a Python call (exactly one of them; ValueError otherwise).
@@ -72,3 +76,39 @@ void WarnUnit(const std::string& message);
 void RequireReadableFile(const std::string& path);
 
 }  // namespace robomach::python
+
+namespace pybind11::detail {
+
+// FrfKey <-> (pose_id, response, excitation[, response_point, excitation_point]).
+template <>
+struct type_caster<robomach::dynamics::FrfKey> {
+  PYBIND11_TYPE_CASTER(robomach::dynamics::FrfKey, const_name("tuple[str, str, str]"));
+
+  bool load(handle src, bool /*convert*/) {
+    if (!isinstance<tuple>(src)) return false;
+    const auto t = reinterpret_borrow<tuple>(src);
+    if (t.size() != 3 && t.size() != 5) return false;
+    if (!isinstance<str>(t[0]) || !isinstance<str>(t[1]) || !isinstance<str>(t[2])) return false;
+    value.pose_id = t[0].cast<std::string>();
+    // A direction other than x, y, z is a ValueError naming it.
+    value.response = robomach::python::ParseAxis(t[1].cast<std::string>());
+    value.excitation = robomach::python::ParseAxis(t[2].cast<std::string>());
+    value.response_point = 0;
+    value.excitation_point = 0;
+    if (t.size() == 5) {
+      if (!isinstance<int_>(t[3]) || !isinstance<int_>(t[4])) return false;
+      value.response_point = t[3].cast<int>();
+      value.excitation_point = t[4].cast<int>();
+    }
+    return true;
+  }
+
+  static handle cast(const robomach::dynamics::FrfKey& k, return_value_policy, handle) {
+    const std::string r = robomach::python::AxisString(k.response);
+    const std::string e = robomach::python::AxisString(k.excitation);
+    if (k.response_point == 0 && k.excitation_point == 0) return pybind11::make_tuple(k.pose_id, r, e).release();
+    return pybind11::make_tuple(k.pose_id, r, e, k.response_point, k.excitation_point).release();
+  }
+};
+
+}  // namespace pybind11::detail

@@ -36,11 +36,6 @@ Axis ParseAxis(const std::string& name) {
 
 std::string AxisString(Axis a) { return std::string(1, AxisName(a)); }
 
-dynamics::FrfKey ToKey(const KeyTuple& t) {
-  return {std::get<0>(t), ParseAxis(std::get<1>(t)), ParseAxis(std::get<2>(t))};
-}
-
-KeyTuple FromKey(const dynamics::FrfKey& k) { return {k.pose_id, AxisString(k.response), AxisString(k.excitation)}; }
 
 namespace {
 PyObject* g_unit_warning = nullptr;  // robomach.UnitWarning, made at import
