@@ -82,7 +82,8 @@ namespace pybind11::detail {
 // FrfKey <-> (pose_id, response, excitation[, response_point, excitation_point]).
 template <>
 struct type_caster<robomach::dynamics::FrfKey> {
-  PYBIND11_TYPE_CASTER(robomach::dynamics::FrfKey, const_name("tuple[str, str, str]"));
+  PYBIND11_TYPE_CASTER(robomach::dynamics::FrfKey,
+                       const_name("tuple[str, str, str] | tuple[str, str, str, int, int]"));
 
   bool load(handle src, bool /*convert*/) {
     if (!isinstance<tuple>(src)) return false;

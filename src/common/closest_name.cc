@@ -46,7 +46,8 @@ std::string ClosestName(const std::string& given, const std::vector<std::string>
   for (const std::string& candidate : known) {
     const std::string c = Folded(candidate);
     const size_t raw = EditDistance(g, c);
-    const size_t d = raw > 0 && Stem(g) == Stem(c) ? 1 : raw;
+    const bool same_stem = Stem(g) == Stem(c) || g == Stem(c) || c == Stem(g);
+    const size_t d = raw > 0 && same_stem ? 1 : raw;
     if (d < best_d || (d == best_d && raw < best_raw)) {
       best_d = d;
       best_raw = raw;

@@ -121,9 +121,13 @@ YamlDoc YamlDoc::operator[](const std::string& key) const {
   if (!child) {
     // A key of the map that is close to the one missing is most likely it,
     // mistyped: that key's place and name (issue #35).
+    // Keys read already are not the one mistyped.
     std::vector<std::string> present;
     for (const auto& kv : node_) {
-      if (kv.first.IsScalar()) present.push_back(kv.first.Scalar());
+      if (kv.first.IsScalar() &&
+          std::find(used_keys_->begin(), used_keys_->end(), kv.first.Scalar()) == used_keys_->end()) {
+        present.push_back(kv.first.Scalar());
+      }
     }
     const std::string closest = ClosestName(key, present);
     if (!closest.empty()) {

@@ -62,6 +62,8 @@ TEST(ClosestName, FindsTheNameANewUserMeant) {
   EXPECT_EQ(ClosestName("ktc_N_per_m2", keys), "ktc_N_per_mm2");
   EXPECT_EQ(ClosestName("diameter_m", keys), "diameter_mm");
   EXPECT_EQ(ClosestName("diameter", keys), "diameter_mm");
+  // The other way round: the name looked for has the unit, the file's key not.
+  EXPECT_EQ(ClosestName("spindle_speed_max_rpm", {"spindle_speed_max", "teeth"}), "spindle_speed_max");
 }
 
 TEST(ClosestName, SaysNothingWhenNoNameIsClose) {
