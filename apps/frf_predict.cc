@@ -26,6 +26,10 @@ namespace robomach::apps {
 namespace {
 
 constexpr char kTool[] = "frf-predict";
+// Postures x lines computed before anything is written (no partial outputs):
+// 2e6 is a 100-posture campaign on a 20 000-line grid, about 1 GB of CSV
+// with all nine direction pairs.
+constexpr double kMaxFrfLines = 2e6;
 
 Eigen::VectorXd ReadFrequencyFile(const std::string& path) {
   const io::CsvTable t = io::CsvTable::ReadFile(path);
@@ -128,11 +132,33 @@ int Run(int argc, char** argv) {
       }
       // Count in double first: a tiny step would overflow the integer.
       const double lines = std::floor((fmax_hz - fmin_hz) / df_hz + 1e-9) + 1.0;
-      if (lines > 1e6) throw UsageError("more than 1e6 frequency lines: raise --df-hz");
+      if (lines > dynamics::kMaxFrequencyLines) {
+        std::string why = fmax_hz > dynamics::kMaxPlausibleFmaxHz
+                              ? "; --fmax-hz " + FormatNumber(fmax_hz, 7) + " Hz is beyond the " +
+                                    FormatNumber(dynamics::kMaxPlausibleFmaxHz, 7) +
+                                    " Hz of hammer tests (a frequency in kHz typed in the Hz option?)"
+                              : "";
+        throw UsageError("--fmin-hz " + FormatNumber(fmin_hz, 7) + " to --fmax-hz " + FormatNumber(fmax_hz, 7) +
+                         " in steps of --df-hz " + FormatNumber(df_hz, 7) + " is " + FormatNumber(lines, 7) +
+                         " frequency lines, more than the " + FormatNumber(dynamics::kMaxFrequencyLines, 7) +
+                         " allowed (FFT analysers give 400 - 25 600)" + why + ": raise --df-hz or lower --fmax-hz");
+      }
       const long n = static_cast<long>(lines);
       freq_hz = Eigen::VectorXd::LinSpaced(n, fmin_hz, fmin_hz + (n - 1) * df_hz);
     }
 
+    // A band far beyond any hammer test is a unit mistake (docs/plausibility.md).
+    std::vector<std::string> implausible_options;
+    if (freq_hz.size() > 0) {
+      const std::string m = ImplausibleOption(
+          "--fmax-hz", freq_file.empty() ? fmax_hz : freq_hz.maxCoeff(), dynamics::kMinPlausibleFmaxHz, dynamics::kMaxPlausibleFmaxHz, "Hz",
+          "hammer tests (lines to 0.1 - 10 kHz; robot modes below 2 kHz)", "a frequency in kHz typed in the Hz option?",
+          "a frequency in mHz typed in the Hz option?");
+      if (!m.empty()) {
+        implausible_options.push_back(m);
+        Warn(kTool, freq_file.empty() ? m : m + " (the highest line of " + freq_file + ")");
+      }
+    }
     io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     ApplyAddsAndSets(adds, sets, &cfg);
     if (verbose) {
@@ -149,11 +175,12 @@ int Run(int argc, char** argv) {
     // Everything is computed before anything is written (no partial
     // outputs), so bound the memory: 3×3 complex values per line and posture.
     const double values = static_cast<double>(postures.size()) * static_cast<double>(freq_hz.size());
-    if (values > 2e7) {
-      throw UsageError(std::to_string(postures.size()) + " postures × " +
-                       std::to_string(freq_hz.size()) +
-                       " frequency lines is more than 2e7 FRF lines (~3 GB): split the "
-                       "posture file or coarsen the grid");
+    // About 60 bytes per direction pair and line in the CSV (formats.md §3).
+    const double csv_gb = values * static_cast<double>(pairs.size()) * 60e-9;
+    if (values > kMaxFrfLines) {
+      throw UsageError(std::to_string(postures.size()) + " postures × " + std::to_string(freq_hz.size()) +
+                       " frequency lines is more than " + FormatNumber(kMaxFrfLines, 7) + " FRF lines (a CSV of about " +
+                       FormatNumber(csv_gb, 2) + " GB): split the posture file or coarsen the grid");
     }
 
     std::vector<dynamics::NamedPosture> named;
@@ -228,7 +255,7 @@ int Run(int argc, char** argv) {
             .SavePng((std::filesystem::path(plot_dir) / (stems.at(preds[p].pose_id) + ".png")).string());
       }
     }
-    return posture_units.empty() && cfg.implausible.empty() ? ExitCodeFor(result.status()) : kExitFlagged;
+    return posture_units.empty() && cfg.implausible.empty() && implausible_options.empty() ? ExitCodeFor(result.status()) : kExitFlagged;
   });
 }
 

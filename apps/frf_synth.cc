@@ -13,6 +13,7 @@
 #include "cli_support.h"
 #include "robomach/calibration/virtual_hammer_test.h"
 #include "robomach/common/number_format.h"
+#include "robomach/dynamics/frf_prediction.h"
 #include "robomach/io/frf_files.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/prediction_files.h"
@@ -35,7 +36,8 @@ constexpr double kMaxPlausibleRelativeNoise = 0.5;
 // data sheets). Noise floors: tool-tip receptances are 1e-8 - 1e-5 m/N, a
 // floor 1e-4 - 1e-2 of the peak (Ewins, "Modal Testing", §3); accelerometers
 // resolve 1e-4 - 1e-2 m/s² under 10 - 1000 N impacts.
-constexpr double kMinPlausibleFmaxHz = 1.0, kMaxPlausibleFmaxHz = 50000.0;
+using dynamics::kMinPlausibleFmaxHz;
+using dynamics::kMaxPlausibleFmaxHz;
 constexpr double kMinPlausibleSampleRateHz = 100.0, kMaxPlausibleSampleRateHz = 1e6;
 constexpr double kMinPlausibleHammerCutoffHz = 50.0, kMaxPlausibleHammerCutoffHz = 50000.0;
 constexpr double kMaxPlausibleNoiseMPerN = 1e-6;        // receptance floor

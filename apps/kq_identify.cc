@@ -52,7 +52,6 @@ void PrintReport(const identification::JointStiffnessResult& r, std::ostream& os
      << " mm (all cases " << 1e3 * r.rms_residual_all << " mm; displacement noise " << 1e3 * r.noise_sigma_displacement
      << " mm per coordinate), chi2/dof " << std::setprecision(2) << r.reduced_chi2
      << ", condition number of the scaled problem " << std::setprecision(1) << r.condition_number << "\n";
-  for (const auto& a : r.advice) os << kTool << ": NOTE: " << a << "\n";
 }
 
 void PlotResiduals(const std::string& path, const identification::JointStiffnessResult& r,
@@ -311,7 +310,12 @@ int Run(int argc, char** argv) {
     identification::JointStiffnessResult r = identification::IdentifyJointStiffness(
         *model, cases, opt, [&](long done, long) { progress.Update(done); });
     progress.Finish();
+    // The table, then each problem as a warning (the unit findings were
+    // warned above), before any output is written: the summary lists them all.
+    PrintReport(r, std::cerr);
+    for (const std::string& a : r.advice) Warn(kTool, a);
     r.advice.insert(r.advice.begin(), implausible.begin(), implausible.end());
+    const int exit_code = r.flagged() || !cfg.implausible.empty() || !implausible.empty() ? kExitFlagged : kExitOk;
 
     // Outputs, each complete or absent (docs/formats.md §4).
     const std::vector<std::string> header{
@@ -333,9 +337,14 @@ int Run(int argc, char** argv) {
     if (!plot_path.empty()) {
       PlotResiduals(plot_path, r, r.outlier_threshold, "kq-identify: " + tracker_path);
     }
-    if (!json_path.empty()) io::WriteFileAtomically(json_path, SummaryText(io::KqSummaryJson(r)));
-    PrintReport(r, std::cerr);
-    return r.flagged() || !cfg.implausible.empty() || !implausible.empty() ? kExitFlagged : kExitOk;
+    if (!json_path.empty()) {
+      nlohmann::json j = io::KqSummaryJson(r);
+      j["tool"] = kTool;
+      j["flagged"] = exit_code == kExitFlagged;
+      j["exit_code"] = exit_code;
+      io::WriteFileAtomically(json_path, SummaryText(j));
+    }
+    return exit_code;
   });
 }
 

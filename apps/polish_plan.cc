@@ -217,6 +217,13 @@ int Run(int argc, char** argv) {
     if (const std::string w = RadiansInDegreeOption("--line-angle-deg", po.line_angle_deg); !w.empty()) {
       implausible.push_back(w);
     }
+    for (std::string w : polishing::ImplausiblePlanOptions(po)) {
+      // Under the command line's names.
+      if (w.find("target_removal_um") != std::string::npos) {
+        w.replace(w.find("target_removal_um"), 17, "--target-removal-um");
+      }
+      implausible.push_back(w);
+    }
     for (const std::string& w : implausible) Warn(kTool, w);
     const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
     {

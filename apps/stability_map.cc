@@ -141,6 +141,8 @@ int Run(int argc, char** argv) {
       }
       report::SaveHeatMapPng(hm, plot_path);
     }
+    // Warned before the summary is written: its `warnings` lists them.
+    for (const Finding& f : map.findings) Warn(kTool, f.message);
     if (!summary_path.empty()) {
       nlohmann::json j = io::StabilityMapSummaryJson(points, map);
       j["tool"] = kTool;
@@ -152,7 +154,6 @@ int Run(int argc, char** argv) {
       j["exit_code"] = !implausible ? ExitCodeFor(map.status()) : kExitFlagged;
       io::WriteFileAtomically(summary_path, SummaryText(j));
     }
-    for (const Finding& f : map.findings) Warn(kTool, f.message);
     return !implausible ? ExitCodeFor(map.status()) : kExitFlagged;
   });
 }

@@ -201,6 +201,7 @@ void BindPolishing(py::module_& m) {
     auto plan = std::make_unique<PyPlan>();
     plan->surface = surface;
     polishing::CheckRanges(o);
+    for (const std::string& w : polishing::ImplausiblePlanOptions(o)) WarnUnit(w);
     {
       py::gil_scoped_release release;
       // A face too large to plan within polish-plan's limits is refused before the work.

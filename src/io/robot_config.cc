@@ -11,6 +11,7 @@
 #include "plausible.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/effect.h"
+#include "robomach/dynamics/gravity_torque.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/io/file_kind.h"
 #include "robomach/io/number_format.h"
@@ -282,10 +283,23 @@ void CheckJointFrequencies(RobotConfig& cfg, const YamlDoc& doc, const YamlDoc& 
   }
   Eigen::MatrixXd M;
   double alpha = 0.0, beta = 0.0;
-  Eigen::VectorXd k(n);
+  Eigen::VectorXd k(n), gravity_torque;
   try {
     const auto model = cfg.Build();
     M = dynamics::EvaluatePosture(model, q).M_q();
+    // The largest weight each joint holds: each joint swept through its
+    // range (9 angles, the others at q), so that the arm is near horizontal
+    // once (RNE, microseconds each).
+    gravity_torque = dynamics::GravityTorque(*model, q).cwiseAbs();
+    for (int i = 0; i < n; ++i) {
+      const auto& lim = arm.limits()[i];
+      const double lo = lim.bounded ? lim.lower : -kPi, hi = lim.bounded ? lim.upper : kPi;
+      for (int s = 0; s <= 8; ++s) {
+        Eigen::VectorXd qs = q;
+        qs(i) = lo + (hi - lo) * s / 8.0;
+        gravity_torque = gravity_torque.cwiseMax(dynamics::GravityTorque(*model, qs).cwiseAbs());
+      }
+    }
     for (int j = 0; j < n; ++j) k(j) = model->joint_stiffness()(j);
     alpha = model->alpha();
     beta = model->beta();
@@ -322,6 +336,34 @@ void CheckJointFrequencies(RobotConfig& cfg, const YamlDoc& doc, const YamlDoc& 
         zeta_max = zeta;
         zeta_joint = j;
       }
+    }
+  }
+  // The robot's own weight against the stiffness: a stiffness per degree
+  // (/57.3) keeps the joint frequencies in range but turns the joints by
+  // degrees (docs/plausibility.md).
+  if (!frequency_found) {
+    int worst = -1;
+    double worst_sag = 0.0;
+    for (int j = 0; j < n; ++j) {
+      const double sag = k(j) > 0.0 ? gravity_torque(j) / k(j) : 0.0;
+      if (sag > worst_sag) {
+        worst_sag = sag;
+        worst = j;
+      }
+    }
+    if (worst >= 0 && worst_sag > kMaxPlausibleGravitySagRad) {
+      frequency_found = true;
+      const double deg = worst_sag * 180.0 / kPi;
+      cfg.implausible.push_back(
+          "implausible (unit mistake?): " + kq.at(worst).location().ToString() + ": joint " +
+          std::to_string(worst + 1) + " (" + arm.joint_names()[worst] + "): the robot's own weight (" +
+          robomach::FormatNumber(gravity_torque(worst), 4) + " N·m at most, the joints swept through their limits) "
+          "turns it by " +
+          robomach::FormatNumber(deg, 3) + " deg against its stiffness " + FormatNumber(k(worst)) +
+          " N·m/rad; robot gearboxes turn by a few arc-minutes under their rated torque (plausible up to " +
+          robomach::FormatNumber(kMaxPlausibleGravitySagRad * 180.0 / kPi, 3) +
+          " deg): a stiffness per degree typed in the N·m/rad field (N·m/rad = N·m/deg x 57.3: " +
+          robomach::FormatNumber(k(worst) * 180.0 / kPi, 5) + "), or a stiffness in kN·m/rad (x1000)?");
     }
   }
   // A joint frequency off by 31.6 explains any damping ratio: say it once.

@@ -105,6 +105,20 @@ void CheckRanges(const PlanOptions& o) {
   }
 }
 
+std::vector<std::string> ImplausiblePlanOptions(const PlanOptions& o) {
+  std::vector<std::string> out;
+  const double t = o.target_removal_um;
+  if (t != 0.0 && !(t >= kMinPlausibleTargetRemovalUm && t <= kMaxPlausibleTargetRemovalUm)) {
+    out.push_back("implausible (unit mistake?): target_removal_um " + FormatNumber(t, 7) +
+                  " um is outside the " + FormatNumber(kMinPlausibleTargetRemovalUm, 7) + " to " +
+                  FormatNumber(kMaxPlausibleTargetRemovalUm, 7) +
+                  " um of one polishing or belt-grinding pass (polishing 0.1 - 10 um, belt grinding up to 500 um): " +
+                  (t > kMaxPlausibleTargetRemovalUm ? "a removal in nm typed in the um option (5 um is 5, not 5000)?"
+                                                    : "a removal in mm typed in the um option (5 um is 5, not 0.005)?"));
+  }
+  return out;
+}
+
 PlanRequest ToPlanRequest(const PlanOptions& o, const PlanningContext& c) {
   if (o.guides != "offsets" && o.guides != "parallel") {
     throw std::invalid_argument("guides: expected offsets or parallel, got " + o.guides);

@@ -15,6 +15,10 @@ file(MAKE_DIRECTORY ${WORK}/copy)
 
 # A config copied to another folder without its URDF.
 configure_file(${SRC}/config/kr210.yaml ${WORK}/copy/kr210.yaml COPYONLY)
+# A machining region 0.6 m farther out than the demo's: most points out of reach.
+file(READ ${SRC}/config/region_demo.yaml region)
+string(REPLACE "origin_mm: [1900, -400, 800]" "origin_mm: [2500, -400, 800]" region "${region}")
+file(WRITE ${WORK}/region_far.yaml "${region}")
 # A picture or document given as the robot config.
 file(WRITE ${WORK}/report.pdf "%PDF-1.4\n%binary follows\n")
 # The same config with a negative mass on line 38 (the URDF by absolute path).
@@ -27,6 +31,11 @@ string(REPLACE "mass_kg: -22.0" "mass_kg: 22.0" cfg "${cfg}")
 string(REPLACE "[3.3479e+6, 3.1318e+6, 4.2895e+6, 2.4787e+5, 6.4292e+5, 1.8847e+5]"
                "[3.3479e+9, 3.1318e+9, 4.2895e+9, 2.4787e+8, 6.4292e+8, 1.8847e+8]" cfg "${cfg}")
 file(WRITE ${WORK}/kq_Nmm.yaml "${cfg}")
+# The joint stiffnesses per degree (N·m/deg: the values / 57.3).
+string(REPLACE "[3.3479e+9, 3.1318e+9, 4.2895e+9, 2.4787e+8, 6.4292e+8, 1.8847e+8]"
+               "[58432, 54660, 74866, 4326.2, 11221, 3289.4]" cfg "${cfg}")
+file(MAKE_DIRECTORY ${WORK}/copy_deg)
+file(WRITE ${WORK}/copy_deg/kr210_deg.yaml "${cfg}")
 # The spindle_toolholder_interface section with a taper diameter in mm, a
 # drawbar force in kN, a zero diameter, a billion elements; hammer_test's
 # sample rate in kHz. Each from the shipped config with one mistake (the
@@ -157,6 +166,44 @@ foreach(line IN LISTS lines)
         file(READ ${f} text)
         if(NOT text MATCHES "${want}")
           list(APPEND problems "${f} does not match '${want}'")
+        endif()
+      endif()
+    elseif(c MATCHES "^warnings_in=(.+)$")
+      # warnings_in=SUMMARY: every "tool: warning: ..." line on stderr is in
+      # the JSON summary's `warnings` (a warning printed after the summary
+      # was written is missing from it).
+      set(f "${CMAKE_MATCH_1}")
+      if(NOT EXISTS ${f})
+        list(APPEND problems "${f} was not written")
+      else()
+        file(READ ${f} text)
+        string(JSON nw ERROR_VARIABLE jerr LENGTH "${text}" warnings)
+        if(jerr)
+          list(APPEND problems "${f}: no warnings list (${jerr})")
+        else()
+          set(listed "")
+          if(nw GREATER 0)
+            math(EXPR last "${nw} - 1")
+            foreach(i RANGE ${last})
+              string(JSON w GET "${text}" warnings ${i})
+              string(REPLACE ";" "<semicolon>" w "${w}")
+              list(APPEND listed "${w}")
+            endforeach()
+          endif()
+          string(REPLACE ";" "<semicolon>" err_safe "${err}")
+          string(REGEX MATCHALL "[a-z0-9-]+: warning: [^\n]*" printed "${err_safe}")
+          set(nprinted 0)
+          foreach(p IN LISTS printed)
+            math(EXPR nprinted "${nprinted} + 1")
+            string(REGEX REPLACE "^[a-z0-9-]+: warning: " "" m "${p}")
+            list(FIND listed "${m}" at)
+            if(at LESS 0)
+              list(APPEND problems "printed but not in ${f}'s warnings: ${m}")
+            endif()
+          endforeach()
+          if(nprinted EQUAL 0)
+            list(APPEND problems "no warning printed (the row expects some)")
+          endif()
         endif()
       endif()
     elseif(c MATCHES "^stderr_not=(.+)$")

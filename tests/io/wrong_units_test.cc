@@ -118,6 +118,11 @@ const std::vector<WrongUnitCase>& Cases() {
       {"robot_config", "config/kr210.yaml", "joint_stiffness_Nm_per_rad[0]", 0, 1000, Expect::kFlagged, "joint_stiffness_Nm_per_rad\\[0\\] 3347900000 N·m/rad .*a stiffness in N·mm/rad"},
       {"robot_config", "config/kr210.yaml", "joint_stiffness_Nm_per_rad", 0, 1000, Expect::kFlagged, "joint 6 \\(joint_6\\).* 7\\d\\d\\d Hz.*a stiffness in N·mm/rad"},
       {"robot_config", "config/kr210.yaml", "joint_stiffness_Nm_per_rad", 0, 1e-3, Expect::kFlagged, "joint 2 \\(joint_2\\).* 0.328 Hz.*a stiffness in kN·m/rad"},
+      // A stiffness typed per degree (N·m/deg, the value / 57.3): the joint
+      // frequencies move by only 7.6 (the lowest to 1.3 Hz, in range); the
+      // robot's own weight then turns joint 2 by about 5 deg (0.09 deg as shipped).
+      {"robot_config", "config/kr210.yaml", "joint_stiffness_Nm_per_rad", 0, kRadPerDeg, Expect::kFlagged, "joint 2 \\(joint_2\\): the robot's own weight .* turns it by [4-6]\\.\\d+ deg .*a stiffness per degree typed in the N·m/rad field"},
+      {"robot_config", "config/kr210_dh.yaml", "joint_stiffness_Nm_per_rad", 0, kRadPerDeg, Expect::kFlagged, "joint 2 \\(joint_2\\): the robot's own weight .* turns it by \\d+\\.\\d+ deg .*a stiffness per degree"},
       {"robot_config", "config/kr210.yaml", "alpha_s", 0, 1000, Expect::kFlagged, "alpha_s in ms"},
       {"robot_config", "config/kr210.yaml", "beta_per_s", 0, 1000, Expect::kRefused, "beta_per_s: expected a number in \\[0, 1000\\] /s"},
       {"robot_config", "config/kr210.yaml", "m6_kg", 0, 1000, Expect::kRefused, "1000 x 29.05: a value in g typed in the kg field"},

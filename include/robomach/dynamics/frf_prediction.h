@@ -48,6 +48,19 @@ struct PosturePredictionResult {
 /// modes start at a few Hz; docs/plausibility.md's joint frequencies >= 1 Hz).
 inline constexpr double kMinPredictedModeHz = 0.01;
 
+/// Plausible top of an FRF band [Hz] (docs/plausibility.md): hammer tests of
+/// robots and machine tools have lines to 0.1 - 10 kHz (Schmitz and Smith,
+/// "Machining Dynamics", ch. 2); a robot's structural modes are below 2 kHz
+/// (the joint frequencies of docs/plausibility.md). Outside: kHz or mHz
+/// typed in an Hz option (frf-synth, frf-predict flag it, exit 3).
+inline constexpr double kMinPlausibleFmaxHz = 1.0;
+inline constexpr double kMaxPlausibleFmaxHz = 50000.0;
+/// Most lines of a predicted or synthesised frequency grid: FFT analysers
+/// give 400 - 25 600 lines, so 200 000 is 8 times the finest of them; a grid
+/// over it is refused (exit 64), because its outputs are gigabytes (5
+/// postures x 800 000 lines made a 2.28 GB CSV).
+inline constexpr double kMaxFrequencyLines = 200000.0;
+
 struct FrfPredictionResult : RunFindings {
   std::vector<PosturePredictionResult> postures;  // in the order given
 };

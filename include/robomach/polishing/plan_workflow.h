@@ -98,6 +98,20 @@ std::vector<PlanOptionRange> PlanOptionRanges(const PlanOptions& options);
 ///   for the first option outside its range.
 void CheckRanges(const PlanOptions& options);
 
+/// Plausible removal of one planned pass [um] (docs/plausibility.md): fine
+/// polishing removes 0.1 - 10 um, robotic belt grinding of blades and
+/// castings 10 - 500 um per pass (Ren, Kuhlenkoetter and Mueller, Int. J.
+/// Adv. Manuf. Technol. 27 (2006); Huang et al., J. Mater. Process. Technol.
+/// 127 (2002)); 0 is "at the speed limit".
+inline constexpr double kMinPlausibleTargetRemovalUm = 0.01;
+inline constexpr double kMaxPlausibleTargetRemovalUm = 1000.0;
+
+/// Sense checks of the options a user types (issue #35): one message per
+/// value outside its plausible range, "implausible (unit mistake?): ..."
+/// naming the likely unit mistake, for polish-plan to warn and flag (exit
+/// 3) and for Python to issue as UnitWarnings. Empty when all are plausible.
+std::vector<std::string> ImplausiblePlanOptions(const PlanOptions& options);
+
 /// The request `options` make on `context` (the zig-zag's default spacing
 /// is its contact width); `progress` is not set.
 /// @throws std::invalid_argument for an unknown pattern, guides or
