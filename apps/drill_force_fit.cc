@@ -114,7 +114,7 @@ int RunDrillForceFit(int argc, char** argv) {
   app.add_option("--predict", predict_path, "CSV of rows to predict (diameter_mm, feed_mm_per_rev[, speed_rpm])");
   app.add_option("--predictions", predictions_path, "CSV written for --predict: diameter_mm, feed_mm_per_rev, thrust_N, torque_Nm[, speed_rpm]");
   app.add_option("--chisel", chisel, "chisel-edge model: seed_scaling (F_A = 2.5 F_L, T_A = 1.67 T), orthogonal, none")
-      ->check(CLI::IsMember({"seed_scaling", "orthogonal", "none"}))->capture_default_str();
+      ->check(OneOf({"seed_scaling", "orthogonal", "none"}))->capture_default_str();
   app.add_flag("--verbose", verbose, "list ignored (unknown) table columns on stderr");
   try {
     app.parse(argc, argv);

@@ -56,7 +56,7 @@ int Run(int argc, char** argv) {
                  "plain least squares. A second line of defence against outlier lines the noise model kept")
       ->capture_default_str();
   app.add_option("--objective", objective, "modal-two-stage (frequencies, then peak amplitudes), modal-joint, whole-curve")
-      ->check(CLI::IsMember({"modal-two-stage", "modal-joint", "whole-curve"}))->capture_default_str();
+      ->check(OneOf({"modal-two-stage", "modal-joint", "whole-curve"}))->capture_default_str();
   app.add_option("--fmin-hz", opt.fmin_hz, "lowest frequency used (modal fit and whole curve) [Hz]")->capture_default_str();
   app.add_option("--fmax-hz", opt.fmax_hz, "highest frequency used [Hz]; default: all lines");
   app.add_option("--set", sets, "start value of a parameter, NAME=VALUE in its unit");

@@ -118,10 +118,10 @@ int Run(int argc, char** argv) {
                  "response direction per channel, NAME=AXIS (e.g. acc_tip=y); default from a name ending in "
                  "_x/_y/_z (or named x/y/z)");
   app.add_option("--quantity", quantity, "output quantity: receptance, mobility or accelerance")
-      ->check(CLI::IsMember({"receptance", "mobility", "accelerance"}))
+      ->check(OneOf({"receptance", "mobility", "accelerance"}))
       ->capture_default_str();
   app.add_option("--estimator", estimator, "h1 (noise on the response) or h2 (noise on the force)")
-      ->check(CLI::IsMember({"h1", "h2"}))
+      ->check(OneOf({"h1", "h2"}))
       ->capture_default_str();
   app.add_option("--fmax-hz", o.fmax_hz, "highest line written [Hz]; 0: sample rate / 2.56; above the Nyquist frequency (sample rate / 2): "
                  "exit 64, as frf-synth")->capture_default_str();

@@ -53,7 +53,7 @@ int Run(int argc, char** argv) {
   app.add_option("--weights", weights,
                  "noise: 1/sigma of the noise model (the fit to within the noise); quantity: every line of the file's "
                  "quantity alike (the unweighted least squares of modal software, which favours the peaks)")
-      ->check(CLI::IsMember({"noise", "quantity"}))
+      ->check(OneOf({"noise", "quantity"}))
       ->capture_default_str();
   app.add_flag("--per-frf", opt.per_frf, "fit each FRF alone (its own poles) instead of one set per posture");
   AddNoiseOptions(app, &noise_opt);

@@ -100,7 +100,7 @@ int Run(int argc, char** argv) {
   app.add_option("--directions", directions,
                  "response/excitation pairs to write, e.g. xx,yy,xy, or 'all'")->capture_default_str();
   app.add_option("--method", method, "modal (superposition) or direct (solve per line)")
-      ->check(CLI::IsMember({"modal", "direct"}))->capture_default_str();
+      ->check(OneOf({"modal", "direct"}))->capture_default_str();
   app.add_option("--set", sets, "override a model parameter, NAME=VALUE in its unit (e.g. m6_kg=30.2)");
   app.add_option("--add", adds, "switch on an effect by name with its default parameters (e.g. tip_mass)");
   app.add_flag("--verbose", verbose, "list model parameters and ignored input columns on stderr");

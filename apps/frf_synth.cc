@@ -93,7 +93,7 @@ int Run(int argc, char** argv) {
   app.add_option("--seed", o.seed, "random seed of the noise")->capture_default_str();
   app.add_flag("--coherence", o.coherence, "also write a coherence (expected for the noise level)");
   app.add_option("--quantity", quantity, "receptance, mobility or accelerance")
-      ->check(CLI::IsMember({"receptance", "mobility", "accelerance"}))->capture_default_str();
+      ->check(OneOf({"receptance", "mobility", "accelerance"}))->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

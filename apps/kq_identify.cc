@@ -203,7 +203,7 @@ int Run(int argc, char** argv) {
   app.add_option("--summary,--json", json_path, "summary JSON ('-' = stdout; --json is the old name): the full result (stiffness, covariance, residuals, advice)");
   app.add_option("--robust", robust,
                  "robust loss against outlier cases: cauchy or huber (outliers are then left out)")
-      ->check(CLI::IsMember({"cauchy", "huber"}))
+      ->check(OneOf({"cauchy", "huber"}))
       ->expected(0, 1)
       ->default_str("cauchy");
   app.add_option("--noise-mm", noise_mm, "tracker noise, 1 sigma per coordinate [mm]")->capture_default_str();

@@ -140,13 +140,15 @@ int Run(int argc, char** argv) {
       help += (help.empty() ? "" : "; ") + p->description();
       names.push_back(p->name());
     }
-    app.add_option("--pattern", pattern, help)->check(CLI::IsMember(names))->capture_default_str();
+    app.add_option("--pattern", pattern, help)->check(OneOf(names, {{"zigzag", "parallel"}, {"zig-zag", "parallel"}, {"zig_zag", "parallel"},
+                                                                {"raster", "parallel"}, {"trochoid", "cycloid"},
+                                                                {"trochoidal", "cycloid"}}))->capture_default_str();
   }
   app.add_option("--guides", guides, "cycloid guide lines: offsets (of the region boundary, closed loops) or parallel")
-      ->check(CLI::IsMember({"offsets", "parallel"}))->capture_default_str();
+      ->check(OneOf({"offsets", "parallel"}))->capture_default_str();
   app.add_option("--optimise", optimise, "none, nlopt (grid, then COBYLA multi-start with the target as a constraint; "
                                         "guide family chosen unless --guides is given) or pso (seed eq. 18)")
-      ->check(CLI::IsMember({"none", "nlopt", "pso"}))->capture_default_str();
+      ->check(OneOf({"none", "nlopt", "pso"}))->capture_default_str();
   app.add_option("--target-removal-um", target_um, "mean removal over the region [um]; sets the speed (0: run at max speed)")->capture_default_str();
   app.add_option("--offset-mm", offset_mm, "guide-line spacing d [mm] (parallel pattern: row spacing; default there: one contact width)");
   app.add_option("--radius-mm", radius_mm, "cycloid radius r [mm]")->capture_default_str();

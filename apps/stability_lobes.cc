@@ -140,7 +140,7 @@ int Run(int argc, char** argv) {
   app.add_option("--modal-table", modal_path, "modal table CSV (docs/formats.md §4): freq_hz, damping_ratio, modal_mass_kg or modal_stiffness_N_per_m, ux,uy,uz");
   app.add_option("--tool-axis", tool_axis_text, "with --frf/--modal-table: tool axis from tip to spindle in the FRF frame, x,y,z (not used for a "
                  "file with one direct FRF, a symmetric tool, except for the frame of --modes-out)")->capture_default_str();
-  app.add_option("--method", method, "zoa, sd or both")->check(CLI::IsMember({"zoa", "sd", "both"}))->capture_default_str();
+  app.add_option("--method", method, "zoa, sd or both")->check(OneOf({"zoa", "sd", "both"}))->capture_default_str();
   app.add_option("--out", out_path, "lobes CSV (spindle_speed_rpm, critical_depth_mm, chatter_freq_hz, lobe_index, method); stdout if omitted");
   app.add_option("--plot", plot_path, "lobe diagram PNG (speed [rpm] against depth [mm])")->check(PngFileName());
   app.add_option("--summary", summary_path,

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <iomanip>
 #include <sstream>
 
 #include "cli_support.h"
@@ -75,9 +76,10 @@ int Run(int argc, char** argv) {
     const io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     const auto model = cfg.Build();
     const io::CutSpec cut = io::ReadCutFile(cut_path);
-    const bool implausible = !cut.implausible.empty() || !cfg.implausible.empty();
     for (const std::string& w : cut.implausible) Warn(kTool, w);
     const io::RegionSpec region = io::ReadRegionFile(region_path, model->num_joints());
+    for (const std::string& w : region.implausible) Warn(kTool, w);
+    const bool implausible = !cut.implausible.empty() || !cfg.implausible.empty() || !region.implausible.empty();
 
     stability::MapOptions opt;
     opt.seed_q = region.seed_q;
@@ -117,8 +119,9 @@ int Run(int argc, char** argv) {
     // criterion (issue #6 asks to report it).
     if (const stability::ClosedFormAgreement a = stability::CompareClosedForm(pts); a.points > 0) {
       std::ostringstream msg;
-      msg << kTool << ": mode coupling, closed form / eigenvalue criterion over " << a.points << " points: median "
-          << a.median << ", range [" << a.min << ", " << a.max << "]\n";
+      msg << kTool << ": mode coupling, the seed's closed-form critical depth over the eigenvalue criterion's "
+          << "(a ratio; 1 = they agree) at " << a.points << " points: median " << std::setprecision(3) << a.median
+          << ", range [" << a.min << ", " << a.max << "]\n";
       std::cerr << msg.str();
     }
     if (!plot_path.empty() && !grid) Warn(kTool, "--plot draws grids only; ignored with --path");

@@ -70,7 +70,7 @@ int Run(int argc, char** argv) {
   app.add_option("--outliers", outliers, "number of cases with a gross error")->capture_default_str();
   app.add_option("--outlier-mm", outlier_mm, "size of that error [mm]")->capture_default_str();
   app.add_option("--form", form, "load columns: rope (mass_kg + rope points) or force (fx_N..fz_N)")
-      ->check(CLI::IsMember({"rope", "force"}))
+      ->check(OneOf({"rope", "force"}))
       ->capture_default_str();
   app.add_option("--seed", seed, "random seed (postures, noise, outliers)")->capture_default_str();
   app.add_option("--set", sets, "override a model parameter of the truth, NAME=VALUE (e.g. kq3_Nm_per_rad=4e6)");

@@ -9,6 +9,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -366,6 +367,27 @@ void CheckOptionRange(const std::string& option, double value, double lo, double
     s << option << ": expected a value in [" << lo << ", " << hi << "], got " << value;
     throw UsageError(s.str());
   }
+}
+
+CLI::Validator OneOf(std::vector<std::string> names, std::map<std::string, std::string> aliases) {
+  std::string list;
+  for (size_t i = 0; i < names.size(); ++i) {
+    list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  }
+  return CLI::Validator(
+      [names, aliases, list](std::string& value) -> std::string {
+        if (std::find(names.begin(), names.end(), value) != names.end()) return "";
+        std::string low = value;
+        for (char& c : low) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        std::string meant;
+        if (const auto a = aliases.find(low); a != aliases.end()) {
+          meant = a->second;
+        } else {
+          meant = ClosestName(value, names);
+        }
+        return "expected " + list + ", got '" + value + "'" + (meant.empty() ? "" : ": did you mean " + meant + "?");
+      },
+      "{" + list + "}");
 }
 
 std::string ImplausibleOption(const std::string& option, double value, double lo, double hi, const std::string& unit,

@@ -18,6 +18,7 @@
 
 namespace CLI {
 class App;
+class Validator;
 }  // namespace CLI
 #include <iostream>
 #include <stdexcept>
@@ -198,6 +199,13 @@ void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& 
 /// name differs from it, naming `option` and the name used.
 std::map<std::string, std::string> FileStemsForIds(const std::string& tool, const std::string& option,
                                                    const std::vector<std::string>& ids);
+
+/// The check of an option that takes one of `names` (CLI::IsMember with
+/// its answer): an unknown value gets "expected a, b or c, got 'x'" and the
+/// name meant, from `aliases` (a word users reach for: "zigzag" for
+/// "parallel"; keys lower-case) or else the closest name (ClosestName:
+/// "zoaa" -> "zoa").
+CLI::Validator OneOf(std::vector<std::string> names, std::map<std::string, std::string> aliases = {});
 
 /// @throws UsageError unless lo <= value <= hi (and finite).
 void CheckOptionRange(const std::string& option, double value, double lo, double hi);

@@ -63,7 +63,7 @@ void AddNoiseOptions(CLI::App& app, NoiseCliOptions* o) {
                  "noise of each measured FRF: auto (from the coherence when the file has one and the number of "
                  "averages is known, else estimated from the scatter of the data), coherence, scatter, or none "
                  "(every line, weights 1/|H|: no noise model)")
-      ->check(CLI::IsMember({"auto", "coherence", "scatter", "none"}))
+      ->check(OneOf({"auto", "coherence", "scatter", "none"}))
       ->capture_default_str();
   app.add_option("--min-snr", o->min_snr,
                  "a line is used where |H| is at least this many times the additive noise floor (3: the "

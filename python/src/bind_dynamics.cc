@@ -338,11 +338,18 @@ void BindDynamics(py::module_& m) {
       .def("__repr__", [](const io::Posture& p) { return "<Posture " + p.id + ">"; });
   m.def("read_posture_file", [](const std::string& path, int num_joints) {
     RequireReadableFile(path);
-    py::gil_scoped_release release;
-    return io::ReadPostureFile(path, num_joints);
+    std::vector<std::string> units;  // radians under _deg headers, degrees under _rad
+    std::vector<io::Posture> postures;
+    {
+      py::gil_scoped_release release;
+      postures = io::ReadPostureFile(path, num_joints, &units);
+    }
+    for (const std::string& w : units) WarnUnit(w);
+    return postures;
   }, py::arg("path"), py::arg("num_joints"),
      "Reads a posture file (pose_id,q1_deg..qn_deg or _rad; docs/formats.md §1) into a list of "
-     "Posture with q in radians. InputError with file:line:col.");
+     "Posture with q in radians. InputError with file:line:col; a robomach.UnitWarning when the angles look "
+     "like the other unit (the tools' exit 3).");
   m.def("write_posture_file", [](const std::string& path, const std::vector<io::Posture>& postures) {
     py::gil_scoped_release release;
     io::WritePostureFile(path, postures);

@@ -339,6 +339,7 @@ void BindStability(py::module_& m) {
   m.def("region_targets", [](const std::string& path, int num_joints, const io::CutSpec& cut) {
     RequireReadableFile(path);
     const io::RegionSpec region = io::ReadRegionFile(path, num_joints);
+    for (const std::string& w : region.implausible) WarnUnit(w);
     py::dict d;
     d["targets"] = region.Targets(cut.feed_direction_B);
     d["rows"] = region.num_v();

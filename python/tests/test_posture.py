@@ -157,3 +157,19 @@ def test_plausible_angles_do_not_warn_and_one_unit_is_required():
         ev.evaluate()
     with pytest.raises(ValueError, match='not both'):
         ev.evaluate(np.zeros(6), q_deg=np.zeros(6))
+
+
+def test_read_posture_file_warns_of_radians_under_deg_headers(tmp_path):
+    # The posture files' rule, as frf-predict's exit 3: every angle within
+    # 2 pi and some fractional under _deg headers are radians.
+    ok = tmp_path / 'deg.csv'
+    ok.write_text(POSTURES)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        degrees = rm.read_posture_file(str(ok), 6)
+    rad = tmp_path / 'rad.csv'
+    rad.write_text('pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\n'
+                   + ''.join(f'{p.id},' + ','.join(f'{x:.4f}' for x in p.q) + '\n' for p in degrees))
+    with pytest.warns(rm.UnitWarning, match=r'rad\.csv.*radians'):
+        rm.read_posture_file(str(rad), 6)

@@ -7,12 +7,14 @@
 #include <fstream>
 #include <sstream>
 
+#include "robomach/common/closest_name.h"
 #include "text.h"
 
 namespace robomach::io {
 namespace {
 
 // Splits one CSV line (RFC 4180 quoting, no embedded newlines).
+// `starts` receives the 0-based offset in `line` where each cell begins.
 std::vector<std::string> SplitLine(std::string_view line, const std::string& path, int line_no) {
   std::vector<std::string> cells;
   std::string cur;
@@ -57,6 +59,18 @@ std::vector<std::string> SplitLine(std::string_view line, const std::string& pat
 }
 
 }  // namespace
+
+std::string JointColumnHint(const CsvTable& table, int joint, int num_joints) {
+  std::vector<std::string> others{"pose_id", "case_id"};
+  for (int k = 0; k < num_joints; ++k) {
+    if (k == joint) continue;
+    others.push_back("q" + std::to_string(k + 1) + "_deg");
+    others.push_back("q" + std::to_string(k + 1) + "_rad");
+  }
+  const std::string stem = "q" + std::to_string(joint + 1);
+  const std::string deg = table.CloseColumn(stem + "_deg", others);
+  return deg.empty() ? table.CloseColumn(stem + "_rad", others) : deg;
+}
 
 bool ParseFiniteNumber(std::string_view text, double* value) {
   std::string t = Trim(text);
@@ -113,6 +127,19 @@ CsvTable CsvTable::Parse(std::string_view text, const std::string& path) {
     }
     std::vector<std::string> cells = SplitLine(line, path, line_no);
     if (t.header_.empty()) {
+      // A spreadsheet in a German or French locale saves ';' (or a tab)
+      // between the cells: one header cell holding every name.
+      if (cells.size() == 1) {
+        for (const char sep : {';', '\t'}) {
+          if (cells[0].find(sep) == std::string::npos) continue;
+          throw InputError({path, line_no, 0},
+                           std::string("the header '") + cells[0] + "' is separated by " +
+                               (sep == ';' ? "semicolons" : "tabs") +
+                               "; robomach's CSV files separate cells with commas and use a decimal point "
+                               "(docs/formats.md): save the table as CSV with ',' as the separator (a "
+                               "spreadsheet set to a German or French locale writes ';' and decimal commas)");
+        }
+      }
       std::map<std::string_view, size_t> first;  // (not a pairwise check: quadratic in the columns)
       for (size_t c = 0; c < cells.size(); ++c) {
         if (cells[c].empty()) {
@@ -154,12 +181,68 @@ int CsvTable::ColumnIndex(std::string_view name) const {
   return -1;
 }
 
-void CsvTable::RequireColumn(std::string_view name) const {
+void CsvTable::RequireColumn(std::string_view name, std::string_view own) const {
   if (HasColumn(name)) return;
   std::string have;
   for (const auto& h : header_) have += (have.empty() ? "" : ",") + h;
   throw InputError({path_, header_line_, 0},
-                   "missing required column '" + std::string(name) + "'; the header has: " + have);
+                   "missing required column '" + std::string(name) + "'" + CloseColumn(name) +
+                       "; the header has: " + have + LooksLike(own));
+}
+
+std::string CsvTable::LooksLike(std::string_view own) const {
+  // Each of robomach's CSV formats by the columns only it has (formats.md).
+  const auto has = [&](std::initializer_list<const char*> cols) {
+    for (const char* c : cols) {
+      if (!HasColumn(c)) return false;
+    }
+    return true;
+  };
+  std::string kind, tag;
+  if (has({"freq_hz", "re", "im"}) || has({"freq_hz", "response", "excitation"})) {
+    kind = "a measured or predicted FRF (docs/formats.md §3; freq_hz, re, im)", tag = "frf";
+  } else if (has({"freq_hz", "damping_ratio"})) {
+    kind = "a modal table (docs/formats.md §4; freq_hz, damping_ratio)", tag = "modal";
+  } else if (has({"case_id", "x0_mm"})) {
+    kind = "a laser-tracker load test (docs/formats.md §2; case_id, x0_mm..)", tag = "tracker";
+  } else if (has({"pose_id", "q1_deg"}) || has({"pose_id", "q1_rad"})) {
+    kind = "a posture file (docs/formats.md §1; pose_id, q1_deg..)", tag = "posture";
+  } else if (has({"x_mm", "y_mm", "z_mm", "tool_i"})) {
+    kind = "a tool path (x_mm, y_mm, z_mm, tool_i..)", tag = "path";
+  } else if (has({"target_mm", "measured_mm"}) || has({"target_deg", "measured_deg"})) {
+    kind = "ISO 230-2 runs (docs/formats.md §8; target_mm, measured_mm)", tag = "iso";
+  } else if (has({"time_s", "force_N"})) {
+    kind = "hammer records (time_s, force_N)", tag = "hammer";
+  }
+  if (tag == own) return "";
+  return kind.empty() ? "" : "; the columns are those of " + kind + ": the file for another option?";
+}
+
+std::string CsvTable::CellPosition(std::string_view column) const {
+  // An empty cell shows nothing to find it by: count the commas.
+  return " (cell " + std::to_string(ColumnIndex(column) + 1) + " of " + std::to_string(header_.size()) +
+         " in the row, after " + std::to_string(ColumnIndex(column)) + " commas)";
+}
+
+std::string CsvTable::CloseColumn(std::string_view name, const std::vector<std::string>& exclude) const {
+  std::vector<std::string> candidates;
+  for (const std::string& h : header_) {
+    if (std::find(exclude.begin(), exclude.end(), h) == exclude.end()) candidates.push_back(h);
+  }
+  const std::string close = ClosestName(std::string(name), candidates);
+  if (close.empty() || close == name) return "";
+  // Column names are short and alike (case_id, pose_id): one edit per four
+  // characters at most, or the same name with its unit suffix changed.
+  const auto lower = [](std::string_view v) {
+    std::string out(v);
+    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+  };
+  const std::string a = lower(name), b = lower(close);
+  const auto stem = [](const std::string& v) { return v.substr(0, v.rfind('_')); };
+  const bool same_stem = stem(a) == b || stem(b) == a || (stem(a) == stem(b) && stem(a) != a);
+  if (!same_stem && EditDistance(a, b) > std::max<size_t>(1, a.size() / 4)) return "";
+  return " (the header has '" + close + "' (column " + std::to_string(ColumnIndex(close) + 1) + "): mistyped?)";
 }
 
 std::vector<std::string> CsvTable::UnknownColumns(const std::vector<std::string>& known) const {
@@ -173,9 +256,7 @@ std::vector<std::string> CsvTable::UnknownColumns(const std::vector<std::string>
 const std::string& CsvTable::Cell(int row, int column) const { return rows_[row][column]; }
 
 InputError CsvTable::ErrorAt(int row, std::string_view column, const std::string& message) const {
-  const int c = ColumnIndex(column);
-  return InputError({path_, lines_[row], 0},
-                    "column " + std::string(column) + (c < 0 ? "" : "") + ": " + message);
+  return InputError({path_, lines_[row], 0}, "column " + std::string(column) + ": " + message);
 }
 
 InputError CsvTable::ErrorAtRow(int row, const std::string& message) const {
@@ -185,7 +266,7 @@ InputError CsvTable::ErrorAtRow(int row, const std::string& message) const {
 std::string CsvTable::Text(int row, std::string_view column) const {
   RequireColumn(column);
   const std::string& s = Cell(row, ColumnIndex(column));
-  if (s.empty()) throw ErrorAt(row, column, "expected a value, got an empty cell");
+  if (s.empty()) throw ErrorAt(row, column, "expected a value, got an empty cell" + CellPosition(column));
   return s;
 }
 
@@ -199,7 +280,7 @@ double CsvTable::Number(int row, std::string_view column) const {
   const std::string& s = Cell(row, ColumnIndex(column));
   double v = 0.0;
   if (ParseFiniteNumber(s, &v)) return v;
-  if (s.empty()) throw ErrorAt(row, column, "expected a number, got an empty cell");
+  if (s.empty()) throw ErrorAt(row, column, "expected a number, got an empty cell" + CellPosition(column));
   std::string hint;
   if (s.find(',') != std::string::npos) hint = " (decimal comma?)";
   const std::string low = Lower(s);

@@ -39,7 +39,7 @@ FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
     }
     out.averages = static_cast<int>(n);
   }
-  for (const char* c : {"pose_id", "response", "excitation", "freq_hz", "re", "im"}) t.RequireColumn(c);
+  for (const char* c : {"pose_id", "response", "excitation", "freq_hz", "re", "im"}) t.RequireColumn(c, "frf");
   const bool has_coherence = t.HasColumn("coherence");
   // Point numbers of a roving test (formats.md §3): `point` is the roving
   // transducer's point, read as the response point (by reciprocity a

@@ -1,5 +1,9 @@
 #include "robomach/io/frf_files.h"
 
+#include <algorithm>
+
+#include "robomach/common/number_format.h"
+#include "robomach/dynamics/frf_prediction.h"
 #include "robomach/io/file_kind.h"
 #include "robomach/io/uff58.h"
 #include "frf_text.h"
@@ -23,6 +27,21 @@ FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_po
   FrfReadResult r = ReadFrfCsv(path, keep_points);
   r.file_format = dynamics::FrfFileFormat::kCsv;
   return r;
+}
+
+std::vector<std::string> FrequencyUnitFindings(const FrfReadResult& read, const std::string& path) {
+  double top = 0.0;
+  for (const auto& [key, frf] : read.frfs) {
+    if (frf.size() > 0) top = std::max(top, frf.freq_hz().maxCoeff());
+  }
+  if (read.frfs.empty() || !(top > 0.0) || top >= dynamics::kMinPlausibleFmaxHz) return {};
+  const bool uff = read.file_format == dynamics::FrfFileFormat::kUff58;
+  return {path + ": the FRFs' highest line is at " + robomach::FormatNumber(top, 4) + " Hz, below the " +
+          robomach::FormatNumber(dynamics::kMinPlausibleFmaxHz, 4) +
+          " Hz of any hammer test (lines to 0.1 - 10 kHz; robot modes 5 - 2000 Hz): frequencies in kHz " +
+          (uff ? std::string("in the abscissa (UFF58 record 7's start and increment, record 8's unit)")
+               : std::string("under the freq_hz header")) +
+          "? (" + robomach::FormatNumber(top, 4) + " kHz is " + robomach::FormatNumber(1e3 * top, 4) + " Hz)"};
 }
 
 }  // namespace robomach::io

@@ -54,8 +54,8 @@ FileHits ReadOne(const std::string& path, bool prefix_ids) {
                        "<name>_m_per_s2, optional hit)");
     }
   }
-  t.RequireColumn("time_s");
-  t.RequireColumn("force_N");
+  t.RequireColumn("time_s", "hammer");
+  t.RequireColumn("force_N", "hammer");
   const int c_time = t.ColumnIndex("time_s"), c_force = t.ColumnIndex("force_N"), c_hit = t.ColumnIndex("hit");
   FileHits out;
   std::vector<int> c_resp;

@@ -11,7 +11,7 @@ namespace robomach::io {
 
 IsoRuns ReadIsoRuns(const std::string& path) {
   const CsvTable t = CsvTable::ReadFile(path);
-  for (const char* c : {"axis", "run", "direction"}) t.RequireColumn(c);
+  for (const char* c : {"axis", "run", "direction"}) t.RequireColumn(c, "iso");
   const bool mm = t.HasColumn("target_mm") || t.HasColumn("measured_mm");
   const bool deg = t.HasColumn("target_deg") || t.HasColumn("measured_deg");
   if (mm && deg) {
@@ -22,8 +22,8 @@ IsoRuns ReadIsoRuns(const std::string& path) {
   IsoRuns runs;
   runs.rotary = deg;
   const std::string u = deg ? "_deg" : "_mm";
-  t.RequireColumn("target" + u);
-  t.RequireColumn("measured" + u);
+  t.RequireColumn("target" + u, "iso");
+  t.RequireColumn("measured" + u, "iso");
   for (int r = 0; r < t.num_rows(); ++r) {
     const std::string axis = t.Text(r, "axis");
     machine::Iso230Approach a;

@@ -107,7 +107,7 @@ void WriteLoadTestPlanCsv(const std::string& path, const identification::TestPla
 LoadTestPlanFile ReadLoadTestPlanCsv(const std::string& path, int num_joints) {
   // One row per posture and rope direction, rows of one posture together.
   const CsvTable t = CsvTable::ReadFile(path);
-  t.RequireColumn("pose_id");
+  t.RequireColumn("pose_id", "posture");
   LoadTestPlanFile plan;
   for (int r = 0; r < t.num_rows(); ++r) {
     const std::string id = t.Text(r, "pose_id");

@@ -51,7 +51,7 @@ std::vector<std::string> PostureUnitWarnings(const std::string& path, const std:
 std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints,
                                      std::vector<std::string>* unit_warnings) {
   const CsvTable t = CsvTable::ReadFile(path, kPostureCsvFormat);
-  t.RequireColumn("pose_id");
+  t.RequireColumn("pose_id", "posture");
   // Which joint columns exist, and in which unit.
   const std::regex qcol(R"(q(\d+)_(deg|rad))");
   int max_joint = 0;
@@ -88,7 +88,8 @@ std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints,
     if (!t.HasColumn(deg) && !t.HasColumn(rad)) {
       throw InputError({path, t.header_line(), 0},
                        "missing column " + deg + " (or " + rad + "): the robot has " +
-                           std::to_string(num_joints) + " joints");
+                           std::to_string(num_joints) + " joints" +
+                           JointColumnHint(t, j, num_joints) + t.LooksLike("posture"));
     }
     is_deg[j] = t.HasColumn(deg);
     cols[j] = is_deg[j] ? deg : rad;

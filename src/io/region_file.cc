@@ -4,6 +4,8 @@
 
 #include <Eigen/Geometry>
 
+#include "plausible.h"
+#include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/yaml_doc.h"
@@ -68,6 +70,18 @@ RegionSpec ReadRegionFile(const std::string& path, int num_joints) {
     r.origin_B = Vec3(o) * 1e-3;
     r.origin_line = o.location().line;
     r.origin_column = o.location().column;
+    // A machining region is where the tool reaches: 50 mm to 20 m from the
+    // base (as the tracker file's target distance). The demo's corner is
+    // 2.1 m out; in metres it would be 2.1 "mm".
+    const double d_mm = 1e3 * r.origin_B.norm();
+    if (d_mm < kMinPlausibleRegionDistanceMm || d_mm > kMaxPlausibleRegionDistanceMm) {
+      r.implausible.push_back(ImplausibleMessage(
+          o, "at " + (d_mm >= 10.0 ? std::to_string(std::lround(d_mm)) : robomach::FormatNumber(d_mm, 4)),
+          {kMinPlausibleRegionDistanceMm, kMaxPlausibleRegionDistanceMm, "mm",
+           "a robot's machining regions (their corner 0.05 - 20 m from the base)", "a position in m typed in the mm field?",
+           "a position in um typed in the mm field?"},
+          d_mm < kMinPlausibleRegionDistanceMm));
+    }
   }
   r.u_B = Direction(doc["u_axis"]);
   {
@@ -127,6 +141,9 @@ RegionSpec ReadRegionFile(const std::string& path, int num_joints) {
     const std::vector<double> q = s.Numbers(num_joints);
     r.seed_q.resize(num_joints);
     for (int j = 0; j < num_joints; ++j) r.seed_q(j) = DegToRad(q[j]);
+    std::vector<TypedAngle> angles;
+    for (int j = 0; j < num_joints; ++j) angles.push_back({s.at(j), q[j]});
+    CheckDegreesNotRadians(angles, &r.implausible);
   }
   doc.RejectUnknownKeys();
   return r;
@@ -134,10 +151,10 @@ RegionSpec ReadRegionFile(const std::string& path, int num_joints) {
 
 std::vector<PathPoint> ReadToolPathFile(const std::string& path, const Eigen::Vector3d& default_feed_B) {
   const CsvTable t = CsvTable::ReadFile(path);
-  for (const char* c : {"x_mm", "y_mm", "z_mm", "tool_i", "tool_j", "tool_k"}) t.RequireColumn(c);
+  for (const char* c : {"x_mm", "y_mm", "z_mm", "tool_i", "tool_j", "tool_k"}) t.RequireColumn(c, "path");
   const bool has_feed = t.HasColumn("feed_i") || t.HasColumn("feed_j") || t.HasColumn("feed_k");
   if (has_feed) {
-    for (const char* c : {"feed_i", "feed_j", "feed_k"}) t.RequireColumn(c);
+    for (const char* c : {"feed_i", "feed_j", "feed_k"}) t.RequireColumn(c, "path");
   }
   std::vector<PathPoint> out;
   for (int r = 0; r < t.num_rows(); ++r) {

@@ -180,11 +180,17 @@ std::string ThousandHint(double value, double reference, const std::string& smal
 }
 
 // The findings so far, for a refusal they may explain (a body mass in g
-// makes m6_kg disagree with the bodies).
-std::string Also(const std::vector<std::string>& findings) {
-  std::string s;
-  for (const std::string& f : findings) s += "; the likely cause, " + f;
-  return s;
+// makes m6_kg disagree with the bodies): put first, since the refusal is
+// only their consequence (issue #35: the cause came at the end).
+std::string LikelyCause(const std::vector<std::string>& findings) {
+  if (findings.empty()) return "";
+  const std::string prefix = "implausible (unit mistake?): ";
+  std::string s = "the likely cause: ";
+  for (size_t i = 0; i < findings.size(); ++i) {
+    const std::string& f = findings[i];
+    s += (i ? "; and " : "") + (f.rfind(prefix, 0) == 0 ? f.substr(prefix.size()) : f);
+  }
+  return s + " -- which makes this check fail: ";
 }
 
 // The keys of `spindle_toolholder_interface` (docs/plausibility.md): a value
@@ -250,9 +256,9 @@ void CheckSpindleInterface(const YamlDoc& section, std::vector<std::string>* imp
     const YamlDoc ratio = section["taper_ratio"];
     const double L = section["taper_length_m"].Number(), D = section["taper_large_diameter_m"].Number();
     if (!(ratio.Number() * L < D)) {
-      throw ratio.Error("the taper's small diameter taper_large_diameter_m - taper_ratio x taper_length_m = " +
-                        FormatDouble(D) + " - " + ratio.String() + " x " + FormatDouble(L) + " m is not > 0" +
-                        Also(*implausible));
+      throw ratio.Error(LikelyCause(*implausible) +
+                        "the taper's small diameter taper_large_diameter_m - taper_ratio x taper_length_m = " +
+                        FormatDouble(D) + " - " + ratio.String() + " x " + FormatDouble(L) + " m is not > 0");
     }
   }
 }
@@ -499,18 +505,19 @@ RobotConfig LoadRobotConfig(const std::string& path) {
   if (ee.Has("m6_kg")) {
     const YamlDoc node = ee["m6_kg"];
     if (std::abs(node.Number() - m6) > 1e-6 * std::max(1.0, m6)) {
-      throw node.Error("the last link and the end-effector bodies weigh " + FormatNumber(m6) +
+      throw node.Error(LikelyCause(cfg.implausible) + "the last link and the end-effector bodies weigh " +
+                       FormatNumber(m6) +
                        " kg; m6_kg must state that reference (put a calibrated m6 under "
-                       "'parameters: m6_kg')" + ThousandHint(node.Number(), m6, "g", "kg") + Also(cfg.implausible));
+                       "'parameters: m6_kg')" + ThousandHint(node.Number(), m6, "g", "kg"));
     }
   }
   if (ee.Has("d6_m")) {
     const YamlDoc node = ee["d6_m"];
     if (std::abs(node.Number() - d6) > 1e-6) {
-      throw node.Error("the geometry puts the tool tip " + FormatNumber(d6) +
+      throw node.Error(LikelyCause(cfg.implausible) + "the geometry puts the tool tip " + FormatNumber(d6) +
                        " m from the wrist centre along the last joint axis; d6_m must state "
                        "that reference (put a calibrated d6 under 'parameters: d6_m')" +
-                       ThousandHint(node.Number(), d6, "mm", "m") + Also(cfg.implausible));
+                       ThousandHint(node.Number(), d6, "mm", "m"));
     }
   }
   ee.MarkUsed("m6_kg");

@@ -48,7 +48,7 @@ std::vector<FrfSetOfPose> ReadTipFrfs(const std::string& path, const std::string
 
 std::vector<ModalTableEntry> ReadModalTable(const std::string& path) {
   const CsvTable t = CsvTable::ReadFile(path);
-  for (const char* c : {"pose_id", "freq_hz", "damping_ratio", "ux", "uy", "uz"}) t.RequireColumn(c);
+  for (const char* c : {"pose_id", "freq_hz", "damping_ratio", "ux", "uy", "uz"}) t.RequireColumn(c, "modal");
   const bool has_m = t.HasColumn("modal_mass_kg"), has_k = t.HasColumn("modal_stiffness_N_per_m");
   if (has_m == has_k) {
     throw InputError({path, t.header_line(), 0},

@@ -137,9 +137,9 @@ TrackerFile ReadTrackerFile(const std::string& path, int num_joints) {
   TrackerFile f;
   f.path = path;
   f.metadata = t.metadata();
-  t.RequireColumn("case_id");
-  t.RequireColumn("pose_id");
-  for (const auto& c : kPositionCols) t.RequireColumn(c);
+  t.RequireColumn("case_id", "tracker");
+  t.RequireColumn("pose_id", "tracker");
+  for (const auto& c : kPositionCols) t.RequireColumn(c, "tracker");
 
   // Joint columns, as in the posture file (formats.md §1).
   const std::regex qcol(R"(q(\d+)_(deg|rad))");
@@ -170,7 +170,8 @@ TrackerFile ReadTrackerFile(const std::string& path, int num_joints) {
     if (!t.HasColumn(deg) && !t.HasColumn(rad)) {
       throw InputError({path, t.header_line(), 0},
                        "missing column " + deg + " (or " + rad + "): the robot has " +
-                           std::to_string(num_joints) + " joints");
+                           std::to_string(num_joints) + " joints" +
+                           JointColumnHint(t, j, num_joints) + t.LooksLike("tracker"));
     }
     is_deg[j] = t.HasColumn(deg);
     qcols[j] = is_deg[j] ? deg : rad;
@@ -194,7 +195,7 @@ TrackerFile ReadTrackerFile(const std::string& path, int num_joints) {
   for (const auto& c : f.rope_form ? kRopeCols : kForceCols) {
     if (!t.HasColumn(c)) {
       throw InputError({path, t.header_line(), 0},
-                       "missing column " + c + " (the " +
+                       "missing column " + c + t.CloseColumn(c) + " (the " +
                            std::string(f.rope_form ? "rope" : "force") + " load form needs all of " +
                            (f.rope_form ? "mass_kg,ax_mm..bz_mm" : "fx_N,fy_N,fz_N") + ")");
     }

@@ -55,7 +55,18 @@ PlanningContext PreparePlanning(const NurbsSurface& surface, const PolishingProc
   try {
     c.contact_width = ContactWidthAtCentre(surface, *c.grid, process);
   } catch (const std::domain_error& e) {
-    throw InputError({surface_source, 0, 0}, std::string("at the centre of the region: ") + e.what());
+    // A spot too concave for the wheel is the surface's.
+    if (std::string(e.what()).find("exceeds belt_width_mm") == std::string::npos) {
+      throw InputError({surface_source, 0, 0}, std::string("at the centre of the region: ") + e.what());
+    }
+    // The process presses the contact wider than its belt: the process
+    // file's numbers are the cause, not the surface (issue #35).
+    throw InputError({process_source, 0, 0},
+                     "process.force_N " + FormatNumber(process.force, 6) + " N on a pad of pad_modulus_MPa " +
+                         FormatNumber(1e-6 * process.pad_modulus, 6) + " makes a " + e.what() +
+                         " at the centre of the region of " + surface_source +
+                         ": a force too large for this belt (kN or mN typed in the N field? belts press 1 - 200 N), "
+                         "a pad modulus too small (kPa typed for MPa?), or the belt's width mistyped");
   }
   const double cell = 0.5 * c.contact_width;  // index cell ~ the contact semi-axis
   c.simulator = std::make_shared<const RemovalSimulator>(surface, process, c.grid->points(), c.grid->normals(), cell);

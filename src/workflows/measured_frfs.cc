@@ -81,7 +81,10 @@ MeasuredFrfs ReadMeasuredFrfFiles(const MeasuredFrfOptions& o, const MessageSink
     for (const std::string& n : r.notes) Tell(on_message, Message::Kind::kNote, n);
     // On each FRF's usable band only (issue #34 item 5): a tap test's drift
     // lines are no measure of the unit.
-    for (const std::string& f : calibration::ReceptanceUnitFindings(r.frfs, path, r.averages, r.file_format)) {
+    std::vector<std::string> unit_findings = io::FrequencyUnitFindings(r, path);
+    // A frequency axis in kHz makes every receptance judgement moot.
+    if (unit_findings.empty()) unit_findings = calibration::ReceptanceUnitFindings(r.frfs, path, r.averages, r.file_format);
+    for (const std::string& f : unit_findings) {
       Tell(on_message, Message::Kind::kWarning, "implausible (unit mistake?): " + f);
       all.unit_findings.push_back(f);
     }

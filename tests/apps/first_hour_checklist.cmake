@@ -19,6 +19,11 @@ configure_file(${SRC}/config/kr210.yaml ${WORK}/copy/kr210.yaml COPYONLY)
 file(READ ${SRC}/config/region_demo.yaml region)
 string(REPLACE "origin_mm: [1900, -400, 800]" "origin_mm: [2500, -400, 800]" region "${region}")
 file(WRITE ${WORK}/region_far.yaml "${region}")
+# Posture files with the mistakes of a spreadsheet: ';' between the cells,
+# a header name mistyped, an empty cell.
+file(WRITE ${WORK}/semi.csv "pose_id;q1_deg;q2_deg;q3_deg;q4_deg;q5_deg;q6_deg\nP1;0;-90;90;0;45;0\n")
+file(WRITE ${WORK}/typo.csv "pose_id,q1_deg,q2deg,q3_deg,q4_deg,q5_deg,q6_deg\nP1,0,-90,90,0,45,0\n")
+file(WRITE ${WORK}/blank.csv "pose_id,q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg\nP1,0,-90,90,0,45,0\nP2,0,-90,,0,45,0\n")
 # A picture or document given as the robot config.
 file(WRITE ${WORK}/report.pdf "%PDF-1.4\n%binary follows\n")
 # The same config with a negative mass on line 38 (the URDF by absolute path).

@@ -31,9 +31,25 @@ TEST(CsvTable, NumberErrorsNameFileLineColumnAndWhatWasFound) {
   EXPECT_EQ(CaptureError([&] { t.Number(2, "fy_N"); }),
             "tracker.csv:4: column fy_N: expected a number, got \"nan\" (nan and inf are not allowed)");
   EXPECT_EQ(CaptureError([&] { t.Number(3, "fy_N"); }),
-            "tracker.csv:5: column fy_N: expected a number, got an empty cell");
+            "tracker.csv:5: column fy_N: expected a number, got an empty cell (cell 2 of 3 in the row, after 1 "
+            "commas)");
   EXPECT_EQ(CaptureError([&] { t.Number(0, "mass_kg"); }),
             "tracker.csv:1: missing required column 'mass_kg'; the header has: fx_N,fy_N,fz_N");
+}
+
+TEST(CsvTable, AMissingColumnNamesTheCloseOneAndASemicolonHeaderIsNamed) {
+  const CsvTable t = CsvTable::Parse("pose_id,q1deg,q2_deg\nP1,0,0\n", "p.csv");
+  EXPECT_EQ(CaptureError([&] { t.RequireColumn("q1_deg"); }),
+            "p.csv:1: missing required column 'q1_deg' (the header has 'q1deg' (column 2): mistyped?); the header "
+            "has: pose_id,q1deg,q2_deg");
+  // Nothing close: no guess.
+  EXPECT_EQ(t.CloseColumn("force_N"), "");
+  // A spreadsheet's ';' (German or French locale) and a tab-separated export.
+  EXPECT_THAT(CaptureError([] { CsvTable::Parse("pose_id;q1_deg;q2_deg\nP1;0,5;0\n", "s.csv"); }),
+              HasSubstr("s.csv:1: the header 'pose_id;q1_deg;q2_deg' is separated by semicolons; robomach's CSV "
+                        "files separate cells with commas"));
+  EXPECT_THAT(CaptureError([] { CsvTable::Parse("pose_id\tq1_deg\nP1\t0\n", "t.csv"); }),
+              HasSubstr("t.csv:1: the header 'pose_id\tq1_deg' is separated by tabs"));
 }
 
 TEST(CsvTable, StructuralErrors) {

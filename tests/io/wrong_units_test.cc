@@ -23,6 +23,7 @@
 #include "robomach/io/drilling_files.h"
 #include "robomach/io/machine_file.h"
 #include "robomach/io/polishing_files.h"
+#include "robomach/io/region_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/temperature_log.h"
 #include "test_support.h"
@@ -72,6 +73,7 @@ const std::vector<NamedReader>& Readers() {
          ReadTemperatureLog(p, ReadMachineFile(SourcePath("config/machine/dmu80p.yaml")), &w);
          return w;
        }},
+      {"region", [](const std::string& p) { return ReadRegionFile(p, 6).implausible; }},
       {"counts_file",
        [](const std::string& p) {
          std::vector<std::string> w;
@@ -111,10 +113,10 @@ constexpr double kRadPerDeg = kPi / 180.0;
 const std::vector<WrongUnitCase>& Cases() {
   static const std::vector<WrongUnitCase> cases = {
       // robot config (config/kr210.yaml; DH table config/kr210_dh.yaml)
-      {"robot_config", "config/kr210.yaml", "mass_kg", 0, 1000, Expect::kRefused, "m6_kg must state .*the likely cause, .*mass_kg 22000 kg .*a mass in g typed in the kg field"},
+      {"robot_config", "config/kr210.yaml", "mass_kg", 0, 1000, Expect::kRefused, "the likely cause: .*mass_kg 22000 kg .*a mass in g typed in the kg field.* -- which makes this check fail: .*m6_kg must state"},
       {"robot_config", "config/kr210_dh.yaml", "mass_kg", 0, 1000, Expect::kFlagged, "mass_kg 363070 kg .*a mass in g typed in the kg field"},
       {"robot_config", "config/kr210.yaml", "com_m[2]", 0, 1000, Expect::kFlagged, "com_m\\[2\\] 110 m .*a length in mm typed in the m field"},
-      {"robot_config", "config/kr210.yaml", "tcp_m[2]", 0, 1000, Expect::kRefused, "tcp_m\\[2\\] 335 m .*a length in mm typed in the m field"},
+      {"robot_config", "config/kr210.yaml", "tcp_m[2]", 0, 1000, Expect::kRefused, "the likely cause: .*tcp_m\\[2\\] 335 m .*a length in mm typed in the m field.*which makes this check fail: the geometry puts the tool tip"},
       {"robot_config", "config/kr210.yaml", "joint_stiffness_Nm_per_rad[0]", 0, 1000, Expect::kFlagged, "joint_stiffness_Nm_per_rad\\[0\\] 3347900000 N·m/rad .*a stiffness in N·mm/rad"},
       {"robot_config", "config/kr210.yaml", "joint_stiffness_Nm_per_rad", 0, 1000, Expect::kFlagged, "joint 6 \\(joint_6\\).* 7\\d\\d\\d Hz.*a stiffness in N·mm/rad"},
       {"robot_config", "config/kr210.yaml", "joint_stiffness_Nm_per_rad", 0, 1e-3, Expect::kFlagged, "joint 2 \\(joint_2\\).* 0.328 Hz.*a stiffness in kN·m/rad"},
@@ -131,7 +133,7 @@ const std::vector<WrongUnitCase>& Cases() {
       {"robot_config", "config/kr210_dh.yaml", "d_m", 0, 1000, Expect::kFlagged, "d_m -645 m .*a length in mm typed in the m field"},
       // its spindle_toolholder_interface (the spindle_interface effect) and hammer_test sections
       {"robot_config", "config/kr210.yaml", "taper_large_diameter_m", 0, 1000, Expect::kFlagged, "kr210.yaml:\\d+:\\d+: spindle_toolholder_interface.taper_large_diameter_m 24.007 m .*a diameter in mm typed in the m field"},
-      {"robot_config", "config/kr210.yaml", "taper_length_m", 0, 1000, Expect::kRefused, "taper_ratio.*small diameter.*not > 0.*the likely cause.*taper_length_m 16 m .*a length in mm typed in the m field"},
+      {"robot_config", "config/kr210.yaml", "taper_length_m", 0, 1000, Expect::kRefused, "the likely cause: .*taper_length_m 16 m .*a length in mm typed in the m field.*which makes this check fail: the taper's small diameter.*not > 0"},
       {"robot_config", "config/kr210.yaml", "drawbar_force_N", 0, 1e-3, Expect::kFlagged, "drawbar_force_N 5 N .*a force in kN typed in the N field"},
       {"robot_config", "config/kr210.yaml", "friction_coefficient", 0, 100, Expect::kFlagged, "friction_coefficient 15 .*a percentage typed"},
       {"robot_config", "config/kr210.yaml", "sample_rate_hz", 0, 1e-3, Expect::kFlagged, "hammer_test.sample_rate_hz 5.12 Hz .*a rate in kHz typed in the Hz field"},
@@ -160,6 +162,11 @@ const std::vector<WrongUnitCase>& Cases() {
       {"polish_process", "config/polishing/belt_2N.yaml", "preston_coefficient_m2_per_N", 0, 1e6, Expect::kFlagged, "preston_coefficient_m2_per_N .*mm²/N"},
       {"polish_process", "config/polishing/belt_2N.yaml", "max_speed_mm_per_s", 0, 1e-3, Expect::kFlagged, "max_speed_mm_per_s 0.05 mm/s .*m/s typed in the mm/s field"},
       {"robot_config", "config/kr210_dh.yaml", "alpha_prev_deg|theta_offset_deg|lower_deg|upper_deg|base_rpy_deg|tip_rpy_deg", -1, kRadPerDeg, Expect::kRefused, "radians typed in _deg fields"},
+      // stability-map's region (config/region_demo.yaml: corner 2.1 m from the base; the
+      // first origin_mm line is its comment)
+      {"region", "config/region_demo.yaml", "origin_mm", 1, 1e-3, Expect::kFlagged, "region_demo.yaml:\\d+:\\d+: origin_mm at 2.1\\d* mm is outside the 50 to 20000 mm .*a position in m typed in the mm field"},
+      {"region", "config/region_demo.yaml", "origin_mm", 1, 1000, Expect::kFlagged, "origin_mm at 2\\d{6} mm .*a position in um typed in the mm field"},
+      {"region", "config/region_demo.yaml", "seed_posture_deg", 0, kRadPerDeg, Expect::kFlagged, "seed_posture_deg.*radians typed in _deg fields"},
       // five-axis machine file (config/machine/dmu80p.yaml)
       {"machine_file", "config/machine/dmu80p.yaml", "resolution_mm", -1, 1000, Expect::kFlagged, "resolution_mm 0.5 mm .*a resolution in um typed in the mm field"},
       {"machine_file", "config/machine/dmu80p.yaml", "resolution_mm", -1, 1e-3, Expect::kFlagged, "resolution_mm 5e-07 mm .*a resolution in m typed in the mm field"},

@@ -14,7 +14,9 @@ namespace robomach::io {
 /// row naming the columns, `#` comment lines, `# key: value` metadata before
 /// the header. Columns are found by name. Every accessor that fails throws
 /// InputError naming the file, the line and the column, e.g.
-/// `tracker.csv:17: column fy_N: expected a number, got "12,5" (decimal comma?)`.
+/// `tracker.csv:17: column fy_N: expected a number, got "12,5" (decimal comma?)`;
+/// an empty cell also gets its place in the row ("cell 3 of 7"). A header
+/// separated by ';' or tabs is refused as such.
 class CsvTable {
  public:
   /// @throws MissingFileError if the file is missing or cannot be read;
@@ -36,8 +38,23 @@ class CsvTable {
 
   bool HasColumn(std::string_view name) const { return ColumnIndex(name) >= 0; }
   int ColumnIndex(std::string_view name) const;
-  /// @throws InputError "path:header_line: missing required column 'name'".
-  void RequireColumn(std::string_view name) const;
+  /// @throws InputError "path:header_line: missing required column 'name'",
+  /// with a close column (CloseColumn) and the format the header is of
+  /// (LooksLike(own): `own` the reader's own format, not named).
+  void RequireColumn(std::string_view name, std::string_view own = "") const;
+  /// " (the header has 'q1deg' (column 2): mistyped?)" when a header
+  /// column is close to `name` (ClosestName), else "": for messages about
+  /// a missing column.
+  /// Columns in `exclude` (the ones the reader uses) are not suggested.
+  std::string CloseColumn(std::string_view name, const std::vector<std::string>& exclude = {}) const;
+  /// "; the columns are those of a posture file (...): the file for another
+  /// option?" when the header is that of one of robomach's other CSV
+  /// formats (an FRF given as --tracker), else "". `own`: the reader's
+  /// format ("frf", "modal", "tracker", "posture", "path", "iso",
+  /// "hammer"), never named.
+  std::string LooksLike(std::string_view own = "") const;
+  /// " (cell 3 of 7 in the row, after 2 commas)" for an empty cell's message.
+  std::string CellPosition(std::string_view column) const;
   /// Header columns not in `known`, in file order.
   std::vector<std::string> UnknownColumns(const std::vector<std::string>& known) const;
 
@@ -61,6 +78,10 @@ class CsvTable {
   std::vector<std::vector<std::string>> rows_;
   std::vector<int> lines_;
 };
+
+/// CloseColumn for joint `joint` (0-based) of a posture or tracker file:
+/// q<j>_deg, else q<j>_rad, among the columns that are not another joint's.
+std::string JointColumnHint(const CsvTable& table, int joint, int num_joints);
 
 /// Parses a decimal or exponent-form number. Returns false for anything
 /// else, including nan and inf.

@@ -7,6 +7,7 @@
 // (style.md §2.5). This header includes them all and picks the reader.
 
 #include <string>
+#include <vector>
 
 #include "robomach/io/frf_csv.h"
 #include "robomach/io/frf_quantity.h"
@@ -26,5 +27,13 @@ namespace robomach::io {
 /// which pairs the posture holds and what to do.
 FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_pose_id = "",
                           bool keep_points = false);
+
+/// The frequency axis judged (docs/plausibility.md): the highest line of
+/// all FRFs of a file below 1 Hz (kMinPlausibleFmaxHz) is a frequency axis
+/// in kHz (a hammer test's lines reach 0.1 - 10 kHz; the robot's modes
+/// are 5 - 2000 Hz). One finding, "path: ...", without the "implausible
+/// (unit mistake?): " prefix, naming where the file keeps its frequencies;
+/// empty when plausible.
+std::vector<std::string> FrequencyUnitFindings(const FrfReadResult& read, const std::string& path);
 
 }  // namespace robomach::io

@@ -9,6 +9,11 @@
 
 namespace robomach::io {
 
+/// Plausible distance of a region's corner from the robot's base [mm]: a
+/// robot's tool is 0.05 - 20 m from its base (as the tracker file's
+/// kMin/MaxPlausibleTargetDistanceMm).
+inline constexpr double kMinPlausibleRegionDistanceMm = 50.0, kMaxPlausibleRegionDistanceMm = 20000.0;
+
 /// A rectangular work region as `region_*.yaml` describes it (see
 /// config/region_demo.yaml for the documented schema), in SI and radians.
 struct RegionSpec {
@@ -25,6 +30,10 @@ struct RegionSpec {
   Eigen::VectorXd seed_q;                         // preferred arm configuration [rad]
   std::string path;
   int origin_line{0}, origin_column{0};  // where origin_mm is, for messages
+  /// Sense checks (docs/plausibility.md; the tool warns and exits 3): the
+  /// corner within 50 mm of the base (metres typed under origin_mm), the
+  /// seed posture all within one turn and fractional (radians under _deg).
+  std::vector<std::string> implausible;
 
   int num_u() const;  // grid points along u (size/step + 1)
   int num_v() const;
