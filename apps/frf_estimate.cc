@@ -20,18 +20,12 @@
 #include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/json.h"
+#include "robomach/workflows/frf_estimate.h"
 
 namespace robomach::apps {
 namespace {
 
 constexpr char kTool[] = "frf-estimate";
-
-Axis ParseAxisOption(const std::string& option, const std::string& text) {
-  if (text == "x") return Axis::kX;
-  if (text == "y") return Axis::kY;
-  if (text == "z") return Axis::kZ;
-  throw UsageError(option + ": expected x, y or z, got '" + text + "'");
-}
 
 void SavePlot(const std::string& path, const calibration::FrfEstimateResult& r, const dynamics::FrfSet& frfs,
               const std::vector<std::string>& labels, const std::vector<int>& channel_of, io::FrfQuantity quantity,
@@ -162,125 +156,74 @@ int Run(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   return RunGuarded(kTool, [&]() -> int {
-    CheckOptionRange("--min-hits", min_hits, 1, 1e6);
     const std::vector<FieldSource> fields = {
         {"force_window_s", "--force-window-s"},       {"force_window_pre_s", "--force-window-pre-s"},
         {"force_window_taper_s", "--force-window-taper-s"}, {"exponential_tau_s", "--exp-window-tau-s"},
         {"fmax_hz", "--fmax-hz"},                     {"trigger_fraction", "--trigger-fraction"},
         {"double_hit_fraction", "--double-hit-fraction"}, {"flat_top_samples", "--flat-top-samples"},
-        {"force_range_N", "--force-range-N"},         {"response_range", "--response-range"}};
-    ValidateOptions(fields, [&] { calibration::CheckValid(o); });
-    const Axis exc = ParseAxisOption("--excitation", excitation);
-    std::map<std::string, std::string> dir_given;
+        {"force_range_N", "--force-range-N"},         {"response_range", "--response-range"},
+        {"directions", "--direction"},                {"excitation", "--excitation"},
+        {"estimator", "--estimator"},                 {"min_hits", "--min-hits"}};
+    workflows::FrfEstimateRunOptions w;
+    w.record_paths = records;
+    w.pose_id = pose_id;
+    w.excitation = excitation;
+    w.estimator = estimator;
+    w.min_hits = min_hits;
+    w.min_hits_name = "--min-hits";
+    w.estimate = o;
     for (const std::string& d : directions) {
       const size_t eq = d.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        throw UsageError("--direction: expected NAME=AXIS, got '" + d + "'");
-      }
-      dir_given[d.substr(0, eq)] = d.substr(eq + 1);
+      if (eq == std::string::npos || eq == 0) throw UsageError("--direction: expected NAME=AXIS, got '" + d + "'");
+      w.directions[d.substr(0, eq)] = d.substr(eq + 1);
     }
+    for (const std::string& text : response_ranges) {
+      const auto [name, value] = ParseAssignment("--response-range", text);
+      w.response_ranges[name] = value;
+    }
+    ValidateOptions(fields, [&] { w.Validate(); });
     std::vector<std::pair<std::string, std::string>> inputs;
     for (const std::string& r : records) {
       RequireReadableFile(r, "hammer record file");
       inputs.push_back({"records", r});
     }
     CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}, {"--plot", plot_path}});
-
-    const io::HammerRecords rec = io::ReadHammerRecords(records);
-    // Keys before the work, so that a naming problem is reported at once.
-    std::vector<dynamics::FrfKey> keys;
+    const io::FrfQuantity out_q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
+    workflows::FrfEstimateRun run;
     try {
-      keys = io::ChannelKeys(rec, pose_id, exc, dir_given);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(std::string("--direction ") + e.what());
+      run = workflows::RunFrfEstimate(w, MessagePrinter(kTool));
+    } catch (const OptionError& e) {
+      ValidateOptions(fields, [&] { throw e; });  // the field as the option (exit 64)
     }
-    std::map<std::string, double> ranges;
-    for (const std::string& text : response_ranges) {
-      const auto [name, value] = ParseAssignment("--response-range", text);
-      ranges[name] = value;
-    }
-    try {
-      o.response_range = io::ResponseRanges(rec, ranges);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(std::string("--response-range ") + e.what());
-    }
-    // Options that the records' sample rate decides (docs/frf-estimate.md).
-    const double fs = rec.hits.front().sample_rate_hz;
-    if (o.fmax_hz > 0.5 * fs) {
-      throw UsageError("--fmax-hz " + FormatNumber(o.fmax_hz, 7) + ": above the Nyquist frequency " +
-                       FormatNumber(0.5 * fs, 7) + " Hz of the records (sample rate " + FormatNumber(fs, 7) +
-                       " Hz): the highest line is at most fs/2 (0, the default: fs/2.56 = " +
-                       FormatNumber(fs / 2.56, 7) + " Hz)");
-    }
-    if (o.exponential_tau_s > 0.0 && o.exponential_tau_s < calibration::kMinExponentialWindowSamples / fs) {
-      const double f_hi = o.fmax_hz > 0.0 ? o.fmax_hz : fs / 2.56;
-      throw UsageError("--exp-window-tau-s " + FormatNumber(o.exponential_tau_s, 7) + ": shorter than " +
-                       FormatNumber(calibration::kMinExponentialWindowSamples, 3) + " sample periods (" +
-                       FormatNumber(calibration::kMinExponentialWindowSamples / fs, 3) + " s at " +
-                       FormatNumber(fs, 7) + " Hz): the window would add a damping ratio 1/(tau omega) of " +
-                       FormatNumber(1.0 / (o.exponential_tau_s * 2.0 * kPi * f_hi), 3) + " even at " +
-                       FormatNumber(f_hi, 6) + " Hz, more at lower lines; "
-                       "choose tau near the record length / 4.6 (docs/frf-estimate.md)");
-    }
-    std::cerr << kTool << ": " << rec.hits.size() << " hit(s) at " << FormatNumber(rec.hits.front().sample_rate_hz, 7)
-              << " Hz; pose " << pose_id << ", excitation " << AxisName(exc) << ", responses";
-    for (size_t c = 0; c < keys.size(); ++c) {
-      std::cerr << (c ? ", " : " ") << rec.channel_columns[c] << " -> " << AxisName(keys[c].response);
-    }
-    std::cerr << " (--pose-id, --excitation, --direction)\n";
-    const calibration::FrfEstimateResult r = calibration::EstimateFrf(rec.hits, rec.channels, o);
-
+    const calibration::FrfEstimateResult& r = run.result;
     std::vector<std::string> rejected;
     for (const auto& h : r.hits) {
-      if (h.status == calibration::HitStatus::kAccepted) continue;
-      rejected.push_back(h.id + " (" + calibration::HitStatusName(h.status) + ")");
-      for (const std::string& note : h.notes) {
-        std::cerr << kTool << ": hit " << h.id << " (" << h.source << ", hit at t = " << FormatNumber(h.hit_time_s, 6)
-                  << " s) rejected: " << note << '\n';
+      if (h.status != calibration::HitStatus::kAccepted) {
+        rejected.push_back(h.id + " (" + calibration::HitStatusName(h.status) + ")");
       }
     }
-    for (const std::string& w : r.warnings) Warn(kTool, w);
-
-    const RunFindings verdict = calibration::JudgeFrfEstimate(r, min_hits, "--min-hits");
-    std::vector<std::string> flags;
-    for (const Finding& f : verdict.findings) {
-      Warn(kTool, "result flagged: " + f.message);
-      flags.push_back(f.message);
+    int rc = run.every_hit_rejected() ? kExitDataError : ExitCodeFor(run.verdict.status());
+    if (run.frfs) {
+      const auto& meta = run.frfs->metadata;
+      io::WriteEstimatedFrfCsv(out_path, run.frfs->frfs, out_q, r.averages, meta);
+      if (!plot_path.empty()) {
+        SavePlot(plot_path, r, run.frfs->frfs, run.frfs->labels, run.frfs->channel_of, out_q,
+                 estimator == "h1" ? "H1" : "H2");
+      }
     }
-    int rc = ExitCodeFor(verdict.status());
-
-    // The FRFs, in receptance inside; written in --quantity.
-    const io::FrfQuantity out_q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
-    dynamics::FrfSet frfs;
-    std::vector<std::string> labels;
-    std::vector<int> channel_of;
-    if (r.status == calibration::FrfEstimateStatus::kOk) {
-      io::EstimatedFrfs est = io::ToEstimatedFrfs(r, rec, keys, estimator == "h2");
-      frfs = std::move(est.frfs);
-      labels = std::move(est.labels);
-      channel_of = std::move(est.channel_of);
-      const auto& meta = est.metadata;
-      io::WriteEstimatedFrfCsv(out_path, frfs, out_q, r.averages, meta);
-    }
-    if (!plot_path.empty() && r.status == calibration::FrfEstimateStatus::kOk) {
-      SavePlot(plot_path, r, frfs, labels, channel_of, out_q, estimator == "h1" ? "H1" : "H2");
-    }
-    if (r.status != calibration::FrfEstimateStatus::kOk) rc = kExitDataError;
-
     if (!summary_path.empty()) {
-      nlohmann::json j = io::FrfEstimateSummaryJson(r, rec, keys);
+      nlohmann::json j = run.Summary(estimator);
       j["tool"] = kTool;
       j["records"] = records;
       j["exit_code"] = rc;
-      j["estimator"] = estimator == "h1" ? "H1" : "H2";
-      j["flags"] = flags;
       io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }
-    if (r.status != calibration::FrfEstimateStatus::kOk) {
+    if (run.every_hit_rejected()) {
       std::cerr << kTool << ": every hit was rejected; no FRF written to " << out_path << '\n';
       CommitOutputsNow();  // the summary says why (exit 65 otherwise writes nothing)
       return rc;
     }
+    const dynamics::FrfSet& frfs = run.frfs->frfs;
     std::ostringstream msg;
     msg << kTool << ": " << r.averages << " of " << r.hits.size() << " hits averaged";
     if (!rejected.empty()) {

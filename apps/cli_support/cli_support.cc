@@ -369,6 +369,16 @@ void CheckOptionRange(const std::string& option, double value, double lo, double
   }
 }
 
+MessageSink MessagePrinter(const std::string& tool) {
+  return [tool](const Message& m) {
+    switch (m.kind) {
+      case Message::Kind::kWarning: Warn(tool, m.text); break;
+      case Message::Kind::kNote: Note(tool, m.text); break;
+      case Message::Kind::kInfo: std::cerr << tool << ": " << m.text << '\n'; break;
+    }
+  };
+}
+
 CLI::Validator OneOf(std::vector<std::string> names, std::map<std::string, std::string> aliases) {
   std::string list;
   for (size_t i = 0; i < names.size(); ++i) {

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json_fwd.hpp>
 
+#include "robomach/common/messages.h"
 #include "robomach/common/run_status.h"
 #include "robomach/io/file_kind.h"
 #include "robomach/io/robot_config.h"
@@ -199,6 +200,11 @@ void CheckDistinctPaths(const std::vector<std::pair<std::string, std::string>>& 
 /// name differs from it, naming `option` and the name used.
 std::map<std::string, std::string> FileStemsForIds(const std::string& tool, const std::string& option,
                                                    const std::vector<std::string>& ids);
+
+/// The library's messages (common/messages.h) on stderr under the tool's
+/// name: warnings through Warn (so the summary lists them), notes through
+/// Note, info lines as "tool: text".
+MessageSink MessagePrinter(const std::string& tool);
 
 /// The check of an option that takes one of `names` (CLI::IsMember with
 /// its answer): an unknown value gets "expected a, b or c, got 'x'" and the

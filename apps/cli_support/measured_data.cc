@@ -14,16 +14,6 @@ namespace robomach::apps {
 
 namespace {
 
-// The library's messages on stderr under the tool's name.
-MessageSink Printer(const std::string& tool) {
-  return [tool](const Message& m) {
-    switch (m.kind) {
-      case Message::Kind::kWarning: Warn(tool, m.text); break;
-      case Message::Kind::kNote: Note(tool, m.text); break;
-      case Message::Kind::kInfo: std::cerr << tool << ": " << m.text << '\n'; break;
-    }
-  };
-}
 
 workflows::MeasuredFrfOptions LibraryOptions(const NoiseCliOptions& o) {
   CheckOptionRange("--min-snr", o.min_snr, 1e-3, 1e6);
@@ -55,7 +45,7 @@ MeasuredData ReadMeasuredFiles(const std::string& tool, const std::vector<std::s
   o.what = what;
   o.pose_option = pose_option;
   o.keep_points = keep_points;
-  return workflows::ReadMeasuredFrfFiles(o, Printer(tool));
+  return workflows::ReadMeasuredFrfFiles(o, MessagePrinter(tool));
 }
 
 void AddNoiseOptions(CLI::App& app, NoiseCliOptions* o) {
@@ -93,7 +83,7 @@ calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const Meas
                                              const NoiseCliOptions& o) {
   const workflows::MeasuredFrfOptions w = LibraryOptions(o);
   try {
-    return workflows::EstimateNoiseModels(data, w, Printer(tool));
+    return workflows::EstimateNoiseModels(data, w, MessagePrinter(tool));
   } catch (const OptionError& e) {
     // The data cannot meet an option: the option, and what to give.
     throw UsageError((e.field() == "averages" ? "--noise-model " + o.model + " needs --averages N: "

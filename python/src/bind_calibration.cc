@@ -22,6 +22,7 @@
 #include "robomach/io/kq_files.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/tracker_file.h"
+#include "robomach/workflows/kq_identify.h"
 
 namespace robomach::python {
 namespace {
@@ -472,6 +473,48 @@ void BindCalibration(py::module_& m) {
      "call); the model's stiffness is the prior. tracker_noise_m: 1 sigma per measured coordinate "
      "[m]; loss: 'none', 'huber', 'cauchy'. Numerical trouble is a status in the result. Releases "
      "the GIL.");
+
+  m.def("run_kq_identify", [](const std::string& robot, const std::string& tracker, double noise_mm,
+                              const std::string& robust) {
+    workflows::KqIdentifyOptions o;
+    o.robot_path = robot;
+    o.tracker_path = tracker;
+    o.noise_mm = noise_mm;
+    o.robust = robust;
+    o.Validate();
+    RequireReadableFile(robot);
+    RequireReadableFile(tracker);
+    std::vector<Message> said;
+    workflows::KqIdentifyResult run;
+    {
+      py::gil_scoped_release release;
+      run = workflows::RunKqIdentify(o, [&](const Message& msg) { said.push_back(msg); });
+    }
+    for (const std::string& f : run.config.implausible) WarnUnit(f);
+    for (const std::string& f : run.unit_findings) WarnUnit(f);
+    py::list messages;
+    for (const Message& msg : said) {
+      py::dict d;
+      d["kind"] = msg.kind == Message::Kind::kWarning ? "warning" : msg.kind == Message::Kind::kNote ? "note" : "info";
+      d["text"] = msg.text;
+      messages.append(d);
+    }
+    py::dict d;
+    d["fit"] = run.fit;
+    d["messages"] = messages;
+    d["unit_findings"] = run.unit_findings;
+    d["flagged"] = run.flagged();
+    d["report"] = workflows::KqReportLines(run.fit);
+    d["summary"] = py::module_::import("json").attr("loads")(run.Summary().dump());
+    return d;
+  }, py::arg("robot"), py::arg("tracker"), py::arg("noise_mm") = workflows::KqIdentifyOptions{}.noise_mm,
+     py::arg("robust") = "",
+     "kq-identify as one call (workflows::RunKqIdentify): a robot config and a tracker file (formats.md §2), the "
+     "tool's --noise-mm and --robust ('', 'cauchy', 'huber'). Returns a dict: fit (JointStiffnessResult), "
+     "messages (dicts {kind, text}: the warnings the tool prints before its table), unit_findings (also as "
+     "UnitWarning, with the config's), flagged (the tool's exit 3), report (the table's lines) and summary (the "
+     "tool's --summary JSON but for tool, exit_code and warnings). ValueError naming the option; "
+     "FileNotFoundError, InputError for files. Releases the GIL.");
 
   py::class_<identification::PlannedLoad>(m, "PlannedLoad", "One planned rope direction at one posture [SI, in B].")
       .def_readonly("pose_id", &identification::PlannedLoad::pose_id)

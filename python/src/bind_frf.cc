@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bindings.h"
+#include "robomach/workflows/frf_estimate.h"
 #include "robomach/calibration/frf_estimate.h"
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/dynamics/measured_frf.h"
@@ -90,42 +91,41 @@ py::dict EstimateFrfs(const std::vector<std::string>& records, const std::string
                       const std::string& excitation, const std::map<std::string, std::string>& directions,
                       const std::string& estimator, int min_hits, calibration::FrfEstimateOptions o,
                       const std::map<std::string, double>& response_range) {
-  if (records.empty()) throw std::invalid_argument("records: expected at least one hammer record file");
+  // frf-estimate's own call (workflows::RunFrfEstimate): the same checks,
+  // the sample rate's among them.
+  workflows::FrfEstimateRunOptions w;
+  w.record_paths = records;
+  w.pose_id = pose_id;
+  w.excitation = excitation;
+  w.directions = directions;
+  w.response_ranges = response_range;
+  w.estimator = estimator;
+  w.min_hits = min_hits;
+  w.estimate = o;
+  w.Validate();
   for (const std::string& r : records) RequireReadableFile(r);
-  if (estimator != "h1" && estimator != "h2") {
-    throw std::invalid_argument("estimator: expected 'h1' or 'h2', got '" + estimator + "'");
-  }
-  if (min_hits < 1) throw std::invalid_argument("min_hits: expected at least 1");
-  calibration::CheckValid(o);
-  const Axis exc = ParseAxis(excitation);
-  io::HammerRecords rec;
-  std::vector<dynamics::FrfKey> keys;
-  calibration::FrfEstimateResult r;
+  workflows::FrfEstimateRun run;
   {
     py::gil_scoped_release release;
-    rec = io::ReadHammerRecords(records);
-    keys = io::ChannelKeys(rec, pose_id, exc, directions);
-    o.response_range = io::ResponseRanges(rec, response_range);
-    r = calibration::EstimateFrf(rec.hits, rec.channels, o);
+    run = workflows::RunFrfEstimate(w);
   }
-  const RunFindings verdict = calibration::JudgeFrfEstimate(r, min_hits, "min_hits");
+  const calibration::FrfEstimateResult& r = run.result;
   py::dict d;
-  const bool estimated = r.status == calibration::FrfEstimateStatus::kOk;
-  d["status"] = estimated ? RunStatusName(verdict.status()) : "no_estimate";
-  std::vector<std::string> findings = FindingMessages(verdict);
+  const bool estimated = !run.every_hit_rejected();
+  d["status"] = estimated ? RunStatusName(run.verdict.status()) : "no_estimate";
+  std::vector<std::string> findings = FindingMessages(run.verdict);
   if (!estimated) findings.insert(findings.begin(), "every hit was rejected: no estimate (summary['hits'] says why)");
   d["findings"] = findings;
   d["averages"] = r.averages;
-  if (estimated) {
-    io::EstimatedFrfs est = io::ToEstimatedFrfs(r, rec, keys, estimator == "h2");
-    d["frfs"] = est.frfs;
-    d["labels"] = est.labels;
+  if (run.frfs) {
+    d["frfs"] = run.frfs->frfs;
+    d["labels"] = run.frfs->labels;
   } else {
     d["frfs"] = py::none();
     d["labels"] = std::vector<std::string>{};
   }
-  // The result part of frf-estimate's --summary, as a dict.
-  d["summary"] = py::module_::import("json").attr("loads")(io::FrfEstimateSummaryJson(r, rec, keys).dump());
+  // frf-estimate's --summary but for tool, records and exit_code, as a dict.
+  d["summary"] = py::module_::import("json").attr("loads")(run.Summary(estimator).dump());
   return d;
 }
 

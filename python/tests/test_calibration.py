@@ -187,3 +187,48 @@ def test_noise_free_synthesis_equals_the_predicted_receptance():
             assert np.abs(h - ref).max() <= 1e-12 * np.abs(ref).max()
     with pytest.raises(ValueError, match='at least 2'):
         rm.synthesize_hammer_test(cfg, postures, coherence=True, averages=1)
+
+
+@pytest.mark.parametrize('campaign', ['shipped', 'masses_in_g'])
+def test_run_kq_identify_equals_the_tools_summary(tmp_path, campaign):
+    """Issue #36 acceptance: kq-identify's JSON summary and the Python call's
+    result (workflows::RunKqIdentify), on the shipped campaign and on the
+    same file with its masses in g (a unit finding: exit 3, a warning)."""
+    path = os.path.join(DATA, 'tracker_campaign.csv')
+    if campaign == 'masses_in_g':
+        lines = open(path).read().splitlines()
+        head = next(i for i, l in enumerate(lines) if not l.startswith('#'))
+        m = lines[head].split(',').index('mass_kg')
+        out = lines[:head + 1]
+        for l in lines[head + 1:]:
+            cells = l.split(',')
+            cells[m] = repr(float(cells[m]) * 1000.0)
+            out.append(','.join(cells))
+        path = str(tmp_path / 'grams.csv')
+        open(path, 'w').write('\n'.join(out) + '\n')
+    r = run_tool('kq-identify', '--robot', KR210, '--tracker', path, '--out', tmp_path / 'kq.yaml',
+                 '--summary', tmp_path / 'tool.json', expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool = json.loads((tmp_path / 'tool.json').read_text())
+    import warnings
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        run = rm.run_kq_identify(KR210, path)
+    assert run['flagged'] == (r.returncode == 3) == tool['flagged']
+    assert tool['exit_code'] == r.returncode
+    tool_warnings = tool.pop('warnings')
+    for key in ('tool', 'exit_code', 'robomach_version'):
+        tool.pop(key, None)
+    assert run['summary'] == tool
+    # The warnings the tool printed before its table are the call's messages,
+    # its table is the call's report, and its unit findings are UnitWarnings.
+    said = [m['text'] for m in run['messages'] if m['kind'] == 'warning']
+    assert tool_warnings[:len(said)] == said
+    for line in run['report']:
+        assert f'kq-identify: {line}' in r.stderr
+    assert [str(w.message) for w in caught if issubclass(w.category, rm.UnitWarning)] == run['unit_findings']
+    if campaign == 'masses_in_g':
+        assert run['unit_findings'] and 'mass_kg' in run['unit_findings'][0], run['unit_findings']
+        assert run['flagged']
+    else:
+        assert run['unit_findings'] == []

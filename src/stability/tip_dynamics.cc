@@ -9,6 +9,7 @@
 #include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
+#include "robomach/dynamics/frf_prediction.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 
 namespace robomach::stability {
@@ -167,6 +168,16 @@ std::pair<double, double> CommonUsableBand(const std::vector<DirectionFit>& fits
 }  // namespace
 
 std::string TipFrfsUnitFinding(const TipFrfs& s) {
+  // A frequency axis in kHz first: the receptance's band means nothing then
+  // (io::FrequencyUnitFindings, the other readers' rule).
+  if (s.freq_hz.size() > 0 && s.freq_hz.maxCoeff() > 0.0 && s.freq_hz.maxCoeff() < dynamics::kMinPlausibleFmaxHz) {
+    const double top = s.freq_hz.maxCoeff();
+    return s.source + (s.pose_id.empty() ? std::string() : ": posture " + s.pose_id) +
+           ": the FRFs' highest line is at " + FormatNumber(top, 4) + " Hz, below the " +
+           FormatNumber(dynamics::kMinPlausibleFmaxHz, 4) +
+           " Hz of any hammer test (lines to 0.1 - 10 kHz; robot modes 5 - 2000 Hz): frequencies in kHz? (" +
+           FormatNumber(top, 4) + " kHz is " + FormatNumber(1e3 * top, 4) + " Hz)";
+  }
   // Each FRF on its own usable band (issue #34 item 5): a tap test's drift
   // lines below ~100 Hz reach 1e-3 m/N on a 1e-6 m/N tool tip.
   calibration::UsableBandPeak largest;

@@ -32,7 +32,8 @@ constexpr double kPi = 3.14159265358979323846;
 // (receptance of a single-DOF oscillator), 2 % relative noise, with the
 // coherence that noise gives for 5 averages: γ² = |H|²/(|H|² + 4 σ²),
 // σ = 0.02 |H| (formats.md §3; frf-synth --help states the same rule).
-std::string HammerCsv(const std::string& dir) {
+// `freq_scale` 1e-3 writes the frequencies in kHz under freq_hz (a user's mistake).
+std::string HammerCsv(const std::string& dir, double freq_scale = 1.0) {
   std::ostringstream s;
   s.precision(12);
   s << "# quantity: receptance\n# averages: 5\npose_id,response,excitation,freq_hz,re,im,coherence\n";
@@ -46,12 +47,12 @@ std::string HammerCsv(const std::string& dir) {
         const std::complex<double> h = 1.0 / (m * std::complex<double>(wn * wn - w * w, 2 * zeta * wn * w));
         const std::complex<double> noisy = h * (1.0 + 0.02 * std::complex<double>(n01(rng), n01(rng)) / std::sqrt(2.0));
         const double coh = std::norm(h) / (std::norm(h) + 4.0 * std::pow(0.02 * std::abs(h), 2));
-        s << pose << "," << d << "," << d << "," << f << "," << noisy.real() << "," << noisy.imag() << "," << coh
+        s << pose << "," << d << "," << d << "," << f * freq_scale << "," << noisy.real() << "," << noisy.imag() << "," << coh
           << "\n";
       }
     }
   }
-  return WriteText(dir + "/hammer.csv", s.str());
+  return WriteText(dir + (freq_scale == 1.0 ? "/hammer.csv" : "/hammer_scaled.csv"), s.str());
 }
 
 // The route on a hand-written CSV: four FRFs read with their file, the
@@ -90,6 +91,25 @@ TEST(MeasuredFrfs, HandWrittenCsvGivesItsFrfsNoiseAndUsableLines) {
   const MeasuredFrfs all = ReadMeasuredFrfs(o);
   EXPECT_TRUE(all.noise.empty());
   for (const auto& [key, frf] : all.FitData()) EXPECT_EQ(frf.size(), 800);
+}
+
+// Frequencies in kHz under freq_hz (lines to 0.8 "Hz"): named as such, and
+// the receptance is not judged on that axis; the same file in Hz is not.
+TEST(MeasuredFrfs, FrequenciesInKilohertzAreNamed) {
+  MeasuredFrfOptions o;
+  o.noise_model = NoiseModelChoice::kNone;
+  o.files = {HammerCsv(TempDir("workflows_khz"), 1e-3)};
+  std::vector<Message> said;
+  const MeasuredFrfs m = ReadMeasuredFrfs(o, [&](const Message& msg) { said.push_back(msg); });
+  ASSERT_EQ(m.unit_findings.size(), 1u);
+  EXPECT_THAT(m.unit_findings[0], HasSubstr("hammer_scaled.csv: the FRFs' highest line is at 0.8 Hz, below the 1 Hz "
+                                            "of any hammer test"));
+  EXPECT_THAT(m.unit_findings[0], HasSubstr("frequencies in kHz under the freq_hz header? (0.8 kHz is 800 Hz)"));
+  int warned = 0;
+  for (const Message& msg : said) warned += msg.kind == Message::Kind::kWarning;
+  EXPECT_EQ(warned, 1);
+  o.files = {HammerCsv(TempDir("workflows_khz"))};
+  EXPECT_TRUE(ReadMeasuredFrfs(o).unit_findings.empty());
 }
 
 // What the route refuses, and how: a missing file (io::MissingFileError:

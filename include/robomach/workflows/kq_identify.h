@@ -1,0 +1,115 @@
+#pragma once
+// kq-identify as a library call (issue #36 §1): a robot config and a
+// laser-tracker file -> the load cases -> the joint stiffness with its
+// uncertainty and the verdict (RunKqIdentify). The tool parses its options
+// into KqIdentifyOptions and writes what the call returns; the checks of
+// the input and their messages live here. --plan N is RunKqPlan.
+
+#include <memory>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "robomach/common/messages.h"
+#include "robomach/common/run_status.h"
+#include "robomach/dynamics/robot_model.h"
+#include "robomach/identification/joint_stiffness.h"
+#include "robomach/identification/test_plan.h"
+#include "robomach/io/robot_config.h"
+#include "robomach/io/tracker_file.h"
+
+namespace robomach::workflows {
+
+/// kq-identify's options when it identifies (the tool's option is the
+/// field's name with dashes and without _path: robot_path is --robot).
+struct KqIdentifyOptions {
+  std::string robot_path;    // robot config YAML; its stiffness is the prior
+  std::string tracker_path;  // tracker CSV (formats.md §2)
+  double noise_mm{0.01};     // tracker noise, 1 sigma per coordinate [mm]
+  std::string robust;        // "" (least squares), "cauchy" or "huber"
+  /// How messages name noise_mm (the tool: "--noise-mm").
+  std::string noise_mm_name{"noise_mm"};
+
+  /// @throws OptionError naming the field: noise_mm not finite > 0, robust
+  ///   not one of "", cauchy, huber, a path empty.
+  void Validate() const;
+};
+
+/// Everything kq-identify prints and writes.
+struct KqIdentifyResult {
+  io::RobotConfig config;  // as loaded (config.implausible: its unit findings)
+  std::shared_ptr<const dynamics::RobotModel> model;
+  io::TrackerFile tracker;  // (tracker.unknown_columns for --verbose)
+  std::vector<identification::LoadCase> cases;
+  /// The fit (its advice: the fit's own; a tool writing notes puts the
+  /// unit findings in front).
+  identification::JointStiffnessResult fit;
+  /// Unit findings of the tracker file and of noise_mm ("implausible (unit
+  /// mistake?): ..."), each also a warning message.
+  std::vector<std::string> unit_findings;
+
+  /// kq-identify's exit 3: the fit is flagged (identification's rule), or
+  /// the config, the file or the noise has a unit finding.
+  bool flagged() const { return fit.flagged() || !config.implausible.empty() || !unit_findings.empty(); }
+  RunStatus status() const { return flagged() ? RunStatus::kFlagged : RunStatus::kOk; }
+  /// kq-identify's --summary but for the keys only the tool knows (tool,
+  /// exit_code, warnings, robomach_version): io::KqSummaryJson of the fit
+  /// with the unit findings first in its advice, and `flagged`.
+  nlohmann::json Summary() const;
+};
+
+/// Loads the config and the tracker file, checks them (the config's and
+/// the file's units, the noise's, joints outside their limits, effects the
+/// load-test model does not have: each a kWarning message, in that order),
+/// and identifies the joint stiffness. `progress` is
+/// called with (cases done, cases). The fit's advice is not sent as
+/// messages (the caller prints the table first); it is in fit.advice.
+/// @throws OptionError (Validate), io::MissingFileError, InputError for the
+///   files.
+KqIdentifyResult RunKqIdentify(const KqIdentifyOptions& options, const MessageSink& on_message = {},
+                               const std::function<void(long, long)>& progress = {});
+
+/// The table kq-identify prints for a fit, one line each (no tool name):
+/// the fit's end, each joint's stiffness, standard deviation, 95 % interval
+/// and determination, the residuals against the noise.
+std::vector<std::string> KqReportLines(const identification::JointStiffnessResult& fit);
+
+/// kq-identify --plan N (noise and masses in the command line's units).
+struct KqPlanOptions {
+  std::string robot_path;
+  int num_postures{12};   // [1, 500]
+  double noise_mm{0.01};  // tracker noise, 1 sigma per coordinate [mm], > 0
+  unsigned seed{1};
+  std::optional<Eigen::Vector3d> load_point_m, target_m;  // in the tip frame [m]; none: the TCP
+  std::vector<double> masses_kg{10.0, 20.0, 30.0};          // each > 0
+  double max_rope_angle_deg{45.0};
+
+  /// @throws OptionError naming the field and its bound.
+  void Validate() const;
+};
+
+struct KqPlanResult {
+  io::RobotConfig config;  // as loaded (config.implausible: its unit findings)
+  std::shared_ptr<const dynamics::RobotModel> model;
+  identification::PlanOptions planner;  // in SI, as planned
+  identification::TestPlan plan;
+  /// What the tool prints after writing the plan: the plan's size and each
+  /// joint's expected standard deviation (no tool name).
+  std::vector<std::string> lines;
+  /// The plan's findings (a joint no plan can determine), then one per joint
+  /// it would leave weakly determined with what to change.
+  std::vector<std::string> warnings;
+  /// kq-identify --plan's exit 3: a joint not determinable, or the config's
+  /// unit findings.
+  bool flagged() const { return plan.flagged() || !config.implausible.empty(); }
+};
+
+/// Loads the config (its unit findings are kWarning messages) and plans the
+/// test (identification::PlanLoadTests); `warnings` are returned, not sent.
+KqPlanResult RunKqPlan(const KqPlanOptions& options, const MessageSink& on_message = {});
+
+}  // namespace robomach::workflows
