@@ -192,7 +192,21 @@ int RunDrillSim(int argc, char** argv) {
       progress->Update(p.done);
     });
 
-    // All runs done: write every output (each atomically).
+    // All runs done: the result lines and the verdict (diverged runs, unit
+    // plausibility: drilling/plausibility.h) first, so that every summary
+    // lists its warnings; then every output (each atomically; exit 3 keeps them).
+    for (const Run& run : runs) {
+      const drilling::SimResult& r = run.result;
+      const bool stopped = r.diverged;  // the last 10 % was never simulated
+      std::ostringstream line;
+      line << run.parameters.kind << ": settling "
+           << (std::isnan(r.settling_time) ? std::string("never") : FormatNumber(r.settling_time) + " s")
+           << ", max |e| " << FormatNumber(RadToDeg(r.max_abs_error.maxCoeff())) << " deg, last 10 % max |e| "
+           << (stopped ? std::string("n/a (run stopped)") : FormatNumber(RadToDeg(r.max_abs_error_last_10pc.maxCoeff())) + " deg");
+      std::cerr << kTool << ": " << line.str() << "\n";
+    }
+    const RunFindings verdict = drilling::JudgeControllerRuns(runs, setup.unit_findings);
+    for (const Finding& f : verdict.findings) Warn(kTool, f.message);
     for (const Run& run : runs) {
       const std::string kind = run.parameters.kind;
       const nlohmann::json j = io::DrillRunSummaryJson(run, *sc, limit);
@@ -204,19 +218,6 @@ int RunDrillSim(int argc, char** argv) {
       }
     }
     if (!plot_path.empty()) Plot(plot_path, runs, n);
-    for (const Run& run : runs) {
-      const drilling::SimResult& r = run.result;
-      std::ostringstream line;
-      line << run.parameters.kind << ": settling "
-           << (std::isnan(r.settling_time) ? std::string("never") : FormatNumber(r.settling_time) + " s")
-           << ", max |e| " << FormatNumber(RadToDeg(r.max_abs_error.maxCoeff()))
-           << " deg, last 10 % max |e| " << FormatNumber(RadToDeg(r.max_abs_error_last_10pc.maxCoeff()))
-           << " deg";
-      std::cerr << kTool << ": " << line.str() << "\n";
-    }
-    // Diverged runs and unit plausibility (drilling/plausibility.h): outputs stay written, exit 3.
-    const RunFindings verdict = drilling::JudgeControllerRuns(runs, setup.unit_findings);
-    for (const Finding& f : verdict.findings) Warn(kTool, f.message);
     return ExitCodeFor(verdict.status());
   });
 }

@@ -136,7 +136,7 @@ int Run(int argc, char** argv) {
         std::string why = fmax_hz > dynamics::kMaxPlausibleFmaxHz
                               ? "; --fmax-hz " + FormatNumber(fmax_hz, 7) + " Hz is beyond the " +
                                     FormatNumber(dynamics::kMaxPlausibleFmaxHz, 7) +
-                                    " Hz of hammer tests (a frequency in kHz typed in the Hz option?)"
+                                    " Hz of hammer tests (a frequency in mHz, or a line count, typed in the Hz option?)"
                               : "";
         throw UsageError("--fmin-hz " + FormatNumber(fmin_hz, 7) + " to --fmax-hz " + FormatNumber(fmax_hz, 7) +
                          " in steps of --df-hz " + FormatNumber(df_hz, 7) + " is " + FormatNumber(lines, 7) +

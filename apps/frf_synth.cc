@@ -211,6 +211,9 @@ int Run(int argc, char** argv) {
       postures.push_back({p.id, p.q});
     }
     for (const std::string& w : posture_units) Warn(kTool, w);
+    // Before the summary is made: its `warnings` lists every one printed.
+    for (const std::string& w : implausible) Warn(kTool, w);
+    const int exit_code = implausible.empty() && posture_units.empty() && cfg.implausible.empty() ? kExitOk : kExitFlagged;
     const dynamics::FrfSet frfs = calibration::SynthesizeHammerTest(model, postures, o);
     const io::FrfQuantity q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
     if (uff && out_path != "-") {
@@ -261,14 +264,15 @@ int Run(int argc, char** argv) {
                         {"peak_receptance_m_per_N", peak}});
       }
       j["frfs"] = list;
+      j["flagged"] = exit_code == kExitFlagged;
+      j["exit_code"] = exit_code;
       io::WriteFileAtomically(summary_path, SummaryText(j));
     }
     std::ostringstream msg;
     msg << kTool << ": wrote " << frfs.size() << " FRFs of " << calibration::HammerTestGrid(o).size()
         << " lines to " << out_path << '\n';
     std::cerr << msg.str();
-    for (const std::string& w : implausible) Warn(kTool, w);
-    return implausible.empty() && posture_units.empty() && cfg.implausible.empty() ? kExitOk : kExitFlagged;
+    return exit_code;
   });
 }
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "robomach/common/number_format.h"
-#include "robomach/dynamics/frf_prediction.h"
+#include "robomach/dynamics/measured_frf.h"
 #include "robomach/io/file_kind.h"
 #include "robomach/io/uff58.h"
 #include "frf_text.h"
@@ -34,11 +34,11 @@ std::vector<std::string> FrequencyUnitFindings(const FrfReadResult& read, const 
   for (const auto& [key, frf] : read.frfs) {
     if (frf.size() > 0) top = std::max(top, frf.freq_hz().maxCoeff());
   }
-  if (read.frfs.empty() || !(top > 0.0) || top >= dynamics::kMinPlausibleFmaxHz) return {};
+  if (read.frfs.empty() || !(top > 0.0) || top >= dynamics::kMinPlausibleMeasuredTopHz) return {};
   const bool uff = read.file_format == dynamics::FrfFileFormat::kUff58;
   return {path + ": the FRFs' highest line is at " + robomach::FormatNumber(top, 4) + " Hz, below the " +
-          robomach::FormatNumber(dynamics::kMinPlausibleFmaxHz, 4) +
-          " Hz of any hammer test (lines to 0.1 - 10 kHz; robot modes 5 - 2000 Hz): frequencies in kHz " +
+          robomach::FormatNumber(dynamics::kMinPlausibleMeasuredTopHz, 4) +
+          " Hz a hammer test of a tool tip reaches (lines to 0.1 - 10 kHz; robot modes 5 - 2000 Hz): frequencies in kHz " +
           (uff ? std::string("in the abscissa (UFF58 record 7's start and increment, record 8's unit)")
                : std::string("under the freq_hz header")) +
           "? (" + robomach::FormatNumber(top, 4) + " kHz is " + robomach::FormatNumber(1e3 * top, 4) + " Hz)"};

@@ -48,6 +48,27 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
            FormatDouble(1e3 * process.max_speed));
   }
   s.stats = polishing::ComputeRemovalStats(s.removal, s.grid->areas(), s.grid->in_region());
+  // A path that cannot be this surface's (issue #35: a path in metres under
+  // the _mm headers polished nothing, exit 0): its extent against the
+  // region's, and a region left untouched.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo, glo = lo, ghi = -lo;
+  for (const auto& row : s.file.rows) {
+    lo = lo.cwiseMin(row.p);
+    hi = hi.cwiseMax(row.p);
+  }
+  for (const Eigen::Vector3d& p : s.grid->points()) {
+    glo = glo.cwiseMin(p);
+    ghi = ghi.cwiseMax(p);
+  }
+  const double path_span = s.file.rows.empty() ? 0.0 : (hi - lo).norm(), region_span = (ghi - glo).norm();
+  if (region_span > 0.0 && path_span < 0.01 * region_span) {
+    s.Flag("implausible (unit mistake?): " + s.file.path + ": the path spans " + FormatNumber(1e3 * path_span, 3) +
+           " mm, under 1 % of the " + FormatNumber(1e3 * region_span, 4) + " mm across the surface " + surface_source +
+           ": positions in m under the _mm headers (or a path for another part)?");
+  } else if (!(s.stats.coverage > 0.0)) {
+    s.Flag(s.file.path + ": the path polishes none of the region of " + surface_source +
+           " (coverage 0): a path for another part, or in another frame?");
+  }
   return s;
 }
 

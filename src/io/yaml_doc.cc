@@ -141,9 +141,52 @@ YamlDoc YamlDoc::operator[](const std::string& key) const {
       }
     }
     throw InputError(location(), "missing key '" + key + "'" +
-                                     (key_path_.empty() ? "" : " in '" + key_path_ + "'"));
+                                     (key_path_.empty() ? "" : " in '" + key_path_ + "'") +
+                                     (key_path_.empty() ? OtherYamlKind(key) : ""));
   }
   return YamlDoc(child, path_, key_path_.empty() ? key : key_path_ + "." + key);
+}
+
+std::string YamlDoc::OtherYamlKind(const std::string& missing) const {
+  // robomach's YAML files by the top-level keys only each has (the shipped
+  // examples in config/): a missing key at the top that the file's own kind
+  // does not have is the file given to another option (drill-sim --robot
+  // config/kr210.yaml: "missing key 'flexible_joints'").
+  if (!node_.IsMap()) return "";
+  const auto has = [&](const char* k) { return static_cast<bool>(node_[k]); };
+  struct Kind {
+    bool match;
+    const char* what;
+    std::vector<std::string> keys;  // the kind's own top-level keys
+  };
+  const Kind kinds[] = {
+      {has("flexible_joints"), "a flexible-joint robot for drill-sim --robot (config/drilling/planar3r.yaml)",
+       {"robot", "flexible_joints", "dh"}},
+      {has("joint_stiffness_Nm_per_rad") || has("end_effector"), "a robot config (config/kr210.yaml)",
+       {"robot", "joint_stiffness_Nm_per_rad", "damping", "end_effector", "spindle_toolholder_interface",
+        "hammer_test", "parameters", "effects", "urdf", "dh"}},
+      {has("drill") && has("process"), "a drill file for drill-sim --drill (config/drilling/drill_5mm.yaml)",
+       {"drill", "process", "offset", "simulation"}},
+      {has("material"), "a material file (config/drilling/q235.yaml)", {"material", "std_dev", "fit", "table"}},
+      {has("axes") && has("kinematics"), "a machine file (config/machine/dmu80p.yaml)",
+       {"axes", "kinematics", "controller_axes", "errors"}},
+      {has("cutting_coefficients"), "a cut file for stability-lobes and stability-map --cut (config/cut_demo.yaml)",
+       {"diameter_mm", "teeth", "radial_immersion", "milling", "feed_direction", "feed_per_tooth_mm",
+        "cutting_coefficients", "spindle_speed_min_rpm", "spindle_speed_max_rpm", "spindle_speed_count",
+        "spindle_speed_rpm"}},
+      {has("origin_mm") && has("grid_step_mm"), "a region file for stability-map --region (config/region_demo.yaml)",
+       {"origin_mm", "u_axis", "v_axis", "size_mm", "grid_step_mm", "tool_axis", "rotation_about_tool_axis",
+        "seed_posture_deg"}},
+      {has("nurbs"), "a NURBS surface for polish-plan --surface (config/polishing/dome.yaml)", {"nurbs"}},
+      {has("tool") && has("workpiece"), "a polishing process for --process (config/polishing/belt_2N.yaml)",
+       {"tool", "workpiece", "process", "robot"}},
+  };
+  for (const Kind& k : kinds) {
+    if (!k.match) continue;
+    if (std::find(k.keys.begin(), k.keys.end(), missing) != k.keys.end()) return "";  // its own kind, incomplete
+    return "; the file's keys are those of " + std::string(k.what) + ": the file for another option?";
+  }
+  return "";
 }
 
 std::vector<std::string> YamlDoc::Keys() const {

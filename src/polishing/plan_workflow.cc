@@ -63,9 +63,9 @@ PlanningContext PreparePlanning(const NurbsSurface& surface, const PolishingProc
     // file's numbers are the cause, not the surface (issue #35).
     throw InputError({process_source, 0, 0},
                      "process.force_N " + FormatNumber(process.force, 6) + " N on a pad of pad_modulus_MPa " +
-                         FormatNumber(1e-6 * process.pad_modulus, 6) + " makes a " + e.what() +
-                         " at the centre of the region of " + surface_source +
-                         ": a force too large for this belt (kN or mN typed in the N field? belts press 1 - 200 N), "
+                         FormatNumber(1e-6 * process.pad_modulus, 6) +
+                         " presses a contact wider than the belt at the centre of the region of " + surface_source +
+                         " (" + e.what() + "): a force too large for this belt (kN or mN typed in the N field? belts press 1 - 200 N), "
                          "a pad modulus too small (kPa typed for MPa?), or the belt's width mistyped");
   }
   const double cell = 0.5 * c.contact_width;  // index cell ~ the contact semi-axis

@@ -170,12 +170,12 @@ std::pair<double, double> CommonUsableBand(const std::vector<DirectionFit>& fits
 std::string TipFrfsUnitFinding(const TipFrfs& s) {
   // A frequency axis in kHz first: the receptance's band means nothing then
   // (io::FrequencyUnitFindings, the other readers' rule).
-  if (s.freq_hz.size() > 0 && s.freq_hz.maxCoeff() > 0.0 && s.freq_hz.maxCoeff() < dynamics::kMinPlausibleFmaxHz) {
+  if (s.freq_hz.size() > 0 && s.freq_hz.maxCoeff() > 0.0 && s.freq_hz.maxCoeff() < dynamics::kMinPlausibleMeasuredTopHz) {
     const double top = s.freq_hz.maxCoeff();
     return s.source + (s.pose_id.empty() ? std::string() : ": posture " + s.pose_id) +
            ": the FRFs' highest line is at " + FormatNumber(top, 4) + " Hz, below the " +
-           FormatNumber(dynamics::kMinPlausibleFmaxHz, 4) +
-           " Hz of any hammer test (lines to 0.1 - 10 kHz; robot modes 5 - 2000 Hz): frequencies in kHz? (" +
+           FormatNumber(dynamics::kMinPlausibleMeasuredTopHz, 4) +
+           " Hz a hammer test of a tool tip reaches (lines to 0.1 - 10 kHz; robot modes 5 - 2000 Hz): frequencies in kHz? (" +
            FormatNumber(top, 4) + " kHz is " + FormatNumber(1e3 * top, 4) + " Hz)";
   }
   // Each FRF on its own usable band (issue #34 item 5): a tap test's drift

@@ -1,4 +1,5 @@
 #include "robomach/stability/tip_dynamics.h"
+#include "robomach/common/number_format.h"
 
 #include <algorithm>
 #include <cmath>
@@ -158,6 +159,21 @@ TEST(TipsFromMeasuredFrfs, ReceptanceOutsideThePlausibleRangeIsAFinding) {
   const std::vector<std::string> w = TipFitWarnings(tips[0], false);
   ASSERT_FALSE(w.empty());
   EXPECT_THAT(w[0], HasSubstr("implausible (unit mistake?): tap.csv: posture P1"));
+}
+
+// The tap test (lines to about 4 kHz) with its frequencies in kHz: the
+// axis is named as such, not the receptance (whose band means nothing
+// then); in Hz it passes.
+TEST(TipsFromMeasuredFrfs, FrequenciesInKilohertzAreNamed) {
+  const testing::TapTest t = testing::MakeTapTest(testing::TapTestOptions{});
+  TipFrfs s = TapTestFrfs(t, 2);
+  EXPECT_EQ(TipFrfsUnitFinding(s), "");
+  const double top = s.freq_hz.maxCoeff();
+  s.freq_hz *= 1e-3;
+  const std::string f = TipFrfsUnitFinding(s);
+  EXPECT_THAT(f, HasSubstr("tap.csv: posture P1: the FRFs' highest line is at " + FormatNumber(top * 1e-3, 4) +
+                           " Hz, below the 25 Hz a hammer test of a tool tip reaches"));
+  EXPECT_THAT(f, HasSubstr("frequencies in kHz?"));
 }
 
 // Issue #34 item 5, a tap test as it really comes: three modes near

@@ -122,6 +122,11 @@ class FrfSet {
 // "Chatter stability in robotic milling", Robot. CIM 55 (2019) 11-18),
 // machine-tool tips 1e-8..1e-6 m/N (Altintas, Manufacturing Automation,
 // 2nd ed. (2012), Ch. 3 examples).
+/// The highest line of a measured tool-tip FRF [Hz]: a hammer test of a
+/// robot's tool reaches 100 Hz and more (its modes are 5 - 2000 Hz; tests
+/// run to 0.1 - 10 kHz). Below, the frequencies are in kHz: a test to 1 kHz
+/// saved in kHz ends at 1 "Hz", one to 20 kHz at 20.
+inline constexpr double kMinPlausibleMeasuredTopHz = 25.0;
 inline constexpr double kMaxPlausibleReceptance = 1e-3;
 inline constexpr double kMinPlausibleReceptance = 1e-12;
 

@@ -29,8 +29,8 @@ FrfReadResult ReadFrfFile(const std::string& path, const std::string& default_po
                           bool keep_points = false);
 
 /// The frequency axis judged (docs/plausibility.md): the highest line of
-/// all FRFs of a file below 1 Hz (kMinPlausibleFmaxHz) is a frequency axis
-/// in kHz (a hammer test's lines reach 0.1 - 10 kHz; the robot's modes
+/// all FRFs of a file below 25 Hz (dynamics::kMinPlausibleMeasuredTopHz) is
+/// a frequency axis in kHz (a hammer test's lines reach 0.1 - 10 kHz; the robot's modes
 /// are 5 - 2000 Hz). One finding, "path: ...", without the "implausible
 /// (unit mistake?): " prefix, naming where the file keeps its frequencies;
 /// empty when plausible.

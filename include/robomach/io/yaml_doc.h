@@ -36,6 +36,11 @@ class YamlDoc {
   /// @throws InputError "file:line:col: missing key 'x' in 'parent'".
   YamlDoc operator[](const std::string& key) const;
   /// Keys of a map in file order.
+  /// "; the file's keys are those of a robot config (...): the file for
+  /// another option?" when this map's keys are those of one of robomach's
+  /// YAML files and `missing` is not a key of that kind; "" otherwise.
+  /// Added to a missing top-level key.
+  std::string OtherYamlKind(const std::string& missing) const;
   std::vector<std::string> Keys() const;
   int size() const;               // sequence length
   YamlDoc at(int index) const;    // sequence element
