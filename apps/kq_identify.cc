@@ -89,6 +89,8 @@ int Run(int argc, char** argv) {
   if (app.count("--robust") > 0 && robust.empty()) robust = "cauchy";
 
   return RunGuarded(kTool, [&]() -> int {
+    // Before any file is looked at (the options first: exit 64).
+    if (!(noise_mm > 0.0) || !std::isfinite(noise_mm)) throw UsageError("--noise-mm: expected a finite noise > 0 mm");
     CheckOptionRange("--plan", plan_n, 0, 500);  // 500 postures: ~15 s of planning
     // The two modes' options are not mixed silently (issue #35: --plan with
     // --tracker planned and ignored the file).
@@ -122,6 +124,8 @@ int Run(int argc, char** argv) {
       po.target_m = ParsePointMm("--target-mm", target);
       po.masses_kg = ParsePositiveList("--masses-kg", masses);
       po.max_rope_angle_deg = rope_angle_deg;
+      po.num_postures_name = "--plan N";
+      po.points_name = "--load-point-mm, --target-mm";
       ValidateOptions({{"num_postures", "--plan"}, {"noise_mm", "--noise-mm"}, {"masses_kg", "--masses-kg"}},
                       [&] { po.Validate(); });
       const workflows::KqPlanResult plan = workflows::RunKqPlan(po, MessagePrinter(kTool));

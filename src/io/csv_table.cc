@@ -14,7 +14,6 @@ namespace robomach::io {
 namespace {
 
 // Splits one CSV line (RFC 4180 quoting, no embedded newlines).
-// `starts` receives the 0-based offset in `line` where each cell begins.
 std::vector<std::string> SplitLine(std::string_view line, const std::string& path, int line_no) {
   std::vector<std::string> cells;
   std::string cur;
@@ -203,7 +202,7 @@ std::string CsvTable::LooksLike(std::string_view own) const {
     kind = "a measured or predicted FRF (docs/formats.md §3; freq_hz, re, im)", tag = "frf";
   } else if (has({"freq_hz", "damping_ratio"})) {
     kind = "a modal table (docs/formats.md §4; freq_hz, damping_ratio)", tag = "modal";
-  } else if (has({"case_id", "x0_mm"})) {
+  } else if (has({"case_id"})) {
     kind = "a laser-tracker load test (docs/formats.md §2; case_id, x0_mm..)", tag = "tracker";
   } else if (has({"pose_id", "q1_deg"}) || has({"pose_id", "q1_rad"})) {
     kind = "a posture file (docs/formats.md §1; pose_id, q1_deg..)", tag = "posture";
@@ -239,6 +238,20 @@ std::string CsvTable::CloseColumn(std::string_view name, const std::vector<std::
     return out;
   };
   const std::string a = lower(name), b = lower(close);
+  // Siblings of a family are not typos of each other: x0_mm and y0_mm,
+  // fx_N and fy_N, tool_i and tool_j, q1_deg and q2_deg (one character
+  // apart, both a coordinate or an index).
+  if (a.size() == b.size()) {
+    size_t diff = 0, at = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+      if (a[i] != b[i]) {
+        ++diff;
+        at = i;
+      }
+    }
+    const std::string family = "xyzijk0123456789";
+    if (diff == 1 && family.find(a[at]) != std::string::npos && family.find(b[at]) != std::string::npos) return "";
+  }
   const auto stem = [](const std::string& v) { return v.substr(0, v.rfind('_')); };
   const bool same_stem = stem(a) == b || stem(b) == a || (stem(a) == stem(b) && stem(a) != a);
   if (!same_stem && EditDistance(a, b) > std::max<size_t>(1, a.size() / 4)) return "";

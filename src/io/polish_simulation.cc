@@ -56,15 +56,19 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
     lo = lo.cwiseMin(row.p);
     hi = hi.cwiseMax(row.p);
   }
-  for (const Eigen::Vector3d& p : s.grid->points()) {
-    glo = glo.cwiseMin(p);
-    ghi = ghi.cwiseMax(p);
+  const std::vector<Eigen::Vector3d>& pts = s.grid->points();
+  const auto& in_region = s.grid->in_region();
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (!in_region.empty() && !in_region[i]) continue;
+    glo = glo.cwiseMin(pts[i]);
+    ghi = ghi.cwiseMax(pts[i]);
   }
   const double path_span = s.file.rows.empty() ? 0.0 : (hi - lo).norm(), region_span = (ghi - glo).norm();
-  if (region_span > 0.0 && path_span < 0.01 * region_span) {
+  if (s.file.rows.size() >= 2 && region_span > 0.0 && path_span < 0.01 * region_span) {
     s.Flag("implausible (unit mistake?): " + s.file.path + ": the path spans " + FormatNumber(1e3 * path_span, 3) +
            " mm, under 1 % of the " + FormatNumber(1e3 * region_span, 4) + " mm across the surface " + surface_source +
-           ": positions in m under the _mm headers (or a path for another part)?");
+           ": positions in m under the _mm headers (or a path for another part)? (A spot or dwell test this "
+           "small is flagged too.)");
   } else if (!(s.stats.coverage > 0.0)) {
     s.Flag(s.file.path + ": the path polishes none of the region of " + surface_source +
            " (coverage 0): a path for another part, or in another frame?");

@@ -296,15 +296,20 @@ void CheckJointFrequencies(RobotConfig& cfg, const YamlDoc& doc, const YamlDoc& 
     // The largest weight each joint holds: each joint swept through its
     // range (9 angles, the others at q), so that the arm is near horizontal
     // once (RNE, microseconds each).
-    gravity_torque = dynamics::GravityTorque(*model, q).cwiseAbs();
-    for (int i = 0; i < n; ++i) {
-      const auto& lim = arm.limits()[i];
-      const double lo = lim.bounded ? lim.lower : -kPi, hi = lim.bounded ? lim.upper : kPi;
-      for (int s = 0; s <= 8; ++s) {
-        Eigen::VectorXd qs = q;
-        qs(i) = lo + (hi - lo) * s / 8.0;
-        gravity_torque = gravity_torque.cwiseMax(dynamics::GravityTorque(*model, qs).cwiseAbs());
+    // (Its own try: a failure leaves the sag unjudged, not the frequencies.)
+    try {
+      gravity_torque = dynamics::GravityTorque(*model, q).cwiseAbs();
+      for (int i = 0; i < n; ++i) {
+        const auto& lim = arm.limits()[i];
+        const double lo = lim.bounded ? lim.lower : -kPi, hi = lim.bounded ? lim.upper : kPi;
+        for (int s = 0; s <= 8; ++s) {
+          Eigen::VectorXd qs = q;
+          qs(i) = lo + (hi - lo) * s / 8.0;
+          gravity_torque = gravity_torque.cwiseMax(dynamics::GravityTorque(*model, qs).cwiseAbs());
+        }
       }
+    } catch (const std::exception&) {
+      gravity_torque = Eigen::VectorXd::Zero(n);
     }
     for (int j = 0; j < n; ++j) k(j) = model->joint_stiffness()(j);
     alpha = model->alpha();

@@ -1,5 +1,6 @@
 #include "robomach/workflows/frf_estimate.h"
 
+#include <cctype>
 #include <sstream>
 
 #include "robomach/common/frames.h"
@@ -14,7 +15,8 @@ void Tell(const MessageSink& sink, Message::Kind kind, const std::string& text) 
   if (sink) sink({kind, text});
 }
 
-Axis ParseExcitation(const std::string& text) {
+Axis ParseExcitation(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));  // "X" as Python took it
   if (text == "x") return Axis::kX;
   if (text == "y") return Axis::kY;
   if (text == "z") return Axis::kZ;

@@ -32,8 +32,8 @@ void KqIdentifyOptions::Validate() const {
   if (!(noise_mm > 0.0) || !std::isfinite(noise_mm)) {
     throw OptionError("noise_mm", "noise_mm: expected a finite noise > 0 mm, got " + FormatNumber(noise_mm, 6));
   }
-  if (!robust.empty() && robust != "cauchy" && robust != "huber") {
-    throw OptionError("robust", "robust: expected cauchy or huber (or nothing for least squares), got " + robust);
+  if (!robust.empty() && robust != "none" && robust != "cauchy" && robust != "huber") {
+    throw OptionError("robust", "robust: expected cauchy or huber (or none for least squares), got " + robust);
   }
 }
 
@@ -166,13 +166,13 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
     r.lines.push_back(row.str());
   }
   for (const Finding& f : r.plan.findings) {
-    r.warnings.push_back(f.message + (f.input_index == n - 1 ? " (the load point and the target)" : ""));
+    r.warnings.push_back(f.message + (f.input_index == n - 1 ? " (" + o.points_name + ")" : ""));
   }
   for (int j = 0; j < n; ++j) {
     if (r.plan.expected_determination[j] != identification::Determination::kWeak) continue;
     std::ostringstream m;
     m << "joint " << j + 1 << " would be weakly determined (±" << std::fixed << std::setprecision(0)
-      << 100 * r.plan.expected_relative_std(j) << " % at 1 sigma): plan more postures"
+      << 100 * r.plan.expected_relative_std(j) << " % at 1 sigma): plan more postures (" << o.num_postures_name << ")"
       << (j == n - 1 ? " or put the load point and the target farther off the tool axis" : "");
     r.warnings.push_back(m.str());
   }

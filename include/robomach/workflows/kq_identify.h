@@ -30,7 +30,7 @@ struct KqIdentifyOptions {
   std::string robot_path;    // robot config YAML; its stiffness is the prior
   std::string tracker_path;  // tracker CSV (formats.md §2)
   double noise_mm{0.01};     // tracker noise, 1 sigma per coordinate [mm]
-  std::string robust;        // "" (least squares), "cauchy" or "huber"
+  std::string robust;        // "" or "none" (least squares), "cauchy" or "huber"
   /// How messages name noise_mm (the tool: "--noise-mm").
   std::string noise_mm_name{"noise_mm"};
 
@@ -62,9 +62,10 @@ struct KqIdentifyResult {
   nlohmann::json Summary() const;
 };
 
-/// Loads the config and the tracker file, checks them (the config's and
-/// the file's units, the noise's, joints outside their limits, effects the
-/// load-test model does not have: each a kWarning message, in that order),
+/// Loads the config and the tracker file, checks them (the config's units,
+/// effects the load-test model does not have, the file's and the noise's
+/// units, joints outside their limits: each a kWarning message, in that
+/// order),
 /// and identifies the joint stiffness. `progress` is
 /// called with (cases done, cases). The fit's advice is not sent as
 /// messages (the caller prints the table first); it is in fit.advice.
@@ -87,6 +88,10 @@ struct KqPlanOptions {
   std::optional<Eigen::Vector3d> load_point_m, target_m;  // in the tip frame [m]; none: the TCP
   std::vector<double> masses_kg{10.0, 20.0, 30.0};          // each > 0
   double max_rope_angle_deg{45.0};
+  /// How the warnings name the options to change (the tool: "--plan N" and
+  /// "--load-point-mm, --target-mm").
+  std::string num_postures_name{"num_postures"};
+  std::string points_name{"load_point_m, target_m"};
 
   /// @throws OptionError naming the field and its bound.
   void Validate() const;
