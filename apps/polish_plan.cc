@@ -212,7 +212,7 @@ int Run(int argc, char** argv) {
 
     if (list_faces) return ListFaces(surface_path, process_path, list_out, choice, pattern, radius_mm, sample_mm, offset_mm,
                                      pitch_mm, row_step_mm);
-    if (!list_out.empty()) throw UsageError("--out goes with --list-faces");
+    if (!list_out.empty()) throw UsageError("--out goes with --list-faces (the face list); the planned path is written with --path, the removal with --removal");
     std::vector<std::string> implausible;  // unit findings of the process file
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path, &implausible);
     // The one angle option: radians typed under _deg (1.5708 for 90 deg).
