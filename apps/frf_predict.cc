@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "cli_support.h"
@@ -19,6 +20,7 @@
 #include "robomach/io/posture_file.h"
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/io/uncertainty_file.h"
 #include "robomach/report/frf_plot.h"
 #include "robomach/report/json.h"
 
@@ -82,7 +84,9 @@ int Run(int argc, char** argv) {
   std::string robot_path, postures_path, out_path, modes_path, plot_path, plot_dir, details_path,
       freq_file, directions = "all", method = "modal";
   double fmin_hz = 0.625, fmax_hz = 500.0, df_hz = 0.625;
-  std::vector<std::string> sets, adds;
+  std::vector<std::string> sets, adds, uncertainty_paths;
+  dynamics::PropagationOptions uo;
+  std::string uncertainty_method = "auto";
   bool verbose = false;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
@@ -103,6 +107,18 @@ int Run(int argc, char** argv) {
       ->check(OneOf({"modal", "direct"}))->capture_default_str();
   app.add_option("--set", sets, "override a model parameter, NAME=VALUE in its unit (e.g. m6_kg=30.2)");
   app.add_option("--add", adds, "switch on an effect by name with its default parameters (e.g. tip_mass)");
+  app.add_option("--uncertainty", uncertainty_paths,
+                 "parameter-uncertainty YAML (docs/formats.md §12, from kq-identify --uncertainty-out); repeatable, "
+                 "files from different campaigns are taken as independent. Its estimates replace the config's "
+                 "values; --modes and --summary gain each mode's interval");
+  app.add_option("--confidence", uo.confidence, "two-sided confidence level of the intervals, in (0, 1)")
+      ->capture_default_str();
+  app.add_option("--uncertainty-method", uncertainty_method,
+                 "auto (first order, Monte Carlo where the outputs bend within the interval), first-order or "
+                 "monte-carlo")
+      ->check(OneOf({"auto", "first-order", "monte-carlo"}))->capture_default_str();
+  app.add_option("--samples", uo.samples, "Monte Carlo samples per posture")->capture_default_str();
+  app.add_option("--seed", uo.seed, "Monte Carlo seed")->capture_default_str();
   app.add_flag("--verbose", verbose, "list model parameters and ignored input columns on stderr");
   try {
     app.parse(argc, argv);
@@ -159,8 +175,34 @@ int Run(int argc, char** argv) {
         Warn(kTool, freq_file.empty() ? m : m + " (the highest line of " + freq_file + ")");
       }
     }
+    uo.method = dynamics::ParsePropagationMethod(uncertainty_method);
+    if (!uncertainty_paths.empty()) {
+      ValidateOptions({{"confidence", "--confidence"}, {"samples", "--samples"}}, [&] { dynamics::CheckValid(uo); });
+      if (modes_path.empty() && details_path.empty()) {
+        throw UsageError("--uncertainty gives the modes' intervals in --modes and --summary: give one of them");
+      }
+      for (const std::string& p : uncertainty_paths) {
+        RequireInputFile("--uncertainty", p, "parameter-uncertainty file", {io::FileKind::kYaml},
+                         io::kUncertaintyFileFormat);
+      }
+    }
     io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     ApplyAddsAndSets(adds, sets, &cfg);
+    std::optional<dynamics::ParameterUncertainty> uncertainty;
+    if (!uncertainty_paths.empty()) {
+      uncertainty = io::ReadParameterUncertainties(uncertainty_paths);
+      for (const std::string& set : sets) {
+        const std::string name = set.substr(0, set.find('='));
+        for (const auto& up : uncertainty->parameters) {
+          if (up.name == name) {
+            throw UsageError("--set " + name + " and --uncertainty (" + uncertainty->source + ") both give " + name +
+                             ": the file's estimate goes with its covariance; drop one of the two");
+          }
+        }
+      }
+      const std::string changed = dynamics::UseEstimates(*uncertainty, &cfg.parameters);
+      if (!changed.empty()) Note(kTool, "--uncertainty: its estimates replace the config's values: " + changed);
+    }
     if (verbose) {
       for (const auto& s : cfg.parameters.specs()) {
         std::cerr << kTool << ": parameter " << s.name << " = " << cfg.parameters.Get(s.name) << " "
@@ -218,7 +260,19 @@ int Run(int argc, char** argv) {
       ids.push_back(postures[p].id);
       modes.push_back(dyns[p].modes);
     }
-    if (!modes_path.empty()) io::WriteModalTableCsv(modes_path, ids, modes);
+    std::vector<dynamics::PostureModeIntervals> intervals;
+    if (uncertainty) {
+      ProgressLine up(kTool, "postures' intervals", static_cast<long>(postures.size()));
+      for (size_t p = 0; p < postures.size(); ++p) {
+        intervals.push_back(dynamics::ModalIntervals(cfg.description, cfg.parameters, postures[p].q, *uncertainty, uo));
+        up.Update(static_cast<long>(p + 1));
+      }
+      up.Finish();
+      for (size_t p = 0; p < postures.size(); ++p) {
+        std::cerr << kTool << ": " << dynamics::IntervalLine(ids[p], intervals[p], uo.confidence) << '\n';
+      }
+    }
+    if (!modes_path.empty()) io::WriteModalTableCsv(modes_path, ids, modes, uncertainty ? &intervals : nullptr);
     if (!details_path.empty()) {
       nlohmann::json j;
       j["robot"] = robot_path;
@@ -226,7 +280,16 @@ int Run(int argc, char** argv) {
       for (const auto& s : model->parameters().specs()) params[s.name] = model->parameters().Get(s.name);
       j["parameters"] = params;
       j["postures"] = nlohmann::json::array();
-      for (size_t p = 0; p < postures.size(); ++p) j["postures"].push_back(io::PostureToJson(ids[p], dyns[p]));
+      for (size_t p = 0; p < postures.size(); ++p) {
+        j["postures"].push_back(io::PostureToJson(ids[p], dyns[p]));
+        if (uncertainty) j["postures"].back()["mode_intervals"] = io::ModeIntervalsToJson(intervals[p]);
+      }
+      if (uncertainty) {
+        j["uncertainty"] = {{"files", uncertainty_paths},
+                            {"confidence", uo.confidence},
+                            {"method", uncertainty_method},
+                            {"parameters", io::ParameterUncertaintyToJson(*uncertainty)}};
+      }
       io::WriteFileAtomically(details_path, SummaryText(j));
     }
     std::string title = "robomach frf-predict: " + robot_path;

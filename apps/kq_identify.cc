@@ -15,6 +15,7 @@
 #include "robomach/io/kq_files.h"
 #include "robomach/io/kq_yaml.h"
 #include "robomach/io/number_format.h"
+#include "robomach/io/uncertainty_file.h"
 #include "robomach/workflows/kq_identify.h"
 #include "robomach/report/residual_plot.h"
 #include "robomach/report/json.h"
@@ -46,7 +47,7 @@ int Run(int argc, char** argv) {
   app.footer(ExitCodeHelp() +
              "\nExit code 3 also means: a joint is weakly or not determined, the fit did not converge,\n"
              "or outliers were found without --robust (the outputs are written).");
-  std::string robot_path, tracker_path, out_path, residuals_path, plot_path, json_path, robust,
+  std::string robot_path, tracker_path, out_path, residuals_path, plot_path, json_path, uncertainty_path, robust,
       load_point = "tcp", target = "tcp", masses = "10,20,30";
   double noise_mm = 0.01, rope_angle_deg = 45.0;
   int plan_n = 0;
@@ -67,6 +68,9 @@ int Run(int argc, char** argv) {
       ->expected(0, 1)
       ->default_str("cauchy");
   app.add_option("--noise-mm", noise_mm, "tracker noise, 1 sigma per coordinate [mm]")->capture_default_str();
+  app.add_option("--uncertainty-out", uncertainty_path,
+                 "the fitted stiffnesses' estimates and covariance, YAML (docs/formats.md §12), for "
+                 "frf-predict --uncertainty");
   app.add_flag("--merge", merge, "write a full robot config with the identified stiffness to --out");
   app.add_flag("--as-parameters", as_parameters,
                "write a parameters: block (kq1_Nm_per_rad ...) instead of joint_stiffness_Nm_per_rad");
@@ -96,7 +100,7 @@ int Run(int argc, char** argv) {
     // --tracker planned and ignored the file).
     if (plan_n != 0) {
       for (const char* name : {"--tracker", "--residuals", "--plot", "--summary", "--robust", "--merge",
-                               "--as-parameters"}) {
+                               "--as-parameters", "--uncertainty-out"}) {
         if (app.count(name) > 0) {
           throw UsageError(std::string(name) + " is for identifying from a tracker file, and --plan " +
                            std::to_string(plan_n) + " plans a test instead (no file is read): give one of the two");
@@ -113,7 +117,7 @@ int Run(int argc, char** argv) {
     RequireInputFile("--robot", robot_path, "robot config", {io::FileKind::kYaml}, io::kRobotConfigFormat);
     CheckDistinctPaths({{"--robot", robot_path}, {"--tracker", tracker_path}},
                        {{"--out", out_path}, {"--residuals", residuals_path}, {"--plot", plot_path},
-                        {"--summary", json_path}});
+                        {"--summary", json_path}, {"--uncertainty-out", uncertainty_path}});
     if (plan_n != 0) {
       workflows::KqPlanOptions po;
       po.robot_path = robot_path;
@@ -188,6 +192,10 @@ int Run(int argc, char** argv) {
       ko.header_comments = header;
       const std::string yaml = io::JointStiffnessYaml(noted, ko);
       io::WriteFileAtomically(out_path.empty() ? "-" : out_path, yaml);
+    }
+    if (!uncertainty_path.empty()) {
+      io::WriteParameterUncertainty(uncertainty_path,
+                                    identification::StiffnessUncertainty(r, header[0] + "; " + header[1]));
     }
     if (!residuals_path.empty()) io::WriteKqResidualsCsv(residuals_path, r, run.cases);
     if (!plot_path.empty()) {

@@ -92,6 +92,34 @@ void CheckValid(const IdentificationOptions& o) {
   if (o.max_iterations < 1) fail("max_iterations", o.max_iterations, "at least 1");
 }
 
+dynamics::ParameterUncertainty StiffnessUncertainty(const JointStiffnessResult& result, const std::string& source) {
+  std::vector<int> joints;
+  for (int j = 0; j < result.num_joints; ++j) {
+    if (j < result.log_stiffness_covariance.rows() && std::isfinite(result.log_stiffness_covariance(j, j))) {
+      joints.push_back(j);
+    }
+  }
+  if (joints.empty()) throw std::invalid_argument("no joint stiffness was determined: no uncertainty to write");
+  dynamics::ParameterUncertainty u;
+  u.source = source;
+  const auto m = static_cast<Eigen::Index>(joints.size());
+  u.covariance.resize(m, m);
+  for (Eigen::Index a = 0; a < m; ++a) {
+    const int ja = joints[a];
+    u.parameters.push_back({"kq" + std::to_string(ja + 1) + "_Nm_per_rad", result.joint_stiffness(ja),
+                            dynamics::UncertainScale::kInverse});
+    for (Eigen::Index b = 0; b < m; ++b) {
+      const int jb = joints[b];
+      // c = 1/k = e^{-log k}: cov(c_a, c_b) = c_a c_b cov(log k_a, log k_b),
+      // exact here because the fit's covariance is that of the linear
+      // problem in the compliances (see the 95 % intervals above).
+      u.covariance(a, b) = result.log_stiffness_covariance(ja, jb) / (result.joint_stiffness(ja) * result.joint_stiffness(jb));
+    }
+  }
+  u.covariance = (0.5 * (u.covariance + u.covariance.transpose())).eval();  // symmetric to the last bit
+  return u;
+}
+
 double ChiSquare3UpperQuantile(double p) {
   if (!(p > 0.0 && p < 1.0)) throw std::invalid_argument("ChiSquare3UpperQuantile: p outside (0, 1)");
   // Survival function of χ²₃: erfc(√(x/2)) + √(2x/π) e^(−x/2)
@@ -404,10 +432,14 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     res.lower_95(j) = k0(j) / (x + kZ95 * sx);
     res.upper_95(j) = x - kZ95 * sx > 0.0 ? k0(j) / (x - kZ95 * sx) : kInf;
   }
+  res.log_stiffness_covariance = Eigen::MatrixXd::Constant(n, n, kNaN);
   for (int a : free) {
     for (int b : free) {
       const double d = std::sqrt(cov_theta(a, a) * cov_theta(b, b));
       if (d > 0.0) res.correlation(a, b) = cov_theta(a, b) / d;
+      if (std::isfinite(res.relative_std(a)) && std::isfinite(res.relative_std(b))) {
+        res.log_stiffness_covariance(a, b) = cov_theta(a, b);
+      }
     }
   }
   // Why a joint's uncertainty is what it is: the information of the final

@@ -71,16 +71,36 @@ void WritePredictedFrfCsv(std::ostream& os, const std::vector<PosturePrediction>
 }
 
 void WriteModalTableCsv(const std::string& path, const std::vector<std::string>& pose_ids,
-                        const std::vector<std::vector<dynamics::Mode>>& modes) {
+                        const std::vector<std::vector<dynamics::Mode>>& modes,
+                        const std::vector<dynamics::PostureModeIntervals>* intervals) {
   WriteFileAtomically(path, [&](std::ostream& os) {
-    os << "pose_id,mode,freq_hz,damping_ratio,modal_mass_kg,ux,uy,uz\n";
+    os << "pose_id,mode,freq_hz,damping_ratio,modal_mass_kg,ux,uy,uz";
+    if (intervals) {
+      os << ",freq_hz_lower,freq_hz_upper,damping_ratio_lower,damping_ratio_upper,peak_receptance_m_per_N,"
+            "peak_receptance_m_per_N_lower,peak_receptance_m_per_N_upper,interval_method";
+    }
+    os << '\n';
     for (size_t p = 0; p < pose_ids.size(); ++p) {
       for (size_t k = 0; k < modes[p].size(); ++k) {
         const dynamics::Mode& m = modes[p][k];
         os << pose_ids[p] << ',' << k + 1 << ',' << FormatDouble(m.freq_hz) << ','
            << FormatDouble(m.damping_ratio) << ',' << FormatDouble(m.modal_mass_kg) << ','
            << FormatDouble(m.shape_T(0)) << ',' << FormatDouble(m.shape_T(1)) << ','
-           << FormatDouble(m.shape_T(2)) << '\n';
+           << FormatDouble(m.shape_T(2));
+        if (intervals) {
+          const dynamics::PostureModeIntervals& pi = (*intervals)[p];
+          if (k < pi.modes.size()) {
+            const dynamics::ModeIntervals& mi = pi.modes[k];
+            os << ',' << FormatCell(mi.freq_hz.lower) << ',' << FormatCell(mi.freq_hz.upper) << ','
+               << FormatCell(mi.damping_ratio.lower) << ',' << FormatCell(mi.damping_ratio.upper) << ','
+               << FormatCell(mi.peak_receptance_m_per_N.value) << ',' << FormatCell(mi.peak_receptance_m_per_N.lower)
+               << ',' << FormatCell(mi.peak_receptance_m_per_N.upper) << ','
+               << dynamics::ToString(pi.propagation.method_used);
+          } else {
+            os << ",,,,,,,,";
+          }
+        }
+        os << '\n';
       }
     }
   });

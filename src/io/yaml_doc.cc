@@ -178,6 +178,8 @@ std::string YamlDoc::OtherYamlKind(const std::string& missing) const {
        {"origin_mm", "u_axis", "v_axis", "size_mm", "grid_step_mm", "tool_axis", "rotation_about_tool_axis",
         "seed_posture_deg"}},
       {has("nurbs"), "a NURBS surface for polish-plan --surface (config/polishing/dome.yaml)", {"nurbs"}},
+      {has("parameter_uncertainty"), "a parameter-uncertainty file for --uncertainty (docs/formats.md §12)",
+       {"parameter_uncertainty"}},
       {has("tool") && has("workpiece"), "a polishing process for --process (config/polishing/belt_2N.yaml)",
        {"tool", "workpiece", "process", "robot"}},
   };

@@ -71,4 +71,51 @@ fi
 # Duplicated direction pairs and absurd grids are usage errors.
 expect_exit 64 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --directions xx,xx
 expect_exit 64 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --df-hz 1e-17
+
+# --uncertainty (issue #37), against a closed form: every joint stiffness
+# scaled by one factor s with sigma(ln s) = 0.1 (a rank-one covariance in
+# ln k) scales every undamped frequency by sqrt(s), so the first-order 95 %
+# interval of each is f (1 -+ 1.959964 * 0.05); the shipped values are the
+# estimates (no note of changed values).
+{
+  echo "parameter_uncertainty:"
+  echo "  source: all joints scaled together"
+  echo "  parameters:"
+  for j in 1 2 3 4 5 6; do
+    k=$(grep -o 'joint_stiffness_Nm_per_rad: \[[^]]*\]' config/kr210.yaml | sed 's/.*\[//; s/\]//' | cut -d, -f$j | tr -d ' ')
+    echo "    - {name: kq${j}_Nm_per_rad, value: $k, scale: log}"
+  done
+  echo "  covariance:"
+  for j in 1 2 3 4 5 6; do echo "    - [0.01, 0.01, 0.01, 0.01, 0.01, 0.01]"; done
+} > "$work/common_scale.yaml"
+expect_exit 0 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --modes "$work/umodes.csv" \
+  --uncertainty "$work/common_scale.yaml" --uncertainty-method first-order
+expect_in "$work/umodes.csv" "freq_hz_lower,freq_hz_upper,damping_ratio_lower,damping_ratio_upper,peak_receptance_m_per_N,"
+expect_in "$work/stderr" "P1: 95 % intervals (first-order): mode 1 10.51 Hz"
+if grep -q "estimates replace" "$work/stderr"; then echo "FAIL: the shipped values were called changed"; fails=$((fails+1)); fi
+bad=$(awk -F, 'NR > 1 { lo = $3 * (1 - 1.959964 * 0.05); hi = $3 * (1 + 1.959964 * 0.05);
+  if ((($9 - lo) / $3) ^ 2 > 1e-10 || (($10 - hi) / $3) ^ 2 > 1e-10 || $16 != "first-order") print }' "$work/umodes.csv")
+[ -z "$bad" ] || { echo "FAIL: intervals off the closed form:"; echo "$bad" | head -3; fails=$((fails+1)); }
+# The intervals go to --modes or --summary; one of them is needed.
+expect_exit 64 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --out "$work/x.csv" \
+  --uncertainty "$work/common_scale.yaml"
+expect_in "$work/stderr" "give one of them"
+# A parameter from the file and from --set: refused, naming both.
+expect_exit 64 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --modes "$work/x.csv" \
+  --uncertainty "$work/common_scale.yaml" --set kq2_Nm_per_rad=3e6
+expect_in "$work/stderr" "--set kq2_Nm_per_rad and --uncertainty"
+# A confidence typed as a percentage.
+expect_exit 64 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --modes "$work/x.csv" \
+  --uncertainty "$work/common_scale.yaml" --confidence 95
+expect_in "$work/stderr" "a percentage? 95 % is 0.95"
+# The robot config given as the uncertainty file.
+expect_exit 65 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --modes "$work/x.csv" \
+  --uncertainty config/kr210.yaml
+expect_in "$work/stderr" "a robot config"
+# A parameter the model does not have.
+sed 's/kq6_Nm_per_rad/kq7_Nm_per_rad/' "$work/common_scale.yaml" > "$work/kq7.yaml"
+expect_exit 65 "$tool" --robot config/kr210.yaml --postures config/postures_demo.csv --modes "$work/x.csv" \
+  --uncertainty "$work/kq7.yaml"
+expect_in "$work/stderr" "kq7_Nm_per_rad' (from $work/kq7.yaml (all joints scaled together)) is not a parameter of this model"
+expect_no_file "$work/x.csv"
 finish

@@ -9,6 +9,7 @@
 #include "robomach/common/progress.h"
 #include "robomach/common/solver_status.h"
 #include "robomach/dynamics/robot_model.h"
+#include "robomach/dynamics/uncertainty.h"
 #include "robomach/identification/load_case.h"
 
 namespace robomach::identification {
@@ -83,6 +84,9 @@ struct JointStiffnessResult {
   Eigen::VectorXd lower_95, upper_95;
   Eigen::VectorXd relative_std;         // σ(log k) ≈ σ_k / k [-]
   Eigen::MatrixXd correlation;          // of the stiffnesses (NaN rows for undetermined joints)
+  /// Covariance of log k (≈ that of the relative compliances, and scaled as
+  /// std_dev is); NaN rows and columns for joints not determined.
+  Eigen::MatrixXd log_stiffness_covariance;
   std::vector<Determination> determination;
   /// Per fitted joint: σ² over its σ² with every other joint known (>= 1;
   /// NaN for a joint not fitted). 2 or more means over half its variance
@@ -168,6 +172,14 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
                                             const std::vector<LoadCase>& cases,
                                             const IdentificationOptions& options = {},
                                             const ProgressCallback& progress = {});
+
+/// The fitted joints' stiffnesses with their covariance, as the parameters
+/// kq<j>_Nm_per_rad on the inverse scale: the compliances 1/k, in which the
+/// tracker model is linear, so that their estimate is Gaussian (the 95 %
+/// intervals of the result are built the same way). Joints not determined
+/// are left out (they kept the prior and have no finite variance).
+/// @throws std::invalid_argument if no joint was determined.
+dynamics::ParameterUncertainty StiffnessUncertainty(const JointStiffnessResult& result, const std::string& source);
 
 /// Upper quantile of the χ² distribution with 3 degrees of freedom:
 /// x with P(χ²₃ > x) = p, for 0 < p < 1.

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "robomach/dynamics/posture_dynamics.h"
+#include "robomach/dynamics/uncertainty.h"
 
 namespace robomach::io {
 
@@ -33,9 +34,14 @@ void WritePredictedFrfCsv(std::ostream& os, const std::vector<PosturePrediction>
                           const DirectionPairs& pairs);
 
 /// Writes the modal table of formats.md §4:
-/// pose_id,mode,freq_hz,damping_ratio,modal_mass_kg,ux,uy,uz.
+/// pose_id,mode,freq_hz,damping_ratio,modal_mass_kg,ux,uy,uz; with
+/// `intervals` (one per posture, from --uncertainty) also the columns
+/// freq_hz_lower, freq_hz_upper, damping_ratio_lower, damping_ratio_upper,
+/// peak_receptance_m_per_N, peak_receptance_m_per_N_lower,
+/// peak_receptance_m_per_N_upper and interval_method.
 void WriteModalTableCsv(const std::string& path, const std::vector<std::string>& pose_ids,
-                        const std::vector<std::vector<dynamics::Mode>>& modes);
+                        const std::vector<std::vector<dynamics::Mode>>& modes,
+                        const std::vector<dynamics::PostureModeIntervals>* intervals = nullptr);
 
 /// Everything of one posture as JSON with unit-suffixed keys (frf-predict's
 /// --summary, one per posture): q_rad, tcp position, J and its condition

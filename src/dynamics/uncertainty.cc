@@ -1,0 +1,415 @@
+#include "robomach/dynamics/uncertainty.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+
+#include "robomach/common/number_format.h"
+#include "robomach/dynamics/posture_dynamics.h"
+
+namespace robomach::dynamics {
+namespace {
+
+// θ (the Gaussian coordinates) from values and back.
+Eigen::VectorXd ToTheta(const ParameterUncertainty& u, const Eigen::VectorXd& values) {
+  Eigen::VectorXd t = values;
+  for (size_t i = 0; i < u.parameters.size(); ++i) {
+    if (u.parameters[i].scale == UncertainScale::kLog) t(i) = std::log(values(i));
+    if (u.parameters[i].scale == UncertainScale::kInverse) t(i) = 1.0 / values(i);
+  }
+  return t;
+}
+
+Eigen::VectorXd FromTheta(const ParameterUncertainty& u, const Eigen::VectorXd& theta) {
+  Eigen::VectorXd v = theta;
+  for (size_t i = 0; i < u.parameters.size(); ++i) {
+    if (u.parameters[i].scale == UncertainScale::kLog) v(i) = std::exp(theta(i));
+    // A sampled compliance <= 0 has no stiffness: NaN, a failed sample.
+    if (u.parameters[i].scale == UncertainScale::kInverse) v(i) = theta(i) > 0.0 ? 1.0 / theta(i) : NAN;
+  }
+  return v;
+}
+
+// Sample quantile with linear interpolation between order statistics
+// (Hyndman & Fan 1996, definition 7: NumPy's default).
+double Quantile(std::vector<double> sorted_values, double p) {
+  const double h = p * static_cast<double>(sorted_values.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(h));
+  const size_t hi = std::min(lo + 1, sorted_values.size() - 1);
+  return sorted_values[lo] + (h - static_cast<double>(lo)) * (sorted_values[hi] - sorted_values[lo]);
+}
+
+std::string Percent(double x) { return FormatNumber(100.0 * x, 3) + " %"; }
+
+}  // namespace
+
+const char* ToString(UncertainScale s) {
+  switch (s) {
+    case UncertainScale::kLog: return "log";
+    case UncertainScale::kInverse: return "inverse";
+    case UncertainScale::kLinear: return "linear";
+  }
+  return "?";
+}
+
+UncertainScale ParseUncertainScale(const std::string& name) {
+  for (UncertainScale s : {UncertainScale::kLinear, UncertainScale::kLog, UncertainScale::kInverse}) {
+    if (name == ToString(s)) return s;
+  }
+  throw std::invalid_argument("unknown scale '" + name + "'; expected linear, log or inverse");
+}
+
+void CheckValid(const ParameterUncertainty& u) {
+  const int n = static_cast<int>(u.parameters.size());
+  if (n == 0) throw std::invalid_argument("parameter uncertainty: no parameter");
+  std::set<std::string> names;
+  for (const UncertainParameter& p : u.parameters) {
+    if (p.name.empty()) throw std::invalid_argument("parameter uncertainty: a parameter without a name");
+    if (!names.insert(p.name).second) {
+      throw std::invalid_argument("parameter uncertainty: parameter '" + p.name + "' given twice");
+    }
+    if (!std::isfinite(p.value)) {
+      throw std::invalid_argument("parameter uncertainty: " + p.name + " has the non-finite value " +
+                                  FormatNumber(p.value, 7));
+    }
+    if (p.scale != UncertainScale::kLinear && !(p.value > 0.0)) {
+      throw std::invalid_argument("parameter uncertainty: " + p.name + " = " + FormatNumber(p.value, 7) +
+                                  " on the " + ToString(p.scale) + " scale must be > 0");
+    }
+  }
+  if (u.covariance.rows() != n || u.covariance.cols() != n) {
+    throw std::invalid_argument("parameter uncertainty: the covariance is " + std::to_string(u.covariance.rows()) +
+                                " x " + std::to_string(u.covariance.cols()) + ", expected " + std::to_string(n) +
+                                " x " + std::to_string(n) + " (one row and column per parameter)");
+  }
+  if (!u.covariance.allFinite()) throw std::invalid_argument("parameter uncertainty: the covariance is not finite");
+  const double scale = std::max(u.covariance.cwiseAbs().maxCoeff(), 1e-300);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < i; ++j) {
+      if (std::abs(u.covariance(i, j) - u.covariance(j, i)) > 1e-8 * scale) {
+        throw std::invalid_argument("parameter uncertainty: the covariance is not symmetric (row " +
+                                    std::to_string(i + 1) + ", column " + std::to_string(j + 1) + ": " +
+                                    FormatNumber(u.covariance(i, j), 7) + " vs " +
+                                    FormatNumber(u.covariance(j, i), 7) + ")");
+      }
+    }
+  }
+  const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(u.covariance, Eigen::EigenvaluesOnly)
+                                 .eigenvalues();
+  if (ev.minCoeff() < -1e-9 * std::max(ev.maxCoeff(), 0.0) || ev.maxCoeff() < 0.0) {
+    throw std::invalid_argument("parameter uncertainty: the covariance has the negative eigenvalue " +
+                                FormatNumber(ev.minCoeff(), 4) + " (largest " + FormatNumber(ev.maxCoeff(), 4) +
+                                "): not a covariance matrix");
+  }
+}
+
+ParameterUncertainty CombineIndependent(const std::vector<ParameterUncertainty>& parts) {
+  ParameterUncertainty out;
+  int n = 0;
+  for (const auto& p : parts) n += static_cast<int>(p.parameters.size());
+  out.covariance = Eigen::MatrixXd::Zero(n, n);
+  int at = 0;
+  std::vector<std::string> owners;
+  for (const auto& part : parts) {
+    for (const UncertainParameter& p : part.parameters) {
+      for (size_t k = 0; k < out.parameters.size(); ++k) {
+        if (out.parameters[k].name == p.name) {
+          throw std::invalid_argument("parameter " + p.name + " is in two uncertainty files (" + owners[k] + " and " +
+                                      part.source + "): a parameter fitted twice must be fitted once from both "
+                                      "campaigns (kq-identify --merge), not taken as independent");
+        }
+      }
+      out.parameters.push_back(p);
+      owners.push_back(part.source);
+    }
+    const auto m = static_cast<Eigen::Index>(part.parameters.size());
+    if (part.covariance.rows() != m || part.covariance.cols() != m) {
+      throw std::invalid_argument("parameter uncertainty from " + part.source + ": covariance of the wrong size");
+    }
+    out.covariance.block(at, at, m, m) = part.covariance;
+    at += static_cast<int>(m);
+    out.source += (out.source.empty() ? "" : "; ") + part.source;
+  }
+  return out;
+}
+
+double NormalQuantile(double p) {
+  if (!(p > 0.0 && p < 1.0)) throw std::invalid_argument("NormalQuantile: p outside (0, 1)");
+  // Φ(z) = erfc(−z/√2)/2 is increasing; |z| < 40 covers every double p.
+  double lo = -40.0, hi = 40.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p) {
+      lo = mid;
+    } else {
+      hi = mid;
+    }
+  }
+  return 0.5 * (lo + hi);
+}
+
+const char* ToString(PropagationMethod m) {
+  switch (m) {
+    case PropagationMethod::kAuto: return "auto";
+    case PropagationMethod::kFirstOrder: return "first-order";
+    case PropagationMethod::kMonteCarlo: return "monte-carlo";
+  }
+  return "?";
+}
+
+PropagationMethod ParsePropagationMethod(const std::string& name) {
+  for (PropagationMethod m : {PropagationMethod::kAuto, PropagationMethod::kFirstOrder, PropagationMethod::kMonteCarlo}) {
+    if (name == ToString(m)) return m;
+  }
+  throw std::invalid_argument("unknown propagation method '" + name + "'; expected auto, first-order or monte-carlo");
+}
+
+void CheckValid(const PropagationOptions& o) {
+  if (!(o.confidence > 0.0 && o.confidence < 1.0)) {
+    throw std::invalid_argument("confidence: expected a level in (0, 1), got " + FormatNumber(o.confidence, 7) +
+                                (o.confidence > 1.0 && o.confidence < 100.0 ? " (a percentage? 95 % is 0.95)" : ""));
+  }
+  if (o.samples < 100 || o.samples > 10000000) {
+    throw std::invalid_argument("samples: expected 100 - 10 000 000 Monte Carlo samples, got " +
+                                std::to_string(o.samples));
+  }
+  if (!(o.nonlinearity_tolerance > 0.0 && o.nonlinearity_tolerance <= 1.0)) {
+    throw std::invalid_argument("nonlinearity_tolerance: expected (0, 1], got " +
+                                FormatNumber(o.nonlinearity_tolerance, 7));
+  }
+}
+
+PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction& f, const PropagationOptions& o,
+                            const std::vector<std::string>& output_names) {
+  CheckValid(u);
+  CheckValid(o);
+  const int n = static_cast<int>(u.parameters.size());
+  Eigen::VectorXd values(n);
+  for (int i = 0; i < n; ++i) values(i) = u.parameters[i].value;
+  const Eigen::VectorXd theta0 = ToTheta(u, values);
+  PropagationResult res;
+  const Eigen::VectorXd f0 = f(values);
+  ++res.evaluations;
+  if (!f0.allFinite()) throw std::invalid_argument("the outputs at the estimates are not finite");
+  const int m = static_cast<int>(f0.size());
+  const double z = NormalQuantile(0.5 * (1.0 + o.confidence));
+  res.outputs.assign(m, OutputInterval{});
+  for (int k = 0; k < m; ++k) res.outputs[k].value = f0(k);
+
+  auto first_order = [&]() {
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(m, n);
+    for (int i = 0; i < n; ++i) {
+      const double sigma = std::sqrt(std::max(u.covariance(i, i), 0.0));
+      if (!(sigma > 0.0)) continue;  // a parameter without uncertainty adds none
+      const double h = 1e-3 * sigma;
+      Eigen::VectorXd tp = theta0, tm = theta0;
+      tp(i) += h;
+      tm(i) -= h;
+      J.col(i) = (f(FromTheta(u, tp)) - f(FromTheta(u, tm))) / (2.0 * h);
+      res.evaluations += 2;
+    }
+    const Eigen::MatrixXd cov = J * u.covariance * J.transpose();
+    for (int k = 0; k < m; ++k) {
+      const double s = std::sqrt(std::max(cov(k, k), 0.0));
+      res.outputs[k].std_dev = s;
+      res.outputs[k].lower = f0(k) - z * s;
+      res.outputs[k].upper = f0(k) + z * s;
+    }
+    return J;
+  };
+
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(u.covariance);
+  const Eigen::VectorXd lambda = eig.eigenvalues().cwiseMax(0.0);
+  const Eigen::MatrixXd& V = eig.eigenvectors();
+
+  bool monte_carlo = o.method == PropagationMethod::kMonteCarlo;
+  if (o.method != PropagationMethod::kMonteCarlo) {
+    const Eigen::MatrixXd J = first_order();
+    res.method_used = PropagationMethod::kFirstOrder;
+    if (o.method == PropagationMethod::kFirstOrder) {
+      res.reason = "first order, as asked (--uncertainty-method first-order)";
+    } else {
+      // Sigma points along the covariance's principal axes, at the interval's
+      // half-width: where the outputs bend within the interval, the linear
+      // interval is wrong and Monte Carlo is used instead.
+      double worst = 0.0;
+      int worst_output = -1;
+      for (auto& out : res.outputs) out.nonlinearity = 0.0;
+      for (int k = 0; k < n; ++k) {
+        if (!(lambda(k) > 1e-300)) continue;
+        for (double sign : {-1.0, 1.0}) {
+          const Eigen::VectorXd step = sign * z * std::sqrt(lambda(k)) * V.col(k);
+          Eigen::VectorXd fk;
+          try {
+            fk = f(FromTheta(u, theta0 + step));
+          } catch (const std::exception&) {
+            fk = Eigen::VectorXd::Constant(m, NAN);
+          }
+          ++res.evaluations;
+          const Eigen::VectorXd linear = f0 + J * step;
+          for (int j = 0; j < m; ++j) {
+            const double half = z * res.outputs[j].std_dev;
+            const double scale = std::max(half, 1e-12 * std::max(std::abs(f0(j)), 1e-300));
+            const double d = std::isfinite(fk(j)) ? std::abs(fk(j) - linear(j)) / scale : INFINITY;
+            res.outputs[j].nonlinearity = std::max(res.outputs[j].nonlinearity, d);
+            if (d > worst) {
+              worst = d;
+              worst_output = j;
+            }
+          }
+        }
+      }
+      res.nonlinearity = worst;
+      if (worst <= o.nonlinearity_tolerance) {
+        res.reason = "first order: at the sigma points the outputs depart from linear by at most " + Percent(worst) +
+                     " of the half-width (under " + Percent(o.nonlinearity_tolerance) + ")";
+      } else {
+        monte_carlo = true;
+        const std::string what = worst_output < static_cast<int>(output_names.size())
+                                     ? output_names[worst_output]
+                                     : "output " + std::to_string(worst_output + 1);
+        res.reason = "Monte Carlo: " + what + " departs from linear by " +
+                     (std::isfinite(worst) ? Percent(worst) : std::string("an undefined amount (not computable)")) +
+                     " of its half-width at a sigma point (over " + Percent(o.nonlinearity_tolerance) +
+                     "): the first-order interval would be wrong";
+      }
+    }
+  } else {
+    res.reason = "Monte Carlo, as asked (--uncertainty-method monte-carlo)";
+  }
+
+  if (monte_carlo) {
+    res.method_used = PropagationMethod::kMonteCarlo;
+    std::mt19937_64 rng(o.seed);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    const Eigen::MatrixXd L = V * lambda.cwiseSqrt().asDiagonal();
+    std::vector<std::vector<double>> samples(m);
+    for (auto& s : samples) s.reserve(o.samples);
+    Eigen::VectorXd xi(n);
+    for (int s = 0; s < o.samples; ++s) {
+      for (int i = 0; i < n; ++i) xi(i) = normal(rng);
+      Eigen::VectorXd fs;
+      try {
+        fs = f(FromTheta(u, theta0 + L * xi));
+      } catch (const std::exception&) {
+        fs.resize(0);
+      }
+      ++res.evaluations;
+      if (fs.size() != m || !fs.allFinite()) {
+        ++res.failed_samples;
+        continue;
+      }
+      for (int k = 0; k < m; ++k) samples[k].push_back(fs(k));
+    }
+    const int good = o.samples - res.failed_samples;
+    if (good < 100) {
+      throw std::invalid_argument("Monte Carlo: only " + std::to_string(good) + " of " + std::to_string(o.samples) +
+                                  " samples could be evaluated (sampled parameters outside their bounds?)");
+    }
+    for (int k = 0; k < m; ++k) {
+      std::vector<double>& v = samples[k];
+      std::sort(v.begin(), v.end());
+      double mean = 0.0;
+      for (double x : v) mean += x;
+      mean /= static_cast<double>(v.size());
+      double var = 0.0;
+      for (double x : v) var += (x - mean) * (x - mean);
+      res.outputs[k].std_dev = std::sqrt(var / static_cast<double>(v.size() - 1));
+      res.outputs[k].lower = Quantile(v, 0.5 * (1.0 - o.confidence));
+      res.outputs[k].upper = Quantile(v, 0.5 * (1.0 + o.confidence));
+    }
+    res.reason += "; " + std::to_string(good) + " samples, seed " + std::to_string(o.seed);
+    if (res.failed_samples > 0) {
+      res.reason += "; " + std::to_string(res.failed_samples) +
+                    " samples could not be evaluated and were left out (sampled parameters outside their bounds)";
+    }
+  }
+  return res;
+}
+
+ParameterSet WithValues(const ParameterSet& base, const ParameterUncertainty& u, const Eigen::VectorXd& values) {
+  ParameterSet out = base;
+  for (size_t i = 0; i < u.parameters.size(); ++i) {
+    if (!out.Has(u.parameters[i].name)) {
+      throw std::invalid_argument("the uncertainty's parameter '" + u.parameters[i].name + "'" +
+                                  (u.source.empty() ? "" : " (from " + u.source + ")") +
+                                  " is not a parameter of this model (" + out.NameList() +
+                                  "): an effect it belongs to is not switched on?");
+    }
+    out.Set(u.parameters[i].name, values(static_cast<Eigen::Index>(i)));
+  }
+  return out;
+}
+
+PostureModeIntervals ModalIntervals(const RobotDescription& description, const ParameterSet& base,
+                                    const Eigen::VectorXd& q, const ParameterUncertainty& u,
+                                    const PropagationOptions& options) {
+  PostureOptions po;
+  po.cartesian = false;
+  po.jacobian_condition = false;
+  auto outputs = [&](const Eigen::VectorXd& values) {
+    const auto model = RobotModel::Build(description, WithValues(base, u, values));
+    const PostureDynamics d = EvaluatePosture(model, q, po);
+    Eigen::VectorXd out(3 * static_cast<Eigen::Index>(d.modes.size()));
+    for (size_t k = 0; k < d.modes.size(); ++k) {
+      const Mode& mode = d.modes[k];
+      const double w = 2.0 * M_PI * mode.freq_hz;
+      out(3 * k) = mode.freq_hz;
+      out(3 * k + 1) = mode.damping_ratio;
+      out(3 * k + 2) = std::isfinite(mode.modal_mass_kg) && mode.damping_ratio > 0.0
+                           ? 1.0 / (mode.modal_mass_kg * w * w * 2.0 * mode.damping_ratio)
+                           : 0.0;
+    }
+    return out;
+  };
+  PostureModeIntervals r;
+  std::vector<std::string> names;
+  for (int k = 1; k <= 100; ++k) {
+    for (const char* what : {"frequency", "damping ratio", "peak receptance"}) {
+      names.push_back("mode " + std::to_string(k) + "'s " + what);
+    }
+  }
+  r.propagation = Propagate(u, outputs, options, names);
+  const size_t modes = r.propagation.outputs.size() / 3;
+  for (size_t k = 0; k < modes; ++k) {
+    r.modes.push_back({r.propagation.outputs[3 * k], r.propagation.outputs[3 * k + 1],
+                       r.propagation.outputs[3 * k + 2]});
+  }
+  return r;
+}
+
+std::string UseEstimates(const ParameterUncertainty& u, ParameterSet* parameters) {
+  Eigen::VectorXd values(static_cast<Eigen::Index>(u.parameters.size()));
+  std::string changed;
+  for (size_t i = 0; i < u.parameters.size(); ++i) {
+    values(static_cast<Eigen::Index>(i)) = u.parameters[i].value;
+  }
+  const ParameterSet updated = WithValues(*parameters, u, values);
+  for (const UncertainParameter& p : u.parameters) {
+    const double before = parameters->Get(p.name);
+    if (std::abs(before - p.value) > 1e-9 * std::max(std::abs(before), std::abs(p.value))) {
+      changed += (changed.empty() ? "" : ", ") + p.name + " " + FormatNumber(before, 4) + " -> " +
+                 FormatNumber(p.value, 4);
+    }
+  }
+  *parameters = updated;
+  return changed;
+}
+
+std::string IntervalLine(const std::string& pose_id, const PostureModeIntervals& intervals, double confidence) {
+  std::string line = pose_id + ": " + FormatNumber(100.0 * confidence, 3) + " % intervals (" +
+                     ToString(intervals.propagation.method_used) + ")";
+  for (size_t k = 0; k < std::min<size_t>(3, intervals.modes.size()); ++k) {
+    const OutputInterval& f = intervals.modes[k].freq_hz;
+    line += std::string(k ? "," : ":") + " mode " + std::to_string(k + 1) + " " + FormatNumber(f.value, 4) +
+            " Hz [" + FormatNumber(f.lower, 4) + ", " + FormatNumber(f.upper, 4) + "]";
+  }
+  return line;
+}
+
+}  // namespace robomach::dynamics
