@@ -84,9 +84,8 @@ int Run(int argc, char** argv) {
   std::string robot_path, postures_path, out_path, modes_path, plot_path, plot_dir, details_path,
       freq_file, directions = "all", method = "modal";
   double fmin_hz = 0.625, fmax_hz = 500.0, df_hz = 0.625;
-  std::vector<std::string> sets, adds, uncertainty_paths;
-  dynamics::PropagationOptions uo;
-  std::string uncertainty_method = "auto";
+  std::vector<std::string> sets, adds;
+  UncertaintyCli unc;
   bool verbose = false;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
@@ -107,18 +106,7 @@ int Run(int argc, char** argv) {
       ->check(OneOf({"modal", "direct"}))->capture_default_str();
   app.add_option("--set", sets, "override a model parameter, NAME=VALUE in its unit (e.g. m6_kg=30.2)");
   app.add_option("--add", adds, "switch on an effect by name with its default parameters (e.g. tip_mass)");
-  app.add_option("--uncertainty", uncertainty_paths,
-                 "parameter-uncertainty YAML (docs/formats.md §12, from kq-identify --uncertainty-out); repeatable, "
-                 "files from different campaigns are taken as independent. Its estimates replace the config's "
-                 "values; --modes and --summary gain each mode's interval");
-  app.add_option("--confidence", uo.confidence, "two-sided confidence level of the intervals, in (0, 1)")
-      ->capture_default_str();
-  app.add_option("--uncertainty-method", uncertainty_method,
-                 "auto (first order, Monte Carlo where the outputs bend within the interval), first-order or "
-                 "monte-carlo")
-      ->check(OneOf({"auto", "first-order", "monte-carlo"}))->capture_default_str();
-  app.add_option("--samples", uo.samples, "Monte Carlo samples per posture")->capture_default_str();
-  app.add_option("--seed", uo.seed, "Monte Carlo seed")->capture_default_str();
+  AddUncertaintyOptions(app, &unc, "--modes and --summary gain each mode's interval");
   app.add_flag("--verbose", verbose, "list model parameters and ignored input columns on stderr");
   try {
     app.parse(argc, argv);
@@ -175,20 +163,17 @@ int Run(int argc, char** argv) {
         Warn(kTool, freq_file.empty() ? m : m + " (the highest line of " + freq_file + ")");
       }
     }
-    uo.method = dynamics::ParsePropagationMethod(uncertainty_method);
-    if (!uncertainty_paths.empty()) {
-      ValidateOptions({{"confidence", "--confidence"}, {"samples", "--samples"}}, [&] { dynamics::CheckValid(uo); });
-      if (modes_path.empty() && details_path.empty()) {
-        throw UsageError("--uncertainty gives the modes' intervals in --modes and --summary: give one of them");
-      }
-      for (const std::string& p : uncertainty_paths) {
-        RequireInputFile("--uncertainty", p, "parameter-uncertainty file", {io::FileKind::kYaml},
-                         io::kUncertaintyFileFormat);
-      }
+    if (!unc.paths.empty() && modes_path.empty() && details_path.empty()) {
+      throw UsageError("--uncertainty gives the modes' intervals in --modes and --summary: give one of them");
     }
+    unc.Finish();
+    const dynamics::PropagationOptions& uo = unc.propagation;
     io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
     ApplyAddsAndSets(adds, sets, &cfg);
     std::optional<dynamics::ParameterUncertainty> uncertainty;
+    // The config's `uncertainty:` files serve the outputs that carry intervals.
+    const std::vector<std::string> uncertainty_paths =
+        unc.paths.empty() && modes_path.empty() && details_path.empty() ? std::vector<std::string>{} : unc.PathsFor(cfg);
     if (!uncertainty_paths.empty()) {
       uncertainty = io::ReadParameterUncertainties(uncertainty_paths);
       for (const std::string& set : sets) {
@@ -287,7 +272,7 @@ int Run(int argc, char** argv) {
       if (uncertainty) {
         j["uncertainty"] = {{"files", uncertainty_paths},
                             {"confidence", uo.confidence},
-                            {"method", uncertainty_method},
+                            {"method", unc.method},
                             {"parameters", io::ParameterUncertaintyToJson(*uncertainty)}};
       }
       io::WriteFileAtomically(details_path, SummaryText(j));

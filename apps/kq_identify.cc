@@ -185,7 +185,8 @@ int Run(int argc, char** argv) {
     if (merge) {
       std::vector<std::string> h = header;
       for (const auto& a : noted.advice) h.push_back("NOTE: " + a);
-      io::WriteFileAtomically(out_path, io::MergeJointStiffness(robot_path, r.joint_stiffness, out_path, h));
+      io::WriteFileAtomically(out_path,
+                              io::MergeJointStiffness(robot_path, r.joint_stiffness, out_path, h, uncertainty_path));
     } else {
       io::KqYamlOptions ko;
       ko.as_parameters = as_parameters;

@@ -161,6 +161,10 @@ int Run(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--sd-max-depth-mm", sd_max_depth_mm, "SD: largest depth searched [mm]")->capture_default_str();
   app.add_option("--threads", threads, "SD: worker threads, 0 = all cores")->capture_default_str();
+  UncertaintyCli unc;
+  AddUncertaintyOptions(app, &unc,
+                        "with --robot: each ZOA speed's critical depth gets its interval (critical_depth_mm_lower, "
+                        "the safe depth, and _upper in --out; a band in --plot)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -187,11 +191,15 @@ int Run(int argc, char** argv) {
     o.sd_modes = sd_modes;
     o.sd_max_depth_mm = sd_max_depth_mm;
     o.threads = threads;
+    unc.Finish();
+    o.uncertainty_paths = unc.paths;
+    o.uncertainty = unc.propagation;
     ValidateOptions({{"robot_path", "--robot"}, {"postures_path", "--postures"}, {"frf_y_path", "--frf-y"},
                      {"frf_path", "--frf"}, {"modal_table_path", "--modal-table"}, {"tool_axis", "--tool-axis"},
                      {"speeds", "--speeds"}, {"max_lobe", "--max-lobe"}, {"sd_speeds", "--sd-speeds"},
                      {"sd_steps", "--sd-steps"}, {"sd_steps_per_mode_period", "--sd-steps-per-mode-period"},
-                     {"sd_modes", "--sd-modes"}, {"sd_max_depth_mm", "--sd-max-depth-mm"}, {"threads", "--threads"}},
+                     {"sd_modes", "--sd-modes"}, {"sd_max_depth_mm", "--sd-max-depth-mm"}, {"threads", "--threads"},
+                     {"uncertainty_paths", "--uncertainty"}},
                     [&] { o.Validate(); });
     if (frf_path.empty()) {
       for (const auto& [opt, v] : {std::pair{"--fit-plot", &fit_plot_path}, {"--modes-out", &modes_out_path}}) {
@@ -226,7 +234,7 @@ int Run(int argc, char** argv) {
         });
     const std::vector<stability::LobeRow>& rows = run.lobes.rows;
 
-    io::WriteLobesCsv(out_path.empty() ? "-" : out_path, rows);
+    io::WriteLobesCsv(out_path.empty() ? "-" : out_path, rows, !run.bands.empty());
     if (!plot_path.empty()) {
       std::vector<report::LobeCurve> curves;
       for (const stability::TipDynamics& t : run.tips) {
@@ -236,6 +244,10 @@ int Run(int argc, char** argv) {
             if (r.id != t.id || r.method != m) continue;
             c.speed_rpm.push_back(RadPerSecToRpm(r.point.spindle_speed_rad_s));
             c.depth_mm.push_back(r.point.status == stability::LobeStatus::kOk ? MToMm(r.point.critical_depth) : NAN);
+            if (!run.bands.empty() && m == "zoa") {
+              c.lower_mm.push_back(MToMm(r.depth_lower));
+              c.upper_mm.push_back(MToMm(r.depth_upper));
+            }
           }
           if (c.speed_rpm.empty()) continue;
           c.label = t.id + " " + (m == "zoa" ? "ZOA" : "SD");

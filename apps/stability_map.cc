@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <iostream>
 #include <iomanip>
@@ -18,6 +19,8 @@
 #include "robomach/io/region_file.h"
 #include "robomach/io/stability_map_file.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/io/uncertainty_file.h"
+#include "robomach/stability/lobe_uncertainty.h"
 #include "robomach/report/heat_map.h"
 #include "robomach/report/json.h"
 #include "robomach/stability/stability_map.h"
@@ -36,7 +39,7 @@ int Run(int argc, char** argv) {
       "speed of its range); optionally the rotation about the tool axis that maximises the depth."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
-  std::string robot_path, cut_path, region_path, path_path, out_path, plot_path, summary_path;
+  std::string robot_path, cut_path, region_path, path_path, out_path, plot_path, safe_plot_path, summary_path;
   int threads = 0, speeds = 0, rotation_evals = 20;
   double max_depth_mm = 50.0;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
@@ -52,6 +55,12 @@ int Run(int argc, char** argv) {
   app.add_option("--speeds", speeds, "speeds scanned for the best one (default: the cut file's spindle_speed_count)");
   app.add_option("--max-depth-mm", max_depth_mm, "largest depth searched for mode coupling [mm]")->capture_default_str();
   app.add_option("--rotation-evals", rotation_evals, "evaluations per point when the rotation is free")->capture_default_str();
+  UncertaintyCli unc;
+  AddUncertaintyOptions(app, &unc,
+                        "each point's critical depth gets its interval (critical_depth_mm_lower, the safe depth, "
+                        "and _upper in --out); --safe-plot draws the safe depth");
+  app.add_option("--safe-plot", safe_plot_path, "with --uncertainty: heat map PNG of the safe depth [mm] (grid only)")
+      ->check(PngFileName());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -73,7 +82,17 @@ int Run(int argc, char** argv) {
     CheckDistinctPaths({{"--robot", robot_path}, {"--cut", cut_path}, {"--region", region_path}, {"--path", path_path}},
                        {{"--out", out_path}, {"--plot", plot_path}, {"--summary", summary_path}});
     if (!path_path.empty()) RequireReadableFile(path_path, "tool-path file");
-    const io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
+    if (!safe_plot_path.empty() && unc.paths.empty() && io::LoadRobotConfig(robot_path).uncertainty_files.empty()) {
+      throw UsageError("--safe-plot needs --uncertainty (or a robot config that names uncertainty files)");
+    }
+    unc.Finish();
+    io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
+    std::optional<dynamics::ParameterUncertainty> uncertainty;
+    if (!unc.PathsFor(cfg).empty()) {
+      uncertainty = io::ReadParameterUncertainties(unc.PathsFor(cfg));
+      const std::string changed = dynamics::UseEstimates(*uncertainty, &cfg.parameters);
+      if (!changed.empty()) Note(kTool, "--uncertainty: its estimates replace the config's values: " + changed);
+    }
     const auto model = cfg.Build();
     const io::CutSpec cut = io::ReadCutFile(cut_path);
     for (const std::string& w : cut.implausible) Warn(kTool, w);
@@ -124,11 +143,26 @@ int Run(int argc, char** argv) {
           << ", range [" << a.min << ", " << a.max << "]\n";
       std::cerr << msg.str();
     }
+    std::optional<stability::MapDepthIntervals> intervals;
+    if (uncertainty) {
+      ProgressLine up(kTool, "points' intervals", static_cast<long>(targets.size()));
+      intervals = stability::StabilityMapIntervals(cfg.description, cfg.parameters, targets, pts, cut.process,
+                                                   opt.analysis, *uncertainty, unc.propagation, threads,
+                                                   [&](long done, long) { up.Update(done); });
+      up.Finish();
+      std::cerr << kTool << ": intervals at " << FormatNumber(100.0 * unc.propagation.confidence, 3) << " %: "
+                << intervals->first_order << " points first order, " << intervals->monte_carlo
+                << " Monte Carlo (" << intervals->example_reason << ")\n";
+    }
     if (!plot_path.empty() && !grid) Warn(kTool, "--plot draws grids only; ignored with --path");
-    io::WriteStabilityMapCsv(out_path.empty() ? "-" : out_path, points, pts, model->num_joints());
-    if (!plot_path.empty() && grid) {
+    if (!safe_plot_path.empty() && !grid) Warn(kTool, "--safe-plot draws grids only; ignored with --path");
+    io::WriteStabilityMapCsv(out_path.empty() ? "-" : out_path, points, pts, model->num_joints(),
+                             intervals ? &intervals->depth : nullptr);
+    auto heat_map = [&](const std::string& path, bool safe) {
       report::HeatMap hm;
-      hm.title = "robomach stability-map: critical axial depth (" + cut_path + ")";
+      hm.title = safe ? "robomach stability-map: safe depth, the " + FormatNumber(100.0 * unc.propagation.confidence, 3) +
+                            " % lower bound (" + cut_path + ")"
+                      : "robomach stability-map: critical axial depth (" + cut_path + ")";
       hm.x_label = "u [mm] from the region origin";
       hm.y_label = "v [mm] from the region origin";
       hm.colorbar_label = "depth [mm]";
@@ -137,13 +171,17 @@ int Run(int argc, char** argv) {
       hm.ny = points.rows;
       hm.mark_label = "unreachable / joint limits";
       hm.nan_label = "no limit found";
-      for (const auto& p : pts) {
+      for (size_t i = 0; i < pts.size(); ++i) {
+        const stability::MapPoint& p = pts[i];
         const bool out = p.status == stability::PointStatus::kUnreachable || p.status == stability::PointStatus::kJointLimits;
-        hm.values.push_back(out ? NAN : MToMm(p.stability.critical_depth));
+        const double depth = safe ? intervals->depth[i].lower : p.stability.critical_depth;
+        hm.values.push_back(out ? NAN : MToMm(depth));
         hm.marks.push_back(out ? 1 : 0);
       }
-      report::SaveHeatMapPng(hm, plot_path);
-    }
+      report::SaveHeatMapPng(hm, path);
+    };
+    if (!plot_path.empty() && grid) heat_map(plot_path, false);
+    if (!safe_plot_path.empty() && grid) heat_map(safe_plot_path, true);
     // Warned before the summary is written: its `warnings` lists them.
     for (const Finding& f : map.findings) Warn(kTool, f.message);
     if (!summary_path.empty()) {
@@ -154,6 +192,18 @@ int Run(int argc, char** argv) {
       if (!region_path.empty()) j["region"] = region_path;
       if (!path_path.empty()) j["path"] = path_path;
       j["points_csv"] = out_path.empty() ? "-" : out_path;
+      if (intervals) {
+        double safe_min = INFINITY;
+        for (const auto& d : intervals->depth) {
+          if (std::isfinite(d.lower)) safe_min = std::min(safe_min, d.lower);
+        }
+        j["uncertainty"] = {{"files", unc.PathsFor(cfg)},
+                            {"confidence", unc.propagation.confidence},
+                            {"points_first_order", intervals->first_order},
+                            {"points_monte_carlo", intervals->monte_carlo},
+                            {"reason", intervals->example_reason},
+                            {"smallest_safe_depth_mm", std::isfinite(safe_min) ? MToMm(safe_min) : NAN}};
+      }
       j["exit_code"] = !implausible ? ExitCodeFor(map.status()) : kExitFlagged;
       io::WriteFileAtomically(summary_path, SummaryText(j));
     }

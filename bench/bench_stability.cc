@@ -13,6 +13,8 @@
 #include "robomach/io/region_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/stability/tool_tip_model.h"
+#include "robomach/io/uncertainty_file.h"
+#include "robomach/stability/lobe_uncertainty.h"
 #include "robomach/stability/mode_coupling.h"
 #include "robomach/stability/posture_stability.h"
 #include "robomach/stability/semi_discretization.h"
@@ -130,6 +132,34 @@ BENCHMARK(BM_Map100x100)
     ->Iterations(1)
     ->UseRealTime()
     ->ComputeStatistics("min", [](const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); });
+
+// Issue #37: the same map's safe depth, first order, with the uncertainty of
+// the shipped kq-identify campaign fixture (six joint stiffnesses, full
+// covariance): 12 extra analyses per point. Target: at most 3 x BM_Map100x100.
+void BM_Map100x100SafeDepthFirstOrder(benchmark::State& state) {
+  const Setup s;
+  const io::RobotConfig cfg = io::LoadRobotConfig(Src("config/kr210.yaml"));
+  const dynamics::ParameterUncertainty u = io::ReadParameterUncertainty(Src("tests/data/uncertainty/kq_demo.yaml"));
+  io::RegionSpec region = io::ReadRegionFile(Src("config/region_demo.yaml"), 6);
+  region.size_u = region.size_v = 0.5;
+  region.grid_step = 0.5 / 99.0;
+  const auto targets = region.Targets(s.cut.feed_direction_B);
+  stability::MapOptions opt;
+  opt.seed_q = region.seed_q;
+  opt.rotation = region.rotation_fixed;
+  opt.analysis.spindle_speed_rad_s =
+      Eigen::VectorXd::LinSpaced(200, s.cut.spindle_speed_min_rad_s, s.cut.spindle_speed_max_rad_s);
+  dynamics::PropagationOptions po;
+  po.method = dynamics::PropagationMethod::kFirstOrder;
+  for (auto _ : state) {
+    const auto pts = stability::EvaluateStabilityMap(s.model, targets, region.num_v(), region.num_u(),
+                                                     s.cut.process, opt);
+    const auto iv = stability::StabilityMapIntervals(cfg.description, cfg.parameters, targets, pts, s.cut.process,
+                                                     opt.analysis, u, po);
+    benchmark::DoNotOptimize(iv.depth.data());
+  }
+}
+BENCHMARK(BM_Map100x100SafeDepthFirstOrder)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 // Semi-discretization lobes on the Insperger-Stepan 2004 benchmark (1 DOF,
 // 922 Hz, 2 teeth) as `stability-lobes --method sd` runs them by default:

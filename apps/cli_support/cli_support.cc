@@ -21,6 +21,7 @@
 
 #include "robomach/common/errors.h"
 #include "robomach/common/version.h"
+#include "robomach/io/uncertainty_file.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/file_kind.h"
@@ -377,6 +378,32 @@ MessageSink MessagePrinter(const std::string& tool) {
       case Message::Kind::kInfo: std::cerr << tool << ": " << m.text << '\n'; break;
     }
   };
+}
+
+void AddUncertaintyOptions(CLI::App& app, UncertaintyCli* u, const std::string& gains) {
+  app.add_option("--uncertainty", u->paths,
+                 "parameter-uncertainty YAML (docs/formats.md §12, from kq-identify --uncertainty-out); repeatable, "
+                 "files from different campaigns are taken as independent. Its estimates replace the config's "
+                 "values; " + gains);
+  app.add_option("--confidence", u->propagation.confidence, "two-sided confidence level of the intervals, in (0, 1)")
+      ->capture_default_str();
+  app.add_option("--uncertainty-method", u->method,
+                 "auto (first order, Monte Carlo where the outputs bend within the interval), first-order or "
+                 "monte-carlo")
+      ->check(OneOf({"auto", "first-order", "monte-carlo"}))->capture_default_str();
+  app.add_option("--samples", u->propagation.samples, "Monte Carlo samples per posture")->capture_default_str();
+  app.add_option("--seed", u->propagation.seed, "Monte Carlo seed")->capture_default_str();
+}
+
+void UncertaintyCli::Finish() {
+  // The method and options also serve a robot config's `uncertainty:` files.
+  propagation.method = dynamics::ParsePropagationMethod(method);
+  ValidateOptions({{"confidence", "--confidence"}, {"samples", "--samples"}},
+                  [&] { dynamics::CheckValid(propagation); });
+  for (const std::string& p : paths) {
+    RequireInputFile("--uncertainty", p, "parameter-uncertainty file", {io::FileKind::kYaml},
+                     io::kUncertaintyFileFormat);
+  }
 }
 
 CLI::Validator OneOf(std::vector<std::string> names, std::map<std::string, std::string> aliases) {

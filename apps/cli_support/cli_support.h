@@ -14,6 +14,7 @@
 
 #include "robomach/common/messages.h"
 #include "robomach/common/run_status.h"
+#include "robomach/dynamics/uncertainty.h"
 #include "robomach/io/file_kind.h"
 #include "robomach/io/robot_config.h"
 
@@ -212,6 +213,27 @@ MessageSink MessagePrinter(const std::string& tool);
 /// "parallel"; keys lower-case) or else the closest name (ClosestName:
 /// "zoaa" -> "zoa").
 CLI::Validator OneOf(std::vector<std::string> names, std::map<std::string, std::string> aliases = {});
+
+/// The options of the tools that predict with a parameter uncertainty
+/// (issue #37): --uncertainty FILE (repeatable), --confidence,
+/// --uncertainty-method, --samples, --seed.
+struct UncertaintyCli {
+  std::vector<std::string> paths;
+  dynamics::PropagationOptions propagation;
+  std::string method{"auto"};
+  /// propagation.method from `method`, the options checked (exit 64 naming
+  /// the option) and each file of --uncertainty required as a YAML file (66
+  /// when missing).
+  void Finish();
+  /// The files to use: --uncertainty's, else those the robot config names
+  /// (`uncertainty:`).
+  const std::vector<std::string>& PathsFor(const io::RobotConfig& config) const {
+    return paths.empty() ? config.uncertainty_files : paths;
+  }
+};
+/// Adds the options to `app`; `gains` says what the files add ("--modes and
+/// --summary gain each mode's interval").
+void AddUncertaintyOptions(CLI::App& app, UncertaintyCli* u, const std::string& gains);
 
 /// @throws UsageError unless lo <= value <= hi (and finite).
 void CheckOptionRange(const std::string& option, double value, double lo, double hi);

@@ -30,6 +30,7 @@ void BindStability(py::module_& m);
 void BindDrilling(py::module_& m);
 void BindPolishing(py::module_& m);
 void BindMachine(py::module_& m);
+void BindUncertainty(py::module_& m);
 
 /// Receptance matrices per line -> complex128 array of shape (lines, 3, 3).
 py::array_t<std::complex<double>> ToArray(const std::vector<Eigen::Matrix3cd>& h);

@@ -160,4 +160,5 @@ PYBIND11_MODULE(robomach, m) {
   BindDrilling(m);
   BindPolishing(m);
   BindMachine(m);
+  BindUncertainty(m);
 }

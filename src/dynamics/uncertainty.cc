@@ -201,19 +201,28 @@ PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction&
   res.outputs.assign(m, OutputInterval{});
   for (int k = 0; k < m; ++k) res.outputs[k].value = f0(k);
 
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(u.covariance);
+  const Eigen::VectorXd lambda = eig.eigenvalues().cwiseMax(0.0);
+  const Eigen::MatrixXd& V = eig.eigenvectors();
+
+  // Σ_f = Σ_k λ_k (∂f/∂v_k)(∂f/∂v_k)ᵀ over the covariance's principal axes
+  // v_k: central differences along each axis with a step of 1e-3 √λ_k
+  // (2 evaluations per axis; axes without variance are skipped, so a
+  // rank-one covariance costs 3 evaluations). J = Σ_k (∂f/∂v_k) v_kᵀ is the
+  // Jacobian on the span of the covariance, which the sigma-point check uses.
   auto first_order = [&]() {
     Eigen::MatrixXd J = Eigen::MatrixXd::Zero(m, n);
-    for (int i = 0; i < n; ++i) {
-      const double sigma = std::sqrt(std::max(u.covariance(i, i), 0.0));
-      if (!(sigma > 0.0)) continue;  // a parameter without uncertainty adds none
-      const double h = 1e-3 * sigma;
-      Eigen::VectorXd tp = theta0, tm = theta0;
-      tp(i) += h;
-      tm(i) -= h;
-      J.col(i) = (f(FromTheta(u, tp)) - f(FromTheta(u, tm))) / (2.0 * h);
+    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(m, m);
+    const double lambda_max = lambda.maxCoeff();
+    for (int k = 0; k < n; ++k) {
+      if (!(lambda(k) > 1e-14 * lambda_max)) continue;
+      const double h = 1e-3 * std::sqrt(lambda(k));
+      const Eigen::VectorXd d =
+          (f(FromTheta(u, theta0 + h * V.col(k))) - f(FromTheta(u, theta0 - h * V.col(k)))) / (2.0 * h);
       res.evaluations += 2;
+      J += d * V.col(k).transpose();
+      cov += lambda(k) * d * d.transpose();
     }
-    const Eigen::MatrixXd cov = J * u.covariance * J.transpose();
     for (int k = 0; k < m; ++k) {
       const double s = std::sqrt(std::max(cov(k, k), 0.0));
       res.outputs[k].std_dev = s;
@@ -222,10 +231,6 @@ PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction&
     }
     return J;
   };
-
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(u.covariance);
-  const Eigen::VectorXd lambda = eig.eigenvalues().cwiseMax(0.0);
-  const Eigen::MatrixXd& V = eig.eigenvectors();
 
   bool monte_carlo = o.method == PropagationMethod::kMonteCarlo;
   if (o.method != PropagationMethod::kMonteCarlo) {

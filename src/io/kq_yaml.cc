@@ -1,6 +1,7 @@
 #include "robomach/io/kq_yaml.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <regex>
@@ -81,7 +82,8 @@ std::string JointStiffnessYaml(const identification::JointStiffnessResult& r,
 
 std::string MergeJointStiffness(const std::string& config_path, const Eigen::VectorXd& kq,
                                 const std::string& output_path,
-                                const std::vector<std::string>& header_comments) {
+                                const std::vector<std::string>& header_comments,
+                                const std::string& uncertainty_path) {
   std::ifstream in(config_path);
   if (!in) throw InputError({config_path, 0, 0}, "cannot read the robot config");
   // Check the structure with the YAML reader first (file:line:col errors).
@@ -99,6 +101,7 @@ std::string MergeJointStiffness(const std::string& config_path, const Eigen::Vec
   for (const auto& c : header_comments) out << "# " << c << "\n";
   const std::regex kq_line(R"(^joint_stiffness_Nm_per_rad\s*:\s*\[.*\]\s*(#.*)?$)");
   const std::regex urdf_line(R"(^(\s+urdf\s*:\s*)([^#\s]+)(.*)$)");
+  const std::regex uncertainty_line(R"(^uncertainty\s*:.*$)");
   std::string line;
   int line_no = 0, replaced = 0;
   while (std::getline(in, line)) {
@@ -109,6 +112,8 @@ std::string MergeJointStiffness(const std::string& config_path, const Eigen::Vec
       for (int j = 0; j < kq.size(); ++j) out << (j ? ", " : "") << Value(kq(j));
       out << "]   # identified by kq-identify\n";
       ++replaced;
+    } else if (!uncertainty_path.empty() && std::regex_match(line, m, uncertainty_line)) {
+      continue;  // replaced at the end
     } else if (std::regex_match(line, m, urdf_line)) {
       out << m[1].str() << RebaseRelative(config_path, m[2].str(), output_path) << m[3].str() << "\n";
     } else {
@@ -119,6 +124,17 @@ std::string MergeJointStiffness(const std::string& config_path, const Eigen::Vec
     throw InputError({config_path, 0, 0},
                      "expected exactly one line 'joint_stiffness_Nm_per_rad: [k1, ..., kn]' at the "
                      "start of a line to merge into, found " + std::to_string(replaced));
+  }
+  if (!uncertainty_path.empty()) {
+    // The file as the output's folder sees it (the tool writes both).
+    namespace fs = std::filesystem;
+    const std::string ref =
+        fs::path(uncertainty_path).is_absolute()
+            ? uncertainty_path
+            : fs::absolute(uncertainty_path).lexically_normal().lexically_relative(
+                  fs::absolute(output_path).lexically_normal().parent_path()).string();
+    out << "# the identified stiffnesses' covariance (kq-identify --uncertainty-out; docs/formats.md §12)\n"
+        << "uncertainty: [\"" << ref << "\"]\n";
   }
   return out.str();
 }

@@ -10,20 +10,23 @@ namespace robomach::io {
 
 double LobeSpeedRpm(double speed_rad_s) { return std::round(RadPerSecToRpm(speed_rad_s) * 1e9) / 1e9; }
 
-void WriteLobesCsv(std::ostream& os, const std::vector<stability::LobeRow>& rows) {
-  os << "pose_id,spindle_speed_rpm,critical_depth_mm,chatter_freq_hz,lobe_index,method,status,sd_steps\n";
+void WriteLobesCsv(std::ostream& os, const std::vector<stability::LobeRow>& rows, bool with_bounds) {
+  os << "pose_id,spindle_speed_rpm,critical_depth_mm,chatter_freq_hz,lobe_index,method,status,sd_steps"
+     << (with_bounds ? ",critical_depth_mm_lower,critical_depth_mm_upper" : "") << '\n';
   for (const stability::LobeRow& r : rows) {
     const stability::LobePoint& p = r.point;
     os << r.id << ',' << FormatDouble(LobeSpeedRpm(p.spindle_speed_rad_s)) << ','
        << (std::isfinite(p.critical_depth) ? FormatDouble(MToMm(p.critical_depth)) : "") << ','
        << (std::isfinite(p.chatter_freq_hz) ? FormatDouble(p.chatter_freq_hz) : "") << ','
        << (p.lobe_index >= 0 ? std::to_string(p.lobe_index) : "") << ',' << r.method << ','
-       << stability::ToString(p.status) << ',' << (p.sd_steps > 0 ? std::to_string(p.sd_steps) : "") << '\n';
+       << stability::ToString(p.status) << ',' << (p.sd_steps > 0 ? std::to_string(p.sd_steps) : "");
+    if (with_bounds) os << ',' << FormatCell(MToMm(r.depth_lower)) << ',' << FormatCell(MToMm(r.depth_upper));
+    os << '\n';
   }
 }
 
-void WriteLobesCsv(const std::string& path, const std::vector<stability::LobeRow>& rows) {
-  WriteFileAtomically(path, [&](std::ostream& os) { WriteLobesCsv(os, rows); });
+void WriteLobesCsv(const std::string& path, const std::vector<stability::LobeRow>& rows, bool with_bounds) {
+  WriteFileAtomically(path, [&](std::ostream& os) { WriteLobesCsv(os, rows, with_bounds); });
 }
 
 nlohmann::json LobesSummaryJson(const std::vector<stability::TipDynamics>& tips, const stability::LobesResult& lobes) {

@@ -591,6 +591,12 @@ RobotConfig LoadRobotConfig(const std::string& path) {
     }
   }
   doc.MarkUsed("parameters");
+  // Parameter-uncertainty files (formats.md §12), relative to the config.
+  if (doc.Has("uncertainty")) {
+    const YamlDoc files = doc["uncertainty"];
+    for (const std::string& f : files.Strings()) cfg.uncertainty_files.push_back(ResolveRelative(path, f));
+  }
+  doc.MarkUsed("uncertainty");
   doc.RejectUnknownKeys();
   CheckJointFrequencies(cfg, doc, kq, damping);
   return cfg;

@@ -40,7 +40,8 @@ MapPoints MapPointsOfPathFile(const std::string& path, const Eigen::Vector3d& de
 }
 
 void WriteStabilityMapCsv(const std::string& path, const MapPoints& points,
-                          const std::vector<stability::MapPoint>& results, int num_joints) {
+                          const std::vector<stability::MapPoint>& results, int num_joints,
+                          const std::vector<dynamics::OutputInterval>* depth_intervals) {
   const int n = num_joints;
   const bool grid = points.grid;
   const int cols = points.cols;
@@ -48,7 +49,8 @@ void WriteStabilityMapCsv(const std::string& path, const MapPoints& points,
     os << (grid ? "row,col,x_mm,y_mm," : "point_id,") << "px_mm,py_mm,pz_mm,rotation_deg";
     for (int j = 0; j < n; ++j) os << ",q" << j + 1 << "_deg";
     os << ",depth_mode_coupling_mm,depth_closed_form_mm,deformation_ratio,depth_regenerative_mm,"
-          "spindle_speed_rpm,critical_depth_mm,limiting_mechanism,chatter_freq_hz,jacobian_condition,status\n";
+          "spindle_speed_rpm,critical_depth_mm,limiting_mechanism,chatter_freq_hz,jacobian_condition,status"
+       << (depth_intervals ? ",critical_depth_mm_lower,critical_depth_mm_upper" : "") << '\n';
     for (size_t i = 0; i < results.size(); ++i) {
       const stability::MapPoint& p = results[i];
       const stability::PostureStability& s = p.stability;
@@ -75,7 +77,11 @@ void WriteStabilityMapCsv(const std::string& path, const MapPoints& points,
          << (analysed ? FormatCell(s.critical_depth * 1e3) : "") << ','
          << (analysed ? stability::ToString(s.limiting) : "") << ','
          << (analysed ? FormatCell(s.chatter_freq_hz) : "") << ',' << FormatCell(p.jacobian_condition) << ','
-         << stability::ToString(p.status) << '\n';
+         << stability::ToString(p.status);
+      if (depth_intervals) {
+        os << ',' << FormatCell(MToMm((*depth_intervals)[i].lower)) << ',' << FormatCell(MToMm((*depth_intervals)[i].upper));
+      }
+      os << '\n';
     }
   });
 }

@@ -164,7 +164,7 @@ std::string YamlDoc::OtherYamlKind(const std::string& missing) const {
        {"robot", "flexible_joints", "dh"}},
       {has("joint_stiffness_Nm_per_rad") || has("end_effector"), "a robot config (config/kr210.yaml)",
        {"robot", "joint_stiffness_Nm_per_rad", "damping", "end_effector", "spindle_toolholder_interface",
-        "hammer_test", "parameters", "effects", "urdf", "dh"}},
+        "hammer_test", "parameters", "effects", "urdf", "dh", "uncertainty"}},
       {has("drill") && has("process"), "a drill file for drill-sim --drill (config/drilling/drill_5mm.yaml)",
        {"drill", "process", "offset", "simulation"}},
       {has("material"), "a material file (config/drilling/q235.yaml)", {"material", "std_dev", "fit", "table"}},

@@ -43,7 +43,27 @@ void SaveLobesPlot(const std::string& path, const std::string& title, const std:
     s.label = c.label;
     s.color = PaletteColor(color++);
     s.markers = c.markers;
+    const Rgb color = s.color;
     ax.series.push_back(std::move(s));
+    if (!c.lower_mm.empty()) {
+      // The band (no legend entry of its own), then its lower end dashed:
+      // the safe depth.
+      Series band;
+      band.x = c.speed_rpm;
+      band.y = c.upper_mm;
+      band.y_fill_to = c.lower_mm;
+      band.color = color;
+      band.thickness = 1;
+      ax.series.insert(ax.series.end() - 1, std::move(band));
+      Series safe;
+      safe.x = c.speed_rpm;
+      safe.y = c.lower_mm;
+      safe.label = c.label + ", lower bound (safe depth)";
+      safe.color = color;
+      safe.dashed = true;
+      safe.thickness = 1;
+      ax.series.push_back(std::move(safe));
+    }
   }
   const double clip_mm = LobesDepthAxisClipMm(curves);
   if (std::isfinite(clip_mm)) {

@@ -81,6 +81,30 @@ void DashedLine(cv::Mat& img, cv::Point a, cv::Point b, cv::Scalar c, int thickn
   }
 }
 
+// A dashed polyline whose dashes run on across its vertices (8 px on, 8 px
+// off along the path), so that a curve of many short segments still reads
+// as dashed.
+void DashedPolyline(cv::Mat& img, const std::vector<cv::Point>& pts, cv::Scalar c, int thickness) {
+  constexpr double kDash = 8.0;
+  double phase = 0.0;  // distance along the path modulo 2 kDash
+  for (size_t i = 1; i < pts.size(); ++i) {
+    const cv::Point2d a(pts[i - 1]), b(pts[i]);
+    const double len = std::hypot(b.x - a.x, b.y - a.y);
+    double at = 0.0;
+    while (at < len) {
+      const bool on = phase < kDash;
+      const double step = std::min(len - at, (on ? kDash : 2.0 * kDash) - phase);
+      if (on && len > 0.0) {
+        const cv::Point2d p0 = a + (b - a) * (at / len), p1 = a + (b - a) * ((at + step) / len);
+        cv::line(img, cv::Point(cvRound(p0.x), cvRound(p0.y)), cv::Point(cvRound(p1.x), cvRound(p1.y)), c, thickness,
+                 cv::LINE_AA);
+      }
+      at += step;
+      phase = std::fmod(phase + step, 2.0 * kDash);
+    }
+  }
+}
+
 struct Range {
   double lo, hi;
 };
@@ -284,12 +308,45 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
   // marker labels are placed where it is clear (PlaceLabels).
   cv::Mat roi = img(plot);
   cv::Mat1b ink(plot.size(), static_cast<unsigned char>(0));
+  // Bands first, blended under the curves.
+  auto to_px = [&](double x, double y) {
+    return cv::Point(static_cast<int>(std::lround(std::clamp(tx(x) - plot.x, -1e4, 1e4))),
+                     static_cast<int>(std::lround(std::clamp(ty(y) - plot.y, -1e4, 1e4))));
+  };
   for (const Series& s : ax.series) {
+    if (s.y_fill_to.empty()) continue;
+    cv::Mat overlay = roi.clone();
+    std::vector<cv::Point> top, bottom;
+    auto fill = [&] {
+      if (top.size() >= 2) {
+        std::vector<cv::Point> poly(top);
+        poly.insert(poly.end(), bottom.rbegin(), bottom.rend());
+        cv::fillPoly(overlay, std::vector<std::vector<cv::Point>>{poly}, ToCv(s.color), cv::LINE_AA);
+      }
+      top.clear();
+      bottom.clear();
+    };
+    const size_t n = std::min({s.x.size(), s.y.size(), s.y_fill_to.size()});
+    for (size_t i = 0; i < n; ++i) {
+      const bool ok = std::isfinite(s.x[i]) && std::isfinite(s.y[i]) && std::isfinite(s.y_fill_to[i]) &&
+                      (!ax.log_x || s.x[i] > 0) && (!ax.log_y || (s.y[i] > 0 && s.y_fill_to[i] > 0));
+      if (!ok) {
+        fill();
+        continue;
+      }
+      top.push_back(to_px(s.x[i], s.y[i]));
+      bottom.push_back(to_px(s.x[i], s.y_fill_to[i]));
+    }
+    fill();
+    cv::addWeighted(overlay, 0.25, roi, 0.75, 0.0, roi);
+  }
+  for (const Series& s : ax.series) {
+    if (!s.y_fill_to.empty()) continue;  // a band only
     std::vector<cv::Point> pts;
     auto flush = [&] {
       if (pts.size() >= 2 && !s.markers) {
         if (s.dashed) {
-          for (size_t i = 1; i < pts.size(); ++i) DashedLine(roi, pts[i - 1], pts[i], ToCv(s.color), s.thickness);
+          DashedPolyline(roi, pts, ToCv(s.color), s.thickness);
         } else {
           cv::polylines(roi, pts, false, ToCv(s.color), s.thickness, cv::LINE_AA);
         }

@@ -1,5 +1,6 @@
 #include "robomach/workflows/stability_lobes.h"
 
+#include <optional>
 #include <string>
 
 #include "robomach/common/errors.h"
@@ -7,6 +8,7 @@
 #include "robomach/common/units.h"
 #include "robomach/io/lobes_file.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/io/uncertainty_file.h"
 #include "robomach/workflows/tip_sources.h"
 
 namespace robomach::workflows {
@@ -41,6 +43,22 @@ void StabilityLobesOptions::Validate() const {
   }
   if (!robot_path.empty() && postures_path.empty()) throw OptionError("postures_path", "robot_path needs postures_path");
   if (!frf_y_path.empty() && frf_path.empty()) throw OptionError("frf_y_path", "frf_y_path needs frf_path");
+  if (!uncertainty_paths.empty()) {
+    if (robot_path.empty()) {
+      throw OptionError("uncertainty_paths",
+                        "uncertainty_paths needs robot_path: the parameter uncertainty is of a robot model's "
+                        "parameters (a measured FRF's uncertainty is its noise)");
+    }
+    if (method == stability::LobeMethod::kSd) {
+      throw OptionError("uncertainty_paths", "uncertainty_paths bands the ZOA lobes: use method zoa or both "
+                                             "(the SD's band would take hundreds of SD runs)");
+    }
+    try {
+      dynamics::CheckValid(uncertainty);
+    } catch (const std::invalid_argument& e) {
+      throw OptionError("uncertainty", e.what());
+    }
+  }
   if (!(tool_axis.allFinite() && tool_axis.norm() > 0.0)) {
     throw OptionError("tool_axis", AxisSource(*this) + ": expected a non-zero vector x,y,z");
   }
@@ -90,12 +108,34 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const stabil
   }
   const std::string axis_source = AxisSource(o);
   if (!o.robot_path.empty()) {
-    const io::RobotConfig cfg = io::LoadRobotConfig(o.robot_path);
+    io::RobotConfig cfg = io::LoadRobotConfig(o.robot_path);
     for (const std::string& w : cfg.implausible) {
       Say(tell, stability::TipMessage::Kind::kWarning, w);
       run.input_findings.push_back(w);
     }
-    run.tips = TipsFromRobotPostures(cfg.Build(), o.postures_path, o.pose_ids, run.cut, tell);
+    std::optional<dynamics::ParameterUncertainty> u;
+    // The config's `uncertainty:` files when none were given (the ZOA only).
+    const std::vector<std::string>& files =
+        !o.uncertainty_paths.empty() || o.method == stability::LobeMethod::kSd ? o.uncertainty_paths
+                                                                                : cfg.uncertainty_files;
+    if (!files.empty()) {
+      run.uncertainty_files = files;
+      u = io::ReadParameterUncertainties(files);
+      const std::string changed = dynamics::UseEstimates(*u, &cfg.parameters);
+      if (!changed.empty()) {
+        Say(tell, stability::TipMessage::Kind::kNote,
+            "the uncertainty's estimates replace the config's values: " + changed);
+      }
+    }
+    std::vector<io::Posture> postures;
+    run.tips = TipsFromRobotPostures(cfg.Build(), o.postures_path, o.pose_ids, run.cut, tell, &postures);
+    if (u) {
+      const stability::LobesOptions lo = MakeLobesOptions(run.cut, o);
+      for (const io::Posture& p : postures) {
+        run.bands.push_back(stability::ZoaLobeBand(cfg.description, cfg.parameters, p.id, p.q,
+                                                   run.cut.feed_direction_B, lo, *u, o.uncertainty));
+      }
+    }
   } else if (!o.frf_path.empty()) {
     stability::MeasuredTipOptions mo;
     mo.frf_path = o.frf_path;
@@ -113,6 +153,21 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const stabil
     run.tips = TipsFromModalTableFile(o.modal_table_path, o.pose_ids, R, run.cut);
   }
   run.lobes = stability::ComputeLobes(run.tips, MakeLobesOptions(run.cut, o), tell, progress);
+  for (const stability::ZoaBand& b : run.bands) {
+    size_t at = 0;
+    for (stability::LobeRow& r : run.lobes.rows) {
+      if (r.id != b.id || r.method != "zoa" || at >= b.depth.size()) continue;
+      r.depth_lower = b.depth[at].lower;
+      r.depth_upper = b.depth[at].upper;
+      ++at;
+    }
+    Say(tell, stability::TipMessage::Kind::kNote,
+        b.id + ": smallest critical depth (ZOA) " + FormatNumber(1e3 * b.min_depth.value, 4) + " mm, " +
+            FormatNumber(100.0 * o.uncertainty.confidence, 3) + " % interval [" +
+            FormatNumber(1e3 * b.min_depth.lower, 4) + ", " + FormatNumber(1e3 * b.min_depth.upper, 4) +
+            "] mm: the safe depth at every speed is " + FormatNumber(1e3 * b.min_depth.lower, 4) + " mm (" +
+            b.propagation.reason + ")");
+  }
   return run;
 }
 
@@ -131,6 +186,22 @@ nlohmann::json StabilityLobesRun::Summary(const StabilityLobesOptions& o) const 
   j["teeth"] = cut.process.teeth;
   j["radial_immersion"] = cut.process.radial_immersion;
   j["input_findings"] = input_findings;
+  if (!bands.empty()) {
+    nlohmann::json u;
+    u["files"] = uncertainty_files;
+    u["confidence"] = o.uncertainty.confidence;
+    u["tips"] = nlohmann::json::array();
+    for (const stability::ZoaBand& b : bands) {
+      u["tips"].push_back({{"pose_id", b.id},
+                           {"min_critical_depth_mm", 1e3 * b.min_depth.value},
+                           {"min_critical_depth_mm_lower", 1e3 * b.min_depth.lower},
+                           {"min_critical_depth_mm_upper", 1e3 * b.min_depth.upper},
+                           {"method", dynamics::ToString(b.propagation.method_used)},
+                           {"reason", b.propagation.reason},
+                           {"failed_samples", b.propagation.failed_samples}});
+    }
+    j["uncertainty"] = u;
+  }
   return j;
 }
 

@@ -24,7 +24,8 @@ Eigen::Matrix3d CutFrame(const io::CutSpec& cut, const Eigen::Vector3d& tool_axi
 std::vector<stability::TipDynamics> TipsFromRobotPostures(const std::shared_ptr<const dynamics::RobotModel>& model,
                                                           const std::string& postures_path,
                                                           const std::vector<std::string>& pose_ids, const io::CutSpec& cut,
-                                                          const stability::TipMessageSink& tell) {
+                                                          const stability::TipMessageSink& tell,
+                                                          std::vector<io::Posture>* chosen_postures) {
   const std::vector<io::Posture> postures = io::ReadPostureFile(postures_path, model->num_joints());
   std::vector<const io::Posture*> chosen;
   for (const std::string& id : pose_ids) {
@@ -42,6 +43,7 @@ std::vector<stability::TipDynamics> TipsFromRobotPostures(const std::shared_ptr<
   std::vector<stability::TipDynamics> tips;
   dynamics::PostureEvaluator ev(model);
   for (const io::Posture* p : chosen) {
+    if (chosen_postures) chosen_postures->push_back(*p);
     const dynamics::PostureDynamics d = ev.Evaluate(p->q);
     if (d.near_singular && tell) {
       tell({stability::TipMessage::Kind::kWarning, postures_path + ":" + std::to_string(p->line) + ": posture " +

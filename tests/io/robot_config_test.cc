@@ -79,6 +79,17 @@ TEST(RobotConfig, BadValuesAreLocated) {
               HasSubstr("unknown effect 'tip_mas'; available: "));
 }
 
+// Issue #37: a config names parameter-uncertainty files relative to its
+// folder, as it names its URDF.
+TEST(RobotConfig, UncertaintyFilesAreResolvedAgainstTheConfigsFolder) {
+  const std::string p = Variant("uncertainty", "\ndamping:", "\nuncertainty: [unc/kq.yaml, /abs/other.yaml]\ndamping:");
+  const RobotConfig cfg = LoadRobotConfig(p);
+  ASSERT_EQ(cfg.uncertainty_files.size(), 2u);
+  EXPECT_EQ(cfg.uncertainty_files[0], (std::filesystem::path(p).parent_path() / "unc/kq.yaml").lexically_normal().string());
+  EXPECT_EQ(cfg.uncertainty_files[1], "/abs/other.yaml");
+  EXPECT_TRUE(LoadRobotConfig(testing::SourcePath("config/kr210.yaml")).uncertainty_files.empty());
+}
+
 TEST(RobotConfig, MalformedYamlIsLocated) {
   const std::string dir = TempDir("config_yaml");
   const std::string p = WriteText(dir + "/r.yaml", "robot:\n  urdf: [a, b\n");

@@ -116,8 +116,10 @@ using OutputFunction = std::function<Eigen::VectorXd(const Eigen::VectorXd& valu
 
 /// Carries the parameter uncertainty to the outputs of `f`.
 ///
-/// First order (the delta method): J = ∂f/∂θ by central differences with
-/// steps of 1e-3 σ_θ per parameter, Σ_f = J Σ_θ Jᵀ, interval value ± z σ_f,
+/// First order (the delta method): the derivatives of f along the
+/// covariance's principal axes v_k by central differences with steps of
+/// 1e-3 √λ_k (2 r + 1 evaluations for a covariance of rank r),
+/// Σ_f = Σ_k λ_k (∂f/∂v_k)(∂f/∂v_k)ᵀ = J Σ_θ Jᵀ, interval value ± z σ_f,
 /// z = Φ⁻¹((1 + P)/2). Monte Carlo: θ ~ N(θ̂, Σ_θ) drawn with std::mt19937_64
 /// from `seed` through the covariance's eigen-decomposition (semi-definite
 /// allowed), interval between the (1 − P)/2 and (1 + P)/2 sample quantiles.

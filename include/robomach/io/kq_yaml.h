@@ -26,8 +26,12 @@ std::string JointStiffnessYaml(const identification::JointStiffnessResult& resul
 /// valid from the output's folder. Comments and everything else are kept.
 /// @throws InputError if the config has no one-line joint_stiffness entry or
 ///   sets kq parameters under `parameters:` (which would override it).
+/// With `uncertainty_path` (kq-identify --merge --uncertainty-out) the copy
+/// ends with `uncertainty: [path]` (relative to the output's folder when
+/// the path is relative), replacing an `uncertainty:` line it had.
 std::string MergeJointStiffness(const std::string& config_path, const Eigen::VectorXd& kq,
                                 const std::string& output_path,
-                                const std::vector<std::string>& header_comments = {});
+                                const std::vector<std::string>& header_comments = {},
+                                const std::string& uncertainty_path = "");
 
 }  // namespace robomach::io

@@ -13,12 +13,15 @@
 namespace robomach::io {
 
 /// `pose_id,spindle_speed_rpm,critical_depth_mm,chatter_freq_hz,lobe_index,method,status,sd_steps`,
-/// one row per point, empty cells where a point has no value. Speeds are
+/// one row per point, empty cells where a point has no value; with
+/// `with_bounds` (parameter uncertainty) also `critical_depth_mm_lower,
+/// critical_depth_mm_upper` (LobeRow::depth_lower/upper; the lower one is
+/// the safe depth). Speeds are
 /// rounded to 1e-9 rpm: they went rpm -> rad/s -> rpm, and this hides the
 /// last-bit residue (6000.000000000001). The path version is atomic; "-"
 /// is stdout.
-void WriteLobesCsv(std::ostream& os, const std::vector<stability::LobeRow>& rows);
-void WriteLobesCsv(const std::string& path, const std::vector<stability::LobeRow>& rows);
+void WriteLobesCsv(std::ostream& os, const std::vector<stability::LobeRow>& rows, bool with_bounds = false);
+void WriteLobesCsv(const std::string& path, const std::vector<stability::LobeRow>& rows, bool with_bounds = false);
 
 /// A speed [rad/s] in rpm as the lobes CSV writes it (rounded to 1e-9 rpm).
 double LobeSpeedRpm(double speed_rad_s);

@@ -25,6 +25,10 @@ struct RobotConfig {
   /// `spindle_toolholder_interface` and `hammer_test`), so that a tool that
   /// refuses one of them can name its file:line:col.
   std::map<std::string, SourceLocation> extra_value_locations;
+  /// `uncertainty: [files]`: parameter-uncertainty files (formats.md §12,
+  /// kq-identify --uncertainty-out), resolved against the config's folder;
+  /// the predicting tools use them when --uncertainty is not given.
+  std::vector<std::string> uncertainty_files;
   std::shared_ptr<const dynamics::RobotModel> Build() const {
     return dynamics::RobotModel::Build(description, parameters);
   }

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "robomach/dynamics/uncertainty.h"
 #include "robomach/io/region_file.h"
 #include "robomach/stability/stability_map.h"
 
@@ -38,8 +39,11 @@ MapPoints MapPointsOfPathFile(const std::string& path, const Eigen::Vector3d& de
 /// pose, the joint angles, the mode-coupling, closed-form and regenerative
 /// depths, the limiting mechanism, the chatter frequency, cond(J) and the
 /// status. Written through WriteFileAtomically ("-" = stdout).
+/// With `depth_intervals` (stability-map --uncertainty) the columns
+/// critical_depth_mm_lower (the safe depth) and critical_depth_mm_upper follow.
 void WriteStabilityMapCsv(const std::string& path, const MapPoints& points,
-                          const std::vector<stability::MapPoint>& results, int num_joints);
+                          const std::vector<stability::MapPoint>& results, int num_joints,
+                          const std::vector<dynamics::OutputInterval>* depth_intervals = nullptr);
 
 /// The summary's result part (docs/formats.md §4.1): mode, points, grid
 /// size, points reached, flagged and by status, and the smallest and

@@ -13,6 +13,10 @@ struct LobeCurve {
   std::vector<double> speed_rpm;  // [rpm]
   std::vector<double> depth_mm;   // [mm]
   bool markers{false};            // SD's points (a coarser grid) as markers
+  /// Optional (parameter uncertainty): the depth's interval per speed [mm],
+  /// drawn as a band in the curve's colour with its lower end (the safe
+  /// depth) as a dashed line; empty or NaN: no band there.
+  std::vector<double> lower_mm, upper_mm;
 };
 
 /// Where the depth axis ends, or NaN when it shows the curves' full range.

@@ -24,6 +24,11 @@ struct Series {
   int thickness{2};        // [px]
   bool dashed{false};
   bool markers{false};     // small circles at the points instead of a line
+  /// Optional: the series is a band filled between y and these values
+  /// (same x), in its colour at 25 % opacity, under every curve, with no
+  /// line of its own; a non-finite value on either side leaves a gap (a
+  /// confidence band).
+  std::vector<double> y_fill_to;
 };
 
 /// A labelled vertical line (a mode frequency, a limit).

@@ -30,6 +30,9 @@ struct LobeRow {
   std::string id;      // the tool tip's id
   std::string method;  // "zoa" or "sd"
   LobePoint point;
+  /// With parameter uncertainty (ZoaLobeBand): the critical depth's
+  /// interval [m]; NaN otherwise.
+  double depth_lower{NAN}, depth_upper{NAN};
 };
 
 struct LobesOptions {

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "robomach/io/cut_file.h"
+#include "robomach/stability/lobe_uncertainty.h"
 #include "robomach/stability/lobes_workflow.h"
 #include "robomach/stability/tip_dynamics.h"
 
@@ -44,6 +45,11 @@ struct StabilityLobesOptions {
   int sd_modes{3};
   double sd_max_depth_mm{20.0};  // [mm]
   int threads{0};                // SD worker threads; 0: all cores
+  /// Parameter-uncertainty files (formats.md §12; robot source, ZOA): the
+  /// estimates replace the config's values and each ZOA row gets the
+  /// critical depth's interval (ZoaLobeBand).
+  std::vector<std::string> uncertainty_paths;
+  dynamics::PropagationOptions uncertainty;
 
   /// The bounds keep a typo from hours of work or an allocation failure.
   /// @throws OptionError naming the field, its value and its bound (speeds
@@ -51,7 +57,9 @@ struct StabilityLobesOptions {
   ///   [2, 1000], sd_steps_per_mode_period [4, 1000], sd_modes [1, 200],
   ///   sd_max_depth_mm [1e-6, 1e4], threads [0, 256], a non-zero
   ///   tool_axis), or the source fields when not exactly one source is given
-  ///   (robot_path needs postures_path; frf_y_path needs frf_path).
+  ///   (robot_path needs postures_path; frf_y_path needs frf_path);
+  ///   uncertainty_paths without robot_path or with method sd, and the
+  ///   uncertainty's options (confidence, samples).
   void Validate() const;
   /// Validate's checks of the lobe settings alone (method to threads): for
   /// a caller that brings its own tool tips (Python's stability_lobes).
@@ -71,6 +79,10 @@ struct StabilityLobesRun {
   /// The cut file's and the robot config's unit findings ("implausible
   /// (unit mistake?): ..."), each also told as a warning: they flag the run.
   std::vector<std::string> input_findings;
+  /// Per tip, with uncertainty_paths: the ZOA band (its rows' bounds are in
+  /// lobes.rows).
+  std::vector<stability::ZoaBand> bands;
+  std::vector<std::string> uncertainty_files;  // the files the bands came from
 
   /// stability-lobes' exit 3: the lobes are flagged or an input was implausible.
   bool flagged() const { return lobes.flagged() || !input_findings.empty(); }

@@ -12,6 +12,7 @@
 
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/io/cut_file.h"
+#include "robomach/io/posture_file.h"
 #include "robomach/stability/tip_dynamics.h"
 
 namespace robomach::workflows {
@@ -32,7 +33,8 @@ Eigen::Matrix3d CutFrame(const io::CutSpec& cut, const Eigen::Vector3d& tool_axi
 std::vector<stability::TipDynamics> TipsFromRobotPostures(const std::shared_ptr<const dynamics::RobotModel>& model,
                                                           const std::string& postures_path,
                                                           const std::vector<std::string>& pose_ids, const io::CutSpec& cut,
-                                                          const stability::TipMessageSink& tell = {});
+                                                          const stability::TipMessageSink& tell = {},
+                                                          std::vector<io::Posture>* chosen_postures = nullptr);
 
 /// The tool tips of the measured FRFs of options.frf_path (and
 /// options.frf_y_path): io::ReadTipFrfs, its warnings told, then

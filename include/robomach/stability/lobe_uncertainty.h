@@ -1,0 +1,66 @@
+#pragma once
+// The ZOA lobes of a robot posture with the uncertainty of fitted model
+// parameters (issue #37): each speed's critical depth and the smallest one
+// as intervals, whose lower ends are the safe depths of cut.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "robomach/dynamics/robot_model.h"
+#include "robomach/dynamics/uncertainty.h"
+#include "robomach/stability/lobes_workflow.h"
+#include "robomach/stability/stability_map.h"
+
+namespace robomach::stability {
+
+struct ZoaBand {
+  std::string id;
+  Eigen::VectorXd speed_rad_s;                  // the ZOA's speeds (LobesOptions::zoa_speeds_rad_s)
+  /// Per speed: the critical depth [m] and its interval; NaN where the lobes
+  /// have no boundary at the estimates (those speeds are not propagated).
+  std::vector<dynamics::OutputInterval> depth;
+  /// The smallest critical depth over the speeds [m] (the lobe bottom a
+  /// process engineer reads): its lower end is the depth that is stable at
+  /// every speed with the confidence asked for.
+  dynamics::OutputInterval min_depth;
+  dynamics::PropagationResult propagation;      // method, reason, evaluations
+};
+
+/// The ZOA critical depths at `options.zoa_speeds_rad_s` of the tool tip of
+/// `description` with `base` parameters at posture q (TipFromPosture with
+/// `feed_B`, the process's teeth and options.max_speed_rad_s, then
+/// ComputeZoaLobes as ComputeLobes runs it), with intervals from `u`. A
+/// sample whose lobes lose the boundary at a propagated speed counts as
+/// failed (PropagationResult::failed_samples).
+/// @throws std::invalid_argument as dynamics::Propagate, or when the lobes
+///   have no boundary at any speed at the estimates.
+ZoaBand ZoaLobeBand(const dynamics::RobotDescription& description, const dynamics::ParameterSet& base,
+                    const std::string& id, const Eigen::VectorXd& q, const Eigen::Vector3d& feed_B,
+                    const LobesOptions& options, const dynamics::ParameterUncertainty& u,
+                    const dynamics::PropagationOptions& propagation = {});
+
+/// The interval of each map point's critical depth (its lower end is the
+/// point's safe depth): the point's posture and rotation as the map found
+/// them (the IK does not depend on the uncertain parameters), the analysis
+/// (AnalysePosture: mode coupling and ZOA) repeated by the propagation.
+/// Points not analysed (unreachable, joint limits) or without a finite
+/// critical depth get NaN. `progress` is called with (points done, total)
+/// from the calling thread; `threads` as MapOptions (0: all cores).
+struct MapDepthIntervals {
+  std::vector<dynamics::OutputInterval> depth;  // per point [m]
+  int first_order{0}, monte_carlo{0};           // points by the method used
+  std::string example_reason;                   // the reason of the first point that used Monte Carlo, else of the first
+  long evaluations{0};
+};
+MapDepthIntervals StabilityMapIntervals(const dynamics::RobotDescription& description,
+                                        const dynamics::ParameterSet& base,
+                                        const std::vector<ToolPoseTarget>& targets,
+                                        const std::vector<MapPoint>& points, const MillingProcess& process,
+                                        const PostureStabilityOptions& analysis,
+                                        const dynamics::ParameterUncertainty& u,
+                                        const dynamics::PropagationOptions& propagation, int threads = 0,
+                                        const ProgressCallback& progress = {});
+
+}  // namespace robomach::stability
