@@ -82,11 +82,11 @@ int Run(int argc, char** argv) {
     CheckDistinctPaths({{"--robot", robot_path}, {"--cut", cut_path}, {"--region", region_path}, {"--path", path_path}},
                        {{"--out", out_path}, {"--plot", plot_path}, {"--summary", summary_path}});
     if (!path_path.empty()) RequireReadableFile(path_path, "tool-path file");
-    if (!safe_plot_path.empty() && unc.paths.empty() && io::LoadRobotConfig(robot_path).uncertainty_files.empty()) {
-      throw UsageError("--safe-plot needs --uncertainty (or a robot config that names uncertainty files)");
-    }
     unc.Finish();
     io::RobotConfig cfg = LoadRobotConfigWarned(kTool, robot_path);
+    if (!safe_plot_path.empty() && unc.PathsFor(cfg).empty()) {
+      throw UsageError("--safe-plot needs --uncertainty (or a robot config that names uncertainty files)");
+    }
     std::optional<dynamics::ParameterUncertainty> uncertainty;
     if (!unc.PathsFor(cfg).empty()) {
       uncertainty = io::ReadParameterUncertainties(unc.PathsFor(cfg));

@@ -99,17 +99,27 @@ BENCHMARK(BM_ModeCouplingSearchOnePosture)->Unit(benchmark::kMicrosecond);
 
 // The 100 × 100 map over the demo region (500 mm × 500 mm, 5.05 mm
 // step), 200 speeds per point, all cores.
+struct Map100x100 {
+  io::RegionSpec region;
+  std::vector<stability::ToolPoseTarget> targets;
+  stability::MapOptions opt;
+  explicit Map100x100(const Setup& s) : region(io::ReadRegionFile(Src("config/region_demo.yaml"), 6)) {
+    region.size_u = region.size_v = 0.5;
+    region.grid_step = 0.5 / 99.0;
+    targets = region.Targets(s.cut.feed_direction_B);
+    opt.seed_q = region.seed_q;
+    opt.rotation = region.rotation_fixed;
+    opt.analysis.spindle_speed_rad_s =
+        Eigen::VectorXd::LinSpaced(200, s.cut.spindle_speed_min_rad_s, s.cut.spindle_speed_max_rad_s);
+  }
+};
+
 void BM_Map100x100(benchmark::State& state) {
   const Setup s;
-  io::RegionSpec region = io::ReadRegionFile(Src("config/region_demo.yaml"), 6);
-  region.size_u = region.size_v = 0.5;
-  region.grid_step = 0.5 / 99.0;
-  const auto targets = region.Targets(s.cut.feed_direction_B);
-  stability::MapOptions opt;
-  opt.seed_q = region.seed_q;
-  opt.rotation = region.rotation_fixed;
-  opt.analysis.spindle_speed_rad_s =
-      Eigen::VectorXd::LinSpaced(200, s.cut.spindle_speed_min_rad_s, s.cut.spindle_speed_max_rad_s);
+  const Map100x100 m(s);
+  const auto& region = m.region;
+  const auto& targets = m.targets;
+  const auto& opt = m.opt;
   double evals = 0.0, analysed = 0.0;
   for (auto _ : state) {
     const auto pts = stability::EvaluateStabilityMap(s.model, targets, region.num_v(), region.num_u(),
@@ -140,15 +150,10 @@ void BM_Map100x100SafeDepthFirstOrder(benchmark::State& state) {
   const Setup s;
   const io::RobotConfig cfg = io::LoadRobotConfig(Src("config/kr210.yaml"));
   const dynamics::ParameterUncertainty u = io::ReadParameterUncertainty(Src("tests/data/uncertainty/kq_demo.yaml"));
-  io::RegionSpec region = io::ReadRegionFile(Src("config/region_demo.yaml"), 6);
-  region.size_u = region.size_v = 0.5;
-  region.grid_step = 0.5 / 99.0;
-  const auto targets = region.Targets(s.cut.feed_direction_B);
-  stability::MapOptions opt;
-  opt.seed_q = region.seed_q;
-  opt.rotation = region.rotation_fixed;
-  opt.analysis.spindle_speed_rad_s =
-      Eigen::VectorXd::LinSpaced(200, s.cut.spindle_speed_min_rad_s, s.cut.spindle_speed_max_rad_s);
+  const Map100x100 m(s);
+  const auto& region = m.region;
+  const auto& targets = m.targets;
+  const auto& opt = m.opt;
   dynamics::PropagationOptions po;
   po.method = dynamics::PropagationMethod::kFirstOrder;
   for (auto _ : state) {

@@ -119,10 +119,13 @@ def test_python_calls_equal_the_tools(identified):
     p3 = next(p for p in rm.read_posture_file(postures, 6) if p.id == 'P3')
     b = rm.zoa_lobe_band(cfg, rm.read_cut_file(cut_path), u, p3.q, id='P3')
     assert len(lobes) == len(b['critical_depth_mm_lower'])
+    compared = 0
     for row, lo, hi in zip(lobes, b['critical_depth_mm_lower'], b['critical_depth_mm_upper']):
         if row['critical_depth_mm_lower']:
             assert float(row['critical_depth_mm_lower']) == pytest.approx(lo, rel=1e-9)
             assert float(row['critical_depth_mm_upper']) == pytest.approx(hi, rel=1e-9)
+            compared += 1
+    assert compared >= len(lobes) // 2, 'most speeds must have a band to compare'
     summary = json.loads((tmp / 'lobes.json').read_text())['uncertainty']['tips'][0]
     assert summary['min_critical_depth_mm_lower'] == pytest.approx(b['min_critical_depth_mm_lower'], rel=1e-9)
     assert summary['min_critical_depth_mm_lower'] < summary['min_critical_depth_mm'] < summary[

@@ -246,7 +246,7 @@ PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction&
       int worst_output = -1;
       for (auto& out : res.outputs) out.nonlinearity = 0.0;
       for (int k = 0; k < n; ++k) {
-        if (!(lambda(k) > 1e-300)) continue;
+        if (!(lambda(k) > 1e-14 * lambda.maxCoeff())) continue;  // the axes first_order used
         for (double sign : {-1.0, 1.0}) {
           const Eigen::VectorXd step = sign * z * std::sqrt(lambda(k)) * V.col(k);
           Eigen::VectorXd fk;
