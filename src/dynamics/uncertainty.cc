@@ -99,6 +99,27 @@ void CheckValid(const ParameterUncertainty& u) {
       }
     }
   }
+  // A positive parameter's relative standard deviation above 100 % (inverse
+  // scale: the compliance's interval reaches zero within 1 sigma) or a
+  // factor of 10 (log scale) is no fit's result: the covariance of another
+  // coordinate (of the value itself, in its unit squared) typed under this
+  // scale is the likely mistake.
+  for (int i = 0; i < n; ++i) {
+    const UncertainParameter& p = u.parameters[static_cast<size_t>(i)];
+    const double s = std::sqrt(std::max(u.covariance(i, i), 0.0));
+    const double relative = p.scale == UncertainScale::kInverse ? s * p.value
+                            : p.scale == UncertainScale::kLog   ? s
+                                                                : 0.0;
+    const double limit = p.scale == UncertainScale::kLog ? std::log(10.0) : 1.0;
+    if (relative > limit) {
+      throw std::invalid_argument(
+          "parameter uncertainty: " + p.name + " on the " + ToString(p.scale) + " scale has a relative standard "
+          "deviation of " + FormatNumber(100.0 * relative, 3) + " % (at most " +
+          FormatNumber(100.0 * limit, 3) + " % is a fit's result): the covariance must be of " +
+          (p.scale == UncertainScale::kInverse ? "1/value" : "log(value)") +
+          " (the covariance of the value itself, in its unit squared, given under this scale?)");
+    }
+  }
   const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(u.covariance, Eigen::EigenvaluesOnly)
                                  .eigenvalues();
   if (ev.minCoeff() < -1e-9 * std::max(ev.maxCoeff(), 0.0) || ev.maxCoeff() < 0.0) {

@@ -72,6 +72,19 @@ TEST(UncertaintyFile, BrokenFilesAreRefusedAtTheirPlace) {
   });
   EXPECT_THAT(msg, HasSubstr("neg.yaml:3:"));
   EXPECT_THAT(msg, HasSubstr("> 0 on the inverse scale"));
+  // The covariance of k [N²·m²/rad²] typed under the inverse scale: a
+  // relative standard deviation of 1.5e13 %, refused naming the mistake.
+  msg = CaptureError([&] {
+    ReadParameterUncertainty(WriteText(
+        dir + "/k2.yaml", "parameter_uncertainty:\n  parameters:\n    - {name: kq1_Nm_per_rad, value: 3e6, scale: inverse}\n"
+                          "  covariance: [[2.25e10]]\n"));
+  });
+  EXPECT_THAT(msg, HasSubstr("k2.yaml:4:"));
+  EXPECT_THAT(msg, HasSubstr("the covariance of the value itself"));
+  // A weak joint (60 %) is a fit's result and is read.
+  EXPECT_NO_THROW(ReadParameterUncertainty(WriteText(
+      dir + "/weak.yaml", "parameter_uncertainty:\n  parameters:\n    - {name: kq6_Nm_per_rad, value: 2e5, scale: inverse}\n"
+                          "  covariance: [[9e-12]]\n")));
   // A robot config given as the uncertainty file names what it is.
   msg = CaptureError([&] { ReadParameterUncertainty(testing::SourcePath("config/kr210.yaml")); });
   EXPECT_THAT(msg, HasSubstr("missing key 'parameter_uncertainty'"));

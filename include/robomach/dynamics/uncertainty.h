@@ -43,7 +43,10 @@ struct ParameterUncertainty {
 /// @throws std::invalid_argument naming the field: no parameter, a repeated
 ///   or empty name, a non-finite value, a log- or inverse-scale value <= 0, a covariance
 ///   of the wrong size, not finite, not symmetric (relative 1e-8) or with an
-///   eigenvalue below −1e-9 of the largest (not a covariance).
+///   eigenvalue below −1e-9 of the largest (not a covariance), or a
+///   relative standard deviation no fit gives (over 100 % on the inverse
+///   scale, over a factor of 10 on the log scale: a covariance of the value
+///   itself typed under that scale, the message says).
 void CheckValid(const ParameterUncertainty& u);
 
 /// Parameters fitted in different campaigns, taken as independent: the
