@@ -36,7 +36,8 @@ int Run(int argc, char** argv) {
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() + " Exit 3 also when the fit did not converge or a parameter is weakly identified, "
                                 "or a measured receptance is outside 1e-12..1e-3 m/N (a unit mistake).");
-  std::string robot_path, postures_path, out_path, report_dir, summary_path, objective = "modal-two-stage";
+  std::string robot_path, postures_path, out_path, report_dir, summary_path, uncertainty_path,
+      objective = "modal-two-stage";
   std::vector<std::string> measured_files, pose_files, validate_files, validate_pose_files, frees, sets, adds;
   bool only_free = false;
   calibration::CalibrationOptions opt;
@@ -47,6 +48,9 @@ int Run(int argc, char** argv) {
   app.add_option("--out", out_path, "calibrated robot config YAML; '-' = stdout")->required();
   app.add_option("--report", report_dir, "report folder (created)")->required();
   app.add_option("--summary", summary_path, "also write the report's summary.json here ('-' = stdout)");
+  app.add_option("--uncertainty-out", uncertainty_path,
+                 "write the fitted parameters' estimates and covariance here (docs/formats.md §12), for "
+                 "frf-predict, stability-lobes and stability-map --uncertainty");
   app.add_option("--validate", validate_files, "held-out measured FRFs scored with the calibrated model; repeatable");
   app.add_option("--validate-pose", validate_pose_files, "held-out UFF58 file of one posture: ID=file.uff; repeatable");
   app.add_option("--free", frees, "also fit this parameter (any name of the model, e.g. kq2_Nm_per_rad); repeatable");
@@ -82,7 +86,8 @@ int Run(int argc, char** argv) {
       for (const auto& f : validate_files) inputs.emplace_back("--validate", f);
       for (const auto& f : pose_files) inputs.emplace_back("--pose", f.substr(f.find('=') + 1));
       for (const auto& f : validate_pose_files) inputs.emplace_back("--validate-pose", f.substr(f.find('=') + 1));
-      CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}}, {{"--report", report_dir}});
+      CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}, {"--uncertainty-out", uncertainty_path}},
+                         {{"--report", report_dir}});
     }
     if (measured_files.empty() && pose_files.empty()) {
       throw UsageError("no measured FRFs: give --measured FILE or --pose ID=file.uff");
@@ -211,6 +216,12 @@ int Run(int argc, char** argv) {
     if (!holdout_noise.empty()) summary["holdout_noise"] = report::NoiseSummaryJson(holdout_noise, noise_opt.model, noise_opt.min_snr);
     summary["robot"] = robot_path;
     summary["calibrated_config"] = out_path;
+    {
+      std::string source = std::string(kTool) + " of " + robot_path + " on";
+      for (const auto& f : measured_files) source += " " + f;
+      for (const auto& f : pose_files) source += " " + f;
+      summary["uncertainty_out"] = WriteFittedUncertainty(kTool, uncertainty_path, result, source);
+    }
     io::WriteFileAtomically((dir / "summary.json").string(), SummaryText(summary));
     dynamics::PostureEvaluator eb(model_before), ea(model_after);
     // Overlays show every measured line with the noise model, not only the usable ones.

@@ -50,7 +50,8 @@ Eigen::VectorXd ReadFrequencyFile(const std::string& path) {
 
 report::Figure PostureFigure(const std::vector<const io::PosturePrediction*>& preds,
                              const std::vector<const dynamics::PostureDynamics*>& dyn,
-                             const std::string& title) {
+                             const std::string& title,
+                             const std::vector<const dynamics::ReceptanceBand*>& bands = {}) {
   report::Figure fig(static_cast<int>(preds.size()), 2, 760, 340);
   fig.title = title;
   for (size_t p = 0; p < preds.size(); ++p) {
@@ -62,6 +63,11 @@ report::Figure PostureFigure(const std::vector<const io::PosturePrediction*>& pr
       for (Eigen::Index i = 0; i < c.freq_hz.size(); ++i) c.receptance(i) = preds[p]->H[i](a, a);
       c.label = std::string("H") + "xyz"[a] + "xyz"[a];
       c.color = report::PaletteColor(a);
+      if (p < bands.size() && bands[p]) {
+        c.band_freq_hz = bands[p]->freq_hz;
+        c.band_lower = bands[p]->lower[a];
+        c.band_upper = bands[p]->upper[a];
+      }
       curves.push_back(std::move(c));
     }
     std::vector<double> fn;
@@ -163,8 +169,9 @@ int Run(int argc, char** argv) {
         Warn(kTool, freq_file.empty() ? m : m + " (the highest line of " + freq_file + ")");
       }
     }
-    if (!unc.paths.empty() && modes_path.empty() && details_path.empty()) {
-      throw UsageError("--uncertainty gives the modes' intervals in --modes and --summary: give one of them");
+    if (!unc.paths.empty() && modes_path.empty() && details_path.empty() && plot_path.empty() && plot_dir.empty()) {
+      throw UsageError("--uncertainty gives the modes' intervals in --modes and --summary and the |H| bands in "
+                       "--plot and --plot-dir: give one of them");
     }
     unc.Finish();
     const dynamics::PropagationOptions& uo = unc.propagation;
@@ -186,7 +193,7 @@ int Run(int argc, char** argv) {
         }
       }
       const std::string changed = dynamics::UseEstimates(*uncertainty, &cfg.parameters);
-      if (!changed.empty()) Note(kTool, "--uncertainty: its estimates replace the config's values: " + changed);
+      if (!changed.empty()) Note(kTool, changed);
     }
     if (verbose) {
       for (const auto& s : cfg.parameters.specs()) {
@@ -279,19 +286,40 @@ int Run(int argc, char** argv) {
     }
     std::string title = "robomach frf-predict: " + robot_path;
     for (const auto& e : model->effects()) title += " + " + e.effect->name();
+    // The |H| bands of the postures drawn (issue #37 §3).
+    std::vector<dynamics::ReceptanceBand> bands;
+    if (uncertainty && (!plot_path.empty() || !plot_dir.empty())) {
+      const size_t drawn = plot_dir.empty() ? std::min<size_t>(preds.size(), 12) : preds.size();
+      ProgressLine bp(kTool, "|H| bands", static_cast<long>(drawn));
+      for (size_t p = 0; p < drawn; ++p) {
+        bands.push_back(dynamics::DirectReceptanceBand(cfg.description, cfg.parameters, postures[p].q, *uncertainty,
+                                                       preds[p].freq_hz, uo));
+        bp.Update(static_cast<long>(p + 1));
+      }
+      bp.Finish();
+      std::cerr << kTool << ": the plots show the " << FormatNumber(100.0 * uo.confidence, 3) << " % band of |H| ("
+                << dynamics::ToString(bands.front().propagation.method_used) << ": "
+                << bands.front().propagation.reason << ")\n";
+      title += " (" + FormatNumber(100.0 * uo.confidence, 3) + " % band)";
+    }
+    const auto band_of = [&](size_t p) -> const dynamics::ReceptanceBand* {
+      return p < bands.size() ? &bands[p] : nullptr;
+    };
     if (!plot_path.empty()) {
       constexpr size_t kMaxSheet = 12;
       std::vector<const io::PosturePrediction*> pp;
       std::vector<const dynamics::PostureDynamics*> dd;
+      std::vector<const dynamics::ReceptanceBand*> bb;
       for (size_t p = 0; p < std::min(preds.size(), kMaxSheet); ++p) {
         pp.push_back(&preds[p]);
         dd.push_back(&dyns[p]);
+        bb.push_back(band_of(p));
       }
       if (preds.size() > kMaxSheet) {
         Warn(kTool, "the sheet shows the first 12 of " + std::to_string(preds.size()) +
                         " postures; use --plot-dir for one picture per posture");
       }
-      PostureFigure(pp, dd, title).SavePng(plot_path);
+      PostureFigure(pp, dd, title, bb).SavePng(plot_path);
     }
     if (!plot_dir.empty()) {
       io::EnsureDirectory(plot_dir);
@@ -299,7 +327,7 @@ int Run(int argc, char** argv) {
       for (const auto& pred : preds) ids.push_back(pred.pose_id);
       const std::map<std::string, std::string> stems = FileStemsForIds(kTool, "--plot-dir", ids);
       for (size_t p = 0; p < preds.size(); ++p) {
-        PostureFigure({&preds[p]}, {&dyns[p]}, title)
+        PostureFigure({&preds[p]}, {&dyns[p]}, title, {band_of(p)})
             .SavePng((std::filesystem::path(plot_dir) / (stems.at(preds[p].pose_id) + ".png")).string());
       }
     }

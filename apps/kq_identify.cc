@@ -48,7 +48,9 @@ int Run(int argc, char** argv) {
              "\nExit code 3 also means: a joint is weakly or not determined, the fit did not converge,\n"
              "or outliers were found without --robust (the outputs are written).");
   std::string robot_path, tracker_path, out_path, residuals_path, plot_path, json_path, uncertainty_path, robust,
-      load_point = "tcp", target = "tcp", masses = "10,20,30";
+      load_point = "tcp", target = "tcp", masses = "10,20,30", target_postures, target_quantity = "frequency",
+      cut_path;
+  double target_band_pct = 0.0;
   double noise_mm = 0.01, rope_angle_deg = 45.0;
   int plan_n = 0;
   unsigned seed = 1;
@@ -83,6 +85,17 @@ int Run(int argc, char** argv) {
   app.add_option("--max-rope-angle-deg", rope_angle_deg, "--plan: largest rope angle from vertical [deg]")
       ->capture_default_str();
   app.add_option("--seed", seed, "--plan: seed of the candidate postures")->capture_default_str();
+  app.add_option("--target-postures", target_postures,
+                 "--plan: a targeted plan (not D-optimal): the postures of the work region (posture CSV) whose "
+                 "--target quantity must be known well");
+  app.add_option("--target-quantity", target_quantity,
+                 "--plan --target-postures: frequency (the lowest natural frequency) or safe-depth (the ZOA lobes' "
+                 "smallest critical depth of --cut)")
+      ->check(OneOf({"frequency", "safe-depth"}))->capture_default_str();
+  app.add_option("--cut", cut_path, "--plan --target-quantity safe-depth: the cut file (docs/formats.md §5)");
+  app.add_option("--target-band-pct", target_band_pct,
+                 "--plan --target-postures: the 95 % half-width wanted [%]; the plan says how many of its postures "
+                 "reach it (exit 3 when it does not, with about how many would)");
   app.add_flag("--verbose", verbose, "list ignored tracker columns on stderr");
   try {
     app.parse(argc, argv);
@@ -107,7 +120,8 @@ int Run(int argc, char** argv) {
         }
       }
     } else {
-      for (const char* name : {"--load-point-mm", "--target-mm", "--masses-kg", "--max-rope-angle-deg", "--seed"}) {
+      for (const char* name : {"--load-point-mm", "--target-mm", "--masses-kg", "--max-rope-angle-deg", "--seed",
+                               "--target-postures", "--target-quantity", "--cut", "--target-band-pct"}) {
         if (app.count(name) > 0) {
           throw UsageError(std::string(name) + " is an option of --plan N (planning a test); without --plan, "
                            "kq-identify identifies from --tracker and does not use it");
@@ -130,7 +144,18 @@ int Run(int argc, char** argv) {
       po.max_rope_angle_deg = rope_angle_deg;
       po.num_postures_name = "--plan N";
       po.points_name = "--load-point-mm, --target-mm";
-      ValidateOptions({{"num_postures", "--plan"}, {"noise_mm", "--noise-mm"}, {"masses_kg", "--masses-kg"}},
+      if (!target_postures.empty()) {
+        RequireInputFile("--target-postures", target_postures, "posture file", {io::FileKind::kCsv},
+                         io::kPostureCsvFormat);
+      }
+      if (!cut_path.empty()) RequireInputFile("--cut", cut_path, "cut file", {io::FileKind::kYaml}, io::kCutFileFormat);
+      po.target_postures_path = target_postures;
+      po.target_quantity = target_quantity;
+      po.cut_path = cut_path;
+      CheckOptionRange("--target-band-pct", target_band_pct, 0.0, 99.0);
+      po.target_half_width = target_band_pct / 100.0;
+      ValidateOptions({{"num_postures", "--plan"}, {"noise_mm", "--noise-mm"}, {"masses_kg", "--masses-kg"},
+                       {"target_quantity", "--target-quantity"}, {"cut_path", "--cut"}, {"target_half_width", "--target-band-pct"}},
                       [&] { po.Validate(); });
       const workflows::KqPlanResult plan = workflows::RunKqPlan(po, MessagePrinter(kTool));
       io::LoadTestPlanHeader header;

@@ -17,6 +17,7 @@
 #include "robomach/io/frf_files.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/io/uncertainty_file.h"
 #include "robomach/report/audit_report.h"
 #include "robomach/report/json.h"
 
@@ -65,8 +66,9 @@ int Run(int argc, char** argv) {
              "explained (the effect is named and effects.yaml written, but a misfit remains), or a fit failed (the "
              "report is complete; candidates.csv says which and why), or a measured receptance is outside 1e-12..1e-3 "
              "m/N (a unit mistake).");
-  std::string robot_path, postures_path, report_dir, compare_dir, candidates_list, summary_path, write_config;
-  std::vector<std::string> measured_files, pose_files, adds;
+  std::string robot_path, postures_path, report_dir, compare_dir, candidates_list, summary_path, write_config,
+      uncertainty_out;
+  std::vector<std::string> measured_files, pose_files, adds, uncertainty_paths;
   audit::AuditOptions opt;
   app.add_option("--robot", robot_path, "robot config YAML (e.g. config/kr210.yaml)")->required();
   app.add_option("--postures", postures_path, "posture file CSV: pose_id,q1_deg..q6_deg")->required();
@@ -80,6 +82,16 @@ int Run(int argc, char** argv) {
                  "write the robot config with the named change: the effect (or the parameters found off) and every "
                  "calibration value fitted with it; with no failure, the calibrated current model; with no named "
                  "change, nothing (a warning says so). Loadable by every tool");
+  app.add_option("--uncertainty", uncertainty_paths,
+                 "parameter-uncertainty YAML (docs/formats.md §12, e.g. kq-identify --uncertainty-out); repeatable; "
+                 "default: the files the robot config names (uncertainty:). Their estimates replace the config's "
+                 "values, and the verdict says which part of the misfit those parameters could explain within their "
+                 "confidence region (a misfit they cover is not evidence of a missing effect)");
+  app.add_option("--confidence", opt.uncertainty_confidence, "confidence level of that region, in (0, 1)")
+      ->capture_default_str();
+  app.add_option("--uncertainty-out", uncertainty_out,
+                 "write the parameters fitted with the named change (with no failure: the calibration's) and their "
+                 "covariance here (docs/formats.md §12), for the predicting tools' --uncertainty");
   bool no_parameters = false;
   app.add_flag("--no-parameter-hypotheses", no_parameters,
                "do not try freeing the model's joint stiffnesses (kq1..kqn) as explanations");
@@ -117,6 +129,14 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--max-iterations", opt.max_iterations, 1, 100000);
     CheckOptionRange("--virtual-joints", virtual_joints, 0, 50);
     CheckOptionRange("--robust-loss-sigma", opt.robust_scale, 0.0, 1e6);
+    if (!(opt.uncertainty_confidence > 0.0 && opt.uncertainty_confidence < 1.0)) {
+      throw UsageError("--confidence: expected a level between 0 and 1 (0.95 for 95 %), got " +
+                       FormatNumber(opt.uncertainty_confidence));
+    }
+    for (const std::string& p : uncertainty_paths) {
+      RequireInputFile("--uncertainty", p, "parameter-uncertainty file", {io::FileKind::kYaml},
+                       io::kUncertaintyFileFormat);
+    }
     opt.virtual_joints_fitted = virtual_joints;
     opt.try_parameters = !no_parameters;
     {
@@ -139,7 +159,10 @@ int Run(int argc, char** argv) {
                                                                   {"--postures", postures_path}};
       for (const auto& f : measured_files) inputs.push_back({"--measured", f});
       for (const auto& f : pose_files) inputs.push_back({"--pose", f.substr(f.find('=') + 1)});
-      CheckDistinctPaths(inputs, {{"--summary", summary_path}, {"--write-config", write_config}},
+      for (const auto& f : uncertainty_paths) inputs.push_back({"--uncertainty", f});
+      CheckDistinctPaths(inputs,
+                         {{"--summary", summary_path}, {"--write-config", write_config},
+                          {"--uncertainty-out", uncertainty_out}},
                          {{"--report", report_dir}});
     }
     if (measured_files.empty() && pose_files.empty()) {
@@ -164,6 +187,17 @@ int Run(int argc, char** argv) {
       // parameters are calibrated with the others.
       for (const auto& spec : cfg.parameters.specs()) {
         if (spec.fittable && spec.name.rfind(name + ".", 0) == 0) opt.calibration_parameters.push_back(spec.name);
+      }
+    }
+    {
+      // The parameters' uncertainty (issue #37 §4), its estimates the audited values.
+      const std::vector<std::string>& paths = uncertainty_paths.empty() ? cfg.uncertainty_files : uncertainty_paths;
+      if (!paths.empty()) {
+        opt.parameter_uncertainty = io::ReadParameterUncertainties(paths);
+        const std::string changed = FromOption("--uncertainty", [&] {
+          return dynamics::UseEstimates(opt.parameter_uncertainty, &cfg.parameters);
+        });
+        if (!changed.empty()) Note(kTool, changed);
       }
     }
     calibration::PostureMap postures;
@@ -216,12 +250,15 @@ int Run(int argc, char** argv) {
     // The config with the named change (issue #33 §6): built and checked
     // (loaded back) before anything is written.
     std::string config_text;
+    // The change the audit names (--write-config and --uncertainty-out):
+    // the named candidate, or with no failure the calibrated current model.
+    const audit::CandidateResult* named =
+        r.grade == audit::AuditGrade::kExplained || r.grade == audit::AuditGrade::kMostlyExplained
+            ? audit::AcceptedCandidate(r)
+            : nullptr;
+    const bool has_change = named || r.grade == audit::AuditGrade::kNoFailure;
     if (!write_config.empty()) {
-      const audit::CandidateResult* named =
-          r.grade == audit::AuditGrade::kExplained || r.grade == audit::AuditGrade::kMostlyExplained
-              ? audit::AcceptedCandidate(r)
-              : nullptr;
-      if (named || r.grade == audit::AuditGrade::kNoFailure) {
+      if (has_change) {
         audit::CandidateResult change;
         if (named) {
           change = *named;
@@ -247,6 +284,17 @@ int Run(int argc, char** argv) {
         ro.written_config = write_config;
       } else {
         Warn(kTool, "--write-config " + write_config + " not written: the audit names no change (" +
+                        audit::AuditGradeName(r.grade) + ")");
+      }
+    }
+    if (!uncertainty_out.empty()) {
+      if (has_change) {
+        ro.uncertainty_out = WriteFittedUncertainty(
+            kTool, uncertainty_out, named ? named->fit : r.baseline_fit,
+            std::string(kTool) + " of " + robot_path + ": " +
+                (named ? audit::DescribeCandidate(*named, r.configured) : std::string("the calibrated current model")));
+      } else {
+        Warn(kTool, "--uncertainty-out " + uncertainty_out + " not written: the audit names no change (" +
                         audit::AuditGradeName(r.grade) + ")");
       }
     }

@@ -91,7 +91,7 @@ int Run(int argc, char** argv) {
     if (!unc.PathsFor(cfg).empty()) {
       uncertainty = io::ReadParameterUncertainties(unc.PathsFor(cfg));
       const std::string changed = dynamics::UseEstimates(*uncertainty, &cfg.parameters);
-      if (!changed.empty()) Note(kTool, "--uncertainty: its estimates replace the config's values: " + changed);
+      if (!changed.empty()) Note(kTool, changed);
     }
     const auto model = cfg.Build();
     const io::CutSpec cut = io::ReadCutFile(cut_path);

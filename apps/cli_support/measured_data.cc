@@ -9,6 +9,7 @@
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/messages.h"
+#include "robomach/io/uncertainty_file.h"
 
 namespace robomach::apps {
 
@@ -90,6 +91,29 @@ calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const Meas
                                               : "--noise-model " + o.model + ": ") +
                      std::string(e.what()));
   }
+}
+
+nlohmann::json WriteFittedUncertainty(const std::string& tool, const std::string& path,
+                                      const calibration::CalibrationResult& result, const std::string& source) {
+  if (path.empty()) return nullptr;
+  const calibration::FittedUncertainty fu = calibration::FittedParameterUncertainty(result, source);
+  std::string left_out;
+  for (const std::string& w : fu.left_out) left_out += (left_out.empty() ? "" : "; ") + w;
+  if (fu.uncertainty.parameters.empty()) {
+    const std::string w = "--uncertainty-out " + path + " not written: no fitted parameter has a covariance (" +
+                          left_out + ")";
+    Warn(tool, w);
+    return {{"file", path}, {"written", false}, {"left_out", fu.left_out}, {"warning", w}};
+  }
+  io::WriteParameterUncertainty(path, fu.uncertainty);
+  nlohmann::json names = nlohmann::json::array();
+  for (const auto& p : fu.uncertainty.parameters) names.push_back(p.name);
+  std::ostringstream m;
+  m << tool << ": wrote the covariance of " << fu.uncertainty.parameters.size() << " fitted parameter"
+    << (fu.uncertainty.parameters.size() == 1 ? "" : "s") << " to " << path;
+  if (!left_out.empty()) m << "; left out (taken as exact by the tools that read it): " << left_out;
+  std::cerr << m.str() << '\n';
+  return {{"file", path}, {"written", true}, {"parameters", names}, {"left_out", fu.left_out}};
 }
 
 }  // namespace robomach::apps

@@ -9,6 +9,9 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "robomach/calibration/frf_calibration.h"
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/workflows/measured_frfs.h"
@@ -56,6 +59,17 @@ void AddNoiseOptions(CLI::App& app, NoiseCliOptions* options);
 ///   to give.
 calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const MeasuredData& data,
                                              const NoiseCliOptions& options);
+
+/// --uncertainty-out of frf-calibrate and model-audit (issue #37): writes
+/// calibration::FittedParameterUncertainty(result, source) to `path`
+/// (docs/formats.md §12), says on stderr what it wrote and which fitted
+/// parameters it left out, and returns that for the summary ({"file",
+/// "written", "parameters", "left_out"}). When no parameter has a
+/// covariance nothing is written (a file the reader refuses): a warning
+/// says why and the summary gets it ("written": false, "warning").
+/// Nothing when `path` is empty (null).
+nlohmann::json WriteFittedUncertainty(const std::string& tool, const std::string& path,
+                                      const calibration::CalibrationResult& result, const std::string& source);
 
 // FitData(data, noise): workflows::FitData (found by argument-dependent lookup).
 

@@ -70,6 +70,27 @@ py::dict ResultDict(const audit::AuditResult& r) {
     screen.append(sd);
   }
   d["virtual_joint_screen"] = screen;
+  if (r.uncertainty) {
+    // Issue #37 §4: what the parameters' own uncertainty allows.
+    const audit::UncertaintyAllowance& u = *r.uncertainty;
+    py::dict ud, values;
+    for (const auto& n : u.parameters) values[py::str(n)] = u.at.Get(n);
+    ud["parameters"] = u.parameters;
+    ud["left_out"] = u.left_out;
+    ud["confidence"] = u.confidence;
+    ud["rank"] = u.rank;
+    ud["chi2"] = u.chi2;
+    ud["distance"] = number(u.distance);
+    ud["radius"] = number(u.radius);
+    ud["values_at_most_favourable_point"] = values;
+    ud["error_noise_units"] = number(u.error_noise_units);
+    ud["fraction_removed"] = number(u.fraction_removed);
+    ud["covers_failure"] = u.covers_failure;
+    ud["sentence"] = u.sentence;
+    d["parameter_uncertainty"] = ud;
+  } else {
+    d["parameter_uncertainty"] = py::none();
+  }
   const RunFindings verdict = audit::JudgeAudit(r);
   d["status"] = RunStatusName(verdict.status());
   d["findings"] = FindingMessages(verdict);
@@ -101,8 +122,16 @@ void BindAudit(py::module_& m) {
                     const dynamics::FrfSet& measured, const std::map<KeyTuple, calibration::FrfNoise>& noise,
                     const std::optional<std::string>& report_dir, const std::vector<std::string>& candidates,
                     const std::vector<std::string>& calibration_parameters, double fmin_hz, double fmax_hz,
-                    int max_iterations, const std::optional<dynamics::FrfSet>& measured_all) {
+                    int max_iterations, const std::optional<dynamics::FrfSet>& measured_all,
+                    const std::optional<dynamics::ParameterUncertainty>& uncertainty, double confidence) {
     audit::AuditOptions o;
+    io::RobotConfig cfg = config;
+    if (uncertainty) {
+      // As model-audit: the file's estimates are the audited values.
+      o.parameter_uncertainty = *uncertainty;
+      dynamics::UseEstimates(*uncertainty, &cfg.parameters);
+    }
+    o.uncertainty_confidence = confidence;
     o.candidates = candidates;
     o.calibration_parameters = calibration_parameters;
     o.fmin_hz = fmin_hz;
@@ -118,7 +147,7 @@ void BindAudit(py::module_& m) {
     report::AuditReport rep;
     {
       py::gil_scoped_release release;
-      r = audit::RunAudit(config.description, config.parameters, q, measured, o);
+      r = audit::RunAudit(cfg.description, cfg.parameters, q, measured, o);
       if (report_dir) {
         report::AuditReportOptions ro;
         ro.robot_path = config.path;
@@ -143,7 +172,7 @@ void BindAudit(py::module_& m) {
      py::arg("candidates") = std::vector<std::string>{},
      py::arg("calibration_parameters") = audit::AuditOptions{}.calibration_parameters, py::arg("fmin_hz") = 0.0,
      py::arg("fmax_hz") = std::numeric_limits<double>::infinity(), py::arg("max_iterations") = 100,
-     py::arg("measured_all") = py::none(),
+     py::arg("measured_all") = py::none(), py::arg("uncertainty") = py::none(), py::arg("confidence") = 0.95,
      "model-audit's call: calibrates `config` (RobotConfig) against `measured` (FrfSet, receptance "
      "[m/N]; usable_data(...) of it, as the tool fits) at `postures` ({pose_id: q [rad]}), tries each "
      "library effect not in the model (or `candidates`) and grades the best. Returns a dict of plain "
@@ -153,7 +182,10 @@ void BindAudit(py::module_& m) {
      "or 'flagged': model-audit's exit 3 but for the unit checks of its reader) with its findings. "
      "With report_dir it also writes model-audit's report folder there (noise: the noise models of "
      "estimate_noise; measured_all: every measured line for the overlays) and adds 'report' and "
-     "'summary' (summary.json as a dict). Releases the GIL (seconds to minutes).");
+     "'summary' (summary.json as a dict). uncertainty (ParameterUncertainty, e.g. read_parameter_uncertainty of "
+     "kq-identify's file; its estimates replace the config's values) adds 'parameter_uncertainty': which part of "
+     "the misfit those parameters could explain within their `confidence` region (model-audit --uncertainty; None "
+     "without one or without a significant failure). Releases the GIL (seconds to minutes).");
 }
 
 }  // namespace robomach::python

@@ -254,6 +254,15 @@ void BindCalibration(py::module_& m) {
       .def_readonly("misfit_final", &CalibrationResult::misfit_final, "whole-curve chi^2 of the result")
       .def_readonly("start_used", &CalibrationResult::start_used)
       .def_readonly("starts_tried", &CalibrationResult::starts_tried)
+      .def_readonly("covariance", &CalibrationResult::covariance,
+                    "covariance of the free parameters' values (estimates order, SI units; NaN rows for a parameter "
+                    "without one; block-diagonal over the two-stage objective's stages)")
+      .def("uncertainty", [](const CalibrationResult& r, const std::string& source) {
+        calibration::FittedUncertainty fu = calibration::FittedParameterUncertainty(r, source);
+        return py::make_tuple(fu.uncertainty, fu.left_out);
+      }, py::arg("source") = "robomach calibrate",
+         "(ParameterUncertainty, left_out): what frf-calibrate --uncertainty-out writes (log scale; parameters "
+         "without a covariance or with sigma above their value left out, named with why)")
       .def("__repr__", [](const CalibrationResult& r) {
         return "<CalibrationResult " + calibration::FitStatusName(r.status) + ">";
       });
@@ -547,13 +556,35 @@ void BindCalibration(py::module_& m) {
       .def_property_readonly("findings", [](const PyTestPlan& p) { return FindingMessages(p.plan); },
                              "one sentence per joint the plan cannot determine")
       .def_property_readonly("flagged", [](const PyTestPlan& p) { return p.plan.flagged(); },
-                             "kq-identify --plan's exit 3: a joint the plan cannot determine");
+                             "kq-identify --plan's exit 3: a joint the plan cannot determine, or a target band "
+                             "out of reach")
+      .def_property_readonly("expected_target_relative_std", [](const PyTestPlan& p) {
+        return p.plan.expected_target_relative_std;
+      }, "with target_gradients: each target's relative standard deviation with the whole plan")
+      .def_property_readonly("target_half_width_by_postures", [](const PyTestPlan& p) {
+        return p.plan.target_half_width_by_postures;
+      }, "the worst target's relative half-width with the plan's first k postures, k = 1..num_postures")
+      .def_property_readonly("postures_for_target_width", [](const PyTestPlan& p) {
+        return p.plan.postures_for_target_width;
+      }, "the fewest first postures reaching target_half_width (0: the plan does not)")
+      .def_property_readonly("postures_for_target_width_estimate", [](const PyTestPlan& p) {
+        return p.plan.postures_for_target_width_estimate;
+      }, "when the plan does not: about how many postures would");
+  m.def("log_stiffness_information", [](const std::shared_ptr<dynamics::RobotModel>& model,
+                                        const std::vector<identification::LoadCase>& cases, const Eigen::VectorXd& kq,
+                                        double sigma_displacement_m) {
+    return identification::LogStiffnessInformation(*model, cases, kq, sigma_displacement_m);
+  }, py::arg("model"), py::arg("cases"), py::arg("kq_Nm_per_rad"), py::arg("sigma_displacement_m"),
+     "Fisher information of log k of load cases (their forces, no displacement needed) with displacement noise "
+     "sigma per coordinate [m]: its inverse is the covariance of log k a campaign of them gives "
+     "(identification::LogStiffnessInformation).");
   const identification::PlanOptions plan_defaults;
   m.def("plan_load_tests", [](const std::shared_ptr<dynamics::RobotModel>& model, int num_postures,
                               double tracker_noise_m, const std::vector<double>& masses_kg,
                               const std::optional<Eigen::Vector3d>& p_load_tip_m,
                               const std::optional<Eigen::Vector3d>& p_target_tip_m, double max_rope_angle_rad,
-                              int directions_per_posture, unsigned seed, int num_candidate_postures) {
+                              int directions_per_posture, unsigned seed, int num_candidate_postures,
+                              const std::optional<Eigen::MatrixXd>& target_gradients, double target_half_width) {
     PyTestPlan p;
     identification::PlanOptions& o = p.options;
     o.num_postures = num_postures;
@@ -565,6 +596,8 @@ void BindCalibration(py::module_& m) {
     o.directions_per_posture = directions_per_posture;
     o.seed = seed;
     o.num_candidate_postures = num_candidate_postures;
+    if (target_gradients) o.target_gradients = *target_gradients;
+    o.target_half_width = target_half_width;
     identification::CheckValid(o);
     py::gil_scoped_release release;
     p.plan = identification::PlanLoadTests(*model, o);
@@ -575,9 +608,12 @@ void BindCalibration(py::module_& m) {
      py::arg("max_rope_angle_rad") = plan_defaults.max_rope_angle,
      py::arg("directions_per_posture") = plan_defaults.directions_per_posture, py::arg("seed") = plan_defaults.seed,
      py::arg("num_candidate_postures") = plan_defaults.num_candidate_postures,
+     py::arg("target_gradients") = py::none(), py::arg("target_half_width") = 0.0,
      "Plans load tests (kq-identify --plan's library call): postures within the joint limits and "
      "rope directions that maximise log det of the Fisher information of log-stiffness at the "
-     "model's stiffness (D-optimal). p_load_tip_m, p_target_tip_m: load point and tracker target "
+     "model's stiffness (D-optimal), or with target_gradients (joints x targets: d ln y / d ln k, as "
+     "kq-identify --target-postures computes them) minimise the targets' summed relative variance; "
+     "target_half_width: the relative 95 % half-width wanted. p_load_tip_m, p_target_tip_m: load point and tracker target "
      "in the tip frame [m], None = the TCP. num_candidate_postures 0 = max(400, 4 num_postures). "
      "Deterministic for a seed. Releases the GIL.");
   m.def("write_load_test_plan_csv", [](const std::string& path, const PyTestPlan& p, const std::string& robot_config) {

@@ -82,6 +82,34 @@ def test_calibrate_equals_frf_calibrate_and_finds_the_truth(hammer):
     assert bad['rms_per_residual_in_noise_units'] > 1.3
 
 
+def test_calibration_uncertainty_equals_frf_calibrate_uncertainty_out(hammer, tmp_path):
+    """Issue #37: result.uncertainty() is what frf-calibrate --uncertainty-out
+    writes (same fit, same covariance), on the log scale; the file reads back."""
+    tmp, _ = hammer
+    out = tmp_path / 'cal_unc.yaml'
+    args = ['--robot', KR210, '--postures', POSTURES, '--measured', tmp / 'hammer.csv', '--only-free']
+    for f in FREE:
+        args += ['--free', f]
+    run_tool('frf-calibrate', *args, '--out', tmp_path / 'cal.yaml', '--report', tmp_path / 'report',
+             '--uncertainty-out', out)
+    cfg = rm.RobotConfig(KR210)
+    postures = {p.id: p.q for p in rm.read_posture_file(POSTURES, cfg.num_joints)}
+    read = rm.read_frf_csv(str(tmp / 'hammer.csv'))
+    data = rm.usable_data(read['frfs'], rm.estimate_noise(read['frfs'], rm.NoiseOptions(averages=read['averages'])))
+    result = rm.calibrate(cfg, postures, data, free_parameters=FREE)
+    u, left_out = result.uncertainty()
+    assert left_out == []
+    assert u.names == FREE
+    cov = np.asarray(result.covariance)
+    for i, e in enumerate(result.estimates):
+        assert np.sqrt(cov[i, i]) == pytest.approx(e.std_dev, rel=1e-12)
+    written = rm.read_parameter_uncertainty([str(out)])
+    assert written.names == u.names
+    assert np.allclose(written.values, u.values, rtol=1e-10)
+    # Numeric derivatives repeat to about 1e-6 (as the std_dev above).
+    assert np.allclose(written.covariance, u.covariance, rtol=1e-5, atol=0)
+
+
 def test_calibrate_rejects_unknown_parameters_and_postures(hammer):
     tmp, _ = hammer
     cfg = rm.RobotConfig(KR210)

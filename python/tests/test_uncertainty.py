@@ -130,3 +130,59 @@ def test_python_calls_equal_the_tools(identified):
     assert summary['min_critical_depth_mm_lower'] == pytest.approx(b['min_critical_depth_mm_lower'], rel=1e-9)
     assert summary['min_critical_depth_mm_lower'] < summary['min_critical_depth_mm'] < summary[
         'min_critical_depth_mm_upper']
+
+
+def test_audit_says_a_misfit_within_the_parameter_uncertainty_is_no_evidence():
+    """Issue #37 §4 from Python: kq2 10 % lower than configured in noisy
+    hammer data, its uncertainty 8 % (inverse scale): audit(uncertainty=...)
+    says the misfit is within it (the truth is 1.3 sigma away); with 1 % the
+    most favourable point lies on the region's boundary and leaves most of
+    the misfit (model-audit's summary has the same block)."""
+    cfg = rm.load_robot_config(KR210)
+    plist = rm.read_posture_file(os.path.join(DATA, 'calibration', 'postures_two.csv'), 6)
+    postures = {p.id: p.q for p in plist}
+    truth = cfg.copy()
+    kq2 = cfg.get('kq2_Nm_per_rad')
+    truth.set('kq2_Nm_per_rad', 0.9 * kq2)
+    frfs = rm.synthesize_hammer_test(truth, plist, noise_rel=0.01, seed=6)
+    data = rm.usable_data(frfs, rm.estimate_noise(frfs, rm.NoiseOptions()))
+    results = {}
+    for rel in (0.08, 0.01):
+        u = rm.ParameterUncertainty([('kq2_Nm_per_rad', kq2, 'inverse')], np.array([[(rel / kq2) ** 2]]))
+        r = rm.audit(cfg, postures, data, candidates=['kq2_Nm_per_rad'], uncertainty=u)
+        assert r['significant_failure'], r['verdict']
+        results[rel] = r['parameter_uncertainty']
+    wide, narrow = results[0.08], results[0.01]
+    assert wide['covers_failure'] and wide['error_noise_units'] <= 1.3, wide['sentence']
+    assert wide['values_at_most_favourable_point']['kq2_Nm_per_rad'] == pytest.approx(0.9 * kq2, rel=0.02)
+    assert wide['radius'] == pytest.approx(1.959964, rel=1e-5)  # one parameter: sqrt(chi2_1(0.95))
+    assert not narrow['covers_failure'], narrow['sentence']
+    assert narrow['distance'] == pytest.approx(narrow['radius'], rel=1e-3)
+    assert 0 < narrow['fraction_removed'] < 0.9
+    assert 'the rest is a model error' in narrow['sentence']
+
+
+def test_targeted_plan_narrows_its_target_more_than_the_d_optimal_plan():
+    """Issue #37 §5 from Python: plan_load_tests with target gradients (here
+    a quantity resting on joints 2, 3 and 5) narrows that quantity more than
+    the D-optimal plan of the same size; the reported width is sqrt(g' I^-1 g)
+    of the planned cases' information (log_stiffness_information, a second
+    route)."""
+    cfg = rm.load_robot_config(KR210)
+    model = cfg.build()
+    g = np.array([[0.0], [0.35], [-0.25], [0.0], [0.4], [0.0]])
+    kw = dict(num_postures=6, num_candidate_postures=150)
+    d_opt = rm.plan_load_tests(model, **kw)
+    targeted = rm.plan_load_tests(model, target_gradients=g, target_half_width=0.01, **kw)
+    assert len(targeted.target_half_width_by_postures) == 6
+    assert targeted.postures_for_target_width == 0 and targeted.postures_for_target_width_estimate > 6
+    assert targeted.flagged and any('postures would reach it' in f for f in targeted.findings)
+    sigma = math.sqrt(2.0) * 1e-5
+    kq = np.array([cfg.get(f'kq{j + 1}_Nm_per_rad') for j in range(6)])
+
+    def target_std(plan):
+        info = np.asarray(rm.log_stiffness_information(model, plan.cases, kq, sigma))[:5, :5]
+        return math.sqrt(g[:5, 0] @ np.linalg.solve(info, g[:5, 0]))
+
+    assert targeted.expected_target_relative_std[0] == pytest.approx(target_std(targeted), rel=1e-6)
+    assert target_std(targeted) < 0.8 * target_std(d_opt)

@@ -7,9 +7,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <iomanip>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
+#include <Eigen/SVD>
 
 #include "robomach/common/errors.h"
 #include "robomach/common/parallel.h"
@@ -94,17 +97,15 @@ std::vector<std::string> VirtualJointNames(const dynamics::RobotDescription& des
   return out;
 }
 
-std::vector<ScreenedVirtualJoint> ScreenVirtualJoints(const dynamics::RobotDescription& desc,
-                                                      const dynamics::ParameterSet& calibrated,
-                                                      const std::vector<std::string>& calibration,
-                                                      const FitContext& x, double* baseline) {
-  std::vector<ScreenedVirtualJoint> out;
-  *baseline = NAN;
-  const Eigen::VectorXd r0 = WholeCurveResidualVector(desc, calibrated, x.banded);
-  if (r0.size() == 0 || !(x.noise_floor > 0.0)) return out;
-  // Sensitivity of the residuals to the calibration parameters (central
-  // differences in the logarithm; additive for a parameter at zero): the
-  // linearised re-adjustment every screened value gets.
+namespace {
+
+// An orthonormal basis Q of the whole-curve residuals' sensitivity to the
+// calibration parameters at `calibrated` (central differences in the
+// logarithm; additive for a parameter at zero; residuals r0 there): the
+// best linearised re-adjustment of them leaves r − Q Qᵀ r.
+Eigen::MatrixXd CalibrationBasis(const dynamics::RobotDescription& desc, const dynamics::ParameterSet& calibrated,
+                                 const std::vector<std::string>& calibration, const BandedFitData& banded,
+                                 const Eigen::VectorXd& r0) {
   Eigen::MatrixXd J(r0.size(), static_cast<Eigen::Index>(calibration.size()));
   for (size_t j = 0; j < calibration.size(); ++j) {
     const std::string& name = calibration[j];
@@ -120,14 +121,29 @@ std::vector<ScreenedVirtualJoint> ScreenVirtualJoints(const dynamics::RobotDescr
       hi.SetClamped(name, v + 1e-4 * std::max(std::abs(spec.default_value), 1e-12));
       span = hi.Get(name) - v;
     }
-    const Eigen::VectorXd a = WholeCurveResidualVector(desc, lo, x.banded);
-    const Eigen::VectorXd b = WholeCurveResidualVector(desc, hi, x.banded);
+    const Eigen::VectorXd a = WholeCurveResidualVector(desc, lo, banded);
+    const Eigen::VectorXd b = WholeCurveResidualVector(desc, hi, banded);
     J.col(static_cast<Eigen::Index>(j)) =
         a.size() == r0.size() && b.size() == r0.size() && span > 0.0 ? Eigen::VectorXd((b - a) / span)
                                                                      : Eigen::VectorXd::Zero(r0.size());
   }
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(J);
-  const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(J.rows(), J.cols());
+  return qr.householderQ() * Eigen::MatrixXd::Identity(J.rows(), J.cols());
+}
+
+}  // namespace
+
+std::vector<ScreenedVirtualJoint> ScreenVirtualJoints(const dynamics::RobotDescription& desc,
+                                                      const dynamics::ParameterSet& calibrated,
+                                                      const std::vector<std::string>& calibration,
+                                                      const FitContext& x, double* baseline) {
+  std::vector<ScreenedVirtualJoint> out;
+  *baseline = NAN;
+  const Eigen::VectorXd r0 = WholeCurveResidualVector(desc, calibrated, x.banded);
+  if (r0.size() == 0 || !(x.noise_floor > 0.0)) return out;
+  // The linearised re-adjustment of the calibration parameters every
+  // screened value gets.
+  const Eigen::MatrixXd Q = CalibrationBasis(desc, calibrated, calibration, x.banded, r0);
   // The cost after the best linearised step of the calibration parameters:
   // |r − Q Qᵀ r|², r the residuals with the virtual joint at one stiffness.
   const auto projected = [&](const Eigen::VectorXd& r) { return (r - Q * (Q.transpose() * r)).squaredNorm(); };
@@ -168,6 +184,183 @@ std::vector<ScreenedVirtualJoint> ScreenVirtualJoints(const dynamics::RobotDescr
     return a.predicted_error < b.predicted_error;
   });
   return out;
+}
+
+namespace {
+
+// θ of a value on its scale, and back.
+double ToTheta(double v, dynamics::UncertainScale s) {
+  switch (s) {
+    case dynamics::UncertainScale::kLog: return std::log(v);
+    case dynamics::UncertainScale::kInverse: return 1.0 / v;
+    case dynamics::UncertainScale::kLinear: return v;
+  }
+  return v;
+}
+double FromTheta(double t, dynamics::UncertainScale s) {
+  switch (s) {
+    case dynamics::UncertainScale::kLog: return std::exp(t);
+    case dynamics::UncertainScale::kInverse: return t > 0.0 ? 1.0 / t : std::numeric_limits<double>::infinity();
+    case dynamics::UncertainScale::kLinear: return t;
+  }
+  return t;
+}
+
+// min |b + A w|² subject to |w| <= c: the trust-region subproblem, through
+// the SVD of A (w(λ) = −V diag(s / (s² + λ)) Uᵀ b, |w(λ)| decreasing in λ).
+Eigen::VectorXd ConstrainedStep(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, double c) {
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd s = svd.singularValues();
+  const Eigen::VectorXd g = svd.matrixU().transpose() * b;
+  const double tol = s.size() > 0 ? 1e-12 * s(0) : 0.0;
+  const auto step = [&](double lambda) {
+    Eigen::VectorXd y = Eigen::VectorXd::Zero(s.size());
+    for (Eigen::Index k = 0; k < s.size(); ++k) {
+      if (s(k) > tol || lambda > 0.0) y(k) = -s(k) * g(k) / (s(k) * s(k) + lambda);
+    }
+    return Eigen::VectorXd(svd.matrixV() * y);
+  };
+  Eigen::VectorXd w = step(0.0);
+  if (w.norm() <= c) return w;
+  double lo = 0.0, hi = s.size() > 0 ? std::max(s(0) * s(0), 1e-300) : 1.0;
+  while (step(hi).norm() > c && hi < 1e300) hi *= 10.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (step(mid).norm() > c ? lo : hi) = mid;
+  }
+  return step(hi);
+}
+
+}  // namespace
+
+std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::RobotDescription& desc,
+                                                           const dynamics::ParameterSet& calibrated,
+                                                           const dynamics::ParameterUncertainty& u,
+                                                           double confidence, const FitContext& x,
+                                                           double error_before) {
+  const AuditOptions& o = x.options;
+  UncertaintyAllowance a;
+  a.confidence = confidence;
+  std::vector<int> kept;
+  for (size_t i = 0; i < u.parameters.size(); ++i) {
+    const std::string& n = u.parameters[i].name;
+    if (!calibrated.Has(n)) {
+      a.left_out.push_back(n + ": not a parameter of this model");
+    } else if (Contains(o.calibration_parameters, n)) {
+      a.left_out.push_back(n + ": calibrated by the audit against these data");
+    } else {
+      kept.push_back(static_cast<int>(i));
+      a.parameters.push_back(n);
+    }
+  }
+  const int n = static_cast<int>(kept.size());
+  if (n == 0) return std::nullopt;
+  Eigen::MatrixXd cov(n, n);
+  Eigen::VectorXd theta0(n);
+  for (int i = 0; i < n; ++i) {
+    const auto& p = u.parameters[kept[i]];
+    theta0(i) = ToTheta(p.value, p.scale);
+    for (int j = 0; j < n; ++j) cov(i, j) = u.covariance(kept[i], kept[j]);
+  }
+  // Whitened coordinates: θ = θ̂ + B w, B = V √Λ over the covariance's rank,
+  // the region |w| <= √χ²(P, rank).
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(cov);
+  const double lmax = es.eigenvalues().maxCoeff();
+  std::vector<int> axes;
+  for (int k = 0; k < n; ++k) {
+    if (es.eigenvalues()(k) > 1e-14 * lmax && es.eigenvalues()(k) > 0.0) axes.push_back(k);
+  }
+  if (axes.empty()) return std::nullopt;
+  a.rank = static_cast<int>(axes.size());
+  Eigen::MatrixXd B(n, a.rank);
+  for (int k = 0; k < a.rank; ++k) B.col(k) = es.eigenvectors().col(axes[k]) * std::sqrt(es.eigenvalues()(axes[k]));
+  a.chi2 = dynamics::ChiSquaredQuantile(confidence, a.rank);
+  a.radius = std::sqrt(a.chi2);
+  const auto point = [&](const Eigen::VectorXd& w) {
+    dynamics::ParameterSet p = calibrated;
+    const Eigen::VectorXd t = theta0 + B * w;
+    for (int i = 0; i < n; ++i) p.SetClamped(a.parameters[i], FromTheta(t(i), u.parameters[kept[i]].scale));
+    return p;
+  };
+  const auto residuals = [&](const Eigen::VectorXd& w) { return WholeCurveResidualVector(desc, point(w), x.banded); };
+  const Eigen::VectorXd r0 = residuals(Eigen::VectorXd::Zero(a.rank));
+  if (r0.size() == 0) return std::nullopt;
+  // The calibration parameters' linear re-adjustment (as the screen's).
+  const Eigen::MatrixXd Q = CalibrationBasis(desc, calibrated, o.calibration_parameters, x.banded, r0);
+  const auto project = [&](const Eigen::MatrixXd& m) -> Eigen::MatrixXd { return m - Q * (Q.transpose() * m); };
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(a.rank);
+  double best = project(r0).squaredNorm();
+  for (int iteration = 0; iteration < 4; ++iteration) {
+    const Eigen::VectorXd rw = residuals(w);
+    if (rw.size() != r0.size()) break;
+    Eigen::MatrixXd A(r0.size(), a.rank);
+    constexpr double h = 0.05;  // in standard deviations along each axis
+    bool ok = true;
+    for (int k = 0; k < a.rank && ok; ++k) {
+      Eigen::VectorXd wp = w, wm = w;
+      wp(k) += h;
+      wm(k) -= h;
+      const Eigen::VectorXd rp = residuals(wp), rm = residuals(wm);
+      ok = rp.size() == r0.size() && rm.size() == r0.size();
+      if (ok) A.col(k) = (rp - rm) / (2.0 * h);
+    }
+    if (!ok) break;
+    const Eigen::MatrixXd PA = project(A);
+    const Eigen::VectorXd next = ConstrainedStep(PA, Eigen::VectorXd(project(rw) - PA * w), a.radius);
+    const Eigen::VectorXd rn = residuals(next);
+    if (rn.size() != r0.size()) break;
+    const double cost = project(rn).squaredNorm();
+    if (!(cost < best * (1.0 - 1e-6))) break;
+    best = cost;
+    w = next;
+  }
+  a.distance = w.norm();
+  // The calibration refitted at the point: the error in the audit's own
+  // measure (rms log magnitude over every line), comparable with error_before.
+  const dynamics::ParameterSet start = point(w);
+  const calibration::CalibrationResult fit = CalibrateWithRetry(desc, start, o.calibration_parameters, x);
+  a.at = fit.status == calibration::FitStatus::kFailed ? start : fit.parameters;
+  a.errors = ComputeErrors(dynamics::RobotModel::Build(desc, a.at), x.postures, x.measured, o.fmin_hz, o.fmax_hz,
+                           o.num_bands);
+  a.error_noise_units = a.errors.total_rms_log_mag / x.noise_floor;
+  a.fraction_removed = FractionRemoved(error_before, a.errors.total_rms_log_mag, x.noise_floor);
+  const bool significant = !(error_before <= o.significance_factor * x.noise_floor);
+  a.covers_failure = significant && a.errors.total_rms_log_mag <= o.significance_factor * x.noise_floor;
+
+  // Words: the parameters that moved the most, relative to their estimates.
+  std::vector<std::pair<double, std::string>> moved;
+  for (int i = 0; i < n; ++i) {
+    const double v0 = u.parameters[kept[i]].value, v1 = a.at.Get(a.parameters[i]);
+    const double rel = v0 != 0.0 ? v1 / v0 - 1.0 : v1 - v0;
+    std::ostringstream m;
+    m.precision(1);
+    m << a.parameters[i] << ' ' << (rel >= 0 ? "+" : "") << std::fixed << 100.0 * rel << " %";
+    moved.push_back({-std::abs(rel), m.str()});
+  }
+  std::sort(moved.begin(), moved.end());
+  std::string names;
+  for (size_t i = 0; i < a.parameters.size(); ++i) names += (i ? ", " : "") + a.parameters[i];
+  std::ostringstream m;
+  m.precision(3);
+  const double pct = std::round(100.0 * confidence * 10.0) / 10.0;
+  const double before_units = error_before / x.noise_floor;
+  if (a.covers_failure) {
+    m << "within the parameter uncertainty: with " << names << " inside " << (n == 1 ? "its " : "their ") << pct
+      << " % confidence region the error falls from " << before_units << " to " << a.error_noise_units
+      << " x the noise floor, so this misfit is not evidence of a missing effect; narrow "
+      << (n == 1 ? "its" : "their") << " uncertainty (kq-identify --plan) before adding one";
+  } else {
+    const double f = std::isfinite(a.fraction_removed) ? std::max(0.0, a.fraction_removed) : 0.0;
+    m << "the uncertainty of " << names << " (" << pct << " % confidence region) explains " << std::fixed
+      << std::setprecision(0) << 100.0 * f << " % of the excess misfit" << std::defaultfloat << std::setprecision(3)
+      << " (error " << before_units << " -> " << a.error_noise_units
+      << " x the noise floor at its most favourable point); the rest is a model error";
+  }
+  m << " (most moved: ";
+  for (size_t i = 0; i < moved.size() && i < 3; ++i) m << (i ? ", " : "") << moved[i].second;
+  m << "; Mahalanobis distance " << a.distance << " of " << a.radius << ")";
+  a.sentence = m.str();
+  return a;
 }
 
 }  // namespace robomach::audit::internal

@@ -54,6 +54,11 @@ void CheckValid(const AuditOptions& o) {
   if (!(o.robust_scale >= 0.0) || !std::isfinite(o.robust_scale)) {
     throw std::invalid_argument("AuditOptions::robust_scale must be >= 0 (0: none), got " + std::to_string(o.robust_scale));
   }
+  if (!(o.uncertainty_confidence > 0.0 && o.uncertainty_confidence < 1.0)) {
+    throw std::invalid_argument("AuditOptions::uncertainty_confidence must be in (0, 1), got " +
+                                std::to_string(o.uncertainty_confidence));
+  }
+  if (!o.parameter_uncertainty.parameters.empty()) dynamics::CheckValid(o.parameter_uncertainty);
 }
 
 double Bic(double rss, int n, int k) {
@@ -193,6 +198,19 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
                      const calibration::PostureMap& postures, const dynamics::FrfSet& measured,
                      const AuditOptions& options) {
   CheckValid(options);
+  for (const auto& p : options.parameter_uncertainty.parameters) {
+    if (!parameters.Has(p.name) || std::find(options.calibration_parameters.begin(),
+                                             options.calibration_parameters.end(),
+                                             p.name) != options.calibration_parameters.end()) {
+      continue;  // left out, and said so (AuditResult::uncertainty)
+    }
+    const double v = parameters.Get(p.name);
+    if (!(std::abs(v - p.value) <= 1e-9 * std::max(std::abs(p.value), 1e-300))) {
+      throw std::invalid_argument("AuditOptions::parameter_uncertainty: the estimate of " + p.name + " (" +
+                                  FormatNumber(p.value) + ") is not the audited value (" + FormatNumber(v) +
+                                  "); put the estimates into the parameters first (dynamics::UseEstimates)");
+    }
+  }
   AuditOptions o = options;  // fit_line_stride 0 is resolved below
   const auto say = [&](const std::string& s) {
     if (o.progress) o.progress(s);
@@ -379,6 +397,14 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
   const BandedFitData banded = BandFitData(postures, fit_data, o.fmin_hz, o.fmax_hz);
   const FitContext context{postures,      fit_data,      measured, features, o, r.baseline_bic,
                            r.noise_floor, r.errors_before.total_rms_log_mag, parameters, banded};
+  if (r.significant_failure && !o.parameter_uncertainty.parameters.empty()) {
+    // Issue #37 §4: how much of the misfit the parameters' own uncertainty allows.
+    say("the parameter uncertainty: the calibrated model at its most favourable point within the " +
+        FormatNumber(100.0 * o.uncertainty_confidence) + " % region");
+    r.uncertainty = AllowanceOfUncertainty(description, r.baseline_fit.parameters, o.parameter_uncertainty,
+                                           o.uncertainty_confidence, context, r.errors_before.total_rms_log_mag);
+    if (r.uncertainty) say(r.uncertainty->sentence);
+  }
   std::mutex say_mutex;
   const auto timed = [&](const std::function<CandidateResult()>& f) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -655,6 +681,30 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
     if (pairs.front().bic < bar && pairs.front().plausible) r.best = static_cast<int>(num_singles);
   }
   GradeVerdict(o, &r);
+  if (r.uncertainty) {
+    while (!r.verdict.empty() && (r.verdict.back() == '.' || r.verdict.back() == ' ')) r.verdict.pop_back();
+    r.verdict += "; " + r.uncertainty->sentence;
+    if (r.uncertainty->covers_failure) {
+      r.headline += " The parameter uncertainty alone could explain it: within the " +
+                    FormatNumber(100.0 * r.uncertainty->confidence) + " % region of " +
+                    [&] {
+                      std::string l;
+                      for (const auto& n : r.uncertainty->parameters) l += (l.empty() ? "" : ", ") + n;
+                      return l;
+                    }() +
+                    " the error falls to " + FormatNumber(r.uncertainty->error_noise_units, 3) + " x the noise floor.";
+      std::string names;
+      for (const auto& n : r.uncertainty->parameters) names += (names.empty() ? "" : ", ") + n;
+      r.next_steps.insert(r.next_steps.begin(),
+                          "Narrow the uncertainty of " + names + " before adding an effect: within " +
+                              (r.uncertainty->parameters.size() == 1 ? "its " : "their ") +
+                              FormatNumber(100.0 * r.uncertainty->confidence) +
+                              " % confidence region the error falls to " +
+                              FormatNumber(r.uncertainty->error_noise_units, 3) +
+                              " x the noise floor. A tracker campaign planned for the work region (kq-identify "
+                              "--plan N --target-postures work.csv) narrows the joint stiffnesses that matter there.");
+    }
+  }
   return r;
 }
 

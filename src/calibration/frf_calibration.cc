@@ -483,6 +483,9 @@ struct StageOutcome {
   StageSummary summary;
   std::vector<double> values;   // in parameter units
   std::vector<double> std_dev;  // in parameter units, NaN if unknown
+  /// Covariance in parameter units (NaN rows and columns for a parameter
+  /// held on a bound; empty without a covariance).
+  Eigen::MatrixXd covariance;
   ceres::TerminationType termination{ceres::FAILURE};
 };
 
@@ -589,9 +592,14 @@ StageOutcome SolveStage(const std::string& stage_name, ModelResidual residual, c
     cov.GetCovarianceBlock(x.data(), x.data(), c.data());
     const double dof = std::max(1, m - n);
     const double s2 = 2.0 * summary.final_cost / dof;
+    auto held = [&](int i) { return std::find(pinned.begin(), pinned.end(), i) != pinned.end(); };
+    out.covariance = Eigen::MatrixXd::Constant(n, n, NAN);
     for (int i = 0; i < n; ++i) {
-      if (std::find(pinned.begin(), pinned.end(), i) != pinned.end()) continue;
+      if (held(i)) continue;
       out.std_dev[i] = std::sqrt(std::max(0.0, c[i * n + i] * s2)) * std::abs(map.Slope(x[i], i));
+      for (int j = 0; j < n; ++j) {
+        if (!held(j)) out.covariance(i, j) = c[i * n + j] * s2 * map.Slope(x[i], i) * map.Slope(x[j], j);
+      }
     }
     out.summary.covariance_ok = true;
   }
@@ -672,9 +680,11 @@ CalibrationResult CalibrateOnce(const dynamics::RobotDescription& description, c
   std::vector<ModeMatch> matches = result.matches_before;
   std::map<std::string, std::pair<double, std::string>> std_devs;  // name -> (std, stage)
   std::vector<StageSummary> stages;
+  std::vector<StageOutcome> outcomes;  // the last round's, for the covariance
   bool ok = true, converged = true;
   for (int round = 0; round < std::max(1, o.max_match_rounds); ++round) {
     stages.clear();
+    outcomes.clear();
     std_devs.clear();
     ok = true;
     converged = true;
@@ -709,6 +719,7 @@ CalibrationResult CalibrateOnce(const dynamics::RobotDescription& description, c
       if (s.termination == ceres::FAILURE || s.termination == ceres::USER_FAILURE) ok = false;
       if (s.termination != ceres::CONVERGENCE) converged = false;
       stages.push_back(s.summary);
+      outcomes.push_back(std::move(s));
     };
     switch (o.objective) {
       case Objective::kModalTwoStage:
@@ -730,6 +741,33 @@ CalibrationResult CalibrateOnce(const dynamics::RobotDescription& description, c
   result.parameters = current;
   result.stages = stages;
   result.matches_after = matches;
+  {
+    // Block-diagonal over the stages: a later stage's parameters are
+    // conditional on the earlier ones, held at their fitted values.
+    const int n = static_cast<int>(o.free_parameters.size());
+    result.covariance = Eigen::MatrixXd::Constant(n, n, NAN);
+    auto index = [&](const std::string& nm) {
+      return static_cast<int>(std::find(o.free_parameters.begin(), o.free_parameters.end(), nm) -
+                              o.free_parameters.begin());
+    };
+    for (const StageOutcome& s : outcomes) {
+      if (s.covariance.size() == 0) continue;
+      for (size_t i = 0; i < s.summary.parameters.size(); ++i) {
+        for (size_t j = 0; j < s.summary.parameters.size(); ++j) {
+          result.covariance(index(s.summary.parameters[i]), index(s.summary.parameters[j])) =
+              s.covariance(static_cast<int>(i), static_cast<int>(j));
+        }
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        if (i != j && std::isfinite(result.covariance(i, i)) && std::isfinite(result.covariance(j, j)) &&
+            std::isnan(result.covariance(i, j))) {
+          result.covariance(i, j) = 0.0;  // different stages
+        }
+      }
+    }
+  }
   for (const std::string& nm : o.free_parameters) {
     ParameterEstimate e;
     e.name = nm;
@@ -770,6 +808,48 @@ CalibrationResult CalibrateOnce(const dynamics::RobotDescription& description, c
 }
 
 }  // namespace
+
+FittedUncertainty FittedParameterUncertainty(const CalibrationResult& result, const std::string& source) {
+  FittedUncertainty out;
+  out.uncertainty.source = source;
+  std::vector<int> kept;
+  const int n = static_cast<int>(result.estimates.size());
+  const bool has_cov = result.covariance.rows() == n && result.covariance.cols() == n;
+  for (int i = 0; i < n; ++i) {
+    const ParameterEstimate& e = result.estimates[i];
+    const double var = has_cov ? result.covariance(i, i) : NAN;
+    if (!std::isfinite(var)) {
+      out.left_out.push_back(e.name + (e.at_bound ? ": held on a bound, no covariance" : ": no covariance"));
+      continue;
+    }
+    const double sd = std::sqrt(std::max(0.0, var));
+    if (e.value != 0.0 && sd > std::abs(e.value)) {
+      std::ostringstream why;
+      why << e.name << ": not determined, σ " << std::lround(100.0 * sd / std::abs(e.value)) << " % of its value";
+      out.left_out.push_back(why.str());
+      continue;
+    }
+    kept.push_back(i);
+    dynamics::UncertainParameter p;
+    p.name = e.name;
+    p.value = e.value;
+    p.scale = e.value > 0.0 ? dynamics::UncertainScale::kLog : dynamics::UncertainScale::kLinear;
+    out.uncertainty.parameters.push_back(p);
+  }
+  const int k = static_cast<int>(kept.size());
+  out.uncertainty.covariance.resize(k, k);
+  for (int a = 0; a < k; ++a) {
+    for (int b = 0; b < k; ++b) {
+      // d log v = dv / v on the log scale.
+      double c = result.covariance(kept[a], kept[b]);
+      if (out.uncertainty.parameters[a].scale == dynamics::UncertainScale::kLog) c /= result.estimates[kept[a]].value;
+      if (out.uncertainty.parameters[b].scale == dynamics::UncertainScale::kLog) c /= result.estimates[kept[b]].value;
+      out.uncertainty.covariance(a, b) = c;
+    }
+  }
+  out.uncertainty.covariance = 0.5 * (out.uncertainty.covariance + out.uncertainty.covariance.transpose()).eval();
+  return out;
+}
 
 double HuberRho(double s, double c) {
   if (!(c > 0.0) || s <= c * c) return s;
@@ -884,6 +964,7 @@ CalibrationResult Calibrate(const dynamics::RobotDescription& description, const
       e.std_dev = NAN;
       e.at_bound = false;
     }
+    kept.covariance.resize(0, 0);  // the fit's, not the start's
     kept.status = FitStatus::kNotImproved;
     kept.start_used = "none (start kept)";
     kept.misfit_final = misfit_start;

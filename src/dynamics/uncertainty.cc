@@ -11,6 +11,7 @@
 
 #include "robomach/common/number_format.h"
 #include "robomach/dynamics/posture_dynamics.h"
+#include "robomach/dynamics/tool_tip_frf.h"
 
 namespace robomach::dynamics {
 namespace {
@@ -170,6 +171,41 @@ double NormalQuantile(double p) {
     } else {
       hi = mid;
     }
+  }
+  return 0.5 * (lo + hi);
+}
+
+double ChiSquaredCdf(double x, int dof) {
+  if (dof < 1) throw std::invalid_argument("ChiSquaredCdf: degrees of freedom below 1");
+  if (!(x > 0.0)) return 0.0;
+  // Closed forms for whole degrees of freedom (Abramowitz & Stegun 26.4.4,
+  // 26.4.5): the upper tail Q(x|k).
+  const double h = 0.5 * x;
+  double q;
+  if (dof % 2 == 0) {
+    double term = 1.0, sum = 1.0;
+    for (int j = 1; j < dof / 2; ++j) sum += (term *= h / j);
+    q = std::exp(-h) * sum;
+  } else {
+    const double r = std::sqrt(x), phi = std::exp(-h) / std::sqrt(2.0 * M_PI);
+    double term = r, sum = 0.0;
+    for (int j = 1; j <= (dof - 1) / 2; ++j) {
+      sum += term;
+      term *= x / (2.0 * j + 1.0);
+    }
+    q = std::erfc(r / std::sqrt(2.0)) + 2.0 * phi * sum;
+  }
+  return std::clamp(1.0 - q, 0.0, 1.0);
+}
+
+double ChiSquaredQuantile(double p, int dof) {
+  if (!(p > 0.0 && p < 1.0)) throw std::invalid_argument("ChiSquaredQuantile: p outside (0, 1)");
+  if (dof < 1) throw std::invalid_argument("ChiSquaredQuantile: degrees of freedom below 1");
+  double lo = 0.0, hi = std::max(10.0, 4.0 * dof);
+  while (ChiSquaredCdf(hi, dof) < p && hi < 1e6) hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * std::max(1.0, hi); ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (ChiSquaredCdf(mid, dof) < p ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }
@@ -409,6 +445,72 @@ PostureModeIntervals ModalIntervals(const RobotDescription& description, const P
   return r;
 }
 
+ReceptanceBand DirectReceptanceBand(const RobotDescription& description, const ParameterSet& base,
+                                    const Eigen::VectorXd& q, const ParameterUncertainty& u,
+                                    const Eigen::VectorXd& all_lines, const PropagationOptions& options,
+                                    int max_lines) {
+  if (max_lines < 2) throw std::invalid_argument("DirectReceptanceBand: max_lines must be >= 2");
+  PostureOptions po;
+  po.cartesian = false;
+  po.jacobian_condition = false;
+  po.static_compliance = false;
+  // The lines: every k-th, and the one nearest each mode at the estimates.
+  std::set<Eigen::Index> chosen;
+  {
+    Eigen::VectorXd values(static_cast<Eigen::Index>(u.parameters.size()));
+    for (size_t i = 0; i < u.parameters.size(); ++i) values(static_cast<Eigen::Index>(i)) = u.parameters[i].value;
+    const PostureDynamics d = EvaluatePosture(RobotModel::Build(description, WithValues(base, u, values)), q, po);
+    const Eigen::Index total = all_lines.size();
+    std::vector<Eigen::Index> peaks;
+    for (const Mode& m : d.modes) {
+      if (total == 0 || m.freq_hz < all_lines(0) || m.freq_hz > all_lines(total - 1)) continue;
+      Eigen::Index best = 0;
+      (all_lines.array() - m.freq_hz).abs().minCoeff(&best);
+      peaks.push_back(best);
+    }
+    const Eigen::Index room = std::max<Eigen::Index>(2, max_lines - static_cast<Eigen::Index>(peaks.size()));
+    const Eigen::Index stride = std::max<Eigen::Index>(1, (total + room - 1) / room);
+    for (Eigen::Index i = 0; i < total; i += stride) chosen.insert(i);
+    if (total > 0) chosen.insert(total - 1);
+    for (Eigen::Index i : peaks) chosen.insert(i);
+    while (static_cast<int>(chosen.size()) > max_lines) chosen.erase(std::next(chosen.begin(), 1));
+  }
+  Eigen::VectorXd freq_hz(static_cast<Eigen::Index>(chosen.size()));
+  {
+    Eigen::Index k = 0;
+    for (Eigen::Index i : chosen) freq_hz(k++) = all_lines(i);
+  }
+  const Eigen::Index n = freq_hz.size();
+  auto outputs = [&](const Eigen::VectorXd& values) {
+    const auto model = RobotModel::Build(description, WithValues(base, u, values));
+    const ReceptanceEvaluator h(EvaluatePosture(model, q, po));
+    Eigen::VectorXd out(3 * n);
+    for (int a = 0; a < 3; ++a) out.segment(a * n, n) = h.Entry(freq_hz, a, a).cwiseAbs().array().log().matrix();
+    return out;
+  };
+  std::vector<std::string> names;
+  for (int a = 0; a < 3; ++a) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      names.push_back(std::string("|H") + "xyz"[a] + "xyz"[a] + "| at " + FormatNumber(freq_hz(i), 4) + " Hz");
+    }
+  }
+  ReceptanceBand b;
+  b.freq_hz = freq_hz;
+  b.propagation = Propagate(u, outputs, options, names);
+  for (int a = 0; a < 3; ++a) {
+    b.magnitude[a].resize(n);
+    b.lower[a].resize(n);
+    b.upper[a].resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const OutputInterval& o = b.propagation.outputs[static_cast<size_t>(a * n + i)];
+      b.magnitude[a](i) = std::exp(o.value);
+      b.lower[a](i) = std::exp(o.lower);
+      b.upper[a](i) = std::exp(o.upper);
+    }
+  }
+  return b;
+}
+
 std::string UseEstimates(const ParameterUncertainty& u, ParameterSet* parameters) {
   Eigen::VectorXd values(static_cast<Eigen::Index>(u.parameters.size()));
   std::string changed;
@@ -424,7 +526,7 @@ std::string UseEstimates(const ParameterUncertainty& u, ParameterSet* parameters
     }
   }
   *parameters = updated;
-  return changed;
+  return changed.empty() ? changed : "the uncertainty's estimates replace the config's values: " + changed;
 }
 
 std::string IntervalLine(const std::string& pose_id, const PostureModeIntervals& intervals, double confidence) {

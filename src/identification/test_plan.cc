@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <random>
 #include <sstream>
@@ -32,10 +33,23 @@ struct Candidate {
   std::vector<Eigen::MatrixXd> info;  // per direction, all masses included
 };
 
+// The design's criterion, higher better: log det I (D-optimal), or
+// −Σ_t g_tᵀ I⁻¹ g_t with target gradients G (L-optimal); −inf where I is
+// not positive definite.
+using Criterion = std::function<double(const Eigen::MatrixXd&)>;
+Criterion DesignCriterion(const Eigen::MatrixXd& G) {
+  if (G.size() == 0) return LogDet;
+  return [G](const Eigen::MatrixXd& I) {
+    const Eigen::LLT<Eigen::MatrixXd> llt(I);
+    if (llt.info() != Eigen::Success) return -kInf;
+    return -(G.transpose() * llt.solve(G)).trace();
+  };
+}
+
 // Best `count` directions of a candidate given the current information
-// (greedy within the posture); returns the log det reached.
-double ChooseDirections(const Candidate& c, const Eigen::MatrixXd& I, int count,
-                        std::vector<int>* chosen) {
+// (greedy within the posture); returns the criterion reached.
+double ChooseDirections(const Candidate& c, const Eigen::MatrixXd& I, int count, std::vector<int>* chosen,
+                        const Criterion& criterion) {
   Eigen::MatrixXd acc = I;
   chosen->clear();
   double best_total = -kInf;
@@ -44,7 +58,7 @@ double ChooseDirections(const Candidate& c, const Eigen::MatrixXd& I, int count,
     double best_ld = -kInf;
     for (size_t d = 0; d < c.directions.size(); ++d) {
       if (std::find(chosen->begin(), chosen->end(), static_cast<int>(d)) != chosen->end()) continue;
-      const double ld = LogDet(acc + c.info[d]);
+      const double ld = criterion(acc + c.info[d]);
       if (ld > best_ld) {
         best_ld = ld;
         best = static_cast<int>(d);
@@ -56,6 +70,80 @@ double ChooseDirections(const Candidate& c, const Eigen::MatrixXd& I, int count,
     best_total = best_ld;
   }
   return best_total;
+}
+
+// The targets' expected widths with the whole plan and with its first k
+// postures, and how many postures reach the width asked for.
+void TargetWidths(const PlanOptions& o, const Eigen::MatrixXd& info, const std::vector<int>& sel,
+                  const std::vector<std::vector<int>>& sel_dirs,
+                  const std::function<Eigen::MatrixXd(int, const std::vector<int>&)>& contribution, TestPlan* plan) {
+  const Eigen::MatrixXd& G = o.target_gradients;
+  const int n = static_cast<int>(info.rows());
+  const double z = [&] {
+    // Two-sided normal quantile by bisection on erfc (no dynamics dependency here).
+    double lo = 0.0, hi = 40.0;
+    for (int i = 0; i < 200; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (std::erfc(mid / std::sqrt(2.0)) > 1.0 - o.target_confidence ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  }();
+  auto stds = [&](const Eigen::MatrixXd& I) {
+    Eigen::VectorXd s = Eigen::VectorXd::Constant(G.cols(), kInf);
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(I);
+    if (!lu.isInvertible() || lu.rcond() < 1e-14) {
+      // Some joint unseen: a target that does not depend on it is still determined.
+      const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(I);
+      const Eigen::MatrixXd P = cod.pseudoInverse();
+      for (Eigen::Index t = 0; t < G.cols(); ++t) {
+        const Eigen::VectorXd g = G.col(t);
+        // g must lie in I's range: its part in the null space is not determined.
+        const Eigen::VectorXd r = g - I * (P * g);
+        if (r.norm() <= 1e-6 * std::max(g.norm(), 1e-300)) s(t) = std::sqrt(std::max(0.0, g.dot(P * g)));
+      }
+      return s;
+    }
+    const Eigen::MatrixXd X = lu.solve(G);
+    for (Eigen::Index t = 0; t < G.cols(); ++t) s(t) = std::sqrt(std::max(0.0, G.col(t).dot(X.col(t))));
+    return s;
+  };
+  plan->expected_target_relative_std = stds(info);
+  Eigen::MatrixXd I = Eigen::MatrixXd::Zero(n, n);
+  for (size_t s = 0; s < sel.size(); ++s) {
+    I += contribution(static_cast<int>(s), sel_dirs[s]);
+    const double hw = z * stds(I).maxCoeff();
+    plan->target_half_width_by_postures.push_back(hw);
+    if (o.target_half_width > 0.0 && plan->postures_for_target_width == 0 && hw <= o.target_half_width) {
+      plan->postures_for_target_width = static_cast<int>(s) + 1;
+    }
+  }
+  if (o.target_half_width > 0.0 && plan->postures_for_target_width == 0) {
+    const double hw = plan->target_half_width_by_postures.back();
+    if (std::isfinite(hw)) {
+      const double k = std::ceil(static_cast<double>(sel.size()) * (hw / o.target_half_width) * (hw / o.target_half_width));
+      plan->postures_for_target_width_estimate = static_cast<int>(std::min(k, 1e6));
+    }
+    std::ostringstream m;
+    m.precision(3);
+    m << "the targets' " << 100 * o.target_confidence << " % half-width is ±" << 100 * hw << " % with all "
+      << sel.size() << " postures, not the ±" << 100 * o.target_half_width << " % asked for";
+    if (plan->postures_for_target_width_estimate >= 1000000) {
+      m << ": over a million postures would be needed (a lower tracker noise or heavier loads, --noise-mm and "
+           "--masses-kg, narrow every band)";
+    } else if (plan->postures_for_target_width_estimate > 0) {
+      m << ": about " << plan->postures_for_target_width_estimate << " postures would reach it";
+    } else {
+      m << ": a target depends on a joint these tests cannot determine";
+      std::string joints;
+      for (int j = 0; j < n; ++j) {
+        if (!std::isfinite(plan->expected_relative_std(j)) && TargetsDependOnJoint(o, j)) {
+          joints += (joints.empty() ? " (joint " : ", ") + std::to_string(j + 1);
+        }
+      }
+      if (!joints.empty()) m << joints << ")";
+    }
+    plan->Flag(m.str());
+  }
 }
 
 }  // namespace
@@ -71,6 +159,11 @@ Eigen::MatrixXd LogStiffnessInformation(const dynamics::RobotModel& model,
     I.noalias() += G.transpose() * G;
   }
   return I / (sigma_displacement * sigma_displacement);
+}
+
+bool TargetsDependOnJoint(const PlanOptions& o, int joint) {
+  if (o.target_gradients.size() == 0) return true;
+  return o.target_gradients.row(joint).cwiseAbs().maxCoeff() > 1e-3 * o.target_gradients.cwiseAbs().maxCoeff();
 }
 
 void CheckValid(const PlanOptions& o) {
@@ -94,11 +187,24 @@ void CheckValid(const PlanOptions& o) {
   }
   if (o.num_azimuths < 1) fail("num_azimuths", o.num_azimuths, "at least 1");
   if (!(o.joint_limit_margin >= 0.0)) fail("joint_limit_margin", o.joint_limit_margin, "a value >= 0 rad");
+  if (o.target_gradients.size() > 0 && !o.target_gradients.allFinite()) {
+    throw std::invalid_argument("PlanOptions::target_gradients: expected finite numbers");
+  }
+  if (!(o.target_half_width >= 0.0 && std::isfinite(o.target_half_width))) {
+    fail("target_half_width", o.target_half_width, "a relative half-width >= 0 (0: none)");
+  }
+  if (!(o.target_confidence > 0.0 && o.target_confidence < 1.0)) {
+    fail("target_confidence", o.target_confidence, "a level in (0, 1)");
+  }
 }
 
 TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) {
   CheckValid(o);
   const int n = model.num_joints();
+  if (o.target_gradients.size() > 0 && o.target_gradients.rows() != n) {
+    throw std::invalid_argument("PlanOptions::target_gradients: expected " + std::to_string(n) +
+                                " rows (one per joint), got " + std::to_string(o.target_gradients.rows()));
+  }
   const Eigen::VectorXd kq = model.joint_stiffness();
   const double sigma = std::sqrt(2.0) * o.tracker_noise;
   double sum_m2 = 0.0;
@@ -167,6 +273,7 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
   // A ridge of 1e-6 (a prior σ(θ) of 1000, i.e. no knowledge) keeps log det
   // finite while joints are still unseen; one load case adds ~1e3.
   const Eigen::MatrixXd ridge = 1e-6 * Eigen::MatrixXd::Identity(n, n);
+  const Criterion criterion = DesignCriterion(o.design_for_targets ? o.target_gradients : Eigen::MatrixXd());
   std::vector<int> sel;
   std::vector<std::vector<int>> sel_dirs;
   Eigen::MatrixXd I = ridge;
@@ -182,7 +289,7 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
     std::vector<int> best_dirs;
     for (int ci = 0; ci < static_cast<int>(cands.size()); ++ci) {
       if (std::find(sel.begin(), sel.end(), ci) != sel.end()) continue;
-      const double ld = ChooseDirections(cands[ci], I, o.directions_per_posture, &chosen);
+      const double ld = ChooseDirections(cands[ci], I, o.directions_per_posture, &chosen, criterion);
       if (ld > best_ld) {
         best_ld = ld;
         best = ci;
@@ -198,10 +305,10 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
     bool improved = false;
     for (int s = 0; s < o.num_postures; ++s) {
       const Eigen::MatrixXd I_minus = I - contribution(sel[s], sel_dirs[s]);
-      double cur = LogDet(I);
+      double cur = criterion(I);
       for (int ci = 0; ci < static_cast<int>(cands.size()); ++ci) {
         if (std::find(sel.begin(), sel.end(), ci) != sel.end()) continue;
-        const double ld = ChooseDirections(cands[ci], I_minus, o.directions_per_posture, &chosen);
+        const double ld = ChooseDirections(cands[ci], I_minus, o.directions_per_posture, &chosen, criterion);
         if (ld > cur + 1e-9) {
           sel[s] = ci;
           sel_dirs[s] = chosen;
@@ -221,7 +328,7 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
   for (int j = 0; j < n; ++j) {
     plan.expected_determination.push_back(
         DeterminationFromRelativeStd(plan.expected_relative_std(j), o.weak_relative_std));
-    if (plan.expected_determination.back() == Determination::kNotDetermined) {
+    if (plan.expected_determination.back() == Determination::kNotDetermined && TargetsDependOnJoint(o, j)) {
       // The last joint turns the tool about its own axis: only a load or a
       // target off that axis feels it.
       plan.Flag("joint " + std::to_string(j + 1) + " cannot be determined with this set-up" +
@@ -229,6 +336,11 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
                 j);
     }
   }
+  if (o.target_gradients.size() > 0) TargetWidths(o, info, sel, sel_dirs, [&](int s, const std::vector<int>& ds) {
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
+    for (int d : ds) M += cands[sel[s]].info[d];
+    return M;
+  }, &plan);
   for (int s = 0; s < o.num_postures; ++s) {
     const Candidate& c = cands[sel[s]];
     const std::string pose_id = "P" + std::to_string(s + 1);

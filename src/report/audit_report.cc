@@ -184,6 +184,24 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
                                                    {"fitted", s.fitted}});
   }
   if (!ro.written_config.empty()) j["written_config"] = ro.written_config;
+  if (!ro.uncertainty_out.is_null()) j["uncertainty_out"] = ro.uncertainty_out;
+  if (r.uncertainty) {
+    const audit::UncertaintyAllowance& u = *r.uncertainty;
+    json values = json::object();
+    for (const auto& n : u.parameters) values[n] = u.at.Get(n);
+    j["parameter_uncertainty"] = {{"parameters", u.parameters},
+                                  {"left_out", u.left_out},
+                                  {"confidence", u.confidence},
+                                  {"rank", u.rank},
+                                  {"chi2", u.chi2},
+                                  {"distance", number(u.distance)},
+                                  {"radius", number(u.radius)},
+                                  {"values_at_most_favourable_point", values},
+                                  {"error_noise_units", number(u.error_noise_units)},
+                                  {"fraction_removed", number(u.fraction_removed)},
+                                  {"covers_failure", u.covers_failure},
+                                  {"sentence", u.sentence}};
+  }
   // The YAML to paste: the accepted candidate's effects, or else the
   // effects switched on with --add, with their calibrated values.
   std::string yaml;
@@ -310,6 +328,16 @@ AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResu
     h << "</ul>\n<p>Pattern of the remainder: " << HtmlEscape(r.pattern) << ".</p>\n";
   } else {
     h << "<p>" << HtmlEscape(r.verdict) << "</p>\n";
+  }
+  if (r.uncertainty) {
+    // Issue #37 §4 (in verdict.text too; the mostly-explained layout above lists parts).
+    const audit::UncertaintyAllowance& u = *r.uncertainty;
+    h << "<p><b>Parameter uncertainty:</b> " << HtmlEscape(u.sentence) << ".";
+    if (!u.left_out.empty()) {
+      h << " Not moved:";
+      for (const auto& l : u.left_out) h << ' ' << HtmlEscape(l) << ';';
+    }
+    h << "</p>\n";
   }
   if (!r.next_steps.empty()) {
     h << "<p>What to try next:</p><ul>";

@@ -32,6 +32,16 @@ void FillFrfPanels(const std::vector<FrfCurve>& curves, const std::vector<double
   phase->y_max = 180.0;
   phase->y_ticks = {-180, -90, 0, 90, 180};
   for (const auto& c : curves) {
+    if (c.band_freq_hz.size() > 0) {
+      Series band;  // no legend entry: the curve's own colour says whose
+      band.x.assign(c.band_freq_hz.data(), c.band_freq_hz.data() + c.band_freq_hz.size());
+      band.y.assign(c.band_upper.data(), c.band_upper.data() + c.band_upper.size());
+      band.y_fill_to.assign(c.band_lower.data(), c.band_lower.data() + c.band_lower.size());
+      band.color = c.color;
+      mag->series.push_back(std::move(band));
+    }
+  }
+  for (const auto& c : curves) {
     Series m, p;
     m.label = c.label;
     m.color = p.color = c.color;

@@ -16,28 +16,34 @@
 
 namespace robomach::stability {
 
-ZoaBand ZoaLobeBand(const dynamics::RobotDescription& description, const dynamics::ParameterSet& base,
-                    const std::string& id, const Eigen::VectorXd& q, const Eigen::Vector3d& feed_B,
-                    const LobesOptions& options, const dynamics::ParameterUncertainty& u,
-                    const dynamics::PropagationOptions& propagation) {
+Eigen::VectorXd ZoaCriticalDepths(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
+                                  const std::string& id, const Eigen::VectorXd& q, const Eigen::Vector3d& feed_B,
+                                  const LobesOptions& options) {
   ZoaOptions zo;
   zo.max_lobe_index = options.max_lobe_index;
   zo.min_spindle_speed_rad_s = options.min_speed_rad_s;
   dynamics::PostureOptions po;
   po.cartesian = false;
   po.jacobian_condition = false;
+  const auto model = dynamics::RobotModel::Build(description, parameters);
+  const TipDynamics tip = TipFromPosture(id, dynamics::EvaluatePosture(model, q, po), feed_B, options.process.teeth,
+                                         options.max_speed_rad_s);
+  const std::vector<LobePoint> points =
+      ComputeZoaLobes(tip.freq_hz, tip.Phi_C, options.process, zo).At(options.zoa_speeds_rad_s);
+  Eigen::VectorXd d(static_cast<Eigen::Index>(points.size()));
+  for (size_t i = 0; i < points.size(); ++i) {
+    d(static_cast<Eigen::Index>(i)) = points[i].status == LobeStatus::kOk ? points[i].critical_depth : NAN;
+  }
+  return d;
+}
+
+ZoaBand ZoaLobeBand(const dynamics::RobotDescription& description, const dynamics::ParameterSet& base,
+                    const std::string& id, const Eigen::VectorXd& q, const Eigen::Vector3d& feed_B,
+                    const LobesOptions& options, const dynamics::ParameterUncertainty& u,
+                    const dynamics::PropagationOptions& propagation) {
   // The critical depth at every speed [m], NaN where there is no boundary.
   auto depths = [&](const Eigen::VectorXd& values) {
-    const auto model = dynamics::RobotModel::Build(description, dynamics::WithValues(base, u, values));
-    const TipDynamics tip = TipFromPosture(id, dynamics::EvaluatePosture(model, q, po), feed_B, options.process.teeth,
-                                           options.max_speed_rad_s);
-    const std::vector<LobePoint> points =
-        ComputeZoaLobes(tip.freq_hz, tip.Phi_C, options.process, zo).At(options.zoa_speeds_rad_s);
-    Eigen::VectorXd d(static_cast<Eigen::Index>(points.size()));
-    for (size_t i = 0; i < points.size(); ++i) {
-      d(static_cast<Eigen::Index>(i)) = points[i].status == LobeStatus::kOk ? points[i].critical_depth : NAN;
-    }
-    return d;
+    return ZoaCriticalDepths(description, dynamics::WithValues(base, u, values), id, q, feed_B, options);
   };
   Eigen::VectorXd at_estimates(static_cast<Eigen::Index>(u.parameters.size()));
   for (size_t i = 0; i < u.parameters.size(); ++i) at_estimates(static_cast<Eigen::Index>(i)) = u.parameters[i].value;

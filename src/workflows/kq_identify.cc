@@ -1,6 +1,7 @@
 #include "robomach/workflows/kq_identify.h"
 
 #include <cmath>
+#include <limits>
 #include <iomanip>
 #include <sstream>
 
@@ -8,7 +9,11 @@
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 #include "robomach/identification/load_case.h"
+#include "robomach/dynamics/posture_dynamics.h"
+#include "robomach/io/cut_file.h"
 #include "robomach/io/kq_files.h"
+#include "robomach/stability/lobe_uncertainty.h"
+#include "robomach/workflows/stability_lobes.h"
 
 namespace robomach::workflows {
 namespace {
@@ -131,6 +136,69 @@ void KqPlanOptions::Validate() const {
       throw OptionError("masses_kg", "masses_kg: expected masses > 0 kg, got " + FormatNumber(m, 6));
     }
   }
+  if (target_quantity != "frequency" && target_quantity != "safe-depth") {
+    throw OptionError("target_quantity", "target_quantity: expected frequency or safe-depth, got '" +
+                                             target_quantity + "'");
+  }
+  if (!target_postures_path.empty() && target_quantity == "safe-depth" && cut_path.empty()) {
+    throw OptionError("cut_path", "cut_path: the safe depth needs the cut (a cut file)");
+  }
+  if (!(target_half_width >= 0.0 && target_half_width < 1.0)) {
+    throw OptionError("target_half_width", "target_half_width: expected a relative half-width in [0, 1) (0.05 for "
+                                           "±5 %), got " + FormatNumber(target_half_width, 6));
+  }
+  if (target_half_width > 0.0 && target_postures_path.empty()) {
+    throw OptionError("target_half_width", "target_half_width: a band of what? give the target postures");
+  }
+}
+
+Eigen::MatrixXd TargetGradients(const io::RobotConfig& config, const std::vector<io::Posture>& postures,
+                                const std::string& quantity, const std::string& cut_path) {
+  const int n = config.description.arm.num_joints();
+  std::optional<stability::LobesOptions> lobes;
+  Eigen::Vector3d feed = Eigen::Vector3d::UnitX();
+  if (quantity == "safe-depth") {
+    const io::CutSpec cut = io::ReadCutFile(cut_path);
+    StabilityLobesOptions so;
+    so.ValidateSettings();
+    lobes = MakeLobesOptions(cut, so);
+    feed = cut.feed_direction_B;
+  }
+  dynamics::PostureOptions po;
+  po.cartesian = false;
+  po.jacobian_condition = false;
+  auto value = [&](const dynamics::ParameterSet& p, const io::Posture& posture) {
+    double y = NAN;
+    if (lobes) {
+      const Eigen::VectorXd d = stability::ZoaCriticalDepths(config.description, p, posture.id, posture.q, feed, *lobes);
+      y = std::numeric_limits<double>::infinity();
+      for (Eigen::Index i = 0; i < d.size(); ++i) {
+        if (std::isfinite(d(i))) y = std::min(y, d(i));
+      }
+    } else {
+      const dynamics::PostureDynamics d = dynamics::EvaluatePosture(dynamics::RobotModel::Build(config.description, p),
+                                                                    posture.q, po);
+      if (!d.modes.empty()) y = d.modes.front().freq_hz;
+    }
+    if (!(y > 0.0) || !std::isfinite(y)) {
+      throw std::invalid_argument("posture " + posture.id + ": the " +
+                                  (lobes ? "ZOA lobes have no boundary" : "model has no mode") +
+                                  ", so it cannot be a target");
+    }
+    return y;
+  };
+  constexpr double h = 1e-3;
+  Eigen::MatrixXd G(n, static_cast<Eigen::Index>(postures.size()));
+  for (size_t t = 0; t < postures.size(); ++t) {
+    for (int j = 0; j < n; ++j) {
+      const std::string name = "kq" + std::to_string(j + 1) + "_Nm_per_rad";
+      dynamics::ParameterSet lo = config.parameters, hi = config.parameters;
+      lo.Set(name, config.parameters.Get(name) * std::exp(-h));
+      hi.Set(name, config.parameters.Get(name) * std::exp(h));
+      G(j, static_cast<Eigen::Index>(t)) = (std::log(value(hi, postures[t])) - std::log(value(lo, postures[t]))) / (2 * h);
+    }
+  }
+  return G;
 }
 
 KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
@@ -147,6 +215,21 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
   p.p_target_tip = o.target_m;
   p.masses_kg = o.masses_kg;
   p.max_rope_angle = DegToRad(o.max_rope_angle_deg);
+  std::vector<io::Posture> targets;
+  if (!o.target_postures_path.empty()) {
+    std::vector<std::string> units;
+    targets = io::ReadPostureFile(o.target_postures_path, r.model->num_joints(), &units);
+    for (const std::string& w : units) {
+      Tell(on_message, Message::Kind::kWarning, w);
+      r.config.implausible.push_back(w);  // flags the plan (exit 3) like the config's own findings
+    }
+    Tell(on_message, Message::Kind::kNote,
+         "targeted plan: the " + std::string(o.target_quantity == "frequency" ? "lowest natural frequency"
+                                                                                : "smallest ZOA critical depth") +
+             " at " + std::to_string(targets.size()) + " postures");
+    p.target_gradients = TargetGradients(r.config, targets, o.target_quantity, o.cut_path);
+    p.target_half_width = o.target_half_width;
+  }
   r.plan = identification::PlanLoadTests(*r.model, p);
   const int n = r.model->num_joints();
   std::ostringstream head;
@@ -165,11 +248,42 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
         << Sci(r.plan.expected_std_dev(j), 2) << " N·m/rad (" << rel.str() << ")";
     r.lines.push_back(row.str());
   }
+  if (!targets.empty()) {
+    std::ostringstream m;
+    m << "expected 95 % half-width of the " << (o.target_quantity == "frequency" ? "lowest natural frequency"
+                                                                               : "smallest ZOA critical depth")
+      << ":";
+    const double z = 1.959963984540054;
+    for (size_t t = 0; t < targets.size(); ++t) {
+      const double hw = z * r.plan.expected_target_relative_std(static_cast<Eigen::Index>(t));
+      r.target_half_widths.push_back({targets[t].id, hw});
+      m << (t ? "," : "") << " " << targets[t].id << " ±" << std::setprecision(3) << 100 * hw << " %";
+    }
+    {
+      // The same targets with the D-optimal plan of the same size: what targeting gains.
+      identification::PlanOptions d = p;
+      d.design_for_targets = false;
+      d.target_half_width = 0.0;
+      const identification::TestPlan dp = identification::PlanLoadTests(*r.model, d);
+      r.d_optimal_target_half_width = z * dp.expected_target_relative_std.maxCoeff();
+      m << " (worst ±" << 100 * z * r.plan.expected_target_relative_std.maxCoeff() << " %; a D-optimal plan of "
+        << o.num_postures << " postures: ±" << 100 * r.d_optimal_target_half_width << " %)";
+    }
+    r.lines.push_back(m.str());
+    if (o.target_half_width > 0.0 && r.plan.postures_for_target_width > 0) {
+      std::ostringstream w;
+      w << "the first " << r.plan.postures_for_target_width << " postures of the plan ("
+        << r.plan.postures_for_target_width * p.directions_per_posture * static_cast<int>(p.masses_kg.size())
+        << " load cases) bring every target within ±" << 100 * o.target_half_width << " %";
+      r.lines.push_back(w.str());
+    }
+  }
   for (const Finding& f : r.plan.findings) {
     r.warnings.push_back(f.message + (f.input_index == n - 1 ? " (" + o.points_name + ")" : ""));
   }
   for (int j = 0; j < n; ++j) {
     if (r.plan.expected_determination[j] != identification::Determination::kWeak) continue;
+    if (!identification::TargetsDependOnJoint(p, j)) continue;  // a targeted plan need not determine it
     std::ostringstream m;
     m << "joint " << j + 1 << " would be weakly determined (±" << std::fixed << std::setprecision(0)
       << 100 * r.plan.expected_relative_std(j) << " % at 1 sigma): plan more postures (" << o.num_postures_name << ")"

@@ -122,10 +122,7 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const stabil
       run.uncertainty_files = files;
       u = io::ReadParameterUncertainties(files);
       const std::string changed = dynamics::UseEstimates(*u, &cfg.parameters);
-      if (!changed.empty()) {
-        Say(tell, stability::TipMessage::Kind::kNote,
-            "the uncertainty's estimates replace the config's values: " + changed);
-      }
+      if (!changed.empty()) Say(tell, stability::TipMessage::Kind::kNote, changed);
     }
     std::vector<io::Posture> postures;
     run.tips = TipsFromRobotPostures(cfg.Build(), o.postures_path, o.pose_ids, run.cut, tell, &postures);

@@ -108,6 +108,82 @@ TEST(AuditHypotheses, JointStiffnessOffOnTwoJointsIsNamedAsParametersNotAsAnEffe
   EXPECT_LE(r.remainder_noise_units, 1.3);
 }
 
+// Issue #37 §4: a misfit within what the joint stiffnesses' uncertainty
+// allows is not evidence of a missing effect. kq2 15 % lower and kq3 10 %
+// higher than configured; the configured kq1..kq6 carry a kq-identify-like
+// uncertainty (compliances, σ a fixed fraction of each). With σ 10 % the
+// truth lies inside the 95 % region (Mahalanobis distance² ≈ 3.9 against
+// χ²₆(0.95) = 12.6): the allowance must cover the failure, bring the error
+// within the noise and find kq2 near the truth. With σ 1 % the truth is
+// 15 σ away: the most favourable point lies on the region's boundary and
+// explains only part of the misfit. (With σ 3 %, 6 σ for kq2, the trade-off
+// with kq3 and the calibration parameters still covers it: 1.2 x the noise.)
+dynamics::ParameterUncertainty StiffnessUncertainty(const dynamics::ParameterSet& p, double rel) {
+  dynamics::ParameterUncertainty u;
+  for (int j = 1; j <= 6; ++j) {
+    const std::string n = "kq" + std::to_string(j) + "_Nm_per_rad";
+    u.parameters.push_back({n, p.Get(n), dynamics::UncertainScale::kInverse});
+  }
+  u.covariance = Eigen::MatrixXd::Zero(6, 6);
+  for (int j = 0; j < 6; ++j) u.covariance(j, j) = std::pow(rel / u.parameters[j].value, 2);
+  u.covariance(1, 2) = u.covariance(2, 1) = 0.3 * std::sqrt(u.covariance(1, 1) * u.covariance(2, 2));
+  u.source = "test";
+  return u;
+}
+
+AuditResult RunWithUncertainty(const Campaign& c, const dynamics::FrfSet& measured, double rel) {
+  AuditOptions o;
+  o.candidates = {"kq2_Nm_per_rad"};  // the allowance is under test, not the candidates
+  o.parameter_uncertainty = StiffnessUncertainty(c.cfg.parameters, rel);
+  o.progress = [](const std::string& m) { std::cout << "  " << m << std::endl; };
+  AuditResult r = RunAudit(c.cfg.description, c.cfg.parameters, c.postures, measured, o);
+  std::cout << "verdict: " << r.verdict << "\nheadline: " << r.headline << "\n";
+  return r;
+}
+
+dynamics::FrfSet StiffnessOffMeasured(const Campaign& c, unsigned seed) {
+  dynamics::ParameterSet truth = c.cfg.parameters;
+  OffsetCalibration(c.cfg.parameters, &truth);
+  truth.Set("kq2_Nm_per_rad", 0.85 * c.cfg.parameters.Get("kq2_Nm_per_rad"));
+  truth.Set("kq3_Nm_per_rad", 1.10 * c.cfg.parameters.Get("kq3_Nm_per_rad"));
+  return Measure(dynamics::RobotModel::Build(c.cfg.description, truth), c.poses, seed, "kq_unc");
+}
+
+TEST(AuditUncertainty, MisfitWithinTheStiffnessUncertaintyIsCoveredAndNotEvidence) {
+  const Campaign c = MakeSixPostureCampaign();
+  const AuditResult r = RunWithUncertainty(c, StiffnessOffMeasured(c, 417), 0.10);
+  ASSERT_TRUE(r.significant_failure) << r.verdict;
+  ASSERT_TRUE(r.uncertainty.has_value());
+  const UncertaintyAllowance& u = *r.uncertainty;
+  EXPECT_EQ(u.rank, 6);
+  EXPECT_NEAR(u.chi2, 12.5916, 1e-3);
+  EXPECT_TRUE(u.covers_failure) << u.sentence;
+  EXPECT_LE(u.error_noise_units, 1.3) << u.sentence;
+  EXPECT_LE(u.distance, u.radius * (1.0 + 1e-9));
+  EXPECT_NEAR(u.at.Get("kq2_Nm_per_rad") / c.cfg.parameters.Get("kq2_Nm_per_rad"), 0.85, 0.05) << u.sentence;
+  EXPECT_NE(r.verdict.find("not evidence of a missing effect"), std::string::npos) << r.verdict;
+  EXPECT_NE(r.headline.find("uncertainty alone could explain"), std::string::npos) << r.headline;
+  ASSERT_FALSE(r.next_steps.empty());
+  EXPECT_NE(r.next_steps.front().find("kq-identify --plan"), std::string::npos) << r.next_steps.front();
+}
+
+TEST(AuditUncertainty, MisfitBeyondTheStiffnessUncertaintyIsPartlyExplainedOnTheBoundary) {
+  const Campaign c = MakeSixPostureCampaign();
+  const AuditResult r = RunWithUncertainty(c, StiffnessOffMeasured(c, 419), 0.01);
+  ASSERT_TRUE(r.significant_failure) << r.verdict;
+  ASSERT_TRUE(r.uncertainty.has_value());
+  const UncertaintyAllowance& u = *r.uncertainty;
+  EXPECT_FALSE(u.covers_failure) << u.sentence;
+  // The best point within the region is on its boundary (the truth is
+  // outside); which parameters spend the region's budget is the fit's
+  // business (kq3 and the calibration parameters trade off with kq2).
+  EXPECT_NEAR(u.distance / u.radius, 1.0, 0.02) << u.sentence;
+  EXPECT_GT(u.fraction_removed, 0.0) << u.sentence;
+  EXPECT_LT(u.fraction_removed, 0.9) << u.sentence;
+  EXPECT_GT(u.error_noise_units, 1.3);
+  EXPECT_NE(r.verdict.find("the rest is a model error"), std::string::npos) << r.verdict;
+}
+
 // The same two joints off, with data from a second model that shares no
 // code with the library: tests/audit/numpy_robot_frf.py (NumPy on the URDF:
 // forward kinematics, body Jacobians, M = Σ m JvᵀJv + JωᵀIJω, Rayleigh

@@ -142,6 +142,62 @@ TEST(FrfCalibration, AcceptanceTwoStageRecoversTruthFromNoisyHammerTests) {
     EXPECT_LT(std::abs(e.value - s.truth.Get(e.name)), 5.0 * e.std_dev) << e.name;
     EXPECT_FALSE(e.weakly_identified) << e.name;
   }
+  // The covariance (issue #37): its diagonal is the reported σ², the stages
+  // are independent blocks, and the truth lies inside the 99.9 % ellipsoid
+  // of each stage's pair (χ²₂ = 13.8) with the correlation taken into account.
+  ASSERT_EQ(r.covariance.rows(), 4);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(std::sqrt(r.covariance(i, i)) / r.estimates[i].std_dev, 1.0, 1e-9) << r.estimates[i].name;
+    for (int j = 0; j < 4; ++j) {
+      EXPECT_NEAR(r.covariance(i, j), r.covariance(j, i), 1e-12 * r.covariance.cwiseAbs().maxCoeff());
+      if ((i < 2) != (j < 2)) {
+        EXPECT_EQ(r.covariance(i, j), 0.0) << i << "," << j;
+      }
+    }
+  }
+  for (int b = 0; b < 4; b += 2) {
+    const Eigen::Matrix2d c = r.covariance.block<2, 2>(b, b);
+    EXPECT_LT(std::abs(c(0, 1)) / std::sqrt(c(0, 0) * c(1, 1)), 1.0);
+    const Eigen::Vector2d d(r.estimates[b].value - s.truth.Get(r.estimates[b].name),
+                            r.estimates[b + 1].value - s.truth.Get(r.estimates[b + 1].name));
+    EXPECT_LT(d.dot(c.inverse() * d), 13.8) << r.estimates[b].name << ", " << r.estimates[b + 1].name;
+  }
+  // What --uncertainty-out writes: log scale, the relative covariance.
+  const FittedUncertainty fu = FittedParameterUncertainty(r, "test");
+  ASSERT_EQ(fu.uncertainty.parameters.size(), 4u);
+  EXPECT_TRUE(fu.left_out.empty());
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(fu.uncertainty.parameters[i].scale, dynamics::UncertainScale::kLog);
+    EXPECT_NEAR(std::sqrt(fu.uncertainty.covariance(i, i)), r.estimates[i].std_dev / r.estimates[i].value, 1e-12);
+  }
+  EXPECT_NO_THROW(dynamics::CheckValid(fu.uncertainty));
+}
+
+TEST(FittedParameterUncertainty, LeavesOutWhatTheDataDoNotDetermine) {
+  CalibrationResult r;
+  r.estimates = {{"m6_kg", "kg", 10, 12, 0.3}, {"d6_m", "m", 0.3, 0.25, 0.5}, {"alpha_s", "s", 1, 1, NAN},
+                 {"beta_per_s", "1/s", 1, -0.5, 0.1}};
+  r.estimates[2].at_bound = true;
+  r.covariance = Eigen::MatrixXd::Constant(4, 4, NAN);
+  r.covariance(0, 0) = 0.09;
+  r.covariance(1, 1) = 0.25;
+  r.covariance(3, 3) = 0.01;
+  r.covariance(0, 3) = r.covariance(3, 0) = 0.015;  // correlation 0.5
+  r.covariance(0, 1) = r.covariance(1, 0) = 0.0;
+  r.covariance(1, 3) = r.covariance(3, 1) = 0.0;
+  const FittedUncertainty fu = FittedParameterUncertainty(r, "test");
+  ASSERT_EQ(fu.uncertainty.parameters.size(), 2u);
+  EXPECT_EQ(fu.uncertainty.parameters[0].name, "m6_kg");
+  EXPECT_EQ(fu.uncertainty.parameters[0].scale, dynamics::UncertainScale::kLog);
+  EXPECT_EQ(fu.uncertainty.parameters[1].name, "beta_per_s");
+  EXPECT_EQ(fu.uncertainty.parameters[1].scale, dynamics::UncertainScale::kLinear);  // a value <= 0
+  // log m6: σ 0.3 / 12; the cross term 0.015 / 12 (only m6 on the log scale).
+  EXPECT_NEAR(fu.uncertainty.covariance(0, 0), 0.09 / 144, 1e-15);
+  EXPECT_NEAR(fu.uncertainty.covariance(0, 1), 0.015 / 12, 1e-15);
+  EXPECT_NEAR(fu.uncertainty.covariance(1, 1), 0.01, 1e-15);
+  ASSERT_EQ(fu.left_out.size(), 2u);
+  EXPECT_NE(fu.left_out[0].find("d6_m: not determined, σ 200 %"), std::string::npos) << fu.left_out[0];
+  EXPECT_NE(fu.left_out[1].find("alpha_s: held on a bound"), std::string::npos) << fu.left_out[1];
 }
 
 TEST(FrfCalibration, AcceptanceJointAndWholeCurveObjectives) {
@@ -319,6 +375,10 @@ TEST(FrfCalibration, NeverWorseThanTheStart) {
     EXPECT_LE(m1, m0) << label;
     if (r.status == FitStatus::kNotImproved) {
       EXPECT_EQ(r.parameters.values(), start->values()) << label;
+      // No covariance of the start values: --uncertainty-out writes none of them.
+      const FittedUncertainty fu = FittedParameterUncertainty(r, label);
+      EXPECT_TRUE(fu.uncertainty.parameters.empty()) << label;
+      EXPECT_EQ(fu.left_out.size(), r.estimates.size()) << label;
     }
     // Another robot: the calibrated model still misses the data by far more
     // than the noise, which the caller reports (frf-calibrate exits 3).

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "robomach/dynamics/posture_dynamics.h"
+#include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/dynamics/uncertainty.h"
 #include "test_models.h"
 
@@ -29,6 +30,19 @@ TEST(NormalQuantile, PublishedValues) {
   EXPECT_NEAR(NormalQuantile(0.5), 0.0, 1e-11);
   EXPECT_NEAR(NormalQuantile(0.025), -1.959963985, 1e-9);
   EXPECT_THROW(NormalQuantile(1.0), std::invalid_argument);
+}
+
+TEST(ChiSquaredQuantile, PublishedValues) {
+  // Abramowitz & Stegun Table 26.8 (upper 5 % and 1 % points).
+  const double p95[] = {3.841459, 5.991465, 7.814728, 9.487729, 11.070498, 12.591587};
+  for (int k = 1; k <= 6; ++k) EXPECT_NEAR(ChiSquaredQuantile(0.95, k), p95[k - 1], 2e-6) << k << " dof";
+  EXPECT_NEAR(ChiSquaredQuantile(0.99, 7), 18.475307, 2e-6);
+  EXPECT_NEAR(ChiSquaredQuantile(0.95, 10), 18.307038, 2e-6);
+  // One degree of freedom: the square of the two-sided normal quantile.
+  EXPECT_NEAR(ChiSquaredQuantile(0.9, 1), std::pow(NormalQuantile(0.95), 2), 1e-8);
+  EXPECT_NEAR(ChiSquaredCdf(ChiSquaredQuantile(0.3, 9), 9), 0.3, 1e-10);
+  EXPECT_THROW(ChiSquaredQuantile(0.95, 0), std::invalid_argument);
+  EXPECT_THROW(ChiSquaredQuantile(1.0, 3), std::invalid_argument);
 }
 
 TEST(Propagate, LinearMapIsExactToFirstOrderAndAutoKeepsIt) {
@@ -159,6 +173,48 @@ TEST(ModalIntervals, CommonStiffnessScaleMovesEveryFrequencyByItsSquareRoot) {
     const double f = d.modes[k].freq_hz;
     EXPECT_NEAR(2.0 / sigma * std::log(m.modes[k].freq_hz.upper / f), 1.959963985, 0.17) << k;
     EXPECT_NEAR(2.0 / sigma * std::log(m.modes[k].freq_hz.lower / f), -1.959963985, 0.17) << k;
+  }
+}
+
+// frf-predict's |H| band: with every joint stiffness scaled by one factor
+// s (σ(ln s) = 0.1), the quasi-static receptance is (s K)⁻¹ projected to the
+// tip, so ln|H| at 0.25 Hz (40 times below the lowest mode: dynamic terms
+// ~(f/f₁)² = 6e-4) moves by −ln s: its first-order half-width is 1.96 × 0.1.
+// The thinned grid keeps the line nearest every mode, and the band holds
+// the curve.
+TEST(DirectReceptanceBand, QuasiStaticBandOfACommonStiffnessScaleIsItsSpread) {
+  const io::RobotConfig cfg = testing::Kr210Config();
+  ParameterUncertainty u;
+  for (int j = 0; j < 6; ++j) {
+    const std::string name = "kq" + std::to_string(j + 1) + "_Nm_per_rad";
+    u.parameters.push_back({name, cfg.parameters.Get(name), UncertainScale::kLog});
+  }
+  u.covariance = Eigen::MatrixXd::Constant(6, 6, 0.01);
+  Eigen::VectorXd q(6);
+  q << 0.3, -1.2, 1.0, 0.4, 0.9, -0.5;
+  PropagationOptions o;
+  o.method = PropagationMethod::kFirstOrder;
+  const Eigen::VectorXd f = Eigen::VectorXd::LinSpaced(2000, 0.25, 500.0);
+  const ReceptanceBand b = DirectReceptanceBand(cfg.description, cfg.parameters, q, u, f, o, 300);
+  ASSERT_LE(b.freq_hz.size(), 300);
+  ASSERT_GE(b.freq_hz.size(), 250);
+  EXPECT_EQ(b.freq_hz(0), 0.25);
+  EXPECT_EQ(b.freq_hz(b.freq_hz.size() - 1), 500.0);
+  const PostureDynamics d = EvaluatePosture(cfg.Build(), q);
+  const double df = f(1) - f(0);
+  for (const Mode& m : d.modes) {
+    if (m.freq_hz > 500.0) continue;
+    EXPECT_LE((b.freq_hz.array() - m.freq_hz).abs().minCoeff(), 0.5 * df + 1e-9) << m.freq_hz << " Hz";
+  }
+  const std::vector<Eigen::Matrix3cd> H = Receptance(d, b.freq_hz);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(std::log(b.upper[a](0) / b.magnitude[a](0)), 1.959963985 * 0.1, 2e-3 * 0.196) << a;
+    EXPECT_NEAR(std::log(b.magnitude[a](0) / b.lower[a](0)), 1.959963985 * 0.1, 2e-3 * 0.196) << a;
+    for (Eigen::Index i = 0; i < b.freq_hz.size(); ++i) {
+      EXPECT_NEAR(b.magnitude[a](i), std::abs(H[static_cast<size_t>(i)](a, a)), 1e-9 * b.magnitude[a](i));
+      EXPECT_LE(b.lower[a](i), b.magnitude[a](i) * (1 + 1e-12));
+      EXPECT_GE(b.upper[a](i), b.magnitude[a](i) * (1 - 1e-12));
+    }
   }
 }
 

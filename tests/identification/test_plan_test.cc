@@ -107,5 +107,58 @@ TEST(PlanLoadTests, AutomaticCandidateCount) {
   EXPECT_THROW(CheckValid(o), std::invalid_argument);
 }
 
+// A targeted plan (issue #37 §5): with the gradients of a quantity the user
+// cares about (here one that rests on joints 2, 3 and 5, as a lobe bottom
+// can), the plan minimises that quantity's variance instead of log det I.
+// Checked through a second route (LogStiffnessInformation of the planned
+// cases): the reported relative std is √(gᵀ I⁻¹ g); the targeted plan beats
+// the D-optimal one on it by a clear margin; the half-width never grows with
+// more postures; a joint no target feels is not flagged (joint 6 with the
+// load and the target on the tool axis), and a band out of reach is flagged
+// with an estimate of the postures that would reach it.
+TEST(PlanLoadTests, TargetedPlanNarrowsItsTargetMoreThanTheDOptimalOne) {
+  const auto model = Kr210();
+  PlanOptions o;
+  o.num_postures = 6;
+  o.num_candidate_postures = 150;
+  Eigen::VectorXd g(6);
+  g << 0.0, 0.35, -0.25, 0.0, 0.4, 0.0;
+  const TestPlan d_optimal = PlanLoadTests(*model, o);
+  EXPECT_TRUE(d_optimal.flagged());  // joint 6 on the tool axis
+  o.target_gradients = g;
+  o.target_half_width = 0.01;  // out of reach of 6 postures (±2.9 %)
+  const TestPlan targeted = PlanLoadTests(*model, o);
+  const double sigma = std::sqrt(2.0) * o.tracker_noise;
+  auto target_std = [&](const TestPlan& p) {
+    const Eigen::MatrixXd I = LogStiffnessInformation(*model, p.cases, model->joint_stiffness(), sigma);
+    const Eigen::MatrixXd sub = I.topLeftCorner(5, 5);  // joint 6 unseen: g(5) = 0 keeps the target determined
+    return std::sqrt(g.head(5).dot(sub.ldlt().solve(g.head(5))));
+  };
+  ASSERT_EQ(targeted.expected_target_relative_std.size(), 1);
+  EXPECT_NEAR(targeted.expected_target_relative_std(0) / target_std(targeted), 1.0, 1e-6);
+  EXPECT_LT(target_std(targeted), 0.8 * target_std(d_optimal));
+  ASSERT_EQ(targeted.target_half_width_by_postures.size(), 6u);
+  for (size_t k = 1; k < 6; ++k) {
+    EXPECT_LE(targeted.target_half_width_by_postures[k], targeted.target_half_width_by_postures[k - 1] * (1 + 1e-9));
+  }
+  EXPECT_NEAR(targeted.target_half_width_by_postures.back(), 1.959964 * targeted.expected_target_relative_std(0), 1e-6);
+  EXPECT_EQ(targeted.postures_for_target_width, 0);
+  // Variance as 1/k: 6 (2.85 / 1)² ≈ 49 postures.
+  EXPECT_NEAR(targeted.postures_for_target_width_estimate,
+              6 * std::pow(targeted.target_half_width_by_postures.back() / 0.01, 2), 1.0);
+  ASSERT_EQ(targeted.findings.size(), 1u);  // the band, not joint 6
+  EXPECT_NE(targeted.findings[0].message.find("postures would reach it"), std::string::npos)
+      << targeted.findings[0].message;
+  // A band within reach: the first k postures reach it, no finding.
+  o.target_half_width = targeted.target_half_width_by_postures[3] * 1.0001;
+  const TestPlan reached = PlanLoadTests(*model, o);
+  EXPECT_FALSE(reached.flagged());
+  EXPECT_GE(reached.postures_for_target_width, 1);
+  EXPECT_LE(reached.postures_for_target_width, 4);
+  // Gradients of the wrong size are refused.
+  o.target_gradients = Eigen::VectorXd::Ones(5);
+  EXPECT_THROW(PlanLoadTests(*model, o), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace robomach::identification

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/dynamics/parameters.h"
 #include "robomach/dynamics/robot_model.h"
+#include "robomach/dynamics/uncertainty.h"
 
 namespace robomach::audit {
 
@@ -105,6 +107,15 @@ struct AuditOptions {
   double robust_scale{0.0};
   /// Candidates fitted at the same time (each fit is single-threaded).
   int threads{2};
+  /// The uncertainty of model parameters the audit does not calibrate
+  /// (issue #37 §4): kq-identify's joint stiffnesses, a previous
+  /// calibration's effect parameters (docs/formats.md §12). Its estimates
+  /// must be the values in the parameters audited (model-audit puts them
+  /// there). Empty: none. Parameters the audit calibrates anyway and names
+  /// the model does not have are left out (AuditResult::uncertainty says so).
+  dynamics::ParameterUncertainty parameter_uncertainty;
+  /// Confidence level of the region the parameters may move in.
+  double uncertainty_confidence{0.95};
   /// Called with one line per step (for progress on stderr); may be empty.
   std::function<void(const std::string&)> progress;
 };
@@ -249,6 +260,35 @@ struct ScreenedVirtualJoint {
   bool fitted{false};            // one of the best, fitted fully as a candidate
 };
 
+/// What the parameter uncertainty allows (issue #37 §4): the calibrated
+/// model's error with the uncertain parameters at their most favourable
+/// values within the confidence region, the calibration parameters refitted.
+/// A failure this covers is not evidence of a missing effect.
+struct UncertaintyAllowance {
+  std::vector<std::string> parameters;  // the uncertain parameters moved
+  /// In the file but not moved, with why ("m6_kg: calibrated by the audit").
+  std::vector<std::string> left_out;
+  double confidence{NAN};
+  /// The region: (θ − θ̂)ᵀ Σ⁻¹ (θ − θ̂) <= chi2, chi2 the χ² quantile of
+  /// `confidence` with as many degrees of freedom as the covariance's rank.
+  double chi2{NAN};
+  int rank{0};
+  /// The most favourable point: found by Gauss–Newton steps constrained to
+  /// the region (the calibration parameters re-adjusted linearly), then the
+  /// calibration refitted there. Its values, the Mahalanobis distance
+  /// √((θ − θ̂)ᵀ Σ⁻¹ (θ − θ̂)) and the region's radius √chi2.
+  dynamics::ParameterSet at;
+  double distance{NAN}, radius{NAN};
+  ModelErrors errors;  // of the refitted model at that point
+  double error_noise_units{NAN};  // errors.total_rms_log_mag / noise floor
+  /// FractionRemoved of the calibrated model's error (error_before) by it.
+  double fraction_removed{NAN};
+  /// A significant failure that the uncertainty brings within
+  /// significance_factor × the noise floor.
+  bool covers_failure{false};
+  std::string sentence;  // in the verdict and the report
+};
+
 /// A calibration parameter of the calibrated current model that ended on a
 /// bound: the calibration stands in for something missing (issue #33).
 struct BoundFlag {
@@ -294,6 +334,9 @@ struct AuditResult {
   /// same measure for the calibrated model without one.
   std::vector<ScreenedVirtualJoint> virtual_joint_screen;
   double virtual_joint_screen_baseline{NAN};
+  /// With AuditOptions::parameter_uncertainty and a significant failure:
+  /// which part of the misfit the uncertainty could explain.
+  std::optional<UncertaintyAllowance> uncertainty;
   AuditGrade grade{AuditGrade::kUnexplained};
   /// grade is kNoFailure or kExplained: the model (with the named effects)
   /// agrees with the measurement within the noise. False for

@@ -24,6 +24,7 @@
 #include "robomach/dynamics/parameters.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/dynamics/robot_model.h"
+#include "robomach/dynamics/uncertainty.h"
 
 namespace robomach::calibration {
 
@@ -291,7 +292,33 @@ struct CalibrationResult {
   /// or "none (start kept)".
   std::string start_used;
   int starts_tried{0};
+  /// Covariance of the free parameters' values (options.free_parameters
+  /// order, parameter units): each stage's ceres::Covariance scaled by its
+  /// residual variance; block-diagonal over the stages of the two-stage
+  /// objective (the peak-amplitude stage's parameters are conditional on
+  /// the frequency stage's, held at their fitted values); NaN rows and
+  /// columns for a parameter without a covariance (held on a bound, or a
+  /// stage whose covariance could not be computed). Empty if none.
+  Eigen::MatrixXd covariance;
 };
+
+/// What --uncertainty-out writes of a calibration (docs/formats.md §12).
+struct FittedUncertainty {
+  /// The fitted parameters with a covariance, on the log scale (positive
+  /// values: what a fit of a mass, a length or a damping coefficient
+  /// determines is its relative error) or linear (a value <= 0).
+  dynamics::ParameterUncertainty uncertainty;
+  /// The free parameters left out, with why ("alpha_s: held on a bound,
+  /// no covariance"; "beta_per_s: not determined, σ 240 % of its value").
+  /// A parameter left out is taken as exact by the tools that read the file.
+  std::vector<std::string> left_out;
+};
+
+/// The result's estimates and covariance as a parameter uncertainty.
+/// A parameter without a covariance, or whose standard deviation exceeds
+/// its value (the data do not determine it), is left out and named.
+/// `source` names the tool and data ("frf-calibrate on hammer.csv").
+FittedUncertainty FittedParameterUncertainty(const CalibrationResult& result, const std::string& source);
 
 /// The whole-curve misfit of a model against measured FRFs in a band: the
 /// sum over lines of the squared log-magnitude and phase residuals

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cmath>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -58,6 +59,15 @@ ParameterUncertainty CombineIndependent(const std::vector<ParameterUncertainty>&
 /// The inverse of the standard normal distribution function: z with
 /// Φ(z) = p, 0 < p < 1 (bisection on std::erfc to 1e-12).
 double NormalQuantile(double p);
+
+/// The χ² distribution function with `dof` (>= 1, whole) degrees of
+/// freedom, from its closed forms (Abramowitz & Stegun 26.4.4-5).
+/// @throws std::invalid_argument for dof < 1.
+double ChiSquaredCdf(double x, int dof);
+/// Its inverse: the x with ChiSquaredCdf(x, dof) = p, 0 < p < 1 (bisection),
+/// the squared radius of a p confidence ellipsoid of dof Gaussian parameters.
+/// @throws std::invalid_argument for p outside (0, 1) or dof < 1.
+double ChiSquaredQuantile(double p, int dof);
 
 enum class PropagationMethod { kAuto, kFirstOrder, kMonteCarlo };
 /// "auto", "first-order", "monte-carlo".
@@ -140,8 +150,9 @@ PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction&
 ParameterSet WithValues(const ParameterSet& base, const ParameterUncertainty& u, const Eigen::VectorXd& values);
 
 /// Puts `u`'s estimates into `parameters` (WithValues at the estimates)
-/// and returns the ones that changed, "kq1_Nm_per_rad 1.2e+06 -> 1.31e+06,
-/// ..." ("" when none did).
+/// and returns the note every tool gives when some changed, "the
+/// uncertainty's estimates replace the config's values: kq1_Nm_per_rad
+/// 1.2e+06 -> 1.31e+06, ..." ("" when none did).
 /// @throws std::invalid_argument as WithValues.
 std::string UseEstimates(const ParameterUncertainty& u, ParameterSet* parameters);
 
@@ -167,6 +178,26 @@ struct PostureModeIntervals {
 PostureModeIntervals ModalIntervals(const RobotDescription& description, const ParameterSet& base,
                                     const Eigen::VectorXd& q, const ParameterUncertainty& u,
                                     const PropagationOptions& options = {});
+
+/// Band of the direct tool-tip receptances |H_xx|, |H_yy|, |H_zz| at a
+/// posture (frf-predict's plot, issue #37 §3).
+struct ReceptanceBand {
+  Eigen::VectorXd freq_hz;                           // the band's lines
+  std::array<Eigen::VectorXd, 3> magnitude, lower, upper;  // [m/N], at the estimates and the interval's ends
+  PropagationResult propagation;  // outputs: ln|H| per direction, then line
+};
+
+/// The interval of ln|H_aa(f)| carried from `u`, returned as magnitudes
+/// (exp of the interval's ends), on at most `max_lines` lines of `freq_hz`:
+/// every k-th line and the line nearest each mode's frequency at the
+/// estimates (so no peak is missed). Near a resonance |H| is far from linear
+/// in the parameters (the peak moves): auto then finds it and runs Monte Carlo.
+/// @throws std::invalid_argument for max_lines < 2, an unknown parameter or
+///   a model that cannot be built at the estimates.
+ReceptanceBand DirectReceptanceBand(const RobotDescription& description, const ParameterSet& base,
+                                    const Eigen::VectorXd& q, const ParameterUncertainty& u,
+                                    const Eigen::VectorXd& freq_hz, const PropagationOptions& options = {},
+                                    int max_lines = 400);
 
 /// One line for a terminal: "P1: 95 % intervals (first order): mode 1
 /// 11.2 Hz [10.9, 11.5], mode 2 ..." (the three lowest modes).

@@ -41,10 +41,31 @@ struct PlanOptions {
   /// A joint whose expected relative standard deviation exceeds this is
   /// weakly determined (the identification's own threshold).
   double weak_relative_std{IdentificationOptions{}.weak_relative_std};
+  /// A targeted design (issue #37 §5): columns g_t = ∂ ln y_t / ∂ ln k (one
+  /// row per joint) of the quantities y_t the user cares about, such as the
+  /// lowest natural frequency or the safe depth at the postures of a work
+  /// region. Non-empty: the postures and directions minimise
+  /// Σ_t g_tᵀ I⁻¹ g_t, the sum of the targets' relative variances (a linear,
+  /// "L-optimal" design [Atkinson & Donev 1992, ch. 10]), instead of
+  /// maximising log det I.
+  Eigen::MatrixXd target_gradients;
+  /// With target_gradients: design for them (true), or keep the D-optimal
+  /// design and only report the targets' widths (false: the comparison).
+  bool design_for_targets{true};
+  /// The relative half-width of the targets' intervals (at
+  /// target_confidence) the user wants, e.g. 0.05; 0: none. The plan says
+  /// how many of its postures reach it.
+  double target_half_width{0.0};
+  double target_confidence{0.95};
 };
 
 /// @throws std::invalid_argument naming the field and the violated bound.
 void CheckValid(const PlanOptions& options);
+
+/// Whether a plan must determine `joint` (0-based): always for a D-optimal
+/// plan; for a targeted one when some target's gradient on it exceeds 1e-3
+/// of the largest (a joint no target feels is neither flagged nor warned about).
+bool TargetsDependOnJoint(const PlanOptions& options, int joint);
 
 /// One planned rope direction at one posture.
 struct PlannedLoad {
@@ -67,14 +88,29 @@ struct TestPlan : RunFindings {
   int num_candidates{0};                 // feasible candidate postures found
   /// Per joint, by DeterminationFromRelativeStd(expected_relative_std).
   std::vector<Determination> expected_determination;
+  /// With target_gradients: each target's expected relative standard
+  /// deviation √(g_tᵀ I⁻¹ g_t) with the whole plan; the largest target's
+  /// relative half-width (z √(g_tᵀ I_k⁻¹ g_t), z the target_confidence
+  /// quantile) with the first k postures of the plan, k = 1..num_postures
+  /// (+inf while some target is not determined).
+  Eigen::VectorXd expected_target_relative_std;
+  std::vector<double> target_half_width_by_postures;
+  /// With target_half_width: the fewest of the plan's first postures that
+  /// bring every target within it (0: the plan does not), and, when the plan
+  /// does not, about how many postures would (a variance falling as 1/k from
+  /// the whole plan's; 0 when no target is determined).
+  int postures_for_target_width{0};
+  int postures_for_target_width_estimate{0};
 };
 
 /// Chooses postures (within the joint limits with a margin) and rope
 /// directions (downward, within max_rope_angle of vertical, reaching the
 /// floor from a load point at least min_load_height above it) that maximise
 /// log det of the Fisher information of log-stiffness at the model's
-/// stiffness (D-optimal design [Atkinson & Donev 1992]): greedy selection
-/// followed by Fedorov-style exchange passes over the random candidate set.
+/// stiffness (D-optimal design [Atkinson & Donev 1992]), or with
+/// target_gradients minimise the targets' summed relative variance:
+/// greedy selection followed by Fedorov-style exchange passes over the
+/// random candidate set. A plan that misses target_half_width is flagged.
 /// Each chosen posture gets `directions_per_posture` directions and every
 /// mass. Deterministic for a given seed.
 /// @throws std::invalid_argument for invalid options.

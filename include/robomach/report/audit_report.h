@@ -37,6 +37,9 @@ struct AuditReportOptions {
   /// Where model-audit --write-config wrote the config with the named
   /// change (empty: not asked), for the report's "what to do".
   std::string written_config;
+  /// What model-audit --uncertainty-out wrote ({"file", "parameters",
+  /// "left_out"}; null: not asked), for summary.json.
+  nlohmann::json uncertainty_out;
 };
 
 struct AuditReport {

@@ -20,6 +20,9 @@ struct FrfCurve {
   int thickness{2};             // [px]
   /// Drawn in the magnitude panel only (a noise floor has no phase).
   bool magnitude_only{false};
+  /// Optional confidence band of |H| (same length, its own lines): filled
+  /// in the curve's colour under the curves in the magnitude panel.
+  Eigen::VectorXd band_freq_hz{}, band_lower{}, band_upper{};  // [Hz], [m/N]
 };
 
 /// Fills a magnitude panel (log |H| in m/N) and a phase panel (degrees, -180..180)

@@ -36,6 +36,13 @@ struct ZoaBand {
 /// failed (PropagationResult::failed_samples).
 /// @throws std::invalid_argument as dynamics::Propagate, or when the lobes
 ///   have no boundary at any speed at the estimates.
+/// The ZOA critical depth [m] at each of options.zoa_speeds_rad_s of the
+/// model at posture q (NaN where the lobes have no boundary): what
+/// ZoaLobeBand propagates. Its smallest finite value is the lobe bottom.
+Eigen::VectorXd ZoaCriticalDepths(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
+                                  const std::string& id, const Eigen::VectorXd& q, const Eigen::Vector3d& feed_B,
+                                  const LobesOptions& options);
+
 ZoaBand ZoaLobeBand(const dynamics::RobotDescription& description, const dynamics::ParameterSet& base,
                     const std::string& id, const Eigen::VectorXd& q, const Eigen::Vector3d& feed_B,
                     const LobesOptions& options, const dynamics::ParameterUncertainty& u,

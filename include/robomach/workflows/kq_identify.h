@@ -19,6 +19,7 @@
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/identification/joint_stiffness.h"
 #include "robomach/identification/test_plan.h"
+#include "robomach/io/posture_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/tracker_file.h"
 
@@ -92,10 +93,28 @@ struct KqPlanOptions {
   /// "--load-point-mm, --target-mm").
   std::string num_postures_name{"num_postures"};
   std::string points_name{"load_point_m, target_m"};
+  /// A targeted plan (issue #37 §5): the posture file (formats.md §1) of the work region whose
+  /// `target_quantity` must be known well — "frequency" (the lowest natural
+  /// frequency) or "safe-depth" (the ZOA lobes' smallest critical depth of
+  /// the cut in `cut_path`, whose lower confidence bound is the safe depth)
+  /// — and the relative half-width wanted at 95 % (0: none). Empty: a
+  /// D-optimal plan.
+  std::string target_postures_path;
+  std::string target_quantity{"frequency"};
+  std::string cut_path;
+  double target_half_width{0.0};
 
   /// @throws OptionError naming the field and its bound.
   void Validate() const;
 };
+
+/// ∂ ln y / ∂ ln k_j of the target quantity at each posture (columns), by
+/// central differences (steps of 1e-3 in ln k_j) on the robot model:
+/// PlanOptions::target_gradients of a targeted plan.
+/// @throws std::invalid_argument if the quantity cannot be computed at a
+///   posture (no lobe boundary, a mode that does not move the tip).
+Eigen::MatrixXd TargetGradients(const io::RobotConfig& config, const std::vector<io::Posture>& postures,
+                                const std::string& quantity, const std::string& cut_path);
 
 struct KqPlanResult {
   io::RobotConfig config;  // as loaded (config.implausible: its unit findings)
@@ -108,8 +127,13 @@ struct KqPlanResult {
   /// The plan's findings (a joint no plan can determine), then one per joint
   /// it would leave weakly determined with what to change.
   std::vector<std::string> warnings;
-  /// kq-identify --plan's exit 3: a joint not determinable, or the config's
-  /// unit findings.
+  /// With target postures: each target's expected relative half-width at
+  /// 95 % with the whole plan, by posture id.
+  std::vector<std::pair<std::string, double>> target_half_widths;
+  /// The worst target's half-width with the D-optimal plan of the same size.
+  double d_optimal_target_half_width{NAN};
+  /// kq-identify --plan's exit 3: a joint not determinable, a target band
+  /// not reached, or the config's unit findings.
   bool flagged() const { return plan.flagged() || !config.implausible.empty(); }
 };
 

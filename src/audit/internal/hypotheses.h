@@ -2,6 +2,7 @@
 
 // The audit's hypotheses beyond the effect library (issue #33). Private to
 // src/audit.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,5 +37,21 @@ std::vector<ScreenedVirtualJoint> ScreenVirtualJoints(const dynamics::RobotDescr
                                                       const dynamics::ParameterSet& calibrated,
                                                       const std::vector<std::string>& calibration,
                                                       const FitContext& x, double* baseline);
+
+/// What the parameter uncertainty allows (AuditResult::uncertainty, issue
+/// #37 §4): the uncertain parameters of `u` (those the model has and the
+/// audit does not calibrate) moved within their `confidence` region around
+/// u's estimates, the calibrated model's whole-curve cost minimised there
+/// by up to four Gauss–Newton steps constrained to the region (a trust-region
+/// subproblem in the covariance's whitened coordinates, the calibration
+/// parameters re-adjusted linearly as in the virtual-joint screen), then
+/// the calibration refitted at the point and its errors computed.
+/// `error_before` and `significance_factor` grade it. std::nullopt when no
+/// parameter of `u` can move.
+std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::RobotDescription& desc,
+                                                           const dynamics::ParameterSet& calibrated,
+                                                           const dynamics::ParameterUncertainty& u,
+                                                           double confidence, const FitContext& x,
+                                                           double error_before);
 
 }  // namespace robomach::audit::internal

@@ -1,0 +1,77 @@
+// The targeted test plan of kq-identify --plan (issue #37 §5):
+// workflows::TargetGradients and RunKqPlan with target postures.
+#include "robomach/workflows/kq_identify.h"
+
+#include <cmath>
+#include <iostream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "robomach/common/errors.h"
+#include "robomach/io/posture_file.h"
+#include "test_support.h"
+
+namespace robomach::workflows {
+namespace {
+
+using robomach::testing::SourcePath;
+
+// Euler's theorem on the KR 210 model (no effects: K = diag(kq)): every joint
+// stiffness scaled by one factor s scales every undamped natural frequency
+// by √s, so the gradients of ln f over ln k_j sum to 1/2 at every posture.
+// The lowest mode of a six-joint arm rests on several joints (no single
+// one carries it all). The smallest ZOA critical depth rises with a
+// stiffer arm (all the gradients' sum is positive).
+TEST(TargetGradients, LowestFrequencyIsHomogeneousOfDegreeOneHalf) {
+  const io::RobotConfig cfg = io::LoadRobotConfig(SourcePath("config/kr210.yaml"));
+  ASSERT_TRUE(cfg.description.effects.empty());
+  const std::vector<io::Posture> postures = io::ReadPostureFile(SourcePath("config/postures_demo.csv"), 6);
+  const Eigen::MatrixXd G = TargetGradients(cfg, postures, "frequency", "");
+  ASSERT_EQ(G.rows(), 6);
+  ASSERT_EQ(G.cols(), static_cast<Eigen::Index>(postures.size()));
+  for (Eigen::Index t = 0; t < G.cols(); ++t) {
+    EXPECT_NEAR(G.col(t).sum(), 0.5, 1e-6) << postures[t].id;
+    EXPECT_LT(G.col(t).maxCoeff(), 0.5 - 1e-3) << postures[t].id;
+  }
+  const Eigen::MatrixXd D = TargetGradients(cfg, postures, "safe-depth", SourcePath("config/cut_demo.yaml"));
+  ASSERT_TRUE(D.allFinite());
+  for (Eigen::Index t = 0; t < D.cols(); ++t) EXPECT_GT(D.col(t).sum(), 0.0) << postures[t].id;
+}
+
+// The whole call as kq-identify --plan runs it: the expected half-width of
+// the safe depth at each target posture in the lines, and a band out of
+// reach flagged with about how many postures would reach it.
+TEST(RunKqPlan, TargetedPlanSaysWhetherItsPosturesReachTheBand) {
+  KqPlanOptions o;
+  o.robot_path = SourcePath("config/kr210.yaml");
+  o.num_postures = 4;
+  o.target_postures_path = SourcePath("config/postures_demo.csv");
+  o.target_quantity = "safe-depth";
+  o.cut_path = SourcePath("config/cut_demo.yaml");
+  o.target_half_width = 0.01;
+  // The safe depth depends on joint 6: the load and the target off the tool axis.
+  o.load_point_m = Eigen::Vector3d(0.15, 0.0, 0.10);
+  o.target_m = Eigen::Vector3d(0.0, 0.12, 0.05);
+  const KqPlanResult r = RunKqPlan(o);
+  ASSERT_EQ(r.target_half_widths.size(), 5u);
+  for (const auto& [id, hw] : r.target_half_widths) {
+    EXPECT_GT(hw, 0.0) << id;
+    EXPECT_LT(hw, 1.0) << id;
+  }
+  // Targeting narrows the worst band against the D-optimal plan of the same size.
+  double worst = 0.0;
+  for (const auto& [id, hw] : r.target_half_widths) worst = std::max(worst, hw);
+  EXPECT_LT(worst, r.d_optimal_target_half_width);
+  std::cout << "worst safe-depth half-width: targeted " << worst << ", D-optimal " << r.d_optimal_target_half_width << "\n";
+  EXPECT_TRUE(r.flagged());
+  bool said = false;
+  for (const std::string& w : r.warnings) said |= w.find("postures would reach it") != std::string::npos;
+  EXPECT_TRUE(said);
+  o.target_half_width = 0.0;
+  o.cut_path.clear();
+  EXPECT_THROW(o.Validate(), OptionError);  // safe-depth without a cut
+}
+
+}  // namespace
+}  // namespace robomach::workflows
