@@ -35,7 +35,8 @@ int Run(int argc, char** argv) {
       "(the modal fits' stabilisation diagrams), summary.json."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() + " Exit 3 also when the fit did not converge or a parameter is weakly identified, "
-                                "or a measured receptance is outside 1e-12..1e-3 m/N (a unit mistake).");
+                                "or a measured receptance is outside 1e-12..1e-3 m/N (a unit mistake), or --uncertainty-out "
+                                "was asked for and not written (no fitted parameter has a covariance).");
   std::string robot_path, postures_path, out_path, report_dir, summary_path, uncertainty_path,
       objective = "modal-two-stage";
   std::vector<std::string> measured_files, pose_files, validate_files, validate_pose_files, frees, sets, adds;
@@ -221,6 +222,11 @@ int Run(int argc, char** argv) {
       for (const auto& f : measured_files) source += " " + f;
       for (const auto& f : pose_files) source += " " + f;
       summary["uncertainty_out"] = WriteFittedUncertainty(kTool, uncertainty_path, result, source);
+      // Asked for and not written: a flag (exit 3), in the summary's flags too.
+      if (summary["uncertainty_out"].contains("warning")) {
+        flags.push_back(summary["uncertainty_out"]["warning"]);
+        summary["misfit"]["flags"] = flags;
+      }
     }
     io::WriteFileAtomically((dir / "summary.json").string(), SummaryText(summary));
     dynamics::PostureEvaluator eb(model_before), ea(model_after);

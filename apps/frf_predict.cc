@@ -180,7 +180,9 @@ int Run(int argc, char** argv) {
     std::optional<dynamics::ParameterUncertainty> uncertainty;
     // The config's `uncertainty:` files serve the outputs that carry intervals.
     const std::vector<std::string> uncertainty_paths =
-        unc.paths.empty() && modes_path.empty() && details_path.empty() ? std::vector<std::string>{} : unc.PathsFor(cfg);
+        unc.paths.empty() && modes_path.empty() && details_path.empty() && plot_path.empty() && plot_dir.empty()
+            ? std::vector<std::string>{}
+            : unc.PathsFor(cfg);
     if (!uncertainty_paths.empty()) {
       uncertainty = io::ReadParameterUncertainties(uncertainty_paths);
       for (const std::string& set : sets) {
@@ -235,6 +237,36 @@ int Run(int argc, char** argv) {
       dyns.push_back(std::move(r.dynamics));
     }
 
+    // The intervals and bands are computed before any output is written.
+    std::vector<dynamics::PostureModeIntervals> intervals;
+    if (uncertainty) {
+      ProgressLine up(kTool, "postures' intervals", static_cast<long>(postures.size()));
+      for (size_t p = 0; p < postures.size(); ++p) {
+        intervals.push_back(dynamics::ModalIntervals(cfg.description, cfg.parameters, postures[p].q, *uncertainty, uo));
+        up.Update(static_cast<long>(p + 1));
+      }
+      up.Finish();
+      for (size_t p = 0; p < postures.size(); ++p) {
+        std::cerr << kTool << ": " << dynamics::IntervalLine(postures[p].id, intervals[p], uo.confidence) << '\n';
+      }
+    }
+    // The |H| bands of the postures drawn (issue #37 §3).
+    std::vector<dynamics::ReceptanceBand> bands;
+    std::string band_title;
+    if (uncertainty && (!plot_path.empty() || !plot_dir.empty())) {
+      const size_t drawn = plot_dir.empty() ? std::min<size_t>(preds.size(), 12) : preds.size();
+      ProgressLine bp(kTool, "|H| bands", static_cast<long>(drawn));
+      for (size_t p = 0; p < drawn; ++p) {
+        bands.push_back(dynamics::DirectReceptanceBand(cfg.description, cfg.parameters, postures[p].q, *uncertainty,
+                                                       preds[p].freq_hz, uo));
+        bp.Update(static_cast<long>(p + 1));
+      }
+      bp.Finish();
+      std::cerr << kTool << ": the plots show the " << FormatNumber(100.0 * uo.confidence, 3) << " % band of |H| ("
+                << dynamics::ToString(bands.front().propagation.method_used) << ": "
+                << bands.front().propagation.reason << ")\n";
+      band_title = " (" + FormatNumber(100.0 * uo.confidence, 3) + " % band)";
+    }
     // Every output is complete before it appears (docs/formats.md §4).
     // Without --out the FRF CSV goes to stdout only when nothing else was
     // asked for: `--plot p.png` alone must not pour megabytes of CSV into
@@ -251,18 +283,6 @@ int Run(int argc, char** argv) {
     for (size_t p = 0; p < postures.size(); ++p) {
       ids.push_back(postures[p].id);
       modes.push_back(dyns[p].modes);
-    }
-    std::vector<dynamics::PostureModeIntervals> intervals;
-    if (uncertainty) {
-      ProgressLine up(kTool, "postures' intervals", static_cast<long>(postures.size()));
-      for (size_t p = 0; p < postures.size(); ++p) {
-        intervals.push_back(dynamics::ModalIntervals(cfg.description, cfg.parameters, postures[p].q, *uncertainty, uo));
-        up.Update(static_cast<long>(p + 1));
-      }
-      up.Finish();
-      for (size_t p = 0; p < postures.size(); ++p) {
-        std::cerr << kTool << ": " << dynamics::IntervalLine(ids[p], intervals[p], uo.confidence) << '\n';
-      }
     }
     if (!modes_path.empty()) io::WriteModalTableCsv(modes_path, ids, modes, uncertainty ? &intervals : nullptr);
     if (!details_path.empty()) {
@@ -286,22 +306,7 @@ int Run(int argc, char** argv) {
     }
     std::string title = "robomach frf-predict: " + robot_path;
     for (const auto& e : model->effects()) title += " + " + e.effect->name();
-    // The |H| bands of the postures drawn (issue #37 §3).
-    std::vector<dynamics::ReceptanceBand> bands;
-    if (uncertainty && (!plot_path.empty() || !plot_dir.empty())) {
-      const size_t drawn = plot_dir.empty() ? std::min<size_t>(preds.size(), 12) : preds.size();
-      ProgressLine bp(kTool, "|H| bands", static_cast<long>(drawn));
-      for (size_t p = 0; p < drawn; ++p) {
-        bands.push_back(dynamics::DirectReceptanceBand(cfg.description, cfg.parameters, postures[p].q, *uncertainty,
-                                                       preds[p].freq_hz, uo));
-        bp.Update(static_cast<long>(p + 1));
-      }
-      bp.Finish();
-      std::cerr << kTool << ": the plots show the " << FormatNumber(100.0 * uo.confidence, 3) << " % band of |H| ("
-                << dynamics::ToString(bands.front().propagation.method_used) << ": "
-                << bands.front().propagation.reason << ")\n";
-      title += " (" + FormatNumber(100.0 * uo.confidence, 3) + " % band)";
-    }
+    title += band_title;
     const auto band_of = [&](size_t p) -> const dynamics::ReceptanceBand* {
       return p < bands.size() ? &bands[p] : nullptr;
     };

@@ -129,7 +129,8 @@ int Run(int argc, char** argv) {
       }
     }
     RequireInputFile("--robot", robot_path, "robot config", {io::FileKind::kYaml}, io::kRobotConfigFormat);
-    CheckDistinctPaths({{"--robot", robot_path}, {"--tracker", tracker_path}},
+    CheckDistinctPaths({{"--robot", robot_path}, {"--tracker", tracker_path}, {"--target-postures", target_postures},
+                        {"--cut", cut_path}},
                        {{"--out", out_path}, {"--residuals", residuals_path}, {"--plot", plot_path},
                         {"--summary", json_path}, {"--uncertainty-out", uncertainty_path}});
     if (plan_n != 0) {
@@ -149,6 +150,16 @@ int Run(int argc, char** argv) {
                          io::kPostureCsvFormat);
       }
       if (!cut_path.empty()) RequireInputFile("--cut", cut_path, "cut file", {io::FileKind::kYaml}, io::kCutFileFormat);
+      if (target_postures.empty()) {
+        for (const char* name : {"--target-quantity", "--cut", "--target-band-pct"}) {
+          if (app.count(name) > 0) {
+            throw UsageError(std::string(name) + " describes the target of a targeted plan: give the work region's "
+                             "postures with --target-postures (without it the plan is D-optimal)");
+          }
+        }
+      } else if (target_quantity == "frequency" && !cut_path.empty()) {
+        throw UsageError("--cut is for --target-quantity safe-depth; the lowest frequency needs no cut");
+      }
       po.target_postures_path = target_postures;
       po.target_quantity = target_quantity;
       po.cut_path = cut_path;

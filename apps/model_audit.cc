@@ -65,7 +65,8 @@ int Run(int argc, char** argv) {
              " Exit 3 when the failure is significant and not explained within the noise: unexplained, or mostly "
              "explained (the effect is named and effects.yaml written, but a misfit remains), or a fit failed (the "
              "report is complete; candidates.csv says which and why), or a measured receptance is outside 1e-12..1e-3 "
-             "m/N (a unit mistake).");
+             "m/N (a unit mistake), or --uncertainty has nothing the audit can move, or --uncertainty-out was asked "
+             "for and not written (no named change).");
   std::string robot_path, postures_path, report_dir, compare_dir, candidates_list, summary_path, write_config,
       uncertainty_out;
   std::vector<std::string> measured_files, pose_files, adds, uncertainty_paths;
@@ -287,6 +288,7 @@ int Run(int argc, char** argv) {
                         audit::AuditGradeName(r.grade) + ")");
       }
     }
+    bool uncertainty_not_written = false;  // asked for and not written: exit 3
     if (!uncertainty_out.empty()) {
       if (has_change) {
         ro.uncertainty_out = WriteFittedUncertainty(
@@ -297,6 +299,7 @@ int Run(int argc, char** argv) {
         Warn(kTool, "--uncertainty-out " + uncertainty_out + " not written: the audit names no change (" +
                         audit::AuditGradeName(r.grade) + ")");
       }
+      uncertainty_not_written = ro.uncertainty_out.is_null() || ro.uncertainty_out.contains("warning");
     }
     for (const audit::BoundFlag& f : r.baseline_on_bound) Warn(kTool, f.message);
     ro.input_warnings = WarningsGiven();
@@ -316,8 +319,10 @@ int Run(int argc, char** argv) {
     io::WriteFileAtomically("-", yaml);
     if (summary_path == "-") io::WriteFileAtomically("-", report::DumpJson(j));
     // measured_read.unit_findings: receptances outside the plausible range, warned when read.
-    return verdict.flagged() || !measured_read.unit_findings.empty() || !cfg.implausible.empty() ? kExitFlagged
-                                                                                                  : kExitOk;
+    return verdict.flagged() || uncertainty_not_written || !measured_read.unit_findings.empty() ||
+                   !cfg.implausible.empty()
+               ? kExitFlagged
+               : kExitOk;
   });
 }
 

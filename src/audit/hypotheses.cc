@@ -254,7 +254,15 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
     }
   }
   const int n = static_cast<int>(kept.size());
-  if (n == 0) return std::nullopt;
+  auto nothing = [&](const std::string& why) {
+    a.sentence = "the parameter uncertainty was not used: " + why;
+    return a;
+  };
+  if (n == 0) {
+    std::string l;
+    for (const auto& s : a.left_out) l += (l.empty() ? "" : "; ") + s;
+    return nothing("it has no parameter the audit can move (" + l + ")");
+  }
   Eigen::MatrixXd cov(n, n);
   Eigen::VectorXd theta0(n);
   for (int i = 0; i < n; ++i) {
@@ -270,7 +278,10 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
   for (int k = 0; k < n; ++k) {
     if (es.eigenvalues()(k) > 1e-14 * lmax && es.eigenvalues()(k) > 0.0) axes.push_back(k);
   }
-  if (axes.empty()) return std::nullopt;
+  if (axes.empty()) {
+    a.parameters.clear();
+    return nothing("its covariance is zero");
+  }
   a.rank = static_cast<int>(axes.size());
   Eigen::MatrixXd B(n, a.rank);
   for (int k = 0; k < a.rank; ++k) B.col(k) = es.eigenvectors().col(axes[k]) * std::sqrt(es.eigenvalues()(axes[k]));
@@ -284,7 +295,10 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
   };
   const auto residuals = [&](const Eigen::VectorXd& w) { return WholeCurveResidualVector(desc, point(w), x.banded); };
   const Eigen::VectorXd r0 = residuals(Eigen::VectorXd::Zero(a.rank));
-  if (r0.size() == 0) return std::nullopt;
+  if (r0.size() == 0) {
+    a.parameters.clear();
+    return nothing("the model cannot be evaluated at its estimates");
+  }
   // The calibration parameters' linear re-adjustment (as the screen's).
   const Eigen::MatrixXd Q = CalibrationBasis(desc, calibrated, o.calibration_parameters, x.banded, r0);
   const auto project = [&](const Eigen::MatrixXd& m) -> Eigen::MatrixXd { return m - Q * (Q.transpose() * m); };
@@ -306,13 +320,22 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
     }
     if (!ok) break;
     const Eigen::MatrixXd PA = project(A);
-    const Eigen::VectorXd next = ConstrainedStep(PA, Eigen::VectorXd(project(rw) - PA * w), a.radius);
-    const Eigen::VectorXd rn = residuals(next);
-    if (rn.size() != r0.size()) break;
-    const double cost = project(rn).squaredNorm();
-    if (!(cost < best * (1.0 - 1e-6))) break;
-    best = cost;
-    w = next;
+    const Eigen::VectorXd step = ConstrainedStep(PA, Eigen::VectorXd(project(rw) - PA * w), a.radius) - w;
+    // A step the true cost does not accept is halved (the region is convex:
+    // every point between w and the step's end lies in it).
+    bool accepted = false;
+    for (double f = 1.0; f > 0.05 && !accepted; f *= 0.5) {
+      const Eigen::VectorXd next = w + f * step;
+      const Eigen::VectorXd rn = residuals(next);
+      if (rn.size() != r0.size()) continue;
+      const double cost = project(rn).squaredNorm();
+      if (cost < best * (1.0 - 1e-6)) {
+        best = cost;
+        w = next;
+        accepted = true;
+      }
+    }
+    if (!accepted) break;
   }
   a.distance = w.norm();
   // The calibration refitted at the point: the error in the audit's own
@@ -347,8 +370,7 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
   if (a.covers_failure) {
     m << "within the parameter uncertainty: with " << names << " inside " << (n == 1 ? "its " : "their ") << pct
       << " % confidence region the error falls from " << before_units << " to " << a.error_noise_units
-      << " x the noise floor, so this misfit is not evidence of a missing effect; narrow "
-      << (n == 1 ? "its" : "their") << " uncertainty (kq-identify --plan) before adding one";
+      << " x the noise floor";
   } else {
     const double f = std::isfinite(a.fraction_removed) ? std::max(0.0, a.fraction_removed) : 0.0;
     m << "the uncertainty of " << names << " (" << pct << " % confidence region) explains " << std::fixed

@@ -403,7 +403,11 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
         FormatNumber(100.0 * o.uncertainty_confidence) + " % region");
     r.uncertainty = AllowanceOfUncertainty(description, r.baseline_fit.parameters, o.parameter_uncertainty,
                                            o.uncertainty_confidence, context, r.errors_before.total_rms_log_mag);
-    if (r.uncertainty) say(r.uncertainty->sentence);
+    if (r.uncertainty && r.uncertainty->parameters.empty()) {
+      r.warnings.push_back(r.uncertainty->sentence);  // asked for and not done: said, and the run flagged
+    } else if (r.uncertainty) {
+      say(r.uncertainty->sentence);
+    }
   }
   std::mutex say_mutex;
   const auto timed = [&](const std::function<CandidateResult()>& f) {
@@ -681,29 +685,40 @@ AuditResult RunAudit(const dynamics::RobotDescription& description, const dynami
     if (pairs.front().bic < bar && pairs.front().plausible) r.best = static_cast<int>(num_singles);
   }
   GradeVerdict(o, &r);
-  if (r.uncertainty) {
-    while (!r.verdict.empty() && (r.verdict.back() == '.' || r.verdict.back() == ' ')) r.verdict.pop_back();
-    r.verdict += "; " + r.uncertainty->sentence;
-    if (r.uncertainty->covers_failure) {
-      r.headline += " The parameter uncertainty alone could explain it: within the " +
-                    FormatNumber(100.0 * r.uncertainty->confidence) + " % region of " +
-                    [&] {
-                      std::string l;
-                      for (const auto& n : r.uncertainty->parameters) l += (l.empty() ? "" : ", ") + n;
-                      return l;
-                    }() +
-                    " the error falls to " + FormatNumber(r.uncertainty->error_noise_units, 3) + " x the noise floor.";
-      std::string names;
-      for (const auto& n : r.uncertainty->parameters) names += (names.empty() ? "" : ", ") + n;
-      r.next_steps.insert(r.next_steps.begin(),
-                          "Narrow the uncertainty of " + names + " before adding an effect: within " +
-                              (r.uncertainty->parameters.size() == 1 ? "its " : "their ") +
-                              FormatNumber(100.0 * r.uncertainty->confidence) +
-                              " % confidence region the error falls to " +
-                              FormatNumber(r.uncertainty->error_noise_units, 3) +
-                              " x the noise floor. A tracker campaign planned for the work region (kq-identify "
-                              "--plan N --target-postures work.csv) narrows the joint stiffnesses that matter there.");
+  if (r.uncertainty && !r.uncertainty->parameters.empty()) {
+    UncertaintyAllowance& u = *r.uncertainty;
+    std::string names;
+    bool stiffness = false;
+    for (const auto& n : u.parameters) {
+      names += (names.empty() ? "" : ", ") + n;
+      stiffness |= n.rfind("kq", 0) == 0;
     }
+    const std::string how = stiffness ? " (a tracker campaign planned for the work region: kq-identify --plan N "
+                                        "--target-postures work.csv)"
+                                      : " (more or better-placed measurements of what fitted them)";
+    const char* its = u.parameters.size() == 1 ? "its" : "their";
+    if (u.covers_failure) {
+      const CandidateResult* named = AcceptedCandidate(r);
+      const bool effect_named = (r.grade == AuditGrade::kExplained || r.grade == AuditGrade::kMostlyExplained) &&
+                                named && !named->is_parameter_hypothesis();
+      u.sentence += effect_named
+                        ? std::string("; the named effect fits, but the parameter uncertainty alone also covers the "
+                                      "misfit, so these data do not establish it: narrow ") +
+                              its + " uncertainty" + how + " and audit again"
+                        : std::string("; so this misfit is not evidence of a missing effect: narrow ") + its +
+                              " uncertainty" + how + " before adding one";
+      r.headline += " The parameter uncertainty alone could explain it: within the " +
+                    FormatNumber(100.0 * u.confidence) + " % region of " + names + " the error falls to " +
+                    FormatNumber(u.error_noise_units, 3) + " x the noise floor.";
+      r.next_steps.insert(r.next_steps.begin(), "Narrow the uncertainty of " + names + " before " +
+                                                    (effect_named ? "trusting the named effect" : "adding an effect") +
+                                                    ": within " + its + " " + FormatNumber(100.0 * u.confidence) +
+                                                    " % confidence region the error falls to " +
+                                                    FormatNumber(u.error_noise_units, 3) + " x the noise floor" + how +
+                                                    ".");
+    }
+    while (!r.verdict.empty() && (r.verdict.back() == '.' || r.verdict.back() == ' ')) r.verdict.pop_back();
+    r.verdict += "; " + u.sentence;
   }
   return r;
 }

@@ -473,7 +473,11 @@ ReceptanceBand DirectReceptanceBand(const RobotDescription& description, const P
     for (Eigen::Index i = 0; i < total; i += stride) chosen.insert(i);
     if (total > 0) chosen.insert(total - 1);
     for (Eigen::Index i : peaks) chosen.insert(i);
-    while (static_cast<int>(chosen.size()) > max_lines) chosen.erase(std::next(chosen.begin(), 1));
+    // Over the budget (many modes): drop strided lines, never a peak's.
+    for (auto it = chosen.begin(); static_cast<int>(chosen.size()) > max_lines && it != chosen.end();) {
+      const bool peak = std::find(peaks.begin(), peaks.end(), *it) != peaks.end();
+      it = peak || *it == 0 ? std::next(it) : chosen.erase(it);
+    }
   }
   Eigen::VectorXd freq_hz(static_cast<Eigen::Index>(chosen.size()));
   {

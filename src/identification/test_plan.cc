@@ -33,6 +33,17 @@ struct Candidate {
   std::vector<Eigen::MatrixXd> info;  // per direction, all masses included
 };
 
+// The target gradients with the rows of joints no target depends on
+// (TargetsDependOnJoint) set to zero: finite-difference noise on such a
+// joint must not make a target "undetermined" when the joint is unseen.
+Eigen::MatrixXd EffectiveTargetGradients(const PlanOptions& o) {
+  Eigen::MatrixXd G = o.target_gradients;
+  for (Eigen::Index j = 0; j < G.rows(); ++j) {
+    if (!TargetsDependOnJoint(o, static_cast<int>(j))) G.row(j).setZero();
+  }
+  return G;
+}
+
 // The design's criterion, higher better: log det I (D-optimal), or
 // −Σ_t g_tᵀ I⁻¹ g_t with target gradients G (L-optimal); −inf where I is
 // not positive definite.
@@ -77,7 +88,7 @@ double ChooseDirections(const Candidate& c, const Eigen::MatrixXd& I, int count,
 void TargetWidths(const PlanOptions& o, const Eigen::MatrixXd& info, const std::vector<int>& sel,
                   const std::vector<std::vector<int>>& sel_dirs,
                   const std::function<Eigen::MatrixXd(int, const std::vector<int>&)>& contribution, TestPlan* plan) {
-  const Eigen::MatrixXd& G = o.target_gradients;
+  const Eigen::MatrixXd G = EffectiveTargetGradients(o);
   const int n = static_cast<int>(info.rows());
   const double z = [&] {
     // Two-sided normal quantile by bisection on erfc (no dynamics dependency here).
@@ -273,7 +284,7 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
   // A ridge of 1e-6 (a prior σ(θ) of 1000, i.e. no knowledge) keeps log det
   // finite while joints are still unseen; one load case adds ~1e3.
   const Eigen::MatrixXd ridge = 1e-6 * Eigen::MatrixXd::Identity(n, n);
-  const Criterion criterion = DesignCriterion(o.design_for_targets ? o.target_gradients : Eigen::MatrixXd());
+  const Criterion criterion = DesignCriterion(o.design_for_targets ? EffectiveTargetGradients(o) : Eigen::MatrixXd());
   std::vector<int> sel;
   std::vector<std::vector<int>> sel_dirs;
   Eigen::MatrixXd I = ridge;

@@ -54,6 +54,12 @@ expect_in "$work/stderr" "within the parameter uncertainty: with kq2_Nm_per_rad 
 expect_in "$work/audit/summary.json" '"covers_failure": true'
 expect_in "$work/audit/index.html" "Parameter uncertainty:"
 expect_in "$work/audit_unc.yaml" "{name: kq2_Nm_per_rad,"
+# frf-calibrate's file holds only what the audit calibrates itself: asked
+# for and not done, said and exit 3.
+expect_exit 3 "$bin/model-audit" --robot config/kr210.yaml --postures $postures --measured "$work/hammer_kq.csv" \
+  --report "$work/audit_cal" --candidates kq2_Nm_per_rad --uncertainty "$work/cal_unc.yaml"
+expect_in "$work/stderr" "the parameter uncertainty was not used: it has no parameter the audit can move (m6_kg: calibrated by the audit"
+expect_in "$work/audit_cal/summary.json" "the parameter uncertainty was not used"
 # A confidence typed as a percentage, and the robot config as the file.
 expect_exit 64 "$bin/model-audit" --robot config/kr210.yaml --postures $postures --measured "$work/hammer_kq.csv" \
   --report "$work/bad" --uncertainty "$work/kq2_unc.yaml" --confidence 95
@@ -89,4 +95,9 @@ expect_in "$work/stderr" "--cut"
 expect_exit 64 "$bin/kq-identify" --robot config/kr210.yaml --tracker tests/data/tracker_campaign.csv \
   --target-postures config/postures_demo.csv
 expect_in "$work/stderr" "--target-postures is an option of --plan N"
+expect_exit 64 "$bin/kq-identify" --robot config/kr210.yaml --plan 4 --out "$work/plan.csv" --cut config/cut_demo.yaml
+expect_in "$work/stderr" "--cut describes the target of a targeted plan"
+expect_exit 64 "$bin/kq-identify" --robot config/kr210.yaml --plan 4 --out config/postures_demo.csv \
+  --target-postures config/postures_demo.csv
+expect_in "$work/stderr" "is also the input of --target-postures"
 finish
