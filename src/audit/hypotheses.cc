@@ -188,24 +188,6 @@ std::vector<ScreenedVirtualJoint> ScreenVirtualJoints(const dynamics::RobotDescr
 
 namespace {
 
-// θ of a value on its scale, and back.
-double ToTheta(double v, dynamics::UncertainScale s) {
-  switch (s) {
-    case dynamics::UncertainScale::kLog: return std::log(v);
-    case dynamics::UncertainScale::kInverse: return 1.0 / v;
-    case dynamics::UncertainScale::kLinear: return v;
-  }
-  return v;
-}
-double FromTheta(double t, dynamics::UncertainScale s) {
-  switch (s) {
-    case dynamics::UncertainScale::kLog: return std::exp(t);
-    case dynamics::UncertainScale::kInverse: return t > 0.0 ? 1.0 / t : std::numeric_limits<double>::infinity();
-    case dynamics::UncertainScale::kLinear: return t;
-  }
-  return t;
-}
-
 // min |b + A w|² subject to |w| <= c: the trust-region subproblem, through
 // the SVD of A (w(λ) = −V diag(s / (s² + λ)) Uᵀ b, |w(λ)| decreasing in λ).
 Eigen::VectorXd ConstrainedStep(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, double c) {
@@ -263,13 +245,17 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
     for (const auto& s : a.left_out) l += (l.empty() ? "" : "; ") + s;
     return nothing("it has no parameter the audit can move (" + l + ")");
   }
-  Eigen::MatrixXd cov(n, n);
-  Eigen::VectorXd theta0(n);
+  // The marginal of the parameters moved (a Gaussian's marginal: the sub-covariance).
+  dynamics::ParameterUncertainty moved_u;
+  moved_u.covariance.resize(n, n);
+  Eigen::VectorXd estimates(n);
   for (int i = 0; i < n; ++i) {
-    const auto& p = u.parameters[kept[i]];
-    theta0(i) = ToTheta(p.value, p.scale);
-    for (int j = 0; j < n; ++j) cov(i, j) = u.covariance(kept[i], kept[j]);
+    moved_u.parameters.push_back(u.parameters[kept[i]]);
+    estimates(i) = u.parameters[kept[i]].value;
+    for (int j = 0; j < n; ++j) moved_u.covariance(i, j) = u.covariance(kept[i], kept[j]);
   }
+  const Eigen::MatrixXd& cov = moved_u.covariance;
+  const Eigen::VectorXd theta0 = dynamics::ToTheta(moved_u, estimates);
   // Whitened coordinates: θ = θ̂ + B w, B = V √Λ over the covariance's rank,
   // the region |w| <= √χ²(P, rank).
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(cov);
@@ -289,8 +275,11 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
   a.radius = std::sqrt(a.chi2);
   const auto point = [&](const Eigen::VectorXd& w) {
     dynamics::ParameterSet p = calibrated;
-    const Eigen::VectorXd t = theta0 + B * w;
-    for (int i = 0; i < n; ++i) p.SetClamped(a.parameters[i], FromTheta(t(i), u.parameters[kept[i]].scale));
+    const Eigen::VectorXd v = dynamics::FromTheta(moved_u, theta0 + B * w);
+    for (int i = 0; i < n; ++i) {
+      // A compliance <= 0 is an infinite stiffness: the parameter's upper bound.
+      p.SetClamped(a.parameters[i], std::isfinite(v(i)) ? v(i) : std::numeric_limits<double>::infinity());
+    }
     return p;
   };
   const auto residuals = [&](const Eigen::VectorXd& w) { return WholeCurveResidualVector(desc, point(w), x.banded); };

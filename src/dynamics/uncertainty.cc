@@ -16,7 +16,19 @@
 namespace robomach::dynamics {
 namespace {
 
-// θ (the Gaussian coordinates) from values and back.
+// Sample quantile with linear interpolation between order statistics
+// (Hyndman & Fan 1996, definition 7: NumPy's default).
+double Quantile(std::vector<double> sorted_values, double p) {
+  const double h = p * static_cast<double>(sorted_values.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(h));
+  const size_t hi = std::min(lo + 1, sorted_values.size() - 1);
+  return sorted_values[lo] + (h - static_cast<double>(lo)) * (sorted_values[hi] - sorted_values[lo]);
+}
+
+std::string Percent(double x) { return FormatNumber(100.0 * x, 3) + " %"; }
+
+}  // namespace
+
 Eigen::VectorXd ToTheta(const ParameterUncertainty& u, const Eigen::VectorXd& values) {
   Eigen::VectorXd t = values;
   for (size_t i = 0; i < u.parameters.size(); ++i) {
@@ -36,18 +48,6 @@ Eigen::VectorXd FromTheta(const ParameterUncertainty& u, const Eigen::VectorXd& 
   return v;
 }
 
-// Sample quantile with linear interpolation between order statistics
-// (Hyndman & Fan 1996, definition 7: NumPy's default).
-double Quantile(std::vector<double> sorted_values, double p) {
-  const double h = p * static_cast<double>(sorted_values.size() - 1);
-  const size_t lo = static_cast<size_t>(std::floor(h));
-  const size_t hi = std::min(lo + 1, sorted_values.size() - 1);
-  return sorted_values[lo] + (h - static_cast<double>(lo)) * (sorted_values[hi] - sorted_values[lo]);
-}
-
-std::string Percent(double x) { return FormatNumber(100.0 * x, 3) + " %"; }
-
-}  // namespace
 
 const char* ToString(UncertainScale s) {
   switch (s) {

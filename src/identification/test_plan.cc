@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 
 #include "robomach/common/units.h"
+#include "robomach/dynamics/uncertainty.h"
 #include "robomach/identification/compliance_model.h"
 
 namespace robomach::identification {
@@ -90,15 +91,7 @@ void TargetWidths(const PlanOptions& o, const Eigen::MatrixXd& info, const std::
                   const std::function<Eigen::MatrixXd(int, const std::vector<int>&)>& contribution, TestPlan* plan) {
   const Eigen::MatrixXd G = EffectiveTargetGradients(o);
   const int n = static_cast<int>(info.rows());
-  const double z = [&] {
-    // Two-sided normal quantile by bisection on erfc (no dynamics dependency here).
-    double lo = 0.0, hi = 40.0;
-    for (int i = 0; i < 200; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (std::erfc(mid / std::sqrt(2.0)) > 1.0 - o.target_confidence ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
-  }();
+  const double z = dynamics::NormalQuantile(0.5 * (1.0 + o.target_confidence));
   auto stds = [&](const Eigen::MatrixXd& I) {
     Eigen::VectorXd s = Eigen::VectorXd::Constant(G.cols(), kInf);
     const Eigen::FullPivLU<Eigen::MatrixXd> lu(I);
@@ -347,11 +340,10 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
                 j);
     }
   }
-  if (o.target_gradients.size() > 0) TargetWidths(o, info, sel, sel_dirs, [&](int s, const std::vector<int>& ds) {
-    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
-    for (int d : ds) M += cands[sel[s]].info[d];
-    return M;
-  }, &plan);
+  if (o.target_gradients.size() > 0) {
+    TargetWidths(o, info, sel, sel_dirs, [&](int s, const std::vector<int>& ds) { return contribution(sel[s], ds); },
+                 &plan);
+  }
   for (int s = 0; s < o.num_postures; ++s) {
     const Candidate& c = cands[sel[s]];
     const std::string pose_id = "P" + std::to_string(s + 1);

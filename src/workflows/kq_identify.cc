@@ -10,6 +10,7 @@
 #include "robomach/common/units.h"
 #include "robomach/identification/load_case.h"
 #include "robomach/dynamics/posture_dynamics.h"
+#include "robomach/dynamics/uncertainty.h"
 #include "robomach/io/cut_file.h"
 #include "robomach/io/kq_files.h"
 #include "robomach/stability/lobe_uncertainty.h"
@@ -253,7 +254,7 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
     m << "expected 95 % half-width of the " << (o.target_quantity == "frequency" ? "lowest natural frequency"
                                                                                : "smallest ZOA critical depth")
       << ":";
-    const double z = 1.959963984540054;
+    const double z = dynamics::NormalQuantile(0.5 * (1.0 + p.target_confidence));
     for (size_t t = 0; t < targets.size(); ++t) {
       const double hw = z * r.plan.expected_target_relative_std(static_cast<Eigen::Index>(t));
       r.target_half_widths.push_back({targets[t].id, hw});

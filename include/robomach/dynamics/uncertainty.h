@@ -50,6 +50,12 @@ struct ParameterUncertainty {
 ///   itself typed under that scale, the message says).
 void CheckValid(const ParameterUncertainty& u);
 
+/// The coordinates θ of `values` (one per parameter of `u`, in their
+/// units) on each parameter's scale, and back; a compliance θ <= 0 (the
+/// inverse scale) has no value: NaN.
+Eigen::VectorXd ToTheta(const ParameterUncertainty& u, const Eigen::VectorXd& values);
+Eigen::VectorXd FromTheta(const ParameterUncertainty& u, const Eigen::VectorXd& theta);
+
 /// Parameters fitted in different campaigns, taken as independent: the
 /// parameter lists concatenated, the covariance block-diagonal.
 /// @throws std::invalid_argument if a name occurs in two parts (naming both
