@@ -42,6 +42,7 @@ void AddHow(const dynamics::PropagationResult& r, py::dict* d) {
   (*d)["reason"] = r.reason;
   (*d)["evaluations"] = r.evaluations;
   (*d)["failed_samples"] = r.failed_samples;
+  (*d)["linearised"] = r.linearised;
 }
 
 }  // namespace
@@ -97,10 +98,15 @@ void BindUncertainty(py::module_& m) {
         "(compliances), as kq-identify --uncertainty-out writes them.");
 
   m.def("propagate", [](const ParameterUncertainty& u, const py::function& f, double confidence,
-                        const std::string& method, int samples, std::uint64_t seed) {
+                        const std::string& method, int samples, std::uint64_t seed,
+                        const std::optional<py::function>& linearisation) {
+    dynamics::OutputFunction lin;
+    if (linearisation) {
+      lin = [&](const Eigen::VectorXd& v) { return (*linearisation)(v).cast<Eigen::VectorXd>(); };
+    }
     const dynamics::PropagationResult r = dynamics::Propagate(
         u, [&](const Eigen::VectorXd& v) { return f(v).cast<Eigen::VectorXd>(); },
-        Options(confidence, method, samples, seed));
+        Options(confidence, method, samples, seed), {}, lin);
     py::dict d;
     py::list outs;
     for (const auto& o : r.outputs) outs.append(IntervalDict(o));
@@ -108,10 +114,13 @@ void BindUncertainty(py::module_& m) {
     AddHow(r, &d);
     return d;
   }, py::arg("uncertainty"), py::arg("f"), py::arg("confidence") = 0.95, py::arg("method") = "auto",
-     py::arg("samples") = 2000, py::arg("seed") = 1,
+     py::arg("samples") = 2000, py::arg("seed") = 1, py::arg("linearisation") = py::none(),
      "Intervals of f(values) -> 1-D array (values in the parameters' units, in the uncertainty's order): "
      "first order, Monte Carlo, or auto (first order unless the sigma-point check finds f bending). "
-     "Returns {outputs: [{value, std_dev, lower, upper}], method, reason, evaluations, failed_samples}.");
+     "linearisation: a local model of f (equal to first order at the estimates, smooth at 1e-3 sigma) whose "
+     "differences give the first-order derivatives instead of f's. "
+     "Returns {outputs: [{value, std_dev, lower, upper}], method, reason, evaluations, failed_samples, "
+     "linearised}.");
 
   m.def("modal_intervals", [](const io::RobotConfig& config, const ParameterUncertainty& u,
                               const std::optional<Eigen::VectorXd>& q_rad, const std::optional<Eigen::VectorXd>& q_deg,

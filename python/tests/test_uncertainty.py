@@ -67,6 +67,22 @@ def test_propagate_a_python_function():
     r = rm.propagate(u, lambda v: np.array([3 * v[0] - 2 * v[1]]))
     assert r['method'] == 'first-order', r['reason']
     assert r['outputs'][0]['std_dev'] == pytest.approx(math.sqrt(0.576), rel=1e-7)
+    assert not r['linearised']
+    # A ripple at the differences' scale (1 % of sigma) spoils f's own
+    # differences; its smooth part as the linearisation gives the exact
+    # derivatives, and the value stays f's.
+    def smooth(v):
+        return np.array([3 * v[0] - 2 * v[1]])
+
+    def rippled(v):
+        return smooth(v) + 1e-3 * math.sin(2 * math.pi * v[0] / 2e-3)
+
+    plain = rm.propagate(u, rippled, method='first-order')
+    assert abs(plain['outputs'][0]['std_dev'] / math.sqrt(0.576) - 1) > 0.5
+    lin = rm.propagate(u, rippled, method='first-order', linearisation=smooth)
+    assert lin['linearised']
+    assert lin['outputs'][0]['std_dev'] == pytest.approx(math.sqrt(0.576), rel=1e-7)
+    assert lin['outputs'][0]['value'] == rippled(np.array([2.0, -1.0]))[0]
     with pytest.raises(ValueError, match='percentage'):
         rm.propagate(u, lambda v: v, confidence=95)
     with pytest.raises(ValueError, match='negative eigenvalue'):

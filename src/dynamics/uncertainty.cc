@@ -27,6 +27,12 @@ double Quantile(std::vector<double> sorted_values, double p) {
 
 std::string Percent(double x) { return FormatNumber(100.0 * x, 3) + " %"; }
 
+// A departure from linear relative to a half-width: in percent up to 10
+// times it, beyond as a factor ("17 times", not "1.7e+03 %").
+std::string OfHalfWidth(double x) {
+  return x < 10.0 ? Percent(x) + " of its half-width" : FormatNumber(x, 2) + " times its half-width";
+}
+
 }  // namespace
 
 Eigen::VectorXd ToTheta(const ParameterUncertainty& u, const Eigen::VectorXd& values) {
@@ -242,7 +248,7 @@ void CheckValid(const PropagationOptions& o) {
 }
 
 PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction& f, const PropagationOptions& o,
-                            const std::vector<std::string>& output_names) {
+                            const std::vector<std::string>& output_names, const OutputFunction& linearisation) {
   CheckValid(u);
   CheckValid(o);
   const int n = static_cast<int>(u.parameters.size());
@@ -265,33 +271,62 @@ PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction&
   // Σ_f = Σ_k λ_k (∂f/∂v_k)(∂f/∂v_k)ᵀ over the covariance's principal axes
   // v_k: central differences along each axis with a step of 1e-3 √λ_k
   // (2 evaluations per axis; axes without variance are skipped, so a
-  // rank-one covariance costs 3 evaluations). J = Σ_k (∂f/∂v_k) v_kᵀ is the
-  // Jacobian on the span of the covariance, which the sigma-point check uses.
-  auto first_order = [&]() {
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(m, n);
-    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(m, m);
-    const double lambda_max = lambda.maxCoeff();
+  // rank-one covariance costs 3 evaluations), or forward differences (1).
+  // D holds ∂f/∂v_k in column k (zero for a skipped axis).
+  const double lambda_max = lambda.maxCoeff();
+  auto differences = [&](const OutputFunction& g, bool central) {
+    Eigen::MatrixXd D = Eigen::MatrixXd::Zero(m, n);
+    Eigen::VectorXd g0 = f0;
+    if (&g != &f && !central) {
+      g0 = g(values);
+      ++res.evaluations;
+    }
+    auto at = [&](const Eigen::VectorXd& theta) {
+      Eigen::VectorXd y = g(FromTheta(u, theta));
+      if (y.size() != m) {
+        throw std::invalid_argument("the local model gives " + std::to_string(y.size()) + " outputs, f " +
+                                    std::to_string(m));
+      }
+      return y;
+    };
+    if (g0.size() != m) throw std::invalid_argument("the local model gives another number of outputs");
     for (int k = 0; k < n; ++k) {
       if (!(lambda(k) > 1e-14 * lambda_max)) continue;
       const double h = 1e-3 * std::sqrt(lambda(k));
-      const Eigen::VectorXd d =
-          (f(FromTheta(u, theta0 + h * V.col(k))) - f(FromTheta(u, theta0 - h * V.col(k)))) / (2.0 * h);
-      res.evaluations += 2;
-      J += d * V.col(k).transpose();
-      cov += lambda(k) * d * d.transpose();
+      D.col(k) = central ? Eigen::VectorXd((at(theta0 + h * V.col(k)) - at(theta0 - h * V.col(k))) / (2.0 * h))
+                         : Eigen::VectorXd((at(theta0 + h * V.col(k)) - g0) / h);
+      res.evaluations += central ? 2 : 1;
     }
+    return D;
+  };
+
+  bool monte_carlo = o.method == PropagationMethod::kMonteCarlo;
+  if (o.method != PropagationMethod::kMonteCarlo) {
+    // With a linearisation, `central_differences` applies to it; an output
+    // it does not reach at some step takes f's own central differences.
+    Eigen::MatrixXd D = differences(linearisation ? linearisation : f, o.central_differences);
+    std::string lost;
+    if (linearisation && !D.allFinite()) {
+      const Eigen::MatrixXd Df = differences(f, true);
+      int outputs_lost = 0;
+      for (int j = 0; j < m; ++j) {
+        if (D.row(j).allFinite()) continue;
+        D.row(j) = Df.row(j);
+        ++outputs_lost;
+      }
+      lost = "; the local model did not reach every step for " + std::to_string(outputs_lost) + " of " +
+             std::to_string(m) + " outputs, whose derivatives are differences of the outputs themselves";
+    }
+    // J = Σ_k (∂f/∂v_k) v_kᵀ, the Jacobian on the span of the covariance
+    // (the sigma-point check uses it).
+    const Eigen::MatrixXd J = D * V.transpose();
+    const Eigen::MatrixXd cov = D * lambda.asDiagonal() * D.transpose();
     for (int k = 0; k < m; ++k) {
       const double s = std::sqrt(std::max(cov(k, k), 0.0));
       res.outputs[k].std_dev = s;
       res.outputs[k].lower = f0(k) - z * s;
       res.outputs[k].upper = f0(k) + z * s;
     }
-    return J;
-  };
-
-  bool monte_carlo = o.method == PropagationMethod::kMonteCarlo;
-  if (o.method != PropagationMethod::kMonteCarlo) {
-    const Eigen::MatrixXd J = first_order();
     res.method_used = PropagationMethod::kFirstOrder;
     if (o.method == PropagationMethod::kFirstOrder) {
       res.reason = "first order, as asked (--uncertainty-method first-order)";
@@ -303,7 +338,7 @@ PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction&
       int worst_output = -1;
       for (auto& out : res.outputs) out.nonlinearity = 0.0;
       for (int k = 0; k < n; ++k) {
-        if (!(lambda(k) > 1e-14 * lambda.maxCoeff())) continue;  // the axes first_order used
+        if (!(lambda(k) > 1e-14 * lambda_max)) continue;  // the axes the differences used
         for (double sign : {-1.0, 1.0}) {
           const Eigen::VectorXd step = sign * z * std::sqrt(lambda(k)) * V.col(k);
           Eigen::VectorXd fk;
@@ -336,10 +371,15 @@ PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction&
                                      ? output_names[worst_output]
                                      : "output " + std::to_string(worst_output + 1);
         res.reason = "Monte Carlo: " + what + " departs from linear by " +
-                     (std::isfinite(worst) ? Percent(worst) : std::string("an undefined amount (not computable)")) +
-                     " of its half-width at a sigma point (over " + Percent(o.nonlinearity_tolerance) +
+                     (std::isfinite(worst) ? OfHalfWidth(worst)
+                                           : std::string("an undefined amount (not computable)")) +
+                     " at a sigma point (over " + Percent(o.nonlinearity_tolerance) +
                      "): the first-order interval would be wrong";
       }
+    }
+    if (!monte_carlo) {
+      res.reason += lost;
+      res.linearised = linearisation && lost.empty();
     }
   } else {
     res.reason = "Monte Carlo, as asked (--uncertainty-method monte-carlo)";

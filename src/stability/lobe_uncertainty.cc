@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -16,9 +17,19 @@
 
 namespace robomach::stability {
 
-Eigen::VectorXd ZoaCriticalDepths(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
-                                  const std::string& id, const Eigen::VectorXd& q, const Eigen::Vector3d& feed_B,
-                                  const LobesOptions& options) {
+namespace {
+
+// The ZOA lobes' points at options.zoa_speeds_rad_s (ZoaCriticalDepths),
+// with the posture's dynamics and cutting frame they came from.
+struct ZoaPoints {
+  dynamics::PostureDynamics d;
+  Eigen::Matrix3d R_BC;
+  std::vector<LobePoint> points;
+};
+
+ZoaPoints ZoaPointsAt(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
+                      const std::string& id, const Eigen::VectorXd& q, const Eigen::Vector3d& feed_B,
+                      const LobesOptions& options) {
   ZoaOptions zo;
   zo.max_lobe_index = options.max_lobe_index;
   zo.min_spindle_speed_rad_s = options.min_speed_rad_s;
@@ -26,10 +37,20 @@ Eigen::VectorXd ZoaCriticalDepths(const dynamics::RobotDescription& description,
   po.cartesian = false;
   po.jacobian_condition = false;
   const auto model = dynamics::RobotModel::Build(description, parameters);
-  const TipDynamics tip = TipFromPosture(id, dynamics::EvaluatePosture(model, q, po), feed_B, options.process.teeth,
-                                         options.max_speed_rad_s);
-  const std::vector<LobePoint> points =
-      ComputeZoaLobes(tip.freq_hz, tip.Phi_C, options.process, zo).At(options.zoa_speeds_rad_s);
+  ZoaPoints out;
+  out.d = dynamics::EvaluatePosture(model, q, po);
+  const TipDynamics tip = TipFromPosture(id, out.d, feed_B, options.process.teeth, options.max_speed_rad_s);
+  out.R_BC = tip.R_BC;
+  out.points = ComputeZoaLobes(tip.freq_hz, tip.Phi_C, options.process, zo).At(options.zoa_speeds_rad_s);
+  return out;
+}
+
+}  // namespace
+
+Eigen::VectorXd ZoaCriticalDepths(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
+                                  const std::string& id, const Eigen::VectorXd& q, const Eigen::Vector3d& feed_B,
+                                  const LobesOptions& options) {
+  const std::vector<LobePoint> points = ZoaPointsAt(description, parameters, id, q, feed_B, options).points;
   Eigen::VectorXd d(static_cast<Eigen::Index>(points.size()));
   for (size_t i = 0; i < points.size(); ++i) {
     d(static_cast<Eigen::Index>(i)) = points[i].status == LobeStatus::kOk ? points[i].critical_depth : NAN;
@@ -47,10 +68,14 @@ ZoaBand ZoaLobeBand(const dynamics::RobotDescription& description, const dynamic
   };
   Eigen::VectorXd at_estimates(static_cast<Eigen::Index>(u.parameters.size()));
   for (size_t i = 0; i < u.parameters.size(); ++i) at_estimates(static_cast<Eigen::Index>(i)) = u.parameters[i].value;
-  const Eigen::VectorXd d0 = depths(at_estimates);
+  const ZoaPoints zoa0 =
+      ZoaPointsAt(description, dynamics::WithValues(base, u, at_estimates), id, q, feed_B, options);
+  Eigen::VectorXd d0(static_cast<Eigen::Index>(zoa0.points.size()));
   std::vector<Eigen::Index> kept;  // the speeds with a boundary at the estimates
-  for (Eigen::Index i = 0; i < d0.size(); ++i) {
-    if (std::isfinite(d0(i))) kept.push_back(i);
+  for (size_t i = 0; i < zoa0.points.size(); ++i) {
+    const bool ok = zoa0.points[i].status == LobeStatus::kOk;
+    d0(static_cast<Eigen::Index>(i)) = ok ? zoa0.points[i].critical_depth : NAN;
+    if (ok) kept.push_back(static_cast<Eigen::Index>(i));
   }
   if (kept.empty()) throw std::invalid_argument("tool tip " + id + ": the ZOA lobes have no boundary at any speed");
   // Outputs: the smallest depth first, then each kept speed's depth.
@@ -66,10 +91,43 @@ ZoaBand ZoaLobeBand(const dynamics::RobotDescription& description, const dynamic
     names.push_back("the critical depth at " +
                     std::to_string(std::lround(RadPerSecToRpm(options.zoa_speeds_rad_s(i)))) + " rpm");
   }
+  // The first-order derivatives from each speed's lobe continued exactly
+  // (ZoaLobeContinuation): the grid's lines move with the modes, and the
+  // differences of `outputs` at 1e-3 sigma see that motion (on the demo
+  // posture the first-order band's width jumped by up to 30 % from one
+  // speed to the next). The smallest depth's derivative is that at the
+  // speed of the smallest depth at the estimates. A speed whose lobe is not
+  // found again is NaN here, and Propagate takes that output's own
+  // differences (its reason says how many).
+  std::vector<ZoaLobeContinuation> lobes;
+  Eigen::Index smallest = 0;
+  for (size_t k = 0; k < kept.size(); ++k) {
+    lobes.emplace_back(zoa0.d, zoa0.R_BC, options.process, zoa0.points[static_cast<size_t>(kept[k])]);
+    if (d0(kept[k]) < d0(kept[static_cast<size_t>(smallest)])) smallest = static_cast<Eigen::Index>(k);
+  }
+  dynamics::PostureOptions po;
+  po.cartesian = false;
+  po.jacobian_condition = false;
+  auto local = [&](const Eigen::VectorXd& values) {
+    const dynamics::PostureDynamics d = dynamics::EvaluatePosture(
+        dynamics::RobotModel::Build(description, dynamics::WithValues(base, u, values)), q, po);
+    const TipModalModel modes = ModalModelFromPosture(d);
+    Eigen::VectorXd out(static_cast<Eigen::Index>(kept.size()) + 1);
+    for (size_t k = 0; k < kept.size(); ++k) {
+      out(static_cast<Eigen::Index>(k) + 1) = lobes[k].ok() ? lobes[k](d, modes) : NAN;
+    }
+    out(0) = out(smallest + 1);
+    return out;
+  };
   ZoaBand band;
   band.id = id;
   band.speed_rad_s = options.zoa_speeds_rad_s;
-  band.propagation = dynamics::Propagate(u, outputs, propagation, names);
+  band.propagation = dynamics::Propagate(u, outputs, propagation, names, local);
+  if (band.propagation.method_used == dynamics::PropagationMethod::kFirstOrder) {
+    band.propagation.reason += band.propagation.linearised
+                                   ? "; derivatives from each speed's lobe continued exactly"
+                                   : "; derivatives from each speed's lobe continued exactly where it was found again";
+  }
   band.min_depth = band.propagation.outputs[0];
   dynamics::OutputInterval none;
   none.value = none.std_dev = none.lower = none.upper = NAN;
@@ -94,7 +152,14 @@ MapDepthIntervals StabilityMapIntervals(const dynamics::RobotDescription& descri
   none.value = none.std_dev = none.lower = none.upper = NAN;
   out.depth.assign(points.size(), none);
   std::vector<dynamics::PropagationResult> how(points.size());
-  std::vector<char> done(points.size(), 0);
+  std::vector<char> done(points.size(), 0), local_used(points.size(), 0);
+  const bool first_order = propagation.method == dynamics::PropagationMethod::kFirstOrder;
+  Eigen::VectorXd estimates(static_cast<Eigen::Index>(u.parameters.size()));
+  bool base_is_estimate = true;
+  for (size_t k = 0; k < u.parameters.size(); ++k) {
+    estimates(static_cast<Eigen::Index>(k)) = u.parameters[k].value;
+    base_is_estimate = base_is_estimate && base.Get(u.parameters[k].name) == u.parameters[k].value;
+  }
   dynamics::PostureOptions po;
   po.cartesian = false;
   po.jacobian_condition = false;
@@ -109,13 +174,66 @@ MapDepthIntervals StabilityMapIntervals(const dynamics::RobotDescription& descri
                             std::isfinite(p.stability.critical_depth);
       if (analysed) {
         const Eigen::Matrix3d R = CuttingFrameAtPosture(targets[i].Pose(p.rotation), targets[i].feed_B);
+        auto dynamics_at = [&](const Eigen::VectorXd& values) {
+          return dynamics::EvaluatePosture(
+              dynamics::RobotModel::Build(description, dynamics::WithValues(base, u, values)), p.q, po);
+        };
         auto depth = [&](const Eigen::VectorXd& values) {
-          const auto model = dynamics::RobotModel::Build(description, dynamics::WithValues(base, u, values));
-          const PostureStability s = AnalysePosture(dynamics::EvaluatePosture(model, p.q, po), R, process, analysis);
+          const PostureStability s = AnalysePosture(dynamics_at(values), R, process, analysis);
           return Eigen::VectorXd::Constant(1, s.critical_depth);
         };
         try {
-          how[i] = dynamics::Propagate(u, depth, propagation, {"the critical depth"});
+          // The derivatives from the local model of the critical depth
+          // (LocalCriticalDepth), not from differences of repeated analyses
+          // (noise from the search's tolerance and the lines that move with
+          // the modes). Its analysis is the map's where the map's model is
+          // the estimates' (the local model checks that it reproduces it),
+          // else one at the estimates. Forced first order: the local model
+          // is the output (forward differences, no analysis at all); auto:
+          // it gives the derivatives, the analyses the sigma points.
+          std::optional<LocalCriticalDepth> local;
+          if (propagation.method != dynamics::PropagationMethod::kMonteCarlo) {
+            const dynamics::PostureDynamics d0 = dynamics_at(estimates);
+            if (base_is_estimate) local.emplace(d0, R, process, analysis, p.stability);
+            if (!local || !local->usable()) {
+              local.emplace(d0, R, process, analysis, AnalysePosture(d0, R, process, analysis));
+            }
+          }
+          const bool usable = local && local->usable();
+          auto local_depth = [&](const Eigen::VectorXd& values) {
+            return Eigen::VectorXd::Constant(1, (*local)(dynamics_at(values)));
+          };
+          dynamics::PropagationOptions forward = propagation;
+          forward.central_differences = false;  // the local model is smooth at the step (1e-3 sigma)
+          bool used_local = false;
+          bool lost_step = false;
+          if (usable && first_order) {
+            try {
+              how[i] = dynamics::Propagate(u, local_depth, forward, {"the critical depth"});
+              used_local = std::isfinite(how[i].outputs[0].std_dev);
+            } catch (const std::invalid_argument&) {
+              used_local = false;  // the local model's value was not finite
+            }
+            lost_step = !used_local;
+          }
+          if (!used_local) {
+            // Auto (the local model gives the derivatives), Monte Carlo, or
+            // a local model that did not reach every step of forced first
+            // order (repeated analyses then).
+            const bool linearise = usable && !first_order;
+            how[i] = dynamics::Propagate(u, depth, linearise ? forward : propagation, {"the critical depth"},
+                                         linearise ? dynamics::OutputFunction(local_depth) : dynamics::OutputFunction());
+            used_local = how[i].linearised;
+          }
+          if (used_local) {
+            how[i].reason += "; derivatives from the rightmost eigenvalue's sensitivity and the lobe at the best speed";
+          } else if (local && !local->usable() && how[i].method_used == dynamics::PropagationMethod::kFirstOrder) {
+            how[i].reason += "; derivatives from repeated analyses: " + local->why_not();
+          } else if (lost_step) {
+            how[i].reason += "; derivatives from repeated analyses: the local model lost the lobe at the best speed "
+                             "at a step";
+          }
+          local_used[i] = used_local;
           out.depth[i] = how[i].outputs[0];
           done[i] = 1;
         } catch (const std::exception& e) {
@@ -141,6 +259,7 @@ MapDepthIntervals StabilityMapIntervals(const dynamics::RobotDescription& descri
   for (size_t i = 0; i < points.size(); ++i) {
     if (!done[i]) continue;
     out.evaluations += how[i].evaluations;
+    out.local_model += local_used[i];
     if (how[i].method_used == dynamics::PropagationMethod::kMonteCarlo) {
       if (out.monte_carlo++ == 0) out.example_reason = how[i].reason;
     } else {

@@ -249,6 +249,79 @@ ModeCouplingResult CriticalDepthModeCouplingModal(const TipModalModel& modes, co
   return ModalSearch<Eigen::Dynamic>(modes, Kc_q, options, stable_below);
 }
 
+namespace {
+
+// The rightmost eigenvalue of A and, if asked, dλ/da = y (∂A/∂a) x with x
+// the right eigenvector and y the row of V⁻¹ that belongs to it (so y x = 1).
+template <class Matrix>
+std::complex<double> RightmostWithDerivative(const Matrix& A, const Matrix& dA_da, std::complex<double>* d) {
+  Eigen::EigenSolver<Matrix> es(A, d != nullptr);
+  const auto& ev = es.eigenvalues();
+  Eigen::Index imax = 0;
+  for (Eigen::Index i = 1; i < ev.size(); ++i) {
+    if (ev(i).real() > ev(imax).real()) imax = i;  // the first of equal maxima, as RightmostSolver
+  }
+  if (d != nullptr) {
+    const Eigen::MatrixXcd V = es.eigenvectors();
+    const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(V);
+    // Row imax of V⁻¹: solve Vᵀ yᵀ = e_imax.
+    Eigen::VectorXcd e = Eigen::VectorXcd::Zero(V.rows());
+    e(imax) = 1.0;
+    const Eigen::VectorXcd y = lu.transpose().solve(e);
+    *d = y.transpose() * dA_da.template cast<std::complex<double>>() * V.col(imax);
+    // The eigenvalue's condition number |y| |x| / |y x| (y x = 1 here): a
+    // defective eigenvalue (two modes coalescing) has no derivative, and
+    // near one the derivative is not to be trusted. 1e8: the derivative
+    // then still has about 8 digits.
+    const double condition = y.norm() * V.col(imax).norm();
+    if (!(condition < 1e8) || !std::isfinite(d->real()) || !std::isfinite(d->imag())) {
+      *d = std::complex<double>(NAN, NAN);
+    }
+  }
+  return ev(imax);
+}
+
+template <int Rows>
+std::complex<double> ModalRightmost(const TipModalModel& modes, const Eigen::MatrixXd& Kc_q, double depth,
+                                    std::complex<double>* d) {
+  const int n = modes.num_modes();
+  using Matrix = Eigen::Matrix<double, Rows, Rows>;
+  // The scaled state of ModalSearch: the same eigenvalues.
+  const Eigen::VectorXd& w = modes.omega_rad_s;
+  const Eigen::MatrixXd Kc_scaled = w.cwiseInverse().asDiagonal() * Kc_q;
+  Matrix A = Matrix::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).diagonal() = w;
+  A.bottomRightCorner(n, n).diagonal() = -2.0 * modes.zeta.cwiseProduct(w);
+  A.bottomLeftCorner(n, n) = -depth * Kc_scaled;
+  A.bottomLeftCorner(n, n).diagonal() -= w;
+  Matrix dA = Matrix::Zero(2 * n, 2 * n);
+  if (d != nullptr) dA.bottomLeftCorner(n, n) = -Kc_scaled;
+  return RightmostWithDerivative(A, dA, d);
+}
+
+}  // namespace
+
+std::complex<double> RightmostEigenvalueModal(const TipModalModel& modes, const Eigen::Matrix3d& Kc, double depth,
+                                              std::complex<double>* d_lambda_d_depth) {
+  modes.Validate();
+  const Eigen::MatrixXd Kc_q = modes.p.transpose() * Kc * modes.p;
+  if (modes.num_modes() == 6) return ModalRightmost<12>(modes, Kc_q, depth, d_lambda_d_depth);
+  return ModalRightmost<Eigen::Dynamic>(modes, Kc_q, depth, d_lambda_d_depth);
+}
+
+std::complex<double> RightmostEigenvalueAndDerivative(const Eigen::MatrixXd& M, const Eigen::MatrixXd& C,
+                                                      const Eigen::MatrixXd& K, const Eigen::MatrixXd& Kc_z,
+                                                      double depth, std::complex<double>* d_lambda_d_depth) {
+  const Eigen::Index n = M.rows();
+  const Eigen::LLT<Eigen::MatrixXd> llt(M);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n), dA = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomLeftCorner(n, n) = -llt.solve(K + depth * Kc_z);
+  A.bottomRightCorner(n, n) = -llt.solve(C);
+  if (d_lambda_d_depth != nullptr) dA.bottomLeftCorner(n, n) = -llt.solve(Kc_z);
+  return RightmostWithDerivative(A, dA, d_lambda_d_depth);
+}
+
 double FlutterDepthClosedForm(const Eigen::Matrix2d& S, const Eigen::Matrix2d& Kc) {
   const double ds = S(0, 0) - S(1, 1), dc = Kc(0, 0) - Kc(1, 1);
   // D(a) = q2 a² + q1 a + q0

@@ -153,53 +153,112 @@ void KqPlanOptions::Validate() const {
   }
 }
 
-Eigen::MatrixXd TargetGradients(const io::RobotConfig& config, const std::vector<io::Posture>& postures,
-                                const std::string& quantity, const std::string& cut_path) {
-  const int n = config.description.arm.num_joints();
-  std::optional<stability::LobesOptions> lobes;
-  Eigen::Vector3d feed = Eigen::Vector3d::UnitX();
-  if (quantity == "safe-depth") {
-    const io::CutSpec cut = io::ReadCutFile(cut_path);
-    StabilityLobesOptions so;
-    so.ValidateSettings();
-    lobes = MakeLobesOptions(cut, so);
-    feed = cut.feed_direction_B;
+namespace {
+
+// The target quantity y at a posture with parameters p: the smallest ZOA
+// critical depth over the cut's speeds, or the lowest natural frequency.
+class TargetQuantity {
+ public:
+  TargetQuantity(const io::RobotConfig& config, const std::string& quantity, const std::string& cut_path)
+      : config_(config) {
+    if (quantity == "safe-depth") {
+      const io::CutSpec cut = io::ReadCutFile(cut_path);
+      StabilityLobesOptions so;
+      so.ValidateSettings();
+      lobes_ = MakeLobesOptions(cut, so);
+      feed_ = cut.feed_direction_B;
+    }
+    po_.cartesian = false;
+    po_.jacobian_condition = false;
   }
-  dynamics::PostureOptions po;
-  po.cartesian = false;
-  po.jacobian_condition = false;
-  auto value = [&](const dynamics::ParameterSet& p, const io::Posture& posture) {
+  double operator()(const dynamics::ParameterSet& p, const io::Posture& posture) const {
     double y = NAN;
-    if (lobes) {
-      const Eigen::VectorXd d = stability::ZoaCriticalDepths(config.description, p, posture.id, posture.q, feed, *lobes);
+    if (lobes_) {
+      const Eigen::VectorXd d =
+          stability::ZoaCriticalDepths(config_.description, p, posture.id, posture.q, feed_, *lobes_);
       y = std::numeric_limits<double>::infinity();
       for (Eigen::Index i = 0; i < d.size(); ++i) {
         if (std::isfinite(d(i))) y = std::min(y, d(i));
       }
     } else {
-      const dynamics::PostureDynamics d = dynamics::EvaluatePosture(dynamics::RobotModel::Build(config.description, p),
-                                                                    posture.q, po);
+      const dynamics::PostureDynamics d =
+          dynamics::EvaluatePosture(dynamics::RobotModel::Build(config_.description, p), posture.q, po_);
       if (!d.modes.empty()) y = d.modes.front().freq_hz;
     }
     if (!(y > 0.0) || !std::isfinite(y)) {
       throw std::invalid_argument("posture " + posture.id + ": the " +
-                                  (lobes ? "ZOA lobes have no boundary" : "model has no mode") +
+                                  (lobes_ ? "ZOA lobes have no boundary" : "model has no mode") +
                                   ", so it cannot be a target");
     }
     return y;
-  };
+  }
+  // The parameters with kq_j (1-based) scaled by exp(step).
+  dynamics::ParameterSet Scaled(int j, double step) const {
+    const std::string name = "kq" + std::to_string(j) + "_Nm_per_rad";
+    dynamics::ParameterSet p = config_.parameters;
+    p.Set(name, config_.parameters.Get(name) * std::exp(step));
+    return p;
+  }
+
+ private:
+  const io::RobotConfig& config_;
+  std::optional<stability::LobesOptions> lobes_;
+  Eigen::Vector3d feed_{Eigen::Vector3d::UnitX()};
+  dynamics::PostureOptions po_;
+};
+
+}  // namespace
+
+Eigen::MatrixXd TargetGradients(const io::RobotConfig& config, const std::vector<io::Posture>& postures,
+                                const std::string& quantity, const std::string& cut_path) {
+  const int n = config.description.arm.num_joints();
+  const TargetQuantity value(config, quantity, cut_path);
   constexpr double h = 1e-3;
   Eigen::MatrixXd G(n, static_cast<Eigen::Index>(postures.size()));
   for (size_t t = 0; t < postures.size(); ++t) {
     for (int j = 0; j < n; ++j) {
-      const std::string name = "kq" + std::to_string(j + 1) + "_Nm_per_rad";
-      dynamics::ParameterSet lo = config.parameters, hi = config.parameters;
-      lo.Set(name, config.parameters.Get(name) * std::exp(-h));
-      hi.Set(name, config.parameters.Get(name) * std::exp(h));
-      G(j, static_cast<Eigen::Index>(t)) = (std::log(value(hi, postures[t])) - std::log(value(lo, postures[t]))) / (2 * h);
+      G(j, static_cast<Eigen::Index>(t)) =
+          (std::log(value(value.Scaled(j + 1, h), postures[t])) - std::log(value(value.Scaled(j + 1, -h), postures[t]))) /
+          (2 * h);
     }
   }
   return G;
+}
+
+std::vector<TargetLinearity> CheckTargetLinearity(const io::RobotConfig& config,
+                                                  const std::vector<io::Posture>& postures,
+                                                  const std::string& quantity, const std::string& cut_path,
+                                                  const Eigen::MatrixXd& gradients, const Eigen::VectorXd& relative_std,
+                                                  const Eigen::VectorXd& target_relative_std, double z) {
+  const TargetQuantity value(config, quantity, cut_path);
+  std::vector<TargetLinearity> out;
+  for (size_t t = 0; t < postures.size(); ++t) {
+    TargetLinearity c;
+    c.id = postures[t].id;
+    const double ln_y0 = std::log(value(config.parameters, postures[t]));
+    const double half = z * target_relative_std(static_cast<Eigen::Index>(t));
+    for (Eigen::Index j = 0; j < relative_std.size(); ++j) {
+      const double s = relative_std(j);
+      if (!(s > 0.0) || !std::isfinite(s) || !(half > 0.0)) continue;
+      for (double sign : {-1.0, 1.0}) {
+        const double step = sign * z * s;  // ln k_j at the joint's own sigma point
+        double departure = INFINITY;
+        try {
+          const double ln_y = std::log(value(value.Scaled(static_cast<int>(j) + 1, step), postures[t]));
+          departure = std::abs(ln_y - (ln_y0 + gradients(j, static_cast<Eigen::Index>(t)) * step)) / half;
+        } catch (const std::invalid_argument&) {
+          // no boundary there: not linear either
+        }
+        if (!(departure <= c.departure)) {
+          c.departure = departure;
+          c.joint = static_cast<int>(j) + 1;
+          c.step = step;
+        }
+      }
+    }
+    out.push_back(c);
+  }
+  return out;
 }
 
 KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
@@ -271,6 +330,33 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
         << o.num_postures << " postures: ±" << 100 * r.d_optimal_target_half_width << " %)";
     }
     r.lines.push_back(m.str());
+    // The promise is first order: where a target bends within its band
+    // (the smallest depth switching to another lobe or speed), the band of
+    // the campaign will be wider.
+    r.target_linearity = CheckTargetLinearity(r.config, targets, o.target_quantity, o.cut_path,
+                                              p.target_gradients, r.plan.expected_relative_std,
+                                              r.plan.expected_target_relative_std, z);
+    for (size_t t = 0; t < r.target_linearity.size(); ++t) {
+      const TargetLinearity& c = r.target_linearity[t];
+      if (c.departure <= kTargetNonlinearityTolerance) continue;
+      const bool frequency = o.target_quantity == "frequency";
+      std::ostringstream w;
+      w << c.id << ": the " << (frequency ? "lowest natural frequency" : "smallest ZOA critical depth")
+        << " bends within its band (at kq" << c.joint << " " << std::showpos << std::setprecision(3)
+        << 100 * (std::exp(c.step) - 1.0) << std::noshowpos << " %, the edge of that joint's expected interval, it is "
+        << (std::isfinite(c.departure) ? FormatNumber(100 * c.departure, 3) + " %" : std::string("an undefined amount"))
+        << " of the half-width off the first-order prediction), so the promised ±"
+        << FormatNumber(100 * r.target_half_widths[t].second, 3)
+        << " % is first order only and the campaign's band there can be wider; check it after the campaign with "
+        << (frequency ? "frf-predict --uncertainty" : "stability-lobes --uncertainty");
+      r.warnings.push_back(w.str());
+      // The band asked for is in doubt when the bend, in ln y, is more than
+      // the tolerance's part of it (a bend of 86 % of a ±1 % promise does
+      // not threaten a ±50 % band; one of 560 % of ±13.5 % threatens ±15 %).
+      r.band_uncertain = r.band_uncertain ||
+                         (o.target_half_width > 0.0 && c.departure * r.target_half_widths[t].second >
+                                                           kTargetNonlinearityTolerance * o.target_half_width);
+    }
     if (o.target_half_width > 0.0 && r.plan.postures_for_target_width > 0) {
       std::ostringstream w;
       w << "the first " << r.plan.postures_for_target_width << " postures of the plan ("

@@ -70,6 +70,55 @@ TEST(Propagate, LinearMapIsExactToFirstOrderAndAutoKeepsIt) {
   EXPECT_NEAR((8.0 - m.outputs[0].lower) / std::sqrt(0.576), 1.959963985, 0.08);
 }
 
+// An output with a ripple at the scale of the differences' steps (as an
+// output interpolated between lines that move with the parameters): its own
+// differences give a wrong first order, its smooth part as `linearisation`
+// the exact one, and forward differences of that smooth part suffice.
+TEST(Propagate, LinearisationGivesTheDerivativesAndFAllElse) {
+  const ParameterUncertainty u = TwoLinear();
+  // The ripple: amplitude 1e-3, period 2e-3 in a (1 % of its sigma; the
+  // steps are 1e-3 sigma), slope up to 3.1 against the smooth part's 3.
+  auto smooth = [](const Eigen::VectorXd& v) { return Eigen::VectorXd::Constant(1, 3 * v(0) - 2 * v(1)); };
+  auto rippled = [&](const Eigen::VectorXd& v) {
+    return Eigen::VectorXd(smooth(v).array() + 1e-3 * std::sin(2.0 * M_PI * v(0) / 2e-3));
+  };
+  PropagationOptions first;
+  first.method = PropagationMethod::kFirstOrder;
+  const PropagationResult plain = Propagate(u, rippled, first);
+  EXPECT_GT(std::abs(plain.outputs[0].std_dev / std::sqrt(0.576) - 1.0), 0.5) << "the ripple spoils the differences";
+  EXPECT_FALSE(plain.linearised);
+  for (bool central : {true, false}) {
+    first.central_differences = central;
+    const PropagationResult r = Propagate(u, rippled, first, {"x"}, smooth);
+    EXPECT_TRUE(r.linearised);
+    EXPECT_NEAR(r.outputs[0].std_dev, std::sqrt(0.576), 1e-8) << "central " << central;
+    EXPECT_EQ(r.outputs[0].value, rippled(Eigen::Vector2d(2.0, -1.0))(0)) << "the value is f's";
+    EXPECT_EQ(r.evaluations, central ? 5 : 4) << "f at the estimate, the local model at the steps (and the estimate)";
+  }
+  // Auto: the sigma points use f (its ripple is 1e-3 of a half-width of
+  // 1.5: linear), the derivatives the local model.
+  PropagationOptions automatic;
+  const PropagationResult a = Propagate(u, rippled, automatic, {"x"}, smooth);
+  EXPECT_EQ(a.method_used, PropagationMethod::kFirstOrder) << a.reason;
+  EXPECT_TRUE(a.linearised);
+  EXPECT_NEAR(a.outputs[0].std_dev, std::sqrt(0.576), 1e-8);
+  // A local model that does not reach a step: f's own differences, said.
+  auto partial = [&](const Eigen::VectorXd& v) {
+    return v(0) > 2.0 ? Eigen::VectorXd::Constant(1, NAN) : smooth(v);
+  };
+  first.central_differences = true;
+  const PropagationResult lost = Propagate(u, smooth, first, {"x"}, partial);
+  EXPECT_FALSE(lost.linearised);
+  EXPECT_NEAR(lost.outputs[0].std_dev, std::sqrt(0.576), 1e-8);
+  EXPECT_NE(lost.reason.find("did not reach"), std::string::npos) << lost.reason;
+  // A local model with another number of outputs is refused.
+  for (bool central : {true, false}) {
+    first.central_differences = central;
+    EXPECT_THROW(Propagate(u, smooth, first, {"x"}, [](const Eigen::VectorXd&) { return Eigen::VectorXd::Zero(2).eval(); }),
+                 std::invalid_argument);
+  }
+}
+
 TEST(Propagate, LogNormalBandGoesToMonteCarloWhenWideAndMatchesTheExactQuantiles) {
   ParameterUncertainty u;
   u.parameters = {{"k_Nm_per_rad", 1e6, UncertainScale::kLog}};

@@ -95,6 +95,14 @@ struct PropagationOptions {
   /// Monte Carlo. 0.1: the linearised and Monte Carlo widths then agree
   /// within about 10 % (issue #37).
   double nonlinearity_tolerance{0.1};
+  /// First order: central differences along each principal axis (two
+  /// evaluations, error O(h²)), or forward differences from the estimates
+  /// (one, error O(h)). The step h is 1e-3 standard deviations, so forward
+  /// differences are as good for outputs that are smooth at that scale,
+  /// such as a local model of them (stability::LocalCriticalDepth). With a
+  /// `linearisation` (Propagate) it applies to that; f's own differences,
+  /// where the local model does not reach, are always central.
+  bool central_differences{true};
 };
 
 /// @throws std::invalid_argument naming the field and its bound.
@@ -125,6 +133,10 @@ struct PropagationResult {
   /// parameter outside its bounds, a model that cannot be built); they are
   /// left out of the quantiles and named in `reason`.
   int failed_samples{0};
+  /// First order whose derivatives all came from Propagate's
+  /// `linearisation` (an output it did not reach at some step takes f's own
+  /// central differences, and `reason` says how many).
+  bool linearised{false};
 };
 
 /// The outputs as a function of the parameters' values, in the order and
@@ -147,8 +159,15 @@ using OutputFunction = std::function<Eigen::VectorXd(const Eigen::VectorXd& valu
 /// @throws std::invalid_argument for invalid options or uncertainty, or if
 ///   f fails at the estimate.
 /// `output_names` (optional, one per output) name the output in `reason`.
+/// `linearisation` (optional): a local model of f, equal to it to first
+/// order at the estimate and smooth at the differences' scale, from which
+/// the first-order derivatives are taken instead of from f, whose
+/// differences at 1e-3 sigma can be noise (an output interpolated between
+/// lines that move with the parameters, a search with a tolerance). The
+/// value, the sigma points of the check and Monte Carlo use f.
 PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction& f,
-                            const PropagationOptions& options = {}, const std::vector<std::string>& output_names = {});
+                            const PropagationOptions& options = {}, const std::vector<std::string>& output_names = {},
+                            const OutputFunction& linearisation = nullptr);
 
 /// The values of `u`'s parameters placed into a copy of `base` (names must
 /// exist in it). @throws std::invalid_argument naming an unknown parameter

@@ -52,6 +52,16 @@ ZoaBand ZoaLobeBand(const dynamics::RobotDescription& description, const dynamic
 /// point's safe depth): the point's posture and rotation as the map found
 /// them (the IK does not depend on the uncertain parameters), the analysis
 /// (AnalysePosture: mode coupling and ZOA) repeated by the propagation.
+/// The first-order derivatives come from LocalCriticalDepth at each point
+/// (one eigenvalue problem and a few one-frequency receptances per step,
+/// not an analysis): with forced first order it is the output (no
+/// analysis at all), with auto it gives the derivatives and the analyses
+/// the sigma points. It is built on the point's analysis when `base` holds
+/// the uncertainty's estimates (`points` must then come from a map of
+/// RobotModel::Build(description, base); the mode-coupling crossing is
+/// checked to be one of these dynamics), else on one analysis at the
+/// estimates. Where it cannot be built or does not reach a step, the
+/// analysis is repeated per step and the point's reason says why.
 /// Points not analysed (unreachable, joint limits) or without a finite
 /// critical depth get NaN. `progress` is called with (points done, total)
 /// from the calling thread; `threads` as MapOptions (0: all cores).
@@ -60,6 +70,7 @@ struct MapDepthIntervals {
   int first_order{0}, monte_carlo{0};           // points by the method used
   std::string example_reason;                   // the reason of the first point that used Monte Carlo, else of the first
   long evaluations{0};
+  int local_model{0};  // first-order points whose derivatives came from LocalCriticalDepth
 };
 MapDepthIntervals StabilityMapIntervals(const dynamics::RobotDescription& description,
                                         const dynamics::ParameterSet& base,

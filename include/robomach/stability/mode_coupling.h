@@ -61,6 +61,22 @@ ModeCouplingResult CriticalDepthModeCoupling(const Eigen::MatrixXd& M, const Eig
 ModeCouplingResult CriticalDepthModeCouplingModal(const TipModalModel& modes, const Eigen::Matrix3d& Kc,
                                                   const ModeCouplingOptions& options = {});
 
+/// The rightmost eigenvalue of the modal system of
+/// CriticalDepthModeCouplingModal at depth a, and, when `d_lambda_d_depth`
+/// is given, its derivative with respect to a from the left and right
+/// eigenvectors y, x of the first-order system matrix A(a):
+/// dλ/da = yᴴ (∂A/∂a) x / (yᴴ x) [Wilkinson 1965, §2.8]. NaN derivative
+/// where the eigenvalue is defective (a coalescing pair). The critical
+/// depth's sensitivity to the model's parameters uses both
+/// (LocalCriticalDepth).
+std::complex<double> RightmostEigenvalueModal(const TipModalModel& modes, const Eigen::Matrix3d& Kc, double depth,
+                                              std::complex<double>* d_lambda_d_depth = nullptr);
+
+/// The same for the joint-space system (1) of RightmostEigenvalue.
+std::complex<double> RightmostEigenvalueAndDerivative(const Eigen::MatrixXd& M, const Eigen::MatrixXd& C,
+                                                      const Eigen::MatrixXd& K, const Eigen::MatrixXd& Kc_z,
+                                                      double depth, std::complex<double>* d_lambda_d_depth);
+
 /// The simplified closed-form criterion (our reading of the seed method;
 /// the seed's text is not in this repository). The in-plane static
 /// stiffness S = (G_C,xy)⁻¹ comes from the compliance G = B K⁻¹ Bᵀ rotated

@@ -1,5 +1,10 @@
 #pragma once
 
+#include <complex>
+#include <optional>
+#include <string>
+#include <utility>
+
 #include <Eigen/Core>
 
 #include "robomach/dynamics/posture_dynamics.h"
@@ -38,5 +43,90 @@ struct PostureStability {
 /// Numerical outcomes are statuses in the result.
 PostureStability AnalysePosture(const dynamics::PostureDynamics& d, const Eigen::Matrix3d& R_BC,
                                 const MillingProcess& process, const PostureStabilityOptions& options);
+
+/// One point of the ZOA lobes (a speed Ω, its lobe k and chatter frequency
+/// f_c, as ZoaLobes::At gives it for dynamics d) followed exactly to other
+/// dynamics at the same speed: secant steps on the lobe's phase condition
+/// Ω (2θ(f) + 2πk) = 2π (2πf) / N on the branch of Φ(f) H₀'s eigenvalues
+/// through the point, the receptance at one frequency per step, and
+/// a_lim = −1/(2 Re λ) there, shifted so that the point's own dynamics give
+/// the point's depth. A grid of lines interpolates the lobe: its value is
+/// good to a fraction of a percent, but its lines move with the modes, so
+/// its derivative with respect to the model's parameters is not
+/// (local_critical_depth_test.cc: by up to the largest derivative on 1200
+/// lines). This one is smooth: what a first-order propagation needs.
+class ZoaLobeContinuation {
+ public:
+  ZoaLobeContinuation(const dynamics::PostureDynamics& d, const Eigen::Matrix3d& R_BC, const MillingProcess& process,
+                      const LobePoint& point);
+  /// False when the point is not kOk or its lobe is not found again from
+  /// its chatter frequency (within 1 % of it and 10 % of its depth).
+  bool ok() const { return exact_.ok; }
+  /// The depth [m] at the point's speed with dynamics d (`modes`: its
+  /// ModalModelFromPosture); NaN where the lobe is lost.
+  double operator()(const dynamics::PostureDynamics& d, const TipModalModel& modes) const;
+
+ private:
+  struct Solution {
+    double depth{NAN}, freq_hz{NAN}, residual{NAN};
+    std::complex<double> lambda;
+    bool ok{false};
+  };
+  std::pair<std::complex<double>, std::complex<double>> PhaseEigenvalues(const dynamics::PostureDynamics& d,
+                                                                         const TipModalModel& modes_C,
+                                                                         double freq_hz) const;
+  double LobeSpeed(double freq_hz, std::complex<double> lambda) const;
+  Solution Solve(const dynamics::PostureDynamics& d, const TipModalModel& modes_C, double f_start,
+                 std::complex<double> lambda_near, double done) const;
+
+  Eigen::Matrix3d R_BC_;
+  Eigen::Matrix2d H0_;
+  int teeth_;
+  double speed_rad_s_, depth_;
+  int lobe_index_;
+  Solution exact_;  // at the dynamics of construction
+};
+
+/// AnalysePosture's critical depth near one of its analyses, for posture
+/// dynamics whose parameters differ a little (same posture, cut, speeds):
+/// exact at the analysis and first-order accurate around it, at a small
+/// part of an analysis' cost. What a first-order propagation needs
+/// (StabilityMapIntervals): its differences see the derivative of the
+/// analysis' depth without the noise of its search tolerance and lines.
+/// - Mode coupling: the implicit function theorem on the growth
+///   g(a, p) = Re λ − 1e-9 |λ| of the rightmost eigenvalue at the analysis'
+///   critical depth a*: a(p) = a* − (g(a*, p) − g(a*, p₀)) / (∂g/∂a), with
+///   ∂g/∂a from the eigenvectors (RightmostEigenvalueModal): one eigenvalue
+///   problem per evaluation instead of a search of 15-30.
+/// - Regenerative: the ZOA depth at the analysis' best speed on its lobe,
+///   by ZoaLobeContinuation: the derivative of a maximum over the speed
+///   grid is the derivative at the grid speed that attains it, as long as
+///   that speed stays the best. Next to a cusp two grid speeds can nearly
+///   tie, and the maximum has a kink there (Monte Carlo sees it; first
+///   order takes the side of the analysis' best speed).
+/// The limiting mechanism is chosen as AnalysePosture chooses it; the other
+/// mechanism is followed only when it is within 10 % of the limiting one.
+class LocalCriticalDepth {
+ public:
+  LocalCriticalDepth(const dynamics::PostureDynamics& d, const Eigen::Matrix3d& R_BC, const MillingProcess& process,
+                     const PostureStabilityOptions& options, const PostureStability& analysis);
+  /// False where the depth has no such model; why_not() says why (a
+  /// crossing that is not transversal, a lobe not found again). The caller
+  /// then repeats the analysis.
+  bool usable() const { return why_not_.empty(); }
+  const std::string& why_not() const { return why_not_; }
+  /// The critical depth [m] with dynamics `d` (NaN where the model does not
+  /// reach: the best speed's lobe was lost).
+  double operator()(const dynamics::PostureDynamics& d) const;
+
+ private:
+  double ModeCoupling(const dynamics::PostureDynamics& d, const TipModalModel& modes) const;
+
+  Eigen::Matrix3d Kc_B_;
+  bool use_mc_{false}, use_rg_{false};
+  double a_star_{NAN}, g_star_{NAN}, dg_da_{NAN};
+  std::optional<ZoaLobeContinuation> lobe_;
+  std::string why_not_;
+};
 
 }  // namespace robomach::stability

@@ -116,6 +116,28 @@ struct KqPlanOptions {
 Eigen::MatrixXd TargetGradients(const io::RobotConfig& config, const std::vector<io::Posture>& postures,
                                 const std::string& quantity, const std::string& cut_path);
 
+/// How far a target departs from its first-order prediction within its
+/// expected band: the quantity at each joint's own interval edges
+/// ln k_j ± z σ_j (one joint at a time, σ_j the plan's expected relative
+/// standard deviation), against ln y₀ + g_tj (± z σ_j), in units of the
+/// target's expected half-width z σ_t. The check of dynamics::Propagate's
+/// auto mode, on the plan's marginal intervals.
+struct TargetLinearity {
+  std::string id;
+  double departure{0.0};  // the largest, in half-widths (inf: no value there)
+  int joint{0};           // where it is largest (1-based; 0: none checked)
+  double step{0.0};       // ln k_j step there
+};
+/// Above this, the target's band from the campaign will be wider than the
+/// plan promises (the tolerance of PropagationOptions::nonlinearity_tolerance).
+inline constexpr double kTargetNonlinearityTolerance = 0.1;
+
+std::vector<TargetLinearity> CheckTargetLinearity(const io::RobotConfig& config,
+                                                  const std::vector<io::Posture>& postures,
+                                                  const std::string& quantity, const std::string& cut_path,
+                                                  const Eigen::MatrixXd& gradients, const Eigen::VectorXd& relative_std,
+                                                  const Eigen::VectorXd& target_relative_std, double z);
+
 struct KqPlanResult {
   io::RobotConfig config;  // as loaded (config.implausible: its unit findings)
   std::shared_ptr<const dynamics::RobotModel> model;
@@ -132,9 +154,16 @@ struct KqPlanResult {
   std::vector<std::pair<std::string, double>> target_half_widths;
   /// The worst target's half-width with the D-optimal plan of the same size.
   double d_optimal_target_half_width{NAN};
+  /// Each target's CheckTargetLinearity; a departure above
+  /// kTargetNonlinearityTolerance is a warning.
+  std::vector<TargetLinearity> target_linearity;
+  /// --target-band-pct was asked and a target bends within its band by
+  /// more than kTargetNonlinearityTolerance of the band asked for (in ln y):
+  /// the plan's count of postures for the band cannot be trusted.
+  bool band_uncertain{false};
   /// kq-identify --plan's exit 3: a joint not determinable, a target band
-  /// not reached, or the config's unit findings.
-  bool flagged() const { return plan.flagged() || !config.implausible.empty(); }
+  /// not reached or not trustworthy, or the config's unit findings.
+  bool flagged() const { return plan.flagged() || band_uncertain || !config.implausible.empty(); }
 };
 
 /// Loads the config (its unit findings are kWarning messages) and plans the
