@@ -47,6 +47,16 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
     s.Flag("the path's traverse speed reaches " + FormatDouble(1e3 * s.max_speed) + " mm/s, above max_speed_mm_per_s " +
            FormatDouble(1e3 * process.max_speed));
   }
+  // Times in milliseconds under the t_s header (issue #35: the planner's
+  // path with t in ms removed 2.3 mm on average, exit 0): no segment then
+  // moves faster than a thousandth of what the process allows.
+  if (s.max_speed > 0.0 && s.max_speed < 1e-2 * process.max_speed &&
+      1e3 * s.max_speed <= process.max_speed * (1 + 1e-6)) {
+    s.Flag("implausible (unit mistake?): " + s.file.path + ": the tool never moves faster than " +
+           FormatNumber(1e3 * s.max_speed, 3) + " mm/s, under 1 % of max_speed_mm_per_s " +
+           FormatNumber(1e3 * process.max_speed, 3) + " (the path takes " + FormatNumber(s.file.rows.back().t, 4) +
+           " s): times in ms under the t_s header? (A deliberately slow path is flagged too.)");
+  }
   s.stats = polishing::ComputeRemovalStats(s.removal, s.grid->areas(), s.grid->in_region());
   // A path that cannot be this surface's (issue #35: a path in metres under
   // the _mm headers polished nothing, exit 0): its extent against the

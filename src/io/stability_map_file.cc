@@ -66,7 +66,10 @@ void WriteStabilityMapCsv(const std::string& path, const MapPoints& points,
       }
       os << FormatCell(t.p_BT.x() * 1e3) << ',' << FormatCell(t.p_BT.y() * 1e3) << ',' << FormatCell(t.p_BT.z() * 1e3)
          << ',' << FormatCell(RadToDeg(p.rotation + (grid ? 0.0 : points.path_rotation[i])));
-      for (int j = 0; j < n; ++j) os << ',' << (p.q.size() == n ? FormatCell(RadToDeg(p.q(j))) : "");
+      // An unreachable point has no posture: the IK's last iterate and its
+      // Jacobian are not the robot's (issue #35), so both stay empty.
+      const bool reached = p.status != stability::PointStatus::kUnreachable && p.q.size() == n;
+      for (int j = 0; j < n; ++j) os << ',' << (reached ? FormatCell(RadToDeg(p.q(j))) : "");
       const bool mc = analysed && s.mode_coupling.status == stability::ModeCouplingStatus::kFound;
       const bool rg = analysed && s.regenerative.status == stability::LobeStatus::kOk;
       os << ',' << (mc ? FormatCell(s.mode_coupling.critical_depth * 1e3) : "") << ','
@@ -76,7 +79,8 @@ void WriteStabilityMapCsv(const std::string& path, const MapPoints& points,
          << (rg ? FormatCell(LobeSpeedRpm(s.regenerative.spindle_speed_rad_s)) : "") << ','
          << (analysed ? FormatCell(s.critical_depth * 1e3) : "") << ','
          << (analysed ? stability::ToString(s.limiting) : "") << ','
-         << (analysed ? FormatCell(s.chatter_freq_hz) : "") << ',' << FormatCell(p.jacobian_condition) << ','
+         << (analysed ? FormatCell(s.chatter_freq_hz) : "") << ',' << (reached ? FormatCell(p.jacobian_condition) : "")
+         << ','
          << stability::ToString(p.status);
       if (depth_intervals) {
         os << ',' << FormatCell(MToMm((*depth_intervals)[i].lower)) << ',' << FormatCell(MToMm((*depth_intervals)[i].upper));

@@ -1,6 +1,8 @@
 // Readers of the stability inputs: cut_*.yaml, region_*.yaml, tool-path
 // CSV, FRF CSV (formats.md §3) and modal tables (§4).
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -10,6 +12,7 @@
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/region_file.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/io/stability_map_file.h"
 #include "robomach/io/tip_dynamics_files.h"
 #include "robomach/workflows/tip_sources.h"
 #include "test_support.h"
@@ -228,6 +231,57 @@ TEST(TipSources, RobotPosturesInTheOrderAskedAndSingularOnesTold) {
   EXPECT_THAT(warnings[0], HasSubstr(postures + ":4: posture W is near a singularity"));
   const std::string unknown = CaptureError([&] { TipsFromRobotPostures(model, postures, {"C"}, cut); });
   EXPECT_THAT(unknown, HasSubstr("no posture \"C\" in the file; it has A, B, W"));
+}
+
+// Issue #35: an unreachable point's row showed the inverse kinematics' last
+// iterate as its joint angles and that iterate's cond(J); it has no
+// posture, so both are empty. A point outside the joint limits keeps the
+// posture the IK reached (which joint is out is worth seeing).
+TEST(StabilityMapCsv, UnreachablePointsHaveNoPosture) {
+  MapPoints pts;
+  pts.grid = true;
+  pts.rows = 1;
+  pts.cols = 2;
+  pts.grid_step = 0.01;
+  pts.targets.resize(2);
+  std::vector<stability::MapPoint> results(2);
+  for (auto& r : results) {
+    r.q = Eigen::VectorXd::Constant(6, 0.5);
+    r.jacobian_condition = 12.5;
+  }
+  results[0].status = stability::PointStatus::kUnreachable;
+  results[1].status = stability::PointStatus::kJointLimits;
+  const std::string path = TempDir("map_csv") + "/map.csv";
+  WriteStabilityMapCsv(path, pts, results, 6);
+  std::ifstream in(path);
+  std::string header, unreachable, limits;
+  std::getline(in, header);
+  std::getline(in, unreachable);
+  std::getline(in, limits);
+  const auto cells = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) out.push_back(c);
+    if (!line.empty() && line.back() == ',') out.push_back("");
+    return out;
+  };
+  const std::vector<std::string> h = cells(header), a = cells(unreachable), b = cells(limits);
+  ASSERT_EQ(a.size(), h.size());
+  ASSERT_EQ(b.size(), h.size());
+  for (size_t i = 0; i < h.size(); ++i) {
+    if (h[i].rfind('q', 0) == 0 && h[i].find("_deg") != std::string::npos) {
+      EXPECT_EQ(a[i], "") << h[i];
+      EXPECT_NEAR(std::stod(b[i]), RadToDeg(0.5), 1e-9) << h[i];
+    }
+    if (h[i] == "jacobian_condition") {
+      EXPECT_EQ(a[i], "");
+      EXPECT_EQ(b[i], "12.5");
+    }
+    if (h[i] == "status") {
+      EXPECT_EQ(a[i], "unreachable");
+      EXPECT_EQ(b[i], "joint_limits");
+    }
+  }
 }
 
 }  // namespace
