@@ -164,6 +164,24 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const stabil
             FormatNumber(1e3 * b.min_depth.lower, 4) + ", " + FormatNumber(1e3 * b.min_depth.upper, 4) +
             "] mm: the safe depth at every speed is " + FormatNumber(1e3 * b.min_depth.lower, 4) + " mm (" +
             b.propagation.reason + ")");
+    // A lower bound at or below zero is not a depth: the linear interval
+    // does not hold (forced first order where the lobes bend; issue #37).
+    double lowest = b.min_depth.lower, at_rpm = NAN;
+    for (size_t i = 0; i < b.depth.size(); ++i) {
+      if (b.depth[i].lower < lowest) {
+        lowest = b.depth[i].lower;
+        at_rpm = RadPerSecToRpm(b.speed_rad_s(static_cast<Eigen::Index>(i)));
+      }
+    }
+    if (b.propagation.method_used == dynamics::PropagationMethod::kFirstOrder && !(lowest > 0.0)) {
+      const std::string w =
+          b.id + ": the first-order interval of the critical depth reaches " + FormatNumber(1e3 * lowest, 4) +
+          " mm" + (std::isfinite(at_rpm) ? " at " + FormatNumber(at_rpm, 5) + " rpm" : std::string()) +
+          ", which is not a depth: first order does not hold here (the lobes bend within the interval); use "
+          "--uncertainty-method auto or monte-carlo";
+      Say(tell, stability::TipMessage::Kind::kWarning, w);
+      run.input_findings.push_back(w);
+    }
   }
   return run;
 }
