@@ -46,7 +46,10 @@ int Run(int argc, char** argv) {
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
              "\nExit code 3 also means: a joint is weakly or not determined, the fit did not converge,\n"
-             "or outliers were found without --robust (the outputs are written).");
+             "or outliers were found without --robust (the outputs are written). With --plan: a joint no plan\n"
+             "can determine, the config's unit findings, or a --target-band-pct band the plan does not reach or\n"
+             "cannot promise (a target that bends within it); a joint the plan leaves weakly determined, and a\n"
+             "bend without --target-band-pct, are warnings with exit 0.");
   std::string robot_path, tracker_path, out_path, residuals_path, plot_path, json_path, uncertainty_path, robust,
       load_point = "tcp", target = "tcp", masses = "10,20,30", target_postures, target_quantity = "frequency",
       cut_path;
@@ -63,7 +66,7 @@ int Run(int argc, char** argv) {
                  "config; with --plan the plan CSV");
   app.add_option("--residuals", residuals_path, "residual of every case, CSV [mm]");
   app.add_option("--plot", plot_path, "residual plot, PNG")->check(PngFileName());
-  app.add_option("--summary,--json", json_path, "summary JSON ('-' = stdout; --json is the old name): the full result (stiffness, covariance, residuals, advice)");
+  app.add_option("--summary,--json", json_path, "summary JSON ('-' = stdout; --json is the old name): the full result (stiffness, covariance, residuals, advice; with --plan the plan's expected widths and warnings)");
   app.add_option("--robust", robust,
                  "robust loss against outlier cases: cauchy or huber (outliers are then left out)")
       ->check(OneOf({"cauchy", "huber"}))
@@ -87,7 +90,7 @@ int Run(int argc, char** argv) {
   app.add_option("--seed", seed, "--plan: seed of the candidate postures")->capture_default_str();
   app.add_option("--target-postures", target_postures,
                  "--plan: a targeted plan (not D-optimal): the postures of the work region (posture CSV) whose "
-                 "--target quantity must be known well");
+                 "--target-quantity must be known well");
   app.add_option("--target-quantity", target_quantity,
                  "--plan --target-postures: frequency (the lowest natural frequency) or safe-depth (the ZOA lobes' "
                  "smallest critical depth of --cut)")
@@ -112,7 +115,7 @@ int Run(int argc, char** argv) {
     // The two modes' options are not mixed silently (issue #35: --plan with
     // --tracker planned and ignored the file).
     if (plan_n != 0) {
-      for (const char* name : {"--tracker", "--residuals", "--plot", "--summary", "--robust", "--merge",
+      for (const char* name : {"--tracker", "--residuals", "--plot", "--robust", "--merge",
                                "--as-parameters", "--uncertainty-out"}) {
         if (app.count(name) > 0) {
           throw UsageError(std::string(name) + " is for identifying from a tracker file, and --plan " +
@@ -134,6 +137,9 @@ int Run(int argc, char** argv) {
                        {{"--out", out_path}, {"--residuals", residuals_path}, {"--plot", plot_path},
                         {"--summary", json_path}, {"--uncertainty-out", uncertainty_path}});
     if (plan_n != 0) {
+      if (json_path == "-" && out_path.empty()) {
+        throw UsageError("--summary - and the plan would both go to stdout: give the plan a file with --out");
+      }
       workflows::KqPlanOptions po;
       po.robot_path = robot_path;
       po.num_postures = plan_n;
@@ -163,23 +169,28 @@ int Run(int argc, char** argv) {
       po.target_postures_path = target_postures;
       po.target_quantity = target_quantity;
       po.cut_path = cut_path;
+      if (app.count("--target-band-pct") > 0 && !(target_band_pct > 0.0)) {
+        throw UsageError("--target-band-pct: expected the 95 % half-width wanted in percent (> 0; 5 for ±5 %), got " +
+                         io::FormatDouble(target_band_pct));
+      }
       CheckOptionRange("--target-band-pct", target_band_pct, 0.0, 99.0);
       po.target_half_width = target_band_pct / 100.0;
+      po.target_half_width_name = "--target-band-pct";
       ValidateOptions({{"num_postures", "--plan"}, {"noise_mm", "--noise-mm"}, {"masses_kg", "--masses-kg"},
                        {"target_quantity", "--target-quantity"}, {"cut_path", "--cut"}, {"target_half_width", "--target-band-pct"}},
                       [&] { po.Validate(); });
       const workflows::KqPlanResult plan = workflows::RunKqPlan(po, MessagePrinter(kTool));
-      io::LoadTestPlanHeader header;
-      header.num_postures = plan_n;
-      header.robot_config = plan.config.path;
-      header.tracker_noise_mm = noise_mm;
-      header.masses_kg = po.masses_kg;
-      header.load_point = plan.planner.p_load_tip;
-      header.target = plan.planner.p_target_tip;
-      io::WriteLoadTestPlanCsv(out_path, plan.plan, header);
+      io::WriteLoadTestPlanCsv(out_path, plan.plan, plan.PlanHeader(po));
       for (const std::string& line : plan.lines) std::cerr << kTool << ": " << line << '\n';
       for (const std::string& w : plan.warnings) Warn(kTool, w);
-      return plan.flagged() ? kExitFlagged : kExitOk;
+      const int exit_code = plan.flagged() ? kExitFlagged : kExitOk;
+      if (!json_path.empty()) {
+        nlohmann::json j = plan.Summary();
+        j["tool"] = kTool;
+        j["exit_code"] = exit_code;
+        io::WriteFileAtomically(json_path, SummaryText(j));
+      }
+      return exit_code;
     }
     if (tracker_path.empty()) throw UsageError("--tracker is required (or --plan N)");
     if (merge && out_path.empty()) throw UsageError("--merge needs --out for the merged config");

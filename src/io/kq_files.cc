@@ -72,7 +72,7 @@ void WriteLoadTestPlanCsv(const std::string& path, const identification::TestPla
                           const LoadTestPlanHeader& h) {
   const int num_joints = static_cast<int>(plan.expected_std_dev.size());
   std::ostringstream csv;
-  csv << "# kq-identify --plan " << h.num_postures << ": D-optimal load tests for " << h.robot_config << "\n";
+  csv << "# kq-identify --plan " << h.num_postures << ": " << h.design << " for " << h.robot_config << "\n";
   csv << "# log_det_information: " << FormatDouble(plan.log_det_information) << "\n";
   csv << "# tracker_noise_mm: " << FormatDouble(h.tracker_noise_mm) << "\n";
   csv << "# masses_kg:";
@@ -87,6 +87,7 @@ void WriteLoadTestPlanCsv(const std::string& path, const identification::TestPla
   };
   point("load_point_mm", h.load_point);
   point("target_mm", h.target);
+  for (const auto& [key, value] : h.more) csv << "# " << key << ": " << value << "\n";
   for (int j = 0; j < num_joints; ++j) {
     csv << "# expected_std_kq" << j + 1 << "_Nm_per_rad: " << FormatDouble(plan.expected_std_dev(j)) << "\n";
   }

@@ -154,6 +154,13 @@ std::string YamlDoc::OtherYamlKind(const std::string& missing) const {
   // config/kr210.yaml: "missing key 'flexible_joints'").
   if (!node_.IsMap()) return "";
   const auto has = [&](const char* k) { return static_cast<bool>(node_[k]); };
+  // kq-identify writes two files: the stiffness to paste (--out) and its
+  // uncertainty (--uncertainty-out); the first given for the second.
+  if (missing == "parameter_uncertainty" && (has("joint_stiffness_Nm_per_rad") || has("parameters")) &&
+      !has("robot") && !has("urdf") && !has("dh")) {
+    return "; this is kq-identify's --out (the stiffness to paste into the robot config): --uncertainty takes the "
+           "file kq-identify writes with --uncertainty-out (docs/formats.md §12)";
+  }
   struct Kind {
     bool match;
     const char* what;

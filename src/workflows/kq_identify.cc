@@ -288,9 +288,19 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
                                                                                 : "smallest ZOA critical depth") +
              " at " + std::to_string(targets.size()) + " postures");
     p.target_gradients = TargetGradients(r.config, targets, o.target_quantity, o.cut_path);
+    r.target_quantity = o.target_quantity;
     p.target_half_width = o.target_half_width;
   }
   r.plan = identification::PlanLoadTests(*r.model, p);
+  // A band the plan does not reach and narrower than 0.5 %: most likely a
+  // fraction typed for a percentage (0.05 for 5 %); the finding says so.
+  if (o.target_half_width > 0.0 && o.target_half_width < 0.005 && r.plan.postures_for_target_width == 0) {
+    const std::string w = o.target_half_width_name + ": a band of ±" + FormatNumber(100 * o.target_half_width, 3) +
+                          " % is not reached; was ±" + FormatNumber(1e4 * o.target_half_width, 3) +
+                          " % meant (a fraction typed for a percentage)?";
+    Tell(on_message, Message::Kind::kWarning, w);
+    r.option_findings.push_back(w);
+  }
   const int n = r.model->num_joints();
   std::ostringstream head;
   head << "plan of " << o.num_postures << " postures x " << p.directions_per_posture << " rope directions x "
@@ -317,7 +327,7 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
     for (size_t t = 0; t < targets.size(); ++t) {
       const double hw = z * r.plan.expected_target_relative_std(static_cast<Eigen::Index>(t));
       r.target_half_widths.push_back({targets[t].id, hw});
-      m << (t ? "," : "") << " " << targets[t].id << " ±" << std::setprecision(3) << 100 * hw << " %";
+      m << (t ? "," : "") << " target " << targets[t].id << " ±" << std::setprecision(3) << 100 * hw << " %";
     }
     {
       // The same targets with the D-optimal plan of the same size: what targeting gains.
@@ -341,7 +351,8 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
       if (c.departure <= kTargetNonlinearityTolerance) continue;
       const bool frequency = o.target_quantity == "frequency";
       std::ostringstream w;
-      w << c.id << ": the " << (frequency ? "lowest natural frequency" : "smallest ZOA critical depth")
+      // "target P2": the plan's own postures are P1..PN too.
+      w << "target " << c.id << ": the " << (frequency ? "lowest natural frequency" : "smallest ZOA critical depth")
         << " bends within its band (at kq" << c.joint << " " << std::showpos << std::setprecision(3)
         << 100 * (std::exp(c.step) - 1.0) << std::noshowpos << " %, the edge of that joint's expected interval, it is "
         << (std::isfinite(c.departure) ? FormatNumber(100 * c.departure, 3) + " %" : std::string("an undefined amount"))
@@ -349,19 +360,23 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
         << FormatNumber(100 * r.target_half_widths[t].second, 3)
         << " % is first order only and the campaign's band there can be wider; check it after the campaign with "
         << (frequency ? "frf-predict --uncertainty" : "stability-lobes --uncertainty");
-      r.warnings.push_back(w.str());
       // The band asked for is in doubt when the bend, in ln y, is more than
       // the tolerance's part of it (a bend of 86 % of a ±1 % promise does
       // not threaten a ±50 % band; one of 560 % of ±13.5 % threatens ±15 %).
-      r.band_uncertain = r.band_uncertain ||
-                         (o.target_half_width > 0.0 && c.departure * r.target_half_widths[t].second >
-                                                           kTargetNonlinearityTolerance * o.target_half_width);
+      if (o.target_half_width > 0.0 &&
+          c.departure * r.target_half_widths[t].second > kTargetNonlinearityTolerance * o.target_half_width) {
+        r.band_uncertain = true;
+        w << "; the bend is more than a tenth of the ±" << FormatNumber(100 * o.target_half_width, 3) << " % asked for ("
+          << o.target_half_width_name << "), so the plan cannot promise that band here (exit 3)";
+      }
+      r.warnings.push_back(w.str());
     }
     if (o.target_half_width > 0.0 && r.plan.postures_for_target_width > 0) {
       std::ostringstream w;
       w << "the first " << r.plan.postures_for_target_width << " postures of the plan ("
         << r.plan.postures_for_target_width * p.directions_per_posture * static_cast<int>(p.masses_kg.size())
-        << " load cases) bring every target within ±" << 100 * o.target_half_width << " %";
+        << " load cases) bring every target within ±" << 100 * o.target_half_width << " %"
+        << (r.band_uncertain ? " to first order (not where a target bends: see the warnings)" : "");
       r.lines.push_back(w.str());
     }
   }
@@ -378,6 +393,88 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
     r.warnings.push_back(m.str());
   }
   return r;
+}
+
+nlohmann::json KqPlanResult::Summary() const {
+  nlohmann::json j;
+  j["flagged"] = flagged();
+  j["num_postures"] = planner.num_postures;
+  j["num_load_cases"] = static_cast<int>(plan.cases.size());
+  j["log_det_information"] = plan.log_det_information;
+  nlohmann::json joints = nlohmann::json::array();
+  for (Eigen::Index k = 0; k < plan.expected_std_dev.size(); ++k) {
+    nlohmann::json jj;
+    jj["joint"] = static_cast<int>(k) + 1;
+    jj["stiffness_Nm_per_rad"] = model->joint_stiffness()(k);
+    jj["expected_std_Nm_per_rad"] = plan.expected_std_dev(k);
+    // JSON has no infinity: a joint the plan cannot determine is null.
+    if (std::isfinite(plan.expected_relative_std(k))) jj["expected_relative_std"] = plan.expected_relative_std(k);
+    else jj["expected_relative_std"] = nullptr;
+    jj["determination"] = identification::ToString(plan.expected_determination[static_cast<size_t>(k)]);
+    joints.push_back(jj);
+  }
+  j["joints"] = joints;
+  if (!target_quantity.empty()) {
+    nlohmann::json t;
+    t["quantity"] = target_quantity;
+    nlohmann::json targets = nlohmann::json::array();
+    for (size_t i = 0; i < target_half_widths.size(); ++i) {
+      nlohmann::json x;
+      x["id"] = target_half_widths[i].first;
+      x["half_width_95_pct"] = 100 * target_half_widths[i].second;
+      if (i < target_linearity.size()) {
+        const TargetLinearity& c = target_linearity[i];
+        if (std::isfinite(c.departure)) x["departure_in_half_widths"] = c.departure;
+        else x["departure_in_half_widths"] = nullptr;
+        x["departure_joint"] = c.joint;
+      }
+      targets.push_back(x);
+    }
+    t["targets"] = targets;
+    t["d_optimal_worst_half_width_95_pct"] = 100 * d_optimal_target_half_width;
+    if (planner.target_half_width > 0.0) {
+      t["band_pct"] = 100 * planner.target_half_width;
+      t["postures_for_band"] = plan.postures_for_target_width;
+      t["postures_for_band_estimate"] = plan.postures_for_target_width_estimate;
+      t["band_uncertain"] = band_uncertain;
+    }
+    j["targets"] = t;
+  }
+  nlohmann::json w = nlohmann::json::array();
+  for (const std::string& s : config.implausible) w.push_back(s);
+  for (const std::string& s : option_findings) w.push_back(s);
+  for (const std::string& s : warnings) w.push_back(s);
+  j["warnings"] = w;
+  return j;
+}
+
+io::LoadTestPlanHeader KqPlanResult::PlanHeader(const KqPlanOptions& o) const {
+  io::LoadTestPlanHeader h;
+  h.num_postures = o.num_postures;
+  h.robot_config = config.path;
+  h.tracker_noise_mm = o.noise_mm;
+  h.masses_kg = o.masses_kg;
+  h.load_point = planner.p_load_tip;
+  h.target = planner.p_target_tip;
+  if (!target_quantity.empty()) {
+    const bool frequency = target_quantity == "frequency";
+    h.design = std::string("load tests targeted at the ") +
+               (frequency ? "lowest natural frequency" : "smallest ZOA critical depth") + " at the postures of " +
+               o.target_postures_path;
+    h.more.push_back({"target_postures", o.target_postures_path});
+    h.more.push_back({"target_quantity", target_quantity});
+    if (!frequency) h.more.push_back({"target_cut", o.cut_path});
+    std::string widths;
+    for (const auto& [id, hw] : target_half_widths) {
+      widths += (widths.empty() ? "" : " ") + id + "=" + FormatNumber(100 * hw, 3);
+    }
+    h.more.push_back({"target_half_width_95_pct", widths});
+    if (planner.target_half_width > 0.0) {
+      h.more.push_back({"target_band_pct", FormatNumber(100 * planner.target_half_width, 6)});
+      h.more.push_back({"postures_for_target_band", std::to_string(plan.postures_for_target_width)});
+    }
+  }
+  return h;
 }
 
 }  // namespace robomach::workflows

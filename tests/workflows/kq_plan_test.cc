@@ -109,8 +109,21 @@ TEST(CheckTargetLinearity, FlagsTheTargetsWhoseCampaignsMissedThePromise) {
   EXPECT_FALSE(r.band_uncertain) << "no --target-band-pct: a warning, not exit 3";
 
   o.target_half_width = 0.15;
-  EXPECT_TRUE(RunKqPlan(o).band_uncertain);
-  EXPECT_TRUE(RunKqPlan(o).flagged());
+  const KqPlanResult b = RunKqPlan(o);
+  EXPECT_TRUE(b.band_uncertain);
+  EXPECT_TRUE(b.flagged());
+  // The warnings say which targets make the band uncertain (P2 and P4 at
+  // least), and the summary carries them and the targets' departures.
+  int why = 0;
+  for (const std::string& w : b.warnings) why += w.find("cannot promise that band") != std::string::npos;
+  EXPECT_GE(why, 2);
+  const nlohmann::json j = b.Summary();
+  EXPECT_TRUE(j["targets"]["band_uncertain"].get<bool>());
+  ASSERT_EQ(j["targets"]["targets"].size(), 5u);
+  EXPECT_DOUBLE_EQ(j["targets"]["targets"][1]["departure_in_half_widths"].get<double>(), b.target_linearity[1].departure);
+  EXPECT_EQ(j["warnings"].size(), b.warnings.size());
+  const io::LoadTestPlanHeader h = b.PlanHeader(o);
+  EXPECT_NE(h.design.find("targeted at the smallest ZOA critical depth"), std::string::npos);
 
   o.target_half_width = 0.0;
   o.target_quantity = "frequency";

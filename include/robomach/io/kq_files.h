@@ -5,6 +5,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -36,6 +37,12 @@ struct LoadTestPlanHeader {
   std::vector<double> masses_kg;
   std::optional<Eigen::Vector3d> load_point;        // tip frame [m]; none: the TCP
   std::optional<Eigen::Vector3d> target;            // tip frame [m]; none: the TCP
+  /// How the postures were chosen, in the first line ("D-optimal load
+  /// tests", or a targeted plan's "load tests for the <quantity> at ...").
+  std::string design{"D-optimal load tests"};
+  /// More `# key: value` lines after the target (a targeted plan's target
+  /// file, quantity and promised half-widths).
+  std::vector<std::pair<std::string, std::string>> more;
 };
 
 /// The plan: `# key: value` lines (log det of the information, the noise,

@@ -19,6 +19,7 @@
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/identification/joint_stiffness.h"
 #include "robomach/identification/test_plan.h"
+#include "robomach/io/kq_files.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/tracker_file.h"
@@ -103,6 +104,8 @@ struct KqPlanOptions {
   std::string target_quantity{"frequency"};
   std::string cut_path;
   double target_half_width{0.0};
+  /// How the messages name target_half_width (the tool: "--target-band-pct").
+  std::string target_half_width_name{"target_half_width"};
 
   /// @throws OptionError naming the field and its bound.
   void Validate() const;
@@ -152,6 +155,7 @@ struct KqPlanResult {
   /// With target postures: each target's expected relative half-width at
   /// 95 % with the whole plan, by posture id.
   std::vector<std::pair<std::string, double>> target_half_widths;
+  std::string target_quantity;  // "frequency" or "safe-depth" with target postures, else empty
   /// The worst target's half-width with the D-optimal plan of the same size.
   double d_optimal_target_half_width{NAN};
   /// Each target's CheckTargetLinearity; a departure above
@@ -161,9 +165,22 @@ struct KqPlanResult {
   /// more than kTargetNonlinearityTolerance of the band asked for (in ln y):
   /// the plan's count of postures for the band cannot be trusted.
   bool band_uncertain{false};
+  /// Options that look like a unit mistake (a band of 0.05 % meant as 5 %):
+  /// warnings too, and they flag the plan.
+  std::vector<std::string> option_findings;
   /// kq-identify --plan's exit 3: a joint not determinable, a target band
-  /// not reached or not trustworthy, or the config's unit findings.
-  bool flagged() const { return plan.flagged() || band_uncertain || !config.implausible.empty(); }
+  /// not reached or not trustworthy, the config's unit findings, an option
+  /// finding. A joint left weakly determined or a target that bends within
+  /// its band (without a band asked for) is a warning only.
+  bool flagged() const {
+    return plan.flagged() || band_uncertain || !config.implausible.empty() || !option_findings.empty();
+  }
+  /// kq-identify --plan --summary (formats.md §4.1): the plan's size, each
+  /// joint's expected standard deviation, the targets' promised half-widths
+  /// and linearity, the warnings and `flagged`.
+  nlohmann::json Summary() const;
+  /// The plan file's header: how it was made (targets and promises included).
+  io::LoadTestPlanHeader PlanHeader(const KqPlanOptions& options) const;
 };
 
 /// Loads the config (its unit findings are kWarning messages) and plans the
