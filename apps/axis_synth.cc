@@ -32,6 +32,7 @@ int Run(int argc, char** argv) {
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp());
   std::string machine_path, program_path, comp_path, temp_path, out_path, machine_out, capture_path;
+  long max_rows = 1000000;
   double feed_mm_min = 2000.0, rate_hz = 8000.0, dwell_s = 0.0, start_b_deg = -90.0, glitch_p = 0.0;
   int capture_every = 10, settle = 2;
   unsigned seed = 1;
@@ -60,6 +61,9 @@ int Run(int argc, char** argv) {
                  "chance per capture sample of a one-sample glitch on one channel of an idle axis")
       ->capture_default_str();
   app.add_option("--seed", seed, "random seed (capture start phases, glitches)")->capture_default_str();
+  app.add_option("--max-rows", max_rows,
+                 "refuse (exit 64) a record longer than this many rows (about 45 bytes each) before writing it")
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -71,6 +75,7 @@ int Run(int argc, char** argv) {
     CheckOptionRange("--dwell-s", dwell_s, 0.0, 1e5);
     CheckOptionRange("--start-b-deg", start_b_deg, -720.0, 720.0);
     CheckOptionRange("--glitch-probability", glitch_p, 0.0, 1.0);
+    CheckOptionRange("--max-rows", max_rows, 2L, 1000000000L);
     if (capture_every < 1 || capture_every > 100000) throw UsageError("--capture-every: expected 1..100000");
     if (settle < 0 || settle >= capture_every) throw UsageError("--capture-settle: expected 0 <= settle < --capture-every");
     // Plausible ranges (docs/plausibility.md): feeds of machine tools 10 -
@@ -133,6 +138,15 @@ int Run(int argc, char** argv) {
     o.initial_guess.assign(mf.machine.kinematic_axis.size(), 0.0);
     o.initial_guess[3] = DegToRad(start_b_deg);  // B of the nutating head (X, Y, Z, B, C)
 
+    // A slow feed at a servo rate is a long record (33 mm/min on the cone
+    // frustum: 4.1 M rows, 184 MB): said before anything is computed.
+    if (const long rows = machine::SynthesisRows(path, o); rows > max_rows) {
+      throw UsageError("--feed-mm-min " + io::FormatDouble(feed_mm_min) + " at --sample-rate-hz " +
+                       io::FormatDouble(rate_hz) + ": the path's " + FormatNumber(MToMm(path.length()), 4) +
+                       " mm take " + FormatNumber(static_cast<double>(rows) / rate_hz, 4) + " s, " + std::to_string(rows) +
+                       " rows (about " + std::to_string(rows * 45 / 1000000) + " MB), more than --max-rows " +
+                       std::to_string(max_rows) + ": raise --feed-mm-min, lower --sample-rate-hz, or raise --max-rows");
+    }
     std::vector<double> origin(mf.machine.axes.size());
     for (size_t a = 0; a < origin.size(); ++a) origin[a] = mf.machine.axes[a].origin;
     if (!machine_out.empty()) {
@@ -148,7 +162,7 @@ int Run(int argc, char** argv) {
         const auto& ax = mf.machine.axes[a];
         const double scale = ax.kind == machine::AxisKind::kLinear ? 1e3 : 180.0 / kPi;
         throw InputError({machine_path, 0, 0},
-                         "axis " + ax.name + ": the path starts at measured " + io::FormatDouble(res.start_measured[a] * scale) +
+                         "axis " + ax.name + ": the path starts at measured " + FormatNumber(res.start_measured[a] * scale, 7) +
                              (ax.kind == machine::AxisKind::kLinear ? " mm" : " deg") + ", " + std::to_string(rec.counts[a]) +
                              " counts from origin " + io::FormatDouble(ax.origin * scale) +
                              "; the first counts row must be the reference position (docs/formats.md §8.1): set the "

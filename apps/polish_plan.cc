@@ -274,7 +274,7 @@ int Run(int argc, char** argv) {
                       " --line-angle-deg " + io::FormatDouble(pp.line_angle * 180.0 / kPi) + " --edge-overrun-mm " +
                       io::FormatDouble(1e3 * pp.edge_overrun));
     }
-    const std::string unpolished = polishing::DescribeUnpolished(e.stats, grid.region_area());
+    const std::string unpolished = polishing::DescribeUnpolished(e.stats, grid.region_area(), pattern);
     if (!unpolished.empty()) Warn(kTool, unpolished);
     if (e.stats.coverage < 0.99) {
       Warn(kTool, "coverage " + io::FormatDouble(e.stats.coverage) + " < 0.99: parts of the region are barely polished");

@@ -81,7 +81,8 @@ int Run(int argc, char** argv) {
     const polishing::RemovalStats& stats = sim.stats;
     for (const Finding& f : sim.findings) Warn(kTool, f.message);
     bool flagged = sim.flagged() || !implausible.empty();
-    const std::string unpolished = polishing::DescribeUnpolished(stats, grid.region_area());
+    const std::string unpolished = polishing::DescribeUnpolished(
+        stats, grid.region_area(), file.metadata.count("pattern") > 0 ? file.metadata.at("pattern") : std::string());
     if (!unpolished.empty()) Warn(kTool, unpolished);
     nlohmann::json summary = io::PolishSimSummaryJson(sim, process, sample_mm);
     if (robot.Check(kTool, process, file.rows, &summary)) flagged = true;

@@ -3,6 +3,7 @@
 // io/posture_file.h, io/prediction_files.h).
 #include <map>
 #include <memory>
+#include <optional>
 #include <tuple>
 
 #include "bindings.h"
@@ -336,19 +337,24 @@ void BindDynamics(py::module_& m) {
       .def_property_readonly("q", [](const io::Posture& p) { return Eigen::VectorXd(p.q); }, "joint angles [rad]")
       .def_readonly("line", &io::Posture::line, "line in the file (0 if not read from one)")
       .def("__repr__", [](const io::Posture& p) { return "<Posture " + p.id + ">"; });
-  m.def("read_posture_file", [](const std::string& path, int num_joints) {
+  m.def("read_posture_file", [](const std::string& path, std::optional<int> num_joints) {
     RequireReadableFile(path);
+    if (num_joints && *num_joints < 1) {
+      throw py::value_error("read_posture_file: num_joints: expected the robot's joint count >= 1 (or None: from "
+                            "the file), got " + std::to_string(*num_joints));
+    }
     std::vector<std::string> units;  // radians under _deg headers, degrees under _rad
     std::vector<io::Posture> postures;
     {
       py::gil_scoped_release release;
-      postures = io::ReadPostureFile(path, num_joints, &units);
+      postures = io::ReadPostureFile(path, num_joints.value_or(0), &units);
     }
     for (const std::string& w : units) WarnUnit(w);
     return postures;
-  }, py::arg("path"), py::arg("num_joints"),
+  }, py::arg("path"), py::arg("num_joints") = py::none(),
      "Reads a posture file (pose_id,q1_deg..qn_deg or _rad; docs/formats.md §1) into a list of "
-     "Posture with q in radians. InputError with file:line:col; a robomach.UnitWarning when the angles look "
+     "Posture with q in radians; num_joints is the robot's (a file with other joint columns is an error), "
+     "None takes it from the file. InputError with file:line:col; a robomach.UnitWarning when the angles look "
      "like the other unit (the tools' exit 3).");
   m.def("write_posture_file", [](const std::string& path, const std::vector<io::Posture>& postures) {
     py::gil_scoped_release release;

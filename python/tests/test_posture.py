@@ -173,3 +173,28 @@ def test_read_posture_file_warns_of_radians_under_deg_headers(tmp_path):
                    + ''.join(f'{p.id},' + ','.join(f'{x:.4f}' for x in p.q) + '\n' for p in degrees))
     with pytest.warns(rm.UnitWarning, match=r'rad\.csv.*radians'):
         rm.read_posture_file(str(rad), 6)
+
+
+def test_read_posture_file_takes_the_joint_count_from_the_file(tmp_path):
+    # num_joints is optional (a new user had to know it before reading the
+    # file): None reads as many joints as the file's q columns, the same
+    # postures as with the robot's count; a wrong count is still an error.
+    ok = tmp_path / 'deg.csv'
+    ok.write_text(POSTURES)
+    given = rm.read_posture_file(str(ok), 6)
+    inferred = rm.read_posture_file(str(ok))
+    assert [p.id for p in inferred] == [p.id for p in given]
+    for a, b in zip(inferred, given):
+        assert np.array_equal(a.q, b.q)
+    three = tmp_path / 'three.csv'
+    three.write_text('pose_id,q1_deg,q3_rad,q2_deg\nA,10,0.5,20\n')
+    (p,) = rm.read_posture_file(str(three))
+    assert np.allclose(p.q, [np.radians(10), np.radians(20), 0.5])
+    gap = tmp_path / 'gap.csv'
+    gap.write_text('pose_id,q1_deg,q3_deg\nA,10,20\n')
+    with pytest.raises(rm.InputError, match=r'gap\.csv:1: missing column q2_deg \(or q2_rad\): the file has columns up to q3'):
+        rm.read_posture_file(str(gap))
+    with pytest.raises(rm.InputError, match=r'up to q6 but the robot has 5 joints'):
+        rm.read_posture_file(str(ok), 5)
+    with pytest.raises(ValueError, match='num_joints'):
+        rm.read_posture_file(str(ok), 0)

@@ -70,6 +70,15 @@ std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints,
     }
     max_joint = std::max(max_joint, joint);
   }
+  // num_joints <= 0: as many joints as the file's highest q column.
+  const bool from_file = num_joints <= 0;
+  if (from_file) {
+    if (max_joint == 0) {
+      throw InputError({path, t.header_line(), 0},
+                       "no joint columns: expected q1_deg..qn_deg (or _rad)" + t.LooksLike("posture"));
+    }
+    num_joints = max_joint;
+  }
   if (max_joint > num_joints) {
     throw InputError({path, t.header_line(), 0},
                      "the file has joint columns up to q" + std::to_string(max_joint) +
@@ -87,8 +96,9 @@ std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints,
     }
     if (!t.HasColumn(deg) && !t.HasColumn(rad)) {
       throw InputError({path, t.header_line(), 0},
-                       "missing column " + deg + " (or " + rad + "): the robot has " +
-                           std::to_string(num_joints) + " joints" +
+                       "missing column " + deg + " (or " + rad + "): " +
+                           (from_file ? "the file has columns up to q" + std::to_string(num_joints)
+                                      : "the robot has " + std::to_string(num_joints) + " joints") +
                            JointColumnHint(t, j, num_joints) + t.LooksLike("posture"));
     }
     is_deg[j] = t.HasColumn(deg);

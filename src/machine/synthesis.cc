@@ -52,6 +52,11 @@ std::vector<double> StartMeasured(const Machine& machine, const Compensation* co
   return measured;
 }
 
+long SynthesisRows(const ProgrammedPath& path, const SynthesisOptions& o) {
+  const double duration = o.dwell + path.length() / o.feed;
+  return static_cast<long>(std::ceil(duration * o.sample_rate_hz)) + 1;
+}
+
 SynthesisResult SynthesizeCounts(const Machine& machine, const Compensation* compensation,
                                  const ProgrammedPath& path, const SynthesisOptions& o,
                                  const std::vector<double>& origin) {
@@ -62,8 +67,7 @@ SynthesisResult SynthesizeCounts(const Machine& machine, const Compensation* com
   if (origin.size() != n) throw std::invalid_argument("SynthesizeCounts: one origin per axis expected");
   SynthesisResult res;
   res.record.num_axes = static_cast<int>(n);
-  const double duration = o.dwell + path.length() / o.feed;
-  const long rows = static_cast<long>(std::ceil(duration * o.sample_rate_hz)) + 1;
+  const long rows = SynthesisRows(path, o);
   res.record.t_s.reserve(rows);
   res.record.counts.reserve(rows * n);
   std::vector<double> real(n), measured(n);

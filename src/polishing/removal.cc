@@ -269,13 +269,20 @@ Eigen::Isometry3d ContactFrame(const PathRow& row) {
   return X_PC;
 }
 
-std::string DescribeUnpolished(const RemovalStats& stats, double region_area) {
+std::string DescribeUnpolished(const RemovalStats& stats, double region_area, const std::string& pattern) {
   if (!(stats.unpolished_area > 0.0)) return {};
   std::ostringstream m;
   m << 1e6 * stats.unpolished_area << " mm^2 of the region (" << 100 * stats.unpolished_area / region_area
-    << " %) gets less than 1 % of the mean removal: gaps between rows, or necks and lobes of a trimmed face "
-       "too narrow for the cycloid's circle to enter without leaving the face (a smaller radius or row "
-       "spacing reaches them)";
+    << " %) gets less than 1 % of the mean removal: gaps between rows, or necks and lobes of a trimmed face ";
+  if (pattern == "cycloid") {
+    m << "too narrow for the cycloid's circle to enter without leaving the face (a smaller radius or row "
+         "spacing reaches them)";
+  } else if (pattern == "parallel") {
+    m << "that the parallel rows do not enter (a smaller row step, --row-step-mm, or a line angle along the "
+         "neck reaches them)";
+  } else {
+    m << "that the path does not enter (closer rows reach them)";
+  }
   return m.str();
 }
 

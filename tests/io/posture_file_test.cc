@@ -50,6 +50,15 @@ TEST(PostureFile, BadInputGetsLocatedMessages) {
               HasSubstr("p.csv:2: column q1_deg: expected a number, got \"abc\""));
   EXPECT_THAT(err("pose_id,q1_deg\n,1\n", 1), HasSubstr("p.csv:2: column pose_id: expected a value"));
   EXPECT_THAT(err("pose_id,q1_deg\n", 1), HasSubstr("no postures"));
+  // num_joints 0: the count from the file, no column missing below its highest.
+  EXPECT_THAT(err("pose_id,q1_deg,q3_deg\nA,1,2\n", 0),
+              HasSubstr("p.csv:1: missing column q2_deg (or q2_rad): the file has columns up to q3"));
+  EXPECT_THAT(err("pose_id,x_deg\nA,1\n", 0), HasSubstr("p.csv:1: no joint columns: expected q1_deg..qn_deg"));
+  const std::string path = WriteText(dir + "/p.csv", "pose_id,q2_rad,q1_deg\nA,-1.5,30\n");
+  const auto p = ReadPostureFile(path, 0);
+  ASSERT_EQ(p.size(), 1u);
+  ASSERT_EQ(p[0].q.size(), 2);
+  EXPECT_DOUBLE_EQ(p[0].q(1), -1.5);
 }
 
 }  // namespace

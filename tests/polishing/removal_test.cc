@@ -192,6 +192,13 @@ TEST(DescribeUnpolished, NamesTheAreaAndItsShareOrNothing) {
   s.unpolished_area = 2e-6;  // 2 mm^2 of 8 mm^2
   const std::string m = DescribeUnpolished(s, 8e-6);
   EXPECT_EQ(m.rfind("2 mm^2 of the region (25 %) gets less than 1 % of the mean removal", 0), 0u) << m;
+  // The likely reason is the pattern's: the cycloid's circle is not named
+  // for a parallel path (it was, issue #35).
+  EXPECT_EQ(m.find("cycloid"), std::string::npos) << m;
+  EXPECT_NE(DescribeUnpolished(s, 8e-6, "cycloid").find("cycloid's circle"), std::string::npos);
+  const std::string p = DescribeUnpolished(s, 8e-6, "parallel");
+  EXPECT_EQ(p.find("cycloid"), std::string::npos) << p;
+  EXPECT_NE(p.find("--row-step-mm"), std::string::npos) << p;
 }
 
 }  // namespace

@@ -24,7 +24,8 @@ inline constexpr double kOneTurnRad = 6.283185307179586;
 
 /// Reads a posture file: `pose_id,q1_deg..qn_deg` (or `_rad`; each joint in
 /// one unit, never both). `num_joints` must match the robot model: a missing
-/// q column or one beyond n is an error naming both counts. An angle beyond
+/// q column or one beyond n is an error naming both counts; 0 takes the
+/// count from the file (its highest q column), with no column missing below. An angle beyond
 /// kMaxJointAngleDeg is refused. When `unit_warnings` is given, it receives
 /// "implausible (unit mistake?): ..." when the angles fit the other unit far
 /// better (radians under _deg headers, degrees under _rad headers); a tool

@@ -45,6 +45,9 @@ SynthesisResult SynthesizeCounts(const Machine& machine, const Compensation* com
                                  const ProgrammedPath& path, const SynthesisOptions& options,
                                  const std::vector<double>& origin);
 
+/// The rows SynthesizeCounts writes: ceil((dwell + length / feed) * rate) + 1.
+long SynthesisRows(const ProgrammedPath& path, const SynthesisOptions& options);
+
 /// Measured start positions only (the first sample of SynthesizeCounts).
 std::vector<double> StartMeasured(const Machine& machine, const Compensation* compensation,
                                   const ProgrammedPath& path, const SynthesisOptions& options);

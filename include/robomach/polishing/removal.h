@@ -100,7 +100,8 @@ RemovalStats ComputeRemovalStats(const std::vector<double>& removal, const std::
 
 /// What a user should hear when part of the region is left unpolished
 /// (stats in m and m^2, `region_area` [m^2]): how much, and the likely
-/// reasons. Empty when nothing is.
-std::string DescribeUnpolished(const RemovalStats& stats, double region_area);
+/// reasons for the path's `pattern` ("cycloid", "parallel", or "" when not
+/// known: a path file without its pattern line). Empty when nothing is.
+std::string DescribeUnpolished(const RemovalStats& stats, double region_area, const std::string& pattern = "");
 
 }  // namespace robomach::polishing
