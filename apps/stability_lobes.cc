@@ -55,27 +55,6 @@ Eigen::Vector3d ParseVector(const std::string& option, const std::string& text) 
   return {v[0], v[1], v[2]};
 }
 
-// What the library says while it builds the tool tips and the lobes, on
-// stderr: fit reports and information prefixed by the tool's name (their
-// continuation lines are indented), notes, warnings.
-void Tell(const stability::TipMessage& m) {
-  switch (m.kind) {
-    case stability::TipMessage::Kind::kWarning:
-      Warn(kTool, m.text);
-      return;
-    case stability::TipMessage::Kind::kNote:
-      std::cerr << kTool << ": note: " << m.text << "\n";
-      return;
-    case stability::TipMessage::Kind::kFit: {
-      std::istringstream lines(m.text);
-      for (std::string line; std::getline(lines, line);) {
-        std::cerr << (line.rfind("  ", 0) == 0 ? "" : std::string(kTool) + ": ") << line << "\n";
-      }
-      return;
-    }
-  }
-}
-
 // --fit-plot: each fitted direct FRF with its modal fit, magnitude and phase.
 void PlotFits(const std::string& path, const std::string& frf_path, const std::vector<stability::TipDynamics>& tips) {
   int n = 0;
@@ -221,7 +200,7 @@ int Run(int argc, char** argv) {
     }
     std::optional<ProgressLine> progress;
     const workflows::StabilityLobesRun run =
-        workflows::RunStabilityLobes(o, Tell, [&](const stability::SdProgress& p) {
+        workflows::RunStabilityLobes(o, MessagePrinter(kTool), [&](const stability::SdProgress& p) {
           // Counts the speeds themselves ("12/60"), from 20 speeds on.
           if (p.done == 0 && !p.finished) progress.emplace(kTool, "SD speeds of " + p.id, p.total, 20);
           if (!progress) return;

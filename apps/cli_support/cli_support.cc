@@ -375,7 +375,15 @@ MessageSink MessagePrinter(const std::string& tool) {
     switch (m.kind) {
       case Message::Kind::kWarning: Warn(tool, m.text); break;
       case Message::Kind::kNote: Note(tool, m.text); break;
-      case Message::Kind::kInfo: std::cerr << tool << ": " << m.text << '\n'; break;
+      case Message::Kind::kInfo: {
+        // Several lines (a modal fit's table): continuation lines, indented
+        // by two blanks, go without the tool's name.
+        std::istringstream lines(m.text);
+        for (std::string line; std::getline(lines, line);) {
+          std::cerr << (line.rfind("  ", 0) == 0 ? "" : tool + ": ") << line << '\n';
+        }
+        break;
+      }
     }
   };
 }

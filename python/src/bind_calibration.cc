@@ -493,24 +493,17 @@ void BindCalibration(py::module_& m) {
     o.Validate();
     RequireReadableFile(robot);
     RequireReadableFile(tracker);
-    std::vector<Message> said;
+    CollectedMessages said;
     workflows::KqIdentifyResult run;
     {
       py::gil_scoped_release release;
-      run = workflows::RunKqIdentify(o, [&](const Message& msg) { said.push_back(msg); });
+      run = workflows::RunKqIdentify(o, said.Sink());
     }
     for (const std::string& f : run.config.implausible) WarnUnit(f);
     for (const std::string& f : run.unit_findings) WarnUnit(f);
-    py::list messages;
-    for (const Message& msg : said) {
-      py::dict d;
-      d["kind"] = msg.kind == Message::Kind::kWarning ? "warning" : msg.kind == Message::Kind::kNote ? "note" : "info";
-      d["text"] = msg.text;
-      messages.append(d);
-    }
     py::dict d;
     d["fit"] = run.fit;
-    d["messages"] = messages;
+    d["messages"] = said.List();
     d["unit_findings"] = run.unit_findings;
     d["flagged"] = run.flagged();
     d["report"] = workflows::KqReportLines(run.fit);

@@ -38,28 +38,6 @@ Eigen::Matrix3d FrameOf(const io::CutSpec& cut, const Eigen::Vector3d& tool_axis
   return workflows::CutFrame(cut, tool_axis, AxisText(tool_axis));
 }
 
-py::dict MessageDict(const stability::TipMessage& m) {
-  py::dict d;
-  d["kind"] = m.kind == stability::TipMessage::Kind::kWarning ? "warning"
-              : m.kind == stability::TipMessage::Kind::kNote  ? "note"
-                                                               : "info";
-  d["text"] = m.text;
-  return d;
-}
-
-// Messages gathered while the GIL is released, handed to Python afterwards.
-struct Collected {
-  std::vector<stability::TipMessage> messages;
-  stability::TipMessageSink Sink() {
-    return [this](const stability::TipMessage& m) { messages.push_back(m); };
-  }
-  py::list List() const {
-    py::list l;
-    for (const auto& m : messages) l.append(MessageDict(m));
-    return l;
-  }
-};
-
 py::array_t<std::complex<double>> ToArray2(const std::vector<Eigen::Matrix2cd>& phi) {
   py::array_t<std::complex<double>> a({static_cast<py::ssize_t>(phi.size()), py::ssize_t{2}, py::ssize_t{2}});
   auto r = a.mutable_unchecked<3>();
@@ -165,7 +143,7 @@ void BindStability(py::module_& m) {
     o.cutting_frame = [&cut, tool_axis] { return FrameOf(cut, tool_axis); };
     o.tool_axis_source = AxisText(tool_axis);
     o.sd_modes = sd_modes;
-    Collected said;
+    CollectedMessages said;
     std::vector<TipDynamics> tips;
     {
       py::gil_scoped_release release;
@@ -195,7 +173,7 @@ void BindStability(py::module_& m) {
     wo.threads = threads;
     wo.ValidateSettings();
     const stability::LobesOptions o = workflows::MakeLobesOptions(cut, wo);
-    Collected said;
+    CollectedMessages said;
     stability::LobesResult r;
     {
       py::gil_scoped_release release;
@@ -239,7 +217,7 @@ void BindStability(py::module_& m) {
                                        &o.modal_table_path}) {
             if (!p->empty()) RequireReadableFile(*p);
           }
-          Collected said;
+          CollectedMessages said;
           workflows::StabilityLobesRun run;
           {
             py::gil_scoped_release release;

@@ -15,6 +15,7 @@
 #include <pybind11/stl.h>
 
 #include "robomach/common/frames.h"
+#include "robomach/common/messages.h"
 #include "robomach/common/run_status.h"
 #include "robomach/dynamics/measured_frf.h"
 
@@ -41,6 +42,28 @@ inline std::vector<std::string> FindingMessages(const RunFindings& r) {
   for (const Finding& f : r.findings) v.push_back(f.message);
   return v;
 }
+
+/// A library message as Python sees it: {'kind': 'info'|'note'|'warning', 'text': ...}.
+inline py::dict MessageDict(const Message& m) {
+  py::dict d;
+  d["kind"] = m.kind == Message::Kind::kWarning ? "warning" : m.kind == Message::Kind::kNote ? "note" : "info";
+  d["text"] = m.text;
+  return d;
+}
+
+/// Messages gathered while the GIL is released (Sink()), handed to Python
+/// afterwards as a list of MessageDict (List()).
+struct CollectedMessages {
+  std::vector<Message> messages;
+  MessageSink Sink() {
+    return [this](const Message& m) { messages.push_back(m); };
+  }
+  py::list List() const {
+    py::list l;
+    for (const Message& m : messages) l.append(MessageDict(m));
+    return l;
+  }
+};
 
 /// 'x', 'y', 'z' <-> Axis; @throws std::invalid_argument for anything else.
 Axis ParseAxis(const std::string& name);

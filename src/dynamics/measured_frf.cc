@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "robomach/common/number_format.h"
+
 namespace robomach::dynamics {
 
 Frf Frf::FromSamples(Eigen::VectorXd freq_hz, Eigen::VectorXcd receptance,
@@ -172,6 +174,17 @@ FrfSet FrfSet::ForPose(const std::string& pose_id) const {
 
 void FrfSet::Merge(const FrfSet& other) {
   for (const auto& [k, f] : other.frfs_) Insert(k, f);
+}
+
+std::string FrequencyAxisFinding(const std::string& what, double top, FrfFileFormat format) {
+  if (!(top > 0.0) || top >= kMinPlausibleMeasuredTopHz) return {};
+  const char* where = format == FrfFileFormat::kUff58
+                          ? " in the abscissa (UFF58 record 7's start and increment, record 8's unit)"
+                          : format == FrfFileFormat::kCsv ? " under the freq_hz header" : "";
+  return what + ": the FRFs' highest line is at " + FormatNumber(top, 4) + " Hz, below the " +
+         FormatNumber(kMinPlausibleMeasuredTopHz, 4) +
+         " Hz a hammer test of a tool tip reaches (lines to 0.1 - 10 kHz; robot modes 5 - 2000 Hz): frequencies in kHz" +
+         where + "? (" + FormatNumber(top, 4) + " kHz is " + FormatNumber(1e3 * top, 4) + " Hz)";
 }
 
 std::string ReceptancePeakFinding(const std::string& what, double peak, FrfFileFormat format) {

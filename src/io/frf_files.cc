@@ -34,14 +34,10 @@ std::vector<std::string> FrequencyUnitFindings(const FrfReadResult& read, const 
   for (const auto& [key, frf] : read.frfs) {
     if (frf.size() > 0) top = std::max(top, frf.freq_hz().maxCoeff());
   }
-  if (read.frfs.empty() || !(top > 0.0) || top >= dynamics::kMinPlausibleMeasuredTopHz) return {};
-  const bool uff = read.file_format == dynamics::FrfFileFormat::kUff58;
-  return {path + ": the FRFs' highest line is at " + robomach::FormatNumber(top, 4) + " Hz, below the " +
-          robomach::FormatNumber(dynamics::kMinPlausibleMeasuredTopHz, 4) +
-          " Hz a hammer test of a tool tip reaches (lines to 0.1 - 10 kHz; robot modes 5 - 2000 Hz): frequencies in kHz " +
-          (uff ? std::string("in the abscissa (UFF58 record 7's start and increment, record 8's unit)")
-               : std::string("under the freq_hz header")) +
-          "? (" + robomach::FormatNumber(top, 4) + " kHz is " + robomach::FormatNumber(1e3 * top, 4) + " Hz)"};
+  if (read.frfs.empty()) return {};
+  const std::string f = dynamics::FrequencyAxisFinding(path, top, read.file_format);
+  if (f.empty()) return {};
+  return {f};
 }
 
 }  // namespace robomach::io

@@ -63,7 +63,7 @@ TipModalModel SdModel(const TipDynamics& t, int sd_modes) {
 // not (on issue #18's tap test, 0.886 mm at lobe 0 and 0.971 mm at lobe 2
 // against the ZOA's 0.896 mm). A disagreement is a finding.
 void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<LobeRow>& rows, const LobesOptions& o,
-                     const TipMessageSink& tell, LobesResult* findings) {
+                     const MessageSink& tell, LobesResult* findings) {
   if (o.process.radial_immersion < 0.3) return;
   for (const TipDynamics& t : tips) {
     auto [sd, sd_speed] = MinDepth(rows, t.id, "sd");
@@ -105,10 +105,10 @@ void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
                             ", where they should agree): check " +
                             (t.fits.empty() ? std::string("") : "the modal fit (--fit-plot), ") +
                             "the modes the SD keeps (--sd-modes) and its steps per tooth period (--sd-steps)";
-      if (tell) tell({TipMessage::Kind::kWarning, w});
+      if (tell) tell({Message::Kind::kWarning, w});
       findings->Flag(w);
     } else if (tell) {
-      tell({TipMessage::Kind::kFit, m.str() + " (they agree within 10 %)"});
+      tell({Message::Kind::kInfo, m.str() + " (they agree within 10 %)"});
     }
   }
 }
@@ -116,7 +116,7 @@ void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
 // A measured tip: the ZOA's smallest depth on the measured FRF against the
 // ZOA on the modes fitted to it (see ZoaFitCheck).
 void CheckZoaAgainstFit(const TipDynamics& t, const LobesOptions& o, const ZoaOptions& zo, double measured_min,
-                        const std::function<void(TipMessage::Kind, const std::string&)>& tell, LobesResult* result) {
+                        const std::function<void(Message::Kind, const std::string&)>& tell, LobesResult* result) {
   const Eigen::VectorXd f = LobeFrequencyGrid(t.fit_C, o.process.teeth, o.max_speed_rad_s, kLobeGridLines);
   const auto fit_lobes = ComputeZoaLobes(f, InPlaneModalReceptance(t.fit_C, f), o.process, zo);
   double fit_min = INFINITY;
@@ -135,7 +135,7 @@ void CheckZoaAgainstFit(const TipDynamics& t, const LobesOptions& o, const ZoaOp
   m << t.id << ": the ZOA's smallest critical depth is " << FormatNumber(MToMm(measured_min))
     << " mm on the measured FRF and " << FormatNumber(MToMm(fit_min)) << " mm on its fitted modes";
   if (c.agree) {
-    tell(TipMessage::Kind::kFit, m.str() + " (they agree within 10 %)");
+    tell(Message::Kind::kInfo, m.str() + " (they agree within 10 %)");
     return;
   }
   const std::string w =
@@ -143,7 +143,7 @@ void CheckZoaAgainstFit(const TipDynamics& t, const LobesOptions& o, const ZoaOp
       " %, so the lobes hang on something the fit and the measured lines disagree on: a mode the fit left out or "
       "misplaced (see --fit-plot), or a resonance too narrow for the line spacing (a longer record gives finer "
       "lines); compare --method sd, which uses the fitted modes";
-  tell(TipMessage::Kind::kWarning, w);
+  tell(Message::Kind::kWarning, w);
   result->Flag(w);
 }
 
@@ -176,16 +176,16 @@ std::vector<std::string> TipFitWarnings(const TipDynamics& t, bool sd) {
   return w;
 }
 
-LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOptions& o, const TipMessageSink& on_message,
+LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOptions& o, const MessageSink& on_message,
                          const SdProgressSink& on_progress) {
-  auto tell = [&](TipMessage::Kind kind, const std::string& text) {
+  auto tell = [&](Message::Kind kind, const std::string& text) {
     if (on_message) on_message({kind, text});
   };
   const bool do_zoa = o.method != LobeMethod::kSd, do_sd = o.method != LobeMethod::kZoa;
   LobesResult result;
   for (const TipDynamics& t : tips) {
     for (const std::string& w : TipFitWarnings(t, do_sd)) {
-      tell(TipMessage::Kind::kWarning, w);
+      tell(Message::Kind::kWarning, w);
       result.Flag(w);
     }
   }
@@ -228,11 +228,11 @@ LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOption
         msg << " (automatic: " << FormatDouble(o.sd.steps_per_mode_period) << " per period of the highest mode, at least "
             << o.sd.min_steps_per_period << ")";
       }
-      tell(TipMessage::Kind::kFit, msg.str());
+      tell(Message::Kind::kInfo, msg.str());
       result.sd_discretisation.push_back(
           {t.id, static_cast<int>(m.num_modes()), RadPerSecToHz(m.omega_rad_s.maxCoeff()), k_lo, k_hi, capped});
       if (capped) {
-        tell(TipMessage::Kind::kWarning,
+        tell(Message::Kind::kWarning,
              "SD of " + t.id + ": at the lowest speeds the automatic steps per tooth period were capped at " +
                  std::to_string(k_hi) + " (monodromy matrix of " + std::to_string(o.sd.max_monodromy_dimension) +
                  " rows), fewer than " + FormatDouble(o.sd.steps_per_mode_period) +
@@ -254,7 +254,7 @@ LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOption
   if (do_zoa && do_sd) CompareZoaAndSd(tips, result.rows, o, on_message, &result);
   if (result.no_boundary) {
     const std::string w = "some speeds have no boundary (status column): widen the FRF band or the lobe range";
-    tell(TipMessage::Kind::kWarning, w);
+    tell(Message::Kind::kWarning, w);
     result.Flag(w);
   }
   return result;

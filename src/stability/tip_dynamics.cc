@@ -118,7 +118,7 @@ int RefineBetweenLines(TipDynamics* t) {
 }
 
 // Noise model and modal fit of one direct FRF, told to `on_message`.
-DirectionFit FitOne(const std::string& label, const dynamics::Frf& frf, const TipMessageSink& on_message) {
+DirectionFit FitOne(const std::string& label, const dynamics::Frf& frf, const MessageSink& on_message) {
   DirectionFit d{label, FitDirectFrf(frf), ""};
   std::ostringstream m;
   m << label << ": noise " << d.fit.noise.description << "\n" << label << ": modal fit: " << d.fit.fit.message;
@@ -131,7 +131,7 @@ DirectionFit FitOne(const std::string& label, const dynamics::Frf& frf, const Ti
   if (std::isfinite(d.fit.noise_rms)) {
     m << "\n  rms misfit " << FormatDouble(std::round(d.fit.noise_rms * 100.0) / 100.0) << " x the noise";
   }
-  if (on_message) on_message({TipMessage::Kind::kFit, m.str()});
+  if (on_message) on_message({Message::Kind::kInfo, m.str()});
   return d;
 }
 
@@ -139,13 +139,13 @@ DirectionFit FitOne(const std::string& label, const dynamics::Frf& frf, const Ti
 // (the same lines, every value equal): each distinct FRF is fitted once
 // (issue #34 item 6), its result reused under the new label.
 DirectionFit FitOrReuse(const std::string& label, const dynamics::Frf& frf, const std::vector<DirectionFit>& fits,
-                        const TipMessageSink& on_message) {
+                        const MessageSink& on_message) {
   for (const DirectionFit& d : fits) {
     if (!d.same_as.empty()) continue;
     const dynamics::Frf& m = d.fit.measured;
     if (m.size() == frf.size() && m.freq_hz() == frf.freq_hz() && m.receptance() == frf.receptance()) {
       if (on_message) {
-        on_message({TipMessage::Kind::kFit, label + ": the same FRF as " + d.label + " (every line equal): its noise "
+        on_message({Message::Kind::kInfo, label + ": the same FRF as " + d.label + " (every line equal): its noise "
                                                 "model and modal fit are reused"});
       }
       return DirectionFit{label, d.fit, d.label};
@@ -170,13 +170,9 @@ std::pair<double, double> CommonUsableBand(const std::vector<DirectionFit>& fits
 std::string TipFrfsUnitFinding(const TipFrfs& s) {
   // A frequency axis in kHz first: the receptance's band means nothing then
   // (io::FrequencyUnitFindings, the other readers' rule).
-  if (s.freq_hz.size() > 0 && s.freq_hz.maxCoeff() > 0.0 && s.freq_hz.maxCoeff() < dynamics::kMinPlausibleMeasuredTopHz) {
-    const double top = s.freq_hz.maxCoeff();
-    return s.source + (s.pose_id.empty() ? std::string() : ": posture " + s.pose_id) +
-           ": the FRFs' highest line is at " + FormatNumber(top, 4) + " Hz, below the " +
-           FormatNumber(dynamics::kMinPlausibleMeasuredTopHz, 4) +
-           " Hz a hammer test of a tool tip reaches (lines to 0.1 - 10 kHz; robot modes 5 - 2000 Hz): frequencies in kHz? (" +
-           FormatNumber(top, 4) + " kHz is " + FormatNumber(1e3 * top, 4) + " Hz)";
+  const std::string where = s.source + (s.pose_id.empty() ? std::string() : ": posture " + s.pose_id);
+  if (s.freq_hz.size() > 0) {
+    if (std::string f = dynamics::FrequencyAxisFinding(where, s.freq_hz.maxCoeff()); !f.empty()) return f;
   }
   // Each FRF on its own usable band (issue #34 item 5): a tap test's drift
   // lines below ~100 Hz reach 1e-3 m/N on a 1e-6 m/N tool tip.
@@ -191,8 +187,7 @@ std::string TipFrfsUnitFinding(const TipFrfs& s) {
       if (p.peak_m_per_N > largest.peak_m_per_N) largest = p;
     }
   }
-  return calibration::UsableBandUnitFinding(s.source + (s.pose_id.empty() ? std::string() : ": posture " + s.pose_id),
-                                            largest);
+  return calibration::UsableBandUnitFinding(where, largest);
 }
 
 TipDynamics TipFromPosture(const std::string& id, const dynamics::PostureDynamics& d, const Eigen::Vector3d& feed_B,
@@ -220,8 +215,8 @@ TipDynamics TipFromModes(const std::string& id, const TipModalModel& modes_B, co
 }
 
 std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, const std::vector<TipFrfs>& ysets,
-                                              const MeasuredTipOptions& o, const TipMessageSink& on_message) {
-  auto tell = [&](TipMessage::Kind kind, const std::string& text) {
+                                              const MeasuredTipOptions& o, const MessageSink& on_message) {
+  auto tell = [&](Message::Kind kind, const std::string& text) {
     if (on_message) on_message({kind, text});
   };
   auto frame = [&]() -> Eigen::Matrix3d {
@@ -292,7 +287,7 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
       const dynamics::Frf h = DirectFrf(s, a);
       diagonal(h.receptance(), h.receptance());
       if (!noted) {
-        tell(TipMessage::Kind::kNote, id + " has one direct FRF (" + Hname(a, a) +
+        tell(Message::Kind::kNote, id + " has one direct FRF (" + Hname(a, a) +
                                           "): the tool is taken as symmetric, this FRF in both in-plane directions of "
                                           "the cut and no cross terms; --tool-axis does not apply");
         noted = true;
@@ -330,7 +325,7 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
                                                        "cutting plane the file's directions span, or the second "
                                                        "direction with --frf-y from a file of one direct FRF");
             }
-            tell(TipMessage::Kind::kWarning, o.frf_path + ": posture " + id + ": no cross FRF " + "xyz"[a] + "xyz"[b] +
+            tell(Message::Kind::kWarning, o.frf_path + ": posture " + id + ": no cross FRF " + "xyz"[a] + "xyz"[b] +
                                                  "; taken as zero");
           }
         }
@@ -370,12 +365,12 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
                           .Rotated(R);
             t.modes_C = DominantModes(t.fit_C, 2 * o.sd_modes);
             two_dir_model = true;
-            tell(TipMessage::Kind::kNote, id + ": a mode found in both " + Hname(a, a) + " and " + Hname(b, b) +
+            tell(Message::Kind::kNote, id + ": a mode found in both " + Hname(a, a) + " and " + Hname(b, b) +
                                               " is one mode of the SD's model, its shape's sign from the cross FRF " +
                                               Hname(r, c));
           }
         } else if (cross) {
-          tell(TipMessage::Kind::kNote, id + ": the SD's modal model is fitted to the direct FRFs; the cross FRFs "
+          tell(Message::Kind::kNote, id + ": the SD's modal model is fitted to the direct FRFs; the cross FRFs "
                                              "of the file are used by the ZOA only");
         }
         t.fit_lacks_cross = cross && !two_dir_model;
@@ -400,7 +395,7 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
           }
         }
         if (f.size() >= 3 && static_cast<Eigen::Index>(f.size()) < t.freq_hz.size()) {
-          tell(TipMessage::Kind::kFit, id + ": the ZOA uses the measured FRF in its usable band, " + FormatDouble(lo) +
+          tell(Message::Kind::kInfo, id + ": the ZOA uses the measured FRF in its usable band, " + FormatDouble(lo) +
                                            " to " + FormatDouble(hi) + " Hz");
           t.freq_hz = Eigen::Map<Eigen::VectorXd>(f.data(), static_cast<Eigen::Index>(f.size()));
           t.Phi_C = std::move(phi);
@@ -408,7 +403,7 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
       }
       const int added = RefineBetweenLines(&t);
       if (added > 0) {
-        tell(TipMessage::Kind::kFit, id + ": between the measured lines the ZOA follows the modal fit's shape (" +
+        tell(Message::Kind::kInfo, id + ": between the measured lines the ZOA follows the modal fit's shape (" +
                                          std::to_string(added) + " lines added; the measured lines are kept as " +
                                          "they are)");
       }

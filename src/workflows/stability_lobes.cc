@@ -29,7 +29,7 @@ std::string AxisSource(const StabilityLobesOptions& o) {
          FormatNumber(o.tool_axis(2), 6);
 }
 
-void Say(const stability::TipMessageSink& tell, stability::TipMessage::Kind kind, const std::string& text) {
+void Say(const MessageSink& tell, Message::Kind kind, const std::string& text) {
   if (tell) tell({kind, text});
 }
 
@@ -97,20 +97,20 @@ stability::LobesOptions MakeLobesOptions(const io::CutSpec& cut, const Stability
   return lo;
 }
 
-StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const stability::TipMessageSink& tell,
+StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const MessageSink& tell,
                                     const stability::SdProgressSink& progress) {
   o.Validate();
   StabilityLobesRun run;
   run.cut = io::ReadCutFile(o.cut_path);
   for (const std::string& w : run.cut.implausible) {
-    Say(tell, stability::TipMessage::Kind::kWarning, w);
+    Say(tell, Message::Kind::kWarning, w);
     run.input_findings.push_back(w);
   }
   const std::string axis_source = AxisSource(o);
   if (!o.robot_path.empty()) {
     io::RobotConfig cfg = io::LoadRobotConfig(o.robot_path);
     for (const std::string& w : cfg.implausible) {
-      Say(tell, stability::TipMessage::Kind::kWarning, w);
+      Say(tell, Message::Kind::kWarning, w);
       run.input_findings.push_back(w);
     }
     std::optional<dynamics::ParameterUncertainty> u;
@@ -122,7 +122,7 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const stabil
       run.uncertainty_files = files;
       u = io::ReadParameterUncertainties(files);
       const std::string changed = dynamics::UseEstimates(*u, &cfg.parameters);
-      if (!changed.empty()) Say(tell, stability::TipMessage::Kind::kNote, changed);
+      if (!changed.empty()) Say(tell, Message::Kind::kNote, changed);
     }
     std::vector<io::Posture> postures;
     run.tips = TipsFromRobotPostures(cfg.Build(), o.postures_path, o.pose_ids, run.cut, tell, &postures);
@@ -158,7 +158,7 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const stabil
       r.depth_upper = b.depth[at].upper;
       ++at;
     }
-    Say(tell, stability::TipMessage::Kind::kNote,
+    Say(tell, Message::Kind::kNote,
         b.id + ": smallest critical depth (ZOA) " + FormatNumber(1e3 * b.min_depth.value, 4) + " mm, " +
             FormatNumber(100.0 * o.uncertainty.confidence, 3) + " % interval [" +
             FormatNumber(1e3 * b.min_depth.lower, 4) + ", " + FormatNumber(1e3 * b.min_depth.upper, 4) +
@@ -179,7 +179,7 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const stabil
           " mm" + (std::isfinite(at_rpm) ? " at " + FormatNumber(at_rpm, 5) + " rpm" : std::string()) +
           ", which is not a depth: first order does not hold here (the lobes bend within the interval); use "
           "--uncertainty-method auto or monte-carlo";
-      Say(tell, stability::TipMessage::Kind::kWarning, w);
+      Say(tell, Message::Kind::kWarning, w);
       run.input_findings.push_back(w);
     }
   }

@@ -24,7 +24,7 @@ Eigen::Matrix3d CutFrame(const io::CutSpec& cut, const Eigen::Vector3d& tool_axi
 std::vector<stability::TipDynamics> TipsFromRobotPostures(const std::shared_ptr<const dynamics::RobotModel>& model,
                                                           const std::string& postures_path,
                                                           const std::vector<std::string>& pose_ids, const io::CutSpec& cut,
-                                                          const stability::TipMessageSink& tell,
+                                                          const MessageSink& tell,
                                                           std::vector<io::Posture>* chosen_postures) {
   const std::vector<io::Posture> postures = io::ReadPostureFile(postures_path, model->num_joints());
   std::vector<const io::Posture*> chosen;
@@ -46,7 +46,7 @@ std::vector<stability::TipDynamics> TipsFromRobotPostures(const std::shared_ptr<
     if (chosen_postures) chosen_postures->push_back(*p);
     const dynamics::PostureDynamics d = ev.Evaluate(p->q);
     if (d.near_singular && tell) {
-      tell({stability::TipMessage::Kind::kWarning, postures_path + ":" + std::to_string(p->line) + ": posture " +
+      tell({Message::Kind::kWarning, postures_path + ":" + std::to_string(p->line) + ": posture " +
                                                        p->id + " is near a singularity; the tool-tip FRF (joint "
                                                                "space) stays valid"});
     }
@@ -62,13 +62,13 @@ std::vector<stability::TipDynamics> TipsFromRobotPostures(const std::shared_ptr<
 }
 
 std::vector<stability::TipDynamics> TipsFromFrfFiles(const stability::MeasuredTipOptions& options,
-                                                     const stability::TipMessageSink& tell) {
+                                                     const MessageSink& tell) {
   // Each file's reader warnings as it is read, before the fits speak.
   auto read = [&](const std::string& path) {
     std::vector<std::string> warnings;
     std::vector<io::FrfSetOfPose> sets = io::ReadTipFrfs(path, "", &warnings);
     if (tell) {
-      for (const std::string& w : warnings) tell({stability::TipMessage::Kind::kWarning, w});
+      for (const std::string& w : warnings) tell({Message::Kind::kWarning, w});
     }
     return sets;
   };

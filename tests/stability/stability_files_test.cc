@@ -217,8 +217,8 @@ TEST(TipSources, RobotPosturesInTheOrderAskedAndSingularOnesTold) {
                                          "W,0,-90,90,0,0,0\n");
   const auto model = LoadRobotConfig(SourcePath("config/kr210.yaml")).Build();
   std::vector<std::string> warnings;
-  auto tell = [&](const stability::TipMessage& m) {
-    if (m.kind == stability::TipMessage::Kind::kWarning) warnings.push_back(m.text);
+  auto tell = [&](const Message& m) {
+    if (m.kind == Message::Kind::kWarning) warnings.push_back(m.text);
   };
   const auto two = TipsFromRobotPostures(model, postures, {"B", "A"}, cut, tell);
   ASSERT_EQ(two.size(), 2u);

@@ -101,9 +101,9 @@ TEST(TipsFromMeasuredFrfs, OneDirectFrfIsASymmetricTool) {
   MeasuredTipOptions o;
   o.frf_path = "tap.csv";
   o.sd_modes = 3;
-  std::vector<TipMessage> said;
+  std::vector<Message> said;
   const std::vector<TipDynamics> tips =
-      TipsFromMeasuredFrfs({TapTestFrfs(t, 2)}, {}, o, [&](const TipMessage& m) { said.push_back(m); });
+      TipsFromMeasuredFrfs({TapTestFrfs(t, 2)}, {}, o, [&](const Message& m) { said.push_back(m); });
   ASSERT_EQ(tips.size(), 1u);
   const TipDynamics& tip = tips[0];
   EXPECT_EQ(tip.id, "P1");
@@ -133,9 +133,9 @@ TEST(TipsFromMeasuredFrfs, OneDirectFrfIsASymmetricTool) {
   }
   EXPECT_GT(found, 100);
   bool noted = false, fitted = false;
-  for (const TipMessage& m : said) {
-    noted |= m.kind == TipMessage::Kind::kNote && m.text.find("symmetric") != std::string::npos;
-    fitted |= m.kind == TipMessage::Kind::kFit && m.text.find("P1 Hzz: modal fit") != std::string::npos;
+  for (const Message& m : said) {
+    noted |= m.kind == Message::Kind::kNote && m.text.find("symmetric") != std::string::npos;
+    fitted |= m.kind == Message::Kind::kInfo && m.text.find("P1 Hzz: modal fit") != std::string::npos;
   }
   EXPECT_TRUE(noted);
   EXPECT_TRUE(fitted);
@@ -271,9 +271,9 @@ TEST(ComputeLobes, TapTestZoaAndSdAgreeAndTheCsvHoldsTheRows) {
   o.max_speed_rad_s = cut.spindle_speed_max_rad_s;
   o.zoa_speeds_rad_s = Eigen::VectorXd::LinSpaced(50, o.min_speed_rad_s, o.max_speed_rad_s);
   o.sd_speeds_rad_s = Eigen::VectorXd::LinSpaced(3, o.min_speed_rad_s, o.max_speed_rad_s);
-  std::vector<TipMessage> said;
+  std::vector<Message> said;
   long progress_ends = 0;
-  const LobesResult r = ComputeLobes(tips, o, [&](const TipMessage& m) { said.push_back(m); },
+  const LobesResult r = ComputeLobes(tips, o, [&](const Message& m) { said.push_back(m); },
                                      [&](const SdProgress& p) { progress_ends += p.finished; });
   EXPECT_FALSE(r.flagged());
   EXPECT_TRUE(r.findings.empty());
@@ -287,7 +287,7 @@ TEST(ComputeLobes, TapTestZoaAndSdAgreeAndTheCsvHoldsTheRows) {
   EXPECT_EQ(zoa, 50);
   EXPECT_EQ(sd, 3);
   bool agree = false;
-  for (const TipMessage& m : said) agree |= m.text.find("(they agree within 10 %)") != std::string::npos;
+  for (const Message& m : said) agree |= m.text.find("(they agree within 10 %)") != std::string::npos;
   EXPECT_TRUE(agree);
 
   std::ostringstream csv;
@@ -432,15 +432,15 @@ TEST(ComputeLobes, ZoaOnMeasuredAndOnFitDisagreeingIsAFinding) {
   o.min_speed_rad_s = RpmToRadPerSec(3000.0);
   o.max_speed_rad_s = RpmToRadPerSec(20000.0);
   o.zoa_speeds_rad_s = Eigen::VectorXd::LinSpaced(100, o.min_speed_rad_s, o.max_speed_rad_s);
-  std::vector<TipMessage> said;
-  const LobesResult r = ComputeLobes({t}, o, [&](const TipMessage& m) { said.push_back(m); });
+  std::vector<Message> said;
+  const LobesResult r = ComputeLobes({t}, o, [&](const Message& m) { said.push_back(m); });
   ASSERT_EQ(r.zoa_fit_checks.size(), 1u);
   EXPECT_FALSE(r.zoa_fit_checks[0].agree);
   EXPECT_GT(r.zoa_fit_checks[0].relative_difference, 1.0);
   EXPECT_TRUE(r.flagged());
   bool warned = false;
-  for (const TipMessage& m : said) {
-    warned |= m.kind == TipMessage::Kind::kWarning && m.text.find("fitted modes") != std::string::npos &&
+  for (const Message& m : said) {
+    warned |= m.kind == Message::Kind::kWarning && m.text.find("fitted modes") != std::string::npos &&
               m.text.find("--fit-plot") != std::string::npos;
   }
   EXPECT_TRUE(warned);

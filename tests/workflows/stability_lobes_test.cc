@@ -120,8 +120,8 @@ TEST(RunStabilityLobes, ModalTableAndCutFromFilesGiveTheClosedFormMinimumAndFind
   big.replace(big.find("diameter_mm: 20"), 15, "diameter_mm: 20000");
   o.cut_path = WriteText(dir + "/cut_big.yaml", big);
   std::vector<std::string> told;
-  const StabilityLobesRun flagged = RunStabilityLobes(o, [&](const stability::TipMessage& msg) {
-    if (msg.kind == stability::TipMessage::Kind::kWarning) told.push_back(msg.text);
+  const StabilityLobesRun flagged = RunStabilityLobes(o, [&](const Message& msg) {
+    if (msg.kind == Message::Kind::kWarning) told.push_back(msg.text);
   });
   ASSERT_EQ(flagged.input_findings.size(), 1u);
   EXPECT_TRUE(flagged.flagged());

@@ -141,6 +141,14 @@ enum class FrfFileFormat { kUnknown, kCsv, kUff58 };
 std::string ReceptancePeakFinding(const std::string& what, double peak_m_per_N,
                                   FrfFileFormat format = FrfFileFormat::kUnknown);
 
+/// The one check of a measured FRF's frequency axis: "" when its highest
+/// line `top_hz` reaches kMinPlausibleMeasuredTopHz (or is not positive),
+/// else a sentence starting with `what` that names the line, the bound and
+/// the likely mistake (kHz), and where to look for the format (a CSV's
+/// freq_hz header, a UFF58 file's record 7 and 8; either when kUnknown).
+std::string FrequencyAxisFinding(const std::string& what, double top_hz,
+                                 FrfFileFormat format = FrfFileFormat::kUnknown);
+
 /// The largest median of three neighbouring |H| (a resonance spans several
 /// lines; a lone line is noise) of `frf` on its lines above 0 Hz with
 /// coherence >= 0.5 (all lines above 0 Hz when it has no coherence) [m/N].

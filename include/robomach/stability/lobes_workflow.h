@@ -48,8 +48,8 @@ struct LobesOptions {
   int threads{0};   // SD threads (0 = all cores)
 };
 
-/// What the run has to say as it goes (kFit is information here: the SD's
-/// discretisation), and the SD's progress per tool tip: `done` of `total`
+/// What the run has to say as it goes (kInfo: the SD's discretisation), and
+/// the SD's progress per tool tip: `done` of `total`
 /// speeds; `finished` once, after the last.
 struct SdProgress {
   std::string id;
@@ -123,7 +123,7 @@ std::vector<std::string> TipFitWarnings(const TipDynamics& tip, bool sd);
 /// most 4) lowest ZOA lobes. A measured tip's ZOA is checked against the
 /// ZOA on its fitted modes (ZoaFitCheck; flagged beyond 10 %).
 LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOptions& options,
-                         const TipMessageSink& on_message = {}, const SdProgressSink& on_progress = {});
+                         const MessageSink& on_message = {}, const SdProgressSink& on_progress = {});
 
 /// The lobes of one tip by one method in a few numbers (stability-lobes'
 /// summary): the speeds, those with a boundary, and the smallest and

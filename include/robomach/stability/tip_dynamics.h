@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "robomach/common/messages.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/stability/measured_tip_model.h"
 #include "robomach/stability/tool_tip_model.h"
@@ -102,15 +103,10 @@ struct MeasuredTipOptions {
   int sd_modes{3};   // dominant modes kept per direct FRF (stability-lobes' default)
 };
 
-/// What building the tool tips has to say, as it happens: the noise model
-/// and the modal fit of each direct FRF (kFit, several lines, continuation
-/// lines indented by two blanks), notes and warnings.
-struct TipMessage {
-  enum class Kind { kFit, kNote, kWarning };
-  Kind kind;
-  std::string text;
-};
-using TipMessageSink = std::function<void(const TipMessage&)>;
+// What building the tool tips has to say, as it happens, is a Message
+// (common/messages.h): the noise model and the modal fit of each direct FRF
+// (kInfo, several lines, continuation lines indented by two blanks), notes
+// and warnings.
 
 /// The tool tips of measured FRFs, one per posture (and `ysets`, when given,
 /// the y_C direction of each from a second file of one direct FRF each):
@@ -128,7 +124,7 @@ using TipMessageSink = std::function<void(const TipMessage&)>;
 ///   cutting plane needs but the file lacks, grids that differ between the
 ///   files.
 std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, const std::vector<TipFrfs>& ysets,
-                                              const MeasuredTipOptions& options, const TipMessageSink& on_message);
+                                              const MeasuredTipOptions& options, const MessageSink& on_message);
 
 /// The modes of a tool tip in the frame of its source (p_B = R_BC p_C) as
 /// rows of a modal table: frequency, damping, modal mass 1/|p|², the shape

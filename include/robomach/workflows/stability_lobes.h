@@ -97,7 +97,7 @@ struct StabilityLobesRun {
 /// it goes; the SD's progress to `progress`.
 /// @throws OptionError for bad options, InputError/NoInputError for bad or
 ///   missing files (as the readers throw them).
-StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const stability::TipMessageSink& tell = {},
+StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const MessageSink& tell = {},
                                     const stability::SdProgressSink& progress = {});
 
 }  // namespace robomach::workflows

@@ -33,14 +33,14 @@ Eigen::Matrix3d CutFrame(const io::CutSpec& cut, const Eigen::Vector3d& tool_axi
 std::vector<stability::TipDynamics> TipsFromRobotPostures(const std::shared_ptr<const dynamics::RobotModel>& model,
                                                           const std::string& postures_path,
                                                           const std::vector<std::string>& pose_ids, const io::CutSpec& cut,
-                                                          const stability::TipMessageSink& tell = {},
+                                                          const MessageSink& tell = {},
                                                           std::vector<io::Posture>* chosen_postures = nullptr);
 
 /// The tool tips of the measured FRFs of options.frf_path (and
 /// options.frf_y_path): io::ReadTipFrfs, its warnings told, then
 /// stability::TipsFromMeasuredFrfs.
 std::vector<stability::TipDynamics> TipsFromFrfFiles(const stability::MeasuredTipOptions& options,
-                                                     const stability::TipMessageSink& tell = {});
+                                                     const MessageSink& tell = {});
 
 /// The tool tips of a modal table's postures `pose_ids` (all when empty),
 /// oriented by R_BC (CutFrame).
