@@ -138,9 +138,10 @@ int Run(int argc, char** argv) {
     // criterion (issue #6 asks to report it).
     if (const stability::ClosedFormAgreement a = stability::CompareClosedForm(pts); a.points > 0) {
       std::ostringstream msg;
-      msg << kTool << ": mode coupling, the seed's closed-form critical depth over the eigenvalue criterion's "
-          << "(a ratio; 1 = they agree) at " << a.points << " points: median " << std::setprecision(3) << a.median
-          << ", range [" << a.min << ", " << a.max << "]\n";
+      msg << kTool << ": mode coupling: the seed's simplified closed form (2 DOF, no damping; depth_closed_form_mm) "
+          << "gives " << std::setprecision(3) << a.median << " times the eigenvalue criterion's depth at the median of "
+          << a.points << " points (" << a.min << " to " << a.max << " times): an indicator, not a limit; the map "
+          << "uses the eigenvalue criterion (docs/stability.md)\n";
       std::cerr << msg.str();
     }
     std::optional<stability::MapDepthIntervals> intervals;
@@ -153,6 +154,11 @@ int Run(int argc, char** argv) {
       std::cerr << kTool << ": intervals at " << FormatNumber(100.0 * unc.propagation.confidence, 3) << " %: "
                 << intervals->first_order << " points first order, " << intervals->monte_carlo
                 << " Monte Carlo (" << intervals->example_reason << ")\n";
+      if (const long k = intervals->SmallestLower(); k >= 0) {
+        std::cerr << kTool << ": the smallest safe depth (" << FormatNumber(100.0 * unc.propagation.confidence, 3)
+                  << " % lower bound) is " << FormatNumber(MToMm(intervals->depth[k].lower), 4) << " mm, at row "
+                  << k / points.cols << ", col " << k % points.cols << " of the points\n";
+      }
     }
     if (!plot_path.empty() && !grid) Warn(kTool, "--plot draws grids only; ignored with --path");
     if (!safe_plot_path.empty() && !grid) Warn(kTool, "--safe-plot draws grids only; ignored with --path");
@@ -171,6 +177,14 @@ int Run(int argc, char** argv) {
       hm.ny = points.rows;
       hm.mark_label = "unreachable / joint limits";
       hm.nan_label = "no limit found";
+      if (intervals) {  // the depth and the safe depth on one colour scale
+        hm.range_min = INFINITY, hm.range_max = -INFINITY;
+        for (size_t i = 0; i < pts.size(); ++i) {
+          for (double v : {pts[i].stability.critical_depth, intervals->depth[i].lower}) {
+            if (std::isfinite(v)) hm.range_min = std::min(hm.range_min, MToMm(v)), hm.range_max = std::max(hm.range_max, MToMm(v));
+          }
+        }
+      }
       for (size_t i = 0; i < pts.size(); ++i) {
         const stability::MapPoint& p = pts[i];
         const bool out = p.status == stability::PointStatus::kUnreachable || p.status == stability::PointStatus::kJointLimits;
@@ -193,10 +207,8 @@ int Run(int argc, char** argv) {
       if (!path_path.empty()) j["path"] = path_path;
       j["points_csv"] = out_path.empty() ? "-" : out_path;
       if (intervals) {
-        double safe_min = INFINITY;
-        for (const auto& d : intervals->depth) {
-          if (std::isfinite(d.lower)) safe_min = std::min(safe_min, d.lower);
-        }
+        const long k = intervals->SmallestLower();
+        const double safe_min = k >= 0 ? intervals->depth[static_cast<size_t>(k)].lower : NAN;
         j["uncertainty"] = {{"files", unc.PathsFor(cfg)},
                             {"confidence", unc.propagation.confidence},
                             {"points_first_order", intervals->first_order},

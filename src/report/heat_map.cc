@@ -73,6 +73,7 @@ cv::Mat Render(const HeatMap& m) {
       vmax = std::max(vmax, v);
     }
   }
+  if (std::isfinite(m.range_min) && std::isfinite(m.range_max)) vmin = m.range_min, vmax = m.range_max;
   if (!std::isfinite(vmin)) vmin = 0.0, vmax = 1.0;
   if (!(vmax > vmin)) vmax = vmin + (vmin == 0.0 ? 1.0 : std::abs(vmin) * 0.1);
   // Data extent: cell edges.

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "robomach/report/heat_map.h"
 
@@ -97,6 +98,41 @@ TEST(HeatMap, FirstRowAtTopDrawsRowZeroAbove) {
   ASSERT_GE(x, 0);
   const cv::Vec3b upper = img.at<cv::Vec3b>(top + ph / 4, x), lower = img.at<cv::Vec3b>(top + 3 * ph / 4, x);
   EXPECT_LT(upper[0] + upper[1] + upper[2], lower[0] + lower[1] + lower[2]);
+}
+
+// range_min/range_max fix the colour scale (stability-map draws the depth
+// and the safe depth on one): a single cell of 2 on [0, 4] takes viridis'
+// middle colour (OpenCV's own map at 128), not the top one its own range gives.
+TEST(HeatMap, FixedRangeSetsTheColourScale) {
+  HeatMap m;
+  m.title = "t";
+  m.nx = m.ny = 1;
+  m.values = {2.0};
+  m.width_px = 400;
+  m.height_px = 300;
+  auto cell = [&](const HeatMap& map) {
+    const cv::Mat img = Decode(EncodeHeatMapPng(map));
+    const int y = 60 + (300 - 60 - 90) / 2;
+    for (int c = 0; c < img.cols; ++c) {
+      const cv::Vec3b p = img.at<cv::Vec3b>(y, c);
+      if (!(p[0] == p[1] && p[1] == p[2])) return img.at<cv::Vec3b>(y, c + 10);
+    }
+    return cv::Vec3b(0, 0, 0);
+  };
+  auto viridis = [](int level) {
+    cv::Mat one(1, 1, CV_8UC1, cv::Scalar(level)), out;
+    cv::applyColorMap(one, out, cv::COLORMAP_VIRIDIS);
+    return out.at<cv::Vec3b>(0, 0);
+  };
+  auto near = [](cv::Vec3b a, cv::Vec3b b) {
+    return std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]) <= 6;
+  };
+  EXPECT_FALSE(near(cell(m), viridis(128)));
+  m.range_min = 0.0;
+  m.range_max = 4.0;
+  EXPECT_TRUE(near(cell(m), viridis(128)));
+  m.range_max = 1.0;  // beyond the range: the end colour
+  EXPECT_TRUE(near(cell(m), viridis(255)));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,9 @@ struct HeatMap {
   bool first_row_at_top{false};      // row 0 drawn at the top (tables), not the bottom (plots)
   bool annotate{false};              // print each cell's value (3 significant digits) in it
   bool symmetric_range{false};       // colour range −max|v| … +max|v|: 0 in the middle
+  /// The colour range when both are finite (values beyond take the end
+  /// colours): maps to be compared side by side share one scale.
+  double range_min{NAN}, range_max{NAN};
   int width_px{1000}, height_px{720};
 };
 

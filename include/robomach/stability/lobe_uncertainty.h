@@ -3,6 +3,7 @@
 // parameters (issue #37): each speed's critical depth and the smallest one
 // as intervals, whose lower ends are the safe depths of cut.
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,17 @@ struct MapDepthIntervals {
   std::string example_reason;                   // the reason of the first point that used Monte Carlo, else of the first
   long evaluations{0};
   int local_model{0};  // first-order points whose derivatives came from LocalCriticalDepth
+  /// The point with the smallest finite lower bound (the safe depth that
+  /// holds everywhere), -1 when none is finite.
+  long SmallestLower() const {
+    long best = -1;
+    for (size_t i = 0; i < depth.size(); ++i) {
+      if (std::isfinite(depth[i].lower) && (best < 0 || depth[i].lower < depth[static_cast<size_t>(best)].lower)) {
+        best = static_cast<long>(i);
+      }
+    }
+    return best;
+  }
 };
 MapDepthIntervals StabilityMapIntervals(const dynamics::RobotDescription& description,
                                         const dynamics::ParameterSet& base,
