@@ -55,6 +55,16 @@ Eigen::Vector3d ParseVector(const std::string& option, const std::string& text) 
   return {v[0], v[1], v[2]};
 }
 
+// What the lobes plot's bands are: the level and how they were computed.
+std::string BandNote(const std::vector<stability::ZoaBand>& bands, double confidence) {
+  const dynamics::PropagationMethod m = bands.front().propagation.method_used;
+  std::string method = m == dynamics::PropagationMethod::kMonteCarlo ? "Monte Carlo" : "first order";
+  for (const stability::ZoaBand& b : bands) {
+    if (b.propagation.method_used != m) method = "method per posture in the notes";
+  }
+  return FormatNumber(100.0 * confidence, 3) + " %, " + method;
+}
+
 // --fit-plot: each fitted direct FRF with its modal fit, magnitude and phase.
 void PlotFits(const std::string& path, const std::string& frf_path, const std::vector<stability::TipDynamics>& tips) {
   int n = 0;
@@ -240,7 +250,8 @@ int Run(int argc, char** argv) {
                                 (mp.direction == stability::MillingDirection::kUp ? ", up-milling" : ", down-milling"),
                             curves,
                             out_path.empty() || out_path == "-" ? std::string("the CSV")
-                                                                : std::filesystem::path(out_path).filename().string());
+                                                                : std::filesystem::path(out_path).filename().string(),
+                            run.bands.empty() ? std::string() : BandNote(run.bands, unc.propagation.confidence));
     }
     if (!modes_out_path.empty()) {
       std::vector<std::string> ids;

@@ -30,7 +30,9 @@ std::string Percent(double x) { return FormatNumber(100.0 * x, 3) + " %"; }
 // A departure from linear relative to a half-width: in percent up to 10
 // times it, beyond as a factor ("17 times", not "1.7e+03 %").
 std::string OfHalfWidth(double x) {
-  return x < 10.0 ? Percent(x) + " of its half-width" : FormatNumber(x, 2) + " times its half-width";
+  if (x < 10.0) return Percent(x) + " of its half-width";
+  // Whole times up to a million (110, not 1.1e+02); beyond, a power of ten.
+  return (x < 1e6 ? std::to_string(std::lround(x)) : FormatNumber(x, 2)) + " times its half-width";
 }
 
 }  // namespace

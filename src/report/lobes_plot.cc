@@ -27,7 +27,11 @@ double LobesDepthAxisClipMm(const std::vector<LobeCurve>& curves) {
 }
 
 void SaveLobesPlot(const std::string& path, const std::string& title, const std::string& subtitle,
-                   const std::vector<LobeCurve>& curves, const std::string& csv_name) {
+                   const std::vector<LobeCurve>& curves, const std::string& csv_name, const std::string& band_note) {
+  int banded = 0;
+  for (const LobeCurve& c : curves) banded += c.lower_mm.empty() ? 0 : 1;
+  const bool shade = banded <= 2;
+  bool labelled = false;
   Figure fig(1, 1, 1000, 560);
   fig.title = title;
   Axes& ax = fig.at(0, 0);
@@ -48,17 +52,24 @@ void SaveLobesPlot(const std::string& path, const std::string& title, const std:
     if (!c.lower_mm.empty()) {
       // The band (no legend entry of its own), then its lower end dashed:
       // the safe depth.
-      Series band;
-      band.x = c.speed_rpm;
-      band.y = c.upper_mm;
-      band.y_fill_to = c.lower_mm;
-      band.color = color;
-      band.thickness = 1;
-      ax.series.insert(ax.series.end() - 1, std::move(band));
+      if (shade) {
+        Series band;
+        band.x = c.speed_rpm;
+        band.y = c.upper_mm;
+        band.y_fill_to = c.lower_mm;
+        band.color = color;
+        band.thickness = 1;
+        ax.series.insert(ax.series.end() - 1, std::move(band));
+      }
       Series safe;
       safe.x = c.speed_rpm;
       safe.y = c.lower_mm;
-      safe.label = c.label + ", lower bound (safe depth)";
+      if (!labelled) {
+        const std::string what = band_note.empty() ? std::string() : " (" + band_note + ")";
+        safe.label = shade ? "shaded: interval" + what + "; dashed: safe depth"
+                           : "dashed: safe depth, the lower bound" + what;
+        labelled = true;
+      }
       safe.color = color;
       safe.dashed = true;
       safe.thickness = 1;

@@ -78,7 +78,7 @@ expect_no_file "$work/bad"
 expect_exit 3 "$bin/kq-identify" --robot config/kr210.yaml --plan 4 --out "$work/plan.csv" \
   --target-postures config/postures_demo.csv --target-quantity safe-depth --cut config/cut_demo.yaml \
   --target-band-pct 1 --load-point-mm 150,0,100 --target-mm 0,120,50
-expect_in "$work/stderr" "expected 95 % half-width of the smallest ZOA critical depth: P1 ±"
+expect_in "$work/stderr" "expected 95 % half-width of the smallest ZOA critical depth: target P1 ±"
 expect_in "$work/stderr" "postures would reach it"
 expect_file "$work/plan.csv"
 expect_exit 3 "$bin/kq-identify" --robot config/kr210.yaml --plan 4 --out "$work/plan.csv" \

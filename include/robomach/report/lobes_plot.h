@@ -32,7 +32,14 @@ double LobesDepthAxisClipMm(const std::vector<LobeCurve>& curves);
 /// Draws the diagram to a PNG: `title` above, `subtitle` on the panel
 /// (teeth, immersion, milling direction). A clipped depth axis is said in
 /// the panel's title, naming `csv_name` as where the full range is.
+/// Bands: `band_note` says what they are (level and method, e.g. "95 %,
+/// Monte Carlo"); with the band's meaning it labels the first
+/// dashed lower bound in the legend, the others have no entry of their own.
+/// Up to two banded curves are shaded; with more, overlapping shades mix
+/// into one colour, so only their lower bounds are drawn (the upper ones
+/// are in the CSV) and the legend says so.
 void SaveLobesPlot(const std::string& path, const std::string& title, const std::string& subtitle,
-                   const std::vector<LobeCurve>& curves, const std::string& csv_name);
+                   const std::vector<LobeCurve>& curves, const std::string& csv_name,
+                   const std::string& band_note = "");
 
 }  // namespace robomach::report
