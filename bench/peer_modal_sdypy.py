@@ -11,7 +11,15 @@ Usage (from the repository root, after a build):
     python3 bench/peer_modal_sdypy.py    # with numpy and sdypy-EMA importable
 
 The misfit is sqrt(sum |H_fit - H|^2 / sum |H|^2) over the band in the
-file's quantity (accelerance for pyuff's beam, mobility for dataset58).
+file's quantity (accelerance for pyuff's beam, mobility for dataset58):
+the criterion sdypy-EMA's unweighted least squares minimises, and
+frf-modes' --weights quantity. frf-modes runs with both weightings (its
+default, --weights noise, minimises the misfit in units of the noise).
+When robomach's Python module is importable (PYTHONPATH=build/python),
+every fit is also judged in units of the noise: rms |H_fit - H| / sigma
+over the band, sigma from robomach's noise model of the file
+(estimate_noise with global_modal_fit, frf-modes' own; a model built on
+robomach's fit, which favours robomach a little).
 sdypy-EMA's poles are chosen with select_closest_poles at the frequencies
 robomach found (sdypy-EMA has no automatic selection), so both fit the
 same modes; its order is 60.
@@ -34,17 +42,37 @@ def misfit(h_fit, h):
     return float(np.sqrt(np.sum(np.abs(h_fit - h) ** 2) / np.sum(np.abs(h) ** 2)))
 
 
-def run_robomach(csv_path, fmin, fmax, out_dir):
+def run_robomach(csv_path, fmin, fmax, out_dir, weights):
     summary = os.path.join(out_dir, 'summary.json')
     t0 = time.time()
-    subprocess.run([FRF_MODES, '--measured', csv_path, '--weights', os.environ.get('ROBOMACH_WEIGHTS', 'quantity'), '--fmin-hz', str(fmin), '--fmax-hz', str(fmax),
+    subprocess.run([FRF_MODES, '--measured', csv_path, '--weights', weights, '--fmin-hz', str(fmin), '--fmax-hz', str(fmax),
                     '--out', os.path.join(out_dir, 'modes.csv'), '--summary', summary, '--noise-model', 'scatter'],
                    check=False, capture_output=True)
     t = time.time() - t0
     with open(summary) as f:
         s = json.load(f)
     fit = s['postures'][0]['fits'][0]
-    return [m['freq_hz'] for m in fit['modes']], [x['misfit_relative'] for x in fit['frfs']], t
+    return ([m['freq_hz'] for m in fit['modes']], [x['misfit_relative'] for x in fit['frfs']], t,
+            [x['misfit_noise_sigmas'] for x in fit['frfs']])
+
+
+def noise_sigma(csv_path, freq, band):
+    """robomach's noise sigma of each FRF of the file on the band, in the
+    file's quantity (accelerance: receptance sigma times omega^2), or None
+    without the Python module."""
+    try:
+        import robomach as rm
+    except ImportError:
+        return None
+    frfs = rm.read_frf_file(csv_path)['frfs']
+    noise = rm.estimate_noise(frfs, rm.NoiseOptions(global_modal_fit=True))
+    out = []
+    for key in sorted(frfs.keys(), key=lambda k: str(k)):
+        sig = np.asarray(noise[key].sigma_m_per_N)
+        f = np.asarray(frfs[key].freq_hz)
+        w2 = (2 * np.pi * f) ** 2
+        out.append(np.interp(freq[band], f, sig * w2))
+    return out
 
 
 def run_sdypy(freq, frfs, fmin, fmax, approx):
@@ -61,7 +89,8 @@ def run_sdypy(freq, frfs, fmin, fmax, approx):
     band = np.isin(freq, f_model) if rec.shape[1] == len(f_model) else (freq >= fmin) & (freq <= fmax)
     if rec.shape[1] != np.count_nonzero(band):
         rec = rec[:, band]
-    return list(model.nat_freq), [misfit(rec[i], np.array(frfs)[i][band]) for i in range(len(frfs))], t
+    return (list(model.nat_freq), [misfit(rec[i], np.array(frfs)[i][band]) for i in range(len(frfs))], t,
+            [rec[i] - np.array(frfs)[i][band] for i in range(len(frfs))], band)
 
 
 def write_csv(path, freq, frfs, quantity):
@@ -88,19 +117,28 @@ def main():
         # The three reference points become directions x, y, z of one
         # posture (a file holds one point per posture).
         write_csv(csv, freq, frfs, 'accelerance')
-        f_r, m_r, t_r = run_robomach(csv, 5.0, 999.0, tmp)
+        f_r, m_r, t_r, n_r = run_robomach(csv, 5.0, 999.0, tmp, 'noise')
+        f_q, m_q, t_q, n_q = run_robomach(csv, 5.0, 999.0, tmp, 'quantity')
+        n_s = None
         try:
-            f_s, m_s, t_s = run_sdypy(freq, frfs, 5.0, 999.0, f_r)
+            f_s, m_s, t_s, resid, band = run_sdypy(freq, frfs, 5.0, 999.0, f_r)
+            sig = noise_sigma(csv, freq, band)
+            if sig is not None:
+                n_s = [float(np.sqrt(np.mean(np.abs(r) ** 2 / s_ ** 2))) for r, s_ in zip(resid, sig)]
         except Exception as e:  # noqa: BLE001 - report whatever the peer raised
             f_s, m_s, t_s = [], [], float('nan')
             print('sdypy-EMA failed on the beam: %s' % e)
-        rows.append(('pyuff beam (3 accelerances)', f_r, m_r, t_r, f_s, m_s, t_s))
-    for name, f_r, m_r, t_r, f_s, m_s, t_s in rows:
+        rows.append(('pyuff beam (3 accelerances)', [
+            ('robomach (default, --weights noise)', f_r, m_r, t_r, n_r),
+            ('robomach --weights quantity', f_q, m_q, t_q, n_q),
+            ('sdypy-EMA', f_s, m_s, t_s, n_s)]))
+    for name, fits in rows:
         print('== %s' % name)
-        print('  robomach  %5.2f s  misfit %s' % (t_r, ' / '.join('%.3f' % m for m in m_r)))
-        print('            modes [Hz] %s' % ', '.join('%.1f' % f for f in f_r))
-        print('  sdypy-EMA %5.2f s  misfit %s' % (t_s, ' / '.join('%.3f' % m for m in m_s)))
-        print('            modes [Hz] %s' % ', '.join('%.1f' % f for f in f_s))
+        for who, f, m, t, n in fits:
+            print('  %-36s %5.2f s  misfit %s%s' % (
+                who, t, ' / '.join('%.3f' % x for x in m),
+                '' if n is None else '  in noise units %s' % ' / '.join('%.1f' % x for x in n)))
+            print('  %-36s modes [Hz] %s' % ('', ', '.join('%.1f' % x for x in f)))
     return 0
 
 
