@@ -27,6 +27,7 @@
 #include "robomach/io/file_kind.h"
 #include "robomach/io/file_names.h"
 #include "robomach/report/json.h"
+#include "robomach/workflows/frf_predict.h"
 
 namespace robomach::apps {
 
@@ -484,14 +485,7 @@ std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std
 
 void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<std::string>& sets,
                       io::RobotConfig* cfg) {
-  for (const std::string& name : adds) {
-    std::tie(cfg->description, cfg->parameters) =
-        FromOption("--add " + name, [&] { return dynamics::WithEffect(cfg->description, cfg->parameters, name); });
-  }
-  for (const std::string& s : sets) {
-    const std::pair<std::string, double> assignment = ParseAssignment("--set", s);
-    FromOption("--set " + s, [&] { cfg->parameters.Set(assignment.first, assignment.second); });
-  }
+  ValidateOptions({{"adds", "--add"}, {"sets", "--set"}}, [&] { workflows::ApplyAddsAndSets(adds, sets, cfg); });
 }
 
 }  // namespace robomach::apps

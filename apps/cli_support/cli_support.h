@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json_fwd.hpp>
 
+#include "robomach/common/errors.h"
 #include "robomach/common/messages.h"
 #include "robomach/common/run_status.h"
 #include "robomach/dynamics/uncertainty.h"
@@ -84,6 +85,20 @@ struct FieldSource {
 /// that names none of `fields` is passed on as it came.
 void ValidateOptions(const std::vector<FieldSource>& fields, const std::function<void()>& check);
 
+/// Runs a library call and names its OptionError's fields as `fields` say
+/// (ValidateOptions' mapping: "sets m6_kg=x: ..." -> "--set m6_kg=x: ...",
+/// exit 64). Every other exception passes unchanged (a file's InputError
+/// stays 65).
+template <class F>
+auto FromFields(const std::vector<FieldSource>& fields, F&& body) -> decltype(body()) {
+  try {
+    return body();
+  } catch (const OptionError&) {
+    ValidateOptions(fields, [] { throw; });
+    throw;
+  }
+}
+
 /// Runs `body` and maps exceptions to exit codes with one message on stderr
 /// prefixed by the tool name: UsageError -> 64, NoInputError -> 66,
 /// InputError -> 65, OutputError -> 73, anything else -> 70. A library's
@@ -142,6 +157,38 @@ class ProgressLine {
   bool tty_;
   bool active_;
   std::chrono::steady_clock::time_point start_;
+};
+
+/// A ProgressLine per stage of a library call that reports
+/// (stage, done, total): a new stage finishes the line of the last, and so
+/// does a message, so that it does not land in the middle of a line.
+class StageProgressLines {
+ public:
+  explicit StageProgressLines(std::string tool) : tool_(std::move(tool)) {}
+  std::function<void(const std::string&, long, long)> Callback() {
+    return [this](const std::string& stage, long done, long total) {
+      if (!line_ || stage != stage_) {
+        Finish();
+        stage_ = stage;
+        line_.emplace(tool_, stage, total);
+      }
+      line_->Update(done);
+    };
+  }
+  MessageSink Messages(MessageSink sink) {
+    return [this, sink](const Message& m) {
+      Finish();
+      if (sink) sink(m);
+    };
+  }
+  void Finish() {
+    if (line_) line_->Finish();
+    line_.reset();
+  }
+
+ private:
+  std::string tool_, stage_;
+  std::optional<ProgressLine> line_;
 };
 
 /// Prints "tool: warning: message" on stderr.

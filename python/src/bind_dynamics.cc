@@ -1,6 +1,7 @@
 // Robot configs, models, posture evaluation, tool-tip receptance and
 // posture files (include/robomach/dynamics, io/robot_config.h,
 // io/posture_file.h, io/prediction_files.h).
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -15,6 +16,8 @@
 #include "robomach/io/posture_file.h"
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/robot_config.h"
+#include "robomach/common/number_format.h"
+#include "robomach/workflows/frf_predict.h"
 
 namespace robomach::python {
 namespace {
@@ -427,6 +430,69 @@ void BindDynamics(py::module_& m) {
      "Writes predicted FRFs as frf-predict's --out (docs/formats.md §3, receptance [m/N]): "
      "predictions is a list of (pose_id, freq_hz [Hz], H complex (lines, 3, 3) [m/N]); "
      "directions e.g. 'xx,yy,xy' or 'all'. Atomic; OutputError if it cannot be written.");
+
+  m.def("run_frf_predict",
+        [](const std::string& robot, const std::string& postures, double fmin_hz, double fmax_hz, double df_hz,
+           const std::optional<Eigen::VectorXd>& freq_hz, const std::string& method, const std::vector<std::string>& adds,
+           const std::map<std::string, double>& sets, const std::vector<std::string>& uncertainty, bool intervals,
+           size_t band_postures, double confidence, const std::string& uncertainty_method, int samples,
+           std::uint64_t seed) {
+          workflows::FrfPredictOptions o;
+          o.robot_path = robot;
+          o.postures_path = postures;
+          o.freq_hz = freq_hz ? *freq_hz : workflows::FrequencyGrid(fmin_hz, fmax_hz, df_hz);
+          o.method = method;
+          o.adds = adds;
+          for (const auto& [name, value] : sets) o.sets.push_back(name + "=" + FormatNumber(value, 17));
+          o.uncertainty_paths = uncertainty;
+          o.intervals = intervals;
+          o.band_postures = band_postures;
+          o.uncertainty.confidence = confidence;
+          o.uncertainty.method = dynamics::ParsePropagationMethod(uncertainty_method);
+          o.uncertainty.samples = samples;
+          o.uncertainty.seed = seed;
+          o.Validate();
+          RequireReadableFile(robot);
+          RequireReadableFile(postures);
+          CollectedMessages said;
+          workflows::FrfPredictRun run;
+          {
+            py::gil_scoped_release release;
+            run = workflows::RunFrfPredict(o, said.Sink());
+          }
+          for (const std::string& f : run.unit_findings) WarnUnit(f);
+          py::list predictions;
+          for (size_t p = 0; p < run.predictions.size(); ++p) {
+            py::dict d;
+            d["pose_id"] = run.predictions[p].pose_id;
+            d["freq_hz"] = run.predictions[p].freq_hz;
+            d["receptance"] = ToArray(run.predictions[p].H);
+            predictions.append(d);
+          }
+          py::dict d;
+          d["predictions"] = predictions;
+          d["messages"] = said.List();
+          d["warnings"] = run.warnings;
+          d["unit_findings"] = run.unit_findings;
+          d["flagged"] = run.flagged();
+          d["summary"] = py::module_::import("json").attr("loads")(run.Summary(o, uncertainty_method).dump());
+          return d;
+        },
+        py::arg("robot"), py::arg("postures"), py::arg("fmin_hz") = 0.625, py::arg("fmax_hz") = 500.0,
+        py::arg("df_hz") = 0.625, py::arg("freq_hz") = py::none(), py::arg("method") = "modal",
+        py::arg("adds") = std::vector<std::string>{}, py::arg("sets") = std::map<std::string, double>{},
+        py::arg("uncertainty") = std::vector<std::string>{}, py::arg("intervals") = false,
+        py::arg("band_postures") = 0, py::arg("confidence") = dynamics::PropagationOptions{}.confidence,
+        py::arg("uncertainty_method") = "auto", py::arg("samples") = dynamics::PropagationOptions{}.samples,
+        py::arg("seed") = dynamics::PropagationOptions{}.seed,
+        "frf-predict as one call (workflows::RunFrfPredict): a robot config, a posture file, the frequency grid "
+        "(fmin_hz..fmax_hz step df_hz, or freq_hz), method 'modal' or 'direct', effects to add, parameters to set "
+        "({name: value} in their units), parameter-uncertainty files (intervals=True: each mode's interval, as "
+        "with --modes/--summary; band_postures=N: the |H| band of the first N postures; with either, no files "
+        "take the config's). Returns a dict: predictions (pose_id, freq_hz, receptance (lines, 3, 3) [m/N]), "
+        "messages ({kind, text}), warnings (the prediction's, with file:line), unit_findings (also as "
+        "UnitWarning), flagged (the tool's exit 3) and summary (frf-predict --summary's JSON but for "
+        "robomach_version). ValueError naming the option; FileNotFoundError, InputError for files. Releases the GIL.");
 }
 
 }  // namespace robomach::python

@@ -4,12 +4,13 @@ postures (the C++ tool's output), and analytic identities checked with
 NumPy's own linear algebra (generalised eigenproblem, static compliance)."""
 import csv
 import json
+import os
 
 import numpy as np
 import pytest
 
 import robomach as rm
-from conftest import KR210, run_tool
+from conftest import DATA, KR210, SOURCE_DIR, run_tool
 
 # Same library code on the same inputs (the postures are read by the same
 # reader); JSON and the CSV keep 17 significant digits, so agreement is
@@ -198,3 +199,39 @@ def test_read_posture_file_takes_the_joint_count_from_the_file(tmp_path):
         rm.read_posture_file(str(ok), 5)
     with pytest.raises(ValueError, match='num_joints'):
         rm.read_posture_file(str(ok), 0)
+
+
+@pytest.mark.parametrize('case', ['defaults', 'uncertainty_and_set'])
+def test_run_frf_predict_equals_the_tools_summary(tmp_path, case):
+    """Issue #36 acceptance: frf-predict's JSON summary and the Python call's
+    result (workflows::RunFrfPredict) on the shipped defaults, and with a
+    parameter set, an effect added and the modes' intervals from a
+    parameter-uncertainty file; the predicted receptance equals the tool's
+    CSV."""
+    postures = os.path.join(SOURCE_DIR, 'config', 'postures_demo.csv')
+    args = ['--robot', KR210, '--postures', postures, '--out', tmp_path / 'h.csv', '--summary', tmp_path / 't.json',
+            '--fmax-hz', '50']
+    kwargs = {}
+    if case == 'uncertainty_and_set':
+        unc = os.path.join(DATA, 'uncertainty', 'kq_demo.yaml')
+        args += ['--set', 'm6_kg=31', '--add', 'tip_mass', '--uncertainty', unc, '--samples', '200']
+        kwargs = dict(sets={'m6_kg': 31.0}, adds=['tip_mass'], uncertainty=[unc], intervals=True, samples=200)
+    r = run_tool('frf-predict', *args, expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool = json.loads((tmp_path / 't.json').read_text())
+    run = rm.run_frf_predict(KR210, postures, fmax_hz=50, **kwargs)
+    assert run['flagged'] == (r.returncode == 3)
+    for key in ('tool', 'exit_code', 'robomach_version', 'warnings'):
+        tool.pop(key, None)
+    assert run['summary'] == tool
+    if case == 'uncertainty_and_set':
+        assert 'mode_intervals' in run['summary']['postures'][0]
+        assert run['summary']['parameters']['m6_kg'] == 31.0
+    with open(tmp_path / 'h.csv') as f:
+        rows = [row for row in csv.DictReader(line for line in f if not line.startswith('#'))
+                if row['response'] == 'y' and row['excitation'] == 'y']
+    p0 = run['predictions'][0]
+    mine = [row for row in rows if row['pose_id'] == p0['pose_id']]
+    assert len(mine) == len(p0['freq_hz'])
+    h = np.array([complex(float(x['re']), float(x['im'])) for x in mine])
+    close(np.abs(h), np.abs(p0['receptance'][:, 1, 1]), rel=1e-9)
