@@ -151,6 +151,10 @@ int Run(int argc, char** argv) {
       po.max_rope_angle_deg = rope_angle_deg;
       po.num_postures_name = "--plan N";
       po.points_name = "--load-point-mm, --target-mm";
+      po.noise_mm_name = "--noise-mm";
+      po.masses_name = "--masses-kg";
+      po.load_point_name = "--load-point-mm";
+      po.target_name = "--target-mm";
       if (!target_postures.empty()) {
         RequireInputFile("--target-postures", target_postures, "posture file", {io::FileKind::kCsv},
                          io::kPostureCsvFormat);

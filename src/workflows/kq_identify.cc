@@ -267,6 +267,31 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
   r.config = io::LoadRobotConfig(o.robot_path);
   for (const std::string& w : r.config.implausible) Tell(on_message, Message::Kind::kWarning, w);
   r.model = r.config.Build();
+  // The options' units, as kq-identify checks a tracker file's and
+  // tracker-synth its options (docs/plausibility.md): a plan is made before
+  // the campaign, and a wrong one wastes it.
+  if (std::string w = io::TrackerNoiseUnitFinding(o.noise_mm_name, o.noise_mm); !w.empty()) {
+    r.option_findings.push_back(std::move(w));
+  }
+  for (double m : o.masses_kg) {
+    if (m >= io::kMinPlausibleLoadMassKg && m <= io::kMaxPlausibleLoadMassKg) continue;
+    r.option_findings.push_back("implausible (unit mistake?): " + o.masses_name + " " + FormatNumber(m, 7) +
+                                " kg is outside the " + FormatNumber(io::kMinPlausibleLoadMassKg, 3) + " to " +
+                                FormatNumber(io::kMaxPlausibleLoadMassKg, 3) + " kg of load-test masses (5 - 300 kg): " +
+                                (m > io::kMaxPlausibleLoadMassKg ? "a mass in g typed in the kg option, or a weight in N?"
+                                                                 : "a mass in t typed in the kg option?"));
+    break;
+  }
+  for (const auto& [name, point] : {std::pair{o.load_point_name, o.load_point_m}, std::pair{o.target_name, o.target_m}}) {
+    // No load or target fits within 1 mm of the flange's origin but on it.
+    if (point && point->norm() > 0.0 && point->norm() < 1e-3) {
+      r.option_findings.push_back("implausible (unit mistake?): " + name + " " + FormatNumber(1e3 * point->x(), 4) +
+                                  "," + FormatNumber(1e3 * point->y(), 4) + "," + FormatNumber(1e3 * point->z(), 4) +
+                                  " mm is within 1 mm of the flange's origin: metres typed in the mm option? (" +
+                                  FormatNumber(1e6 * point->norm(), 4) + " mm from the origin if so)");
+    }
+  }
+  for (const std::string& w : r.option_findings) Tell(on_message, Message::Kind::kWarning, w);
   identification::PlanOptions& p = r.planner;
   p.num_postures = o.num_postures;
   p.tracker_noise = MmToM(o.noise_mm);

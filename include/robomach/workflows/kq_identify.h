@@ -94,6 +94,10 @@ struct KqPlanOptions {
   /// "--load-point-mm, --target-mm").
   std::string num_postures_name{"num_postures"};
   std::string points_name{"load_point_m, target_m"};
+  /// How the unit findings name the options (the tool: "--noise-mm",
+  /// "--masses-kg", "--load-point-mm", "--target-mm", in their units).
+  std::string noise_mm_name{"noise_mm"}, masses_name{"masses_kg"}, load_point_name{"load_point_m"},
+      target_name{"target_m"};
   /// A targeted plan (issue #37 §5): the posture file (formats.md §1) of the work region whose
   /// `target_quantity` must be known well — "frequency" (the lowest natural
   /// frequency) or "safe-depth" (the ZOA lobes' smallest critical depth of
