@@ -146,8 +146,15 @@ int Run(int argc, char** argv) {
     }
     std::optional<stability::MapDepthIntervals> intervals;
     if (uncertainty) {
-      // Monte Carlo takes seconds per point: progress from the first point
-      // (the auto map of 187 points ran 51 s without a line).
+      // Monte Carlo takes about half a second per point: progress from the
+      // first point (the auto map of 187 points ran 51 s without a line),
+      // and what first order would cost instead.
+      if (unc.method != "first-order" && targets.size() > 50) {
+        Note(kTool, "--uncertainty-method " + unc.method + ": a linearity check at each of the " +
+                        std::to_string(targets.size()) + " points and Monte Carlo (about 0.5 s a point) where the "
+                        "depth bends within its interval; --uncertainty-method first-order takes about 2.4 times "
+                        "the map's time (docs/uncertainty.md)");
+      }
       ProgressLine up(kTool, "points' intervals", static_cast<long>(targets.size()),
                       unc.method == "first-order" ? 200 : 1);
       intervals = stability::StabilityMapIntervals(cfg.description, cfg.parameters, targets, pts, cut.process,

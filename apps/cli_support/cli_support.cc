@@ -125,9 +125,12 @@ void ProgressLine::Update(long done) { Update(done, ""); }
 void ProgressLine::Update(long done, const std::string& detail) {
   if (!active_ || total_ <= 0) return;
   const int decile = static_cast<int>(10 * done / total_);
-  if (decile == last_decile_) return;
-  last_decile_ = decile;
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  // A log gets a line per tenth; a terminal also a redraw every second, so
+  // that slow work (seconds a step) shows it moves.
+  if (decile == last_decile_ && !(tty_ && s >= last_draw_s_ + 1.0)) return;
+  last_decile_ = decile;
+  last_draw_s_ = s;
   if (tty_) {
     std::cerr << '\r' << tool_ << ": " << what_ << ' ' << done << '/' << total_ << " (" << s << " s)"
               << (detail.empty() ? "" : " ") << detail << std::flush;

@@ -154,6 +154,7 @@ class ProgressLine {
   std::string tool_, what_;
   long total_;
   int last_decile_{-1};
+  double last_draw_s_{0.0};
   bool tty_;
   bool active_;
   std::chrono::steady_clock::time_point start_;

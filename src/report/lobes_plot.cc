@@ -30,8 +30,10 @@ void SaveLobesPlot(const std::string& path, const std::string& title, const std:
                    const std::vector<LobeCurve>& curves, const std::string& csv_name, const std::string& band_note) {
   int banded = 0;
   for (const LobeCurve& c : curves) banded += c.lower_mm.empty() ? 0 : 1;
-  const bool shade = banded <= 2;
-  bool labelled = false;
+  // Two translucent bands that overlap mix into a third colour (brown from
+  // vermillion and pink): only a single band is shaded.
+  const bool shade = banded == 1;
+  Series band_key;  // the bands' legend entry, in grey: it belongs to no posture
   Figure fig(1, 1, 1000, 560);
   fig.title = title;
   Axes& ax = fig.at(0, 0);
@@ -64,11 +66,21 @@ void SaveLobesPlot(const std::string& path, const std::string& title, const std:
       Series safe;
       safe.x = c.speed_rpm;
       safe.y = c.lower_mm;
-      if (!labelled) {
+      if (band_key.label.empty()) {
         const std::string what = band_note.empty() ? std::string() : " (" + band_note + ")";
-        safe.label = shade ? "shaded: interval" + what + "; dashed: safe depth"
-                           : "dashed: safe depth, the lower bound" + what;
-        labelled = true;
+        band_key.label = shade ? "shaded: interval" + what + "; dashed: safe depth"
+                               : "dashed: safe depth, the lower bound" + what;
+        band_key.color = Rgb{110, 110, 110};
+        band_key.dashed = true;
+        band_key.thickness = 1;
+        // One point on the first finite lower bound: listed, drawn over a
+        // dash already there.
+        for (size_t i = 0; i < c.lower_mm.size() && band_key.x.empty(); ++i) {
+          if (std::isfinite(c.lower_mm[i]) && i < c.speed_rpm.size()) {
+            band_key.x = {c.speed_rpm[i], c.speed_rpm[i]};
+            band_key.y = {c.lower_mm[i], c.lower_mm[i]};
+          }
+        }
       }
       safe.color = color;
       safe.dashed = true;
@@ -76,7 +88,22 @@ void SaveLobesPlot(const std::string& path, const std::string& title, const std:
       ax.series.push_back(std::move(safe));
     }
   }
-  const double clip_mm = LobesDepthAxisClipMm(curves);
+  if (!band_key.label.empty()) ax.series.push_back(std::move(band_key));
+  double clip_mm = LobesDepthAxisClipMm(curves);
+  if (!std::isfinite(clip_mm) && banded > 0) {
+    // A band's upper edge can rise far above its lobes (47 mm over lobes of
+    // 1.7 - 6 mm): the axis ends at 1.5 times the curves' largest depth.
+    double largest = 0.0, upper = 0.0;
+    for (const LobeCurve& c : curves) {
+      for (double d : c.depth_mm) {
+        if (std::isfinite(d)) largest = std::max(largest, d);
+      }
+      for (double d : c.upper_mm) {
+        if (std::isfinite(d)) upper = std::max(upper, d);
+      }
+    }
+    if (largest > 0.0 && upper > 1.5 * largest) clip_mm = 1.5 * largest;
+  }
   if (std::isfinite(clip_mm)) {
     ax.y_max = clip_mm;
     char clip_text[96];

@@ -33,11 +33,13 @@ double LobesDepthAxisClipMm(const std::vector<LobeCurve>& curves);
 /// (teeth, immersion, milling direction). A clipped depth axis is said in
 /// the panel's title, naming `csv_name` as where the full range is.
 /// Bands: `band_note` says what they are (level and method, e.g. "95 %,
-/// Monte Carlo"); with the band's meaning it labels the first
-/// dashed lower bound in the legend, the others have no entry of their own.
-/// Up to two banded curves are shaded; with more, overlapping shades mix
-/// into one colour, so only their lower bounds are drawn (the upper ones
-/// are in the CSV) and the legend says so.
+/// Monte Carlo"); with the band's meaning it labels a grey legend entry of
+/// its own (the bands belong to no one posture).
+/// A single banded curve is shaded; with more, overlapping shades mix into
+/// another colour, so only their lower bounds are drawn (the upper ones are
+/// in the CSV) and the legend says so. When no lobe clips the depth axis
+/// but a band's upper edge rises above 1.5 times the largest depth, the
+/// axis ends there (said in the panel's title).
 void SaveLobesPlot(const std::string& path, const std::string& title, const std::string& subtitle,
                    const std::vector<LobeCurve>& curves, const std::string& csv_name,
                    const std::string& band_note = "");
