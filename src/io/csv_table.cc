@@ -204,6 +204,10 @@ std::string CsvTable::LooksLike(std::string_view own) const {
     kind = "a modal table (docs/formats.md §4; freq_hz, damping_ratio)", tag = "modal";
   } else if (has({"case_id"})) {
     kind = "a laser-tracker load test (docs/formats.md §2; case_id, x0_mm..)", tag = "tracker";
+  } else if (has({"pose_id", "rope_ux", "pulley_x_mm"})) {
+    kind = "a load-test plan (kq-identify --plan; pose_id, q1_deg.., rope_ux.., pulley_x_mm..), for tracker-synth "
+           "--plan-file";
+    tag = "plan";
   } else if (has({"pose_id", "q1_deg"}) || has({"pose_id", "q1_rad"})) {
     kind = "a posture file (docs/formats.md §1; pose_id, q1_deg..)", tag = "posture";
   } else if (has({"x_mm", "y_mm", "z_mm", "tool_i"})) {

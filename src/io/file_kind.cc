@@ -71,6 +71,9 @@ std::string NameCsvTable(std::string_view header) {
   }
   if (has("freq_hz") && has("re") && has("im")) return "the FRF CSV of docs/formats.md §3";
   if (has("case_id") && has("pose_id")) return "the laser-tracker CSV of docs/formats.md §2";
+  if (has("pose_id") && has("rope_ux") && has("pulley_x_mm")) {
+    return "a load-test plan of kq-identify --plan (for tracker-synth --plan-file)";
+  }
   if (has("pose_id") && has("q1_deg")) return "the posture CSV of docs/formats.md §1";
   if (has("hit") && has("force_N")) return "the impact-hammer records of docs/formats.md §10";
   return "";

@@ -118,8 +118,9 @@ std::vector<Posture> ReadPostureFile(const std::string& path, int num_joints,
     p.line = t.line(r);
     auto [it, fresh] = seen.emplace(p.id, p.line);
     if (!fresh) {
+      // A plan or a tracker file repeats its postures: say which it is.
       throw t.ErrorAtRow(r, "pose_id \"" + p.id + "\" appears twice (first on line " +
-                                std::to_string(it->second) + ")");
+                                std::to_string(it->second) + ")" + t.LooksLike("posture"));
     }
     p.q.resize(num_joints);
     std::vector<double>& as_written = written.emplace_back(num_joints);

@@ -154,6 +154,11 @@ std::string YamlDoc::OtherYamlKind(const std::string& missing) const {
   // config/kr210.yaml: "missing key 'flexible_joints'").
   if (!node_.IsMap()) return "";
   const auto has = [&](const char* k) { return static_cast<bool>(node_[k]); };
+  // A tool's JSON summary (JSON is YAML): every one has these two keys.
+  if (has("tool") && has("robomach_version") && node_["tool"].IsScalar()) {
+    return "; this is the JSON summary of " + node_["tool"].as<std::string>() +
+           " (its --summary), not the file this option takes";
+  }
   // kq-identify writes two files: the stiffness to paste (--out) and its
   // uncertainty (--uncertainty-out); the first given for the second.
   if (missing == "parameter_uncertainty" && (has("joint_stiffness_Nm_per_rad") || has("parameters")) &&
