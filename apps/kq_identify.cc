@@ -173,11 +173,10 @@ int Run(int argc, char** argv) {
       po.target_postures_path = target_postures;
       po.target_quantity = target_quantity;
       po.cut_path = cut_path;
-      if (app.count("--target-band-pct") > 0 && !(target_band_pct > 0.0)) {
-        throw UsageError("--target-band-pct: expected the 95 % half-width wanted in percent (> 0; 5 for ±5 %), got " +
-                         io::FormatDouble(target_band_pct));
+      if (app.count("--target-band-pct") > 0 && !(target_band_pct > 0.0 && target_band_pct < 100.0)) {
+        throw UsageError("--target-band-pct: expected the 95 % half-width wanted in percent (> 0 and < 100; 5 for "
+                         "±5 %), got " + io::FormatDouble(target_band_pct));
       }
-      CheckOptionRange("--target-band-pct", target_band_pct, 0.0, 99.0);
       po.target_half_width = target_band_pct / 100.0;
       po.target_half_width_name = "--target-band-pct";
       ValidateOptions({{"num_postures", "--plan"}, {"noise_mm", "--noise-mm"}, {"masses_kg", "--masses-kg"},

@@ -277,7 +277,14 @@ int Run(int argc, char** argv) {
     const std::string unpolished = polishing::DescribeUnpolished(e.stats, grid.region_area(), pattern);
     if (!unpolished.empty()) Warn(kTool, unpolished);
     if (e.stats.coverage < 0.99) {
-      Warn(kTool, "coverage " + io::FormatDouble(e.stats.coverage) + " < 0.99: parts of the region are barely polished");
+      Warn(kTool, "coverage " + FormatNumber(e.stats.coverage, 3) + " < 0.99: parts of the region get less than a "
+                  "tenth of the mean removal" + (req.optimise ? "" : " (--optimise, or a smaller --offset-mm, covers them)"));
+    }
+    // An uneven removal is the plan's own result, not a fault of the input:
+    // a note that says what evens it (docs/polishing.md).
+    if (!req.optimise && e.stats.cv > 0.3) {
+      Note(kTool, "the removal varies by " + FormatNumber(100 * e.stats.cv, 2) + " % (CV) over the region: --optimise "
+                  "chooses the pattern's parameters for the most even removal (docs/polishing.md)");
     }
     nlohmann::json summary = io::PolishPlanSummaryJson(outcome, ctx, po);
 

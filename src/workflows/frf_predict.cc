@@ -204,8 +204,7 @@ FrfPredictRun RunFrfPredict(const FrfPredictOptions& o, const MessageSink& tell,
   if (!r.bands.empty()) {
     Tell(tell, Message::Kind::kInfo,
          "the plots show the " + FormatNumber(100.0 * o.uncertainty.confidence, 3) + " % band of |H| (" +
-             dynamics::ToString(r.bands.front().propagation.method_used) + ": " + r.bands.front().propagation.reason +
-             ")");
+             r.bands.front().propagation.reason + ")");
   }
   return r;
 }
