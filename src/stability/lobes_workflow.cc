@@ -185,7 +185,10 @@ LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOption
   LobesResult result;
   for (const TipDynamics& t : tips) {
     for (const std::string& w : TipFitWarnings(t, do_sd)) {
-      tell(Message::Kind::kWarning, w);
+      // The unit finding, said as the tip was built: flagged, not said twice.
+      if (!(t.unit_finding_said && w == "implausible (unit mistake?): " + t.unit_finding)) {
+        tell(Message::Kind::kWarning, w);
+      }
       result.Flag(w);
     }
   }

@@ -1,6 +1,7 @@
 #include "robomach/stability/tip_dynamics.h"
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -234,6 +235,16 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
   };
   std::vector<TipDynamics> tips;
   bool noted = false;
+  // A unit finding is said before the fits' reports (a kHz axis came after
+  // 60 lines of fits in kHz); ComputeLobes flags it without saying it again.
+  auto say_units = [&](TipDynamics* t) {
+    if (t->unit_finding.empty()) return;
+    tell(Message::Kind::kWarning, "implausible (unit mistake?): " + t->unit_finding);
+    t->unit_finding_said = true;
+  };
+  // Missing cross FRFs, said once for the file (a direct-only test of five
+  // postures gave ten warnings).
+  std::map<std::string, std::vector<std::string>> no_cross;  // "xy" -> postures
   for (const TipFrfs& s : sets) {
     const std::string id = ShownId(s.pose_id, o.frf_path);
     if (!o.pose_ids.empty() && std::find(o.pose_ids.begin(), o.pose_ids.end(), id) == o.pose_ids.end()) continue;
@@ -272,6 +283,7 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
       }
       const dynamics::Frf hx = DirectFrf(s, a), hy = DirectFrf(*y, b);
       diagonal(hx.receptance(), hy.receptance());
+      say_units(&t);
       if (o.fit) {
         t.fits.push_back(FitOne(id + " " + Hname(a, a) + " (feed, x of the cut)", hx, on_message));
         t.fits.push_back(FitOrReuse(id + " " + Hname(b, b) + " (normal to the feed, y of the cut)", hy, t.fits,
@@ -292,6 +304,7 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
                                           "the cut and no cross terms; --tool-axis does not apply");
         noted = true;
       }
+      say_units(&t);
       if (o.fit) {
         t.fits.push_back(FitOne(id + " " + Hname(a, a), h, on_message));
         const TipModalModel mx = DominantModes(ModesAlong(t.fits[0].fit.fit, ex), o.sd_modes);
@@ -325,13 +338,13 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
                                                        "cutting plane the file's directions span, or the second "
                                                        "direction with --frf-y from a file of one direct FRF");
             }
-            tell(Message::Kind::kWarning, o.frf_path + ": posture " + id + ": no cross FRF " + "xyz"[a] + "xyz"[b] +
-                                                 "; taken as zero");
+            no_cross[std::string(1, "xyz"[a]) + "xyz"[b]].push_back(id);
           }
         }
       }
       std::vector<Eigen::Matrix3cd> H(s.H.begin() + first, s.H.end());
       t.Phi_C = OrientInCuttingPlane(H, R);
+      say_units(&t);
       if (o.fit) {
         std::vector<TipModalModel> parts, all;
         for (int a : dirs) {
@@ -411,6 +424,19 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
     tips.push_back(std::move(t));
   }
   if (tips.empty()) throw InputError({o.frf_path, 0, 0}, "none of the requested postures is in the file");
+  if (!no_cross.empty()) {
+    std::string pairs, postures;
+    for (const auto& [pair, ids] : no_cross) {
+      pairs += (pairs.empty() ? "" : ", ") + pair;
+      if (postures.empty()) {
+        for (const std::string& id : ids) postures += (postures.empty() ? "" : ", ") + id;
+      }
+    }
+    const size_t n = no_cross.begin()->second.size();
+    tell(Message::Kind::kWarning, o.frf_path + ": no cross FRF " + pairs + " at " +
+                                      (n == 1 ? "posture " : std::to_string(n) + " postures (") + postures +
+                                      (n == 1 ? "" : ")") + "; taken as zero (the directions uncoupled)");
+  }
   return tips;
 }
 

@@ -61,6 +61,7 @@ struct TipDynamics {
   /// (TipFrfsUnitFinding: a mobility or accelerance read as receptance, a
   /// response in mm under _m); empty when plausible or not measured.
   std::string unit_finding;
+  bool unit_finding_said{false};  // told as a warning when the tip was built
 };
 
 /// calibration::UsableBandUnitFinding of the largest
