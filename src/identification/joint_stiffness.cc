@@ -555,6 +555,15 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     const bool unloaded = tr <= lr || tr < 0.01;
     const bool unwatched = lr < tr || lr < 0.01;
     if (tmax == 0.0) return std::string("no load case loads the robot (every force is zero)");
+    // Loaded and watched as well as the best joints: neither is the cause
+    // (a noise of 10 mm read "barely loaded, 502.6 against 502.6 N·m").
+    if (tr >= 0.5 && lr >= 0.5) {
+      s << "it is loaded and seen as well as the other joints (largest moment " << Fixed(res.max_joint_torque(j), 1)
+        << " N·m, lever " << Fixed(1e3 * res.max_target_lever(j), 1)
+        << " mm), so its deflections are small against the tracker noise: check the noise given (its unit), or "
+           "add load cases and heavier masses";
+      return s.str();
+    }
     if (unloaded) {
       s << "it is barely loaded (largest moment about its axis " << Fixed(res.max_joint_torque(j), 1)
         << " N·m, against " << Fixed(tmax, 1) << " N·m on the most loaded joint): " << MomentAdvice(j, n);
