@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iostream>
 #include <sstream>
+#include <tuple>
 
 #include "cli_support.h"
 #include "robomach/common/errors.h"
@@ -166,11 +167,17 @@ int Run(int argc, char** argv) {
       qs = std::move(plan.q);
       plan_pulleys = std::move(plan.pulleys);
       const auto& meta = plan.metadata;
-      if (app.count("--load-point-mm") == 0 && meta.count("load_point_mm")) {
-        o.p_load_tip = ParsePointMm(plan_path + ": load_point_mm", meta.at("load_point_mm"));
-      }
-      if (app.count("--target-mm") == 0 && meta.count("target_mm")) {
-        o.p_target_tip = ParsePointMm(plan_path + ": target_mm", meta.at("target_mm"));
+      // The plan's load point and target, unless the options replace them:
+      // then said, since the plan was chosen for its own.
+      for (const auto& [option, key, point] :
+           {std::tuple{"--load-point-mm", "load_point_mm", &o.p_load_tip}, {"--target-mm", "target_mm", &o.p_target_tip}}) {
+        if (!meta.count(key)) continue;
+        if (app.count(option) == 0) {
+          *point = ParsePointMm(plan_path + ": " + key, meta.at(key));
+        } else if (ParsePointMm(plan_path + ": " + key, meta.at(key)) != *point) {
+          Warn(kTool, std::string(option) + " replaces the plan's " + key + " " + meta.at(key) + " (" + plan_path +
+                          "): the plan's postures and rope directions were chosen for its own");
+        }
       }
     } else if (!postures_path.empty()) {
       for (const auto& p : io::ReadPostureFile(postures_path, model->num_joints())) {
