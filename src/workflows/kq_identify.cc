@@ -412,8 +412,8 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
     if (r.plan.expected_determination[j] != identification::Determination::kWeak) continue;
     if (!identification::TargetsDependOnJoint(p, j)) continue;  // a targeted plan need not determine it
     std::ostringstream m;
-    // Three digits: 10.02 % rounded to "10 %" read as the threshold it exceeds.
-    m << "joint " << j + 1 << " would be weakly determined (±" << FormatNumber(100 * r.plan.expected_relative_std(j), 3)
+    // Four digits: 10.02 % rounded to "10 %" read as the threshold it exceeds.
+    m << "joint " << j + 1 << " would be weakly determined (±" << FormatNumber(100 * r.plan.expected_relative_std(j), 4)
       << " % at 1 sigma, over the 10 % of a determined joint): plan more postures (" << o.num_postures_name << ")"
       << (j == n - 1 ? " or put the load point and the target farther off the tool axis" : "");
     r.warnings.push_back(m.str());
