@@ -112,6 +112,10 @@ int Run(int argc, char** argv) {
     // Before any file is looked at (the options first: exit 64).
     if (!(noise_mm > 0.0) || !std::isfinite(noise_mm)) throw UsageError("--noise-mm: expected a finite noise > 0 mm");
     CheckOptionRange("--plan", plan_n, 0, 500);  // 500 postures: ~15 s of planning
+    if (app.count("--plan") > 0 && plan_n == 0) {
+      throw UsageError("--plan 0: expected the number of postures to plan, 1 to 500 (without --plan, kq-identify "
+                       "identifies from --tracker)");
+    }
     // The two modes' options are not mixed silently (issue #35: --plan with
     // --tracker planned and ignored the file).
     if (plan_n != 0) {
