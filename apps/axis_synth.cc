@@ -144,7 +144,7 @@ int Run(int argc, char** argv) {
       throw UsageError("--feed-mm-min " + io::FormatDouble(feed_mm_min) + " at --sample-rate-hz " +
                        io::FormatDouble(rate_hz) + ": the path's " + FormatNumber(MToMm(path.length()), 4) +
                        " mm take " + FormatNumber(static_cast<double>(rows) / rate_hz, 4) + " s, " + std::to_string(rows) +
-                       " rows (about " + std::to_string(rows * 45 / 1000000) + " MB), more than --max-rows " +
+                       " rows (about " + FormatNumber(static_cast<double>(rows) * 45e-6, 3) + " MB), more than --max-rows " +
                        std::to_string(max_rows) + ": raise --feed-mm-min, lower --sample-rate-hz, or raise --max-rows");
     }
     std::vector<double> origin(mf.machine.axes.size());

@@ -2,7 +2,10 @@
 // model at the postures of a posture file.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <cstdint>
 #include <filesystem>
+#include <map>
 
 #include "cli_support.h"
 #include "robomach/common/number_format.h"

@@ -47,9 +47,9 @@ int Run(int argc, char** argv) {
   app.footer(ExitCodeHelp() +
              "\nExit code 3 also means: a joint is weakly or not determined, the fit did not converge,\n"
              "or outliers were found without --robust (the outputs are written). With --plan: a joint no plan\n"
-             "can determine, the config's unit findings, or a --target-band-pct band the plan does not reach or\n"
-             "cannot promise (a target that bends within it); a joint the plan leaves weakly determined, and a\n"
-             "bend without --target-band-pct, are warnings with exit 0.");
+             "can determine, the config's or the options' unit findings, or a --target-band-pct band the plan\n"
+             "does not reach or cannot promise (a target that bends within it); a joint the plan leaves weakly\n"
+             "determined, and a bend without --target-band-pct, are warnings with exit 0.");
   std::string robot_path, tracker_path, out_path, residuals_path, plot_path, json_path, uncertainty_path, robust,
       load_point = "tcp", target = "tcp", masses = "10,20,30", target_postures, target_quantity = "frequency",
       cut_path;
@@ -141,7 +141,7 @@ int Run(int argc, char** argv) {
                        {{"--out", out_path}, {"--residuals", residuals_path}, {"--plot", plot_path},
                         {"--summary", json_path}, {"--uncertainty-out", uncertainty_path}});
     if (plan_n != 0) {
-      if (json_path == "-" && out_path.empty()) {
+      if (json_path == "-" && (out_path.empty() || out_path == "-")) {
         throw UsageError("--summary - and the plan would both go to stdout: give the plan a file with --out");
       }
       workflows::KqPlanOptions po;

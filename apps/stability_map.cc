@@ -150,10 +150,13 @@ int Run(int argc, char** argv) {
       // first point (the auto map of 187 points ran 51 s without a line),
       // and what first order would cost instead.
       if (unc.method != "first-order" && targets.size() > 50) {
-        Note(kTool, "--uncertainty-method " + unc.method + ": a linearity check at each of the " +
-                        std::to_string(targets.size()) + " points and Monte Carlo (about 0.5 s a point) where the "
-                        "depth bends within its interval; --uncertainty-method first-order takes about 2.4 times "
-                        "the map's time (docs/uncertainty.md)");
+        Note(kTool, "--uncertainty-method " + unc.method + ": " +
+                        (unc.method == "auto" ? "a linearity check at each of the " + std::to_string(targets.size()) +
+                                                    " points and Monte Carlo (about 0.5 s a point) where the depth "
+                                                    "bends within its interval"
+                                              : "Monte Carlo at each of the " + std::to_string(targets.size()) +
+                                                    " points (about 0.5 s a point)") +
+                        "; --uncertainty-method first-order takes about 2.4 times the map's time (docs/uncertainty.md)");
       }
       ProgressLine up(kTool, "points' intervals", static_cast<long>(targets.size()),
                       unc.method == "first-order" ? 200 : 1);
@@ -166,8 +169,10 @@ int Run(int argc, char** argv) {
                 << " Monte Carlo (" << intervals->example_reason << ")\n";
       if (const long k = intervals->SmallestLower(); k >= 0) {
         std::cerr << kTool << ": the smallest safe depth (" << FormatNumber(100.0 * unc.propagation.confidence, 3)
-                  << " % lower bound) is " << FormatNumber(MToMm(intervals->depth[k].lower), 4) << " mm, at row "
-                  << k / points.cols << ", col " << k % points.cols << " of the points\n";
+                  << " % lower bound) is " << FormatNumber(MToMm(intervals->depth[k].lower), 4) << " mm, at "
+                  << (grid ? "row " + std::to_string(k / points.cols) + ", col " + std::to_string(k % points.cols)
+                           : "point " + std::to_string(k + 1) + " of the path")
+                  << "\n";
       }
     }
     if (!plot_path.empty() && !grid) Warn(kTool, "--plot draws grids only; ignored with --path");

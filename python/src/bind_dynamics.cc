@@ -452,6 +452,10 @@ void BindDynamics(py::module_& m) {
           o.uncertainty.samples = samples;
           o.uncertainty.seed = seed;
           o.Validate();
+          if (!uncertainty.empty() && !intervals && band_postures == 0) {
+            throw std::invalid_argument("run_frf_predict: uncertainty gives the modes' intervals (intervals=True) "
+                                        "and the |H| bands (band_postures=N): ask for one of them");
+          }
           RequireReadableFile(robot);
           RequireReadableFile(postures);
           CollectedMessages said;

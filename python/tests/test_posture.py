@@ -227,6 +227,9 @@ def test_run_frf_predict_equals_the_tools_summary(tmp_path, case):
     if case == 'uncertainty_and_set':
         assert 'mode_intervals' in run['summary']['postures'][0]
         assert run['summary']['parameters']['m6_kg'] == 31.0
+        # As the tool refuses --uncertainty without an output that carries it.
+        with pytest.raises(ValueError, match=r'intervals=True'):
+            rm.run_frf_predict(KR210, postures, fmax_hz=50, uncertainty=[unc])
     with open(tmp_path / 'h.csv') as f:
         rows = [row for row in csv.DictReader(line for line in f if not line.startswith('#'))
                 if row['response'] == 'y' and row['excitation'] == 'y']

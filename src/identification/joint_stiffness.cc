@@ -548,7 +548,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
   // The sensitivity of the target to joint j's compliance is the product of
   // the moment about its axis and the target's lever about it; say which of
   // the two is relatively smaller (both if both are under 1 % of the largest).
-  auto sensitivity = [&](int j) {
+  auto sensitivity = [&](int j, bool weak = true) {
     std::ostringstream s;
     const double tr = tmax > 0.0 ? res.max_joint_torque(j) / tmax : 0.0;
     const double lr = lmax > 0.0 ? res.max_target_lever(j) / lmax : 0.0;
@@ -557,7 +557,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
     if (tmax == 0.0) return std::string("no load case loads the robot (every force is zero)");
     // Loaded and watched as well as the best joints: neither is the cause
     // (a noise of 10 mm read "barely loaded, 502.6 against 502.6 N·m").
-    if (tr >= 0.5 && lr >= 0.5) {
+    if (weak && tr >= 0.5 && lr >= 0.5) {
       s << "it is loaded and seen as well as the other joints (largest moment " << Fixed(res.max_joint_torque(j), 1)
         << " N·m, lever " << Fixed(1e3 * res.max_target_lever(j), 1)
         << " mm), so its deflections are small against the tracker noise: check the noise given (its unit), or "
@@ -581,7 +581,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
       "other rope directions";
   for (int j : unseen) {
     res.advice.push_back("joint " + std::to_string(j + 1) +
-                         " is not determined (the data do not depend on its stiffness): " + sensitivity(j));
+                         " is not determined (the data do not depend on its stiffness): " + sensitivity(j, false));
   }
   // Exact trade-offs, one sentence per group of joints sharing null directions.
   std::sort(traded.begin(), traded.end());

@@ -1,6 +1,7 @@
 #include "robomach/machine/synthesis.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -54,7 +55,9 @@ std::vector<double> StartMeasured(const Machine& machine, const Compensation* co
 
 long SynthesisRows(const ProgrammedPath& path, const SynthesisOptions& o) {
   const double duration = o.dwell + path.length() / o.feed;
-  return static_cast<long>(std::ceil(duration * o.sample_rate_hz)) + 1;
+  const double rows = std::ceil(duration * o.sample_rate_hz) + 1.0;
+  // Beyond a long's range the cast is undefined: saturate (callers refuse it).
+  return rows < 9e18 ? static_cast<long>(rows) : std::numeric_limits<long>::max();
 }
 
 SynthesisResult SynthesizeCounts(const Machine& machine, const Compensation* compensation,

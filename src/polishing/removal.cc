@@ -278,7 +278,7 @@ std::string DescribeUnpolished(const RemovalStats& stats, double region_area, co
     m << "too narrow for the cycloid's circle to enter without leaving the face (a smaller radius or row "
          "spacing reaches them)";
   } else if (pattern == "parallel") {
-    m << "that the parallel rows do not enter (a smaller row step, --row-step-mm, or a line angle along the "
+    m << "that the parallel rows do not enter (a smaller row spacing, --offset-mm, or a line angle along the "
          "neck reaches them)";
   } else {
     m << "that the path does not enter (closer rows reach them)";

@@ -240,11 +240,11 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
   auto say_units = [&](TipDynamics* t) {
     if (t->unit_finding.empty()) return;
     tell(Message::Kind::kWarning, "implausible (unit mistake?): " + t->unit_finding);
-    t->unit_finding_said = true;
+    t->unit_finding_said = static_cast<bool>(on_message);  // else ComputeLobes says it
   };
   // Missing cross FRFs, said once for the file (a direct-only test of five
   // postures gave ten warnings).
-  std::map<std::string, std::vector<std::string>> no_cross;  // "xy" -> postures
+  std::map<std::string, std::string> no_cross;  // posture -> its missing pairs ("xy, yx")
   for (const TipFrfs& s : sets) {
     const std::string id = ShownId(s.pose_id, o.frf_path);
     if (!o.pose_ids.empty() && std::find(o.pose_ids.begin(), o.pose_ids.end(), id) == o.pose_ids.end()) continue;
@@ -338,7 +338,8 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
                                                        "cutting plane the file's directions span, or the second "
                                                        "direction with --frf-y from a file of one direct FRF");
             }
-            no_cross[std::string(1, "xyz"[a]) + "xyz"[b]].push_back(id);
+            std::string& pairs = no_cross[id];
+            pairs += (pairs.empty() ? "" : ", ") + std::string(1, "xyz"[a]) + "xyz"[b];
           }
         }
       }
@@ -424,18 +425,18 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
     tips.push_back(std::move(t));
   }
   if (tips.empty()) throw InputError({o.frf_path, 0, 0}, "none of the requested postures is in the file");
-  if (!no_cross.empty()) {
-    std::string pairs, postures;
-    for (const auto& [pair, ids] : no_cross) {
-      pairs += (pairs.empty() ? "" : ", ") + pair;
-      if (postures.empty()) {
-        for (const std::string& id : ids) postures += (postures.empty() ? "" : ", ") + id;
-      }
-    }
-    const size_t n = no_cross.begin()->second.size();
+  // One warning per set of missing pairs, naming its postures.
+  std::map<std::string, std::vector<std::string>> by_pairs;  // "xy, yx" -> postures
+  for (const TipDynamics& t : tips) {
+    if (const auto it = no_cross.find(t.id); it != no_cross.end()) by_pairs[it->second].push_back(t.id);
+  }
+  for (const auto& [pairs, ids] : by_pairs) {
+    std::string postures;
+    for (const std::string& id : ids) postures += (postures.empty() ? "" : ", ") + id;
     tell(Message::Kind::kWarning, o.frf_path + ": no cross FRF " + pairs + " at " +
-                                      (n == 1 ? "posture " : std::to_string(n) + " postures (") + postures +
-                                      (n == 1 ? "" : ")") + "; taken as zero (the directions uncoupled)");
+                                      (ids.size() == 1 ? "posture " : std::to_string(ids.size()) + " postures (") +
+                                      postures + (ids.size() == 1 ? "" : ")") +
+                                      "; taken as zero (the directions uncoupled)");
   }
   return tips;
 }

@@ -198,7 +198,7 @@ TEST(DescribeUnpolished, NamesTheAreaAndItsShareOrNothing) {
   EXPECT_NE(DescribeUnpolished(s, 8e-6, "cycloid").find("cycloid's circle"), std::string::npos);
   const std::string p = DescribeUnpolished(s, 8e-6, "parallel");
   EXPECT_EQ(p.find("cycloid"), std::string::npos) << p;
-  EXPECT_NE(p.find("--row-step-mm"), std::string::npos) << p;
+  EXPECT_NE(p.find("--offset-mm"), std::string::npos) << p;  // the parallel pattern's row spacing
 }
 
 }  // namespace

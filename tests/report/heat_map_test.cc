@@ -102,7 +102,8 @@ TEST(HeatMap, FirstRowAtTopDrawsRowZeroAbove) {
 
 // range_min/range_max fix the colour scale (stability-map draws the depth
 // and the safe depth on one): a single cell of 2 on [0, 4] takes viridis'
-// middle colour (OpenCV's own map at 128), not the top one its own range gives.
+// middle colour (OpenCV's own map at 128), not the end colour its own range
+// gives (a single value is the bottom of its own range).
 TEST(HeatMap, FixedRangeSetsTheColourScale) {
   HeatMap m;
   m.title = "t";

@@ -45,7 +45,8 @@ SynthesisResult SynthesizeCounts(const Machine& machine, const Compensation* com
                                  const ProgrammedPath& path, const SynthesisOptions& options,
                                  const std::vector<double>& origin);
 
-/// The rows SynthesizeCounts writes: ceil((dwell + length / feed) * rate) + 1.
+/// The rows SynthesizeCounts writes: ceil((dwell + length / feed) * rate) + 1
+/// (LONG_MAX when that is beyond a long).
 long SynthesisRows(const ProgrammedPath& path, const SynthesisOptions& options);
 
 /// Measured start positions only (the first sample of SynthesizeCounts).

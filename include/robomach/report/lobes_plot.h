@@ -37,7 +37,7 @@ double LobesDepthAxisClipMm(const std::vector<LobeCurve>& curves);
 /// its own (the bands belong to no one posture).
 /// A single banded curve is shaded; with more, overlapping shades mix into
 /// another colour, so only their lower bounds are drawn (the upper ones are
-/// in the CSV) and the legend says so. When no lobe clips the depth axis
+/// in the CSV) and the legend calls them the lower bound. When no lobe clips the depth axis
 /// but a band's upper edge rises above 1.5 times the largest depth, the
 /// axis ends there (said in the panel's title).
 void SaveLobesPlot(const std::string& path, const std::string& title, const std::string& subtitle,
