@@ -51,8 +51,9 @@ int Run(int argc, char** argv) {
       ->capture_default_str();
   std::string weights = "noise";
   app.add_option("--weights", weights,
-                 "noise: 1/sigma of the noise model (the fit to within the noise); quantity: every line of the file's "
-                 "quantity alike (the unweighted least squares of modal software, which favours the peaks)")
+                 "noise: 1/sigma of the noise model (the fit to within the noise), and where the fit leaves more than "
+                 "twice the noise a model error white in the file's quantity added to sigma; quantity: every line of "
+                 "the file's quantity alike (the unweighted least squares of modal software, which favours the peaks)")
       ->check(OneOf({"noise", "quantity"}))
       ->capture_default_str();
   app.add_flag("--per-frf", opt.per_frf, "fit each FRF alone (its own poles) instead of one set per posture");
@@ -140,7 +141,13 @@ int Run(int argc, char** argv) {
             Warn(kTool, "posture " + p.pose_id + ", " + g.keys[i].Label() +
                             ": the fit leaves " + FormatNumber(ns, 3) +
                             " x the noise (more than 3): a mode or a residual effect is missing, or the noise model is "
-                            "too optimistic (see the picture)");
+                            "too optimistic (see the picture)" +
+                            (i < g.fit.model_error.size() && g.fit.model_error[i] > 0.0
+                                 ? "; the fit took in a model error of " + FormatNumber(g.fit.model_error[i], 3) + " " +
+                                       (power == 0 ? "m/N" : power == 1 ? "(m/s)/N" : "(m/s^2)/N") +
+                                       " rms on every line (summary: model_error_rms), so that the peaks are "
+                                       "fitted rather than the lines of small |H|"
+                                 : std::string()));
             flagged = true;
           }
         }

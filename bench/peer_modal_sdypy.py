@@ -136,7 +136,7 @@ def main():
         print('== %s' % name)
         for who, f, m, t, n in fits:
             print('  %-36s %5.2f s  misfit %s%s' % (
-                who, t, ' / '.join('%.3f' % x for x in m),
+                who, t, ' / '.join('%.4f' % x for x in m),
                 '' if n is None else '  in noise units %s' % ' / '.join('%.1f' % x for x in n)))
             print('  %-36s modes [Hz] %s' % ('', ', '.join('%.1f' % x for x in f)))
     return 0

@@ -244,6 +244,7 @@ std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const Nois
       o.fmin_hz = 0.0;
       o.fmax_hz = std::numeric_limits<double>::infinity();
       if (options.weights_in_file_quantity) o.uniform_weights_power = file_power;
+      if (options.model_error) o.model_error_power = file_power;
       g.fit = FitModesGlobal(g.data, o);
       for (size_t i = 0; i < g.data.size(); ++i) {
         g.misfit.push_back(i < g.fit.per_frf.size() ? RelativeMisfit(g.fit.per_frf[i], g.data[i], file_power) : NAN);

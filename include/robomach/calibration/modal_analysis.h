@@ -32,6 +32,10 @@ struct ModalAnalysisOptions {
   /// and which favours the peaks). See
   /// GlobalModalFitOptions::uniform_weights_power.
   bool weights_in_file_quantity{false};
+  /// With the noise's weights: a fit that leaves more than twice the noise
+  /// on an FRF is made again with a model error white in the file's
+  /// quantity added to σ (GlobalModalFitOptions::model_error_power).
+  bool model_error{true};
   /// A posture's FRFs are fitted together only if at least this many lines
   /// are usable in all of them; else each alone, with a warning.
   int min_common_lines{40};
