@@ -234,6 +234,47 @@ TEST(GlobalModalFit, ModelErrorIsTheErrorTheNoiseModelDidNotKnow) {
   for (size_t r = 0; r < fit.modes.size(); ++r) EXPECT_EQ(fit.modes[r].freq_hz, plain.modes[r].freq_hz);
 }
 
+// Two modes (60, 180 Hz) measured from 5 Hz, a tenth of the lowest, with
+// 0.5 % noise; with `mass_kg` > 0 the structure is free and its receptance
+// has the rigid body's mass line −1/(M ω²) below the modes.
+dynamics::Frf FreeOrGrounded(double mass_kg, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const int n = 396;
+  Eigen::VectorXd f(n), sigma(n);
+  Eigen::VectorXcd H(n);
+  for (int k = 0; k < n; ++k) {
+    f(k) = 5.0 + k;
+    const double w = HzToRadPerSec(f(k));
+    cd h = mass_kg > 0.0 ? cd(-1.0 / (mass_kg * w * w)) : cd(0.0);
+    for (auto [fn, zeta, m] : {std::tuple{60.0, 0.02, 3.0}, std::tuple{180.0, 0.02, 4.0}}) {
+      const double wn = HzToRadPerSec(fn);
+      h += 1.0 / (m * (wn * wn - w * w + cd(0, 2.0 * zeta * wn * w)));
+    }
+    sigma(k) = 0.005 * std::abs(h);
+    H(k) = h + sigma(k) / std::sqrt(2.0) * cd(gauss(rng), gauss(rng));
+  }
+  return dynamics::Frf::FromSamples(f, H).WithNoise(sigma);
+}
+
+TEST(GlobalModalFit, LowerResidualOfAFreeStructureKeptByTheBic) {
+  for (unsigned seed : {11u, 12u}) {
+    const GlobalModalFitResult free = FitModesGlobal({FreeOrGrounded(20.0, seed)});
+    ASSERT_EQ(free.status, ModalFitStatus::kOk) << free.message;
+    EXPECT_NE(free.message.find("lower residual"), std::string::npos) << free.message;
+    // The mass line is the lower residual: L/s² = −L/ω², L = 1/M.
+    EXPECT_NEAR(free.per_frf[0].lower_residual.real(), 1.0 / 20.0, 0.02 / 20.0) << free.message;
+    EXPECT_LT(free.misfit_in_noise[0], 1.3) << free.message;
+    ASSERT_EQ(free.modes.size(), 2u) << free.message;
+    EXPECT_NEAR(free.modes[0].freq_hz, 60.0, 0.1);
+    // Grounded: no mass line, the BIC does not take the two parameters.
+    const GlobalModalFitResult grounded = FitModesGlobal({FreeOrGrounded(0.0, seed)});
+    ASSERT_EQ(grounded.status, ModalFitStatus::kOk) << grounded.message;
+    EXPECT_EQ(grounded.message.find("lower residual"), std::string::npos) << grounded.message;
+    EXPECT_EQ(grounded.per_frf[0].lower_residual, cd(0.0)) << grounded.message;
+  }
+}
+
 TEST(GlobalModalFit, MacOfKnownVectors) {
   Eigen::MatrixXcd a(3, 2), b(3, 1);
   a << 1, 0, 2, 1, 3, 0;
@@ -355,17 +396,17 @@ TEST(GlobalModalFitRealFiles, PyuffBeamModelErrorFitsTheOneLinePeaks) {
   const GlobalModalFitResult noise_only = FitModesGlobal(frfs, plain);
   ASSERT_EQ(noise_only.status, ModalFitStatus::kOk) << noise_only.message;
   if (std::getenv("ROBOMACH_DUMP_FIT")) DumpFit(noise_only, frfs, 2);
-  // The noise model leaves 4-8 times the noise on each FRF, mostly at the
-  // peaks, which are one line wide (ζ 0.01-0.04 % on 1 Hz lines); weighted
-  // with the model error, the peaks are fitted: the relative misfit falls
-  // on every FRF (0.055 / 0.082 / 0.053 to 0.025 / 0.044 / 0.029 on
-  // 2026-12-02; sdypy-EMA's 0.0265 / 0.0504 / 0.0272 in
-  // bench/peer_modal_sdypy.py, not asserted here).
+  // The noise model leaves 2.4 times the noise on FRFs 2 and 3 (1.8 on
+  // FRF 1), mostly at the peaks, which are one line wide (ζ 0.01-0.04 % on
+  // 1 Hz lines); weighted with the model error, the peaks are fitted: the
+  // relative misfit falls on every FRF (0.045 / 0.062 / 0.050 to 0.034 /
+  // 0.048 / 0.034 on 2026-12-02; sdypy-EMA's 0.0265 / 0.0504 / 0.0273 in
+  // bench/peer_modal_sdypy.py, not asserted here). The FRF within twice
+  // its noise keeps no model error.
   ASSERT_EQ(fit.model_error.size(), 3u);
   for (int i = 0; i < 3; ++i) {
-    EXPECT_GT(noise_only.misfit_in_noise[i], 2.0) << "FRF " << i + 1;
-    EXPECT_GT(fit.model_error[i], 0.0) << "FRF " << i + 1;
-    EXPECT_LT(RelativeMisfit(fit.per_frf[i], frfs[i], 2), 0.6 * RelativeMisfit(noise_only.per_frf[i], frfs[i], 2))
+    EXPECT_EQ(fit.model_error[i] > 0.0, noise_only.misfit_in_noise[i] > 2.0) << "FRF " << i + 1;
+    EXPECT_LT(RelativeMisfit(fit.per_frf[i], frfs[i], 2), RelativeMisfit(noise_only.per_frf[i], frfs[i], 2))
         << "FRF " << i + 1 << ": " << fit.message;
   }
   // Every peak the files show still has its mode.
