@@ -136,18 +136,20 @@ int Run(int argc, char** argv) {
         line << ": " << g.fit.message;
         Note(kTool, line.str());
         for (size_t i = 0; i < g.keys.size(); ++i) {
-          const double ns = i < g.fit.misfit_in_noise.size() ? g.fit.misfit_in_noise[i] : NAN;
+          // Judged by the fit with the noise's weights: the model error's
+          // refit gives up misfit in noise units for the peaks on purpose.
+          const double ns = i < g.fit.misfit_in_noise_weights_alone.size() ? g.fit.misfit_in_noise_weights_alone[i] : NAN;
+          const double tau = i < g.fit.model_error.size() ? g.fit.model_error[i] : 0.0;
           if (std::isfinite(ns) && ns > 3.0) {
-            Warn(kTool, "posture " + p.pose_id + ", " + g.keys[i].Label() +
-                            ": the fit leaves " + FormatNumber(ns, 3) +
+            Warn(kTool, "posture " + p.pose_id + ", " + g.keys[i].Label() + ": the fit leaves " + FormatNumber(ns, 3) +
                             " x the noise (more than 3): a mode or a residual effect is missing, or the noise model is "
                             "too optimistic (see the picture)" +
-                            (i < g.fit.model_error.size() && g.fit.model_error[i] > 0.0
-                                 ? "; the fit took in a model error of " + FormatNumber(g.fit.model_error[i], 3) + " " +
-                                       (power == 0 ? "m/N" : power == 1 ? "(m/s)/N" : "(m/s^2)/N") +
-                                       " rms on every line (summary: model_error_rms), so that the peaks are "
-                                       "fitted rather than the lines of small |H|"
-                                 : std::string()));
+                            (tau > 0.0 ? "; so the fit took in a model error of " + FormatNumber(tau, 3) + " " +
+                                             (power == 0 ? "m/N" : power == 1 ? "(m/s)/N" : "(m/s^2)/N") +
+                                             " rms on every line (summary: model_error_rms), which fits the peaks "
+                                             "rather than the lines of small |H| and leaves " +
+                                             FormatNumber(g.fit.misfit_in_noise[i], 3) + " x the noise"
+                                       : std::string()));
             flagged = true;
           }
         }

@@ -93,6 +93,8 @@ void BindCalibration(py::module_& m) {
               f["misfit_relative"] = i < g.misfit.size() ? g.misfit[i] : NAN;
               f["misfit_noise_sigmas"] = i < g.fit.misfit_in_noise.size() ? g.fit.misfit_in_noise[i] : NAN;
               f["model_error_rms"] = i < g.fit.model_error.size() ? g.fit.model_error[i] : 0.0;
+              f["misfit_noise_sigmas_noise_weights"] =
+                  i < g.fit.misfit_in_noise_weights_alone.size() ? g.fit.misfit_in_noise_weights_alone[i] : NAN;
               py::list constants;
               if (i < g.fit.per_frf.size()) {
                 for (const auto& md : g.fit.per_frf[i].modes) constants.append(md.modal_constant);

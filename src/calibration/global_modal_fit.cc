@@ -504,7 +504,8 @@ std::vector<double> ModelErrors(const std::vector<dynamics::Frf>& frfs, const Gl
     // Degrees of freedom: each mode's complex residue, the residual terms
     // and this FRF's share of the common poles.
     const double modes = static_cast<double>(fit.modes.size());
-    const double params = 2.0 * modes + 4.0 + 2.0 * modes / frfs.size();
+    const double params = 2.0 * modes + 4.0 + 2.0 * modes / frfs.size() +
+                          (fit.per_frf[i].lower_residual != cd(0.0) ? 2.0 : 0.0);
     const double nu = std::max(0.5 * n, n - 0.5 * params);
     tau[i] = std::sqrt(ModelErrorVariance(r2, sigma2, w2, nu));
   }
@@ -532,7 +533,8 @@ std::optional<GlobalModalFitResult> RefitWithModelError(const std::vector<dynami
   again.model_error_power = -1;
   std::vector<double> tau = ModelErrors(frfs, fit, p, needs);
   std::optional<GlobalModalFitResult> out;
-  for (int pass = 0; pass < 4; ++pass) {
+  bool settled = false;
+  for (int pass = 0; pass < 4 && !settled; ++pass) {
     std::vector<dynamics::Frf> weighted;
     for (size_t i = 0; i < frfs.size(); ++i) {
       const dynamics::Frf& f = frfs[i];
@@ -547,14 +549,20 @@ std::optional<GlobalModalFitResult> RefitWithModelError(const std::vector<dynami
     next.model_error = tau;
     out = std::move(next);
     const std::vector<double> tau_next = ModelErrors(frfs, *out, p, needs);
-    bool settled = true;
+    settled = true;
     for (size_t i = 0; i < frfs.size(); ++i) settled = settled && std::abs(tau_next[i] - tau[i]) <= 0.05 * tau[i];
-    if (settled) break;
-    tau = tau_next;
+    if (!settled) {
+      for (size_t i = 0; i < frfs.size(); ++i) {
+        // An FRF that needs a τ keeps one (a later pass that finds 0 would
+        // return it to the weights that made the misfit).
+        if (std::isfinite(tau_next[i]) && (tau_next[i] > 0.0 || !needs[i])) tau[i] = tau_next[i];
+      }
+    }
   }
   if (!out) return std::nullopt;
   // The misfit in units of the measurement's noise, as without τ.
   out->misfit_in_noise = MisfitInNoise(frfs, out->per_frf);
+  out->misfit_in_noise_weights_alone = fit.misfit_in_noise;
   out->model_error_power = p;
   static const char* kQuantity[] = {"receptance", "mobility", "accelerance"};
   std::ostringstream s;
@@ -562,7 +570,8 @@ std::optional<GlobalModalFitResult> RefitWithModelError(const std::vector<dynami
   double worst = 0.0;
   for (double m : fit.misfit_in_noise) worst = std::max(worst, m);
   s << ", weighted with a model error white in the " << kQuantity[std::clamp(p, 0, 2)]
-    << " (the noise model explains the misfit only to " << worst << " x the noise)";
+    << " (the noise model explains the misfit only to " << worst << " x the noise"
+    << (settled ? "" : "; the model error had not settled to 5 % after 4 refits") << ")";
   out->message += s.str();
   return out;
 }
@@ -681,6 +690,7 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     GlobalModalFitOptions sub = o;
     sub.max_modes_per_band = 0;
     sub.driving_point = -1;
+    sub.model_error_power = -1;  // τ is estimated once, about the whole band's fit
     for (int g = 0; g < groups && first[g] < n; ++g) {
       const int a = first[g], b = std::min(n, first[g + 1]) - 1;  // this group's clusters
       // Core: from the gap below to the gap above (geometric means); band:
@@ -892,7 +902,14 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     const GlobalProblem with_lower(frfs, result.fmin_hz, o.uniform_weights_power, /*force_lower=*/true);
     const std::vector<cd> p = o.refine && !banded ? with_lower.Refine(poles) : poles;
     const SetFit fit = with_lower.Fit(p);
-    if (bic(fit.cost, p.size(), p, /*force_lower=*/true) < bic(best.cost, poles.size(), poles)) {
+    // Refined with the 1/ω² term a weak low pole could leave the band or
+    // the physical damping range; then the set without it stands.
+    bool physical = true;
+    for (const cd& q : p) {
+      const double wn = std::abs(q), f_hz = RadPerSecToHz(wn), zeta = -q.real() / wn;
+      physical = physical && zeta > 0.0 && zeta < o.max_damping_ratio && f_hz >= result.fmin_hz && f_hz <= result.fmax_hz;
+    }
+    if (physical && bic(fit.cost, p.size(), p, /*force_lower=*/true) < bic(best.cost, poles.size(), poles)) {
       best = fit;
       poles = p;
       lower_by_bic = true;
@@ -938,6 +955,7 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
   }
   result.status = ModalFitStatus::kOk;
   result.model_error.assign(frfs.size(), 0.0);
+  result.misfit_in_noise_weights_alone = result.misfit_in_noise;
   if (o.model_error_power >= 0 && o.uniform_weights_power < 0) {
     if (std::optional<GlobalModalFitResult> again = RefitWithModelError(frfs, result, o)) return *std::move(again);
   }

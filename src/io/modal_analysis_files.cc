@@ -108,6 +108,8 @@ nlohmann::json ModalAnalysisSummaryJson(const std::vector<calibration::PoseModes
         jf["misfit_relative"] = NumberOrNull(i < g.misfit.size() ? g.misfit[i] : NAN);
         jf["misfit_noise_sigmas"] =
             NumberOrNull(i < g.fit.misfit_in_noise.size() ? g.fit.misfit_in_noise[i] : NAN);
+        jf["misfit_noise_sigmas_noise_weights"] = NumberOrNull(
+            i < g.fit.misfit_in_noise_weights_alone.size() ? g.fit.misfit_in_noise_weights_alone[i] : NAN);
         // τ in the file's quantity (the summary's `quantity`, its SI unit).
         jf["model_error_rms"] = i < g.fit.model_error.size() ? g.fit.model_error[i] : 0.0;
         jg["frfs"].push_back(jf);

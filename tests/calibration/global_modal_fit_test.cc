@@ -213,6 +213,9 @@ TEST(GlobalModalFit, ModelErrorIsTheErrorTheNoiseModelDidNotKnow) {
     // standard deviation of τ about 1/(2 sqrt(400)) = 2.5 %): within 10 %.
     EXPECT_NEAR(fit.model_error[0], tau, 0.10 * tau) << fit.message;
     EXPECT_EQ(fit.model_error_power, 2);
+    EXPECT_NEAR(fit.misfit_in_noise_weights_alone[0], plain.misfit_in_noise[0], 1e-9 * plain.misfit_in_noise[0]);
+    // The refit gives up misfit in units of σ alone for the model error.
+    EXPECT_GE(fit.misfit_in_noise[0], 0.99 * plain.misfit_in_noise[0]);
     EXPECT_NE(fit.message.find("model error white in the accelerance"), std::string::npos) << fit.message;
     // Both modes stay where they are.
     ASSERT_EQ(fit.modes.size(), 2u) << fit.message;
@@ -405,7 +408,10 @@ TEST(GlobalModalFitRealFiles, PyuffBeamModelErrorFitsTheOneLinePeaks) {
   // its noise keeps no model error.
   ASSERT_EQ(fit.model_error.size(), 3u);
   for (int i = 0; i < 3; ++i) {
-    EXPECT_EQ(fit.model_error[i] > 0.0, noise_only.misfit_in_noise[i] > 2.0) << "FRF " << i + 1;
+    // The first pass is the fit with the noise's weights alone, and it is
+    // what the summary's misfit_noise_sigmas_noise_weights reports.
+    EXPECT_NEAR(fit.misfit_in_noise_weights_alone[i], noise_only.misfit_in_noise[i],
+                1e-9 * noise_only.misfit_in_noise[i]) << "FRF " << i + 1;
     EXPECT_LT(RelativeMisfit(fit.per_frf[i], frfs[i], 2), RelativeMisfit(noise_only.per_frf[i], frfs[i], 2))
         << "FRF " << i + 1 << ": " << fit.message;
   }
