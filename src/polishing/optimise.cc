@@ -102,6 +102,15 @@ void RunNlopt(nlopt::algorithm alg, int budget, std::vector<double>* x, Tracker*
 
 }  // namespace
 
+std::string ToString(Optimiser o) { return o == Optimiser::kNlopt ? "nlopt" : "pso"; }
+
+Optimiser ParseOptimiser(const std::string& name) {
+  for (Optimiser o : {Optimiser::kNlopt, Optimiser::kPso}) {
+    if (name == ToString(o)) return o;
+  }
+  throw std::invalid_argument("optimiser '" + name + "': expected nlopt or pso");
+}
+
 OptimiseResult OptimiseCycloid(const std::function<double(const PathParameters&)>& objective,
                                const PathParameters& start, const OptimiseOptions& o) {
   OptimiseResult res;

@@ -154,7 +154,7 @@ PlanRequest ToPlanRequest(const PlanOptions& o, const PlanningContext& c) {
   params.line_angle = o.line_angle_deg * kPi / 180.0;
   CheckValid(params);
   req.target_removal = o.target_removal_um * 1e-6;  // [um] -> [m]
-  if (o.optimise != "none") req.optimise = o.optimise == "nlopt" ? Optimiser::kNlopt : Optimiser::kPso;
+  if (o.optimise != "none") req.optimise = ParseOptimiser(o.optimise);
   req.guides_given = o.guides_given;
   req.opt_sample_spacing = MmToM(o.opt_sample_mm);
   req.opt_offset_min_contact_widths = o.opt_offset_min_contact_widths;

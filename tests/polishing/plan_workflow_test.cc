@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "polishing/test_surfaces.h"
+#include "robomach/polishing/optimise.h"
 #include "robomach/polishing/path_patterns.h"
 #include "test_support.h"
 
@@ -103,6 +104,16 @@ TEST(PlanPolishing, ErrorsNameTheFileThatIsWrong) {
   const std::string what = robomach::testing::CaptureError([&] { PlanPolishing(ctx, req); });
   EXPECT_THAT(what, HasSubstr("strip.yaml"));
   EXPECT_THAT(what, HasSubstr("face too narrow for the circle"));
+}
+
+// The optimiser's names are one parser and one printer (issue #36), the
+// names polish-plan's --optimise takes.
+TEST(Optimiser, NamesRoundTripAndAWrongNameListsTheRightOnes) {
+  for (Optimiser o : {Optimiser::kNlopt, Optimiser::kPso}) EXPECT_EQ(ParseOptimiser(ToString(o)), o);
+  EXPECT_EQ(ToString(Optimiser::kNlopt), "nlopt");
+  EXPECT_EQ(ToString(Optimiser::kPso), "pso");
+  EXPECT_THAT(robomach::testing::CaptureError([] { ParseOptimiser("NLopt"); }),
+              HasSubstr("optimiser 'NLopt': expected nlopt or pso"));
 }
 
 }  // namespace

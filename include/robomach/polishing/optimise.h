@@ -27,6 +27,12 @@ namespace robomach::polishing {
 
 enum class Optimiser { kNlopt, kPso };
 
+/// "nlopt", "pso" (the names polish-plan's --optimise and Python take).
+std::string ToString(Optimiser o);
+/// The inverse of ToString. @throws std::invalid_argument naming the
+/// accepted names.
+Optimiser ParseOptimiser(const std::string& name);
+
 struct OptimiseOptions {
   Optimiser method{Optimiser::kNlopt};
   double offset_min{0.004}, offset_max{0.030};  // [m]
