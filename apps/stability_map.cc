@@ -21,6 +21,7 @@
 #include "robomach/io/robot_config.h"
 #include "robomach/io/uncertainty_file.h"
 #include "robomach/stability/lobe_uncertainty.h"
+#include "robomach/workflows/frf_predict.h"
 #include "robomach/report/heat_map.h"
 #include "robomach/report/json.h"
 #include "robomach/stability/stability_map.h"
@@ -87,12 +88,8 @@ int Run(int argc, char** argv) {
     if (!safe_plot_path.empty() && unc.PathsFor(cfg).empty()) {
       throw UsageError("--safe-plot needs --uncertainty (or a robot config that names uncertainty files)");
     }
-    std::optional<dynamics::ParameterUncertainty> uncertainty;
-    if (!unc.PathsFor(cfg).empty()) {
-      uncertainty = io::ReadParameterUncertainties(unc.PathsFor(cfg));
-      const std::string changed = dynamics::UseEstimates(*uncertainty, &cfg.parameters);
-      if (!changed.empty()) Note(kTool, changed);
-    }
+    const std::optional<dynamics::ParameterUncertainty> uncertainty =
+        workflows::UseUncertaintyFiles(unc.PathsFor(cfg), {}, &cfg, MessagePrinter(kTool));
     const auto model = cfg.Build();
     const io::CutSpec cut = io::ReadCutFile(cut_path);
     for (const std::string& w : cut.implausible) Warn(kTool, w);

@@ -11,10 +11,6 @@
 namespace robomach::workflows {
 namespace {
 
-void Tell(const MessageSink& sink, Message::Kind kind, const std::string& text) {
-  if (sink) sink({kind, text});
-}
-
 Axis ParseExcitation(std::string text) {
   for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));  // "X" as Python took it
   if (text == "x") return Axis::kX;

@@ -12,14 +12,6 @@
 #include "robomach/io/uncertainty_file.h"
 
 namespace robomach::workflows {
-namespace {
-
-void Tell(const MessageSink& sink, Message::Kind kind, const std::string& text) {
-  if (sink) sink({kind, text});
-}
-
-}  // namespace
-
 void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<std::string>& sets,
                       io::RobotConfig* cfg) {
   for (const std::string& name : adds) {
@@ -41,6 +33,25 @@ void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<st
       throw OptionError("sets", "sets " + s + ": " + e.what());
     }
   }
+}
+
+std::optional<dynamics::ParameterUncertainty> UseUncertaintyFiles(const std::vector<std::string>& files,
+                                                                  const std::vector<std::string>& sets,
+                                                                  io::RobotConfig* config, const MessageSink& tell) {
+  if (files.empty()) return std::nullopt;
+  dynamics::ParameterUncertainty u = io::ReadParameterUncertainties(files);
+  for (const std::string& set : sets) {
+    const std::string name = set.substr(0, set.find('='));
+    for (const auto& up : u.parameters) {
+      if (up.name == name) {
+        throw OptionError("sets", "sets " + name + " and uncertainty_paths (" + u.source + ") both give " + name +
+                                      ": the file's estimate goes with its covariance; drop one of the two");
+      }
+    }
+  }
+  const std::string changed = dynamics::UseEstimates(u, &config->parameters);
+  if (!changed.empty()) Tell(tell, Message::Kind::kNote, changed);
+  return u;
 }
 
 Eigen::VectorXd FrequencyGrid(double fmin_hz, double fmax_hz, double df_hz) {
@@ -129,21 +140,7 @@ FrfPredictRun RunFrfPredict(const FrfPredictOptions& o, const MessageSink& tell,
   if (o.intervals || o.band_postures > 0) {
     r.uncertainty_files = o.uncertainty_paths.empty() ? r.config.uncertainty_files : o.uncertainty_paths;
   }
-  if (!r.uncertainty_files.empty()) {
-    r.uncertainty = io::ReadParameterUncertainties(r.uncertainty_files);
-    for (const std::string& set : o.sets) {
-      const std::string name = set.substr(0, set.find('='));
-      for (const auto& up : r.uncertainty->parameters) {
-        if (up.name == name) {
-          throw OptionError("sets", "sets " + name + " and uncertainty_paths (" + r.uncertainty->source +
-                                        ") both give " + name +
-                                        ": the file's estimate goes with its covariance; drop one of the two");
-        }
-      }
-    }
-    const std::string changed = dynamics::UseEstimates(*r.uncertainty, &r.config.parameters);
-    if (!changed.empty()) Tell(tell, Message::Kind::kNote, changed);
-  }
+  r.uncertainty = UseUncertaintyFiles(r.uncertainty_files, o.sets, &r.config, tell);
   r.model = r.config.Build();
   std::vector<std::string> posture_units;  // radians under _deg headers, ...
   r.postures = io::ReadPostureFile(o.postures_path, r.model->num_joints(), &posture_units);

@@ -19,10 +19,6 @@
 namespace robomach::workflows {
 namespace {
 
-void Tell(const MessageSink& sink, Message::Kind kind, const std::string& text) {
-  if (sink) sink({kind, text});
-}
-
 std::string Sci(double v, int digits = 3) {
   if (!std::isfinite(v)) return "inf";
   std::ostringstream s;

@@ -14,10 +14,6 @@
 namespace robomach::workflows {
 namespace {
 
-void Tell(const MessageSink& sink, Message::Kind kind, const std::string& text) {
-  if (sink) sink({kind, text});
-}
-
 // A missing or unreadable input file: io::MissingFileError (the tools'
 // exit 66), named as the options name it.
 void RequireReadable(const std::string& path, const std::string& what) {

@@ -9,6 +9,7 @@
 #include "robomach/io/lobes_file.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/uncertainty_file.h"
+#include "robomach/workflows/frf_predict.h"
 #include "robomach/workflows/tip_sources.h"
 
 namespace robomach::workflows {
@@ -27,10 +28,6 @@ std::string AxisSource(const StabilityLobesOptions& o) {
   if (!o.tool_axis_source.empty()) return o.tool_axis_source;
   return "tool_axis " + FormatNumber(o.tool_axis(0), 6) + "," + FormatNumber(o.tool_axis(1), 6) + "," +
          FormatNumber(o.tool_axis(2), 6);
-}
-
-void Say(const MessageSink& tell, Message::Kind kind, const std::string& text) {
-  if (tell) tell({kind, text});
 }
 
 }  // namespace
@@ -103,27 +100,22 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const Messag
   StabilityLobesRun run;
   run.cut = io::ReadCutFile(o.cut_path);
   for (const std::string& w : run.cut.implausible) {
-    Say(tell, Message::Kind::kWarning, w);
+    Tell(tell, Message::Kind::kWarning, w);
     run.input_findings.push_back(w);
   }
   const std::string axis_source = AxisSource(o);
   if (!o.robot_path.empty()) {
     io::RobotConfig cfg = io::LoadRobotConfig(o.robot_path);
     for (const std::string& w : cfg.implausible) {
-      Say(tell, Message::Kind::kWarning, w);
+      Tell(tell, Message::Kind::kWarning, w);
       run.input_findings.push_back(w);
     }
-    std::optional<dynamics::ParameterUncertainty> u;
     // The config's `uncertainty:` files when none were given (the ZOA only).
-    const std::vector<std::string>& files =
-        !o.uncertainty_paths.empty() || o.method == stability::LobeMethod::kSd ? o.uncertainty_paths
-                                                                                : cfg.uncertainty_files;
-    if (!files.empty()) {
-      run.uncertainty_files = files;
-      u = io::ReadParameterUncertainties(files);
-      const std::string changed = dynamics::UseEstimates(*u, &cfg.parameters);
-      if (!changed.empty()) Say(tell, Message::Kind::kNote, changed);
-    }
+    run.uncertainty_files = !o.uncertainty_paths.empty() || o.method == stability::LobeMethod::kSd
+                                ? o.uncertainty_paths
+                                : cfg.uncertainty_files;
+    const std::optional<dynamics::ParameterUncertainty> u =
+        UseUncertaintyFiles(run.uncertainty_files, {}, &cfg, tell);
     std::vector<io::Posture> postures;
     run.tips = TipsFromRobotPostures(cfg.Build(), o.postures_path, o.pose_ids, run.cut, tell, &postures);
     if (u) {
@@ -158,7 +150,7 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const Messag
       r.depth_upper = b.depth[at].upper;
       ++at;
     }
-    Say(tell, Message::Kind::kNote,
+    Tell(tell, Message::Kind::kNote,
         b.id + ": smallest critical depth (ZOA) " + FormatNumber(1e3 * b.min_depth.value, 4) + " mm, " +
             FormatNumber(100.0 * o.uncertainty.confidence, 3) + " % interval [" +
             FormatNumber(1e3 * b.min_depth.lower, 4) + ", " + FormatNumber(1e3 * b.min_depth.upper, 4) +
@@ -179,7 +171,7 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const Messag
           " mm" + (std::isfinite(at_rpm) ? " at " + FormatNumber(at_rpm, 5) + " rpm" : std::string()) +
           ", which is not a depth: first order does not hold here (the lobes bend within the interval); use "
           "--uncertainty-method auto or monte-carlo";
-      Say(tell, Message::Kind::kWarning, w);
+      Tell(tell, Message::Kind::kWarning, w);
       run.input_findings.push_back(w);
     }
   }

@@ -20,4 +20,9 @@ struct Message {
 };
 using MessageSink = std::function<void(const Message&)>;
 
+/// Tells `text` to `sink`, if there is one: the one way a workflow speaks.
+inline void Tell(const MessageSink& sink, Message::Kind kind, const std::string& text) {
+  if (sink) sink({kind, text});
+}
+
 }  // namespace robomach

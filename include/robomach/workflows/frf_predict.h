@@ -35,6 +35,17 @@ namespace robomach::workflows {
 void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<std::string>& sets,
                       io::RobotConfig* config);
 
+/// The parameter uncertainty of `files` put into `config`: the files'
+/// estimates replace the config's parameters (a note says which changed),
+/// since an estimate goes with its covariance. The tools' --uncertainty
+/// (or the config's `uncertainty:` files). No files: nullopt, `config`
+/// untouched.
+/// @throws OptionError "sets" when `sets` ("NAME=VALUE", the tools' --set)
+///   names a parameter the files estimate; the readers' errors.
+std::optional<dynamics::ParameterUncertainty> UseUncertaintyFiles(const std::vector<std::string>& files,
+                                                                  const std::vector<std::string>& sets,
+                                                                  io::RobotConfig* config, const MessageSink& tell);
+
 /// The lines fmin_hz, fmin_hz + df_hz, ... up to fmax_hz [Hz].
 /// @throws OptionError naming fmin_hz, fmax_hz and df_hz: not finite,
 ///   0 <= fmin_hz < fmax_hz and df_hz > 0 violated, or more lines than
