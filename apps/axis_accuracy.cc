@@ -12,6 +12,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/machine_files.h"
 #include "robomach/machine/iso230.h"
+#include "robomach/workflows/iso_evaluation.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/json.h"
 
@@ -53,10 +54,10 @@ int Run(int argc, char** argv) {
   return RunGuarded(kTool, [&]() -> int {
     RequireReadableFile(runs_path, "runs file");
     CheckDistinctPaths({{"--runs", runs_path}}, {{"--out", out_path}, {"--plot", plot_path}});
-    const io::IsoEvaluation eval = io::EvaluateIsoRunsFile(runs_path);
+    const workflows::IsoEvaluation eval = workflows::EvaluateIsoRunsFile(runs_path);
     const io::IsoRuns& runs = eval.runs;
     const std::string unit = runs.rotary ? "deg" : "mm";
-    const nlohmann::json j = io::IsoSummaryJson(eval);
+    const nlohmann::json j = workflows::IsoSummaryJson(eval);
     const auto& results = eval.results;
     const int min_runs = eval.min_runs;
     if (!plot_path.empty()) {

@@ -11,7 +11,7 @@
 #include "robomach/common/units.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/acquired_path_file.h"
-#include "robomach/io/acquisition_inputs.h"
+#include "robomach/workflows/acquisition_inputs.h"
 #include "robomach/machine/acquisition.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/json.h"
@@ -79,8 +79,8 @@ int Run(int argc, char** argv) {
                         {"--temperature", temp_path}, {"--program", program_path}},
                        {{"--out", out_path}, {"--summary", summary_path}, {"--plot", plot_path}});
     // Read and check every input before writing anything.
-    const io::AcquisitionInputs in =
-        io::ReadAcquisitionInputs(machine_path, counts_path, comp_path, temp_path, program_path, "--compensation");
+    const workflows::AcquisitionInputs in =
+        workflows::ReadAcquisitionInputs(machine_path, counts_path, comp_path, temp_path, program_path, "--compensation");
     const io::MachineFile& mf = in.machine;
     const io::CompensationTables& tables = in.tables;
     const std::vector<machine::TemperatureCompensation>& temps = in.temperatures;

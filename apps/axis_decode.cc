@@ -8,7 +8,7 @@
 #include "cli_support.h"
 #include "robomach/common/errors.h"
 #include "robomach/io/atomic_file.h"
-#include "robomach/io/capture_decoding.h"
+#include "robomach/workflows/capture_decoding.h"
 #include "robomach/io/counts_file.h"
 #include "robomach/io/machine_file.h"
 #include "robomach/io/number_format.h"
@@ -66,7 +66,7 @@ int Run(int argc, char** argv) {
     for (const std::string& w : mf.implausible) Warn(kTool, w);
     const auto& axes = mf.machine.axes;
     ProgressLine progress(kTool, "samples", static_cast<long>(std::filesystem::file_size(capture_path) / 2));
-    io::CaptureDecoding d;
+    workflows::CaptureDecoding d;
     io::WriteFileAtomically(out_path, [&](std::ostream& out) {
       io::CountsWriter writer(out, axes,
                               {{"generator", "axis-decode (robomach)"},
@@ -74,12 +74,12 @@ int Run(int argc, char** argv) {
                                {"sample_rate_hz", io::FormatDouble(rate_hz)},
                                {"every", std::to_string(every)},
                                {"glitch_filter", std::to_string(filter)}});
-      d = io::DecodeCaptureFile(capture_path, mf, rate_hz, every, filter,
+      d = workflows::DecodeCaptureFile(capture_path, mf, rate_hz, every, filter,
                                 [&](double t_s, const std::int64_t* counts) { writer.Row(t_s, counts); },
                                 [&](long done, long) { progress.Update(done); });
     });
     progress.Finish();
-    const nlohmann::json j = io::CaptureDecodingSummaryJson(d, axes, rate_hz, every, filter);
+    const nlohmann::json j = workflows::CaptureDecodingSummaryJson(d, axes, rate_hz, every, filter);
     if (!summary_path.empty()) io::WriteFileAtomically(summary_path, SummaryText(j));
     for (const Finding& f : d.findings) Warn(kTool, f.message);
     return mf.implausible.empty() && rate_w.empty() ? ExitCodeFor(d.status()) : kExitFlagged;

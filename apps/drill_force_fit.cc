@@ -17,7 +17,7 @@
 #include "robomach/drilling/plausibility.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/drilling_files.h"
-#include "robomach/io/drilling_setup.h"
+#include "robomach/workflows/drilling_setup.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
 
@@ -132,7 +132,7 @@ int RunDrillForceFit(int argc, char** argv) {
     if (!predict_path.empty()) RequireReadableFile(predict_path, "rows to predict");
     drilling::ForceFitOptions options;
     options.chisel = FromOption("--chisel", [&] { return drilling::ParseChiselModel(chisel); });
-    const io::ForceFitRun run = io::FitForceTableFiles(table_path, drill_path, options);
+    const workflows::ForceFitRun run = workflows::FitForceTableFiles(table_path, drill_path, options);
     const io::ForceTableFile& table = run.table;
     const io::DrillFile& drill = run.drill;
     const drilling::ForceFitResult& fit = run.fit;

@@ -24,7 +24,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/drill_series_file.h"
 #include "robomach/io/drilling_files.h"
-#include "robomach/io/drilling_setup.h"
+#include "robomach/workflows/drilling_setup.h"
 #include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/json.h"
@@ -148,7 +148,7 @@ int RunDrillSim(int argc, char** argv) {
     RequireReadableFile(robot_path, "robot file");
     RequireReadableFile(drill_path, "drill file");
     RequireReadableFile(material_path, "material file");
-    const io::DrillingSetup setup = io::LoadDrillingSetup(robot_path, drill_path, material_path, limit_Nm);
+    const workflows::DrillingSetup setup = workflows::LoadDrillingSetup(robot_path, drill_path, material_path, limit_Nm);
     for (const auto& u : setup.robot_file.unused_sections) {
       Warn(kTool, robot_path + ": section '" + u + "' is not used by drill-sim");
     }

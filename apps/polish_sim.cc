@@ -16,7 +16,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/number_format.h"
-#include "robomach/io/polish_simulation.h"
+#include "robomach/workflows/polish_simulation.h"
 #include "robomach/io/polishing_summary.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/paths.h"
@@ -73,8 +73,8 @@ int Run(int argc, char** argv) {
     std::vector<std::string> implausible;  // unit findings of the process file
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path, &implausible);
     for (const std::string& w : implausible) Warn(kTool, w);
-    io::PolishSimulation sim =
-        io::SimulatePolishPathFile(surface, process, path_in, MmToM(sample_mm), surface_path, process_path);
+    workflows::PolishSimulation sim =
+        workflows::SimulatePolishPathFile(surface, process, path_in, MmToM(sample_mm), surface_path, process_path);
     io::PolishPathFile& file = sim.file;
     const polishing::SampleGrid& grid = *sim.grid;
     const std::vector<double>& removal = sim.removal;
@@ -84,7 +84,7 @@ int Run(int argc, char** argv) {
     const std::string unpolished = polishing::DescribeUnpolished(
         stats, grid.region_area(), file.metadata.count("pattern") > 0 ? file.metadata.at("pattern") : std::string());
     if (!unpolished.empty()) Warn(kTool, unpolished);
-    nlohmann::json summary = io::PolishSimSummaryJson(sim, process, sample_mm);
+    nlohmann::json summary = workflows::PolishSimSummaryJson(sim, process, sample_mm);
     if (robot.Check(kTool, process, file.rows, &summary)) flagged = true;
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, grid, removal);
     robot.WriteJoints(file.rows);

@@ -220,7 +220,7 @@ std::vector<std::string> WritePictures(const std::string& png, const polishing::
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/number_format.h"
-#include "robomach/io/polish_robot_check.h"
+#include "robomach/workflows/polish_robot_check.h"
 
 namespace robomach::apps {
 
@@ -254,9 +254,9 @@ bool RobotOptions::Check(const std::string& tool, const polishing::PolishingProc
   if (!robot_) return false;
   Eigen::VectorXd q0(robot_->num_joints());
   for (int j = 0; j < q0.size(); ++j) q0(j) = DegToRad(seed_deg_[j]);
-  check_ = io::CheckPolishPathOnRobot(*robot_, io::PartFrameFromMmDeg(part_), process, rows, q0);
-  (*summary)["robot"] = io::PolishRobotSummaryJson(rows, check_);
-  const RunFindings verdict = io::JudgePolishPathOnRobot(check_);
+  check_ = workflows::CheckPolishPathOnRobot(*robot_, workflows::PartFrameFromMmDeg(part_), process, rows, q0);
+  (*summary)["robot"] = workflows::PolishRobotSummaryJson(rows, check_);
+  const RunFindings verdict = workflows::JudgePolishPathOnRobot(check_);
   for (const Finding& f : verdict.findings) Warn(tool, f.message);
   return verdict.flagged();
 }

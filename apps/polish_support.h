@@ -1,7 +1,7 @@
 #pragma once
 
 // Shared by polish-plan and polish-sim: surface loading, the pictures and
-// the "on the robot" options (the work is in io/polish_robot_check.h).
+// the "on the robot" options (the work is in workflows/polish_robot_check.h).
 
 #include <memory>
 #include <string>
@@ -82,7 +82,7 @@ class RobotOptions {
   void Prepare(std::vector<std::pair<std::string, std::string>>* outs);
   bool enabled() const { return robot_ != nullptr; }
   const std::string& robot_path() const { return robot_path_; }
-  /// Checks `rows` on the robot (io::CheckPolishPathOnRobot), fills
+  /// Checks `rows` on the robot (workflows::CheckPolishPathOnRobot), fills
   /// summary["robot"], warns on stderr under `tool` for flagged rows and
   /// returns true if any row is flagged.
   bool Check(const std::string& tool, const polishing::PolishingProcess& process,

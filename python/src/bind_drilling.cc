@@ -1,5 +1,5 @@
 // Python bindings of the drilling robot (docs/python.md): drill-sim's call
-// (io::LoadDrillingSetup, then drilling::RunControllers) and its series CSV.
+// (workflows::LoadDrillingSetup, then drilling::RunControllers) and its series CSV.
 #include <cmath>
 #include <map>
 #include <string>
@@ -12,7 +12,7 @@
 #include "robomach/drilling/force_fit.h"
 #include "robomach/io/drill_series_file.h"
 #include "robomach/io/atomic_file.h"
-#include "robomach/io/drilling_setup.h"
+#include "robomach/workflows/drilling_setup.h"
 
 namespace robomach::python {
 
@@ -85,7 +85,7 @@ void BindDrilling(py::module_& m) {
     std::vector<std::string> findings;
     {
       py::gil_scoped_release release;
-      io::DrillingSetup setup = io::LoadDrillingSetup(robot, drill, material, motor_torque_limit_Nm);
+      workflows::DrillingSetup setup = workflows::LoadDrillingSetup(robot, drill, material, motor_torque_limit_Nm);
       o.motor_torque_limit = setup.motor_torque_limit;
       runs = drilling::RunControllers(*setup.scenario, o);
       findings = setup.unit_findings;
@@ -104,10 +104,10 @@ void BindDrilling(py::module_& m) {
     RequireReadableFile(drill);
     drilling::ForceFitOptions o;
     o.chisel = drilling::ParseChiselModel(chisel);
-    io::ForceFitRun run;
+    workflows::ForceFitRun run;
     {
       py::gil_scoped_release release;
-      run = io::FitForceTableFiles(table, drill, o);
+      run = workflows::FitForceTableFiles(table, drill, o);
     }
     const drilling::ForceFitResult& f = run.fit;
     py::dict d;

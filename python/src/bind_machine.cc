@@ -10,13 +10,13 @@
 #include "bindings.h"
 #include "robomach/common/errors.h"
 #include "robomach/io/acquired_path_file.h"
-#include "robomach/io/acquisition_inputs.h"
+#include "robomach/workflows/acquisition_inputs.h"
 #include "robomach/common/number_format.h"
 #include "robomach/io/atomic_file.h"
-#include "robomach/io/capture_decoding.h"
+#include "robomach/workflows/capture_decoding.h"
 #include "robomach/io/counts_file.h"
 #include "robomach/io/machine_file.h"
-#include "robomach/io/iso_runs_file.h"
+#include "robomach/workflows/iso_evaluation.h"
 #include "robomach/machine/iso230.h"
 
 namespace robomach::python {
@@ -29,7 +29,7 @@ void BindMachine(py::module_& m) {
                           temperature, program}) {
       if (p) RequireReadableFile(*p);
     }
-    const io::AcquisitionInputs in = io::ReadAcquisitionInputs(machine_path, counts_path, compensation.value_or(""),
+    const workflows::AcquisitionInputs in = workflows::ReadAcquisitionInputs(machine_path, counts_path, compensation.value_or(""),
                                                                 temperature.value_or(""), program.value_or(""));
     // axis-acquire's exit 3 (docs/plausibility.md): a UnitWarning per finding
     // of the machine file, the tables, the temperature log and the counts.
@@ -109,10 +109,10 @@ void BindMachine(py::module_& m) {
     const int n = static_cast<int>(mf.machine.axes.size());
     std::vector<double> t;
     std::vector<std::int64_t> counts;
-    io::CaptureDecoding d;
+    workflows::CaptureDecoding d;
     {
       py::gil_scoped_release release;
-      d = io::DecodeCaptureFile(capture, mf, sample_rate_hz, every, glitch_filter, [&](double t_s, const std::int64_t* c) {
+      d = workflows::DecodeCaptureFile(capture, mf, sample_rate_hz, every, glitch_filter, [&](double t_s, const std::int64_t* c) {
         t.push_back(t_s);
         counts.insert(counts.end(), c, c + n);
       });
@@ -155,7 +155,7 @@ void BindMachine(py::module_& m) {
 
   m.def("iso230_evaluate", [](const std::string& runs_path) {
     RequireReadableFile(runs_path);
-    const io::IsoEvaluation eval = io::EvaluateIsoRunsFile(runs_path);
+    const workflows::IsoEvaluation eval = workflows::EvaluateIsoRunsFile(runs_path);
     py::dict axes;
     for (const auto& [axis, r] : eval.results) {
       py::dict a;

@@ -9,7 +9,7 @@
 #include "bindings.h"
 #include "robomach/common/units.h"
 #include "robomach/io/cad_face.h"
-#include "robomach/io/polish_simulation.h"
+#include "robomach/workflows/polish_simulation.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/face_check.h"
 #include "robomach/polishing/path_patterns.h"
@@ -231,19 +231,19 @@ void BindPolishing(py::module_& m) {
      "for the cycloid, one contact width for the zig-zag. surface_source and process_source name the files in "
      "errors. The GIL is released while it runs.");
 
-  py::class_<io::PolishSimulation>(m, "PolishSimulation", "A path file simulated on a surface (polish-sim's result).")
-      .def_property_readonly("removal_m", [](const io::PolishSimulation& r) { return r.removal; },
+  py::class_<workflows::PolishSimulation>(m, "PolishSimulation", "A path file simulated on a surface (polish-sim's result).")
+      .def_property_readonly("removal_m", [](const workflows::PolishSimulation& r) { return r.removal; },
                              "removal at every grid point [m]")
-      .def_property_readonly("stats", [](const io::PolishSimulation& r) { return StatsDict(r.stats); })
-      .def_readonly("max_speed_m_per_s", &io::PolishSimulation::max_speed)
-      .def_readonly("speed_limit_exceeded", &io::PolishSimulation::speed_limit_exceeded,
+      .def_property_readonly("stats", [](const workflows::PolishSimulation& r) { return StatsDict(r.stats); })
+      .def_readonly("max_speed_m_per_s", &workflows::PolishSimulation::max_speed)
+      .def_readonly("speed_limit_exceeded", &workflows::PolishSimulation::speed_limit_exceeded,
                     "polish-sim exits 3: a segment faster than the process's max_speed beyond the file's rounding")
-      .def_property_readonly("status", [](const io::PolishSimulation& r) { return RunStatusName(r.status()); },
+      .def_property_readonly("status", [](const workflows::PolishSimulation& r) { return RunStatusName(r.status()); },
                              "'ok' or 'flagged'")
-      .def_property_readonly("findings", [](const io::PolishSimulation& r) { return FindingMessages(r); },
+      .def_property_readonly("findings", [](const workflows::PolishSimulation& r) { return FindingMessages(r); },
                              "why it is flagged (polish-sim's warnings)")
-      .def_property_readonly("rows", [](const io::PolishSimulation& r) { return r.file.rows.size(); })
-      .def("__repr__", [](const io::PolishSimulation& r) {
+      .def_property_readonly("rows", [](const workflows::PolishSimulation& r) { return r.file.rows.size(); })
+      .def("__repr__", [](const workflows::PolishSimulation& r) {
         return "<PolishSimulation " + std::to_string(r.file.rows.size()) + " rows>";
       });
   m.def("simulate_polish_path", [](const SurfacePtr& surface, const PolishingProcess& process, const std::string& path,
@@ -251,12 +251,12 @@ void BindPolishing(py::module_& m) {
     RequireReadableFile(path);
     if (!(sample_mm > 0.0 && sample_mm <= 0.5)) throw std::invalid_argument("sample_mm: expected in (0, 0.5]");
     py::gil_scoped_release release;
-    return io::SimulatePolishPathFile(*surface, process, path, MmToM(sample_mm), surface_source, process_source);
+    return workflows::SimulatePolishPathFile(*surface, process, path, MmToM(sample_mm), surface_source, process_source);
   }, py::arg("surface").none(false), py::arg("process"), py::arg("path"), py::arg("sample_mm") = 0.5,
      py::arg("surface_source") = "surface", py::arg("process_source") = "process",
      "polish-sim's call: the tool path file (docs/formats.md §6) attached to the surface and simulated "
      "(Hertz contact, Preston removal) on the region sampled every sample_mm.");
-  m.def("write_simulated_removal_map", [](const std::string& path, const io::PolishSimulation& r) {
+  m.def("write_simulated_removal_map", [](const std::string& path, const workflows::PolishSimulation& r) {
     io::WriteRemovalMap(path, *r.grid, r.removal);
   }, py::arg("path"), py::arg("simulation"), "polish-sim's --removal, atomic.");
 

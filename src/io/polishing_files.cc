@@ -289,4 +289,20 @@ std::vector<std::pair<std::string, std::string>> PlannedPathMetadata(const polis
   return meta;
 }
 
+void WriteJointTrajectoryCsv(const std::string& path, const std::vector<polishing::PathRow>& rows,
+                             const kinematics::PosePathCheck& check, int num_joints) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "t_s";
+    for (int j = 0; j < num_joints; ++j) out << ",q" << j + 1 << "_deg";
+    out << ",reachable,limit_margin_deg,jacobian_condition\n";
+    for (size_t r = 0; r < rows.size(); ++r) {
+      out << FormatDouble(rows[r].t);
+      for (int j = 0; j < num_joints; ++j) out << ',' << (check.reachable[r] ? FormatDouble(RadToDeg(check.q[r](j))) : "");
+      out << ',' << (check.reachable[r] ? 1 : 0) << ','
+          << (check.reachable[r] ? FormatDouble(RadToDeg(check.limit_margin[r])) : "") << ','
+          << (check.reachable[r] ? FormatDouble(check.condition[r]) : "") << '\n';
+    }
+  });
+}
+
 }  // namespace robomach::io

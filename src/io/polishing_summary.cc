@@ -138,26 +138,4 @@ nlohmann::json PolishPlanSummaryJson(const polishing::PlanOutcome& outcome, cons
   return summary;
 }
 
-nlohmann::json PolishSimSummaryJson(const PolishSimulation& sim, const polishing::PolishingProcess& process,
-                                    double sample_mm) {
-  const PolishPathFile& file = sim.file;
-  nlohmann::json summary;
-  summary["removal_um"] = RemovalSummaryJson(sim.stats);
-  summary["path"] = PathSummaryJson(file.rows);
-  auto meta = [&](const char* k) {
-    const auto it = file.metadata.find(k);
-    double v = 0;
-    return it != file.metadata.end() && ParseFiniteNumber(it->second, &v) ? v : 0.0;
-  };
-  const auto pat = file.metadata.find("pattern");
-  const std::string pattern = pat != file.metadata.end() ? pat->second : std::string("unknown");
-  summary["parameters"] = {{"pattern", pattern},
-                           {"offset_mm", meta("offset_mm")}, {"radius_mm", meta("radius_mm")},
-                           {"pitch_mm", meta("pitch_mm")}, {"omega_rad_per_s", 0.0},
-                           {"centre_speed_mm_per_s", 0.0}};
-  summary["region"] = RegionSummaryJson(*sim.grid, sim.stats, sample_mm, process);
-  summary["speed_limit_exceeded"] = sim.speed_limit_exceeded;
-  return summary;
-}
-
 }  // namespace robomach::io

@@ -11,7 +11,8 @@
 #include "robomach/common/units.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/kq_files.h"
-#include "robomach/io/polish_robot_check.h"
+#include "robomach/io/polishing_files.h"
+#include "robomach/workflows/polish_robot_check.h"
 #include "test_support.h"
 
 namespace robomach::io {
@@ -56,26 +57,26 @@ TEST(LoadTestPlanCsv, RefusesSplitPosturesAndEmptyPlansWithTheLine) {
 }
 
 TEST(PartFrameFromMmDeg, MillimetresAndFixedAxisAnglesZYX) {
-  const Eigen::Isometry3d t = PartFrameFromMmDeg({100, 200, 300, 0, 0, 0});
+  const Eigen::Isometry3d t = workflows::PartFrameFromMmDeg({100, 200, 300, 0, 0, 0});
   EXPECT_TRUE(t.translation().isApprox(Eigen::Vector3d(0.1, 0.2, 0.3)));
   EXPECT_TRUE(t.linear().isIdentity(1e-15));
   // rx = 90 deg turns y into z; rz = 90 deg then turns x into y and leaves z.
-  const Eigen::Matrix3d R = PartFrameFromMmDeg({0, 0, 0, 90, 0, 90}).linear();
+  const Eigen::Matrix3d R = workflows::PartFrameFromMmDeg({0, 0, 0, 90, 0, 90}).linear();
   EXPECT_TRUE((R * Eigen::Vector3d::UnitY()).isApprox(Eigen::Vector3d::UnitZ(), 1e-12));
   EXPECT_TRUE((R * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY(), 1e-12));
   // ry = 90 deg turns z into x.
-  const Eigen::Matrix3d Ry = PartFrameFromMmDeg({0, 0, 0, 0, 90, 0}).linear();
+  const Eigen::Matrix3d Ry = workflows::PartFrameFromMmDeg({0, 0, 0, 0, 90, 0}).linear();
   EXPECT_TRUE((Ry * Eigen::Vector3d::UnitZ()).isApprox(Eigen::Vector3d::UnitX(), 1e-12));
-  EXPECT_THROW(PartFrameFromMmDeg({1, 2, 3}), std::invalid_argument);
+  EXPECT_THROW(workflows::PartFrameFromMmDeg({1, 2, 3}), std::invalid_argument);
 }
 
 TEST(PolishPathOnRobot, VerdictCountsTheFlaggedRowsAndNamesTheFirst) {
   kinematics::PosePathCheck check;
-  EXPECT_FALSE(JudgePolishPathOnRobot(check).flagged());
+  EXPECT_FALSE(workflows::JudgePolishPathOnRobot(check).flagged());
   check.num_unreachable = 2;
   check.num_jumps = 1;
   check.first_bad_row = 4;
-  const RunFindings v = JudgePolishPathOnRobot(check);
+  const RunFindings v = workflows::JudgePolishPathOnRobot(check);
   ASSERT_EQ(v.findings.size(), 1u);
   EXPECT_EQ(v.findings[0].message,
             "2 rows unreachable, 0 outside the joint limits, 1 with a joint jump > 0.5 rad (first: row 5)");

@@ -10,7 +10,8 @@
 #include <sstream>
 
 #include "robomach/common/units.h"
-#include "robomach/io/capture_decoding.h"
+#include "robomach/workflows/capture_decoding.h"
+#include "robomach/workflows/iso_evaluation.h"
 #include "robomach/io/iso_runs_file.h"
 #include "test_support.h"
 
@@ -292,7 +293,7 @@ TEST(TemperatureLog, ACompensationFileOrAnotherKindIsNamed) {
 TEST(CaptureFile, TextOrAKnownBinaryKindIsNamedNotDecoded) {
   const MachineFile m = DefaultMachine();
   const auto error = [&](const std::string& path) {
-    return CaptureError([&] { DecodeCaptureFile(path, m, 2e6, 250, 0, [](double, const std::int64_t*) {}); });
+    return CaptureError([&] { workflows::DecodeCaptureFile(path, m, 2e6, 250, 0, [](double, const std::int64_t*) {}); });
   };
   const std::string counts = error(SourcePath("tests/data/machine/counts_tiny.csv"));
   EXPECT_THAT(counts, HasSubstr("counts_tiny.csv: this is a CSV table; expected the raw binary capture"));
@@ -307,7 +308,7 @@ TEST(CaptureFile, TextOrAKnownBinaryKindIsNamedNotDecoded) {
   // A real capture (every word's high byte below 0x04 for five axes) is
   // binary and decodes; an empty one keeps its own message.
   long rows = 0;
-  DecodeCaptureFile(WriteText(dir + "/ok.bin", std::string("\x00\x00\x01\x00\x03\x00\x02\x00", 8)), m, 1e6, 1, 0,
+  workflows::DecodeCaptureFile(WriteText(dir + "/ok.bin", std::string("\x00\x00\x01\x00\x03\x00\x02\x00", 8)), m, 1e6, 1, 0,
                     [&](double, const std::int64_t*) { ++rows; });
   EXPECT_EQ(rows, 4);
   EXPECT_THAT(error(WriteText(dir + "/empty.bin", "")), HasSubstr("the capture is empty"));
@@ -371,9 +372,9 @@ TEST(IsoRuns, ShortStrokeAxisIsPlausibleAndMicrometresUnderMmAreNot) {
         }
       }
     }
-    return EvaluateIsoRunsFile(WriteText(dir + "/" + name, os.str()));
+    return workflows::EvaluateIsoRunsFile(WriteText(dir + "/" + name, os.str()));
   };
-  const IsoEvaluation good = file("short.csv", 1.0, 1.0);
+  const workflows::IsoEvaluation good = file("short.csv", 1.0, 1.0);
   ASSERT_EQ(good.results.size(), 1u);
   double dev = 0.0;
   for (const machine::Iso230Target& t : good.results[0].second.targets) {
@@ -383,13 +384,13 @@ TEST(IsoRuns, ShortStrokeAxisIsPlausibleAndMicrometresUnderMmAreNot) {
   EXPECT_GT(dev, machine::kMaxPlausibleDeviationFraction * 8.0);  // the former rule's false alarm
   EXPECT_TRUE(good.unit_findings.empty()) << good.unit_findings.front();
   EXPECT_EQ(good.status(), RunStatus::kOk);
-  const IsoEvaluation dev_um = file("short_dev_um.csv", 1000.0, 1.0);
+  const workflows::IsoEvaluation dev_um = file("short_dev_um.csv", 1000.0, 1.0);
   ASSERT_EQ(dev_um.unit_findings.size(), 1u);
   EXPECT_THAT(dev_um.unit_findings[0], HasSubstr("axis X: deviations up to 95.81 mm are 1.2e+03 % of the targets' "
                                                   "magnitude (8 mm"));
   EXPECT_THAT(dev_um.unit_findings[0], HasSubstr("measured values in um (or targets in m) under the _mm headers"));
   EXPECT_EQ(dev_um.status(), RunStatus::kFlagged);
-  const IsoEvaluation measured_um = file("short_measured_um.csv", 1.0, 1000.0);
+  const workflows::IsoEvaluation measured_um = file("short_measured_um.csv", 1.0, 1000.0);
   ASSERT_EQ(measured_um.unit_findings.size(), 1u);
   EXPECT_THAT(measured_um.unit_findings[0], HasSubstr("measured values in um"));
 }

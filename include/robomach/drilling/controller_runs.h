@@ -63,7 +63,7 @@ std::vector<ControllerRun> RunControllers(DrillingScenario& scenario, const Cont
 
 /// drill-sim's verdict (its exit 3): one finding per run that diverged, then
 /// one per implausible unit of the set-up (`unit_findings`, as
-/// io::LoadDrillingSetup gives them).
+/// workflows::LoadDrillingSetup gives them).
 RunFindings JudgeControllerRuns(const std::vector<ControllerRun>& runs, const std::vector<std::string>& unit_findings);
 
 }  // namespace robomach::drilling

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "robomach/kinematics/pose_path.h"
 #include "robomach/polishing/nurbs_surface.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/process.h"
@@ -73,5 +74,10 @@ std::vector<std::pair<std::string, std::string>> PlannedPathMetadata(const polis
 
 /// Removal map CSV x_mm,y_mm,z_mm,u,v,removal_um of the region's points. Atomic.
 void WriteRemovalMap(const std::string& path, const polishing::SampleGrid& grid, const std::vector<double>& removal_m);
+
+/// Joint trajectory CSV: t_s,q1_deg..qn_deg,reachable,limit_margin_deg,jacobian_condition
+/// (empty cells where a row is unreachable). Atomic.
+void WriteJointTrajectoryCsv(const std::string& path, const std::vector<polishing::PathRow>& rows,
+                             const kinematics::PosePathCheck& check, int num_joints);
 
 }  // namespace robomach::io

@@ -8,7 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "robomach/io/polish_simulation.h"
+#include "robomach/io/polishing_files.h"
+#include "robomach/polishing/removal.h"
+#include "robomach/polishing/surface_grid.h"
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/plan_workflow.h"
 #include "robomach/polishing/process.h"
@@ -37,10 +39,5 @@ nlohmann::json RegionSummaryJson(const polishing::SampleGrid& grid, const polish
 /// zig-zag).
 nlohmann::json PolishPlanSummaryJson(const polishing::PlanOutcome& outcome, const polishing::PlanningContext& context,
                                      const polishing::PlanOptions& options);
-
-/// polish-sim's summary of a simulated path file: removal_um, path,
-/// parameters (from the file's header), region, speed_limit_exceeded.
-nlohmann::json PolishSimSummaryJson(const PolishSimulation& sim, const polishing::PolishingProcess& process,
-                                    double sample_mm);
 
 }  // namespace robomach::io

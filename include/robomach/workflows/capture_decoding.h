@@ -14,7 +14,7 @@
 #include "robomach/common/run_status.h"
 #include "robomach/io/machine_file.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
 /// Flagged (RunFindings; axis-decode's exit 3) when any axis has error
 /// events: each leaves its position uncertain by 2 counts.
@@ -29,7 +29,7 @@ struct CaptureDecoding : RunFindings {
 /// every, 2 every, ... (t_s = sample / rate_hz; counts in axes order).
 /// @throws InputError naming the capture for an odd size (a truncated
 ///   16-bit word), an empty capture or a read error.
-CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const MachineFile& machine, double rate_hz,
+CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const io::MachineFile& machine, double rate_hz,
                                   long every, int glitch_filter,
                                   const std::function<void(double, const std::int64_t*)>& on_row,
                                   const ProgressCallback& progress = {});
@@ -39,4 +39,4 @@ CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const Machine
 nlohmann::json CaptureDecodingSummaryJson(const CaptureDecoding& decoding, const std::vector<machine::AxisScale>& axes,
                                           double rate_hz, long every, int glitch_filter);
 
-}  // namespace robomach::io
+}  // namespace robomach::workflows

@@ -1,4 +1,4 @@
-#include "robomach/io/capture_decoding.h"
+#include "robomach/workflows/capture_decoding.h"
 
 #include <algorithm>
 #include <bit>
@@ -9,9 +9,9 @@
 #include "robomach/io/file_kind.h"
 #include "robomach/machine/quadrature_decoder.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
-CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const MachineFile& mf, double rate_hz, long every,
+CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const io::MachineFile& mf, double rate_hz, long every,
                                   int filter, const std::function<void(double, const std::int64_t*)>& on_row,
                                   const ProgressCallback& progress) {
   if (!(rate_hz > 0.0) || every < 1 || filter < 0) {
@@ -23,7 +23,7 @@ CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const Machine
   if (ec) throw InputError({capture_path, 0, 0}, "cannot open file for reading");
   // Text (a counts CSV given as the capture) or a PNG decodes to millions
   // of error events; name what the file is instead (file_kind.h).
-  RequireBinaryFile(capture_path, kCaptureFileFormat);
+  io::RequireBinaryFile(capture_path, io::kCaptureFileFormat);
   if (bytes % 2 != 0) {
     throw InputError({capture_path, 0, 0}, "size " + std::to_string(bytes) +
                                                " bytes is not a whole number of 16-bit words (truncated capture?)");
@@ -89,4 +89,4 @@ nlohmann::json CaptureDecodingSummaryJson(const CaptureDecoding& d, const std::v
   return j;
 }
 
-}  // namespace robomach::io
+}  // namespace robomach::workflows

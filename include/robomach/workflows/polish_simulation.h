@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "robomach/common/run_status.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/nurbs_surface.h"
@@ -14,12 +16,12 @@
 #include "robomach/polishing/removal.h"
 #include "robomach/polishing/surface_grid.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
 /// Flagged (RunFindings; polish-sim's exit 3) when the path is faster than
 /// the process allows.
 struct PolishSimulation : RunFindings {
-  PolishPathFile file;      // the rows attached to the surface (u, v filled)
+  io::PolishPathFile file;      // the rows attached to the surface (u, v filled)
   std::shared_ptr<const polishing::SampleGrid> grid;
   std::vector<double> removal;  // at every grid point [m]
   polishing::RemovalStats stats;
@@ -39,4 +41,9 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
                                         double sample_spacing, const std::string& surface_source,
                                         const std::string& process_source);
 
-}  // namespace robomach::io
+/// polish-sim's summary of a simulated path file: removal_um, path,
+/// parameters (from the file's header), region, speed_limit_exceeded.
+nlohmann::json PolishSimSummaryJson(const PolishSimulation& sim, const polishing::PolishingProcess& process,
+                                    double sample_mm);
+
+}  // namespace robomach::workflows

@@ -17,11 +17,11 @@
 #include "robomach/drilling/force_fit.h"
 #include "robomach/io/drilling_files.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
 struct DrillingSetup {
-  FlexibleRobotFile robot_file;
-  DrillFile drill;
+  io::FlexibleRobotFile robot_file;
+  io::DrillFile drill;
   drilling::DrillingMaterial material;
   std::unique_ptr<drilling::FlexibleJointRobot> robot;
   std::unique_ptr<drilling::DrillingScenario> scenario;  // on *robot
@@ -44,8 +44,8 @@ DrillingSetup LoadDrillingSetup(const std::string& robot_path, const std::string
 /// did not converge, the Kienzle exponent ended on its bound, the model
 /// misses a row by more than 10 %, or a unit is implausible.
 struct ForceFitRun : RunFindings {
-  ForceTableFile table;
-  DrillFile drill;
+  io::ForceTableFile table;
+  io::DrillFile drill;
   drilling::ForceFitResult fit;
   std::string material_yaml;  // MaterialYaml of the fit (empty when it failed)
   /// Unit plausibility of the table, the fitted material and the drill
@@ -58,4 +58,4 @@ struct ForceFitRun : RunFindings {
 ForceFitRun FitForceTableFiles(const std::string& table_path, const std::string& drill_path,
                                const drilling::ForceFitOptions& options = {});
 
-}  // namespace robomach::io
+}  // namespace robomach::workflows

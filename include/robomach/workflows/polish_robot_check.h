@@ -16,7 +16,7 @@
 #include "robomach/polishing/paths.h"
 #include "robomach/polishing/process.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
 /// X_BP from x, y, z [mm] and rx, ry, rz [deg] about the fixed x, y, z axes
 /// (R = Rz Ry Rx). @throws std::invalid_argument unless 6 numbers.
@@ -43,9 +43,5 @@ RunFindings JudgePolishPathOnRobot(const kinematics::PosePathCheck& check);
 nlohmann::json PolishRobotSummaryJson(const std::vector<polishing::PathRow>& rows,
                                       const kinematics::PosePathCheck& check);
 
-/// Joint trajectory CSV: t_s,q1_deg..qn_deg,reachable,limit_margin_deg,jacobian_condition
-/// (empty cells where a row is unreachable). Atomic.
-void WriteJointTrajectoryCsv(const std::string& path, const std::vector<polishing::PathRow>& rows,
-                             const kinematics::PosePathCheck& check, int num_joints);
 
-}  // namespace robomach::io
+}  // namespace robomach::workflows

@@ -1,20 +1,20 @@
-#include "robomach/io/drilling_setup.h"
+#include "robomach/workflows/drilling_setup.h"
 
 #include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
 #include "robomach/drilling/plausibility.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
 DrillingSetup LoadDrillingSetup(const std::string& robot_path, const std::string& drill_path,
                                 const std::string& material_path, double motor_torque_limit_Nm) {
   DrillingSetup s;
-  s.robot_file = ReadFlexibleRobotFile(robot_path);
-  s.drill = ReadDrillFile(drill_path);
+  s.robot_file = io::ReadFlexibleRobotFile(robot_path);
+  s.drill = io::ReadDrillFile(drill_path);
   if (!s.drill.has_process) {
     throw InputError({drill_path, 0, 0}, "expected a 'process:' section (feed, speed, posture, hole axis)");
   }
-  s.material = ReadMaterialFile(material_path);
+  s.material = io::ReadMaterialFile(material_path);
   s.robot = std::make_unique<drilling::FlexibleJointRobot>(s.robot_file.chain, s.robot_file.drives);
   const int n = s.robot->num_joints();
   if (s.drill.process.initial_posture.size() != n) {
@@ -48,8 +48,8 @@ DrillingSetup LoadDrillingSetup(const std::string& robot_path, const std::string
 ForceFitRun FitForceTableFiles(const std::string& table_path, const std::string& drill_path,
                                const drilling::ForceFitOptions& options) {
   ForceFitRun r;
-  r.table = ReadForceTable(table_path);
-  r.drill = ReadDrillFile(drill_path);
+  r.table = io::ReadForceTable(table_path);
+  r.drill = io::ReadDrillFile(drill_path);
   if (r.table.rows.size() < 2) {
     throw InputError({table_path, r.table.lines.back(), 0},
                      "expected at least 2 rows to fit 3 coefficients to thrust and torque");
@@ -61,7 +61,7 @@ ForceFitRun FitForceTableFiles(const std::string& table_path, const std::string&
     throw InputError({table_path, r.table.lines.at(e.row()), 0}, e.what());
   }
   if (r.fit.status == drilling::FitStatus::kFailed) return r;
-  r.material_yaml = MaterialYaml(r.fit, r.drill.drill, r.table);
+  r.material_yaml = io::MaterialYaml(r.fit, r.drill.drill, r.table);
   r.unit_findings = drilling::ForceTableFindings(r.table.rows);
   for (const auto& more : {drilling::MaterialFindings(r.fit.material), drilling::ToolingFindings(r.drill.drill, nullptr)}) {
     r.unit_findings.insert(r.unit_findings.end(), more.begin(), more.end());
@@ -79,4 +79,4 @@ ForceFitRun FitForceTableFiles(const std::string& table_path, const std::string&
   return r;
 }
 
-}  // namespace robomach::io
+}  // namespace robomach::workflows

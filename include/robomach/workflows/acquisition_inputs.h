@@ -14,11 +14,11 @@
 #include "robomach/machine/compensation.h"
 #include "robomach/machine/synthesis.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
 struct AcquisitionInputs {
-  MachineFile machine;
-  CompensationTables tables;                                 // empty without a compensation file
+  io::MachineFile machine;
+  io::CompensationTables tables;                                 // empty without a compensation file
   std::vector<machine::TemperatureCompensation> temperatures;  // empty without a temperature log
   std::unique_ptr<machine::Compensation> compensation;       // all of them; empty() when none
   std::optional<machine::ProgrammedPath> program;
@@ -51,4 +51,4 @@ AcquisitionInputs ReadAcquisitionInputs(const std::string& machine_path, const s
                                         const std::string& program_path = "",
                                         const std::string& compensation_option = "");
 
-}  // namespace robomach::io
+}  // namespace robomach::workflows

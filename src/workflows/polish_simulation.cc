@@ -1,4 +1,7 @@
-#include "robomach/io/polish_simulation.h"
+#include "robomach/workflows/polish_simulation.h"
+
+#include "robomach/io/csv_table.h"
+#include "robomach/io/polishing_summary.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,14 +10,14 @@
 #include "robomach/common/number_format.h"
 #include "robomach/polishing/paths.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
 PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
                                         const polishing::PolishingProcess& process, const std::string& path_file,
                                         double sample_spacing, const std::string& surface_source,
                                         const std::string& process_source) {
   PolishSimulation s;
-  s.file = ReadPolishPath(path_file);
+  s.file = io::ReadPolishPath(path_file);
   try {
     s.grid = std::make_shared<const polishing::SampleGrid>(
         polishing::SampleGrid::Build(surface, sample_spacing, process.margin, process.flip_normal));
@@ -86,4 +89,26 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
   return s;
 }
 
-}  // namespace robomach::io
+nlohmann::json PolishSimSummaryJson(const PolishSimulation& sim, const polishing::PolishingProcess& process,
+                                    double sample_mm) {
+  const io::PolishPathFile& file = sim.file;
+  nlohmann::json summary;
+  summary["removal_um"] = io::RemovalSummaryJson(sim.stats);
+  summary["path"] = io::PathSummaryJson(file.rows);
+  auto meta = [&](const char* k) {
+    const auto it = file.metadata.find(k);
+    double v = 0;
+    return it != file.metadata.end() && io::ParseFiniteNumber(it->second, &v) ? v : 0.0;
+  };
+  const auto pat = file.metadata.find("pattern");
+  const std::string pattern = pat != file.metadata.end() ? pat->second : std::string("unknown");
+  summary["parameters"] = {{"pattern", pattern},
+                           {"offset_mm", meta("offset_mm")}, {"radius_mm", meta("radius_mm")},
+                           {"pitch_mm", meta("pitch_mm")}, {"omega_rad_per_s", 0.0},
+                           {"centre_speed_mm_per_s", 0.0}};
+  summary["region"] = io::RegionSummaryJson(*sim.grid, sim.stats, sample_mm, process);
+  summary["speed_limit_exceeded"] = sim.speed_limit_exceeded;
+  return summary;
+}
+
+}  // namespace robomach::workflows

@@ -1,13 +1,11 @@
-#include "robomach/io/polish_robot_check.h"
+#include "robomach/workflows/polish_robot_check.h"
 
 #include <ostream>
 #include <stdexcept>
 
 #include "robomach/common/units.h"
-#include "robomach/io/atomic_file.h"
-#include "robomach/io/number_format.h"
 
-namespace robomach::io {
+namespace robomach::workflows {
 
 Eigen::Isometry3d PartFrameFromMmDeg(const std::vector<double>& v) {
   if (v.size() != 6) throw std::invalid_argument("part frame: expected x,y,z,rx,ry,rz (6 numbers)");
@@ -54,20 +52,4 @@ nlohmann::json PolishRobotSummaryJson(const std::vector<polishing::PathRow>& row
           {"max_jacobian_condition", c.max_condition}};
 }
 
-void WriteJointTrajectoryCsv(const std::string& path, const std::vector<polishing::PathRow>& rows,
-                             const kinematics::PosePathCheck& check, int num_joints) {
-  WriteFileAtomically(path, [&](std::ostream& out) {
-    out << "t_s";
-    for (int j = 0; j < num_joints; ++j) out << ",q" << j + 1 << "_deg";
-    out << ",reachable,limit_margin_deg,jacobian_condition\n";
-    for (size_t r = 0; r < rows.size(); ++r) {
-      out << FormatDouble(rows[r].t);
-      for (int j = 0; j < num_joints; ++j) out << ',' << (check.reachable[r] ? FormatDouble(RadToDeg(check.q[r](j))) : "");
-      out << ',' << (check.reachable[r] ? 1 : 0) << ','
-          << (check.reachable[r] ? FormatDouble(RadToDeg(check.limit_margin[r])) : "") << ','
-          << (check.reachable[r] ? FormatDouble(check.condition[r]) : "") << '\n';
-    }
-  });
-}
-
-}  // namespace robomach::io
+}  // namespace robomach::workflows
