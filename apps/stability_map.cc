@@ -211,7 +211,7 @@ int Run(int argc, char** argv) {
     // Warned before the summary is written: its `warnings` lists them.
     for (const Finding& f : map.findings) Warn(kTool, f.message);
     if (!summary_path.empty()) {
-      nlohmann::json j = io::StabilityMapSummaryJson(points, map);
+      nlohmann::json j = io::StabilityMapSummaryJson(points, map, stability::FindCriticalDepthExtremes(map.points));
       j["tool"] = kTool;
       j["robot"] = robot_path;
       j["cut"] = cut_path;

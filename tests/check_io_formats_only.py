@@ -49,8 +49,6 @@ PENDING = {
                                      'pipeline for speed)',
     'machine::ContourTracker::Next': 'acquired_path_file.cc: the contour error streamed into the CSV writer',
     'machine::Stats': "acquired_path_file.cc: axis-acquire's contour summary",
-    'stability::FindCriticalDepthExtremes': "stability_map_file.cc: stability-map's summary",
-    'stability::SummarizeLobes': "lobes_file.cc: stability-lobes' summary",
     'calibration::ShapesOfRovingTest': "modal_analysis_files.cc: frf-modes' mode-shape CSV",
     'polishing::ContactLength': "polishing_summary.cc: polish-plan's summary",
     'polishing::CountLifts': "polishing_summary.cc: polish-plan's summary",

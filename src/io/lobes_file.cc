@@ -29,9 +29,10 @@ void WriteLobesCsv(const std::string& path, const std::vector<stability::LobeRow
   WriteFileAtomically(path, [&](std::ostream& os) { WriteLobesCsv(os, rows, with_bounds); });
 }
 
-nlohmann::json LobesSummaryJson(const std::vector<stability::TipDynamics>& tips, const stability::LobesResult& lobes) {
+nlohmann::json LobesSummaryJson(const std::vector<stability::TipDynamics>& tips, const stability::LobesResult& lobes,
+                                const std::vector<stability::LobeSummary>& summaries) {
   nlohmann::json results = nlohmann::json::array();
-  for (const stability::LobeSummary& l : stability::SummarizeLobes(tips, lobes.rows)) {
+  for (const stability::LobeSummary& l : summaries) {
     nlohmann::json r;
     r["pose_id"] = l.id;
     r["method"] = l.method;

@@ -90,7 +90,8 @@ void WriteStabilityMapCsv(const std::string& path, const MapPoints& points,
   });
 }
 
-nlohmann::json StabilityMapSummaryJson(const MapPoints& points, const stability::StabilityMapResult& map) {
+nlohmann::json StabilityMapSummaryJson(const MapPoints& points, const stability::StabilityMapResult& map,
+                                       const stability::CriticalDepthExtremes& e) {
   const std::vector<stability::MapPoint>& pts = map.points;
   nlohmann::json j;
   j["mode"] = points.grid ? "grid" : "path";
@@ -124,7 +125,6 @@ nlohmann::json StabilityMapSummaryJson(const MapPoints& points, const stability:
     w["status"] = stability::ToString(pts[i].status);
     return w;
   };
-  const stability::CriticalDepthExtremes e = stability::FindCriticalDepthExtremes(pts);
   j["points_with_critical_depth"] = e.with_depth;
   if (e.with_depth > 0) {
     j["min_critical_depth_mm"] = MToMm(pts[static_cast<size_t>(e.min_index)].stability.critical_depth);

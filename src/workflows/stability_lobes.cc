@@ -179,7 +179,7 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const Messag
 }
 
 nlohmann::json StabilityLobesRun::Summary(const StabilityLobesOptions& o) const {
-  nlohmann::json j = io::LobesSummaryJson(tips, lobes);
+  nlohmann::json j = io::LobesSummaryJson(tips, lobes, stability::SummarizeLobes(tips, lobes.rows));
   j["cut"] = o.cut_path;
   j["source"] = o.Source();
   if (!o.robot_path.empty()) {

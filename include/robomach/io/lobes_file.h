@@ -27,10 +27,11 @@ void WriteLobesCsv(const std::string& path, const std::vector<stability::LobeRow
 double LobeSpeedRpm(double speed_rad_s);
 
 /// The summary's result part (docs/formats.md §4.1): `lobes`, per tip and
-/// method (SummarizeLobes) the speeds, those with a boundary and, when
+/// method (`summaries`: stability::SummarizeLobes of the rows) the speeds, those with a boundary and, when
 /// any, the smallest and largest critical depth [mm] with their speed
 /// [rpm] (and the chatter frequency at the smallest); then
 /// `no_boundary_at_some_speeds` and `flagged`.
-nlohmann::json LobesSummaryJson(const std::vector<stability::TipDynamics>& tips, const stability::LobesResult& lobes);
+nlohmann::json LobesSummaryJson(const std::vector<stability::TipDynamics>& tips, const stability::LobesResult& lobes,
+                                const std::vector<stability::LobeSummary>& summaries);
 
 }  // namespace robomach::io

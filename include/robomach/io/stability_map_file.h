@@ -47,7 +47,9 @@ void WriteStabilityMapCsv(const std::string& path, const MapPoints& points,
 
 /// The summary's result part (docs/formats.md §4.1): mode, points, grid
 /// size, points reached, flagged and by status, and the smallest and
-/// largest critical depth with where they are (as in the CSV).
-nlohmann::json StabilityMapSummaryJson(const MapPoints& points, const stability::StabilityMapResult& map);
+/// largest critical depth with where they are (as in the CSV; `extremes`:
+/// stability::FindCriticalDepthExtremes of map.points).
+nlohmann::json StabilityMapSummaryJson(const MapPoints& points, const stability::StabilityMapResult& map,
+                                       const stability::CriticalDepthExtremes& extremes);
 
 }  // namespace robomach::io
