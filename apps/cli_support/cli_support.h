@@ -171,7 +171,8 @@ class StageProgressLines {
       if (!line_ || stage != stage_) {
         Finish();
         stage_ = stage;
-        line_.emplace(tool_, stage, total);
+        const auto m = min_total_.find(stage);
+        line_.emplace(tool_, stage, total, m == min_total_.end() ? 200 : m->second);
       }
       line_->Update(done);
     };
@@ -186,10 +187,14 @@ class StageProgressLines {
     if (line_) line_->Finish();
     line_.reset();
   }
+  /// The stage's line shows from this many items (ProgressLine's min_total;
+  /// 200 unless set).
+  void MinTotal(const std::string& stage, long min_total) { min_total_[stage] = min_total; }
 
  private:
   std::string tool_, stage_;
   std::optional<ProgressLine> line_;
+  std::map<std::string, long> min_total_;
 };
 
 /// Prints "tool: warning: message" on stderr.

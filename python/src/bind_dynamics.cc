@@ -447,10 +447,7 @@ void BindDynamics(py::module_& m) {
           o.uncertainty_paths = uncertainty;
           o.intervals = intervals;
           o.band_postures = band_postures;
-          o.uncertainty.confidence = confidence;
-          o.uncertainty.method = dynamics::ParsePropagationMethod(uncertainty_method);
-          o.uncertainty.samples = samples;
-          o.uncertainty.seed = seed;
+          o.uncertainty = PropagationFrom(confidence, uncertainty_method, samples, seed);
           o.Validate();
           if (!uncertainty.empty() && !intervals && band_postures == 0) {
             throw std::invalid_argument("run_frf_predict: uncertainty gives the modes' intervals (intervals=True) "

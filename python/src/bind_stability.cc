@@ -17,6 +17,7 @@
 #include "robomach/io/region_file.h"
 #include "robomach/io/tip_dynamics_files.h"
 #include "robomach/workflows/stability_lobes.h"
+#include "robomach/workflows/stability_map.h"
 #include "robomach/workflows/tip_sources.h"
 #include "robomach/stability/lobes_workflow.h"
 #include "robomach/stability/stability_map.h"
@@ -332,7 +333,87 @@ void BindStability(py::module_& m) {
      "A region file's grid of tool poses (stability-map --region): dict with targets (row-major), rows, cols, "
      "seed_q [rad], rotation_rad, rotation_free, rotation_min_rad, rotation_max_rad.");
 
-  m.def("stability_map", [](const std::shared_ptr<dynamics::RobotModel>& model, const std::vector<stability::ToolPoseTarget>& targets,
+  // One dict per map point (the CSV's columns that are the analysis').
+  const auto PointDicts = [](const std::vector<stability::MapPoint>& pts) {
+    py::list out;
+    for (const auto& p : pts) {
+      py::dict d;
+      d["status"] = stability::ToString(p.status);
+      d["q"] = p.q;
+      d["rotation_rad"] = p.rotation;
+      d["jacobian_condition"] = p.jacobian_condition;
+      d["critical_depth_mm"] = MToMm(p.stability.critical_depth);
+      d["limiting_mechanism"] = stability::ToString(p.stability.limiting);
+      d["chatter_freq_hz"] = p.stability.chatter_freq_hz;
+      d["regenerative_depth_mm"] = MToMm(p.stability.regenerative.critical_depth);
+      d["mode_coupling_depth_mm"] = MToMm(p.stability.mode_coupling.critical_depth);
+      d["optimiser_status"] = p.optimiser_status;
+      out.append(d);
+    }
+    return out;
+  };
+  const workflows::StabilityMapOptions kMap;  // the tool's defaults
+  m.def("run_stability_map",
+        [PointDicts](const std::string& robot, const std::string& cut, const std::string& region,
+                     const std::optional<std::string>& path, int threads, int speeds, double max_depth_mm,
+                     int rotation_evaluations, const std::vector<std::string>& uncertainty, double confidence,
+                     const std::string& uncertainty_method, int samples, std::uint64_t seed) {
+          workflows::StabilityMapOptions o;
+          o.robot_path = robot;
+          o.cut_path = cut;
+          o.region_path = region;
+          o.path_path = path.value_or("");
+          o.threads = threads;
+          o.speeds = speeds;
+          o.max_depth_mm = max_depth_mm;
+          o.rotation_evaluations = rotation_evaluations;
+          o.uncertainty_paths = uncertainty;
+          o.uncertainty = PropagationFrom(confidence, uncertainty_method, samples, seed);
+          o.Validate();
+          for (const std::string* p : {&o.robot_path, &o.cut_path, &o.region_path, &o.path_path}) {
+            if (!p->empty()) RequireReadableFile(*p);
+          }
+          CollectedMessages said;
+          workflows::StabilityMapRun run;
+          {
+            py::gil_scoped_release release;
+            run = workflows::RunStabilityMap(o, said.Sink());
+          }
+          for (const std::string& f : run.input_findings) WarnUnit(f);
+          py::dict d;
+          d["points"] = PointDicts(run.map.points);
+          d["rows"] = run.points.rows;
+          d["cols"] = run.points.cols;
+          if (run.intervals) {
+            py::list lower, upper;
+            for (const auto& i : run.intervals->depth) {
+              lower.append(MToMm(i.lower));
+              upper.append(MToMm(i.upper));
+            }
+            d["critical_depth_mm_lower"] = lower;
+            d["critical_depth_mm_upper"] = upper;
+          }
+          d["messages"] = said.List();
+          d["input_findings"] = run.input_findings;
+          d["flagged"] = run.status() == RunStatus::kFlagged;
+          d["summary"] = py::module_::import("json").attr("loads")(run.Summary(o).dump());
+          return d;
+        },
+        py::arg("robot"), py::arg("cut"), py::arg("region"), py::arg("path") = py::none(),
+        py::arg("threads") = kMap.threads, py::arg("speeds") = kMap.speeds, py::arg("max_depth_mm") = kMap.max_depth_mm,
+        py::arg("rotation_evaluations") = kMap.rotation_evaluations,
+        py::arg("uncertainty") = std::vector<std::string>{}, py::arg("confidence") = dynamics::PropagationOptions{}.confidence,
+        py::arg("uncertainty_method") = "auto", py::arg("samples") = dynamics::PropagationOptions{}.samples,
+        py::arg("seed") = dynamics::PropagationOptions{}.seed,
+        "stability-map as one call (workflows::RunStabilityMap): a robot config, a cut file and a region file "
+        "(its grid, or with path a tool-path CSV whose seed posture the region gives), the tool's options under "
+        "their names without dashes; parameter-uncertainty files (none: the config's) give each point's interval. "
+        "Returns a dict: points (one dict per point, row-major), rows, cols, critical_depth_mm_lower/_upper with "
+        "uncertainty, messages ({kind, text}), input_findings (also as UnitWarning), flagged (the tool's exit 3) "
+        "and summary (the tool's --summary JSON but for tool, points_csv, warnings and exit_code). ValueError "
+        "naming the option; FileNotFoundError, InputError for files. Releases the GIL.");
+
+  m.def("stability_map", [PointDicts](const std::shared_ptr<dynamics::RobotModel>& model, const std::vector<stability::ToolPoseTarget>& targets,
                             int rows, int cols, const io::CutSpec& cut, const Eigen::VectorXd& seed_q, double rotation_rad,
                             bool optimise_rotation, double rotation_min_rad, double rotation_max_rad, int rotation_evaluations,
                             int speeds, double max_depth_mm, int threads) {
@@ -362,22 +443,7 @@ void BindStability(py::module_& m) {
       py::gil_scoped_release release;
       pts = stability::EvaluateStabilityMap(model, targets, rows, cols, cut.process, o);
     }
-    py::list out;
-    for (const auto& p : pts) {
-      py::dict d;
-      d["status"] = stability::ToString(p.status);
-      d["q"] = p.q;
-      d["rotation_rad"] = p.rotation;
-      d["jacobian_condition"] = p.jacobian_condition;
-      d["critical_depth_mm"] = MToMm(p.stability.critical_depth);
-      d["limiting_mechanism"] = stability::ToString(p.stability.limiting);
-      d["chatter_freq_hz"] = p.stability.chatter_freq_hz;
-      d["regenerative_depth_mm"] = MToMm(p.stability.regenerative.critical_depth);
-      d["mode_coupling_depth_mm"] = MToMm(p.stability.mode_coupling.critical_depth);
-      d["optimiser_status"] = p.optimiser_status;
-      out.append(d);
-    }
-    return out;
+    return PointDicts(pts);
   }, py::arg("model").none(false), py::arg("targets"), py::arg("rows"), py::arg("cols"), py::arg("cut"), py::arg("seed_q"),
      py::arg("rotation_rad") = 0.0, py::arg("optimise_rotation") = false,
      py::arg("rotation_min_rad") = -0.5 * kPi, py::arg("rotation_max_rad") = 0.5 * kPi, py::arg("rotation_evaluations") = 20, py::arg("speeds") = 0,

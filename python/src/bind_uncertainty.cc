@@ -18,16 +18,6 @@ namespace {
 
 using dynamics::ParameterUncertainty;
 
-dynamics::PropagationOptions Options(double confidence, const std::string& method, int samples, std::uint64_t seed) {
-  dynamics::PropagationOptions o;
-  o.confidence = confidence;
-  o.method = dynamics::ParsePropagationMethod(method);
-  o.samples = samples;
-  o.seed = seed;
-  dynamics::CheckValid(o);
-  return o;
-}
-
 py::dict IntervalDict(const dynamics::OutputInterval& i) {
   py::dict d;
   d["value"] = i.value;
@@ -106,7 +96,7 @@ void BindUncertainty(py::module_& m) {
     }
     const dynamics::PropagationResult r = dynamics::Propagate(
         u, [&](const Eigen::VectorXd& v) { return f(v).cast<Eigen::VectorXd>(); },
-        Options(confidence, method, samples, seed), {}, lin);
+        PropagationFrom(confidence, method, samples, seed), {}, lin);
     py::dict d;
     py::list outs;
     for (const auto& o : r.outputs) outs.append(IntervalDict(o));
@@ -131,7 +121,7 @@ void BindUncertainty(py::module_& m) {
     dynamics::PostureModeIntervals r;
     {
       py::gil_scoped_release release;
-      r = dynamics::ModalIntervals(config.description, params, q, u, Options(confidence, method, samples, seed));
+      r = dynamics::ModalIntervals(config.description, params, q, u, PropagationFrom(confidence, method, samples, seed));
     }
     py::dict d;
     py::list modes;
@@ -167,7 +157,7 @@ void BindUncertainty(py::module_& m) {
     {
       py::gil_scoped_release release;
       b = stability::ZoaLobeBand(config.description, params, id, q, cut.feed_direction_B, lo, u,
-                                 Options(confidence, method, samples, seed));
+                                 PropagationFrom(confidence, method, samples, seed));
     }
     py::dict d;
     Eigen::VectorXd rpm(b.speed_rad_s.size()), depth(b.speed_rad_s.size()), lower(b.speed_rad_s.size()),

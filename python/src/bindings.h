@@ -2,6 +2,7 @@
 #pragma once
 
 #include <complex>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -18,6 +19,7 @@
 #include "robomach/common/messages.h"
 #include "robomach/common/run_status.h"
 #include "robomach/dynamics/measured_frf.h"
+#include "robomach/dynamics/uncertainty.h"
 
 namespace robomach::python {
 
@@ -35,6 +37,19 @@ void BindUncertainty(py::module_& m);
 
 /// Receptance matrices per line -> complex128 array of shape (lines, 3, 3).
 py::array_t<std::complex<double>> ToArray(const std::vector<Eigen::Matrix3cd>& h);
+
+/// The propagation options of the Python calls' keywords (confidence,
+/// uncertainty_method, samples, seed), checked as the tools check theirs.
+inline dynamics::PropagationOptions PropagationFrom(double confidence, const std::string& method, int samples,
+                                                    std::uint64_t seed) {
+  dynamics::PropagationOptions o;
+  o.confidence = confidence;
+  o.method = dynamics::ParsePropagationMethod(method);
+  o.samples = samples;
+  o.seed = seed;
+  dynamics::CheckValid(o);
+  return o;
+}
 
 /// A workflow's findings as Python sees them: one sentence each.
 inline std::vector<std::string> FindingMessages(const RunFindings& r) {

@@ -166,6 +166,48 @@ def test_run_stability_lobes_equals_the_tools_summary(tmp, source):
     assert [w.splitlines()[0] for w in tool_warnings] == printed
 
 
+@pytest.mark.parametrize('uncertain', [False, True])
+def test_run_stability_map_equals_the_tools_summary(tmp, uncertain):
+    """Issue #36 acceptance: stability-map's JSON summary and the Python
+    call's on the shipped defaults (the README's robot, cut and region), the
+    same library call (workflows::RunStabilityMap); with a parameter
+    uncertainty, first order, the intervals too."""
+    unc = os.path.join(DATA, 'uncertainty', 'kq_demo.yaml')
+    extra = ['--uncertainty', unc, '--uncertainty-method', 'first-order'] if uncertain else []
+    r = run_tool('stability-map', '--robot', KR210, '--cut', CUT, '--region', REGION, *extra, '--out',
+                 tmp / 'tool.csv', '--summary', tmp / 'tool.json', expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool = json.loads((tmp / 'tool.json').read_text())
+    kw = dict(uncertainty=[unc], uncertainty_method='first-order') if uncertain else {}
+    run = rm.run_stability_map(KR210, CUT, REGION, **kw)
+    assert run['flagged'] == (r.returncode == 3)
+    assert tool['exit_code'] == r.returncode
+    tool.pop('warnings')
+    for key in ('tool', 'points_csv', 'exit_code', 'robomach_version'):  # what only the tool writes
+        del tool[key]
+    assert run['summary'] == tool
+    rows = read_lobes(tmp / 'tool.csv')
+    assert len(rows) == len(run['points']) == run['rows'] * run['cols']
+    for row, p in zip(rows, run['points']):
+        assert row['status'] == p['status']
+        if row['critical_depth_mm']:
+            assert abs(float(row['critical_depth_mm']) - p['critical_depth_mm']) <= 1e-9 * p['critical_depth_mm']
+    if uncertain:
+        lower = [float(row['critical_depth_mm_lower']) for row in rows if row['critical_depth_mm_lower']]
+        py_lower = [v for v in run['critical_depth_mm_lower'] if math.isfinite(v)]
+        assert lower == pytest.approx(py_lower, rel=1e-9)
+        assert any(m['text'].startswith('intervals at 95 %') for m in run['messages'])
+    else:
+        assert 'critical_depth_mm_lower' not in run
+
+
+def test_run_stability_map_names_the_option():
+    with pytest.raises(ValueError, match=r'max_depth_mm 0: expected > 0'):
+        rm.run_stability_map(KR210, CUT, REGION, max_depth_mm=0)
+    with pytest.raises(ValueError, match=r'rotation_evaluations 3: expected >= 8'):
+        rm.run_stability_map(KR210, CUT, REGION, rotation_evaluations=3)
+
+
 def test_run_stability_lobes_names_the_option():
     with pytest.raises(ValueError, match=r'sd_speeds 0 is outside \[1, 10000\]'):
         rm.run_stability_lobes(CUT, modal_table=MODAL, sd_speeds=0)
