@@ -14,6 +14,7 @@
 #include "cli_support.h"
 #include "measured_data.h"
 #include "robomach/calibration/modal_analysis.h"
+#include "robomach/io/frf_quantity.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/modal_analysis_files.h"
 #include "robomach/io/number_format.h"
@@ -101,7 +102,7 @@ int Run(int argc, char** argv) {
     std::string quantity = "receptance";
     if (!all.file_power.empty()) {
       power = all.file_power.begin()->second;
-      quantity = power == 0 ? "receptance" : power == 1 ? "mobility" : "accelerance";
+      quantity = io::QuantityName(static_cast<io::FrfQuantity>(power));
       for (const auto& [key, p] : all.file_power) {
         if (p != power) {
           Warn(kTool, "the files hold different quantities; misfits are reported as " + quantity);
@@ -145,7 +146,7 @@ int Run(int argc, char** argv) {
                             " x the noise (more than 3): a mode or a residual effect is missing, or the noise model is "
                             "too optimistic (see the picture)" +
                             (tau > 0.0 ? "; so the fit took in a model error of " + FormatNumber(tau, 3) + " " +
-                                             (power == 0 ? "m/N" : power == 1 ? "(m/s)/N" : "(m/s^2)/N") +
+                                             io::QuantityUnit(static_cast<io::FrfQuantity>(power)) +
                                              " rms on every line (summary: model_error_rms), which fits the peaks "
                                              "rather than the lines of small |H| and leaves " +
                                              FormatNumber(g.fit.misfit_in_noise[i], 3) + " x the noise"

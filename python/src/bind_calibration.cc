@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "bindings.h"
+#include "robomach/io/frf_quantity.h"
 #include "robomach/common/units.h"
 #include "robomach/io/prediction_files.h"
 #include "robomach/io/posture_file.h"
@@ -93,6 +94,7 @@ void BindCalibration(py::module_& m) {
               f["misfit_relative"] = i < g.misfit.size() ? g.misfit[i] : NAN;
               f["misfit_noise_sigmas"] = i < g.fit.misfit_in_noise.size() ? g.fit.misfit_in_noise[i] : NAN;
               f["model_error_rms"] = i < g.fit.model_error.size() ? g.fit.model_error[i] : 0.0;
+              f["model_error_unit"] = io::QuantityUnit(static_cast<io::FrfQuantity>(file_power));
               f["misfit_noise_sigmas_noise_weights"] =
                   i < g.fit.misfit_in_noise_weights_alone.size() ? g.fit.misfit_in_noise_weights_alone[i] : NAN;
               py::list constants;

@@ -471,10 +471,15 @@ double ModelErrorVariance(const Eigen::VectorXd& r2, const Eigen::VectorXd& sigm
   return hi;
 }
 
-// sqrt(mean |H_fit − H|² / σ²) of each FRF, σ the FRFs' own noise model.
+// sqrt(mean |H_fit − H|² / σ²) of each FRF, σ the FRFs' own noise model
+// (NaN for an FRF without one).
 std::vector<double> MisfitInNoise(const std::vector<dynamics::Frf>& frfs, const std::vector<ModalFitResult>& fits) {
   std::vector<double> out;
   for (size_t i = 0; i < frfs.size(); ++i) {
+    if (!frfs[i].noise_sigma()) {
+      out.push_back(NAN);
+      continue;
+    }
     double sum = 0.0;
     const int n = frfs[i].size();
     for (int k = 0; k < n; ++k) {
@@ -507,7 +512,8 @@ std::vector<double> ModelErrors(const std::vector<dynamics::Frf>& frfs, const Gl
     const double params = 2.0 * modes + 4.0 + 2.0 * modes / frfs.size() +
                           (fit.per_frf[i].lower_residual != cd(0.0) ? 2.0 : 0.0);
     const double nu = std::max(0.5 * n, n - 0.5 * params);
-    tau[i] = std::sqrt(ModelErrorVariance(r2, sigma2, w2, nu));
+    const double t = std::sqrt(ModelErrorVariance(r2, sigma2, w2, nu));
+    tau[i] = std::isfinite(t) ? t : 0.0;  // a non-finite residual gives no model error
   }
   return tau;
 }
@@ -737,6 +743,11 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     from_peaks = !poles.empty();
   }
 
+  // A physical pole in the band: 0 < ζ < max_damping_ratio, fmin..fmax.
+  auto physical = [&](const cd& q) {
+    const double wn = std::abs(q), f_hz = RadPerSecToHz(wn), zeta = -q.real() / wn;
+    return zeta > 0.0 && zeta < o.max_damping_ratio && f_hz >= result.fmin_hz && f_hz <= result.fmax_hz;
+  };
   // Fit, refine, prune (unphysical, out of band, negligible in every FRF,
   // duplicates) until the set no longer changes.
   auto settle = [&](std::vector<cd> p, std::vector<int> sup, SetFit* fit, bool refine = true) {
@@ -751,12 +762,8 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
       std::vector<cd> keep;
       std::vector<int> keep_sup;
       for (size_t r : order) {
-        const double wn = std::abs(p[r]);
-        const double f_hz = RadPerSecToHz(wn), zeta = -p[r].real() / wn;
-        if (!(zeta > 0.0 && zeta < o.max_damping_ratio && f_hz >= result.fmin_hz && f_hz <= result.fmax_hz &&
-              strength[r] >= o.min_relative_contribution)) {
-          continue;
-        }
+        const double f_hz = RadPerSecToHz(std::abs(p[r])), zeta = -p[r].real() / std::abs(p[r]);
+        if (!(physical(p[r]) && strength[r] >= o.min_relative_contribution)) continue;
         bool duplicate = false;
         for (const cd& k : keep) {
           const double fk = RadPerSecToHz(std::abs(k)), zk = -k.real() / std::abs(k);
@@ -904,12 +911,7 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     const SetFit fit = with_lower.Fit(p);
     // Refined with the 1/ω² term a weak low pole could leave the band or
     // the physical damping range; then the set without it stands.
-    bool physical = true;
-    for (const cd& q : p) {
-      const double wn = std::abs(q), f_hz = RadPerSecToHz(wn), zeta = -q.real() / wn;
-      physical = physical && zeta > 0.0 && zeta < o.max_damping_ratio && f_hz >= result.fmin_hz && f_hz <= result.fmax_hz;
-    }
-    if (physical && bic(fit.cost, p.size(), p, /*force_lower=*/true) < bic(best.cost, poles.size(), poles)) {
+    if (std::all_of(p.begin(), p.end(), physical) && bic(fit.cost, p.size(), p, /*force_lower=*/true) < bic(best.cost, poles.size(), poles)) {
       best = fit;
       poles = p;
       lower_by_bic = true;
@@ -941,18 +943,7 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     m.stable_orders = support[k];
     result.modes.push_back(m);
   }
-  for (size_t i = 0; i < frfs.size(); ++i) {
-    const auto& sigma = frfs[i].noise_sigma();
-    if (!sigma) {
-      result.misfit_in_noise.push_back(NAN);
-      continue;
-    }
-    double sum = 0.0;
-    for (int k = 0; k < N; ++k) {
-      sum += std::norm((result.per_frf[i].Evaluate(frfs[i].freq_hz()(k)) - frfs[i].receptance()(k)) / (*sigma)(k));
-    }
-    result.misfit_in_noise.push_back(std::sqrt(sum / N));
-  }
+  result.misfit_in_noise = MisfitInNoise(frfs, result.per_frf);
   result.status = ModalFitStatus::kOk;
   result.model_error.assign(frfs.size(), 0.0);
   result.misfit_in_noise_weights_alone = result.misfit_in_noise;

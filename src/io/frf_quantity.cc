@@ -12,6 +12,15 @@
 namespace robomach::io {
 
 
+std::string QuantityUnit(FrfQuantity q) {
+  switch (q) {
+    case FrfQuantity::kReceptance: return "m/N";
+    case FrfQuantity::kMobility: return "(m/s)/N";
+    case FrfQuantity::kAccelerance: return "(m/s^2)/N";
+  }
+  return "?";
+}
+
 std::string QuantityName(FrfQuantity q) {
   switch (q) {
     case FrfQuantity::kReceptance: return "receptance";

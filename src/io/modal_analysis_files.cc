@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "robomach/common/frames.h"
+#include "robomach/io/frf_quantity.h"
 #include "robomach/io/number_format.h"
 
 namespace robomach::io {
@@ -110,8 +111,11 @@ nlohmann::json ModalAnalysisSummaryJson(const std::vector<calibration::PoseModes
             NumberOrNull(i < g.fit.misfit_in_noise.size() ? g.fit.misfit_in_noise[i] : NAN);
         jf["misfit_noise_sigmas_noise_weights"] = NumberOrNull(
             i < g.fit.misfit_in_noise_weights_alone.size() ? g.fit.misfit_in_noise_weights_alone[i] : NAN);
-        // τ in the file's quantity (the summary's `quantity`, its SI unit).
+        // τ in the file's quantity (the summary's `quantity`), its unit beside it.
         jf["model_error_rms"] = i < g.fit.model_error.size() ? g.fit.model_error[i] : 0.0;
+        for (FrfQuantity q : {FrfQuantity::kReceptance, FrfQuantity::kMobility, FrfQuantity::kAccelerance}) {
+          if (QuantityName(q) == quantity) jf["model_error_unit"] = QuantityUnit(q);
+        }
         jg["frfs"].push_back(jf);
       }
       jg["status"] = g.fit.status == calibration::ModalFitStatus::kOk ? "ok"

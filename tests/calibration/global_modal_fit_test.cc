@@ -265,9 +265,13 @@ TEST(GlobalModalFit, LowerResidualOfAFreeStructureKeptByTheBic) {
     const GlobalModalFitResult free = FitModesGlobal({FreeOrGrounded(20.0, seed)});
     ASSERT_EQ(free.status, ModalFitStatus::kOk) << free.message;
     EXPECT_NE(free.message.find("lower residual"), std::string::npos) << free.message;
-    // The mass line is the lower residual: L/s² = −L/ω², L = 1/M.
-    EXPECT_NEAR(free.per_frf[0].lower_residual.real(), 1.0 / 20.0, 0.02 / 20.0) << free.message;
-    EXPECT_LT(free.misfit_in_noise[0], 1.3) << free.message;
+    // The mass line is the lower residual: L/s² = −L/ω², L = 1/M. It
+    // dominates a few dozen lines below 15 Hz at 0.5 % noise each: L to about
+    // 0.1 % (0.05 % and 0.01 % for the two seeds); within 0.5 %.
+    EXPECT_NEAR(free.per_frf[0].lower_residual.real(), 1.0 / 20.0, 0.005 / 20.0) << free.message;
+    // Within the noise: the rms over 396 lines scatters by about 2.5 %
+    // (0.98, 1.01); under 1.15.
+    EXPECT_LT(free.misfit_in_noise[0], 1.15) << free.message;
     ASSERT_EQ(free.modes.size(), 2u) << free.message;
     EXPECT_NEAR(free.modes[0].freq_hz, 60.0, 0.1);
     // Grounded: no mass line, the BIC does not take the two parameters.

@@ -18,6 +18,8 @@ enum class FrfQuantity { kReceptance, kMobility, kAccelerance };
 
 /// "receptance", "mobility", "accelerance".
 std::string QuantityName(FrfQuantity q);
+/// Its SI unit: "m/N", "(m/s)/N", "(m/s^2)/N".
+std::string QuantityUnit(FrfQuantity q);
 /// The name with its article, for messages: "a receptance", "a mobility",
 /// "an accelerance".
 std::string QuantityWithArticle(FrfQuantity q);
