@@ -5,29 +5,15 @@
 // and summary of docs/formats.md §9.4 and a plot like the seed's Figs. 6-7.
 #include <CLI/CLI.hpp>
 
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
-#include <iostream>
-#include <map>
-#include <optional>
 #include <sstream>
 
 #include "cli_support.h"
-#include "robomach/common/number_format.h"
-#include "robomach/common/errors.h"
 #include "robomach/common/units.h"
-#include "robomach/drilling/controller_kinds.h"
-#include "robomach/drilling/controller_runs.h"
-#include "robomach/drilling/drilling_sim.h"
-#include "robomach/drilling/plausibility.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/drill_series_file.h"
-#include "robomach/io/drilling_files.h"
-#include "robomach/workflows/drilling_setup.h"
-#include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
-#include "robomach/report/json.h"
+#include "robomach/workflows/drilling_setup.h"
 
 namespace robomach::apps {
 namespace {
@@ -123,22 +109,24 @@ int RunDrillSim(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   return RunGuarded(kTool, [&]() -> int {
-    std::vector<std::string> kinds;
-    {
-      std::stringstream ss(controllers);
-      std::string k;
-      while (std::getline(ss, k, ',')) {
-        FromOption("--controller", [&] { drilling::FindControllerKind(k); });
-        if (std::find(kinds.begin(), kinds.end(), k) != kinds.end()) {
-          throw UsageError("--controller: \"" + k + "\" given twice");
-        }
-        kinds.push_back(k);
-      }
-    }
-    if (kinds.empty()) throw UsageError("--controller: expected at least one controller");
-    const bool several = kinds.size() > 1;
+    workflows::DrillSimOptions o;
+    o.robot_path = robot_path;
+    o.drill_path = drill_path;
+    o.material_path = material_path;
+    o.controllers.clear();
+    std::stringstream ss(controllers);
+    for (std::string k; std::getline(ss, k, ',');) o.controllers.push_back(k);
+    o.gains = gain_texts;
+    o.tune = tune;
+    o.tune_evaluations = tune_evaluations;
+    o.motor_torque_limit_Nm = limit_Nm;
+    const std::vector<FieldSource> fields = {
+        {"controllers", "--controller"}, {"gains", "--gains"}, {"tune_evaluations", "--tune-evaluations"},
+        {"motor_torque_limit_Nm", "--motor-torque-limit-Nm"}};
+    FromFields(fields, [&] { o.Validate(); });
+    const bool several = o.controllers.size() > 1;
     std::vector<std::pair<std::string, std::string>> outs;
-    for (const auto& k : kinds) {
+    for (const auto& k : o.controllers) {
       outs.push_back({"--out", WithSuffix(out_path, k, several)});
       outs.push_back({"--summary", WithSuffix(summary_path, k, several)});
     }
@@ -148,77 +136,25 @@ int RunDrillSim(int argc, char** argv) {
     RequireReadableFile(robot_path, "robot file");
     RequireReadableFile(drill_path, "drill file");
     RequireReadableFile(material_path, "material file");
-    const workflows::DrillingSetup setup = workflows::LoadDrillingSetup(robot_path, drill_path, material_path, limit_Nm);
-    for (const auto& u : setup.robot_file.unused_sections) {
-      Warn(kTool, robot_path + ": section '" + u + "' is not used by drill-sim");
-    }
-    drilling::DrillingScenario* sc = setup.scenario.get();
-    const int n = setup.robot->num_joints();
-    const Eigen::VectorXd& limit = setup.motor_torque_limit;
-
-    std::map<std::string, drilling::ControllerParameters> given;
-    for (const std::string& text : gain_texts) {
-      const auto eq = text.find('=');
-      const std::string kind = text.substr(0, eq);
-      if (eq == std::string::npos) {
-        throw UsageError("--gains: expected KIND=OMEGA,ZETA[,THIRD] with KIND " + drilling::ControllerKindList() +
-                         ", got \"" + text + "\"");
-      }
-      const std::vector<double> v = ParseNumberList("--gains", text.substr(eq + 1));
-      given[kind] = FromOption("--gains " + text, [&] { return drilling::ParametersFromGains(kind, v); });
-    }
-    drilling::ControllerRunOptions ro;
-    ro.kinds = kinds;
-    ro.given = given;
-    ro.tune = tune;
-    ro.tune_evaluations = tune_evaluations;
-    ro.motor_torque_limit = limit;
-    std::optional<ProgressLine> progress;
-    const std::vector<Run> runs = drilling::RunControllers(*sc, ro, [&](const drilling::ControllerRunProgress& p) {
-      if (p.tuning) {
-        std::cerr << kTool << ": tuning " << p.kind << " (" << p.total << " simulations)\n";
-        return;
-      }
-      if (p.finished) {
-        if (progress) progress->Finish();
-        progress.reset();
-        if (p.run && p.run->tde_condition_fails()) {
-          Warn(kTool, "pd-tdc: the TDE stability condition ||I - M^-1 Mbar|| < 1 fails (" +
-                          FormatNumber(p.run->tde_measure) + "); lower the Mbar ratio");
-        }
-        return;
-      }
-      if (!progress) progress.emplace(kTool, "simulating " + p.kind, p.total);
-      progress->Update(p.done);
-    });
-
-    // All runs done: the result lines and the verdict (diverged runs, unit
-    // plausibility: drilling/plausibility.h) first, so that every summary
-    // lists its warnings; then every output (each atomically; exit 3 keeps them).
-    for (const Run& run : runs) {
-      const drilling::SimResult& r = run.result;
-      const bool stopped = r.diverged;  // the last 10 % was never simulated
-      std::ostringstream line;
-      line << run.parameters.kind << ": settling "
-           << (std::isnan(r.settling_time) ? std::string("never") : FormatNumber(r.settling_time) + " s")
-           << ", max |e| " << FormatNumber(RadToDeg(r.max_abs_error.maxCoeff())) << " deg, last 10 % max |e| "
-           << (stopped ? std::string("n/a (run stopped)") : FormatNumber(RadToDeg(r.max_abs_error_last_10pc.maxCoeff())) + " deg");
-      std::cerr << kTool << ": " << line.str() << "\n";
-    }
-    const RunFindings verdict = drilling::JudgeControllerRuns(runs, setup.unit_findings);
-    for (const Finding& f : verdict.findings) Warn(kTool, f.message);
-    for (const Run& run : runs) {
-      const std::string kind = run.parameters.kind;
-      const nlohmann::json j = io::DrillRunSummaryJson(run, *sc, limit);
-      if (!out_path.empty()) io::WriteFileAtomically(WithSuffix(out_path, kind, several), io::DrillSeriesCsv(run.result));
+    // The result lines and the verdict are told when all runs are done, so
+    // that every summary lists the warnings; then every output (each
+    // atomically; exit 3 keeps them).
+    StageProgressLines progress(kTool);
+    const workflows::DrillSimRun run = FromFields(
+        fields, [&] { return workflows::RunDrillSim(o, progress.Messages(MessagePrinter(kTool)), progress.Callback()); });
+    progress.Finish();
+    for (const Run& r : run.runs) {
+      const std::string kind = r.parameters.kind;
+      const nlohmann::json j = run.Summary(r);
+      if (!out_path.empty()) io::WriteFileAtomically(WithSuffix(out_path, kind, several), io::DrillSeriesCsv(r.result));
       if (!summary_path.empty()) {
         io::WriteFileAtomically(WithSuffix(summary_path, kind, several), SummaryText(j));
       } else if (out_path.empty()) {
         io::WriteFileAtomically("-", SummaryText(j));
       }
     }
-    if (!plot_path.empty()) Plot(plot_path, runs, n);
-    return ExitCodeFor(verdict.status());
+    if (!plot_path.empty()) Plot(plot_path, run.runs, run.setup.robot->num_joints());
+    return ExitCodeFor(run.status());
   });
 }
 

@@ -5,19 +5,13 @@
 #include <CLI/CLI.hpp>
 
 #include <cmath>
-#include <cstdio>
-#include <map>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_support.h"
-#include "robomach/calibration/frf_estimate.h"
-#include "robomach/common/units.h"
+#include "robomach/common/number_format.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/frf_files.h"
-#include "robomach/io/hammer_records.h"
-#include "robomach/io/number_format.h"
 #include "robomach/report/plot.h"
 #include "robomach/report/json.h"
 #include "robomach/workflows/frf_estimate.h"
@@ -27,9 +21,9 @@ namespace {
 
 constexpr char kTool[] = "frf-estimate";
 
-void SavePlot(const std::string& path, const calibration::FrfEstimateResult& r, const dynamics::FrfSet& frfs,
-              const std::vector<std::string>& labels, const std::vector<int>& channel_of, io::FrfQuantity quantity,
+void SavePlot(const std::string& path, const workflows::FrfEstimateRun& run, io::FrfQuantity quantity,
               const std::string& estimator) {
+  const calibration::FrfEstimateResult& r = run.result;
   report::Figure fig(2, 1, 1000, 400);
   fig.title = "frf-estimate: " + estimator + " of " + std::to_string(r.averages) + " hits";
   if (r.exponential_tau_s > 0.0) {
@@ -37,12 +31,9 @@ void SavePlot(const std::string& path, const calibration::FrfEstimateResult& r, 
   }
   report::Axes& mag = fig.at(0, 0);
   report::Axes& coh = fig.at(1, 0);
-  const std::string unit = quantity == io::FrfQuantity::kReceptance ? "m/N"
-                           : quantity == io::FrfQuantity::kMobility ? "(m/s)/N"
-                                                                    : "(m/s^2)/N";
   mag.title = "|" + estimator + "| (" + io::QuantityName(quantity) + ")";
   mag.x_label = "frequency [Hz]";
-  mag.y_label = "|H| [" + unit + "]";
+  mag.y_label = "|H| [" + io::QuantityUnit(quantity) + "]";
   mag.log_y = true;
   coh.title = "coherence";
   coh.x_label = "frequency [Hz]";
@@ -51,7 +42,7 @@ void SavePlot(const std::string& path, const calibration::FrfEstimateResult& r, 
   coh.y_max = 1.05;
   coh.legend = report::Axes::LegendPosition::kBottomLeft;
   int i = 0;
-  for (const auto& [key, frf] : frfs) {
+  for (const auto& [key, frf] : run.frfs->frfs) {
     report::Series m, c;
     for (int k = 0; k < frf.size(); ++k) {
       const double f = frf.freq_hz()(k);
@@ -60,26 +51,18 @@ void SavePlot(const std::string& path, const calibration::FrfEstimateResult& r, 
       m.x.push_back(f);
       m.y.push_back(v);
     }
-    const auto& g = r.channels[channel_of[i]].coherence;
-    for (int k = 0; k < g.size(); ++k) {
-      c.x.push_back(r.freq_hz(k));
-      c.y.push_back(g(k));
-    }
-    m.label = c.label = labels[i];
+    const Eigen::VectorXd& g = r.channels[run.frfs->channel_of[i]].coherence;  // on r.freq_hz
+    c.x.assign(r.freq_hz.data(), r.freq_hz.data() + g.size());
+    c.y.assign(g.data(), g.data() + g.size());
+    m.label = c.label = run.frfs->labels[i];
     m.color = c.color = report::PaletteColor(i);
     m.thickness = c.thickness = 1;
     mag.series.push_back(std::move(m));
     coh.series.push_back(std::move(c));
     ++i;
   }
-  report::Series limit;
-  limit.x = {r.freq_hz(0), r.freq_hz(r.freq_hz.size() - 1)};
-  limit.y = {0.9, 0.9};
-  limit.label = "0.9";
-  limit.color = {150, 150, 150};
-  limit.dashed = true;
-  limit.thickness = 1;
-  coh.series.push_back(limit);
+  coh.series.push_back({.x = {r.freq_hz(0), r.freq_hz(r.freq_hz.size() - 1)}, .y = {0.9, 0.9}, .label = "0.9",
+                        .color = {150, 150, 150}, .thickness = 1, .dashed = true});
   fig.SavePng(path);
 }
 
@@ -97,24 +80,24 @@ int Run(int argc, char** argv) {
   app.footer(ExitCodeHelp() +
              "\n3 here: fewer accepted hits than --min-hits, or a response that has not decayed by the end of its "
              "record (leakage), or a receptance outside 1e-12..1e-3 m/N (a unit mistake in a column name). 65 also: every hit rejected (the FRF file is then not written; --summary is).\n");
-  std::vector<std::string> records, directions;
-  std::string out_path, summary_path, plot_path, pose_id = "P1", excitation = "x", quantity = "receptance",
-                                                 estimator = "h1";
-  calibration::FrfEstimateOptions o;
-  int min_hits = 3;
-  app.add_option("records", records,
+  // The options go straight into the workflow's fields (their defaults are the tool's).
+  workflows::FrfEstimateRunOptions w;
+  calibration::FrfEstimateOptions& o = w.estimate;
+  std::vector<std::string> directions;
+  std::string out_path, summary_path, plot_path, quantity = "receptance";
+  app.add_option("records", w.record_paths,
                  "hammer record file(s): CSV, or UFF58 time records (function type 1: per hit the force record, "
                  "then its response records; docs/formats.md section 10.1)")->required();
   app.add_option("--out", out_path, "output FRF CSV (docs/formats.md section 3); '-' = stdout")->required();
-  app.add_option("--pose-id", pose_id, "pose id written in the FRF file")->capture_default_str();
-  app.add_option("--excitation", excitation, "hammer direction at the tool tip: x, y or z")->capture_default_str();
+  app.add_option("--pose-id", w.pose_id, "pose id written in the FRF file")->capture_default_str();
+  app.add_option("--excitation", w.excitation, "hammer direction at the tool tip: x, y or z")->capture_default_str();
   app.add_option("--direction", directions,
                  "response direction per channel, NAME=AXIS (e.g. acc_tip=y); default from a name ending in "
                  "_x/_y/_z (or named x/y/z)");
   app.add_option("--quantity", quantity, "output quantity: receptance, mobility or accelerance")
       ->check(OneOf({"receptance", "mobility", "accelerance"}))
       ->capture_default_str();
-  app.add_option("--estimator", estimator, "h1 (noise on the response) or h2 (noise on the force)")
+  app.add_option("--estimator", w.estimator, "h1 (noise on the response) or h2 (noise on the force)")
       ->check(OneOf({"h1", "h2"}))
       ->capture_default_str();
   app.add_option("--fmax-hz", o.fmax_hz, "highest line written [Hz]; 0: sample rate / 2.56; above the Nyquist frequency (sample rate / 2): "
@@ -147,7 +130,7 @@ int Run(int argc, char** argv) {
   app.add_option("--response-range", response_ranges,
                  "overload: |response| at or beyond this, NAME=VALUE in the channel's SI unit (m, m/s or m/s^2), "
                  "e.g. acc_y=490 for a 50 g accelerometer; repeat per channel");
-  app.add_option("--min-hits", min_hits, "fewer accepted hits than this: exit 3 (at least 1)")->capture_default_str();
+  app.add_option("--min-hits", w.min_hits, "fewer accepted hits than this: exit 3 (at least 1)")->capture_default_str();
   app.add_option("--summary", summary_path, "JSON summary: hits with status and notes, windows, warnings");
   app.add_option("--plot", plot_path, "PNG of |H| and the coherence")->check(PngFileName());
   try {
@@ -164,57 +147,34 @@ int Run(int argc, char** argv) {
         {"force_range_N", "--force-range-N"},         {"response_range", "--response-range"},
         {"directions", "--direction"},                {"excitation", "--excitation"},
         {"estimator", "--estimator"},                 {"min_hits", "--min-hits"}};
-    workflows::FrfEstimateRunOptions w;
-    w.record_paths = records;
-    w.pose_id = pose_id;
-    w.excitation = excitation;
-    w.estimator = estimator;
-    w.min_hits = min_hits;
     w.min_hits_name = "--min-hits";
-    w.estimate = o;
-    for (const std::string& d : directions) {
-      const size_t eq = d.find('=');
-      if (eq == std::string::npos || eq == 0) throw UsageError("--direction: expected NAME=AXIS, got '" + d + "'");
-      w.directions[d.substr(0, eq)] = d.substr(eq + 1);
-    }
+    w.directions = FromFields(fields, [&] { return workflows::ParseDirections(directions); });
     for (const std::string& text : response_ranges) {
       const auto [name, value] = ParseAssignment("--response-range", text);
       w.response_ranges[name] = value;
     }
     ValidateOptions(fields, [&] { w.Validate(); });
     std::vector<std::pair<std::string, std::string>> inputs;
-    for (const std::string& r : records) {
+    for (const std::string& r : w.record_paths) {
       RequireReadableFile(r, "hammer record file");
       inputs.push_back({"records", r});
     }
     CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}, {"--plot", plot_path}});
     const io::FrfQuantity out_q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
-    workflows::FrfEstimateRun run;
-    try {
-      run = workflows::RunFrfEstimate(w, MessagePrinter(kTool));
-    } catch (const OptionError& e) {
-      ValidateOptions(fields, [&] { throw e; });  // the field as the option (exit 64)
-    }
+    // An OptionError's field as the option (exit 64).
+    const workflows::FrfEstimateRun run = FromFields(fields, [&] { return workflows::RunFrfEstimate(w, MessagePrinter(kTool)); });
     const calibration::FrfEstimateResult& r = run.result;
-    std::vector<std::string> rejected;
-    for (const auto& h : r.hits) {
-      if (h.status != calibration::HitStatus::kAccepted) {
-        rejected.push_back(h.id + " (" + calibration::HitStatusName(h.status) + ")");
-      }
-    }
-    int rc = run.every_hit_rejected() ? kExitDataError : ExitCodeFor(run.verdict.status());
+    const int rc = run.every_hit_rejected() ? kExitDataError : ExitCodeFor(run.verdict.status());
     if (run.frfs) {
-      const auto& meta = run.frfs->metadata;
-      io::WriteEstimatedFrfCsv(out_path, run.frfs->frfs, out_q, r.averages, meta);
+      io::WriteEstimatedFrfCsv(out_path, run.frfs->frfs, out_q, r.averages, run.frfs->metadata);
       if (!plot_path.empty()) {
-        SavePlot(plot_path, r, run.frfs->frfs, run.frfs->labels, run.frfs->channel_of, out_q,
-                 estimator == "h1" ? "H1" : "H2");
+        SavePlot(plot_path, run, out_q, w.estimator == "h1" ? "H1" : "H2");
       }
     }
     if (!summary_path.empty()) {
-      nlohmann::json j = run.Summary(estimator);
+      nlohmann::json j = run.Summary(w.estimator);
       j["tool"] = kTool;
-      j["records"] = records;
+      j["records"] = w.record_paths;
       j["exit_code"] = rc;
       io::WriteFileAtomically(summary_path, report::DumpJson(j));
     }
@@ -223,17 +183,7 @@ int Run(int argc, char** argv) {
       CommitOutputsNow();  // the summary says why (exit 65 otherwise writes nothing)
       return rc;
     }
-    const dynamics::FrfSet& frfs = run.frfs->frfs;
-    std::ostringstream msg;
-    msg << kTool << ": " << r.averages << " of " << r.hits.size() << " hits averaged";
-    if (!rejected.empty()) {
-      msg << " (rejected: ";
-      for (size_t i = 0; i < rejected.size(); ++i) msg << (i ? ", " : "") << rejected[i];
-      msg << ")";
-    }
-    msg << "; " << frfs.size() << " FRF(s) of " << r.freq_hz.size() << " lines, " << FormatNumber(r.freq_hz(0)) << " to "
-        << FormatNumber(r.freq_hz(r.freq_hz.size() - 1), 6) << " Hz, written to " << out_path << '\n';
-    std::cerr << msg.str();
+    std::cerr << kTool << ": " << run.Outcome() << ", written to " << out_path << '\n';
     return rc;
   });
 }

@@ -16,6 +16,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/number_format.h"
+#include "robomach/workflows/polish_plan.h"
 #include "robomach/workflows/polish_simulation.h"
 #include "robomach/io/polishing_summary.h"
 #include "robomach/io/polishing_files.h"
@@ -55,7 +56,7 @@ int Run(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
-  choice.face_given = app.count("--face") > 0;
+  choice.cad_face_given = app.count("--face") > 0;
   return RunGuarded(kTool, [&]() -> int {
     CheckOptionRange("--sample-mm", sample_mm, 0.05, 0.5);
     RequireReadableFile(surface_path, "surface");
@@ -69,7 +70,9 @@ int Run(int argc, char** argv) {
                         {"--robot", robot.robot_path()}},
                        outs);
 
-    const polishing::NurbsSurface surface = LoadSurface(kTool, surface_path, choice);
+    const polishing::NurbsSurface surface =
+        FromFields({{"cad_face", "--face"}, {"cad_unit_scale", "--cad-unit-scale"}},
+                   [&] { return workflows::LoadPolishSurface(surface_path, choice, MessagePrinter(kTool)); });
     std::vector<std::string> implausible;  // unit findings of the process file
     const polishing::PolishingProcess process = io::ReadPolishingProcess(process_path, &implausible);
     for (const std::string& w : implausible) Warn(kTool, w);

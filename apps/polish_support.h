@@ -1,7 +1,8 @@
 #pragma once
 
-// Shared by polish-plan and polish-sim: surface loading, the pictures and
-// the "on the robot" options (the work is in workflows/polish_robot_check.h).
+// Shared by polish-plan and polish-sim: the surface choice's options, the
+// pictures and the "on the robot" options (the work is in
+// workflows/polish_plan.h and workflows/polish_robot_check.h).
 
 #include <memory>
 #include <string>
@@ -16,6 +17,7 @@
 #include "robomach/polishing/process.h"
 #include "robomach/polishing/removal.h"
 #include "robomach/polishing/surface_grid.h"
+#include "robomach/workflows/polish_plan.h"
 
 namespace CLI {
 class App;
@@ -23,21 +25,8 @@ class App;
 
 namespace robomach::apps {
 
-/// Which surface of the --surface file: --face, whether it was given, and
-/// --cad-unit-scale.
-struct SurfaceChoice {
-  int face{0};              // 1-based; 0: the largest by area
-  bool face_given{false};
-  double cad_unit_scale{1.0};
-};
-
-/// A NURBS YAML or face `choice.face` (1-based; 0 = the largest, named in a
-/// note on stderr) of a STEP/IGES file (formats.md §5), by the file's
-/// extension. Warns under `tool` when the CAD part is under 1 mm or over
-/// 10 m (units plausibility).
-/// @throws UsageError (exit 64) for --face or --cad-unit-scale
-/// with a YAML surface.
-polishing::NurbsSurface LoadSurface(const std::string& tool, const std::string& path, const SurfaceChoice& choice);
+/// --face and --cad-unit-scale (workflows::LoadPolishSurface loads the surface).
+using SurfaceChoice = workflows::SurfaceChoice;
 
 /// Registers --face and --cad-unit-scale on `app` (polish-plan, polish-sim).
 void AddSurfaceChoiceOptions(CLI::App* app, SurfaceChoice* choice);

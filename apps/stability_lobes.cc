@@ -4,66 +4,23 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <climits>
-#include <cstdio>
-#include <cmath>
 #include <filesystem>
-#include <functional>
-#include <iostream>
-#include <map>
 #include <optional>
-#include <sstream>
 
 #include "cli_support.h"
-#include "robomach/calibration/frf_noise.h"
-#include "robomach/common/errors.h"
-#include "robomach/common/number_format.h"
-#include "robomach/common/units.h"
-#include "robomach/io/atomic_file.h"
-#include "robomach/io/csv_table.h"
 #include "robomach/io/cut_file.h"
-#include "robomach/io/number_format.h"
 #include "robomach/io/prediction_files.h"
-#include "robomach/io/robot_config.h"
 #include "robomach/io/lobes_file.h"
 #include "robomach/report/lobes_plot.h"
 #include "robomach/report/modal_fit_plot.h"
 #include "robomach/report/plot.h"
-#include "robomach/report/json.h"
 #include "robomach/stability/semi_discretization.h"
-#include "robomach/stability/lobes_workflow.h"
-#include "robomach/stability/tip_dynamics.h"
 #include "robomach/workflows/stability_lobes.h"
 
 namespace robomach::apps {
 namespace {
 
 constexpr char kTool[] = "stability-lobes";
-
-Eigen::Vector3d ParseVector(const std::string& option, const std::string& text) {
-  std::stringstream ss(text);
-  std::string item;
-  std::vector<double> v;
-  while (std::getline(ss, item, ',')) {
-    double x = 0.0;
-    if (!io::ParseFiniteNumber(item, &x)) break;
-    v.push_back(x);
-  }
-  if (v.size() != 3 || Eigen::Vector3d(v[0], v[1], v[2]).norm() == 0.0) {
-    throw UsageError(option + " " + text + ": expected a non-zero vector x,y,z");
-  }
-  return {v[0], v[1], v[2]};
-}
-
-// What the lobes plot's bands are: the level and how they were computed.
-std::string BandNote(const std::vector<stability::ZoaBand>& bands, double confidence) {
-  const dynamics::PropagationMethod m = bands.front().propagation.method_used;
-  std::string method = m == dynamics::PropagationMethod::kMonteCarlo ? "Monte Carlo" : "first order";
-  for (const stability::ZoaBand& b : bands) {
-    if (b.propagation.method_used != m) method = "method per posture in the notes";
-  }
-  return FormatNumber(100.0 * confidence, 3) + " %, " + method;
-}
 
 // --fit-plot: each fitted direct FRF with its modal fit, magnitude and phase.
 void PlotFits(const std::string& path, const std::string& frf_path, const std::vector<stability::TipDynamics>& tips) {
@@ -75,13 +32,7 @@ void PlotFits(const std::string& path, const std::string& frf_path, const std::v
   int row = 0;
   for (const stability::TipDynamics& t : tips) {
     for (const stability::DirectionFit& d : t.fits) {
-      std::ostringstream title;
-      title << d.label << ": " << d.fit.fit.modes.size() << " modes";
-      if (std::isfinite(d.fit.noise_rms)) {
-        title << ", rms misfit " << io::FormatDouble(std::round(d.fit.noise_rms * 100.0) / 100.0) << " x noise";
-      }
-      title << "; " << calibration::DescribeUsable(d.fit.noise);
-      report::FillModalFitPanels(d.fit.measured, d.fit.noise, d.fit.fit, title.str(), &fig.at(row, 0),
+      report::FillModalFitPanels(d.fit.measured, d.fit.noise, d.fit.fit, workflows::FitPanelTitle(d), &fig.at(row, 0),
                                  &fig.at(row + 1, 0));
       row += 2;
     }
@@ -161,28 +112,16 @@ int Run(int argc, char** argv) {
   }
 
   return RunGuarded(kTool, [&]() -> int {
-    workflows::StabilityLobesOptions o;
-    o.cut_path = cut_path;
-    o.robot_path = robot_path;
-    o.postures_path = postures_path;
-    o.frf_path = frf_path;
-    o.frf_y_path = frf_y_path;
-    o.modal_table_path = modal_path;
-    o.pose_ids = pose_ids;
-    o.tool_axis = ParseVector("--tool-axis", tool_axis_text);
-    o.tool_axis_source = "--tool-axis " + tool_axis_text;
-    o.method = stability::ParseLobeMethod(method);
-    o.speeds = speeds;
-    o.max_lobe = max_lobe;
-    o.sd_speeds = sd_speeds;
-    o.sd_steps = sd_steps;
-    o.sd_steps_per_mode_period = sd_steps_per_mode;
-    o.sd_modes = sd_modes;
-    o.sd_max_depth_mm = sd_max_depth_mm;
-    o.threads = threads;
-    unc.Finish();
-    o.uncertainty_paths = unc.paths;
-    o.uncertainty = unc.propagation;
+    const std::optional<Eigen::Vector3d> axis = workflows::ParseToolAxis(tool_axis_text);
+    if (!axis) throw UsageError("--tool-axis " + tool_axis_text + ": expected a non-zero vector x,y,z");
+    unc.Finish();  // after the axis: the first bad option is named
+    const workflows::StabilityLobesOptions o{
+        .cut_path = cut_path, .robot_path = robot_path, .postures_path = postures_path, .frf_path = frf_path,
+        .frf_y_path = frf_y_path, .modal_table_path = modal_path, .pose_ids = pose_ids, .tool_axis = *axis,
+        .tool_axis_source = "--tool-axis " + tool_axis_text, .method = stability::ParseLobeMethod(method),
+        .speeds = speeds, .max_lobe = max_lobe, .sd_speeds = sd_speeds, .sd_steps = sd_steps,
+        .sd_steps_per_mode_period = sd_steps_per_mode, .sd_modes = sd_modes, .sd_max_depth_mm = sd_max_depth_mm,
+        .threads = threads, .uncertainty_paths = unc.paths, .uncertainty = unc.propagation};
     ValidateOptions({{"robot_path", "--robot"}, {"postures_path", "--postures"}, {"frf_y_path", "--frf-y"},
                      {"frf_path", "--frf"}, {"modal_table_path", "--modal-table"}, {"tool_axis", "--tool-axis"},
                      {"speeds", "--speeds"}, {"max_lobe", "--max-lobe"}, {"sd_speeds", "--sd-speeds"},
@@ -190,11 +129,8 @@ int Run(int argc, char** argv) {
                      {"sd_modes", "--sd-modes"}, {"sd_max_depth_mm", "--sd-max-depth-mm"}, {"threads", "--threads"},
                      {"uncertainty_paths", "--uncertainty"}},
                     [&] { o.Validate(); });
-    if (frf_path.empty()) {
-      for (const auto& [opt, v] : {std::pair{"--fit-plot", &fit_plot_path}, {"--modes-out", &modes_out_path}}) {
-        if (!v->empty()) throw UsageError(std::string(opt) + " needs --frf");
-      }
-    }
+    if (frf_path.empty() && !fit_plot_path.empty()) throw UsageError("--fit-plot needs --frf");
+    if (frf_path.empty() && !modes_out_path.empty()) throw UsageError("--modes-out needs --frf");
     RequireInputFile("--cut", cut_path, "cut file", {io::FileKind::kYaml}, io::kCutFileFormat);
     CheckDistinctPaths({{"--cut", cut_path}, {"--robot", robot_path}, {"--postures", postures_path},
                         {"--frf", frf_path}, {"--frf-y", frf_y_path}, {"--modal-table", modal_path}},
@@ -221,57 +157,32 @@ int Run(int argc, char** argv) {
             progress->Update(p.done);
           }
         });
-    const std::vector<stability::LobeRow>& rows = run.lobes.rows;
-
-    io::WriteLobesCsv(out_path.empty() ? "-" : out_path, rows, !run.bands.empty());
+    io::WriteLobesCsv(out_path.empty() ? "-" : out_path, run.lobes.rows, !run.bands.empty());
     if (!plot_path.empty()) {
       std::vector<report::LobeCurve> curves;
-      for (const stability::TipDynamics& t : run.tips) {
-        for (const std::string m : {"zoa", "sd"}) {
-          report::LobeCurve c;
-          for (const stability::LobeRow& r : rows) {
-            if (r.id != t.id || r.method != m) continue;
-            c.speed_rpm.push_back(RadPerSecToRpm(r.point.spindle_speed_rad_s));
-            c.depth_mm.push_back(r.point.status == stability::LobeStatus::kOk ? MToMm(r.point.critical_depth) : NAN);
-            if (!run.bands.empty() && m == "zoa") {
-              c.lower_mm.push_back(MToMm(r.depth_lower));
-              c.upper_mm.push_back(MToMm(r.depth_upper));
-            }
-          }
-          if (c.speed_rpm.empty()) continue;
-          c.label = t.id + " " + (m == "zoa" ? "ZOA" : "SD");
-          c.markers = m == "sd";
-          curves.push_back(std::move(c));
-        }
+      for (const workflows::LobeDiagramCurve& c : run.DiagramCurves()) {
+        curves.push_back({.label = c.label, .speed_rpm = c.speed_rpm, .depth_mm = c.depth_mm, .markers = c.markers,
+                          .lower_mm = c.lower_mm, .upper_mm = c.upper_mm});
       }
-      const stability::MillingProcess& mp = run.cut.process;
-      report::SaveLobesPlot(plot_path, "robomach stability-lobes: " + cut_path,
-                            std::to_string(mp.teeth) + " teeth, a_e/D = " + io::FormatDouble(mp.radial_immersion) +
-                                (mp.direction == stability::MillingDirection::kUp ? ", up-milling" : ", down-milling"),
-                            curves,
+      report::SaveLobesPlot(plot_path, "robomach stability-lobes: " + cut_path, run.CutDescription(), curves,
                             out_path.empty() || out_path == "-" ? std::string("the CSV")
                                                                 : std::filesystem::path(out_path).filename().string(),
-                            run.bands.empty() ? std::string() : BandNote(run.bands, unc.propagation.confidence));
+                            run.BandNote(o));
     }
     if (!modes_out_path.empty()) {
       std::vector<std::string> ids;
       std::vector<std::vector<dynamics::Mode>> modes;
-      for (const stability::TipDynamics& t : run.tips) {
-        ids.push_back(t.id);
-        modes.push_back(stability::ModesInSourceFrame(t));
-      }
+      run.ModesInSourceFrame(&ids, &modes);
       io::WriteModalTableCsv(modes_out_path, ids, modes);
     }
     if (!fit_plot_path.empty()) PlotFits(fit_plot_path, frf_path, run.tips);
-    const bool flagged = run.flagged();
+    const int exit_code = run.flagged() ? kExitFlagged : kExitOk;
     if (!summary_path.empty()) {
       nlohmann::json j = run.Summary(o);
-      j["tool"] = kTool;
       j["lobes_csv"] = out_path.empty() ? "-" : out_path;
-      j["exit_code"] = flagged ? kExitFlagged : kExitOk;
-      io::WriteFileAtomically(summary_path, SummaryText(j));
+      WriteToolSummary(summary_path, kTool, j, exit_code);
     }
-    return flagged ? kExitFlagged : kExitOk;
+    return exit_code;
   });
 }
 

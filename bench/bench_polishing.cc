@@ -118,7 +118,7 @@ void BM_OptimisePlan(benchmark::State& state) {
     state.counters["feasible"] = r.best.feasible;
     state.counters["parallel_cv"] = r.best_parallel.cv;
     state.counters["evaluations"] = r.evaluations;
-    state.counters["converged"] = r.status == "converged";
+    state.counters["converged"] = r.status == robomach::SolverStatus::kConverged;
   }
 }
 BENCHMARK(BM_OptimisePlan)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();

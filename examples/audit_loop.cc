@@ -110,7 +110,7 @@ int main(int argc, char** argv) try {
   }
   const rm::calibration::CalibrationResult refit = rm::calibration::Calibrate(
       description, start, postures, measured, audit.features, fit);
-  std::printf("refit with %s: %s\n", effect.c_str(), rm::calibration::FitStatusName(refit.status).c_str());
+  std::printf("refit with %s: %s\n", effect.c_str(), rm::ToString(refit.status));
   for (const rm::calibration::ParameterEstimate& e : refit.estimates) {
     std::printf("  %-22s %.4g %s (start %.4g)\n", e.name.c_str(), e.value, e.unit.c_str(), e.initial);
   }

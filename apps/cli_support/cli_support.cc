@@ -28,6 +28,7 @@
 #include "robomach/io/file_names.h"
 #include "robomach/report/json.h"
 #include "robomach/workflows/frf_predict.h"
+#include "robomach/workflows/option_text.h"
 
 namespace robomach::apps {
 
@@ -168,6 +169,12 @@ std::string SummaryText(const nlohmann::json& summary) {
   nlohmann::json j = summary;
   if (j.is_object() && !j.contains("warnings")) j["warnings"] = WarningsGiven();
   return report::DumpJson(j);
+}
+
+void WriteToolSummary(const std::string& path, const std::string& tool, nlohmann::json summary, int exit_code) {
+  summary["tool"] = tool;
+  summary["exit_code"] = exit_code;
+  io::WriteFileAtomically(path, SummaryText(summary));
 }
 
 io::RobotConfig LoadRobotConfigWarned(const std::string& tool, const std::string& path) {
@@ -366,11 +373,17 @@ std::map<std::string, std::string> FileStemsForIds(const std::string& tool, cons
   return stems;
 }
 
+void RefuseOptions(const CLI::App& app, std::initializer_list<const char*> names, const std::string& why) {
+  for (const char* name : names) {
+    if (app.count(name) > 0) throw UsageError(name + why);
+  }
+}
+
 void CheckOptionRange(const std::string& option, double value, double lo, double hi) {
-  if (!(value >= lo && value <= hi)) {
-    std::ostringstream s;
-    s << option << ": expected a value in [" << lo << ", " << hi << "], got " << value;
-    throw UsageError(s.str());
+  try {
+    robomach::CheckOptionRange(option, value, lo, hi);
+  } catch (const OptionError& e) {
+    throw UsageError(e.what());
   }
 }
 
@@ -439,51 +452,22 @@ CLI::Validator OneOf(std::vector<std::string> names, std::map<std::string, std::
       "{" + list + "}");
 }
 
-std::string ImplausibleOption(const std::string& option, double value, double lo, double hi, const std::string& unit,
-                              const std::string& practice, const std::string& low_hint, const std::string& high_hint) {
-  if (value >= lo && value <= hi) return "";
-  const std::string u = unit.empty() ? "" : " " + unit;
-  return "implausible (unit mistake?): " + option + " " + FormatNumber(value, 7) + u + " is outside the " +
-         FormatNumber(lo, 7) + " to " + FormatNumber(hi, 7) + u + " of " + practice + ": " +
-         (value < lo ? low_hint : high_hint);
-}
-
-std::string RadiansInDegreeOption(const std::string& option, double value_deg) {
-  constexpr double kTurnRad = 6.283185307179586;
-  if (value_deg == 0.0 || !(std::abs(value_deg) <= kTurnRad) || value_deg == std::floor(value_deg)) return "";
-  return "implausible (unit mistake?): " + option + " " + FormatNumber(value_deg, 7) +
-         " deg is within 2 pi = 6.28 and not whole, as radians are: radians typed in the deg option? (" +
-         FormatNumber(value_deg, 7) + " rad is " + FormatNumber(value_deg * 180.0 / 3.141592653589793, 4) + " deg)";
-}
-
+// The library's parsers (workflows/option_text.h), worded for a tool: the
+// option's name in the message, a UsageError (exit 64).
 std::vector<double> ParseNumberList(const std::string& option, const std::string& text) {
-  std::vector<double> v;
-  size_t pos = 0;
-  while (pos <= text.size()) {
-    size_t comma = text.find(',', pos);
-    if (comma == std::string::npos) comma = text.size();
-    double x = 0.0;
-    if (!io::ParseFiniteNumber(text.substr(pos, comma - pos), &x)) {
-      throw UsageError(option + ": expected numbers separated by commas, got \"" + text + "\"");
-    }
-    v.push_back(x);
-    pos = comma + 1;
+  try {
+    return workflows::ParseNumberList(option, text);
+  } catch (const OptionError& e) {
+    throw UsageError(e.what());
   }
-  return v;
 }
 
 std::optional<Eigen::Vector3d> ParsePointMm(const std::string& option, const std::string& text) {
-  if (text.empty() || text == "tcp") return std::nullopt;
-  std::vector<double> v;
   try {
-    v = ParseNumberList(option, text);
-  } catch (const std::invalid_argument&) {
-    v.clear();
+    return workflows::ParsePointMm(option, text);
+  } catch (const OptionError& e) {
+    throw UsageError(e.what());
   }
-  if (v.size() != 3) {
-    throw UsageError(option + ": expected x,y,z in mm or 'tcp', got \"" + text + "\"");
-  }
-  return Eigen::Vector3d(v[0] * 1e-3, v[1] * 1e-3, v[2] * 1e-3);
 }
 
 void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<std::string>& sets,

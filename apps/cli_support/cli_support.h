@@ -14,6 +14,7 @@
 
 #include "robomach/common/errors.h"
 #include "robomach/common/messages.h"
+#include "robomach/common/option_checks.h"
 #include "robomach/common/run_status.h"
 #include "robomach/dynamics/uncertainty.h"
 #include "robomach/io/file_kind.h"
@@ -208,6 +209,10 @@ std::vector<std::string> WarningsGiven();
 /// that every warning printed is also in the summary (formats.md §4.1). A
 /// summary that has its own `warnings` keeps them.
 std::string SummaryText(const nlohmann::json& summary);
+/// Writes a tool's --summary to `path` (io::WriteFileAtomically of
+/// SummaryText) with the keys only the tool knows added: `tool` and
+/// `exit_code`.
+void WriteToolSummary(const std::string& path, const std::string& tool, nlohmann::json summary, int exit_code);
 /// LoadRobotConfig with its unit findings (RobotConfig::implausible,
 /// docs/plausibility.md) given to Warn(): the tool flags its result (exit 3)
 /// when the returned config's `implausible` is not empty.
@@ -288,22 +293,20 @@ struct UncertaintyCli {
 /// --summary gain each mode's interval").
 void AddUncertaintyOptions(CLI::App& app, UncertaintyCli* u, const std::string& gains);
 
-/// @throws UsageError unless lo <= value <= hi (and finite).
+/// Refuses options that do not go with the command line's mode (a tool's
+/// other mode, a variant not asked for): the first of `names` given is a
+/// UsageError (exit 64) NAME followed by `why` (" is for ...").
+void RefuseOptions(const CLI::App& app, std::initializer_list<const char*> names, const std::string& why);
+
+/// @throws UsageError unless lo <= value <= hi (and finite): the library's
+/// robomach::CheckOptionRange (common/option_checks.h) worded for a tool.
 void CheckOptionRange(const std::string& option, double value, double lo, double hi);
 
-/// Sense check of a typed option (docs/plausibility.md): "" when lo <= value
-/// <= hi, else "implausible (unit mistake?): OPTION VALUE UNIT is outside
-/// the LO to HI UNIT of PRACTICE: HINT" (low_hint below lo, high_hint above
-/// hi) for the tool to Warn() and flag its result (exit 3).
-std::string ImplausibleOption(const std::string& option, double value, double lo, double hi, const std::string& unit,
-                              const std::string& practice, const std::string& low_hint, const std::string& high_hint);
-
-/// Sense check of a typed angle option in degrees: "" unless the value
-/// looks like radians, i.e. is within one turn in radians (|v| <= 2 pi =
-/// 6.28) and not whole (-1.5708 for -90 deg; 5 deg is degrees), the rule of
-/// the files' _deg fields (io::CheckDegreesNotRadians). The finding names
-/// the angle the value is in degrees, for the tool to Warn() and flag.
-std::string RadiansInDegreeOption(const std::string& option, double value_deg);
+/// The sense checks of a typed option (docs/plausibility.md), the library's
+/// (common/option_checks.h), so that a finding reads the same whether a tool
+/// or a workflow makes it: the tool Warn()s it and flags its result (exit 3).
+using robomach::ImplausibleOption;
+using robomach::RadiansInDegreeOption;
 
 /// "1,2.5,3" -> numbers; @throws UsageError naming the option.
 std::vector<double> ParseNumberList(const std::string& option, const std::string& text);

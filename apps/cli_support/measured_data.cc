@@ -86,11 +86,15 @@ calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const Meas
   try {
     return workflows::EstimateNoiseModels(data, w, MessagePrinter(tool));
   } catch (const OptionError& e) {
-    // The data cannot meet an option: the option, and what to give.
-    throw UsageError((e.field() == "averages" ? "--noise-model " + o.model + " needs --averages N: "
-                                              : "--noise-model " + o.model + ": ") +
-                     std::string(e.what()));
+    throw NoiseOptionError(o, e);
   }
+}
+
+UsageError NoiseOptionError(const NoiseCliOptions& o, const OptionError& e) {
+  // The data cannot meet an option: the option, and what to give.
+  return UsageError((e.field() == "averages" ? "--noise-model " + o.model + " needs --averages N: "
+                                             : "--noise-model " + o.model + ": ") +
+                    std::string(e.what()));
 }
 
 nlohmann::json WriteFittedUncertainty(const std::string& tool, const std::string& path,

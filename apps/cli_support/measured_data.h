@@ -14,7 +14,9 @@
 #include "robomach/calibration/frf_calibration.h"
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/dynamics/measured_frf.h"
+#include "robomach/workflows/frf_calibrate.h"
 #include "robomach/workflows/measured_frfs.h"
+#include "cli_support.h"
 
 namespace CLI {
 class App;
@@ -46,6 +48,9 @@ struct NoiseCliOptions {
   int averages{0};  // 0: from the file
   bool drift_floor{false};  // calibration::NoiseOptions::wide_floor
   bool global_modal_fit{false};  // calibration::NoiseOptions::global_modal_fit (frf-modes)
+
+  /// The workflows' noise options (frf-calibrate, model-audit).
+  workflows::FrfNoiseOptions Workflow() const { return {model, min_snr, averages, drift_floor}; }
 };
 
 /// --noise-model, --min-snr, --averages, --drift-floor.
@@ -70,6 +75,26 @@ calibration::NoiseModels EstimateNoiseModels(const std::string& tool, const Meas
 /// Nothing when `path` is empty (null).
 nlohmann::json WriteFittedUncertainty(const std::string& tool, const std::string& path,
                                       const calibration::CalibrationResult& result, const std::string& source);
+
+/// The UsageError of a noise option the data cannot meet (the OptionError
+/// of workflows::EstimateNoiseModels on noise_model or averages: "--noise-model
+/// coherence needs --averages N: ...").
+UsageError NoiseOptionError(const NoiseCliOptions& options, const OptionError& error);
+
+/// FromFields for a workflow that estimates noise models with `noise`: its
+/// OptionError on noise_model or averages is NoiseOptionError, every other
+/// one is named as `fields` say.
+template <class F>
+auto FromNoiseFields(const NoiseCliOptions& noise, const std::vector<FieldSource>& fields, F&& body)
+    -> decltype(body()) {
+  try {
+    return body();
+  } catch (const OptionError& e) {
+    if (e.field() == "noise_model" || e.field() == "averages") throw NoiseOptionError(noise, e);
+    ValidateOptions(fields, [] { throw; });
+    throw;
+  }
+}
 
 // FitData(data, noise): workflows::FitData (found by argument-dependent lookup).
 

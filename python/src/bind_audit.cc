@@ -12,6 +12,7 @@
 #include "robomach/io/robot_config.h"
 #include "robomach/report/audit_report.h"
 #include "robomach/report/json.h"
+#include "robomach/workflows/model_audit.h"
 
 namespace robomach::python {
 
@@ -186,6 +187,103 @@ void BindAudit(py::module_& m) {
      "kq-identify's file; its estimates replace the config's values) adds 'parameter_uncertainty': which part of "
      "the misfit those parameters could explain within their `confidence` region (model-audit --uncertainty; None "
      "without one or without a significant failure). Releases the GIL (seconds to minutes).");
+
+  const workflows::ModelAuditOptions kAudit;  // model-audit's defaults
+  m.def("run_model_audit",
+        [](const std::string& robot, const std::string& postures, const std::vector<std::string>& measured,
+           const std::vector<std::string>& pose, const std::vector<std::string>& adds,
+           const std::vector<std::string>& uncertainty, double confidence, const std::vector<std::string>& candidates,
+           bool no_parameter_hypotheses, int virtual_joints, double fmin_hz, double fmax_hz, int max_iterations,
+           double robust_loss_sigma, const std::string& noise_model, double min_snr, int averages, bool drift_floor,
+           const std::optional<std::string>& write_config, const std::optional<std::string>& report_dir) {
+          workflows::ModelAuditOptions o;
+          o.robot_path = robot;
+          o.postures_path = postures;
+          o.measured_files = measured;
+          o.pose_files = pose;
+          o.pose_files_name = "pose";
+          o.adds = adds;
+          o.uncertainty_paths = uncertainty;
+          o.confidence = confidence;
+          o.candidates = candidates;
+          o.no_parameter_hypotheses = no_parameter_hypotheses;
+          o.virtual_joints = virtual_joints;
+          o.fmin_hz = fmin_hz;
+          o.fmax_hz = fmax_hz;
+          o.max_iterations = max_iterations;
+          o.robust_loss_sigma = robust_loss_sigma;
+          o.noise = {noise_model, min_snr, averages, drift_floor};
+          o.write_config = write_config.value_or("");
+          o.Validate();
+          RequireReadableFile(robot);
+          RequireReadableFile(postures);
+          for (const std::string& f : measured) RequireReadableFile(f);
+          for (const std::string& f : pose) {
+            if (f.find('=') != std::string::npos) RequireReadableFile(f.substr(f.find('=') + 1));
+          }
+          for (const std::string& f : uncertainty) RequireReadableFile(f);
+          CollectedMessages said;
+          workflows::ModelAuditRun run;
+          report::AuditReport rep;
+          {
+            py::gil_scoped_release release;
+            run = workflows::RunModelAudit(o, said.Sink());
+            if (report_dir) {
+              // model-audit's report folder with the options the tool gives it.
+              report::AuditReportOptions ro;
+              ro.robot_path = o.robot_path;
+              ro.added_effects = o.adds;
+              ro.noise_model = o.noise.noise_model;
+              ro.min_snr = o.noise.min_snr;
+              ro.fmin_hz = o.fmin_hz;
+              ro.fmax_hz = o.fmax_hz;
+              ro.mostly_explained_fraction = run.audit_options.mostly_explained_fraction;
+              ro.clear_bic_gap = run.audit_options.clear_bic_gap;
+              if (!o.write_config.empty() && run.change) ro.written_config = o.write_config;
+              for (const Message& msg : said.messages) {
+                if (msg.kind == Message::Kind::kWarning) ro.input_warnings.push_back(msg.text);
+              }
+              rep = report::WriteAuditReport(*report_dir, run.audit, run.config.description, run.postures,
+                                             run.measured, run.measured_read.frfs, run.noise, ro);
+            }
+          }
+          for (const std::string& f : run.config.implausible) WarnUnit(f);
+          for (const std::string& f : run.measured_read.unit_findings) WarnUnit(f);
+          py::dict d = ResultDict(run.audit);
+          d["change_description"] = run.change_description;
+          d["config_text"] = run.config_text;
+          d["messages"] = said.List();
+          d["unit_findings"] = run.measured_read.unit_findings;
+          d["status"] = RunStatusName(run.status());
+          d["findings"] = FindingMessages(run.verdict);
+          d["flagged"] = run.flagged();
+          if (report_dir) {
+            d["report"] = *report_dir;
+            d["effects_yaml"] = rep.effects_yaml;
+            d["summary"] = py::module_::import("json").attr("loads")(rep.summary.dump());
+          }
+          return d;
+        },
+        py::arg("robot"), py::arg("postures"), py::arg("measured") = std::vector<std::string>{},
+        py::arg("pose") = std::vector<std::string>{}, py::arg("adds") = std::vector<std::string>{},
+        py::arg("uncertainty") = std::vector<std::string>{}, py::arg("confidence") = kAudit.confidence,
+        py::arg("candidates") = std::vector<std::string>{},
+        py::arg("no_parameter_hypotheses") = kAudit.no_parameter_hypotheses,
+        py::arg("virtual_joints") = kAudit.virtual_joints, py::arg("fmin_hz") = kAudit.fmin_hz,
+        py::arg("fmax_hz") = kAudit.fmax_hz, py::arg("max_iterations") = kAudit.max_iterations,
+        py::arg("robust_loss_sigma") = kAudit.robust_loss_sigma, py::arg("noise_model") = kAudit.noise.noise_model,
+        py::arg("min_snr") = kAudit.noise.min_snr, py::arg("averages") = kAudit.noise.averages,
+        py::arg("drift_floor") = kAudit.noise.drift_floor, py::arg("write_config") = py::none(),
+        py::arg("report") = py::none(),
+        "model-audit as one call (workflows::RunModelAudit): a robot config, a posture file and measured FRF files "
+        "(measured: CSV or UFF58; pose: 'ID=file.uff' of one posture), the tool's options under their names without "
+        "dashes (adds: --add; uncertainty: --uncertainty files, none: the config's). Returns audit()'s dict of the "
+        "result plus change_description, config_text (the config with the named change, with write_config: its "
+        "relative urdf path made valid from there; not written), messages ({kind, text}), unit_findings (the measured "
+        "receptances'; with the config's, also as UnitWarning), status/findings/flagged (the tool's exit 3 but for "
+        "--uncertainty-out); with report (a folder) it writes model-audit's report there and adds report, "
+        "effects_yaml and summary (summary.json as a dict, as the tool writes it). ValueError naming the option; "
+        "FileNotFoundError, InputError for files. Releases the GIL (seconds to minutes).");
 }
 
 }  // namespace robomach::python

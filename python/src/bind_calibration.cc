@@ -23,7 +23,11 @@
 #include "robomach/io/kq_files.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/tracker_file.h"
+#include "robomach/common/number_format.h"
+#include "robomach/report/calibration_report.h"
+#include "robomach/workflows/frf_calibrate.h"
 #include "robomach/workflows/kq_identify.h"
+#include "robomach/workflows/tracker_synth.h"
 
 namespace robomach::python {
 namespace {
@@ -114,7 +118,7 @@ void BindCalibration(py::module_& m) {
             py::dict gd;
             gd["frfs"] = frf_list;
             gd["modes"] = modes;
-            gd["ok"] = g.fit.status == calibration::ModalFitStatus::kOk;
+            gd["ok"] = g.fit.status == SolverStatus::kConverged;
             gd["message"] = g.fit.message;
             // A roving test's shapes (frf-modes --mode-shapes): None with the
             // reason otherwise.
@@ -197,12 +201,12 @@ void BindCalibration(py::module_& m) {
       .def_property_readonly("fit_status", [](const MeasuredFeatures& f) {
         std::map<KeyTuple, std::string> out;
         for (const auto& [k, r] : f.fits) {
-          out[FromKey(k)] = r.status == calibration::ModalFitStatus::kOk            ? "ok"
-                             : r.status == calibration::ModalFitStatus::kNoStableModes ? "no stable modes"
-                                                                                       : "failed: " + r.message;
+          out[FromKey(k)] = r.status == SolverStatus::kConverged
+                                ? std::string(robomach::ToString(r.status))
+                                : std::string(robomach::ToString(r.status)) + ": " + r.message;
         }
         return out;
-      }, "{key: 'ok' | 'no stable modes' | 'failed: ...'} per FRF");
+      }, "{key: 'converged' | 'failed: <why>' (no stable pole, too few lines)} per FRF");
   m.def("extract_features", [](const dynamics::FrfSet& measured, double fmin_hz, double fmax_hz) {
     py::gil_scoped_release release;
     return Features(measured, fmin_hz, fmax_hz);
@@ -244,7 +248,7 @@ void BindCalibration(py::module_& m) {
       .def_property_readonly("freq_error", &ModeMatch::freq_error, "model/measured - 1")
       .def_property_readonly("peak_error", &ModeMatch::peak_error, "model/measured - 1");
   py::class_<CalibrationResult>(m, "CalibrationResult", "What calibrate() found; never raises for a poor fit.")
-      .def_property_readonly("status", [](const CalibrationResult& r) { return calibration::FitStatusName(r.status); },
+      .def_property_readonly("status", [](const CalibrationResult& r) { return robomach::ToString(r.status); },
                              "'converged', 'not_converged', 'failed' or 'not_improved' (no start fitted better: the start "
                              "values are kept), as frf-calibrate's summary writes it")
       .def_readonly("message", &CalibrationResult::message)
@@ -269,7 +273,7 @@ void BindCalibration(py::module_& m) {
          "(ParameterUncertainty, left_out): what frf-calibrate --uncertainty-out writes (log scale; parameters "
          "without a covariance or with sigma above their value left out, named with why)")
       .def("__repr__", [](const CalibrationResult& r) {
-        return "<CalibrationResult " + calibration::FitStatusName(r.status) + ">";
+        return std::string("<CalibrationResult ") + robomach::ToString(r.status) + ">";
       });
 
   m.def("calibrate", [](const io::RobotConfig& config, const std::map<std::string, Eigen::VectorXd>& postures,
@@ -425,7 +429,7 @@ void BindCalibration(py::module_& m) {
       .def_readonly("normalized", &CaseResidual::normalized, "|residual| / sigma_D [-]")
       .def_readonly("outlier", &CaseResidual::outlier);
   py::class_<JointStiffnessResult>(m, "JointStiffnessResult", "What identify_joint_stiffness() found.")
-      .def_property_readonly("status", [](const JointStiffnessResult& r) { return std::string(identification::ToString(r.status)); },
+      .def_property_readonly("status", [](const JointStiffnessResult& r) { return std::string(robomach::ToString(r.status)); },
                              "'converged', 'not_converged' or 'failed', as kq-identify's summary writes it")
       .def_readonly("solver_message", &JointStiffnessResult::solver_message)
       .def_readonly("num_cases", &JointStiffnessResult::num_cases)
@@ -522,6 +526,164 @@ void BindCalibration(py::module_& m) {
      "UnitWarning, with the config's), flagged (the tool's exit 3), report (the table's lines) and summary (the "
      "tool's --summary JSON but for tool, exit_code and warnings). ValueError naming the option; "
      "FileNotFoundError, InputError for files. Releases the GIL.");
+
+  const workflows::FrfCalibrateOptions kCal;  // frf-calibrate's defaults
+  m.def("run_frf_calibrate",
+        [](const std::string& robot, const std::string& postures, const std::vector<std::string>& measured,
+           const std::vector<std::string>& pose, const std::vector<std::string>& validate,
+           const std::vector<std::string>& validate_pose, const std::optional<std::string>& out,
+           const std::vector<std::string>& frees, bool only_free, const std::map<std::string, double>& sets,
+           const std::vector<std::string>& adds, const std::string& objective, double fmin_hz, double fmax_hz,
+           int max_iterations, double robust_loss_sigma, const std::string& noise_model, double min_snr,
+           int averages, bool drift_floor) {
+          workflows::FrfCalibrateOptions o;
+          o.robot_path = robot;
+          o.postures_path = postures;
+          o.measured_files = measured;
+          o.pose_files = pose;
+          o.validate_files = validate;
+          o.validate_pose_files = validate_pose;
+          o.pose_files_name = "pose";
+          o.validate_pose_files_name = "validate_pose";
+          o.out_path = out.value_or("");
+          o.frees = frees;
+          o.only_free = only_free;
+          for (const auto& [name, value] : sets) o.sets.push_back(name + "=" + FormatNumber(value, 17));
+          o.adds = adds;
+          o.objective = objective;
+          o.fmin_hz = fmin_hz;
+          o.fmax_hz = fmax_hz;
+          o.max_iterations = max_iterations;
+          o.robust_loss_sigma = robust_loss_sigma;
+          o.noise = {noise_model, min_snr, averages, drift_floor};
+          o.Validate();
+          RequireReadableFile(robot);
+          RequireReadableFile(postures);
+          for (const std::string& f : measured) RequireReadableFile(f);
+          for (const std::string& f : validate) RequireReadableFile(f);
+          for (const std::vector<std::string>* v : {&pose, &validate_pose}) {
+            for (const std::string& f : *v) {
+              if (f.find('=') != std::string::npos) RequireReadableFile(f.substr(f.find('=') + 1));
+            }
+          }
+          CollectedMessages said;
+          workflows::FrfCalibrateRun run;
+          nlohmann::json summary;
+          {
+            py::gil_scoped_release release;
+            run = workflows::RunFrfCalibrate(o, said.Sink());
+            // frf-calibrate's summary.json, as the tool composes it.
+            std::vector<report::TableSet> sets_out = {{"fit", &run.features, run.fit_before, run.fit_after}};
+            if (!run.holdout.empty()) {
+              sets_out.push_back({"holdout", &run.holdout_features, run.holdout_before, run.holdout_after});
+            }
+            summary = report::FrfCalibrateSummaryJson(run.result, run.options, sets_out, run.Misfit(), run.noise,
+                                                      run.holdout_noise, o.noise.noise_model, o.noise.min_snr,
+                                                      o.robot_path);
+          }
+          for (const std::string& f : run.config.implausible) WarnUnit(f);
+          for (const std::string& f : run.measured_read.unit_findings) WarnUnit(f);
+          for (const std::string& f : run.holdout_read.unit_findings) WarnUnit(f);
+          py::dict d;
+          d["result"] = run.result;
+          d["parameters"] = ParameterDict(run.result.parameters);
+          d["config_text"] = run.config_text;
+          d["result_lines"] = run.ResultLines();
+          d["messages"] = said.List();
+          d["flags"] = run.flags;
+          d["findings"] = FindingMessages(run.verdict);
+          d["status"] = RunStatusName(run.status());
+          d["flagged"] = run.status() == RunStatus::kFlagged;
+          d["summary"] = py::module_::import("json").attr("loads")(summary.dump());
+          return d;
+        },
+        py::arg("robot"), py::arg("postures"), py::arg("measured") = std::vector<std::string>{},
+        py::arg("pose") = std::vector<std::string>{}, py::arg("validate") = std::vector<std::string>{},
+        py::arg("validate_pose") = std::vector<std::string>{}, py::arg("out") = py::none(),
+        py::arg("frees") = kCal.frees, py::arg("only_free") = kCal.only_free,
+        py::arg("sets") = std::map<std::string, double>{}, py::arg("adds") = kCal.adds,
+        py::arg("objective") = kCal.objective, py::arg("fmin_hz") = kCal.fmin_hz, py::arg("fmax_hz") = kCal.fmax_hz,
+        py::arg("max_iterations") = kCal.max_iterations, py::arg("robust_loss_sigma") = kCal.robust_loss_sigma,
+        py::arg("noise_model") = kCal.noise.noise_model, py::arg("min_snr") = kCal.noise.min_snr,
+        py::arg("averages") = kCal.noise.averages, py::arg("drift_floor") = kCal.noise.drift_floor,
+        "frf-calibrate as one call (workflows::RunFrfCalibrate): a robot config, a posture file and measured FRF "
+        "files (measured: CSV or UFF58; pose: 'ID=file.uff' of one posture; validate, validate_pose: held out), the "
+        "tool's options under their names without dashes (frees: --free, sets: {name: value} for --set, adds: "
+        "--add). Returns a dict: result (CalibrationResult), parameters ({name: value}, calibrated), config_text (the "
+        "calibrated config, its relative urdf path made valid from `out`'s folder; not written), result_lines (what "
+        "the tool prints last), messages ({kind, text}), flags (what flags the run), findings (the verdict's), "
+        "status, flagged (the tool's exit 3 but for --uncertainty-out) and summary (the report's summary.json but "
+        "for calibrated_config, uncertainty_out and warnings). Unit findings are UnitWarnings too. ValueError naming "
+        "the option; FileNotFoundError, InputError for files. Releases the GIL (seconds to minutes).");
+
+  const workflows::TrackerSynthOptions kTracker;  // tracker-synth's defaults
+  m.def("run_tracker_synth",
+        [](const std::string& robot, const std::optional<std::string>& postures,
+           const std::optional<std::string>& plan_file, int num_postures, double min_reach_mm,
+           const std::string& masses_kg, const std::vector<std::string>& pulley_mm,
+           const std::optional<std::string>& load_point_mm, const std::optional<std::string>& target_mm,
+           double noise_mm, int outliers, double outlier_mm, const std::string& form, unsigned seed,
+           const std::map<std::string, double>& sets, const std::optional<std::string>& out) {
+          workflows::TrackerSynthOptions o;
+          o.robot_path = robot;
+          o.postures_path = postures.value_or("");
+          o.plan_path = plan_file.value_or("");
+          o.num_postures = num_postures;
+          o.min_reach_mm = min_reach_mm;
+          o.masses_kg = masses_kg;
+          o.pulley_mm = pulley_mm;
+          o.load_point_mm = load_point_mm;
+          o.target_mm = target_mm;
+          o.noise_mm = noise_mm;
+          o.outliers = outliers;
+          o.outlier_mm = outlier_mm;
+          o.form = form;
+          o.seed = seed;
+          for (const auto& [name, value] : sets) o.sets.push_back(name + "=" + FormatNumber(value, 17));
+          o.Validate();
+          for (const std::string* p : {&o.robot_path, &o.postures_path, &o.plan_path}) {
+            if (!p->empty()) RequireReadableFile(*p);
+          }
+          CollectedMessages said;
+          workflows::TrackerSynthRun run;
+          {
+            py::gil_scoped_release release;
+            run = workflows::RunTrackerSynth(o, said.Sink());
+            if (out) io::WriteTrackerFile(*out, run.measurements, run.Metadata(o));
+          }
+          for (const std::string& f : run.config.implausible) WarnUnit(f);
+          for (const std::string& f : run.unit_findings) WarnUnit(f);
+          std::vector<LoadCase> cases;
+          for (const auto& meas : run.measurements) cases.push_back(identification::ToLoadCase(meas));
+          py::dict d;
+          d["cases"] = cases;
+          d["pose_ids"] = run.pose_ids;
+          d["postures_source"] = run.postures_source;
+          d["outlier_cases"] = run.outlier_cases;
+          d["counts"] = run.CountsLine();
+          d["messages"] = said.List();
+          d["unit_findings"] = run.unit_findings;
+          d["status"] = RunStatusName(run.status());
+          d["flagged"] = run.flagged();
+          d["summary"] = py::module_::import("json").attr("loads")(run.Summary(o).dump());
+          return d;
+        },
+        py::arg("robot"), py::arg("postures") = py::none(), py::arg("plan_file") = py::none(),
+        py::arg("num_postures") = kTracker.num_postures, py::arg("min_reach_mm") = kTracker.min_reach_mm,
+        py::arg("masses_kg") = kTracker.masses_kg, py::arg("pulley_mm") = kTracker.pulley_mm,
+        py::arg("load_point_mm") = py::none(), py::arg("target_mm") = py::none(),
+        py::arg("noise_mm") = kTracker.noise_mm, py::arg("outliers") = kTracker.outliers,
+        py::arg("outlier_mm") = kTracker.outlier_mm, py::arg("form") = kTracker.form, py::arg("seed") = kTracker.seed,
+        py::arg("sets") = std::map<std::string, double>{}, py::arg("out") = py::none(),
+        "tracker-synth as one call (workflows::RunTrackerSynth): a robot config (its joint stiffness the truth), "
+        "postures from a posture file, a plan_file (kq-identify --plan) or random, the tool's options under their "
+        "names without dashes as the tool takes them (masses_kg 'm1,m2,...', pulley_mm ['x,y,z', ...], "
+        "load_point_mm/target_mm 'x,y,z' or 'tcp', None: the plan's or the defaults; sets {name: value}); out: "
+        "write the tracker file there as the tool's --out. Returns a dict: cases (LoadCase per measurement), pose_ids, "
+        "postures_source, outlier_cases, counts (the line the tool prints), messages ({kind, text}), unit_findings "
+        "(also as UnitWarning, with the config's), status, flagged (the tool's exit 3) and summary (the tool's "
+        "--summary but for tool, out and warnings). ValueError naming the option; FileNotFoundError, InputError for "
+        "files. Releases the GIL.");
 
   py::class_<identification::PlannedLoad>(m, "PlannedLoad", "One planned rope direction at one posture [SI, in B].")
       .def_readonly("pose_id", &identification::PlannedLoad::pose_id)

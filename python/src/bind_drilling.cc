@@ -12,6 +12,7 @@
 #include "robomach/drilling/force_fit.h"
 #include "robomach/io/drill_series_file.h"
 #include "robomach/io/atomic_file.h"
+#include "robomach/common/number_format.h"
 #include "robomach/workflows/drilling_setup.h"
 
 namespace robomach::python {
@@ -29,7 +30,11 @@ void BindDrilling(py::module_& m) {
         return d;
       }, "the gain parameters simulated (given, default or tuned); `third` is r (pid) or the Mbar ratio (pd-tdc)")
       .def_readonly("tuned", &ControllerRun::tuned)
-      .def_property_readonly("tuning_status", [](const ControllerRun& r) { return r.tune.message; })
+      .def_property_readonly("tuning_status",
+                             [](const ControllerRun& r) { return r.tuned ? robomach::ToString(r.tune.status) : ""; },
+                             "how the tuning ended: converged, not_converged, failed or not_improved ('' untuned)")
+      .def_property_readonly("tuning_stop_reason", [](const ControllerRun& r) { return r.tune.message; },
+                             "NLopt's reason for stopping: converged, max_evaluations or roundoff_limited ('' untuned)")
       .def_property_readonly("settling_time_s", [](const ControllerRun& r) { return r.result.settling_time; },
                              "NaN: still outside the band at the end")
       .def_property_readonly("max_abs_error_rad", [](const ControllerRun& r) { return r.result.max_abs_error; })
@@ -99,6 +104,59 @@ void BindDrilling(py::module_& m) {
      "filter_s]])}. Returns (runs, unit_findings): a list of ControllerRun, and the unit plausibility findings "
      "(drill-sim exits 3 on any). The GIL is released while it runs.");
 
+  const workflows::DrillSimOptions kDrill;  // drill-sim's defaults
+  m.def("run_drill_sim",
+        [](const std::string& robot, const std::string& drill, const std::string& material,
+           const std::vector<std::string>& controllers, const std::map<std::string, std::vector<double>>& gains,
+           bool tune, int tune_evaluations, double motor_torque_limit_Nm) {
+          workflows::DrillSimOptions o;
+          o.robot_path = robot;
+          o.drill_path = drill;
+          o.material_path = material;
+          o.controllers = controllers;
+          // --gains KIND=OMEGA,ZETA[,THIRD[,FILTER_S]]
+          for (const auto& [kind, values] : gains) {
+            std::string text = kind + "=";
+            for (size_t i = 0; i < values.size(); ++i) text += (i ? "," : "") + FormatNumber(values[i], 17);
+            o.gains.push_back(text);
+          }
+          o.tune = tune;
+          o.tune_evaluations = tune_evaluations;
+          o.motor_torque_limit_Nm = motor_torque_limit_Nm;
+          o.Validate();
+          for (const std::string& p : {robot, drill, material}) RequireReadableFile(p);
+          CollectedMessages said;
+          workflows::DrillSimRun run;
+          {
+            py::gil_scoped_release release;
+            run = workflows::RunDrillSim(o, said.Sink());
+          }
+          for (const std::string& f : run.setup.unit_findings) WarnUnit(f);
+          const py::object loads = py::module_::import("json").attr("loads");
+          py::dict summaries;
+          for (const ControllerRun& r : run.runs) summaries[py::str(r.parameters.kind)] = loads(run.Summary(r).dump());
+          py::dict d;
+          d["runs"] = run.runs;
+          d["unit_findings"] = run.setup.unit_findings;
+          d["messages"] = said.List();
+          d["findings"] = FindingMessages(run.verdict);
+          d["status"] = RunStatusName(run.status());
+          d["flagged"] = run.status() == RunStatus::kFlagged;
+          d["summaries"] = summaries;
+          return d;
+        },
+        py::arg("robot"), py::arg("drill"), py::arg("material"), py::arg("controllers") = kDrill.controllers,
+        py::arg("gains") = std::map<std::string, std::vector<double>>{}, py::arg("tune") = kDrill.tune,
+        py::arg("tune_evaluations") = kDrill.tune_evaluations,
+        py::arg("motor_torque_limit_Nm") = kDrill.motor_torque_limit_Nm,
+        "drill-sim as one call (workflows::RunDrillSim): the robot, drill-and-process and material files "
+        "(docs/formats.md §9), the tool's options under their names without dashes (controllers: --controller's "
+        "kinds, in order; gains: {kind: (omega_rad_s, zeta[, third[, filter_s]])} for --gains). Returns a dict: runs "
+        "(ControllerRun per kind), unit_findings (also as UnitWarning), messages ({kind, text}), findings (the "
+        "verdict's), status, flagged (the tool's exit 3) and summaries ({kind: the tool's --summary JSON of that "
+        "run but for warnings}). ValueError naming the option; FileNotFoundError, InputError for files. Releases "
+        "the GIL.");
+
   m.def("fit_drill_forces", [](const std::string& table, const std::string& drill, const std::string& chisel) {
     RequireReadableFile(table);
     RequireReadableFile(drill);
@@ -111,7 +169,7 @@ void BindDrilling(py::module_& m) {
     }
     const drilling::ForceFitResult& f = run.fit;
     py::dict d;
-    d["status"] = SolverStatusName(f.status);
+    d["status"] = robomach::ToString(f.status);
     d["solver_message"] = f.solver_message;
     d["shear_stress_thrust_Pa"] = f.material.shear_stress_thrust;
     d["shear_stress_torque_Pa"] = f.material.shear_stress_torque;

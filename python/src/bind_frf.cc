@@ -264,7 +264,8 @@ void BindFrf(py::module_& m) {
       .def_readonly("usable_bands", &FrfNoise::usable_bands, "list of (f_lo_hz, f_hi_hz)")
       .def_readonly("usable_lines", &FrfNoise::usable_lines)
       .def_readonly("iterations", &FrfNoise::iterations)
-      .def_readonly("converged", &FrfNoise::converged)
+      .def_property_readonly("status", [](const FrfNoise& n) { return robomach::ToString(n.status); },
+                             "how the scatter fit ended: 'converged' or 'not_converged' (its iteration limit)")
       .def_readonly("modal_refined", &FrfNoise::modal_refined)
       .def_readonly("description", &FrfNoise::description)
       .def("describe_usable", [](const FrfNoise& n) { return calibration::DescribeUsable(n); })

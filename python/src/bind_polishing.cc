@@ -9,6 +9,7 @@
 #include "bindings.h"
 #include "robomach/common/units.h"
 #include "robomach/io/cad_face.h"
+#include "robomach/workflows/polish_plan.h"
 #include "robomach/workflows/polish_simulation.h"
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/face_check.h"
@@ -146,7 +147,8 @@ void BindPolishing(py::module_& m) {
         const auto& o = *p.outcome.optimisation;
         py::dict d;
         d["method"] = o.method;
-        d["status"] = o.status;
+        d["status"] = robomach::ToString(o.status);
+        d["stop_reason"] = o.stop_reason;
         d["evaluations"] = o.evaluations;
         d["best_cv"] = o.best.cv;
         d["feasible"] = o.best.feasible;
@@ -266,6 +268,90 @@ void BindPolishing(py::module_& m) {
   m.def("write_removal_map", [](const std::string& path, const PyPlan& plan) {
     io::WriteRemovalMap(path, *plan.context.grid, plan.outcome.plan.removal);
   }, py::arg("path"), py::arg("plan"), "polish-plan's --removal, atomic.");
+
+  const workflows::PolishPlanOptions kPlan;  // polish-plan's defaults
+  m.def("run_polish_plan",
+        [](const std::string& surface, const std::string& process, std::optional<int> face, double cad_unit_scale,
+           const std::string& pattern, const std::optional<std::string>& guides, std::optional<double> offset_mm,
+           double radius_mm, double pitch_mm, double edge_inset_mm, double sample_mm, double row_step_mm,
+           double opt_sample_mm, double opt_offset_max_mm, double opt_offset_min_contact_widths,
+           double stagger_loops, double line_angle_deg, double edge_overrun_mm, double target_removal_um,
+           const std::string& optimise, double max_time_s, int threads, unsigned seed) {
+          workflows::PolishPlanOptions o;
+          o.surface_path = surface;
+          o.process_path = process;
+          o.surface_choice.cad_face = face.value_or(0);
+          o.surface_choice.cad_face_given = face.has_value();
+          o.surface_choice.cad_unit_scale = cad_unit_scale;
+          o.pattern = pattern;
+          if (guides) o.guides = *guides;
+          o.guides_given = guides.has_value();  // the optimiser keeps a family the caller chose
+          o.offset_mm = offset_mm;
+          o.radius_mm = radius_mm;
+          o.pitch_mm = pitch_mm;
+          o.edge_inset_mm = edge_inset_mm;
+          o.sample_mm = sample_mm;
+          o.row_step_mm = row_step_mm;
+          o.opt_sample_mm = opt_sample_mm;
+          o.opt_offset_max_mm = opt_offset_max_mm;
+          o.opt_offset_min_contact_widths = opt_offset_min_contact_widths;
+          o.stagger_loops = stagger_loops;
+          o.line_angle_deg = line_angle_deg;
+          o.edge_overrun_mm = edge_overrun_mm;
+          o.target_removal_um = target_removal_um;
+          o.optimise = optimise;
+          o.max_time_s = max_time_s;
+          o.threads = threads;
+          o.seed = seed;
+          o.Validate();
+          RequireReadableFile(surface);
+          RequireReadableFile(process);
+          CollectedMessages said;
+          workflows::PolishPlanRun run;
+          {
+            // The GIL stays held for a STEP/IGES file: OpenCASCADE's readers
+            // keep global state (see load_surface).
+            std::optional<py::gil_scoped_release> release;
+            if (!io::IsCadFile(surface)) release.emplace();
+            run = workflows::RunPolishPlan(o, said.Sink());
+          }
+          for (const std::string& f : run.input_findings) WarnUnit(f);
+          py::dict d;
+          d["stats"] = StatsDict(run.outcome.plan.stats);
+          d["parameters"] = ParamsDict(run.outcome.params);
+          d["messages"] = said.List();
+          d["input_findings"] = run.input_findings;
+          d["findings"] = FindingMessages(run.outcome);
+          d["status"] = RunStatusName(run.status());
+          d["flagged"] = run.flagged();
+          d["summary"] = py::module_::import("json").attr("loads")(run.Summary(o).dump());
+          auto plan = std::make_unique<PyPlan>();
+          plan->surface = std::const_pointer_cast<NurbsSurface>(run.surface);
+          plan->context = std::move(run.context);  // points at *run.surface, which plan->surface keeps
+          plan->outcome = std::move(run.outcome);
+          d["plan"] = py::cast(plan.release(), py::return_value_policy::take_ownership);
+          return d;
+        },
+        py::arg("surface"), py::arg("process"), py::arg("face") = py::none(),
+        py::arg("cad_unit_scale") = kPlan.surface_choice.cad_unit_scale, py::arg("pattern") = kPlan.pattern,
+        py::arg("guides") = py::none(), py::arg("offset_mm") = py::none(), py::arg("radius_mm") = kPlan.radius_mm,
+        py::arg("pitch_mm") = kPlan.pitch_mm, py::arg("edge_inset_mm") = kPlan.edge_inset_mm,
+        py::arg("sample_mm") = kPlan.sample_mm, py::arg("row_step_mm") = kPlan.row_step_mm,
+        py::arg("opt_sample_mm") = kPlan.opt_sample_mm, py::arg("opt_offset_max_mm") = kPlan.opt_offset_max_mm,
+        py::arg("opt_offset_min_contact_widths") = kPlan.opt_offset_min_contact_widths,
+        py::arg("stagger_loops") = kPlan.stagger_loops, py::arg("line_angle_deg") = kPlan.line_angle_deg,
+        py::arg("edge_overrun_mm") = kPlan.edge_overrun_mm, py::arg("target_removal_um") = kPlan.target_removal_um,
+        py::arg("optimise") = kPlan.optimise, py::arg("max_time_s") = kPlan.max_time_s,
+        py::arg("threads") = kPlan.threads, py::arg("seed") = kPlan.seed,
+        "polish-plan as one call (workflows::RunPolishPlan): a surface file (NURBS YAML, or a STEP/IGES file with "
+        "face: 1-based, None: the largest; cad_unit_scale) and a process file, the tool's options under their names "
+        "without dashes (guides None: offsets, the optimiser chooses the family; offset_mm None: 8 mm for the "
+        "cycloid, one contact width for the zig-zag). Returns a dict: plan (PolishPlan, for write_polish_path and "
+        "write_removal_map), stats, parameters, messages ({kind, text}), input_findings (the process file's and the "
+        "options' unit findings, also as UnitWarning), findings (the plan's), status, flagged (the tool's exit 3 "
+        "without --robot) and summary (the tool's --summary JSON but for warnings and the robot block). ValueError "
+        "naming the option; FileNotFoundError, InputError for files. Releases the GIL (not while a STEP/IGES file "
+        "is read).");
 }
 
 }  // namespace robomach::python

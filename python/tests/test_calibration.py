@@ -260,3 +260,68 @@ def test_run_kq_identify_equals_the_tools_summary(tmp_path, campaign):
         assert run['flagged']
     else:
         assert run['unit_findings'] == []
+
+
+DEMO = os.path.join(os.path.dirname(KR210), 'demo')  # the README's hammer tests (scripts/demo.sh)
+DEMO_POSTURES, DEMO_HAMMER = os.path.join(DEMO, 'postures.csv'), os.path.join(DEMO, 'hammer.csv')
+
+
+def test_run_model_audit_equals_the_tools_summary(tmp_path):
+    """Issue #36 acceptance: model-audit's summary.json and the Python call's
+    (workflows::RunModelAudit, then the same report) on the shipped demo
+    (config/demo/), kept fast: one candidate, no virtual joints, no
+    stiffness hypotheses, few iterations - the same options for both."""
+    r = run_tool('model-audit', '--robot', KR210, '--postures', DEMO_POSTURES, '--measured', DEMO_HAMMER,
+                 '--candidates', 'spindle_interface', '--virtual-joints', 0, '--no-parameter-hypotheses',
+                 '--max-iterations', 20, '--report', tmp_path / 'tool_report', '--summary', tmp_path / 'tool.json',
+                 expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool = json.loads((tmp_path / 'tool.json').read_text())
+    run = rm.run_model_audit(KR210, DEMO_POSTURES, measured=[DEMO_HAMMER], candidates=['spindle_interface'],
+                             virtual_joints=0, no_parameter_hypotheses=True, max_iterations=20,
+                             report=str(tmp_path / 'py_report'))
+    assert run['flagged'] == (r.returncode == 3)
+    assert run['status'] == ('flagged' if run['flagged'] else 'ok')
+    tool.pop('robomach_version', None)  # what only the tool writes
+    assert run['summary'] == tool
+    # The YAML the tool prints is the call's effects_yaml.
+    assert run['effects_yaml'] == r.stdout
+
+
+def test_run_frf_calibrate_equals_the_tools_summary(tmp_path):
+    """Issue #36 acceptance: frf-calibrate's summary.json and the Python
+    call's (workflows::RunFrfCalibrate) on the shipped demo hammer tests
+    (config/demo/), few iterations (the same for both); the calibrated
+    config the tool writes is the call's config_text."""
+    r = run_tool('frf-calibrate', '--robot', KR210, '--postures', DEMO_POSTURES, '--measured', DEMO_HAMMER,
+                 '--max-iterations', 10, '--out', tmp_path / 'cal.yaml', '--report', tmp_path / 'report',
+                 '--summary', tmp_path / 'tool.json', expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool = json.loads((tmp_path / 'tool.json').read_text())
+    run = rm.run_frf_calibrate(KR210, DEMO_POSTURES, measured=[DEMO_HAMMER], max_iterations=10,
+                               out=str(tmp_path / 'cal.yaml'))
+    assert run['flagged'] == (r.returncode == 3) == bool(run['flags'])
+    for key in ('calibrated_config', 'uncertainty_out', 'warnings', 'robomach_version'):  # what only the tool writes
+        tool.pop(key, None)
+    assert run['summary'] == tool
+    assert run['config_text'] == (tmp_path / 'cal.yaml').read_text()
+    for line in run['result_lines']:
+        assert f'frf-calibrate: {line}' in r.stderr
+
+
+def test_run_tracker_synth_equals_the_tools_summary(tmp_path):
+    """Issue #36 acceptance: tracker-synth's JSON summary and tracker file and
+    the Python call's (workflows::RunTrackerSynth) on the shipped robot with
+    the tool's defaults but 3 random postures (to keep it fast)."""
+    r = run_tool('tracker-synth', '--robot', KR210, '--num-postures', 3, '--out', tmp_path / 'tool.csv',
+                 '--summary', tmp_path / 'tool.json', expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool = json.loads((tmp_path / 'tool.json').read_text())
+    run = rm.run_tracker_synth(KR210, num_postures=3, out=str(tmp_path / 'py.csv'))
+    assert run['flagged'] == (r.returncode == 3)
+    for key in ('tool', 'out', 'exit_code', 'warnings', 'robomach_version'):  # what only the tool writes
+        tool.pop(key, None)
+    assert run['summary'] == tool
+    assert (tmp_path / 'py.csv').read_text() == (tmp_path / 'tool.csv').read_text()
+    assert f"tracker-synth: {run['counts']}" in r.stderr
+    assert len(run['cases']) == len(rm.read_tracker_file(str(tmp_path / 'tool.csv'), rm.RobotConfig(KR210).num_joints))

@@ -70,3 +70,20 @@ def test_bad_input(tmp):
         rm.drill_sim(ROBOT, DRILL, MATERIAL, gains={'pd': (float('nan'), 1.0)})
     with pytest.raises(ValueError, match='chisel'):
         rm.fit_drill_forces(os.path.join(D, 'q235_hss.csv'), DRILL, chisel='round')
+
+
+def test_run_drill_sim_equals_the_tools_summary(tmp):
+    """Issue #36 acceptance: drill-sim's JSON summary and the Python call's
+    (workflows::RunDrillSim) on the shipped defaults (config/drilling/, the
+    default controller)."""
+    r = run_tool('drill-sim', '--robot', ROBOT, '--drill', DRILL, '--material', MATERIAL, '--summary',
+                 tmp / 'tool.json', expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool = json.loads((tmp / 'tool.json').read_text())
+    run = rm.run_drill_sim(ROBOT, DRILL, MATERIAL)
+    assert run['flagged'] == (r.returncode == 3)
+    assert run['status'] == ('flagged' if run['flagged'] else 'ok')
+    assert [x.controller for x in run['runs']] == list(run['summaries']) == ['pd-tdc']
+    for key in ('warnings', 'robomach_version'):  # what only the tool writes
+        tool.pop(key, None)
+    assert run['summaries']['pd-tdc'] == tool

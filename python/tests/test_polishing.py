@@ -68,6 +68,17 @@ def test_simulate_equals_polish_sim(tmp):
     assert not sim.speed_limit_exceeded
 
 
+def test_optimisation_status():
+    # The optimiser ends with the library's one solver status; its own word
+    # for stopping ("converged", "max_time") is the stop reason beside it.
+    plan = rm.plan_polishing(rm.load_surface(DOME), rm.read_polishing_process(BELT), pattern='parallel',
+                             optimise='nlopt', opt_sample_mm=2.0, max_time_s=1.0)
+    o = plan.optimisation
+    assert o['status'] in ('converged', 'not_converged')
+    assert o['stop_reason'] in ('converged', 'max_time')
+    assert (o['status'] == 'converged') == (o['stop_reason'] == 'converged')
+
+
 def test_bad_input(tmp):
     surface = rm.load_surface(DOME)
     process = rm.read_polishing_process(BELT)
@@ -96,3 +107,24 @@ def test_bad_input(tmp):
         rm.read_polishing_process(str(bad))
     assert e.value.path == str(bad)
     assert set(rm.path_patterns()) == {'cycloid', 'parallel'}
+
+
+def test_run_polish_plan_equals_the_tools_summary(tmp):
+    """Issue #36 acceptance: polish-plan's JSON summary and the Python call's
+    (workflows::RunPolishPlan) on the shipped blade and belt with the
+    README's 5 um target (not optimised, to keep it fast)."""
+    blade = os.path.join(P, 'blade.yaml')
+    r = run_tool('polish-plan', '--surface', blade, '--process', BELT, '--target-removal-um', 5, '--path',
+                 tmp / 'tool_path.csv', '--summary', tmp / 'tool.json', expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool = json.loads((tmp / 'tool.json').read_text())
+    run = rm.run_polish_plan(blade, BELT, target_removal_um=5.0)
+    assert run['flagged'] == (r.returncode == 3)
+    assert run['status'] == ('flagged' if run['flagged'] else 'ok')
+    for key in ('warnings', 'robomach_version'):  # what only the tool writes
+        tool.pop(key, None)
+    assert run['summary'] == tool
+    rm.write_polish_path(str(tmp / 'py_path.csv'), run['plan'])
+    assert (tmp / 'py_path.csv').read_text() == (tmp / 'tool_path.csv').read_text()
+    for f in run['findings']:  # the tool's warnings are the findings
+        assert f in r.stderr

@@ -360,6 +360,191 @@ bool NeedsMoreStarts(const CandidateResult& c, const FitContext& x) {
   return !explains || Doubtful(c);
 }
 
+namespace {
+
+// What every fit of one candidate shares: the model with the effect, the
+// effect's fittable parameters, the free parameters before it and the
+// identifiability screen's verdict; the stages of FitCandidate pass it on
+// instead of a long list of arguments.
+struct CandidateFitter {
+  const dynamics::RobotDescription& desc;
+  const dynamics::ParameterSet& params;
+  const std::vector<std::string>& added;
+  const std::vector<std::string>& base_free;
+  const FitContext& x;
+  Screen screen;
+  std::vector<std::string> scanned;  // the parameters the best-first scan moves
+};
+
+// One fit from `from` of the identifiable parameters, as a copy of `like`
+// with the fit, its errors and its BIC.
+CandidateResult FitFrom(const CandidateFitter& f, const CandidateResult& like, dynamics::ParameterSet from,
+                        const std::string& label) {
+  const AuditOptions& o = f.x.options;
+  const Screen& screen = f.screen;
+  // A held calibration parameter that may be zero is set to zero: the
+  // effect takes over its role entirely (joint damping c_i then includes
+  // alpha k_qi), so the effect's values need not go negative to undo
+  // what the calibrated parameter had absorbed of the missing effect.
+  for (const std::string& n : screen.held_calibration) {
+    if (from.spec(n).lower == 0.0) from.Set(n, 0.0);
+  }
+  CandidateResult cand = like;
+  cand.start = label;
+  cand.not_identifiable = screen.not_identifiable;
+  cand.held_calibration = screen.held_calibration;
+  std::vector<std::string> free;
+  for (const std::string& n : f.base_free) {
+    if (!Contains(screen.held_calibration, n) && !Contains(screen.not_identifiable, n)) free.push_back(n);
+  }
+  for (const std::string& n : f.added) {
+    if (!Contains(screen.not_identifiable, n)) free.push_back(n);
+  }
+  cand.added_parameters = 0;
+  for (const std::string& n : free) cand.added_parameters += n.find('.') != std::string::npos;
+  cand.fit = CalibrateWithRetry(f.desc, from, free, f.x);
+  cand.errors = ComputeErrors(dynamics::RobotModel::Build(f.desc, cand.fit.parameters), f.x.postures, f.x.measured,
+                              o.fmin_hz, o.fmax_hz, o.num_bands);
+  cand.bic = Bic(cand.errors.rss, cand.errors.lines, static_cast<int>(free.size()));
+  cand.bic_change = cand.bic - f.x.baseline_bic;
+  return cand;
+}
+
+// The start of the second fit: every effect parameter at its library
+// default, the calibration parameters at the model's own start values.
+dynamics::ParameterSet DefaultsStart(const CandidateFitter& f) {
+  dynamics::ParameterSet from = f.params;
+  for (const auto& s : from.specs()) {
+    if (s.name.find('.') != std::string::npos) {
+      from.Set(s.name, s.default_value);
+    } else if (f.x.user_start.Has(s.name)) {
+      from.Set(s.name, f.x.user_start.Get(s.name));
+    }
+  }
+  return from;
+}
+
+// The start where the effect adds nothing: each added parameter at the end
+// of its range that is nearest the calibrated model (by whole-curve cost),
+// the calibration parameters as calibrated.
+dynamics::ParameterSet NeutralStart(const CandidateFitter& f) {
+  dynamics::ParameterSet from = f.params;
+  for (const std::string& n : f.added) {
+    const dynamics::ParameterSpec& spec = from.spec(n);
+    dynamics::ParameterSet lo = from, hi = from;
+    lo.SetClamped(n, spec.lower);
+    hi.SetClamped(n, spec.upper);
+    from = WholeCurveCost(f.desc, lo, f.x.banded) <= WholeCurveCost(f.desc, hi, f.x.banded) ? lo : hi;
+  }
+  return from;
+}
+
+// The screen and the fits from up to four starts, the best kept in `c`. `c`
+// is updated in place after each fit, so that a NumericalError thrown by a
+// later fit leaves the earlier result in it (FitCandidate reports it there).
+void FitFromStarts(CandidateFitter& f, bool more_starts, const dynamics::ParameterSet* resume, CandidateResult& c) {
+  const FitContext& x = f.x;
+  // The identifiability screen at the library defaults (typical physical
+  // values), not at a scan result: a scan may park a parameter where the
+  // data no longer see it (a stiffness at 1e10), which says nothing about
+  // whether they could determine it.
+  f.screen = ScreenParameters(f.desc, f.params, f.base_free, f.added, x);
+  // The scan covers the effects already added too (greedy round): fitted
+  // alone, the first effect may have stood in for the second with values
+  // (a damping on its bound) that the pair no longer needs.
+  std::vector<std::string>& scanned = f.scanned;
+  for (const std::string& n : f.base_free) {
+    if (n.find('.') != std::string::npos) scanned.push_back(n);
+  }
+  for (const std::string& n : f.added) {
+    if (!Contains(f.screen.not_identifiable, n)) scanned.push_back(n);
+  }
+  c = FitFrom(f, c, resume != nullptr ? *resume : ScanStart(f.desc, f.params, scanned, x.banded), "scan");
+  // A second start when the first fit is a near miss (it explains much of
+  // the failure, error below half the calibrated model's, but not all)
+  // or ends with an effect parameter on a bound: every effect parameter at
+  // its library default, the calibration parameters at the model's own
+  // start values. The calibrated model has absorbed what it could of the
+  // missing effect, and a first effect fitted alone may have stood in for
+  // a second; either can hold the first fit in a wrong basin (seen: a
+  // stiffer spindle interface at 1.5 × the true model's error with scales
+  // 0.13 and 3 instead of 1.5 and 10; a tool at 3 × 9 mm with damping 0.3
+  // next to a soft flange, instead of 12 × 60 mm with 0.02). A candidate
+  // that barely helps is not worth it.
+  if (more_starts && NeedsMoreStarts(c, x)) {
+    CandidateResult second = FitFrom(f, c, DefaultsStart(f), "defaults");
+    if (Replaces(second, c)) c = std::move(second);
+  }
+  // A third start when the better of the two is still a near miss or
+  // doubtful: the best-first scan again, from that fit. On noisy data
+  // with a narrow usable band both starts can end in the same wrong
+  // basin (seen on accelerance data up to ~700 Hz with a soft flange:
+  // the torsional stiffness parked on its lower bound and the lateral
+  // one at half its value, 2.8 × the noise; the scan from there moves
+  // the torsion off its bound and the fit reaches the noise, as the
+  // greedy round's re-scan did, at the cost of a pair of effects).
+  if (more_starts && NeedsMoreStarts(c, x)) {
+    CandidateResult third =
+        FitFrom(f, c, ScanStart(f.desc, c.fit.parameters, scanned, x.banded), c.start + ", re-scanned");
+    if (Replaces(third, c)) c = std::move(third);
+  }
+  // A candidate is never worse than the model it contains (issue #33: a
+  // spindle interface at 12.4 × the noise against the calibrated model's
+  // 7.04, from a start where the interface was already far off): when it
+  // is, it is fitted again from where the effect adds nothing, each added
+  // parameter at the end of its range that is nearest the calibrated
+  // model (a stiffness at its upper bound, a mass at zero), the
+  // calibration parameters as calibrated. The calibration accepts only a
+  // result better than its start, so this fit ends no worse than the
+  // calibrated model.
+  if (c.fit.status != calibration::FitStatus::kFailed && c.errors.total_rms_log_mag > x.baseline_error) {
+    CandidateResult neutral = FitFrom(f, c, NeutralStart(f), "where it adds nothing");
+    if (neutral.fit.status != calibration::FitStatus::kFailed &&
+        neutral.errors.total_rms_log_mag < c.errors.total_rms_log_mag) {
+      c = std::move(neutral);
+    }
+  }
+}
+
+// An effect parameter on a bound is implausible if the data push it
+// there: moving it into the interior (a factor of two from the bound, or
+// to its default from a zero bound) raises χ² by identifiable_chi2 or more.
+// If they cannot tell the bound from that value, the bound is as good an
+// estimate as any (a joint's damping at zero when the wrist barely moves).
+// Either way the note says so.
+void JudgeBounds(const CandidateFitter& f, CandidateResult& c) {
+  const FitContext& x = f.x;
+  const AuditOptions& o = x.options;
+  Eigen::VectorXd r_fit;
+  for (const auto& e : c.fit.estimates) {
+    bool is_effect = false;
+    for (const auto& eff : c.effects) is_effect |= e.name.rfind(eff + ".", 0) == 0;
+    if (!is_effect || !e.at_bound) continue;
+    const dynamics::ParameterSpec& spec = c.fit.parameters.spec(e.name);
+    const bool at_lower = std::abs(e.value - spec.lower) <= std::abs(e.value - spec.upper);
+    const double inside = at_lower ? (spec.lower > 0.0 ? 2.0 * spec.lower : spec.default_value) : 0.5 * spec.upper;
+    double chi2 = std::numeric_limits<double>::infinity();
+    if (inside > spec.lower && inside < spec.upper && x.noise_floor > 0.0) {
+      if (r_fit.size() == 0) {
+        r_fit = WholeCurveResidualVector(f.desc, c.fit.parameters, x.banded);
+      }
+      chi2 = Chi2OfMove(f.desc, c.fit.parameters, r_fit, e.name, inside, x);
+    }
+    std::ostringstream m;
+    m.precision(3);
+    if (chi2 >= o.identifiable_chi2) {
+      c.plausible = false;
+      c.pinned.push_back(e.name);
+      m << e.name << " pinned at a bound (the data push it there)";
+    } else {
+      m << e.name << " at its bound " << e.value << ", which the data cannot tell from " << inside;
+    }
+    c.note += (c.note.empty() ? "" : "; ") + m.str();
+  }
+}
+
+}  // namespace
+
 // Fits `effect` on top of the model: the identifiability screen, a start
 // from the best-first scan (or, with `resume`, from an earlier fit of the
 // same candidate), and with `more_starts` the further starts where
@@ -368,126 +553,18 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
                              const std::vector<std::string>& base_effects_added, const std::string& effect,
                              const std::vector<std::string>& base_free, const FitContext& x,
                              bool more_starts, const dynamics::ParameterSet* resume) {
-  const AuditOptions& o = x.options;
   CandidateResult c;
   c.effects = base_effects_added;
   c.effects.push_back(effect);
-  // Named references, not a structured binding: the lambdas below capture
-  // them (clang before 16 cannot capture a structured binding).
+  // Named references, not a structured binding: the fitter below holds
+  // them (and clang before 16 cannot capture a structured binding).
   const auto with_effect = WithEffect(base_desc, start, effect);
   const dynamics::RobotDescription& desc = with_effect.first;
   const dynamics::ParameterSet& params = with_effect.second;
   const std::vector<std::string> added = FittableOf(effect);
-  const auto finish = [&](CandidateResult& cand, const std::vector<std::string>& free) {
-    cand.errors = ComputeErrors(dynamics::RobotModel::Build(desc, cand.fit.parameters), x.postures, x.measured,
-                                o.fmin_hz, o.fmax_hz, o.num_bands);
-    cand.bic = Bic(cand.errors.rss, cand.errors.lines, static_cast<int>(free.size()));
-    cand.bic_change = cand.bic - x.baseline_bic;
-  };
-  // The identifiability screen at the library defaults (typical physical
-  // values), not at a scan result: a scan may park a parameter where the
-  // data no longer see it (a stiffness at 1e10), which says nothing about
-  // whether they could determine it.
-  Screen screen;
-  // One fit from `from` of the identifiable parameters.
-  const auto fit_from = [&](dynamics::ParameterSet from, const std::string& label) {
-    // A held calibration parameter that may be zero is set to zero: the
-    // effect takes over its role entirely (joint damping c_i then includes
-    // alpha k_qi), so the effect's values need not go negative to undo
-    // what the calibrated parameter had absorbed of the missing effect.
-    for (const std::string& n : screen.held_calibration) {
-      if (from.spec(n).lower == 0.0) from.Set(n, 0.0);
-    }
-    CandidateResult cand = c;
-    cand.start = label;
-    cand.not_identifiable = screen.not_identifiable;
-    cand.held_calibration = screen.held_calibration;
-    std::vector<std::string> free;
-    for (const std::string& n : base_free) {
-      if (!Contains(screen.held_calibration, n) && !Contains(screen.not_identifiable, n)) free.push_back(n);
-    }
-    for (const std::string& n : added) {
-      if (!Contains(screen.not_identifiable, n)) free.push_back(n);
-    }
-    cand.added_parameters = 0;
-    for (const std::string& n : free) cand.added_parameters += n.find('.') != std::string::npos;
-    cand.fit = CalibrateWithRetry(desc, from, free, x);
-    finish(cand, free);
-    return cand;
-  };
+  CandidateFitter fitter{desc, params, added, base_free, x, {}, {}};
   try {
-    screen = ScreenParameters(desc, params, base_free, added, x);
-    // The scan covers the effects already added too (greedy round): fitted
-    // alone, the first effect may have stood in for the second with values
-    // (a damping on its bound) that the pair no longer needs.
-    std::vector<std::string> scanned;
-    for (const std::string& n : base_free) {
-      if (n.find('.') != std::string::npos) scanned.push_back(n);
-    }
-    for (const std::string& n : added) {
-      if (!Contains(screen.not_identifiable, n)) scanned.push_back(n);
-    }
-    c = fit_from(resume != nullptr ? *resume : ScanStart(desc, params, scanned, x.banded), "scan");
-    // A second start when the first fit is a near miss (it explains much of
-    // the failure, error below half the calibrated model's, but not all)
-    // or ends with an effect parameter on a bound: every effect parameter at
-    // its library default, the calibration parameters at the model's own
-    // start values. The calibrated model has absorbed what it could of the
-    // missing effect, and a first effect fitted alone may have stood in for
-    // a second; either can hold the first fit in a wrong basin (seen: a
-    // stiffer spindle interface at 1.5 × the true model's error with scales
-    // 0.13 and 3 instead of 1.5 and 10; a tool at 3 × 9 mm with damping 0.3
-    // next to a soft flange, instead of 12 × 60 mm with 0.02). A candidate
-    // that barely helps is not worth it.
-    if (more_starts && NeedsMoreStarts(c, x)) {
-      dynamics::ParameterSet from = params;
-      for (const auto& s : from.specs()) {
-        if (s.name.find('.') != std::string::npos) {
-          from.Set(s.name, s.default_value);
-        } else if (x.user_start.Has(s.name)) {
-          from.Set(s.name, x.user_start.Get(s.name));
-        }
-      }
-      CandidateResult second = fit_from(from, "defaults");
-      if (Replaces(second, c)) c = std::move(second);
-    }
-    // A third start when the better of the two is still a near miss or
-    // doubtful: the best-first scan again, from that fit. On noisy data
-    // with a narrow usable band both starts can end in the same wrong
-    // basin (seen on accelerance data up to ~700 Hz with a soft flange:
-    // the torsional stiffness parked on its lower bound and the lateral
-    // one at half its value, 2.8 × the noise; the scan from there moves
-    // the torsion off its bound and the fit reaches the noise, as the
-    // greedy round's re-scan did, at the cost of a pair of effects).
-    if (more_starts && NeedsMoreStarts(c, x)) {
-      CandidateResult third =
-          fit_from(ScanStart(desc, c.fit.parameters, scanned, x.banded), c.start + ", re-scanned");
-      if (Replaces(third, c)) c = std::move(third);
-    }
-    // A candidate is never worse than the model it contains (issue #33: a
-    // spindle interface at 12.4 × the noise against the calibrated model's
-    // 7.04, from a start where the interface was already far off): when it
-    // is, it is fitted again from where the effect adds nothing, each added
-    // parameter at the end of its range that is nearest the calibrated
-    // model (a stiffness at its upper bound, a mass at zero), the
-    // calibration parameters as calibrated. The calibration accepts only a
-    // result better than its start, so this fit ends no worse than the
-    // calibrated model.
-    if (c.fit.status != calibration::FitStatus::kFailed && c.errors.total_rms_log_mag > x.baseline_error) {
-      dynamics::ParameterSet from = params;
-      for (const std::string& n : added) {
-        const dynamics::ParameterSpec& spec = from.spec(n);
-        dynamics::ParameterSet lo = from, hi = from;
-        lo.SetClamped(n, spec.lower);
-        hi.SetClamped(n, spec.upper);
-        from = WholeCurveCost(desc, lo, x.banded) <= WholeCurveCost(desc, hi, x.banded) ? lo : hi;
-      }
-      CandidateResult neutral = fit_from(from, "where it adds nothing");
-      if (neutral.fit.status != calibration::FitStatus::kFailed &&
-          neutral.errors.total_rms_log_mag < c.errors.total_rms_log_mag) {
-        c = std::move(neutral);
-      }
-    }
+    FitFromStarts(fitter, more_starts, resume, c);
   } catch (const NumericalError& e) {
     // Numerical trouble in one candidate (an eigensolver failing at an
     // extreme parameter value) is that candidate's status, reported in its
@@ -501,38 +578,9 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
     return c;
   }
   c.plausible = c.fit.status == calibration::FitStatus::kConverged;
-  if (!c.plausible) c.note = "fit " + calibration::FitStatusName(c.fit.status) + ": " + c.fit.message;
-  // An effect parameter on a bound is implausible if the data push it
-  // there: moving it into the interior (a factor of two from the bound, or
-  // to its default from a zero bound) raises χ² by identifiable_chi2 or more.
-  // If they cannot tell the bound from that value, the bound is as good an
-  // estimate as any (a joint's damping at zero when the wrist barely moves).
-  Eigen::VectorXd r_fit;
-  for (const auto& e : c.fit.estimates) {
-    bool is_effect = false;
-    for (const auto& eff : c.effects) is_effect |= e.name.rfind(eff + ".", 0) == 0;
-    if (!is_effect || !e.at_bound) continue;
-    const dynamics::ParameterSpec& spec = c.fit.parameters.spec(e.name);
-    const bool at_lower = std::abs(e.value - spec.lower) <= std::abs(e.value - spec.upper);
-    const double inside = at_lower ? (spec.lower > 0.0 ? 2.0 * spec.lower : spec.default_value) : 0.5 * spec.upper;
-    double chi2 = std::numeric_limits<double>::infinity();
-    if (inside > spec.lower && inside < spec.upper && x.noise_floor > 0.0) {
-      if (r_fit.size() == 0) {
-        r_fit = WholeCurveResidualVector(desc, c.fit.parameters, x.banded);
-      }
-      chi2 = Chi2OfMove(desc, c.fit.parameters, r_fit, e.name, inside, x);
-    }
-    std::ostringstream m;
-    m.precision(3);
-    if (chi2 >= o.identifiable_chi2) {
-      c.plausible = false;
-      c.pinned.push_back(e.name);
-      m << e.name << " pinned at a bound (the data push it there)";
-    } else {
-      m << e.name << " at its bound " << e.value << ", which the data cannot tell from " << inside;
-    }
-    c.note += (c.note.empty() ? "" : "; ") + m.str();
-  }
+  if (!c.plausible) c.note = std::string("fit ") + ToString(c.fit.status) + ": " + c.fit.message;
+  JudgeBounds(fitter, c);
+  const Screen& screen = fitter.screen;
   if (!screen.note.empty()) c.note += (c.note.empty() ? "" : "; ") + screen.note;
   if (!c.not_identifiable.empty()) {
     std::string names;

@@ -139,16 +139,11 @@ calibration::ModalFitOptions AuditModalFitOptions(const AuditOptions& options) {
   return m;
 }
 
-ErrorPatterns AnalyzeErrorPatterns(const AuditResult& result,
-                                   const std::shared_ptr<const dynamics::RobotModel>& model,
-                                   const calibration::PostureMap& postures, const dynamics::FrfSet& measured,
-                                   const calibration::MeasuredFeatures& features,
-                                   const ErrorPatternOptions& options) {
-  CheckValid(options);
-  if (!model) throw std::invalid_argument("AnalyzeErrorPatterns: no model");
-  // The measured-mode indices of the comparison must refer to these
-  // features; a different modal fit would silently mislabel every mode.
-  const calibration::Comparison& cmp = result.modes_before;
+namespace {
+
+// The measured-mode indices of the comparison must refer to these
+// features; a different modal fit would silently mislabel every mode.
+void CheckFeaturesOfResult(const calibration::Comparison& cmp, const calibration::MeasuredFeatures& features) {
   for (const calibration::ModeMatch& m : cmp.matches) {
     if (m.measured < 0 || m.measured >= static_cast<int>(features.modes.size()) ||
         !(features.modes[m.measured].key == m.key) ||
@@ -165,13 +160,13 @@ ErrorPatterns AnalyzeErrorPatterns(const AuditResult& result,
                                   " modes)");
     }
   }
+}
 
-  ErrorPatterns out;
-  const std::vector<std::string> pose_ids = measured.pose_ids();
-
-  // ---- trends
-  out.descriptors = DescribePostures(*model, postures, pose_ids);
-  ErrorTrends& t = out.trends;
+// ---- trends: the error per posture before and after the best candidate,
+// and its correlation with each of out->descriptors (set before).
+void ComputeTrends(const AuditResult& result, const std::vector<std::string>& pose_ids,
+                   const ErrorPatternOptions& options, ErrorPatterns* out) {
+  ErrorTrends& t = out->trends;
   t.pose_ids = pose_ids;
   t.n = static_cast<int>(pose_ids.size());
   t.significance_level = options.significance_level;
@@ -183,11 +178,11 @@ ErrorPatterns AnalyzeErrorPatterns(const AuditResult& result,
   t.failing_before = failing(t.error_before);
   t.failing_after = t.error_after.size() > 0 && failing(t.error_after);
   auto significant = [&](double r) { return std::isfinite(r) && std::abs(r) > t.critical_correlation; };
-  for (size_t c = 0; c < out.descriptors.names.size(); ++c) {
+  for (size_t c = 0; c < out->descriptors.names.size(); ++c) {
     Trend tr;
-    tr.descriptor = out.descriptors.names[c];
-    tr.unit = out.descriptors.units[c];
-    tr.values = out.descriptors.values.col(static_cast<Eigen::Index>(c));
+    tr.descriptor = out->descriptors.names[c];
+    tr.unit = out->descriptors.units[c];
+    tr.values = out->descriptors.values.col(static_cast<Eigen::Index>(c));
     // Two postures always lie on a line (r = ±1): no trend below three.
     tr.correlation_before = t.n >= 3 ? PearsonCorrelation(tr.values, t.error_before) : NAN;
     tr.significant_before = t.failing_before && significant(tr.correlation_before);
@@ -197,22 +192,121 @@ ErrorPatterns AnalyzeErrorPatterns(const AuditResult& result,
     }
     t.trends.push_back(std::move(tr));
   }
+}
 
-  // ---- error map
-  out.mode_map = BuildModeErrorMap(cmp, pose_ids);
+// What the matching left over in one FRF, with what the second pass
+// compares: the model modes' visibility in the FRF's band (0 outside it)
+// and the largest measured peak.
+struct FrfLeftovers {
+  const dynamics::FrfKey& key;
+  const std::vector<dynamics::Mode>& modes;  // the model's at the FRF's posture
+  std::vector<double> vis;
+  double vis_max = 0.0;
+  double meas_max = 0.0;
+  const std::set<int>& matched;   // model modes the matching paired here
+  const std::vector<int>& meas;   // measured modes it left here
+};
 
-  // ---- modes without a counterpart, FRF by FRF
-  //
-  // The matching tries only modes above its visibility rule on both sides
-  // (MatchOptions::min_relative_visibility against the largest in the FRF),
-  // so a weak mode it left alone may well have a counterpart: a high
-  // mode's receptance peak is naturally small, and a mode seen mostly in
-  // another direction is weak in this one. A second pass therefore pairs
-  // what the matching left over in the FRF (measured modes, and model modes
-  // inside the band) by the matching's own cost and frequency window but
-  // without the visibility rule. What stays unpaired has no counterpart:
-  // every such measured mode (the modal fit already dropped computational
-  // ones), and the model modes that are visible by the rule.
+// The model modes' visibility in the band [lo, hi] of the FRF, and the
+// largest measured peak contribution in it.
+void MeasureVisibility(FrfLeftovers& l, double lo, double hi, const calibration::MeasuredFeatures& features) {
+  const std::vector<dynamics::Mode>& modes = l.modes;
+  l.vis.assign(modes.size(), 0.0);
+  for (size_t k = 0; k < modes.size(); ++k) {
+    if (modes[k].freq_hz < lo || modes[k].freq_hz > hi) continue;
+    l.vis[k] = calibration::ModelModeVisibility(modes[k], l.key);
+    l.vis_max = std::max(l.vis_max, l.vis[k]);
+  }
+  for (const calibration::MeasuredMode& mm : features.modes) {
+    if (mm.key == l.key) l.meas_max = std::max(l.meas_max, mm.fit.peak_contribution);
+  }
+}
+
+// The measured (i) and model (k) modes the second pass paired.
+struct WeakPairs {
+  std::set<int> paired_i, paired_k;
+};
+
+// Second pass: greedy on |ln f ratio| + w |ln visibility ratio|, one to one.
+// Each pair is counted in out->weak_pairs.
+WeakPairs PairWeakModes(const FrfLeftovers& l, const calibration::MeasuredFeatures& features,
+                        const calibration::MatchOptions& mo, ErrorPatterns* out) {
+  const std::vector<dynamics::Mode>& modes = l.modes;
+  const std::vector<double>& vis = l.vis;
+  struct Pair {
+    double cost;
+    int i, k;
+  };
+  std::vector<Pair> pairs;
+  for (int i : l.meas) {
+    const calibration::FittedMode& fm = features.modes[i].fit;
+    for (size_t k = 0; k < modes.size(); ++k) {
+      if (!(vis[k] > 0.0) || l.matched.count(static_cast<int>(k))) continue;
+      const double lf = std::abs(std::log(modes[k].freq_hz / fm.freq_hz));
+      if (lf > mo.max_log_freq_ratio) continue;
+      const double lv = fm.peak_contribution > 0.0 ? std::abs(std::log(vis[k] / fm.peak_contribution)) : 0.0;
+      pairs.push_back({lf + mo.direction_weight * lv, i, static_cast<int>(k)});
+    }
+  }
+  std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) { return a.cost < b.cost; });
+  WeakPairs w;
+  for (const Pair& pr : pairs) {
+    if (w.paired_i.count(pr.i) || w.paired_k.count(pr.k)) continue;
+    w.paired_i.insert(pr.i);
+    w.paired_k.insert(pr.k);
+    ++out->weak_pairs;
+  }
+  return w;
+}
+
+// What stays unpaired in the FRF has no counterpart: every such measured
+// mode, and the model modes that are visible by the matching's rule.
+void RecordUnpaired(const FrfLeftovers& l, const WeakPairs& w, const calibration::MeasuredFeatures& features,
+                    const calibration::MatchOptions& mo, ErrorPatterns* out) {
+  const std::vector<dynamics::Mode>& modes = l.modes;
+  const std::vector<double>& vis = l.vis;
+  for (int i : l.meas) {
+    if (w.paired_i.count(i)) continue;
+    const calibration::MeasuredMode& mm = features.modes[i];
+    UnmatchedMode u;
+    u.key = l.key;
+    u.freq_hz = mm.fit.freq_hz;
+    u.damping_ratio = mm.fit.damping_ratio;
+    u.peak_contribution = mm.fit.peak_contribution;
+    u.relative_visibility = l.meas_max > 0.0 ? mm.fit.peak_contribution / l.meas_max : NAN;
+    u.measured_mode = i;
+    out->unmatched_measured.push_back(u);
+  }
+  for (size_t k = 0; k < modes.size(); ++k) {
+    if (!(vis[k] > 0.0) || vis[k] < mo.min_relative_visibility * l.vis_max) continue;
+    if (l.matched.count(static_cast<int>(k)) || w.paired_k.count(static_cast<int>(k))) continue;
+    UnmatchedMode u;
+    u.key = l.key;
+    u.freq_hz = modes[k].freq_hz;
+    u.damping_ratio = modes[k].damping_ratio;
+    u.peak_contribution = vis[k];
+    u.relative_visibility = vis[k] / l.vis_max;
+    u.model_mode = static_cast<int>(k);
+    out->unmatched_model.push_back(u);
+  }
+}
+
+// ---- modes without a counterpart, FRF by FRF
+//
+// The matching tries only modes above its visibility rule on both sides
+// (MatchOptions::min_relative_visibility against the largest in the FRF),
+// so a weak mode it left alone may well have a counterpart: a high
+// mode's receptance peak is naturally small, and a mode seen mostly in
+// another direction is weak in this one. A second pass therefore pairs
+// what the matching left over in the FRF (measured modes, and model modes
+// inside the band) by the matching's own cost and frequency window but
+// without the visibility rule. What stays unpaired has no counterpart:
+// every such measured mode (the modal fit already dropped computational
+// ones), and the model modes that are visible by the rule.
+void FindUnmatchedModes(const calibration::Comparison& cmp, const std::shared_ptr<const dynamics::RobotModel>& model,
+                        const calibration::PostureMap& postures, const dynamics::FrfSet& measured,
+                        const calibration::MeasuredFeatures& features, const ErrorPatternOptions& options,
+                        ErrorPatterns* out) {
   std::map<dynamics::FrfKey, std::set<int>> matched_model;
   for (const calibration::ModeMatch& m : cmp.matches) matched_model[m.key].insert(m.model_mode);
   std::map<dynamics::FrfKey, std::vector<int>> left_measured;
@@ -222,8 +316,8 @@ ErrorPatterns AnalyzeErrorPatterns(const AuditResult& result,
   const calibration::MatchOptions& mo = options.matching;
   for (const auto& [key, frf] : measured) {
     const auto fit = features.fits.find(key);
-    if (fit == features.fits.end() || fit->second.status != calibration::ModalFitStatus::kOk) {
-      out.frfs_without_modal_fit.push_back(key);
+    if (fit == features.fits.end() || fit->second.status != SolverStatus::kConverged) {
+      out->frfs_without_modal_fit.push_back(key);
       continue;
     }
     const dynamics::Frf band = frf.Band(options.fmin_hz, options.fmax_hz);
@@ -231,73 +325,41 @@ ErrorPatterns AnalyzeErrorPatterns(const AuditResult& result,
     const double lo = band.freq_hz()(0), hi = band.freq_hz()(band.size() - 1);
     auto dit = dyn.find(key.pose_id);
     if (dit == dyn.end()) dit = dyn.emplace(key.pose_id, evaluator.Evaluate(PostureOf(postures, key.pose_id))).first;
-    const std::vector<dynamics::Mode>& modes = dit->second.modes;
-    std::vector<double> vis(modes.size(), 0.0);
-    double vis_max = 0.0;
-    for (size_t k = 0; k < modes.size(); ++k) {
-      if (modes[k].freq_hz < lo || modes[k].freq_hz > hi) continue;
-      vis[k] = calibration::ModelModeVisibility(modes[k], key);
-      vis_max = std::max(vis_max, vis[k]);
-    }
-    double meas_max = 0.0;
-    for (const calibration::MeasuredMode& mm : features.modes) {
-      if (mm.key == key) meas_max = std::max(meas_max, mm.fit.peak_contribution);
-    }
-    // Second pass: greedy on |ln f ratio| + w |ln visibility ratio|, one to one.
-    const std::set<int>& matched = matched_model[key];
-    const std::vector<int>& meas = left_measured[key];
-    struct Pair {
-      double cost;
-      int i, k;
-    };
-    std::vector<Pair> pairs;
-    for (int i : meas) {
-      const calibration::FittedMode& fm = features.modes[i].fit;
-      for (size_t k = 0; k < modes.size(); ++k) {
-        if (!(vis[k] > 0.0) || matched.count(static_cast<int>(k))) continue;
-        const double lf = std::abs(std::log(modes[k].freq_hz / fm.freq_hz));
-        if (lf > mo.max_log_freq_ratio) continue;
-        const double lv = fm.peak_contribution > 0.0 ? std::abs(std::log(vis[k] / fm.peak_contribution)) : 0.0;
-        pairs.push_back({lf + mo.direction_weight * lv, i, static_cast<int>(k)});
-      }
-    }
-    std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) { return a.cost < b.cost; });
-    std::set<int> paired_i, paired_k;
-    for (const Pair& pr : pairs) {
-      if (paired_i.count(pr.i) || paired_k.count(pr.k)) continue;
-      paired_i.insert(pr.i);
-      paired_k.insert(pr.k);
-      ++out.weak_pairs;
-    }
-    for (int i : meas) {
-      if (paired_i.count(i)) continue;
-      const calibration::MeasuredMode& mm = features.modes[i];
-      UnmatchedMode u;
-      u.key = key;
-      u.freq_hz = mm.fit.freq_hz;
-      u.damping_ratio = mm.fit.damping_ratio;
-      u.peak_contribution = mm.fit.peak_contribution;
-      u.relative_visibility = meas_max > 0.0 ? mm.fit.peak_contribution / meas_max : NAN;
-      u.measured_mode = i;
-      out.unmatched_measured.push_back(u);
-    }
-    for (size_t k = 0; k < modes.size(); ++k) {
-      if (!(vis[k] > 0.0) || vis[k] < mo.min_relative_visibility * vis_max) continue;
-      if (matched.count(static_cast<int>(k)) || paired_k.count(static_cast<int>(k))) continue;
-      UnmatchedMode u;
-      u.key = key;
-      u.freq_hz = modes[k].freq_hz;
-      u.damping_ratio = modes[k].damping_ratio;
-      u.peak_contribution = vis[k];
-      u.relative_visibility = vis[k] / vis_max;
-      u.model_mode = static_cast<int>(k);
-      out.unmatched_model.push_back(u);
-    }
+    FrfLeftovers l{key, dit->second.modes, {}, 0.0, 0.0, matched_model[key], left_measured[key]};
+    MeasureVisibility(l, lo, hi, features);
+    const WeakPairs w = PairWeakModes(l, features, mo, out);
+    RecordUnpaired(l, w, features, mo, out);
   }
   auto by_key_then_freq = [](const UnmatchedMode& a, const UnmatchedMode& b) {
     return std::tie(a.key, a.freq_hz) < std::tie(b.key, b.freq_hz);
   };
-  std::stable_sort(out.unmatched_measured.begin(), out.unmatched_measured.end(), by_key_then_freq);
+  std::stable_sort(out->unmatched_measured.begin(), out->unmatched_measured.end(), by_key_then_freq);
+}
+
+}  // namespace
+
+ErrorPatterns AnalyzeErrorPatterns(const AuditResult& result,
+                                   const std::shared_ptr<const dynamics::RobotModel>& model,
+                                   const calibration::PostureMap& postures, const dynamics::FrfSet& measured,
+                                   const calibration::MeasuredFeatures& features,
+                                   const ErrorPatternOptions& options) {
+  CheckValid(options);
+  if (!model) throw std::invalid_argument("AnalyzeErrorPatterns: no model");
+  const calibration::Comparison& cmp = result.modes_before;
+  CheckFeaturesOfResult(cmp, features);
+
+  ErrorPatterns out;
+  const std::vector<std::string> pose_ids = measured.pose_ids();
+
+  // ---- trends
+  out.descriptors = DescribePostures(*model, postures, pose_ids);
+  ComputeTrends(result, pose_ids, options, &out);
+
+  // ---- error map
+  out.mode_map = BuildModeErrorMap(cmp, pose_ids);
+
+  // ---- modes without a counterpart, FRF by FRF (see FindUnmatchedModes)
+  FindUnmatchedModes(cmp, model, postures, measured, features, options, &out);
   return out;
 }
 

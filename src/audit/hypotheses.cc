@@ -60,7 +60,7 @@ CandidateResult FitParameterHypothesis(const dynamics::RobotDescription& desc, c
   c.bic = Bic(c.errors.rss, c.errors.lines, static_cast<int>(free.size()));
   c.bic_change = c.bic - x.baseline_bic;
   c.plausible = c.fit.status == calibration::FitStatus::kConverged;
-  if (!c.plausible) c.note = "fit " + calibration::FitStatusName(c.fit.status) + ": " + c.fit.message;
+  if (!c.plausible) c.note = std::string("fit ") + ToString(c.fit.status) + ": " + c.fit.message;
   // A freed parameter on its bound (three decades from the configured
   // joint stiffness) has found no stiffness: the hypothesis stands in for
   // something else.
@@ -213,93 +213,110 @@ Eigen::VectorXd ConstrainedStep(const Eigen::MatrixXd& A, const Eigen::VectorXd&
   return step(hi);
 }
 
-}  // namespace
-
-std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::RobotDescription& desc,
-                                                           const dynamics::ParameterSet& calibrated,
-                                                           const dynamics::ParameterUncertainty& u,
-                                                           double confidence, const FitContext& x,
-                                                           double error_before) {
-  const AuditOptions& o = x.options;
-  UncertaintyAllowance a;
-  a.confidence = confidence;
+// The parameters of the uncertainty the audit can move (indices into
+// u.parameters), their names in a->parameters; the others, with the reason,
+// in a->left_out.
+std::vector<int> MovableParameters(const dynamics::ParameterSet& calibrated, const dynamics::ParameterUncertainty& u,
+                                   const AuditOptions& o, UncertaintyAllowance* a) {
   std::vector<int> kept;
   for (size_t i = 0; i < u.parameters.size(); ++i) {
     const std::string& n = u.parameters[i].name;
     if (!calibrated.Has(n)) {
-      a.left_out.push_back(n + ": not a parameter of this model");
+      a->left_out.push_back(n + ": not a parameter of this model");
     } else if (Contains(o.calibration_parameters, n)) {
-      a.left_out.push_back(n + ": calibrated by the audit against these data");
+      a->left_out.push_back(n + ": calibrated by the audit against these data");
     } else {
       kept.push_back(static_cast<int>(i));
-      a.parameters.push_back(n);
+      a->parameters.push_back(n);
     }
   }
-  const int n = static_cast<int>(kept.size());
-  auto nothing = [&](const std::string& why) {
-    a.sentence = "the parameter uncertainty was not used: " + why;
-    return a;
-  };
-  if (n == 0) {
-    std::string l;
-    for (const auto& s : a.left_out) l += (l.empty() ? "" : "; ") + s;
-    return nothing("it has no parameter the audit can move (" + l + ")");
+  return kept;
+}
+
+// The confidence region of the parameters moved, in whitened coordinates
+// θ = θ̂ + B w, |w| <= radius, and the model's parameters at a point w: the
+// search and the refit both map through it.
+struct WhitenedRegion {
+  const dynamics::RobotDescription& desc;
+  const dynamics::ParameterSet& calibrated;
+  const std::vector<std::string>& names;  // the parameters moved, as in moved_u
+  const BandedFitData& banded;
+  dynamics::ParameterUncertainty moved_u;
+  Eigen::VectorXd theta0;
+  Eigen::MatrixXd B;
+  int rank = 0;
+  double radius = NAN;
+
+  dynamics::ParameterSet Point(const Eigen::VectorXd& w) const {
+    dynamics::ParameterSet p = calibrated;
+    const Eigen::VectorXd v = dynamics::FromTheta(moved_u, theta0 + B * w);
+    for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+      // A compliance <= 0 is an infinite stiffness: the parameter's upper bound.
+      p.SetClamped(names[i], std::isfinite(v(i)) ? v(i) : std::numeric_limits<double>::infinity());
+    }
+    return p;
   }
-  // The marginal of the parameters moved (a Gaussian's marginal: the sub-covariance).
+  Eigen::VectorXd Residuals(const Eigen::VectorXd& w) const {
+    return WholeCurveResidualVector(desc, Point(w), banded);
+  }
+};
+
+// The marginal of the parameters moved (a Gaussian's marginal: the
+// sub-covariance), and their estimates.
+dynamics::ParameterUncertainty Marginal(const dynamics::ParameterUncertainty& u, const std::vector<int>& kept,
+                                        Eigen::VectorXd* estimates) {
+  const int n = static_cast<int>(kept.size());
   dynamics::ParameterUncertainty moved_u;
   moved_u.covariance.resize(n, n);
-  Eigen::VectorXd estimates(n);
+  estimates->resize(n);
   for (int i = 0; i < n; ++i) {
     moved_u.parameters.push_back(u.parameters[kept[i]]);
-    estimates(i) = u.parameters[kept[i]].value;
+    (*estimates)(i) = u.parameters[kept[i]].value;
     for (int j = 0; j < n; ++j) moved_u.covariance(i, j) = u.covariance(kept[i], kept[j]);
   }
-  const Eigen::MatrixXd& cov = moved_u.covariance;
-  const Eigen::VectorXd theta0 = dynamics::ToTheta(moved_u, estimates);
-  // Whitened coordinates: θ = θ̂ + B w, B = V √Λ over the covariance's rank,
-  // the region |w| <= √χ²(P, rank).
+  return moved_u;
+}
+
+// Whitened coordinates: θ = θ̂ + B w, B = V √Λ over the covariance's rank,
+// the region |w| <= √χ²(P, rank). Sets r->B, r->rank, r->radius and a's
+// rank, chi2 and radius; false (nothing set) if the covariance is zero.
+bool Whiten(double confidence, WhitenedRegion* r, UncertaintyAllowance* a) {
+  const Eigen::MatrixXd& cov = r->moved_u.covariance;
+  const int n = static_cast<int>(cov.rows());
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(cov);
   const double lmax = es.eigenvalues().maxCoeff();
   std::vector<int> axes;
   for (int k = 0; k < n; ++k) {
     if (es.eigenvalues()(k) > 1e-14 * lmax && es.eigenvalues()(k) > 0.0) axes.push_back(k);
   }
-  if (axes.empty()) {
-    a.parameters.clear();
-    return nothing("its covariance is zero");
-  }
-  a.rank = static_cast<int>(axes.size());
-  Eigen::MatrixXd B(n, a.rank);
-  for (int k = 0; k < a.rank; ++k) B.col(k) = es.eigenvectors().col(axes[k]) * std::sqrt(es.eigenvalues()(axes[k]));
-  a.chi2 = dynamics::ChiSquaredQuantile(confidence, a.rank);
-  a.radius = std::sqrt(a.chi2);
-  const auto point = [&](const Eigen::VectorXd& w) {
-    dynamics::ParameterSet p = calibrated;
-    const Eigen::VectorXd v = dynamics::FromTheta(moved_u, theta0 + B * w);
-    for (int i = 0; i < n; ++i) {
-      // A compliance <= 0 is an infinite stiffness: the parameter's upper bound.
-      p.SetClamped(a.parameters[i], std::isfinite(v(i)) ? v(i) : std::numeric_limits<double>::infinity());
-    }
-    return p;
-  };
-  const auto residuals = [&](const Eigen::VectorXd& w) { return WholeCurveResidualVector(desc, point(w), x.banded); };
-  const Eigen::VectorXd r0 = residuals(Eigen::VectorXd::Zero(a.rank));
-  if (r0.size() == 0) {
-    a.parameters.clear();
-    return nothing("the model cannot be evaluated at its estimates");
-  }
-  // The calibration parameters' linear re-adjustment (as the screen's).
-  const Eigen::MatrixXd Q = CalibrationBasis(desc, calibrated, o.calibration_parameters, x.banded, r0);
+  if (axes.empty()) return false;
+  a->rank = static_cast<int>(axes.size());
+  Eigen::MatrixXd B(n, a->rank);
+  for (int k = 0; k < a->rank; ++k) B.col(k) = es.eigenvectors().col(axes[k]) * std::sqrt(es.eigenvalues()(axes[k]));
+  a->chi2 = dynamics::ChiSquaredQuantile(confidence, a->rank);
+  a->radius = std::sqrt(a->chi2);
+  r->B = std::move(B);
+  r->rank = a->rank;
+  r->radius = a->radius;
+  return true;
+}
+
+// The most favourable point of the region: a few Gauss-Newton steps in w,
+// each constrained to the region, on the residuals after the calibration
+// parameters' linear re-adjustment (basis Q; r0 the residuals at w = 0).
+Eigen::VectorXd MostFavourablePoint(const WhitenedRegion& region, const Eigen::MatrixXd& Q, const Eigen::VectorXd& r0) {
+  const int rank = region.rank;
+  const auto residuals = [&](const Eigen::VectorXd& w) { return region.Residuals(w); };
   const auto project = [&](const Eigen::MatrixXd& m) -> Eigen::MatrixXd { return m - Q * (Q.transpose() * m); };
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(a.rank);
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(rank);
   double best = project(r0).squaredNorm();
   for (int iteration = 0; iteration < 4; ++iteration) {
     const Eigen::VectorXd rw = residuals(w);
     if (rw.size() != r0.size()) break;
-    Eigen::MatrixXd A(r0.size(), a.rank);
+    Eigen::MatrixXd A(r0.size(), rank);
     constexpr double h = 0.05;  // in standard deviations along each axis
     bool ok = true;
-    for (int k = 0; k < a.rank && ok; ++k) {
+    for (int k = 0; k < rank && ok; ++k) {
       Eigen::VectorXd wp = w, wm = w;
       wp(k) += h;
       wm(k) -= h;
@@ -309,7 +326,7 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
     }
     if (!ok) break;
     const Eigen::MatrixXd PA = project(A);
-    const Eigen::VectorXd step = ConstrainedStep(PA, Eigen::VectorXd(project(rw) - PA * w), a.radius) - w;
+    const Eigen::VectorXd step = ConstrainedStep(PA, Eigen::VectorXd(project(rw) - PA * w), region.radius) - w;
     // A step the true cost does not accept is halved (the region is convex:
     // every point between w and the step's end lies in it).
     bool accepted = false;
@@ -326,23 +343,18 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
     }
     if (!accepted) break;
   }
-  a.distance = w.norm();
-  // The calibration refitted at the point: the error in the audit's own
-  // measure (rms log magnitude over every line), comparable with error_before.
-  const dynamics::ParameterSet start = point(w);
-  const calibration::CalibrationResult fit = CalibrateWithRetry(desc, start, o.calibration_parameters, x);
-  a.at = fit.status == calibration::FitStatus::kFailed ? start : fit.parameters;
-  a.errors = ComputeErrors(dynamics::RobotModel::Build(desc, a.at), x.postures, x.measured, o.fmin_hz, o.fmax_hz,
-                           o.num_bands);
-  a.error_noise_units = a.errors.total_rms_log_mag / x.noise_floor;
-  a.fraction_removed = FractionRemoved(error_before, a.errors.total_rms_log_mag, x.noise_floor);
-  const bool significant = !(error_before <= o.significance_factor * x.noise_floor);
-  a.covers_failure = significant && a.errors.total_rms_log_mag <= o.significance_factor * x.noise_floor;
+  return w;
+}
 
-  // Words: the parameters that moved the most, relative to their estimates.
+// Words: whether the region covers the failure (or how much of it), the
+// parameters that moved the most relative to their estimates, and how far
+// into the region the point lies.
+std::string AllowanceSentence(const UncertaintyAllowance& a, const Eigen::VectorXd& estimates, double error_before,
+                              double noise_floor) {
+  const int n = static_cast<int>(a.parameters.size());
   std::vector<std::pair<double, std::string>> moved;
   for (int i = 0; i < n; ++i) {
-    const double v0 = u.parameters[kept[i]].value, v1 = a.at.Get(a.parameters[i]);
+    const double v0 = estimates(i), v1 = a.at.Get(a.parameters[i]);
     const double rel = v0 != 0.0 ? v1 / v0 - 1.0 : v1 - v0;
     std::ostringstream m;
     m.precision(1);
@@ -354,8 +366,8 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
   for (size_t i = 0; i < a.parameters.size(); ++i) names += (i ? ", " : "") + a.parameters[i];
   std::ostringstream m;
   m.precision(3);
-  const double pct = std::round(100.0 * confidence * 10.0) / 10.0;
-  const double before_units = error_before / x.noise_floor;
+  const double pct = std::round(100.0 * a.confidence * 10.0) / 10.0;
+  const double before_units = error_before / noise_floor;
   if (a.covers_failure) {
     m << "within the parameter uncertainty: with " << names << " inside " << (n == 1 ? "its " : "their ") << pct
       << " % confidence region the error falls from " << before_units << " to " << a.error_noise_units
@@ -370,8 +382,61 @@ std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::Robot
   m << " (most moved: ";
   for (size_t i = 0; i < moved.size() && i < 3; ++i) m << (i ? ", " : "") << moved[i].second;
   m << "; Mahalanobis distance " << a.distance << " of " << a.radius << ")";
-  a.sentence = m.str();
+  return m.str();
+}
+
+}  // namespace
+
+std::optional<UncertaintyAllowance> AllowanceOfUncertainty(const dynamics::RobotDescription& desc,
+                                                           const dynamics::ParameterSet& calibrated,
+                                                           const dynamics::ParameterUncertainty& u,
+                                                           double confidence, const FitContext& x,
+                                                           double error_before) {
+  const AuditOptions& o = x.options;
+  UncertaintyAllowance a;
+  a.confidence = confidence;
+  const std::vector<int> kept = MovableParameters(calibrated, u, o, &a);
+  const int n = static_cast<int>(kept.size());
+  auto nothing = [&](const std::string& why) {
+    a.sentence = "the parameter uncertainty was not used: " + why;
+    return a;
+  };
+  if (n == 0) {
+    std::string l;
+    for (const auto& s : a.left_out) l += (l.empty() ? "" : "; ") + s;
+    return nothing("it has no parameter the audit can move (" + l + ")");
+  }
+  Eigen::VectorXd estimates;
+  WhitenedRegion region{desc, calibrated, a.parameters, x.banded, Marginal(u, kept, &estimates), {}, {}};
+  region.theta0 = dynamics::ToTheta(region.moved_u, estimates);
+  if (!Whiten(confidence, &region, &a)) {
+    a.parameters.clear();
+    return nothing("its covariance is zero");
+  }
+  const Eigen::VectorXd r0 = region.Residuals(Eigen::VectorXd::Zero(a.rank));
+  if (r0.size() == 0) {
+    a.parameters.clear();
+    return nothing("the model cannot be evaluated at its estimates");
+  }
+  // The calibration parameters' linear re-adjustment (as the screen's).
+  const Eigen::MatrixXd Q = CalibrationBasis(desc, calibrated, o.calibration_parameters, x.banded, r0);
+  const Eigen::VectorXd w = MostFavourablePoint(region, Q, r0);
+  a.distance = w.norm();
+  // The calibration refitted at the point: the error in the audit's own
+  // measure (rms log magnitude over every line), comparable with error_before.
+  const dynamics::ParameterSet start = region.Point(w);
+  const calibration::CalibrationResult fit = CalibrateWithRetry(desc, start, o.calibration_parameters, x);
+  a.at = fit.status == calibration::FitStatus::kFailed ? start : fit.parameters;
+  a.errors = ComputeErrors(dynamics::RobotModel::Build(desc, a.at), x.postures, x.measured, o.fmin_hz, o.fmax_hz,
+                           o.num_bands);
+  a.error_noise_units = a.errors.total_rms_log_mag / x.noise_floor;
+  a.fraction_removed = FractionRemoved(error_before, a.errors.total_rms_log_mag, x.noise_floor);
+  const bool significant = !(error_before <= o.significance_factor * x.noise_floor);
+  a.covers_failure = significant && a.errors.total_rms_log_mag <= o.significance_factor * x.noise_floor;
+
+  a.sentence = AllowanceSentence(a, estimates, error_before, x.noise_floor);
   return a;
 }
+
 
 }  // namespace robomach::audit::internal

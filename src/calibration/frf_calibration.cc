@@ -130,7 +130,7 @@ MeasuredFeatures ExtractFeatures(const dynamics::FrfSet& measured, const ModalFi
   for (const auto& [key, frf] : measured) {
     // The fit frf-modes and stability-lobes make (one fitter, issue #34).
     ModalFitResult fit = FitOneFrf(frf, options);
-    if (fit.status == ModalFitStatus::kOk) {
+    if (fit.status == SolverStatus::kConverged) {
       for (size_t i = 0; i < fit.modes.size(); ++i) {
         const FittedMode& m = fit.modes[i];
         MeasuredMode mm;
@@ -317,7 +317,6 @@ Objective ParseObjective(const std::string& name) {
   throw std::invalid_argument("objective '" + name + "': expected modal-two-stage, modal-joint or whole-curve");
 }
 
-std::string FitStatusName(FitStatus s) { return SolverStatusName(s); }
 
 CalibrationVerdict JudgeCalibration(const CalibrationResult& result, const dynamics::FrfSet& measured,
                                     const CalibrationOptions& options) {
@@ -616,9 +615,9 @@ bool SameMatching(const std::vector<ModeMatch>& a, const std::vector<ModeMatch>&
   return true;
 }
 
-CalibrationResult CalibrateOnce(const dynamics::RobotDescription& description, const dynamics::ParameterSet& initial,
-                                const PostureMap& postures, const dynamics::FrfSet& measured,
-                                const MeasuredFeatures& features, const CalibrationOptions& o) {
+// Throws unless every free parameter is known, fittable and named once: a
+// fit of a name the model does not have would silently fit nothing.
+void CheckFreeParameters(const dynamics::ParameterSet& initial, const CalibrationOptions& o) {
   for (const std::string& name : o.free_parameters) {
     if (!initial.Has(name)) throw std::invalid_argument("unknown parameter '" + name + "'; known: " + initial.NameList());
     if (!initial.spec(name).fittable) throw std::invalid_argument("parameter '" + name + "' is not fittable");
@@ -629,181 +628,254 @@ CalibrationResult CalibrateOnce(const dynamics::RobotDescription& description, c
       if (!seen.insert(name).second) throw std::invalid_argument("parameter '" + name + "' is free twice");
     }
   }
-  const std::vector<std::string> pose_ids = measured.pose_ids();
-  // Fails early, with the message, if a measured posture is unknown.
-  CalibrationResult result;
-  result.parameters = initial;
-  auto evaluate = [&](const dynamics::ParameterSet& p) {
-    return EvaluatePostures(dynamics::RobotModel::Build(description, p), postures, pose_ids);
-  };
-  result.matches_before = MatchModes(evaluate(initial), features, o.matching);
+}
 
+// What every stage of one calibration shares: the robot, its postures, the
+// data and their features, the options and the residual each stage starts from.
+struct CalibrationContext {
+  const dynamics::RobotDescription& description;
+  const dynamics::ParameterSet& initial;
+  const PostureMap& postures;
+  const dynamics::FrfSet& measured;
+  const MeasuredFeatures& features;
+  const CalibrationOptions& o;
+  std::vector<std::string> pose_ids;
   ModelResidual proto;
-  proto.description = &description;
-  proto.postures = &postures;
-  proto.pose_ids = pose_ids;
-  proto.freq_sigma = o.freq_sigma;
-  proto.peak_sigma = o.peak_sigma;
-  auto scales = [&](const std::vector<std::string>& names) {
+
+  // The dynamics of every measured posture for the parameters `p`.
+  std::map<std::string, PostureDynamics> Evaluate(const dynamics::ParameterSet& p) const {
+    return EvaluatePostures(dynamics::RobotModel::Build(description, p), postures, pose_ids);
+  }
+  // The solver's scale of each parameter: |initial value|, 1 where that is 0.
+  std::vector<double> Scales(const std::vector<std::string>& names) const {
     std::vector<double> s;
     for (const std::string& nm : names) {
       const double v = std::abs(initial.Get(nm));
       s.push_back(v > 0.0 ? v : 1.0);
     }
     return s;
-  };
+  }
+};
 
+// The free parameters of the two-stage objective split into those that move
+// the natural frequencies (stage 1) and the rest (stage 2, peak amplitudes);
+// both empty for the other objectives.
+struct StageSplit {
+  std::vector<std::string> stage1, stage2;
+};
+
+StageSplit SplitByFrequencyEffect(const CalibrationContext& c) {
   // Which free parameters move the undamped natural frequencies: a relative
   // change of 1e-3 must move some frequency by more than 1e-9 relative
   // (round-off of the eigen-solution is ~1e-13).
-  std::vector<std::string> stage1, stage2;
-  if (o.objective == Objective::kModalTwoStage) {
-    const auto d0 = evaluate(initial);
-    for (const std::string& nm : o.free_parameters) {
-      dynamics::ParameterSet p = initial;
-      const double v = initial.Get(nm);
+  StageSplit out;
+  if (c.o.objective == Objective::kModalTwoStage) {
+    const auto d0 = c.Evaluate(c.initial);
+    for (const std::string& nm : c.o.free_parameters) {
+      dynamics::ParameterSet p = c.initial;
+      const double v = c.initial.Get(nm);
       const double dv = v != 0.0 ? 1e-3 * v : 1e-6;
-      const auto& spec = initial.spec(nm);
+      const auto& spec = c.initial.spec(nm);
       p.Set(nm, v + dv <= spec.upper ? v + dv : v - dv);
-      const auto d1 = evaluate(p);
+      const auto d1 = c.Evaluate(p);
       double change = 0.0;
       for (const auto& [id, d] : d0) {
         for (size_t k = 0; k < d.modes.size() && k < d1.at(id).modes.size(); ++k) {
           change = std::max(change, std::abs(d1.at(id).modes[k].freq_hz / d.modes[k].freq_hz - 1.0));
         }
       }
-      (change > 1e-9 ? stage1 : stage2).push_back(nm);
+      (change > 1e-9 ? out.stage1 : out.stage2).push_back(nm);
     }
   }
+  return out;
+}
 
-  dynamics::ParameterSet current = initial;
-  std::vector<ModeMatch> matches = result.matches_before;
+// The state of the stage fits: the parameters so far and, for the last
+// round, each fitted parameter's std and stage, the stages' summaries and
+// outcomes and whether they all ended well.
+struct RoundState {
+  dynamics::ParameterSet current;
   std::map<std::string, std::pair<double, std::string>> std_devs;  // name -> (std, stage)
   std::vector<StageSummary> stages;
   std::vector<StageOutcome> outcomes;  // the last round's, for the covariance
   bool ok = true, converged = true;
+};
+
+// One stage: the parameters `free` fitted with the residual `kind` about the
+// current parameters and the mode matching `matches`; the fitted values
+// become the current ones for the next stage.
+void RunStage(const CalibrationContext& c, const std::vector<ModeMatch>& matches, const std::string& name,
+              ResidualKind kind, const std::vector<std::string>& free, RoundState* st) {
+  if (free.empty()) return;
+  const CalibrationOptions& o = c.o;
+  ModelResidual r = c.proto;
+  r.base = st->current;
+  r.names = free;
+  r.scale = c.Scales(free);
+  for (const std::string& nm : free) {
+    const double lower = c.initial.spec(nm).lower, v = c.initial.Get(nm);
+    r.log_scale.push_back(lower > 0.0 && v > 0.0 && std::log(lower / std::abs(v)) > 1.0 - ModelResidual::kLogOffset);
+  }
+  r.kind = kind;
+  r.matches = matches;
+  r.robust_scale = o.robust_scale;
+  if (kind == ResidualKind::kWholeCurve) {
+    for (const auto& [key, frf] : c.measured) {
+      dynamics::Frf band = frf.Band(std::max(o.fmin_hz, 1e-12), o.fmax_hz);
+      if (band.size() > 0) {
+        r.curve_weights.push_back(LogResidualWeights(band));
+        r.curves.emplace_back(key, std::move(band));
+      }
+    }
+  }
+  StageOutcome s = SolveStage(name, std::move(r), o);
+  for (size_t i = 0; i < free.size(); ++i) {
+    st->current.Set(free[i], s.values[i]);
+    st->std_devs[free[i]] = {s.std_dev[i], name};
+  }
+  if (s.termination == ceres::FAILURE || s.termination == ceres::USER_FAILURE) st->ok = false;
+  if (s.termination != ceres::CONVERGENCE) st->converged = false;
+  st->stages.push_back(s.summary);
+  st->outcomes.push_back(std::move(s));
+}
+
+// The stages of the objective, repeated while the fit changes which measured
+// mode matches which model mode (at most max_match_rounds times); `matches`
+// ends as the matching of the final parameters.
+RoundState RunRounds(const CalibrationContext& c, const StageSplit& split, std::vector<ModeMatch>* matches) {
+  const CalibrationOptions& o = c.o;
+  RoundState st;
+  st.current = c.initial;
   for (int round = 0; round < std::max(1, o.max_match_rounds); ++round) {
-    stages.clear();
-    outcomes.clear();
-    std_devs.clear();
-    ok = true;
-    converged = true;
-    auto run = [&](const std::string& name, ResidualKind kind, const std::vector<std::string>& free) {
-      if (free.empty()) return;
-      ModelResidual r = proto;
-      r.base = current;
-      r.names = free;
-      r.scale = scales(free);
-      for (const std::string& nm : free) {
-        const double lower = initial.spec(nm).lower, v = initial.Get(nm);
-        r.log_scale.push_back(lower > 0.0 && v > 0.0 &&
-                              std::log(lower / std::abs(v)) > 1.0 - ModelResidual::kLogOffset);
-      }
-      r.kind = kind;
-      r.matches = matches;
-      r.robust_scale = o.robust_scale;
-      if (kind == ResidualKind::kWholeCurve) {
-        for (const auto& [key, frf] : measured) {
-          dynamics::Frf band = frf.Band(std::max(o.fmin_hz, 1e-12), o.fmax_hz);
-          if (band.size() > 0) {
-            r.curve_weights.push_back(LogResidualWeights(band));
-            r.curves.emplace_back(key, std::move(band));
-          }
-        }
-      }
-      StageOutcome s = SolveStage(name, std::move(r), o);
-      for (size_t i = 0; i < free.size(); ++i) {
-        current.Set(free[i], s.values[i]);
-        std_devs[free[i]] = {s.std_dev[i], name};
-      }
-      if (s.termination == ceres::FAILURE || s.termination == ceres::USER_FAILURE) ok = false;
-      if (s.termination != ceres::CONVERGENCE) converged = false;
-      stages.push_back(s.summary);
-      outcomes.push_back(std::move(s));
-    };
+    st.stages.clear();
+    st.outcomes.clear();
+    st.std_devs.clear();
+    st.ok = true;
+    st.converged = true;
     switch (o.objective) {
       case Objective::kModalTwoStage:
-        run("frequencies", ResidualKind::kFrequency, stage1);
-        run("peak amplitudes", ResidualKind::kPeak, stage2);
+        RunStage(c, *matches, "frequencies", ResidualKind::kFrequency, split.stage1, &st);
+        RunStage(c, *matches, "peak amplitudes", ResidualKind::kPeak, split.stage2, &st);
         break;
       case Objective::kModalJoint:
-        run("joint", ResidualKind::kJoint, o.free_parameters);
+        RunStage(c, *matches, "joint", ResidualKind::kJoint, o.free_parameters, &st);
         break;
       case Objective::kWholeCurve:
-        run("whole curve", ResidualKind::kWholeCurve, o.free_parameters);
+        RunStage(c, *matches, "whole curve", ResidualKind::kWholeCurve, o.free_parameters, &st);
         break;
     }
-    const auto rematched = MatchModes(evaluate(current), features, o.matching);
-    const bool same = SameMatching(rematched, matches);
-    matches = rematched;
+    const auto rematched = MatchModes(c.Evaluate(st.current), c.features, o.matching);
+    const bool same = SameMatching(rematched, *matches);
+    *matches = rematched;
     if (same || o.objective == Objective::kWholeCurve) break;
   }
-  result.parameters = current;
-  result.stages = stages;
-  result.matches_after = matches;
-  {
-    // Block-diagonal over the stages: a later stage's parameters are
-    // conditional on the earlier ones, held at their fitted values.
-    const int n = static_cast<int>(o.free_parameters.size());
-    result.covariance = Eigen::MatrixXd::Constant(n, n, NAN);
-    auto index = [&](const std::string& nm) {
-      return static_cast<int>(std::find(o.free_parameters.begin(), o.free_parameters.end(), nm) -
-                              o.free_parameters.begin());
-    };
-    for (const StageOutcome& s : outcomes) {
-      if (s.covariance.size() == 0) continue;
-      for (size_t i = 0; i < s.summary.parameters.size(); ++i) {
-        for (size_t j = 0; j < s.summary.parameters.size(); ++j) {
-          result.covariance(index(s.summary.parameters[i]), index(s.summary.parameters[j])) =
-              s.covariance(static_cast<int>(i), static_cast<int>(j));
-        }
-      }
-    }
-    for (int i = 0; i < n; ++i) {
-      for (int j = 0; j < n; ++j) {
-        if (i != j && std::isfinite(result.covariance(i, i)) && std::isfinite(result.covariance(j, j)) &&
-            std::isnan(result.covariance(i, j))) {
-          result.covariance(i, j) = 0.0;  // different stages
-        }
+  return st;
+}
+
+// The covariance of the free parameters, block-diagonal over the stages: a
+// later stage's parameters are conditional on the earlier ones, held at
+// their fitted values.
+Eigen::MatrixXd StageCovariance(const std::vector<StageOutcome>& outcomes, const CalibrationOptions& o) {
+  const int n = static_cast<int>(o.free_parameters.size());
+  Eigen::MatrixXd covariance = Eigen::MatrixXd::Constant(n, n, NAN);
+  auto index = [&](const std::string& nm) {
+    return static_cast<int>(std::find(o.free_parameters.begin(), o.free_parameters.end(), nm) -
+                            o.free_parameters.begin());
+  };
+  for (const StageOutcome& s : outcomes) {
+    if (s.covariance.size() == 0) continue;
+    for (size_t i = 0; i < s.summary.parameters.size(); ++i) {
+      for (size_t j = 0; j < s.summary.parameters.size(); ++j) {
+        covariance(index(s.summary.parameters[i]), index(s.summary.parameters[j])) =
+            s.covariance(static_cast<int>(i), static_cast<int>(j));
       }
     }
   }
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      if (i != j && std::isfinite(covariance(i, i)) && std::isfinite(covariance(j, j)) &&
+          std::isnan(covariance(i, j))) {
+        covariance(i, j) = 0.0;  // different stages
+      }
+    }
+  }
+  return covariance;
+}
+
+// One estimate per free parameter (initial and fitted value, std and the
+// stage that fitted it, whether it is weakly identified or on a bound), the
+// weakly identified ones also listed by name.
+void AddEstimates(const CalibrationContext& c, const RoundState& st, CalibrationResult* result) {
+  const CalibrationOptions& o = c.o;
   for (const std::string& nm : o.free_parameters) {
     ParameterEstimate e;
     e.name = nm;
-    e.unit = initial.spec(nm).unit;
-    e.initial = initial.Get(nm);
-    e.value = current.Get(nm);
-    auto it = std_devs.find(nm);
-    if (it != std_devs.end()) {
+    e.unit = c.initial.spec(nm).unit;
+    e.initial = c.initial.Get(nm);
+    e.value = st.current.Get(nm);
+    auto it = st.std_devs.find(nm);
+    if (it != st.std_devs.end()) {
       e.std_dev = it->second.first;
       e.stage = it->second.second;
     }
     e.weakly_identified = !(e.std_dev <= o.weak_relative_std * std::abs(e.value));
-    const auto& spec = initial.spec(nm);
+    const auto& spec = c.initial.spec(nm);
     const double tol = 1e-9 * std::max(1.0, std::abs(e.value));
     e.at_bound = std::abs(e.value - spec.lower) < tol || std::abs(e.value - spec.upper) < tol;
-    if (e.weakly_identified) result.weakly_identified.push_back(nm);
-    result.estimates.push_back(e);
+    if (e.weakly_identified) result->weakly_identified.push_back(nm);
+    result->estimates.push_back(e);
   }
+}
+
+// The status from the stages' terminations and the message that explains it
+// (each stage's termination when one failed or did not converge, the weakly
+// identified parameters).
+void SetStatusAndMessage(const RoundState& st, const CalibrationOptions& o, CalibrationResult* result) {
   std::ostringstream msg;
-  if (!ok) {
-    result.status = FitStatus::kFailed;
+  if (!st.ok) {
+    result->status = FitStatus::kFailed;
     msg << "a stage failed:";
-    for (const auto& s : stages) msg << " [" << s.name << ": " << s.termination << ", " << s.message << "]";
-  } else if (!converged) {
-    result.status = FitStatus::kNotConverged;
+    for (const auto& s : st.stages) msg << " [" << s.name << ": " << s.termination << ", " << s.message << "]";
+  } else if (!st.converged) {
+    result->status = FitStatus::kNotConverged;
     msg << "not converged:";
-    for (const auto& s : stages) msg << " [" << s.name << ": " << s.termination << ", " << s.message << "]";
+    for (const auto& s : st.stages) msg << " [" << s.name << ": " << s.termination << ", " << s.message << "]";
   } else {
-    result.status = FitStatus::kConverged;
+    result->status = FitStatus::kConverged;
     msg << "converged";
   }
-  if (!result.weakly_identified.empty()) {
+  if (!result->weakly_identified.empty()) {
     msg << "; weakly identified (std > " << o.weak_relative_std * 100 << " % of the value, or no covariance):";
-    for (const auto& n : result.weakly_identified) msg << ' ' << n;
+    for (const auto& n : result->weakly_identified) msg << ' ' << n;
   }
-  result.message = msg.str();
+  result->message = msg.str();
+}
+
+CalibrationResult CalibrateOnce(const dynamics::RobotDescription& description, const dynamics::ParameterSet& initial,
+                                const PostureMap& postures, const dynamics::FrfSet& measured,
+                                const MeasuredFeatures& features, const CalibrationOptions& o) {
+  CheckFreeParameters(initial, o);
+  CalibrationContext c{description, initial, postures, measured, features, o, measured.pose_ids(), {}};
+  // Fails early, with the message, if a measured posture is unknown.
+  CalibrationResult result;
+  result.parameters = initial;
+  result.matches_before = MatchModes(c.Evaluate(initial), features, o.matching);
+
+  c.proto.description = &description;
+  c.proto.postures = &postures;
+  c.proto.pose_ids = c.pose_ids;
+  c.proto.freq_sigma = o.freq_sigma;
+  c.proto.peak_sigma = o.peak_sigma;
+
+  const StageSplit split = SplitByFrequencyEffect(c);
+  std::vector<ModeMatch> matches = result.matches_before;
+  const RoundState st = RunRounds(c, split, &matches);
+  result.parameters = st.current;
+  result.stages = st.stages;
+  result.matches_after = matches;
+  result.covariance = StageCovariance(st.outcomes, o);
+  AddEstimates(c, st, &result);
+  SetStatusAndMessage(st, o, &result);
   return result;
 }
 

@@ -153,18 +153,53 @@ int DetectFlatTop(const Eigen::VectorXd& x, int min_run) {
   return -1;
 }
 
-FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::vector<ResponseChannel>& channels,
-                              const FrfEstimateOptions& o) {
-  CheckValid(o);
-  FrfEstimateResult result;
-  result.exponential_tau_s = o.exponential_tau_s;
-  const int nc = static_cast<int>(channels.size());
-  if (nc == 0) throw std::invalid_argument("EstimateFrf: no response channel");
-  if (!o.response_range.empty() && static_cast<int>(o.response_range.size()) != nc) {
-    throw std::invalid_argument("FrfEstimateOptions::response_range has " + std::to_string(o.response_range.size()) +
-                                " entries; expected none or one per channel (" + std::to_string(nc) + ")");
-  }
-  if (hits.empty()) return result;
+namespace {
+
+// The stages of EstimateFrf below, in their order: the records' layout, hit
+// screening (pass 1), the force window, windowed spectra summed over the
+// accepted hits (pass 2) with the leakage check, the H1/H2/coherence
+// estimators, and the findings on units and excitation.
+
+// What every hit is cut to: response channels, sample rate, samples of the
+// FFT block, line spacing and the number of lines up to fmax.
+struct Layout {
+  int nc{0};
+  double fs{0.0};
+  int n{0};
+  double df{0.0};
+  int lines{0};
+};
+
+// Pass 1's outcome besides the hit reports: each hit's pulse, and the
+// longest pulse of an accepted hit (the automatic force window's base).
+struct Screening {
+  std::vector<Pulse> pulses;
+  double longest_pulse_s{0.0};
+};
+
+// The force window [s]: width after the pulse start (< 0 = off), the part
+// before it, and the cosine taper at both ends.
+struct ForceWindowSpec {
+  double width{0.0};
+  double pre{0.0};
+  double taper{0.0};
+};
+
+// Sums (1) over the accepted hits, and what the leakage check saw per channel.
+struct SpectralSums {
+  Eigen::VectorXd g_ff;
+  Eigen::MatrixXd g_xx;
+  Eigen::MatrixXcd g_fx;
+  std::vector<int> leaky_hits;
+  std::vector<double> worst_tail;
+  double shortest_decay_s{std::numeric_limits<double>::infinity()};
+};
+
+// Checks the records agree (sample rate, channels, length, finite samples)
+// and fixes the block length and the lines, with warnings where the records
+// are cut or fmax is above Nyquist.
+Layout CheckRecords(const std::vector<ImpactRecord>& hits, int nc, const FrfEstimateOptions& o,
+                    FrfEstimateResult* result) {
   const double fs = hits.front().sample_rate_hz;
   int n = std::numeric_limits<int>::max();
   int n_max = 0;
@@ -190,19 +225,19 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
     n_max = std::max(n_max, static_cast<int>(h.force_N.size()));
   }
   if (n != n_max) {
-    result.warnings.push_back("records have " + std::to_string(n) + " to " + std::to_string(n_max) +
-                              " samples; all are cut to the shortest (" + std::to_string(n) + ")");
+    result->warnings.push_back("records have " + std::to_string(n) + " to " + std::to_string(n_max) +
+                               " samples; all are cut to the shortest (" + std::to_string(n) + ")");
   }
   if (const int fast = FastFftLength(n); fast != n) {
     // The end of a record holds the least (a decayed response), and the
     // leakage check below still looks at the new end.
-    result.warnings.push_back("the last " + std::to_string(n - fast) + " of " + std::to_string(n) +
-                              " samples are dropped for the FFT (" + std::to_string(fast) +
-                              " has only the factors 2, 3, 5)");
+    result->warnings.push_back("the last " + std::to_string(n - fast) + " of " + std::to_string(n) +
+                               " samples are dropped for the FFT (" + std::to_string(fast) +
+                               " has only the factors 2, 3, 5)");
     n = fast;
   }
-  result.sample_rate_hz = fs;
-  result.block_samples = n;
+  result->sample_rate_hz = fs;
+  result->block_samples = n;
   const double df = fs / n;
   const double fmax = o.fmax_hz > 0.0 ? o.fmax_hz : fs / 2.56;
   // The line count in double before it becomes an int: fmax / df of 1e12 Hz
@@ -210,108 +245,136 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
   const double lines_wanted = std::floor(fmax / df + 1e-9);
   const int lines = lines_wanted >= n / 2 ? n / 2 : static_cast<int>(lines_wanted);
   if (fmax > 0.5 * fs * (1.0 + 1e-12)) {
-    result.warnings.push_back("fmax_hz " + FormatNumber(fmax, 6) + " is above the Nyquist frequency " +
-                              FormatNumber(0.5 * fs, 6) + " Hz of the records (sample rate " + FormatNumber(fs, 6) +
-                              " Hz): the lines stop there");
+    result->warnings.push_back("fmax_hz " + FormatNumber(fmax, 6) + " is above the Nyquist frequency " +
+                               FormatNumber(0.5 * fs, 6) + " Hz of the records (sample rate " + FormatNumber(fs, 6) +
+                               " Hz): the lines stop there");
   }
   if (lines < 1) throw std::invalid_argument("EstimateFrf: fmax_hz " + FormatNumber(fmax) + " is below the line spacing " + FormatNumber(df) + " Hz");
+  return Layout{nc, fs, n, df, lines};
+}
 
-  // Pass 1: pulses, double hits and overloads.
-  std::vector<Pulse> pulses(hits.size());
-  double longest_pulse_s = 0.0;
-  for (size_t h = 0; h < hits.size(); ++h) {
-    const ImpactRecord& rec = hits[h];
-    HitReport rep;
-    rep.id = rec.id;
-    rep.source = rec.source;
-    const Eigen::VectorXd f = rec.force_N.head(n);
-    if (f.cwiseAbs().maxCoeff() == 0.0) {
-      throw std::invalid_argument("hit " + rec.id + " (" + rec.source + "): the force is zero throughout");
-    }
-    const Pulse p = FindPulse(f, n, o.trigger_fraction);
-    pulses[h] = p;
-    rep.peak_force_N = f(p.peak);
-    rep.hit_time_s = rec.start_time_s + p.start / fs;
-    rep.pulse_duration_s = (p.end - p.start + 1) / fs;
-    const auto time_of = [&](int i) { return FormatNumber(rec.start_time_s + i / fs, 5); };
-    // Double hit: a second pulse before or after the main one.
-    const double dbl = o.double_hit_fraction * p.peak_N;
-    int second = -1;
-    for (int i = 0; i < n; ++i) {
-      if (i >= p.start && i <= p.end) continue;
-      if (std::abs(f(i)) > dbl) {
-        second = i;
-        break;
-      }
-    }
-    if (second >= 0) {
-      // Report the second pulse's own peak.
-      int j = second, best = second;
-      while (j < n && (j < p.start || j > p.end) && std::abs(f(j)) > o.trigger_fraction * p.peak_N) {
-        if (std::abs(f(j)) > std::abs(f(best))) best = j;
-        ++j;
-      }
-      rep.status = HitStatus::kDoubleHit;
-      rep.notes.push_back(std::string("double hit: ") + (best > p.end ? "a second" : "an earlier") +
-                          " force pulse at t = " + time_of(best) + " s, " +
-                          FormatNumber(100.0 * std::abs(f(best)) / p.peak_N, 3) + " % of the main pulse's peak (at t = " +
-                          time_of(p.peak) + " s)");
-    }
-    // Overload: flat tops or samples at a given range.
-    const auto check_channel = [&](const Eigen::VectorXd& x, const std::string& name, double range,
-                                   const std::string& unit) {
-      const int flat = DetectFlatTop(x, o.flat_top_samples);
-      if (flat >= 0) {
-        rep.status = rep.status == HitStatus::kAccepted ? HitStatus::kOverload : rep.status;
-        rep.notes.push_back("overload: " + name + " is clipped (flat top at " + FormatNumber(x(flat), 5) + " " + unit +
-                            " from t = " + time_of(flat) + " s)");
-        return;
-      }
-      if (range > 0.0) {
-        Eigen::Index i;
-        const double m = x.cwiseAbs().maxCoeff(&i);
-        if (m >= range) {
-          rep.status = rep.status == HitStatus::kAccepted ? HitStatus::kOverload : rep.status;
-          rep.notes.push_back("overload: " + name + " reaches " + FormatNumber(x(i), 5) + " " + unit + " at t = " +
-                              time_of(static_cast<int>(i)) + " s, at or beyond the range " + FormatNumber(range, 5) +
-                              " " + unit);
-        }
-      }
-    };
-    check_channel(f, "force", o.force_range_N, "N");
-    for (int c = 0; c < nc; ++c) {
-      static const char* kUnits[] = {"m", "m/s", "m/s^2"};
-      check_channel(rec.response.col(c).head(n), "response " + channels[c].name,
-                    o.response_range.empty() ? 0.0 : o.response_range[c],
-                    kUnits[static_cast<int>(channels[c].quantity)]);
-    }
-    if (rep.status == HitStatus::kAccepted) longest_pulse_s = std::max(longest_pulse_s, rep.pulse_duration_s);
-    result.hits.push_back(rep);
+// Pass 1 for one hit: its pulse (into *pulse), double hits and overloads.
+HitReport ScreenHit(const ImpactRecord& rec, const std::vector<ResponseChannel>& channels,
+                    const FrfEstimateOptions& o, const Layout& lay, Pulse* pulse) {
+  const int n = lay.n;
+  const double fs = lay.fs;
+  HitReport rep;
+  rep.id = rec.id;
+  rep.source = rec.source;
+  const Eigen::VectorXd f = rec.force_N.head(n);
+  if (f.cwiseAbs().maxCoeff() == 0.0) {
+    throw std::invalid_argument("hit " + rec.id + " (" + rec.source + "): the force is zero throughout");
   }
+  const Pulse p = FindPulse(f, n, o.trigger_fraction);
+  *pulse = p;
+  rep.peak_force_N = f(p.peak);
+  rep.hit_time_s = rec.start_time_s + p.start / fs;
+  rep.pulse_duration_s = (p.end - p.start + 1) / fs;
+  const auto time_of = [&](int i) { return FormatNumber(rec.start_time_s + i / fs, 5); };
+  // Double hit: a second pulse before or after the main one.
+  const double dbl = o.double_hit_fraction * p.peak_N;
+  int second = -1;
+  for (int i = 0; i < n; ++i) {
+    if (i >= p.start && i <= p.end) continue;
+    if (std::abs(f(i)) > dbl) {
+      second = i;
+      break;
+    }
+  }
+  if (second >= 0) {
+    // Report the second pulse's own peak.
+    int j = second, best = second;
+    while (j < n && (j < p.start || j > p.end) && std::abs(f(j)) > o.trigger_fraction * p.peak_N) {
+      if (std::abs(f(j)) > std::abs(f(best))) best = j;
+      ++j;
+    }
+    rep.status = HitStatus::kDoubleHit;
+    rep.notes.push_back(std::string("double hit: ") + (best > p.end ? "a second" : "an earlier") +
+                        " force pulse at t = " + time_of(best) + " s, " +
+                        FormatNumber(100.0 * std::abs(f(best)) / p.peak_N, 3) + " % of the main pulse's peak (at t = " +
+                        time_of(p.peak) + " s)");
+  }
+  // Overload: flat tops or samples at a given range.
+  const auto check_channel = [&](const Eigen::VectorXd& x, const std::string& name, double range,
+                                 const std::string& unit) {
+    const int flat = DetectFlatTop(x, o.flat_top_samples);
+    if (flat >= 0) {
+      rep.status = rep.status == HitStatus::kAccepted ? HitStatus::kOverload : rep.status;
+      rep.notes.push_back("overload: " + name + " is clipped (flat top at " + FormatNumber(x(flat), 5) + " " + unit +
+                          " from t = " + time_of(flat) + " s)");
+      return;
+    }
+    if (range > 0.0) {
+      Eigen::Index i;
+      const double m = x.cwiseAbs().maxCoeff(&i);
+      if (m >= range) {
+        rep.status = rep.status == HitStatus::kAccepted ? HitStatus::kOverload : rep.status;
+        rep.notes.push_back("overload: " + name + " reaches " + FormatNumber(x(i), 5) + " " + unit + " at t = " +
+                            time_of(static_cast<int>(i)) + " s, at or beyond the range " + FormatNumber(range, 5) +
+                            " " + unit);
+      }
+    }
+  };
+  check_channel(f, "force", o.force_range_N, "N");
+  for (int c = 0; c < lay.nc; ++c) {
+    static const char* kUnits[] = {"m", "m/s", "m/s^2"};
+    check_channel(rec.response.col(c).head(n), "response " + channels[c].name,
+                  o.response_range.empty() ? 0.0 : o.response_range[c],
+                  kUnits[static_cast<int>(channels[c].quantity)]);
+  }
+  return rep;
+}
 
-  const double width = o.force_window_s != 0.0 ? o.force_window_s : 3.0 * longest_pulse_s + 32.0 / fs;
-  const double pre = o.force_window_pre_s > 0.0 ? o.force_window_pre_s : 16.0 / fs;
-  const double taper = o.force_window_taper_s > 0.0 ? o.force_window_taper_s : 8.0 / fs;
-  result.force_window_s = width;
-  result.force_window_pre_s = width < 0.0 ? 0.0 : pre;
+// Pass 1: pulses, double hits and overloads, a report per hit.
+Screening ScreenHits(const std::vector<ImpactRecord>& hits, const std::vector<ResponseChannel>& channels,
+                     const FrfEstimateOptions& o, const Layout& lay, FrfEstimateResult* result) {
+  Screening s;
+  s.pulses.resize(hits.size());
+  for (size_t h = 0; h < hits.size(); ++h) {
+    const HitReport rep = ScreenHit(hits[h], channels, o, lay, &s.pulses[h]);
+    if (rep.status == HitStatus::kAccepted) s.longest_pulse_s = std::max(s.longest_pulse_s, rep.pulse_duration_s);
+    result->hits.push_back(rep);
+  }
+  return s;
+}
 
-  // Pass 2: windows, spectra, sums (1).
+// The force window, the automatic parts from the longest accepted pulse and
+// the sample interval.
+ForceWindowSpec ChooseForceWindow(const FrfEstimateOptions& o, double longest_pulse_s, double fs,
+                                  FrfEstimateResult* result) {
+  ForceWindowSpec w;
+  w.width = o.force_window_s != 0.0 ? o.force_window_s : 3.0 * longest_pulse_s + 32.0 / fs;
+  w.pre = o.force_window_pre_s > 0.0 ? o.force_window_pre_s : 16.0 / fs;
+  w.taper = o.force_window_taper_s > 0.0 ? o.force_window_taper_s : 8.0 / fs;
+  result->force_window_s = w.width;
+  result->force_window_pre_s = w.width < 0.0 ? 0.0 : w.pre;
+  return w;
+}
+
+// Pass 2: windows, spectra, sums (1) over the accepted hits (counted in
+// result->averages), and the leakage check of each windowed response.
+SpectralSums AccumulateSpectra(const std::vector<ImpactRecord>& hits, const std::vector<Pulse>& pulses,
+                               const FrfEstimateOptions& o, const Layout& lay, const ForceWindowSpec& win,
+                               FrfEstimateResult* result) {
+  const int n = lay.n, nc = lay.nc, lines = lay.lines;
+  const double fs = lay.fs;
+  const double pre = win.pre, width = win.width, taper = win.taper;
   Eigen::FFT<double> fft;
   fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
-  Eigen::VectorXd g_ff = Eigen::VectorXd::Zero(lines);
-  Eigen::MatrixXd g_xx = Eigen::MatrixXd::Zero(lines, nc);
-  Eigen::MatrixXcd g_fx = Eigen::MatrixXcd::Zero(lines, nc);
+  SpectralSums s;
+  s.g_ff = Eigen::VectorXd::Zero(lines);
+  s.g_xx = Eigen::MatrixXd::Zero(lines, nc);
+  s.g_fx = Eigen::MatrixXcd::Zero(lines, nc);
   std::vector<double> buf(n);
   std::vector<std::complex<double>> spec_f, spec_x;
   const int tail = std::max(1, n / 20);
-  std::vector<int> leaky_hits(nc, 0);
-  double shortest_decay_s = std::numeric_limits<double>::infinity();
-  std::vector<double> worst_tail(nc, 0.0);
+  s.leaky_hits.assign(nc, 0);
+  s.worst_tail.assign(nc, 0.0);
   for (size_t h = 0; h < hits.size(); ++h) {
-    if (result.hits[h].status != HitStatus::kAccepted) continue;
+    if (result->hits[h].status != HitStatus::kAccepted) continue;
     const ImpactRecord& rec = hits[h];
     const Pulse& p = pulses[h];
-    shortest_decay_s = std::min(shortest_decay_s, (n - p.start) / fs);
+    s.shortest_decay_s = std::min(s.shortest_decay_s, (n - p.start) / fs);
     // Offsets: the mean of the samples before the force window (pre-trigger),
     // if there are at least 8 of them.
     const int pre_end = std::max(0, p.start - static_cast<int>(std::ceil((pre + taper) * fs)));
@@ -324,7 +387,7 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
     const double f0 = offset(f);
     for (int i = 0; i < n; ++i) buf[i] = (f(i) - f0) * ForceWindow((i - p.start) / fs, pre, width, taper) * w_exp(i);
     fft.fwd(spec_f, buf);
-    for (int k = 0; k < lines; ++k) g_ff(k) += std::norm(spec_f[k + 1]);
+    for (int k = 0; k < lines; ++k) s.g_ff(k) += std::norm(spec_f[k + 1]);
     for (int c = 0; c < nc; ++c) {
       const Eigen::VectorXd x = rec.response.col(c).head(n);
       const double x0 = offset(x);
@@ -339,89 +402,131 @@ FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::
       const double tail_rms = std::sqrt(tail_ms);
       const bool above_noise = pre_end >= 8 ? tail_rms > 2.0 * std::sqrt(pre_ms) : true;
       if (tail_rms > o.leakage_fraction * peak && above_noise) {
-        ++leaky_hits[c];
-        worst_tail[c] = std::max(worst_tail[c], tail_rms / peak);
+        ++s.leaky_hits[c];
+        s.worst_tail[c] = std::max(s.worst_tail[c], tail_rms / peak);
       }
       fft.fwd(spec_x, buf);
       for (int k = 0; k < lines; ++k) {
         const std::complex<double> F = spec_f[k + 1], X = spec_x[k + 1];
-        g_xx(k, c) += std::norm(X);
-        g_fx(k, c) += std::conj(F) * X;
+        s.g_xx(k, c) += std::norm(X);
+        s.g_fx(k, c) += std::conj(F) * X;
       }
     }
-    ++result.averages;
+    ++result->averages;
   }
+  return s;
+}
 
-  for (int c = 0; c < nc; ++c) {
-    if (leaky_hits[c] == 0) continue;
-    result.leakage = true;
-    result.warnings.push_back("response " + channels[c].name + ": has not decayed by the end of the record in " +
-                              std::to_string(leaky_hits[c]) + " of " + std::to_string(result.averages) +
-                              " accepted hits (rms of the last 5 % up to " + FormatNumber(100.0 * worst_tail[c], 3) +
-                              " % of the peak): leakage widens the peaks and overstates the damping; use longer "
-                              "records or an exponential window (tau = " + FormatNumber(shortest_decay_s / 6.0, 3) +
-                              " s, a sixth of the shortest time from a hit to its record's end, leaves e^-6 = "
-                              "0.25 %" + (o.exponential_tau_s > 0.0 ? "; the window now has tau = " +
-                                          FormatNumber(o.exponential_tau_s, 3) + " s" : std::string()) + ")");
+// One warning per channel whose response had not decayed by the end of the
+// record in some accepted hit, with the exponential window that would help.
+void WarnLeakage(const SpectralSums& s, const std::vector<ResponseChannel>& channels, const FrfEstimateOptions& o,
+                 FrfEstimateResult* result) {
+  for (size_t c = 0; c < channels.size(); ++c) {
+    if (s.leaky_hits[c] == 0) continue;
+    result->leakage = true;
+    result->warnings.push_back("response " + channels[c].name + ": has not decayed by the end of the record in " +
+                               std::to_string(s.leaky_hits[c]) + " of " + std::to_string(result->averages) +
+                               " accepted hits (rms of the last 5 % up to " + FormatNumber(100.0 * s.worst_tail[c], 3) +
+                               " % of the peak): leakage widens the peaks and overstates the damping; use longer "
+                               "records or an exponential window (tau = " + FormatNumber(s.shortest_decay_s / 6.0, 3) +
+                               " s, a sixth of the shortest time from a hit to its record's end, leaves e^-6 = "
+                               "0.25 %" + (o.exponential_tau_s > 0.0 ? "; the window now has tau = " +
+                                           FormatNumber(o.exponential_tau_s, 3) + " s" : std::string()) + ")");
   }
-  result.freq_hz = Eigen::VectorXd::LinSpaced(lines, df, lines * df);
-  if (result.averages == 0) {
-    result.status = FrfEstimateStatus::kNoHits;
-    return result;
-  }
-  result.status = FrfEstimateStatus::kOk;
-  result.force_autospectrum = g_ff / result.averages;
-  for (int c = 0; c < nc; ++c) {
+}
+
+// The estimators from the averaged sums: H1, H2 and the coherence per
+// channel, and the warning when too few hits make the coherence mean little.
+void EstimateChannels(const SpectralSums& s, const Layout& lay, FrfEstimateResult* result) {
+  const int lines = lay.lines;
+  result->force_autospectrum = s.g_ff / result->averages;
+  for (int c = 0; c < lay.nc; ++c) {
     ChannelFrf ch;
     ch.h1.resize(lines);
     ch.h2.resize(lines);
     ch.coherence.resize(lines);
     for (int k = 0; k < lines; ++k) {
-      const std::complex<double> gfx = g_fx(k, c);
-      ch.h1(k) = g_ff(k) > 0.0 ? gfx / g_ff(k) : std::complex<double>(0.0);
-      ch.h2(k) = std::abs(gfx) > 0.0 ? g_xx(k, c) / std::conj(gfx) : std::complex<double>(0.0);
-      const double den = g_ff(k) * g_xx(k, c);
+      const std::complex<double> gfx = s.g_fx(k, c);
+      ch.h1(k) = s.g_ff(k) > 0.0 ? gfx / s.g_ff(k) : std::complex<double>(0.0);
+      ch.h2(k) = std::abs(gfx) > 0.0 ? s.g_xx(k, c) / std::conj(gfx) : std::complex<double>(0.0);
+      const double den = s.g_ff(k) * s.g_xx(k, c);
       // Cauchy-Schwarz makes |G_fx|² <= G_ff G_xx; clamp the rounding.
       ch.coherence(k) = den > 0.0 ? std::min(1.0, std::norm(gfx) / den) : 0.0;
     }
-    result.channels.push_back(std::move(ch));
+    result->channels.push_back(std::move(ch));
   }
-  if (result.averages == 1) {
-    result.warnings.push_back("one accepted hit: the coherence is 1 on every line by construction and says nothing");
-  } else if (result.averages == 2) {
-    result.warnings.push_back(
+  if (result->averages == 1) {
+    result->warnings.push_back("one accepted hit: the coherence is 1 on every line by construction and says nothing");
+  } else if (result->averages == 2) {
+    result->warnings.push_back(
         "only 2 hits averaged: the coherence needs at least 3 to mean much, 5 or more are usual");
   }
-  // Unit plausibility: the largest receptance on the coherent lines of the
-  // band the noise model finds usable (issue #34 item 5: on a single hit the
-  // 1/ω² of an accelerometer's slow drift made the lowest lines 1e-3 m/N).
-  for (int c = 0; c < nc; ++c) {
+}
+
+// Unit plausibility: the largest receptance on the coherent lines of the
+// band the noise model finds usable (issue #34 item 5: on a single hit the
+// 1/ω² of an accelerometer's slow drift made the lowest lines 1e-3 m/N).
+void CheckReceptanceUnits(const std::vector<ResponseChannel>& channels, int lines, FrfEstimateResult* result) {
+  for (size_t c = 0; c < channels.size(); ++c) {
     const int p = static_cast<int>(channels[c].quantity);  // 0 displacement, 1 velocity, 2 acceleration
     Eigen::VectorXcd receptance(lines);
     for (int k = 0; k < lines; ++k) {
-      const double w = 2.0 * M_PI * result.freq_hz(k);
-      receptance(k) = result.channels[c].h1(k) / std::pow(w, p);
+      const double w = 2.0 * M_PI * result->freq_hz(k);
+      receptance(k) = result->channels[c].h1(k) / std::pow(w, p);
     }
     const UsableBandPeak peak = PeakReceptanceInUsableBand(
-        dynamics::Frf::FromSamples(result.freq_hz, receptance, result.channels[c].coherence), result.averages);
+        dynamics::Frf::FromSamples(result->freq_hz, receptance, result->channels[c].coherence), result->averages);
     const std::string finding = UsableBandUnitFinding("response " + channels[c].name, peak);
     if (!finding.empty()) {
-      result.implausible = true;
-      result.warnings.push_back(finding);
+      result->implausible = true;
+      result->warnings.push_back(finding);
     }
   }
-  // Roll-off of the force spectrum: 20 dB below its level at the lowest lines.
+}
+
+// Roll-off of the force spectrum: 20 dB below its level at the lowest lines.
+void CheckForceRollOff(int lines, FrfEstimateResult* result) {
   const int ref_lines = std::max(1, std::min(lines, 5));
-  const double ref = result.force_autospectrum.head(ref_lines).mean();
+  const double ref = result->force_autospectrum.head(ref_lines).mean();
   for (int k = 0; k < lines; ++k) {
-    if (result.force_autospectrum(k) < 0.01 * ref) {
-      result.warnings.push_back("the force spectrum is 20 dB below its low-frequency level from " +
-                                FormatNumber(result.freq_hz(k), 5) +
-                                " Hz up: the FRF there rests on little excitation (a harder hammer tip "
-                                "excites higher)");
+    if (result->force_autospectrum(k) < 0.01 * ref) {
+      result->warnings.push_back("the force spectrum is 20 dB below its low-frequency level from " +
+                                 FormatNumber(result->freq_hz(k), 5) +
+                                 " Hz up: the FRF there rests on little excitation (a harder hammer tip "
+                                 "excites higher)");
       break;
     }
   }
+}
+
+}  // namespace
+
+FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::vector<ResponseChannel>& channels,
+                              const FrfEstimateOptions& o) {
+  CheckValid(o);
+  FrfEstimateResult result;
+  result.exponential_tau_s = o.exponential_tau_s;
+  const int nc = static_cast<int>(channels.size());
+  if (nc == 0) throw std::invalid_argument("EstimateFrf: no response channel");
+  if (!o.response_range.empty() && static_cast<int>(o.response_range.size()) != nc) {
+    throw std::invalid_argument("FrfEstimateOptions::response_range has " + std::to_string(o.response_range.size()) +
+                                " entries; expected none or one per channel (" + std::to_string(nc) + ")");
+  }
+  if (hits.empty()) return result;
+  const Layout lay = CheckRecords(hits, nc, o, &result);
+  const Screening screening = ScreenHits(hits, channels, o, lay, &result);
+  const ForceWindowSpec win = ChooseForceWindow(o, screening.longest_pulse_s, lay.fs, &result);
+  const SpectralSums sums = AccumulateSpectra(hits, screening.pulses, o, lay, win, &result);
+  WarnLeakage(sums, channels, o, &result);
+  result.freq_hz = Eigen::VectorXd::LinSpaced(lay.lines, lay.df, lay.lines * lay.df);
+  if (result.averages == 0) {
+    result.status = FrfEstimateStatus::kNoHits;
+    return result;
+  }
+  result.status = FrfEstimateStatus::kOk;
+  EstimateChannels(sums, lay, &result);
+  CheckReceptanceUnits(channels, lay.lines, &result);
+  CheckForceRollOff(lay.lines, &result);
   return result;
 }
 

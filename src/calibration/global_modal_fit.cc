@@ -551,7 +551,7 @@ std::optional<GlobalModalFitResult> RefitWithModelError(const std::vector<dynami
       weighted.push_back(f.WithNoise(sigma));
     }
     GlobalModalFitResult next = FitModesGlobal(weighted, again);
-    if (next.status != ModalFitStatus::kOk) break;
+    if (next.status != SolverStatus::kConverged) break;
     next.model_error = tau;
     out = std::move(next);
     const std::vector<double> tau_next = ModelErrors(frfs, *out, p, needs);
@@ -633,9 +633,11 @@ Eigen::MatrixXcd GlobalModalFitResult::ModeShapes(int driving_point) const {
   return phi;
 }
 
-GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const GlobalModalFitOptions& o) {
-  if (all.empty()) throw std::invalid_argument("FitModesGlobal: no FRFs given");
-  GlobalModalFitResult result;
+namespace {
+
+// The FRFs cut to the band; throws unless they all have the same lines
+// there (a global fit needs common lines).
+std::vector<dynamics::Frf> CommonBand(const std::vector<dynamics::Frf>& all, const GlobalModalFitOptions& o) {
   std::vector<dynamics::Frf> frfs;
   // The 0 Hz line carries no pole information and a receptance that a
   // converted accelerance or mobility does not have.
@@ -650,39 +652,50 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
                                   " vs " + std::to_string(N) + " lines); a global fit needs common lines");
     }
   }
-  if (N == 0) {
-    result.message = "no frequency lines in the band";
-    return result;
-  }
-  result.fmin_hz = frfs.front().freq_hz()(0);
-  result.fmax_hz = frfs.front().freq_hz()(N - 1);
-  const int nmax = std::min(o.max_order, N / 3);
-  if (o.min_order < 2 || nmax < o.min_order + 2) {
-    result.message = "too few lines (" + std::to_string(N) + ") for model orders " + std::to_string(o.min_order) +
-                     ".." + std::to_string(o.max_order);
-    return result;
-  }
-  result.orders_tried = nmax - o.min_order + 1;
-  result.min_order = o.min_order;
-  result.max_order = nmax;
-  result.lscf_power = FlattestPower(frfs);
-  const auto by_order = LscfPoles(frfs, result.lscf_power, o.min_order, nmax, result.fmin_hz, result.fmax_hz, o);
-  for (const auto& poles : by_order)
-    for (const OrderPole& p : poles) result.stabilisation.push_back({p.order, p.f_hz, p.zeta, p.stable});
-  const int min_orders = std::max(o.min_stable_orders,
-                                  static_cast<int>(std::ceil(o.min_cluster_fraction * result.orders_tried)));
-  std::vector<Cluster> clusters = ClusterStablePoles(by_order, min_orders, o.cluster_freq_tol);
+  return frfs;
+}
 
-  const GlobalProblem problem(frfs, result.fmin_hz, o.uniform_weights_power);
+// The stabilisation diagram's outcome: the clusters of stable poles and the
+// number of distinct orders a cluster had to span to count.
+struct Diagram {
+  std::vector<Cluster> clusters;
+  int min_orders;
+};
+
+// The LSCF poles of orders min_order..nmax (recorded in `result` with the
+// orders and the power of iω used) and their clusters of stable poles.
+Diagram StabilisationDiagram(const std::vector<dynamics::Frf>& frfs, const GlobalModalFitOptions& o, int nmax,
+                             GlobalModalFitResult* result) {
+  result->orders_tried = nmax - o.min_order + 1;
+  result->min_order = o.min_order;
+  result->max_order = nmax;
+  result->lscf_power = FlattestPower(frfs);
+  const auto by_order = LscfPoles(frfs, result->lscf_power, o.min_order, nmax, result->fmin_hz, result->fmax_hz, o);
+  for (const auto& poles : by_order)
+    for (const OrderPole& p : poles) result->stabilisation.push_back({p.order, p.f_hz, p.zeta, p.stable});
+  const int min_orders = std::max(o.min_stable_orders,
+                                  static_cast<int>(std::ceil(o.min_cluster_fraction * result->orders_tried)));
+  std::vector<Cluster> clusters = ClusterStablePoles(by_order, min_orders, o.cluster_freq_tol);
+  return {clusters, min_orders};
+}
+
+// A set of common poles, each with its support (the number of orders its
+// cluster spanned, 0 for a pole from a peak or the residual) and the fit of
+// every FRF with them.
+struct ModeSet {
   std::vector<cd> poles;
   std::vector<int> support;
-  for (const Cluster& c : clusters) {
-    poles.push_back(PoleFrom(c.f_hz, c.zeta));
-    support.push_back(c.orders);
-  }
-  // A dense FRF: band by band (GlobalModalFitOptions::max_modes_per_band).
-  std::vector<cd> band_poles;
-  std::vector<int> band_support;
+  SetFit best;
+};
+
+// A dense FRF: band by band (GlobalModalFitOptions::max_modes_per_band),
+// each band's fit keeping the modes in its core. The poles of all bands
+// (empty when the FRF is not dense); result->bands is the number of bands.
+ModeSet FitInBands(const std::vector<dynamics::Frf>& all, const GlobalModalFitOptions& o,
+                   const std::vector<Cluster>& clusters, GlobalModalFitResult* result) {
+  ModeSet out;
+  std::vector<cd>& band_poles = out.poles;
+  std::vector<int>& band_support = out.support;
   if (o.max_modes_per_band > 0 && static_cast<int>(clusters.size()) > std::max(o.dense_modes, o.max_modes_per_band)) {
     std::vector<double> fc;
     for (const Cluster& c : clusters) fc.push_back(c.f_hz);
@@ -701,12 +714,12 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
       const int a = first[g], b = std::min(n, first[g + 1]) - 1;  // this group's clusters
       // Core: from the gap below to the gap above (geometric means); band:
       // widened to take in the neighbour mode on each side with its flanks.
-      const double core_lo = a == 0 ? result.fmin_hz : std::sqrt(fc[a - 1] * fc[a]);
-      const double core_hi = b == n - 1 ? result.fmax_hz : std::sqrt(fc[b] * fc[b + 1]);
-      sub.fmin_hz = a == 0 ? result.fmin_hz : std::max(result.fmin_hz, 0.97 * fc[a - 1]);
-      sub.fmax_hz = b == n - 1 ? result.fmax_hz : std::min(result.fmax_hz, 1.03 * fc[b + 1]);
+      const double core_lo = a == 0 ? result->fmin_hz : std::sqrt(fc[a - 1] * fc[a]);
+      const double core_hi = b == n - 1 ? result->fmax_hz : std::sqrt(fc[b] * fc[b + 1]);
+      sub.fmin_hz = a == 0 ? result->fmin_hz : std::max(result->fmin_hz, 0.97 * fc[a - 1]);
+      sub.fmax_hz = b == n - 1 ? result->fmax_hz : std::min(result->fmax_hz, 1.03 * fc[b + 1]);
       const GlobalModalFitResult part = FitModesGlobal(all, sub);
-      if (part.status != ModalFitStatus::kOk) continue;
+      if (part.status != SolverStatus::kConverged) continue;
       for (const GlobalMode& m : part.modes) {
         const bool in_core = m.freq_hz >= core_lo && (m.freq_hz < core_hi || (g == groups - 1 && m.freq_hz <= core_hi));
         if (!in_core) continue;
@@ -714,43 +727,51 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
         band_support.push_back(m.stable_orders);
       }
     }
-    result.bands = groups;
+    result->bands = groups;
   }
-  const bool banded = !band_poles.empty();
-  if (banded) {
-    poles = band_poles;
-    support = band_support;
+  return out;
+}
+
+// No stable cluster: the peaks of the summed |H| start the refinement,
+// so that a clear resonance in noisy data is not lost.
+void PolesFromPeaks(const std::vector<dynamics::Frf>& frfs, ModeSet* set) {
+  const int N = frfs.front().size();
+  Eigen::VectorXcd sum = Eigen::VectorXcd::Zero(N);
+  for (size_t i = 0; i < frfs.size(); ++i) {
+    const double level = frfs[i].receptance().cwiseAbs().maxCoeff();
+    if (level > 0.0) sum += frfs[i].receptance().cwiseAbs().cast<cd>() / level;
   }
-  bool from_peaks = false;
-  if (poles.empty()) {
-    // No stable cluster: the peaks of the summed |H| start the refinement,
-    // so that a clear resonance in noisy data is not lost.
-    Eigen::VectorXcd sum = Eigen::VectorXcd::Zero(N);
-    for (size_t i = 0; i < frfs.size(); ++i) {
-      const double level = frfs[i].receptance().cwiseAbs().maxCoeff();
-      if (level > 0.0) sum += frfs[i].receptance().cwiseAbs().cast<cd>() / level;
-    }
-    const dynamics::Frf summed = dynamics::Frf::FromSamples(frfs.front().freq_hz(), sum);
-    std::vector<PeakEstimate> peaks = PickPeaks(summed);
-    std::sort(peaks.begin(), peaks.end(),
-              [](const PeakEstimate& a, const PeakEstimate& b) { return a.peak_magnitude > b.peak_magnitude; });
-    if (peaks.size() > 12) peaks.resize(12);
-    for (const PeakEstimate& p : peaks) {
-      const double z = std::isfinite(p.damping_ratio) ? std::clamp(p.damping_ratio, 1e-3, 0.2) : 0.02;
-      poles.push_back(PoleFrom(p.peak_freq_hz, z));
-      support.push_back(0);
-    }
-    from_peaks = !poles.empty();
+  const dynamics::Frf summed = dynamics::Frf::FromSamples(frfs.front().freq_hz(), sum);
+  std::vector<PeakEstimate> peaks = PickPeaks(summed);
+  std::sort(peaks.begin(), peaks.end(),
+            [](const PeakEstimate& a, const PeakEstimate& b) { return a.peak_magnitude > b.peak_magnitude; });
+  if (peaks.size() > 12) peaks.resize(12);
+  for (const PeakEstimate& p : peaks) {
+    const double z = std::isfinite(p.damping_ratio) ? std::clamp(p.damping_ratio, 1e-3, 0.2) : 0.02;
+    set->poles.push_back(PoleFrom(p.peak_freq_hz, z));
+    set->support.push_back(0);
   }
+}
+
+// What judges a set of poles for the given problem: whether a pole is
+// physical, the settled set (fitted, refined, pruned) and its BIC.
+struct SetSearch {
+  const GlobalProblem& problem;
+  const std::vector<dynamics::Frf>& frfs;
+  const GlobalModalFitOptions& o;
+  double fmin_hz, fmax_hz;  // the band's first and last line
+  int total_lines;          // lines of all FRFs
 
   // A physical pole in the band: 0 < ζ < max_damping_ratio, fmin..fmax.
-  auto physical = [&](const cd& q) {
+  bool Physical(const cd& q) const {
     const double wn = std::abs(q), f_hz = RadPerSecToHz(wn), zeta = -q.real() / wn;
-    return zeta > 0.0 && zeta < o.max_damping_ratio && f_hz >= result.fmin_hz && f_hz <= result.fmax_hz;
-  };
+    return zeta > 0.0 && zeta < o.max_damping_ratio && f_hz >= fmin_hz && f_hz <= fmax_hz;
+  }
+
   // Fit, refine, prune (unphysical, out of band, negligible in every FRF,
   // duplicates) until the set no longer changes.
-  auto settle = [&](std::vector<cd> p, std::vector<int> sup, SetFit* fit, bool refine = true) {
+  std::pair<std::vector<cd>, std::vector<int>> Settle(std::vector<cd> p, std::vector<int> sup, SetFit* fit,
+                                                       bool refine = true) const {
     for (int pass = 0; pass < 4 && !p.empty(); ++pass) {
       if (o.refine && refine) p = problem.Refine(p);
       *fit = problem.Fit(p);
@@ -763,7 +784,7 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
       std::vector<int> keep_sup;
       for (size_t r : order) {
         const double f_hz = RadPerSecToHz(std::abs(p[r])), zeta = -p[r].real() / std::abs(p[r]);
-        if (!(physical(p[r]) && strength[r] >= o.min_relative_contribution)) continue;
+        if (!(Physical(p[r]) && strength[r] >= o.min_relative_contribution)) continue;
         bool duplicate = false;
         for (const cd& k : keep) {
           const double fk = RadPerSecToHz(std::abs(k)), zk = -k.real() / std::abs(k);
@@ -780,30 +801,30 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     }
     if (!p.empty()) *fit = problem.Fit(p);
     return std::pair{p, sup};
-  };
-  const int total_lines = N * static_cast<int>(frfs.size());
-  auto bic = [&](double cost, size_t modes, const std::vector<cd>& p, bool force_lower = false) {
+  }
+
+  // The Bayesian information criterion of a set's fit: more modes (and the
+  // lower residual's two parameters per FRF) must pay for themselves.
+  double Bic(double cost, size_t modes, const std::vector<cd>& p, bool force_lower = false) const {
     const double n2 = 2.0 * total_lines;
     const bool lower = force_lower || problem.LowerResidual(p);
     const double params = 2.0 * modes + frfs.size() * (2.0 * modes + 4.0 + (lower ? 2.0 : 0.0));
     return n2 * std::log(std::max(cost, 1e-300)) + params * std::log(n2);
-  };
-
-  SetFit best;
-  // Banded: the poles were refined, added and dropped in their bands; here
-  // only the residues of every mode over the whole band (and the pruning of
-  // a mode two bands both found).
-  if (!poles.empty()) std::tie(poles, support) = settle(poles, support, &best, /*refine=*/!banded);
-  if (poles.empty()) {
-    result.status = ModalFitStatus::kNoStableModes;
-    result.message = "no cluster of stable poles over " + std::to_string(min_orders) + " of the orders " +
-                     std::to_string(o.min_order) + ".." + std::to_string(nmax) +
-                     " and no peak of |H| fitted as a mode";
-    return result;
   }
-  // Residual-driven additions on the summed weighted residual of all FRFs.
+};
+
+// Residual-driven additions on the summed weighted residual of all FRFs.
+// Returns the number of modes added.
+int AddFromResidual(const SetSearch& search, ModeSet* set) {
+  const GlobalProblem& problem = search.problem;
+  const std::vector<dynamics::Frf>& frfs = search.frfs;
+  const GlobalModalFitOptions& o = search.o;
+  std::vector<cd>& poles = set->poles;
+  std::vector<int>& support = set->support;
+  SetFit& best = set->best;
+  const int N = frfs.front().size();
   int added = 0;
-  for (int attempt = 0; attempt < (banded ? 0 : o.max_added_modes); ++attempt) {
+  for (int attempt = 0; attempt < o.max_added_modes; ++attempt) {
     Eigen::VectorXd e2 = Eigen::VectorXd::Zero(N);
     for (size_t i = 0; i < frfs.size(); ++i) {
       for (int k = 0; k < N; ++k) {
@@ -850,14 +871,14 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
         trial_poles = p;
       }
     }
-    if (!trial_poles.empty() && bic(trial_best.cost, trial_poles.size(), trial_poles) <
-                                    bic(best.cost, poles.size(), poles)) {
+    if (!trial_poles.empty() && search.Bic(trial_best.cost, trial_poles.size(), trial_poles) <
+                                    search.Bic(best.cost, poles.size(), poles)) {
       trial_sup = support;
       trial_sup.push_back(0);
-      std::tie(trial_poles, trial_sup) = settle(trial_poles, trial_sup, &trial_best);
+      std::tie(trial_poles, trial_sup) = search.Settle(trial_poles, trial_sup, &trial_best);
     }
     if (trial_poles.size() > poles.size() &&
-        bic(trial_best.cost, trial_poles.size(), trial_poles) < bic(best.cost, poles.size(), poles)) {
+        search.Bic(trial_best.cost, trial_poles.size(), trial_poles) < search.Bic(best.cost, poles.size(), poles)) {
       best = trial_best;
       poles = trial_poles;
       support = trial_sup;
@@ -866,12 +887,19 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
       break;
     }
   }
-  // Backward elimination: drop the weakest mode while that lowers the BIC.
-  for (int attempt = 0; attempt < 8 && poles.size() > 1 && !banded; ++attempt) {
+  return added;
+}
+
+// Backward elimination: drop the weakest mode while that lowers the BIC.
+void DropWeakModes(const SetSearch& search, ModeSet* set) {
+  std::vector<cd>& poles = set->poles;
+  std::vector<int>& support = set->support;
+  SetFit& best = set->best;
+  for (int attempt = 0; attempt < 8 && poles.size() > 1; ++attempt) {
     size_t weakest = 0;
     double weakest_s = 1e300;
     for (size_t r = 0; r < poles.size(); ++r) {
-      const double s = RelativeStrength(best, frfs, r);
+      const double s = RelativeStrength(best, search.frfs, r);
       if (s < weakest_s) {
         weakest_s = s;
         weakest = r;
@@ -888,9 +916,9 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     // refined; a drop that does not pay without refitting is rarely worth
     // the refinement's cost), refined when it is kept.
     SetFit fit;
-    std::tie(p, sup) = settle(p, sup, &fit, /*refine=*/false);
-    if (!p.empty() && bic(fit.cost, p.size(), p) < bic(best.cost, poles.size(), poles)) {
-      std::tie(p, sup) = settle(p, sup, &fit);
+    std::tie(p, sup) = search.Settle(p, sup, &fit, /*refine=*/false);
+    if (!p.empty() && search.Bic(fit.cost, p.size(), p) < search.Bic(best.cost, poles.size(), poles)) {
+      std::tie(p, sup) = search.Settle(p, sup, &fit);
       best = fit;
       poles = p;
       support = sup;
@@ -898,6 +926,14 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
       break;
     }
   }
+}
+
+// The set refitted with a lower residual where the band has none by
+// default; kept (returns true) if the BIC falls.
+bool LowerResidualByBic(const SetSearch& search, bool banded, ModeSet* set) {
+  const GlobalModalFitOptions& o = search.o;
+  std::vector<cd>& poles = set->poles;
+  SetFit& best = set->best;
   // A band that starts below a fifth of the lowest mode has no lower
   // residual by default (on a grounded structure the receptance tends to
   // its static value there, and 1/ω² would fit the noise); a free or
@@ -905,34 +941,44 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
   // pyuff's beam, 5-50 Hz under its 51.5 Hz mode, where the fit without it
   // stayed flat two decades below the data). It is kept if the BIC falls.
   bool lower_by_bic = false;
-  if (o.lower_residual_by_bic && !problem.LowerResidual(poles)) {
-    const GlobalProblem with_lower(frfs, result.fmin_hz, o.uniform_weights_power, /*force_lower=*/true);
+  if (o.lower_residual_by_bic && !search.problem.LowerResidual(poles)) {
+    const GlobalProblem with_lower(search.frfs, search.fmin_hz, o.uniform_weights_power, /*force_lower=*/true);
     const std::vector<cd> p = o.refine && !banded ? with_lower.Refine(poles) : poles;
     const SetFit fit = with_lower.Fit(p);
     // Refined with the 1/ω² term a weak low pole could leave the band or
     // the physical damping range; then the set without it stands.
-    if (std::all_of(p.begin(), p.end(), physical) && bic(fit.cost, p.size(), p, /*force_lower=*/true) < bic(best.cost, poles.size(), poles)) {
+    const auto physical = [&](const cd& q) { return search.Physical(q); };
+    if (std::all_of(p.begin(), p.end(), physical) && search.Bic(fit.cost, p.size(), p, /*force_lower=*/true) < search.Bic(best.cost, poles.size(), poles)) {
       best = fit;
       poles = p;
       lower_by_bic = true;
     }
   }
+  return lower_by_bic;
+}
+
+// The modes of `set` into `result` (every FRF's table and the common
+// modes) in ascending frequency, the same order in every FRF's table.
+void Tabulate(const ModeSet& set, const std::vector<dynamics::Frf>& frfs, GlobalModalFitResult* result) {
+  const std::vector<cd>& poles = set.poles;
+  const std::vector<int>& support = set.support;
+  const SetFit& best = set.best;
   // Ascending frequency, the same order in every FRF's table.
   std::vector<size_t> order(poles.size());
   std::iota(order.begin(), order.end(), size_t{0});
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return std::abs(poles[a]) < std::abs(poles[b]); });
-  result.per_frf = best.per_frf;
+  result->per_frf = best.per_frf;
   for (size_t i = 0; i < frfs.size(); ++i) {
-    ModalFitResult& r = result.per_frf[i];
+    ModalFitResult& r = result->per_frf[i];
     std::vector<FittedMode> sorted;
     for (size_t k : order) {
       sorted.push_back(best.per_frf[i].modes[k]);
       sorted.back().stable_orders = support[k];
     }
     r.modes = sorted;
-    r.status = ModalFitStatus::kOk;
-    r.fmin_hz = result.fmin_hz;
-    r.fmax_hz = result.fmax_hz;
+    r.status = SolverStatus::kConverged;
+    r.fmin_hz = result->fmin_hz;
+    r.fmax_hz = result->fmax_hz;
     r.message = "global fit";
   }
   for (size_t k : order) {
@@ -941,24 +987,104 @@ GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const
     m.freq_hz = RadPerSecToHz(std::abs(poles[k]));
     m.damping_ratio = -poles[k].real() / std::abs(poles[k]);
     m.stable_orders = support[k];
-    result.modes.push_back(m);
+    result->modes.push_back(m);
   }
+}
+
+// How the fit came about, for its message.
+struct FitStory {
+  size_t clusters{0};         // clusters of stable poles
+  bool from_peaks{false};     // poles from the peaks of |H| (no cluster)
+  bool banded{false};         // fitted band by band
+  int added{0};               // modes added from the residual
+  bool lower_by_bic{false};   // a lower residual kept by the BIC
+};
+
+// The converged fit's message: the modes, where the poles came from and
+// what the fit did with them.
+std::string SummaryMessage(const GlobalModalFitResult& result, size_t frfs, const GlobalModalFitOptions& o,
+                           const FitStory& story) {
+  const int nmax = result.max_order;
+  return std::to_string(result.modes.size()) + " modes common to " + std::to_string(frfs) + " FRFs: " +
+         (story.from_peaks ? std::string("no cluster of stable poles, poles from the peaks of |H|")
+                           : std::to_string(story.clusters) + " clusters of stable poles over orders " +
+                                 std::to_string(o.min_order) + ".." + std::to_string(nmax)) +
+         (story.banded ? ", a dense FRF fitted in " + std::to_string(result.bands) + " bands" : "") +
+         (o.refine ? ", refined" : "") +
+         (story.added > 0 ? ", " + std::to_string(story.added) + " added from the residual" : "") +
+         (story.lower_by_bic ? ", a lower residual (mass line) below the lowest mode" : "");
+}
+
+}  // namespace
+
+GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const GlobalModalFitOptions& o) {
+  if (all.empty()) throw std::invalid_argument("FitModesGlobal: no FRFs given");
+  GlobalModalFitResult result;
+  const std::vector<dynamics::Frf> frfs = CommonBand(all, o);
+  const int N = frfs.front().size();
+  if (N == 0) {
+    result.message = "no frequency lines in the band";
+    return result;
+  }
+  result.fmin_hz = frfs.front().freq_hz()(0);
+  result.fmax_hz = frfs.front().freq_hz()(N - 1);
+  const int nmax = std::min(o.max_order, N / 3);
+  if (o.min_order < 2 || nmax < o.min_order + 2) {
+    result.message = "too few lines (" + std::to_string(N) + ") for model orders " + std::to_string(o.min_order) +
+                     ".." + std::to_string(o.max_order);
+    return result;
+  }
+  const Diagram diagram = StabilisationDiagram(frfs, o, nmax, &result);
+  const std::vector<Cluster>& clusters = diagram.clusters;
+
+  const GlobalProblem problem(frfs, result.fmin_hz, o.uniform_weights_power);
+  ModeSet set;
+  for (const Cluster& c : clusters) {
+    set.poles.push_back(PoleFrom(c.f_hz, c.zeta));
+    set.support.push_back(c.orders);
+  }
+  FitStory story;
+  story.clusters = clusters.size();
+  const ModeSet bands = FitInBands(all, o, clusters, &result);
+  story.banded = !bands.poles.empty();
+  const bool banded = story.banded;
+  if (banded) {
+    set.poles = bands.poles;
+    set.support = bands.support;
+  }
+  if (set.poles.empty()) {
+    PolesFromPeaks(frfs, &set);
+    story.from_peaks = !set.poles.empty();
+  }
+
+  const SetSearch search{problem, frfs, o, result.fmin_hz, result.fmax_hz, N * static_cast<int>(frfs.size())};
+  // Banded: the poles were refined, added and dropped in their bands; here
+  // only the residues of every mode over the whole band (and the pruning of
+  // a mode two bands both found).
+  if (!set.poles.empty()) {
+    std::tie(set.poles, set.support) = search.Settle(set.poles, set.support, &set.best, /*refine=*/!banded);
+  }
+  if (set.poles.empty()) {
+    result.status = SolverStatus::kFailed;
+    result.message = "no cluster of stable poles over " + std::to_string(diagram.min_orders) + " of the orders " +
+                     std::to_string(o.min_order) + ".." + std::to_string(nmax) +
+                     " and no peak of |H| fitted as a mode";
+    return result;
+  }
+  if (!banded) {
+    story.added = AddFromResidual(search, &set);
+    DropWeakModes(search, &set);
+  }
+  story.lower_by_bic = LowerResidualByBic(search, banded, &set);
+  Tabulate(set, frfs, &result);
   result.misfit_in_noise = MisfitInNoise(frfs, result.per_frf);
-  result.status = ModalFitStatus::kOk;
+  result.status = SolverStatus::kConverged;
   result.model_error.assign(frfs.size(), 0.0);
   result.misfit_in_noise_weights_alone = result.misfit_in_noise;
   if (o.model_error_power >= 0 && o.uniform_weights_power < 0) {
     if (std::optional<GlobalModalFitResult> again = RefitWithModelError(frfs, result, o)) return *std::move(again);
   }
-  result.message = std::to_string(result.modes.size()) + " modes common to " + std::to_string(frfs.size()) +
-                   " FRFs: " +
-                   (from_peaks ? std::string("no cluster of stable poles, poles from the peaks of |H|")
-                               : std::to_string(clusters.size()) + " clusters of stable poles over orders " +
-                                     std::to_string(o.min_order) + ".." + std::to_string(nmax)) +
-                   (banded ? ", a dense FRF fitted in " + std::to_string(result.bands) + " bands" : "") +
-                   (o.refine ? ", refined" : "") +
-                   (added > 0 ? ", " + std::to_string(added) + " added from the residual" : "") +
-                   (lower_by_bic ? ", a lower residual (mass line) below the lowest mode" : "");
+  result.message = SummaryMessage(result, frfs.size(), o, story);
   return result;
 }
 
@@ -971,7 +1097,7 @@ ModalFitResult FitOneFrf(const dynamics::Frf& frf, const ModalFitOptions& option
   o.max_added_modes = options.max_added_modes;
   const GlobalModalFitResult g = FitModesGlobal({frf}, o);
   ModalFitResult r;
-  if (g.status == ModalFitStatus::kOk && !g.per_frf.empty()) r = g.per_frf[0];
+  if (g.status == SolverStatus::kConverged && !g.per_frf.empty()) r = g.per_frf[0];
   r.status = g.status;
   r.message = g.message;
   r.fmin_hz = g.fmin_hz;

@@ -249,7 +249,7 @@ std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const Nois
       for (size_t i = 0; i < g.data.size(); ++i) {
         g.misfit.push_back(i < g.fit.per_frf.size() ? RelativeMisfit(g.fit.per_frf[i], g.data[i], file_power) : NAN);
       }
-      if (g.fit.status != ModalFitStatus::kOk) {
+      if (g.fit.status != SolverStatus::kConverged) {
         std::string which;
         for (const auto& k : g.keys) which += (which.empty() ? "" : ", ") + k.ToString();
         pm.warnings.push_back(which + ": " + g.fit.message);
@@ -289,7 +289,7 @@ std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const Nois
     // alone: the modes of each direct FRF, each a mode in its direction.
     std::vector<std::string> transfer;
     for (const ModalGroup& g : pm.groups) {
-      if (g.fit.status != ModalFitStatus::kOk) continue;
+      if (g.fit.status != SolverStatus::kConverged) continue;
       if (g.keys.size() == 1 && !g.keys[0].IsDrivingPoint()) {
         transfer.push_back(g.keys[0].ToString());
         continue;

@@ -310,24 +310,29 @@ void RefineAll(const dynamics::Frf& frf, bool lower, ModalFitResult* res) {
   res->relative_rms_error = den > 0.0 ? std::sqrt(num / den) : NAN;
 }
 
-}  // namespace
+// One pole of one LSCF order as the pole selection needs it: its λ and how
+// many consecutive orders it has been stable over.
+struct OrderPole {
+  double f_hz, zeta;
+  cd lambda;
+  int chain;  // consecutive stable orders ending here
+};
 
-ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
-  ModalFitResult result;
-  const dynamics::Frf frf = full.Band(o.fmin_hz, o.fmax_hz);
+// The Toeplitz sequences of the LSCF normal equations, formed once for the
+// highest order so that every lower order uses their leading blocks.
+struct LscfSums {
+  int nmax;
+  std::vector<cd> r, s, t;
+  double R(int j, int l) const { return r[l - j + nmax].real(); }
+  double S(int j, int l) const { return -s[l - j + nmax].real(); }
+  double T(int j, int l) const { return t[l - j + nmax].real(); }
+  // Note S is not symmetric: S_jl = −Re Σ W² conj(Ω_j) H Ω_l, which depends
+  // on l − j only through the sign of the exponent (conj(Ω_j) Ω_l).
+};
+
+// Stage 1 of FitModes: the sums of the band's lines, in O(N max_order).
+LscfSums ToeplitzSums(const dynamics::Frf& frf, int nmax, double dt) {
   const int N = frf.size();
-  if (N == 0) {
-    result.message = "no frequency lines in the band";
-    return result;
-  }
-  result.fmin_hz = frf.freq_hz()(0);
-  result.fmax_hz = frf.freq_hz()(N - 1);
-  const int nmax = o.max_order;
-  if (o.min_order < 1 || nmax < o.min_order || 2 * (nmax + 1) > N) {
-    result.message = "too few lines (" + std::to_string(N) + ") for model order " + std::to_string(nmax);
-    return result;
-  }
-  const double dt = 1.0 / (2.0 * result.fmax_hz);
   // Toeplitz sequences r_m, s_m, t_m for m = -nmax..nmax (index m + nmax):
   //   R_jl = Re Σ W² e^{iωΔt(l−j)}, S_jl = −Re Σ W² H e^{iωΔt(l−j)},
   //   T_jl = Re Σ W² |H|² e^{iωΔt(l−j)}.
@@ -336,7 +341,10 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
   // 3 % apart in our tests, while W = 1 resolves them; the weighted
   // nonlinear refinement below then removes the linearisation bias.
   const int L = 2 * nmax + 1;
-  std::vector<cd> r(L, 0.0), s(L, 0.0), t(L, 0.0);
+  LscfSums sums{nmax, std::vector<cd>(L, 0.0), std::vector<cd>(L, 0.0), std::vector<cd>(L, 0.0)};
+  std::vector<cd>& r = sums.r;
+  std::vector<cd>& s = sums.s;
+  std::vector<cd>& t = sums.t;
   for (int k = 0; k < N; ++k) {
     const cd h = frf.receptance()(k);
     const double a2 = std::norm(h);
@@ -353,32 +361,31 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
       if ((m & 31) == 31) e = std::polar(1.0, th * (m + 1 - nmax));  // limit drift
     }
   }
-  auto R = [&](int j, int l) { return r[l - j + nmax].real(); };
-  auto S = [&](int j, int l) { return -s[l - j + nmax].real(); };
-  auto T = [&](int j, int l) { return t[l - j + nmax].real(); };
-  // Note S is not symmetric: S_jl = −Re Σ W² conj(Ω_j) H Ω_l, which depends
-  // on l − j only through the sign of the exponent (conj(Ω_j) Ω_l).
+  return sums;
+}
 
-  struct OrderPole {
-    double f_hz, zeta;
-    cd lambda;
-    int chain;  // consecutive stable orders ending here
-  };
+// Stage 2 of FitModes: the poles of every order from min_order to max_order,
+// each matched with the nearest pole of the order below to grow its stability
+// chain. Every pole also goes into result->stabilisation (the diagram).
+std::vector<std::vector<OrderPole>> StabilisationDiagram(const LscfSums& sums, const ModalFitOptions& o, double dt,
+                                                         ModalFitResult* result) {
+  const int nmax = sums.nmax;
   std::vector<std::vector<OrderPole>> by_order(nmax + 1);
   for (int n = o.min_order; n <= nmax; ++n) {
     const int m = n + 1;
     Eigen::MatrixXd Rm(m, m), Sm(m, m), Tm(m, m);
     for (int j = 0; j < m; ++j) {
       for (int l = 0; l < m; ++l) {
-        Rm(j, l) = R(j, l);
-        Sm(j, l) = S(j, l);
-        Tm(j, l) = T(j, l);
+        Rm(j, l) = sums.R(j, l);
+        Sm(j, l) = sums.S(j, l);
+        Tm(j, l) = sums.T(j, l);
       }
     }
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(Rm);
     if (ldlt.info() != Eigen::Success) continue;
     const Eigen::MatrixXd M = Tm - Sm.transpose() * ldlt.solve(Sm);
-    for (const internal::LscfPole& pole : internal::PolesOfOrder(M, n, dt, o.max_damping_ratio, result.fmin_hz, result.fmax_hz)) {
+    for (const internal::LscfPole& pole :
+         internal::PolesOfOrder(M, n, dt, o.max_damping_ratio, result->fmin_hz, result->fmax_hz)) {
       const double f_hz = pole.f_hz, zeta = pole.zeta;
       OrderPole p{pole.f_hz, pole.zeta, pole.lambda, 1};
       bool stable = false;
@@ -399,34 +406,44 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
         }
       }
       by_order[n].push_back(p);
-      result.stabilisation.push_back({n, f_hz, zeta, stable});
+      result->stabilisation.push_back({n, f_hz, zeta, stable});
     }
   }
-  // Candidate pole sets: the stable poles of each of the five highest
-  // orders. Each is fitted (LSFD, pruning, refinement) and the one with the
-  // smallest refined error wins: a close pair may lose its stability at one
-  // order where noise poles crowd it, and refinement from a poor start can
-  // end in a local minimum.
-  const int N2 = 2 * N;
-  auto lower_for = [&](const std::vector<cd>& poles) {
+  return by_order;
+}
+
+// What every candidate pole set is fitted against: the band's lines, the
+// options, the band's limits and the weights of the error (formed once).
+// Stages 3 to 5 of FitModes all fit pole sets through FitWith.
+struct PoleSetFitter {
+  const dynamics::Frf& frf;
+  const ModalFitOptions& o;
+  double fmin_hz, fmax_hz;
+  Eigen::VectorXd weights;
+
+  // A lower residual where the band starts above a fifth of the lowest pole.
+  bool LowerFor(const std::vector<cd>& poles) const {
     double lowest = 1e300;
     for (const cd& p : poles) lowest = std::min(lowest, RadPerSecToHz(std::abs(p)));
-    return result.fmin_hz > 0.2 * lowest;
-  };
-  auto prune = [&](ModalFitResult* r) {
+    return fmin_hz > 0.2 * lowest;
+  }
+
+  // The poles (and stability chains) of r's modes that are physical,
+  // significant and distinct.
+  std::pair<std::vector<cd>, std::vector<int>> Prune(const ModalFitResult& r) const {
     std::vector<cd> keep;
     std::vector<int> chain;
     std::vector<const FittedMode*> kept;
     // Strongest first, so that of two unresolvable poles the weaker goes.
     std::vector<const FittedMode*> order;
-    for (const FittedMode& m : r->modes) order.push_back(&m);
+    for (const FittedMode& m : r.modes) order.push_back(&m);
     std::sort(order.begin(), order.end(), [](const FittedMode* a, const FittedMode* b) {
       return a->peak_contribution > b->peak_contribution;
     });
     for (const FittedMode* mp : order) {
       const FittedMode& m = *mp;
       if (!(m.damping_ratio > 0.0 && m.damping_ratio < o.max_damping_ratio && std::isfinite(m.freq_hz) &&
-            m.freq_hz >= result.fmin_hz && m.freq_hz <= result.fmax_hz &&
+            m.freq_hz >= fmin_hz && m.freq_hz <= fmax_hz &&
             m.peak_contribution >= o.min_relative_contribution * LocalLevel(frf, m.freq_hz))) {
         continue;
       }
@@ -443,25 +460,29 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
       chain.push_back(m.stable_orders);
     }
     return std::pair{keep, chain};
-  };
-  const Eigen::VectorXd weights = ModalFitWeights(frf);
+  }
+
+  // The squared weighted error of `r` at line k.
+  double LineError(const ModalFitResult& r, int k) const {
+    return std::norm((r.Evaluate(frf.freq_hz()(k)) - frf.receptance()(k)) * weights(k));
+  }
+
   // LSFD, prune, refine, prune again; returns the squared weighted error.
   // `refine_first`: refine before the first pruning (for a pole added by
   // guess, whose linear residue alone may look negligible).
-  auto fit_with = [&](std::vector<cd> poles, std::vector<int> chains, ModalFitResult* r,
-                      bool refine_first = false) {
+  double FitWith(std::vector<cd> poles, std::vector<int> chains, ModalFitResult* r, bool refine_first = false) const {
     for (int pass = 0; pass < 4 && !poles.empty(); ++pass) {
-      FitResidues(frf, poles, lower_for(poles), r);
+      FitResidues(frf, poles, LowerFor(poles), r);
       for (size_t i = 0; i < r->modes.size(); ++i) r->modes[i].stable_orders = chains[i];
-      if (pass > 0 || refine_first) RefineAll(frf, lower_for(poles), r);
-      auto [keep, chain] = prune(r);
+      if (pass > 0 || refine_first) RefineAll(frf, LowerFor(poles), r);
+      auto [keep, chain] = Prune(*r);
       if (keep.size() == r->modes.size() && (pass > 0 || refine_first)) break;
       poles = keep;
       chains = chain;
       if (pass == 3 && !poles.empty()) {
-        FitResidues(frf, poles, lower_for(poles), r);
+        FitResidues(frf, poles, LowerFor(poles), r);
         for (size_t i = 0; i < r->modes.size(); ++i) r->modes[i].stable_orders = chains[i];
-        RefineAll(frf, lower_for(poles), r);
+        RefineAll(frf, LowerFor(poles), r);
       }
     }
     if (poles.empty()) {
@@ -469,11 +490,31 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
       return 1e300;
     }
     double cost = 0.0;
-    for (int k = 0; k < N; ++k) cost += std::norm((r->Evaluate(frf.freq_hz()(k)) - frf.receptance()(k)) * weights(k));
+    for (int k = 0; k < frf.size(); ++k) cost += LineError(*r, k);
     return cost;
-  };
-  ModalFitResult best = result;
-  double best_cost = 1e300;
+  }
+};
+
+// The best fit so far (cost 1e300: none), and how it was reached (for the
+// message).
+struct Selection {
+  ModalFitResult fit;
+  double cost{1e300};
+  bool from_peaks{false};
+  int added{0};  // modes added from the residual
+};
+
+// Stage 3 of FitModes. Candidate pole sets: the stable poles of each of the
+// five highest orders. Each is fitted (LSFD, pruning, refinement) and the one
+// with the smallest refined error wins: a close pair may lose its stability
+// at one order where noise poles crowd it, and refinement from a poor start
+// can end in a local minimum. `base` is the result before any fit.
+Selection FitStablePoleSets(const PoleSetFitter& fitter, const std::vector<std::vector<OrderPole>>& by_order,
+                            const ModalFitResult& base) {
+  const ModalFitOptions& o = fitter.o;
+  const int nmax = o.max_order;
+  Selection best;
+  best.fit = base;
   for (int n = nmax; n >= std::max(o.min_order, nmax - 4); --n) {
     std::vector<cd> poles;
     std::vector<int> chains;
@@ -484,92 +525,102 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
       }
     }
     if (poles.empty()) continue;
-    ModalFitResult r = result;
-    const double cost = fit_with(poles, chains, &r);
-    if (cost < best_cost) {
-      best_cost = cost;
-      best = r;
-      best.order_used = n;
+    ModalFitResult r = base;
+    const double cost = fitter.FitWith(poles, chains, &r);
+    if (cost < best.cost) {
+      best.cost = cost;
+      best.fit = r;
+      best.fit.order_used = n;
     }
   }
-  bool from_peaks = false;
-  if (best_cost >= 1e300) {
-    // No pole was stable: start from the peaks of |H| instead (half-power
-    // damping, 2 % where a side does not reach half power), so that a clear
-    // resonance is never reported as "no mode"; the refinement and the
-    // pruning below still decide whether each is a mode.
-    std::vector<cd> poles;
-    std::vector<int> chains;
-    // At most as many peaks as the highest LSCF order has modes (the
-    // largest): data without physical poles (an active FRF, Im H > 0) have
-    // a local maximum every few lines, and refining 48 such poles took
-    // 80 s on 2000 lines.
-    std::vector<PeakEstimate> peaks = PickPeaks(frf);
-    const size_t max_peaks = static_cast<size_t>(std::max(1, nmax / 2));
-    if (peaks.size() > max_peaks) {
-      std::sort(peaks.begin(), peaks.end(),
-                [](const PeakEstimate& a, const PeakEstimate& b) { return a.peak_magnitude > b.peak_magnitude; });
-      peaks.resize(max_peaks);
-      std::sort(peaks.begin(), peaks.end(),
-                [](const PeakEstimate& a, const PeakEstimate& b) { return a.peak_freq_hz < b.peak_freq_hz; });
-    }
-    for (const PeakEstimate& p : peaks) {
-      const double z = std::isfinite(p.damping_ratio) ? std::clamp(p.damping_ratio, 1e-3, 0.2) : 0.02;
-      const double wn = HzToRadPerSec(p.peak_freq_hz) / std::sqrt(std::max(1e-6, 1.0 - 2.0 * z * z));
-      poles.push_back(cd(-z * wn, wn * std::sqrt(1.0 - z * z)));
-      chains.push_back(0);
-    }
-    if (!poles.empty()) {
-      ModalFitResult r = result;
-      const double cost = fit_with(poles, chains, &r, true);
-      if (cost < 1e300) {
-        best = r;
-        best_cost = cost;
-        best.order_used = 0;
-        from_peaks = true;
-      }
+  return best;
+}
+
+// Stage 3, when no pole was stable: start from the peaks of |H| instead
+// (half-power damping, 2 % where a side does not reach half power), so that
+// a clear resonance is never reported as "no mode"; the refinement and the
+// pruning still decide whether each is a mode.
+void FitFromPeaks(const PoleSetFitter& fitter, const ModalFitResult& base, Selection* best) {
+  std::vector<cd> poles;
+  std::vector<int> chains;
+  // At most as many peaks as the highest LSCF order has modes (the
+  // largest): data without physical poles (an active FRF, Im H > 0) have
+  // a local maximum every few lines, and refining 48 such poles took
+  // 80 s on 2000 lines.
+  std::vector<PeakEstimate> peaks = PickPeaks(fitter.frf);
+  const size_t max_peaks = static_cast<size_t>(std::max(1, fitter.o.max_order / 2));
+  if (peaks.size() > max_peaks) {
+    std::sort(peaks.begin(), peaks.end(),
+              [](const PeakEstimate& a, const PeakEstimate& b) { return a.peak_magnitude > b.peak_magnitude; });
+    peaks.resize(max_peaks);
+    std::sort(peaks.begin(), peaks.end(),
+              [](const PeakEstimate& a, const PeakEstimate& b) { return a.peak_freq_hz < b.peak_freq_hz; });
+  }
+  for (const PeakEstimate& p : peaks) {
+    const double z = std::isfinite(p.damping_ratio) ? std::clamp(p.damping_ratio, 1e-3, 0.2) : 0.02;
+    const double wn = HzToRadPerSec(p.peak_freq_hz) / std::sqrt(std::max(1e-6, 1.0 - 2.0 * z * z));
+    poles.push_back(cd(-z * wn, wn * std::sqrt(1.0 - z * z)));
+    chains.push_back(0);
+  }
+  if (!poles.empty()) {
+    ModalFitResult r = base;
+    const double cost = fitter.FitWith(poles, chains, &r, true);
+    if (cost < 1e300) {
+      best->fit = r;
+      best->cost = cost;
+      best->fit.order_used = 0;
+      best->from_peaks = true;
     }
   }
-  if (best_cost >= 1e300) {
-    result.status = ModalFitStatus::kNoStableModes;
-    result.message = "no pole was stable over " + std::to_string(o.min_stable_orders) +
-                     " consecutive orders up to " + std::to_string(nmax) +
-                     " with a significant residue, and no peak of |H| fitted as a mode";
-    return result;
+}
+
+// The Bayesian information criterion 2N ln(F) + p ln(2N) of a fit with
+// squared weighted error c and `modes` modes over n2 = 2N real residuals.
+double Bic(double c, size_t modes, int n2) {
+  return n2 * std::log(std::max(c, 1e-300)) + (4.0 * modes + 2.0) * std::log(static_cast<double>(n2));
+}
+
+// The line where the weighted residual of `fit` is structured (its local
+// mean square over ±W lines exceeds 4 times the median, i.e. it is not
+// noise), or -1 where it is not.
+int StructuredResidualLine(const PoleSetFitter& fitter, const ModalFitResult& fit) {
+  const int N = fitter.frf.size();
+  Eigen::VectorXd e2(N);
+  for (int k = 0; k < N; ++k) e2(k) = fitter.LineError(fit, k);
+  const int W = std::max(3, N / 200);
+  Eigen::VectorXd local(N);
+  Eigen::VectorXd csum(N + 1);
+  csum(0) = 0.0;
+  for (int k = 0; k < N; ++k) csum(k + 1) = csum(k) + e2(k);
+  for (int k = 0; k < N; ++k) {
+    const int a = std::max(0, k - W), b = std::min(N, k + W + 1);
+    local(k) = (csum(b) - csum(a)) / (b - a);
   }
-  // Residual-driven additions: where the weighted residual is structured
-  // (its local mean square over ±W lines exceeds 4 times the median, i.e. it
-  // is not noise), a mode is missing; add a pole there, refit, and keep it
-  // if the Bayesian information criterion 2N ln(F) + p ln(2N) falls (p the
-  // number of real parameters, 4 per mode).
-  auto bic = [&](double c, size_t modes) {
-    return N2 * std::log(std::max(c, 1e-300)) + (4.0 * modes + 2.0) * std::log(static_cast<double>(N2));
-  };
-  int added = 0;
-  for (int attempt = 0; attempt < o.max_added_modes; ++attempt) {
-    Eigen::VectorXd e2(N);
-    for (int k = 0; k < N; ++k) e2(k) = std::norm((best.Evaluate(frf.freq_hz()(k)) - frf.receptance()(k)) * weights(k));
-    const int W = std::max(3, N / 200);
-    Eigen::VectorXd local(N);
-    Eigen::VectorXd csum(N + 1);
-    csum(0) = 0.0;
-    for (int k = 0; k < N; ++k) csum(k + 1) = csum(k) + e2(k);
-    for (int k = 0; k < N; ++k) {
-      const int a = std::max(0, k - W), b = std::min(N, k + W + 1);
-      local(k) = (csum(b) - csum(a)) / (b - a);
-    }
-    std::vector<double> sorted(local.data(), local.data() + N);
-    std::nth_element(sorted.begin(), sorted.begin() + N / 2, sorted.end());
-    const double median = sorted[N / 2];
-    int kmax = 0;
-    local.maxCoeff(&kmax);
-    if (!(local(kmax) > 4.0 * median)) break;
+  std::vector<double> sorted(local.data(), local.data() + N);
+  std::nth_element(sorted.begin(), sorted.begin() + N / 2, sorted.end());
+  const double median = sorted[N / 2];
+  int kmax = 0;
+  local.maxCoeff(&kmax);
+  if (!(local(kmax) > 4.0 * median)) return -1;
+  return kmax;
+}
+
+// Stage 4 of FitModes. Residual-driven additions: where the weighted residual
+// is structured (its local mean square over ±W lines exceeds 4 times the
+// median, i.e. it is not noise), a mode is missing; add a pole there, refit,
+// and keep it if the Bayesian information criterion 2N ln(F) + p ln(2N) falls
+// (p the number of real parameters, 4 per mode).
+void AddModesFromResidual(const PoleSetFitter& fitter, const ModalFitResult& base, Selection* best) {
+  const int N2 = 2 * fitter.frf.size();
+  for (int attempt = 0; attempt < fitter.o.max_added_modes; ++attempt) {
+    const int kmax = StructuredResidualLine(fitter, best->fit);
+    if (kmax < 0) break;
     // The missing pole may hide under an existing one (a close pair fitted as
     // one mode), so try it at the residual's peak and at ±2ζ and ±4ζ of it,
     // ζ from the nearest fitted mode; keep the best fit.
-    const double f_peak = frf.freq_hz()(kmax);
+    const double f_peak = fitter.frf.freq_hz()(kmax);
     double z0 = 0.03, nearest = 1e300;
-    for (const FittedMode& m : best.modes) {
+    for (const FittedMode& m : best->fit.modes) {
       if (std::abs(m.freq_hz - f_peak) < nearest) {
         nearest = std::abs(m.freq_hz - f_peak);
         z0 = m.damping_ratio;
@@ -582,62 +633,102 @@ ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
       if (!(wn > 0.0)) continue;
       std::vector<cd> poles;
       std::vector<int> chains;
-      for (const FittedMode& m : best.modes) {
+      for (const FittedMode& m : best->fit.modes) {
         poles.push_back(m.pole);
         chains.push_back(m.stable_orders);
       }
       poles.push_back(cd(-z0 * wn, wn * std::sqrt(1 - z0 * z0)));
       chains.push_back(0);
-      ModalFitResult trial = result;
-      const double c = fit_with(poles, chains, &trial, true);
-      if (trial.modes.size() > best.modes.size() && c < cost) {
+      ModalFitResult trial = base;
+      const double c = fitter.FitWith(poles, chains, &trial, true);
+      if (trial.modes.size() > best->fit.modes.size() && c < cost) {
         cost = c;
         r = trial;
       }
     }
-    if (cost < 1e300 && bic(cost, r.modes.size()) < bic(best_cost, best.modes.size()) &&
-        r.modes.size() > best.modes.size()) {
-      r.order_used = best.order_used;
-      best = r;
-      best_cost = cost;
-      ++added;
+    if (cost < 1e300 && Bic(cost, r.modes.size(), N2) < Bic(best->cost, best->fit.modes.size(), N2) &&
+        r.modes.size() > best->fit.modes.size()) {
+      r.order_used = best->fit.order_used;
+      best->fit = r;
+      best->cost = cost;
+      ++best->added;
     } else {
       break;
     }
   }
-  // Backward elimination: drop the weakest mode while that lowers the BIC
-  // (a pole that only fits noise does not pay for its four parameters).
-  for (int attempt = 0; attempt < 8 && best.modes.size() > 1; ++attempt) {
-    auto weakest = std::min_element(best.modes.begin(), best.modes.end(), [&](const FittedMode& a, const FittedMode& b) {
-      return a.peak_contribution / LocalLevel(frf, a.freq_hz) < b.peak_contribution / LocalLevel(frf, b.freq_hz);
+}
+
+// Stage 5 of FitModes. Backward elimination: drop the weakest mode while that
+// lowers the BIC (a pole that only fits noise does not pay for its four
+// parameters).
+void EliminateWeakModes(const PoleSetFitter& fitter, const ModalFitResult& base, Selection* best) {
+  const int N2 = 2 * fitter.frf.size();
+  for (int attempt = 0; attempt < 8 && best->fit.modes.size() > 1; ++attempt) {
+    const std::vector<FittedMode>& modes = best->fit.modes;
+    auto weakest = std::min_element(modes.begin(), modes.end(), [&](const FittedMode& a, const FittedMode& b) {
+      return a.peak_contribution / LocalLevel(fitter.frf, a.freq_hz) <
+             b.peak_contribution / LocalLevel(fitter.frf, b.freq_hz);
     });
     std::vector<cd> poles;
     std::vector<int> chains;
-    for (auto it = best.modes.begin(); it != best.modes.end(); ++it) {
+    for (auto it = modes.begin(); it != modes.end(); ++it) {
       if (it == weakest) continue;
       poles.push_back(it->pole);
       chains.push_back(it->stable_orders);
     }
-    ModalFitResult r = result;
-    const double cost = fit_with(poles, chains, &r);
-    if (cost < 1e300 && bic(cost, r.modes.size()) < bic(best_cost, best.modes.size())) {
-      r.order_used = best.order_used;
-      best = r;
-      best_cost = cost;
+    ModalFitResult r = base;
+    const double cost = fitter.FitWith(poles, chains, &r);
+    if (cost < 1e300 && Bic(cost, r.modes.size(), N2) < Bic(best->cost, best->fit.modes.size(), N2)) {
+      r.order_used = best->fit.order_used;
+      best->fit = r;
+      best->cost = cost;
     } else {
       break;
     }
   }
-  result = best;
+}
+
+}  // namespace
+
+ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
+  ModalFitResult result;
+  const dynamics::Frf frf = full.Band(o.fmin_hz, o.fmax_hz);
+  const int N = frf.size();
+  if (N == 0) {
+    result.message = "no frequency lines in the band";
+    return result;
+  }
+  result.fmin_hz = frf.freq_hz()(0);
+  result.fmax_hz = frf.freq_hz()(N - 1);
+  const int nmax = o.max_order;
+  if (o.min_order < 1 || nmax < o.min_order || 2 * (nmax + 1) > N) {
+    result.message = "too few lines (" + std::to_string(N) + ") for model order " + std::to_string(nmax);
+    return result;
+  }
+  const double dt = 1.0 / (2.0 * result.fmax_hz);
+  const std::vector<std::vector<OrderPole>> by_order = StabilisationDiagram(ToeplitzSums(frf, nmax, dt), o, dt, &result);
+  const PoleSetFitter fitter{frf, o, result.fmin_hz, result.fmax_hz, ModalFitWeights(frf)};
+  Selection best = FitStablePoleSets(fitter, by_order, result);
+  if (best.cost >= 1e300) FitFromPeaks(fitter, result, &best);
+  if (best.cost >= 1e300) {
+    result.status = SolverStatus::kFailed;
+    result.message = "no pole was stable over " + std::to_string(o.min_stable_orders) +
+                     " consecutive orders up to " + std::to_string(nmax) +
+                     " with a significant residue, and no peak of |H| fitted as a mode";
+    return result;
+  }
+  AddModesFromResidual(fitter, result, &best);
+  EliminateWeakModes(fitter, result, &best);
+  result = best.fit;
   std::sort(result.modes.begin(), result.modes.end(),
             [](const FittedMode& a, const FittedMode& b) { return a.freq_hz < b.freq_hz; });
-  result.status = ModalFitStatus::kOk;
+  result.status = SolverStatus::kConverged;
   result.message = std::to_string(result.modes.size()) + " modes: " +
-                   (from_peaks ? std::string("no pole stable over ") + std::to_string(o.min_stable_orders) +
-                                     " orders, poles from the peaks of |H|"
-                               : "stable poles of order " + std::to_string(result.order_used)) +
+                   (best.from_peaks ? std::string("no pole stable over ") + std::to_string(o.min_stable_orders) +
+                                          " orders, poles from the peaks of |H|"
+                                    : "stable poles of order " + std::to_string(result.order_used)) +
                    ", refined" +
-                   (added > 0 ? ", " + std::to_string(added) + " added from the residual" : "");
+                   (best.added > 0 ? ", " + std::to_string(best.added) + " added from the residual" : "");
   return result;
 }
 

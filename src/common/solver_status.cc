@@ -1,10 +1,17 @@
 #include "robomach/common/solver_status.h"
 
+#include <stdexcept>
+
 #include "robomach/common/run_status.h"
 
 namespace robomach {
 
-const char* SolverStatusName(SolverStatus s) {
+namespace {
+constexpr SolverStatus kAllSolverStatuses[] = {SolverStatus::kConverged, SolverStatus::kNotConverged,
+                                               SolverStatus::kFailed, SolverStatus::kNotImproved};
+}  // namespace
+
+const char* ToString(SolverStatus s) {
   switch (s) {
     case SolverStatus::kConverged: return "converged";
     case SolverStatus::kNotConverged: return "not_converged";
@@ -12,6 +19,14 @@ const char* SolverStatusName(SolverStatus s) {
     case SolverStatus::kNotImproved: return "not_improved";
   }
   return "?";
+}
+
+SolverStatus ParseSolverStatus(const std::string& name) {
+  for (SolverStatus s : kAllSolverStatuses) {
+    if (name == ToString(s)) return s;
+  }
+  throw std::invalid_argument("solver status '" + name +
+                              "': expected converged, not_converged, failed or not_improved");
 }
 
 const char* RunStatusName(RunStatus s) { return s == RunStatus::kOk ? "ok" : "flagged"; }

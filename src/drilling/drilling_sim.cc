@@ -273,6 +273,7 @@ TuneResult TuneController(const ControllerParameters& start, DrillingScenario& s
     DrillingScenario* sc;
     SimOptions* run;
     int evals{0};
+    double first_cost{NAN};  // the start's (as BOBYQA places it): the test of kNotImproved
   } ctx{p, &scenario, &run};
   auto f = [](const std::vector<double>& xv, std::vector<double>&, void* data) -> double {
     Ctx* c = static_cast<Ctx*>(data);
@@ -281,8 +282,9 @@ TuneResult TuneController(const ControllerParameters& start, DrillingScenario& s
     q.zeta = std::exp(xv[1]);
     if (xv.size() > 2) q.third = std::exp(xv[2]);
     auto ctl = MakeController(q, *c->sc, c->run->motor_torque_limit);
-    ++c->evals;
-    return c->sc->Run(*ctl, *c->run).cost;
+    const double cost = c->sc->Run(*ctl, *c->run).cost;
+    if (++c->evals == 1) c->first_cost = cost;
+    return cost;
   };
   nlopt::opt opt(nlopt::LN_BOBYQA, dim);
   opt.set_lower_bounds(lo);
@@ -294,10 +296,13 @@ TuneResult TuneController(const ControllerParameters& start, DrillingScenario& s
   opt.set_initial_step(step);
   double fx = 0.0;
   TuneResult out;
+  bool stopped_early = false;  // at max_evaluations or on round-off, not on the tolerance
   try {
     const nlopt::result r = opt.optimize(x, fx);
-    out.message = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : "converged";
+    stopped_early = r == nlopt::MAXEVAL_REACHED;
+    out.message = stopped_early ? "max_evaluations" : "converged";
   } catch (const nlopt::roundoff_limited&) {
+    stopped_early = true;
     out.message = "roundoff_limited";
     fx = f(x, step, &ctx);
   }
@@ -307,6 +312,11 @@ TuneResult TuneController(const ControllerParameters& start, DrillingScenario& s
   out.parameters = p;
   out.cost = fx;
   out.evaluations = ctx.evals;
+  // Every run diverged (each costs kDivergedCost): no usable gains.
+  out.status = !(fx < kDivergedCost)      ? SolverStatus::kFailed
+               : !(fx < ctx.first_cost)   ? SolverStatus::kNotImproved
+               : stopped_early            ? SolverStatus::kNotConverged
+                                          : SolverStatus::kConverged;
   return out;
 }
 

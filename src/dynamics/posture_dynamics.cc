@@ -30,6 +30,14 @@ struct PostureEvaluator::Workspace {
   Eigen::VectorXd eigenvalues;                       // λ ascending
   Eigen::MatrixXd eigenvectors;                      // M-normalised φ
   Eigen::VectorXd c_phi;                             // C φ
+
+  // The stages of Evaluate that use this state (members, not free helpers:
+  // Workspace is private to PostureEvaluator).
+  void Assemble(const RobotModel& model, const Eigen::VectorXd& q, int n, int N, PostureDynamics* out);
+  void JacobianCondition(int n, PostureDynamics* out);
+  void StaticCompliance(const PostureOptions& options, int N, bool k_diagonal, PostureDynamics* out);
+  void SolveEigenproblem(const AssembledSystem& sys, int N, bool k_diagonal);
+  void UndampedModes(const PostureOptions& options, int N, PostureDynamics* out);
 };
 
 PostureEvaluator::PostureEvaluator(std::shared_ptr<const RobotModel> model)
@@ -76,17 +84,12 @@ PostureDynamics PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const Postu
   return out;
 }
 
-void PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& options,
-                                PostureDynamics* out_ptr) {
+// The assembled system of posture q into out->system, with X_BT and J_BT:
+// the rigid chain's M_q, the joint stiffness, the effects' contributions and
+// the damping matrix (n joints, N DOFs).
+void PostureEvaluator::Workspace::Assemble(const RobotModel& model, const Eigen::VectorXd& q, int n, int N,
+                                           PostureDynamics* out_ptr) {
   PostureDynamics& out = *out_ptr;
-  const RobotModel& model = *model_;
-  kinematics::CheckJointVector(model.chain(), q);
-  const int n = model.num_joints();
-  const int N = model.num_dofs();
-  Workspace& w = *ws_;
-
-  out.options = options;
-  out.q = q;
   AssembledSystem& sys = out.system;
   sys.num_joints = n;
   sys.M.setZero(N, N);
@@ -96,7 +99,7 @@ void PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& 
   sys.V_T.setZero(6, N);
   out.J_BT.resize(6, n);
   // Pose, J_BT and M_q in one pass (dynamics/internal/rigid_chain.h).
-  w.rigid.Compute(q.data(), &out.X_BT, out.J_BT, sys.M.topLeftCorner(n, n));
+  rigid.Compute(q.data(), &out.X_BT, out.J_BT, sys.M.topLeftCorner(n, n));
   sys.K.topLeftCorner(n, n).diagonal() = model.joint_stiffness();
   sys.B.leftCols(n) = out.J_BT.topRows<3>();
   sys.V_T.leftCols(n) = out.J_BT;
@@ -107,47 +110,39 @@ void PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& 
   sys.C.resize(N, N);
   sys.C.noalias() = model.alpha() * sys.K + model.beta() * sys.M + sys.C_extra;
   out.proportional_damping = sys.C_extra.isZero(0.0);
-  const bool k_diagonal = IsPositiveDiagonal(sys.K);
+}
 
-  out.jacobian_condition = NAN;
-  out.near_singular = false;
-  if (options.jacobian_condition || options.cartesian) {
-    // cond(J) = sqrt(λmax/λmin) of JᵀJ (n × n). Squaring loses the digits
-    // below eps·λmax, so condition numbers up to ≈ 1e7 are resolved, which is
-    // all the 1e5 threshold needs; beyond, the value is only "very large".
-    // (Three times cheaper than a Jacobi SVD of a 6×6 matrix.)
-    double lmin = 0.0, lmax = 0.0;
-    if (n == 6) {
-      const Matrix6d JtJ = out.J_BT.transpose() * out.J_BT;
-      w.gram6.compute(JtJ, Eigen::EigenvaluesOnly);
-      lmin = w.gram6.eigenvalues()(0);
-      lmax = w.gram6.eigenvalues()(5);
-    } else {
-      const Eigen::VectorXd gram =
-          Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(out.J_BT.transpose() * out.J_BT, Eigen::EigenvaluesOnly)
-              .eigenvalues();
-      lmin = gram(0);
-      lmax = gram(n - 1);
-    }
-    out.jacobian_condition = lmin > 0.0 ? std::sqrt(lmax / lmin) : INFINITY;
-    if (!std::isfinite(out.jacobian_condition)) out.jacobian_condition = INFINITY;
-    out.near_singular = !(out.jacobian_condition <= kNearSingularCondition);
+// out->jacobian_condition and near_singular from the n joints' J_BT.
+void PostureEvaluator::Workspace::JacobianCondition(int n, PostureDynamics* out_ptr) {
+  PostureDynamics& out = *out_ptr;
+  // cond(J) = sqrt(λmax/λmin) of JᵀJ (n × n). Squaring loses the digits
+  // below eps·λmax, so condition numbers up to ≈ 1e7 are resolved, which is
+  // all the 1e5 threshold needs; beyond, the value is only "very large".
+  // (Three times cheaper than a Jacobi SVD of a 6×6 matrix.)
+  double lmin = 0.0, lmax = 0.0;
+  if (n == 6) {
+    const Matrix6d JtJ = out.J_BT.transpose() * out.J_BT;
+    gram6.compute(JtJ, Eigen::EigenvaluesOnly);
+    lmin = gram6.eigenvalues()(0);
+    lmax = gram6.eigenvalues()(5);
+  } else {
+    const Eigen::VectorXd gram =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(out.J_BT.transpose() * out.J_BT, Eigen::EigenvaluesOnly)
+            .eigenvalues();
+    lmin = gram(0);
+    lmax = gram(n - 1);
   }
+  out.jacobian_condition = lmin > 0.0 ? std::sqrt(lmax / lmin) : INFINITY;
+  if (!std::isfinite(out.jacobian_condition)) out.jacobian_condition = INFINITY;
+  out.near_singular = !(out.jacobian_condition <= kNearSingularCondition);
+}
 
-  out.M_X.setConstant(NAN);
-  out.K_X.setConstant(NAN);
-  out.C_X.setConstant(NAN);
-  if (options.cartesian && n == 6 && !out.near_singular) {
-    // Congruence with J⁻¹: M_X = J⁻ᵀ M_q J⁻¹ [Khatib 1987], K_X = J⁻ᵀ K_q J⁻¹.
-    const Matrix6d J = out.J_BT;
-    const Matrix6d Jinv = J.partialPivLu().inverse();
-    // Fixed-size blocks: no heap temporaries in the products.
-    out.M_X = Jinv.transpose() * sys.M.topLeftCorner<6, 6>() * Jinv;
-    out.K_X = Jinv.transpose() * sys.K.topLeftCorner<6, 6>() * Jinv;
-    out.C_X = Jinv.transpose() * sys.C.topLeftCorner<6, 6>() * Jinv;
-  }
-
-  // Static compliance H(0) = B K⁻¹ Bᵀ. K is SPD for positive joint stiffness.
+// Static compliance H(0) = B K⁻¹ Bᵀ into out->static_compliance (NaN when
+// not asked for). K is SPD for positive joint stiffness.
+void PostureEvaluator::Workspace::StaticCompliance(const PostureOptions& options, int N, bool k_diagonal,
+                                                   PostureDynamics* out_ptr) {
+  PostureDynamics& out = *out_ptr;
+  const AssembledSystem& sys = out.system;
   if (!options.static_compliance) {
     out.static_compliance.setConstant(NAN);
   } else if (k_diagonal) {
@@ -155,21 +150,18 @@ void PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& 
     for (int j = 0; j < N; ++j) H0.noalias() += sys.B.col(j) * (sys.B.col(j).transpose() / sys.K(j, j));
     out.static_compliance = H0;
   } else {
-    w.ldlt.compute(sys.K);
-    w.k_inv_bt = sys.B.transpose();
-    w.ldlt.solveInPlace(w.k_inv_bt);
-    out.static_compliance.noalias() = sys.B * w.k_inv_bt;
+    ldlt.compute(sys.K);
+    k_inv_bt = sys.B.transpose();
+    ldlt.solveInPlace(k_inv_bt);
+    out.static_compliance.noalias() = sys.B * k_inv_bt;
   }
+}
 
-  out.complex_modes.poles.resize(0);
-  out.complex_modes.residues.clear();
-  if (!options.modes) {
-    out.modes.clear();
-    return;
-  }
-  // K φ = λ M φ with M-normalised eigenvectors, ascending λ.
-  w.eigenvalues.resize(N);
-  w.eigenvectors.resize(N, N);
+// K φ = λ M φ with M-normalised eigenvectors, ascending λ, into eigenvalues
+// and eigenvectors. @throws NumericalError if M is not positive definite.
+void PostureEvaluator::Workspace::SolveEigenproblem(const AssembledSystem& sys, int N, bool k_diagonal) {
+  eigenvalues.resize(N);
+  eigenvectors.resize(N, N);
   if (N == 6 && k_diagonal) {
     // Reduced through diag K to one standard symmetric problem (header).
     // Eigen's iterative solver, not computeDirect (closed-form 3×3 only and
@@ -177,8 +169,8 @@ void PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& 
     const Vector6d k_diag = sys.K.diagonal();
     const Vector6d d = k_diag.cwiseSqrt().cwiseInverse();
     const Matrix6d M6 = sys.M;
-    w.reduced6.compute(d.asDiagonal() * M6 * d.asDiagonal(), Eigen::ComputeEigenvectors);
-    if (w.reduced6.info() != Eigen::Success || !(w.reduced6.eigenvalues()(0) > 0.0)) {
+    reduced6.compute(d.asDiagonal() * M6 * d.asDiagonal(), Eigen::ComputeEigenvectors);
+    if (reduced6.info() != Eigen::Success || !(reduced6.eigenvalues()(0) > 0.0)) {
       ThrowNotPositiveDefinite();
     }
     for (int k = 0; k < 6; ++k) {
@@ -187,32 +179,39 @@ void PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& 
       // (≈ 1e-13 on the KR210). The Rayleigh quotient λ = vᵀKv / vᵀMv and the
       // M-normalisation of v = K^{-1/2}u restore full precision: λ's error is
       // quadratic in u's, which is ≈ eps·μ_max/gap.
-      const Vector6d v = d.cwiseProduct(w.reduced6.eigenvectors().col(5 - k));
+      const Vector6d v = d.cwiseProduct(reduced6.eigenvectors().col(5 - k));
       const double vMv = v.dot(M6 * v);
-      w.eigenvalues(k) = v.cwiseAbs2().dot(k_diag) / vMv;
-      w.eigenvectors.col(k) = v / std::sqrt(vMv);
+      eigenvalues(k) = v.cwiseAbs2().dot(k_diag) / vMv;
+      eigenvectors.col(k) = v / std::sqrt(vMv);
     }
   } else if (N == 6) {
-    w.general6.compute(Matrix6d(sys.K), Matrix6d(sys.M), Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
-    if (w.general6.info() != Eigen::Success) ThrowNotPositiveDefinite();
-    w.eigenvalues = w.general6.eigenvalues();
-    w.eigenvectors = w.general6.eigenvectors();
+    general6.compute(Matrix6d(sys.K), Matrix6d(sys.M), Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+    if (general6.info() != Eigen::Success) ThrowNotPositiveDefinite();
+    eigenvalues = general6.eigenvalues();
+    eigenvectors = general6.eigenvectors();
   } else {
     Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ges(sys.K, sys.M,
                                                                   Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
     if (ges.info() != Eigen::Success) ThrowNotPositiveDefinite();
-    w.eigenvalues = ges.eigenvalues();
-    w.eigenvectors = ges.eigenvectors();
+    eigenvalues = ges.eigenvalues();
+    eigenvectors = ges.eigenvectors();
   }
+}
 
+// out->modes from the solved eigenproblem: frequency, φ, p_T with its sign
+// normalised, and (as asked) modal mass, shape and the proportional
+// damping ratio.
+void PostureEvaluator::Workspace::UndampedModes(const PostureOptions& options, int N, PostureDynamics* out_ptr) {
+  PostureDynamics& out = *out_ptr;
+  const AssembledSystem& sys = out.system;
   out.modes.resize(N);
-  w.c_phi.resize(N);
+  c_phi.resize(N);
   for (int k = 0; k < N; ++k) {
     Mode& m = out.modes[k];
-    const double lambda = std::max(w.eigenvalues(k), 0.0);
+    const double lambda = std::max(eigenvalues(k), 0.0);
     const double omega = std::sqrt(lambda);
     m.freq_hz = RadPerSecToHz(omega);
-    m.phi = w.eigenvectors.col(k);  // φᵀ M φ = 1
+    m.phi = eigenvectors.col(k);  // φᵀ M φ = 1
     m.p_T.noalias() = sys.B * m.phi;
     NormaliseSign(&m);
     if (options.modal_masses) {
@@ -225,29 +224,89 @@ void PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& 
     }
     if (options.damping_ratios) {
       // Proportional damping: φᵀ C φ = alpha ω² + beta = 2 ζ ω exactly.
-      w.c_phi.noalias() = sys.C * m.phi;
-      m.damping_ratio = omega > 0.0 ? m.phi.dot(w.c_phi) / (2.0 * omega) : 0.0;
+      c_phi.noalias() = sys.C * m.phi;
+      m.damping_ratio = omega > 0.0 ? m.phi.dot(c_phi) / (2.0 * omega) : 0.0;
     } else {
       m.damping_ratio = NAN;
     }
   }
+}
+
+namespace {
+
+// M_X, K_X, C_X into out (NaN unless asked for, six joints and not near
+// singular).
+void CartesianMatrices(const PostureOptions& options, int n, PostureDynamics* out_ptr) {
+  PostureDynamics& out = *out_ptr;
+  const AssembledSystem& sys = out.system;
+  out.M_X.setConstant(NAN);
+  out.K_X.setConstant(NAN);
+  out.C_X.setConstant(NAN);
+  if (options.cartesian && n == 6 && !out.near_singular) {
+    // Congruence with J⁻¹: M_X = J⁻ᵀ M_q J⁻¹ [Khatib 1987], K_X = J⁻ᵀ K_q J⁻¹.
+    const Matrix6d J = out.J_BT;
+    const Matrix6d Jinv = J.partialPivLu().inverse();
+    // Fixed-size blocks: no heap temporaries in the products.
+    out.M_X = Jinv.transpose() * sys.M.topLeftCorner<6, 6>() * Jinv;
+    out.K_X = Jinv.transpose() * sys.K.topLeftCorner<6, 6>() * Jinv;
+    out.C_X = Jinv.transpose() * sys.C.topLeftCorner<6, 6>() * Jinv;
+  }
+}
+
+// The damping ratios of out->modes from the complex poles, which it
+// computes into out->complex_modes.
+void DampingFromComplexPoles(PostureDynamics* out_ptr) {
+  PostureDynamics& out = *out_ptr;
+  out.complex_modes = ComputeComplexModes(out.system);
+  const ComplexModalModel& cm = out.complex_modes;
+  for (Mode& m : out.modes) {
+    double best = INFINITY;
+    for (int k = 0; k < cm.poles.size(); ++k) {
+      const std::complex<double> lam = cm.poles(k);
+      if (lam.imag() <= 0.0) continue;
+      const double d = std::abs(std::abs(lam) - HzToRadPerSec(m.freq_hz));
+      if (d < best) {
+        best = d;
+        m.damping_ratio = -lam.real() / std::abs(lam);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& options,
+                                PostureDynamics* out_ptr) {
+  PostureDynamics& out = *out_ptr;
+  const RobotModel& model = *model_;
+  kinematics::CheckJointVector(model.chain(), q);
+  const int n = model.num_joints();
+  const int N = model.num_dofs();
+  Workspace& w = *ws_;
+
+  out.options = options;
+  out.q = q;
+  w.Assemble(model, q, n, N, &out);
+  const bool k_diagonal = IsPositiveDiagonal(out.system.K);
+
+  out.jacobian_condition = NAN;
+  out.near_singular = false;
+  if (options.jacobian_condition || options.cartesian) w.JacobianCondition(n, &out);
+  CartesianMatrices(options, n, &out);
+  w.StaticCompliance(options, N, k_diagonal, &out);
+
+  out.complex_modes.poles.resize(0);
+  out.complex_modes.residues.clear();
+  if (!options.modes) {
+    out.modes.clear();
+    return;
+  }
+  w.SolveEigenproblem(out.system, N, k_diagonal);
+  w.UndampedModes(options, N, &out);
   if (options.damping_ratios && !out.proportional_damping) {
     // Non-proportional damping: the damping ratio of each mode is that of
     // the complex pole nearest to its undamped frequency.
-    out.complex_modes = ComputeComplexModes(sys);
-    const ComplexModalModel& cm = out.complex_modes;
-    for (Mode& m : out.modes) {
-      double best = INFINITY;
-      for (int k = 0; k < cm.poles.size(); ++k) {
-        const std::complex<double> lam = cm.poles(k);
-        if (lam.imag() <= 0.0) continue;
-        const double d = std::abs(std::abs(lam) - HzToRadPerSec(m.freq_hz));
-        if (d < best) {
-          best = d;
-          m.damping_ratio = -lam.real() / std::abs(lam);
-        }
-      }
-    }
+    DampingFromComplexPoles(&out);
   }
 }
 

@@ -249,6 +249,195 @@ void CheckValid(const PropagationOptions& o) {
   }
 }
 
+namespace {
+
+// What every stage of Propagate shares: the estimates, the outputs there,
+// the covariance's principal axes and the interval's normal quantile
+// (references to Propagate's locals, which outlive the stages).
+struct PropagationBase {
+  const ParameterUncertainty& u;
+  const OutputFunction& f;
+  const Eigen::VectorXd& values;  // the estimates
+  const Eigen::VectorXd& theta0;  // the estimates on the sampling scales
+  const Eigen::VectorXd& f0;      // f(values)
+  const Eigen::VectorXd& lambda;  // the covariance's eigenvalues (clipped at 0)
+  const Eigen::MatrixXd& V;       // its eigenvectors v_k, in columns
+  double lambda_max;
+  double z;  // the normal quantile of the confidence
+  int n;     // parameters
+  int m;     // outputs
+};
+
+// Σ_f = Σ_k λ_k (∂f/∂v_k)(∂f/∂v_k)ᵀ over the covariance's principal axes
+// v_k: central differences along each axis with a step of 1e-3 √λ_k
+// (2 evaluations per axis; axes without variance are skipped, so a
+// rank-one covariance costs 3 evaluations), or forward differences (1).
+// Returns D, which holds ∂f/∂v_k in column k (zero for a skipped axis) of
+// g (b.f or the linearisation); counts the evaluations in res.
+Eigen::MatrixXd Differences(const PropagationBase& b, const OutputFunction& g, bool central,
+                            PropagationResult* res) {
+  const int m = b.m, n = b.n;
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(m, n);
+  Eigen::VectorXd g0 = b.f0;
+  if (&g != &b.f && !central) {
+    g0 = g(b.values);
+    ++res->evaluations;
+  }
+  auto at = [&](const Eigen::VectorXd& theta) {
+    Eigen::VectorXd y = g(FromTheta(b.u, theta));
+    if (y.size() != m) {
+      throw std::invalid_argument("the local model gives " + std::to_string(y.size()) + " outputs, f " +
+                                  std::to_string(m));
+    }
+    return y;
+  };
+  if (g0.size() != m) throw std::invalid_argument("the local model gives another number of outputs");
+  for (int k = 0; k < n; ++k) {
+    if (!(b.lambda(k) > 1e-14 * b.lambda_max)) continue;
+    const double h = 1e-3 * std::sqrt(b.lambda(k));
+    D.col(k) = central ? Eigen::VectorXd((at(b.theta0 + h * b.V.col(k)) - at(b.theta0 - h * b.V.col(k))) / (2.0 * h))
+                       : Eigen::VectorXd((at(b.theta0 + h * b.V.col(k)) - g0) / h);
+    res->evaluations += central ? 2 : 1;
+  }
+  return D;
+}
+
+// The first-order intervals into res->outputs (std_dev, lower, upper).
+// Returns J = Σ_k (∂f/∂v_k) v_kᵀ, the Jacobian on the span of the
+// covariance (the sigma-point check uses it); *lost tells the outputs whose
+// derivatives the linearisation did not give.
+Eigen::MatrixXd FirstOrderIntervals(const PropagationBase& b, const OutputFunction& linearisation,
+                                    const PropagationOptions& o, PropagationResult* res, std::string* lost) {
+  const int m = b.m;
+  // With a linearisation, `central_differences` applies to it; an output
+  // it does not reach at some step takes f's own central differences.
+  Eigen::MatrixXd D = Differences(b, linearisation ? linearisation : b.f, o.central_differences, res);
+  if (linearisation && !D.allFinite()) {
+    const Eigen::MatrixXd Df = Differences(b, b.f, true, res);
+    int outputs_lost = 0;
+    for (int j = 0; j < m; ++j) {
+      if (D.row(j).allFinite()) continue;
+      D.row(j) = Df.row(j);
+      ++outputs_lost;
+    }
+    *lost = "; the local model did not reach every step for " + std::to_string(outputs_lost) + " of " +
+            std::to_string(m) + " outputs, whose derivatives are differences of the outputs themselves";
+  }
+  const Eigen::MatrixXd J = D * b.V.transpose();
+  const Eigen::MatrixXd cov = D * b.lambda.asDiagonal() * D.transpose();
+  for (int k = 0; k < m; ++k) {
+    const double s = std::sqrt(std::max(cov(k, k), 0.0));
+    res->outputs[k].std_dev = s;
+    res->outputs[k].lower = b.f0(k) - b.z * s;
+    res->outputs[k].upper = b.f0(k) + b.z * s;
+  }
+  return J;
+}
+
+// Sigma points along the covariance's principal axes, at the interval's
+// half-width: where the outputs bend within the interval, the linear
+// interval is wrong and Monte Carlo is used instead. Sets res's
+// nonlinearities and reason; returns true if the first-order intervals
+// stand (the departure within o.nonlinearity_tolerance).
+bool SigmaPointsLinear(const PropagationBase& b, const Eigen::MatrixXd& J, const PropagationOptions& o,
+                       const std::vector<std::string>& output_names, PropagationResult* res) {
+  const int m = b.m, n = b.n;
+  double worst = 0.0;
+  int worst_output = -1;
+  for (auto& out : res->outputs) out.nonlinearity = 0.0;
+  for (int k = 0; k < n; ++k) {
+    if (!(b.lambda(k) > 1e-14 * b.lambda_max)) continue;  // the axes the differences used
+    for (double sign : {-1.0, 1.0}) {
+      const Eigen::VectorXd step = sign * b.z * std::sqrt(b.lambda(k)) * b.V.col(k);
+      Eigen::VectorXd fk;
+      try {
+        fk = b.f(FromTheta(b.u, b.theta0 + step));
+      } catch (const std::exception&) {
+        fk = Eigen::VectorXd::Constant(m, NAN);
+      }
+      ++res->evaluations;
+      const Eigen::VectorXd linear = b.f0 + J * step;
+      for (int j = 0; j < m; ++j) {
+        const double half = b.z * res->outputs[j].std_dev;
+        const double scale = std::max(half, 1e-12 * std::max(std::abs(b.f0(j)), 1e-300));
+        const double d = std::isfinite(fk(j)) ? std::abs(fk(j) - linear(j)) / scale : INFINITY;
+        res->outputs[j].nonlinearity = std::max(res->outputs[j].nonlinearity, d);
+        if (d > worst) {
+          worst = d;
+          worst_output = j;
+        }
+      }
+    }
+  }
+  res->nonlinearity = worst;
+  if (worst <= o.nonlinearity_tolerance) {
+    res->reason = "first order: at the sigma points the outputs depart from linear by at most " + Percent(worst) +
+                  " of the half-width (under " + Percent(o.nonlinearity_tolerance) + ")";
+    return true;
+  }
+  const std::string what = worst_output < static_cast<int>(output_names.size())
+                               ? output_names[worst_output]
+                               : "output " + std::to_string(worst_output + 1);
+  res->reason = "Monte Carlo: " + what + " departs from linear by " +
+                (std::isfinite(worst) ? OfHalfWidth(worst) : std::string("an undefined amount (not computable)")) +
+                " at a sigma point (over " + Percent(o.nonlinearity_tolerance) +
+                "): the first-order interval would be wrong";
+  return false;
+}
+
+// The Monte Carlo intervals into res->outputs: o.samples draws of the
+// normal distribution on the sampling scales, a sample whose outputs cannot
+// be evaluated left out (and counted); appends the sample count to the reason.
+void MonteCarloIntervals(const PropagationBase& b, const PropagationOptions& o, PropagationResult* res) {
+  const int m = b.m, n = b.n;
+  res->method_used = PropagationMethod::kMonteCarlo;
+  std::mt19937_64 rng(o.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const Eigen::MatrixXd L = b.V * b.lambda.cwiseSqrt().asDiagonal();
+  std::vector<std::vector<double>> samples(m);
+  for (auto& s : samples) s.reserve(o.samples);
+  Eigen::VectorXd xi(n);
+  for (int s = 0; s < o.samples; ++s) {
+    for (int i = 0; i < n; ++i) xi(i) = normal(rng);
+    Eigen::VectorXd fs;
+    try {
+      fs = b.f(FromTheta(b.u, b.theta0 + L * xi));
+    } catch (const std::exception&) {
+      fs.resize(0);
+    }
+    ++res->evaluations;
+    if (fs.size() != m || !fs.allFinite()) {
+      ++res->failed_samples;
+      continue;
+    }
+    for (int k = 0; k < m; ++k) samples[k].push_back(fs(k));
+  }
+  const int good = o.samples - res->failed_samples;
+  if (good < 100) {
+    throw std::invalid_argument("Monte Carlo: only " + std::to_string(good) + " of " + std::to_string(o.samples) +
+                                " samples could be evaluated (sampled parameters outside their bounds?)");
+  }
+  for (int k = 0; k < m; ++k) {
+    std::vector<double>& v = samples[k];
+    std::sort(v.begin(), v.end());
+    double mean = 0.0;
+    for (double x : v) mean += x;
+    mean /= static_cast<double>(v.size());
+    double var = 0.0;
+    for (double x : v) var += (x - mean) * (x - mean);
+    res->outputs[k].std_dev = std::sqrt(var / static_cast<double>(v.size() - 1));
+    res->outputs[k].lower = Quantile(v, 0.5 * (1.0 - o.confidence));
+    res->outputs[k].upper = Quantile(v, 0.5 * (1.0 + o.confidence));
+  }
+  res->reason += "; " + std::to_string(good) + " samples, seed " + std::to_string(o.seed);
+  if (res->failed_samples > 0) {
+    res->reason += "; " + std::to_string(res->failed_samples) +
+                   " samples could not be evaluated and were left out (sampled parameters outside their bounds)";
+  }
+}
+
+}  // namespace
+
 PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction& f, const PropagationOptions& o,
                             const std::vector<std::string>& output_names, const OutputFunction& linearisation) {
   CheckValid(u);
@@ -269,115 +458,17 @@ PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction&
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(u.covariance);
   const Eigen::VectorXd lambda = eig.eigenvalues().cwiseMax(0.0);
   const Eigen::MatrixXd& V = eig.eigenvectors();
-
-  // Σ_f = Σ_k λ_k (∂f/∂v_k)(∂f/∂v_k)ᵀ over the covariance's principal axes
-  // v_k: central differences along each axis with a step of 1e-3 √λ_k
-  // (2 evaluations per axis; axes without variance are skipped, so a
-  // rank-one covariance costs 3 evaluations), or forward differences (1).
-  // D holds ∂f/∂v_k in column k (zero for a skipped axis).
-  const double lambda_max = lambda.maxCoeff();
-  auto differences = [&](const OutputFunction& g, bool central) {
-    Eigen::MatrixXd D = Eigen::MatrixXd::Zero(m, n);
-    Eigen::VectorXd g0 = f0;
-    if (&g != &f && !central) {
-      g0 = g(values);
-      ++res.evaluations;
-    }
-    auto at = [&](const Eigen::VectorXd& theta) {
-      Eigen::VectorXd y = g(FromTheta(u, theta));
-      if (y.size() != m) {
-        throw std::invalid_argument("the local model gives " + std::to_string(y.size()) + " outputs, f " +
-                                    std::to_string(m));
-      }
-      return y;
-    };
-    if (g0.size() != m) throw std::invalid_argument("the local model gives another number of outputs");
-    for (int k = 0; k < n; ++k) {
-      if (!(lambda(k) > 1e-14 * lambda_max)) continue;
-      const double h = 1e-3 * std::sqrt(lambda(k));
-      D.col(k) = central ? Eigen::VectorXd((at(theta0 + h * V.col(k)) - at(theta0 - h * V.col(k))) / (2.0 * h))
-                         : Eigen::VectorXd((at(theta0 + h * V.col(k)) - g0) / h);
-      res.evaluations += central ? 2 : 1;
-    }
-    return D;
-  };
+  const PropagationBase b{u, f, values, theta0, f0, lambda, V, lambda.maxCoeff(), z, n, m};
 
   bool monte_carlo = o.method == PropagationMethod::kMonteCarlo;
   if (o.method != PropagationMethod::kMonteCarlo) {
-    // With a linearisation, `central_differences` applies to it; an output
-    // it does not reach at some step takes f's own central differences.
-    Eigen::MatrixXd D = differences(linearisation ? linearisation : f, o.central_differences);
     std::string lost;
-    if (linearisation && !D.allFinite()) {
-      const Eigen::MatrixXd Df = differences(f, true);
-      int outputs_lost = 0;
-      for (int j = 0; j < m; ++j) {
-        if (D.row(j).allFinite()) continue;
-        D.row(j) = Df.row(j);
-        ++outputs_lost;
-      }
-      lost = "; the local model did not reach every step for " + std::to_string(outputs_lost) + " of " +
-             std::to_string(m) + " outputs, whose derivatives are differences of the outputs themselves";
-    }
-    // J = Σ_k (∂f/∂v_k) v_kᵀ, the Jacobian on the span of the covariance
-    // (the sigma-point check uses it).
-    const Eigen::MatrixXd J = D * V.transpose();
-    const Eigen::MatrixXd cov = D * lambda.asDiagonal() * D.transpose();
-    for (int k = 0; k < m; ++k) {
-      const double s = std::sqrt(std::max(cov(k, k), 0.0));
-      res.outputs[k].std_dev = s;
-      res.outputs[k].lower = f0(k) - z * s;
-      res.outputs[k].upper = f0(k) + z * s;
-    }
+    const Eigen::MatrixXd J = FirstOrderIntervals(b, linearisation, o, &res, &lost);
     res.method_used = PropagationMethod::kFirstOrder;
     if (o.method == PropagationMethod::kFirstOrder) {
       res.reason = "first order, as asked (--uncertainty-method first-order)";
     } else {
-      // Sigma points along the covariance's principal axes, at the interval's
-      // half-width: where the outputs bend within the interval, the linear
-      // interval is wrong and Monte Carlo is used instead.
-      double worst = 0.0;
-      int worst_output = -1;
-      for (auto& out : res.outputs) out.nonlinearity = 0.0;
-      for (int k = 0; k < n; ++k) {
-        if (!(lambda(k) > 1e-14 * lambda_max)) continue;  // the axes the differences used
-        for (double sign : {-1.0, 1.0}) {
-          const Eigen::VectorXd step = sign * z * std::sqrt(lambda(k)) * V.col(k);
-          Eigen::VectorXd fk;
-          try {
-            fk = f(FromTheta(u, theta0 + step));
-          } catch (const std::exception&) {
-            fk = Eigen::VectorXd::Constant(m, NAN);
-          }
-          ++res.evaluations;
-          const Eigen::VectorXd linear = f0 + J * step;
-          for (int j = 0; j < m; ++j) {
-            const double half = z * res.outputs[j].std_dev;
-            const double scale = std::max(half, 1e-12 * std::max(std::abs(f0(j)), 1e-300));
-            const double d = std::isfinite(fk(j)) ? std::abs(fk(j) - linear(j)) / scale : INFINITY;
-            res.outputs[j].nonlinearity = std::max(res.outputs[j].nonlinearity, d);
-            if (d > worst) {
-              worst = d;
-              worst_output = j;
-            }
-          }
-        }
-      }
-      res.nonlinearity = worst;
-      if (worst <= o.nonlinearity_tolerance) {
-        res.reason = "first order: at the sigma points the outputs depart from linear by at most " + Percent(worst) +
-                     " of the half-width (under " + Percent(o.nonlinearity_tolerance) + ")";
-      } else {
-        monte_carlo = true;
-        const std::string what = worst_output < static_cast<int>(output_names.size())
-                                     ? output_names[worst_output]
-                                     : "output " + std::to_string(worst_output + 1);
-        res.reason = "Monte Carlo: " + what + " departs from linear by " +
-                     (std::isfinite(worst) ? OfHalfWidth(worst)
-                                           : std::string("an undefined amount (not computable)")) +
-                     " at a sigma point (over " + Percent(o.nonlinearity_tolerance) +
-                     "): the first-order interval would be wrong";
-      }
+      monte_carlo = !SigmaPointsLinear(b, J, o, output_names, &res);
     }
     if (!monte_carlo) {
       res.reason += lost;
@@ -387,52 +478,7 @@ PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction&
     res.reason = "Monte Carlo, as asked (--uncertainty-method monte-carlo)";
   }
 
-  if (monte_carlo) {
-    res.method_used = PropagationMethod::kMonteCarlo;
-    std::mt19937_64 rng(o.seed);
-    std::normal_distribution<double> normal(0.0, 1.0);
-    const Eigen::MatrixXd L = V * lambda.cwiseSqrt().asDiagonal();
-    std::vector<std::vector<double>> samples(m);
-    for (auto& s : samples) s.reserve(o.samples);
-    Eigen::VectorXd xi(n);
-    for (int s = 0; s < o.samples; ++s) {
-      for (int i = 0; i < n; ++i) xi(i) = normal(rng);
-      Eigen::VectorXd fs;
-      try {
-        fs = f(FromTheta(u, theta0 + L * xi));
-      } catch (const std::exception&) {
-        fs.resize(0);
-      }
-      ++res.evaluations;
-      if (fs.size() != m || !fs.allFinite()) {
-        ++res.failed_samples;
-        continue;
-      }
-      for (int k = 0; k < m; ++k) samples[k].push_back(fs(k));
-    }
-    const int good = o.samples - res.failed_samples;
-    if (good < 100) {
-      throw std::invalid_argument("Monte Carlo: only " + std::to_string(good) + " of " + std::to_string(o.samples) +
-                                  " samples could be evaluated (sampled parameters outside their bounds?)");
-    }
-    for (int k = 0; k < m; ++k) {
-      std::vector<double>& v = samples[k];
-      std::sort(v.begin(), v.end());
-      double mean = 0.0;
-      for (double x : v) mean += x;
-      mean /= static_cast<double>(v.size());
-      double var = 0.0;
-      for (double x : v) var += (x - mean) * (x - mean);
-      res.outputs[k].std_dev = std::sqrt(var / static_cast<double>(v.size() - 1));
-      res.outputs[k].lower = Quantile(v, 0.5 * (1.0 - o.confidence));
-      res.outputs[k].upper = Quantile(v, 0.5 * (1.0 + o.confidence));
-    }
-    res.reason += "; " + std::to_string(good) + " samples, seed " + std::to_string(o.seed);
-    if (res.failed_samples > 0) {
-      res.reason += "; " + std::to_string(res.failed_samples) +
-                    " samples could not be evaluated and were left out (sampled parameters outside their bounds)";
-    }
-  }
+  if (monte_carlo) MonteCarloIntervals(b, o, &res);
   return res;
 }
 

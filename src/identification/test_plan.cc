@@ -202,23 +202,14 @@ void CheckValid(const PlanOptions& o) {
   }
 }
 
-TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) {
-  CheckValid(o);
-  const int n = model.num_joints();
-  if (o.target_gradients.size() > 0 && o.target_gradients.rows() != n) {
-    throw std::invalid_argument("PlanOptions::target_gradients: expected " + std::to_string(n) +
-                                " rows (one per joint), got " + std::to_string(o.target_gradients.rows()));
-  }
-  const Eigen::VectorXd kq = model.joint_stiffness();
-  const double sigma = std::sqrt(2.0) * o.tracker_noise;
-  double sum_m2 = 0.0;
-  for (double mkg : o.masses_kg) sum_m2 += mkg * mkg;
-  // The displacement is linear in the force, so the masses of one direction
-  // add (m g)² times the unit-force information.
-  const double scale = kStandardGravity * kStandardGravity * sum_m2 / (sigma * sigma);
-  const Eigen::Vector3d tcp = TcpInTip(model);
+namespace {
 
-  // Candidate rope directions: vertical, and rings at half and full tilt.
+// The stages of PlanLoadTests below, in their order: candidate rope
+// directions, candidate postures with their information, the greedy and
+// exchange selection, the expected uncertainty, and the planned loads.
+
+// Candidate rope directions: vertical, and rings at half and full tilt.
+std::vector<Eigen::Vector3d> CandidateDirections(const PlanOptions& o) {
   std::vector<Eigen::Vector3d> dirs{Eigen::Vector3d(0, 0, -1)};
   for (double tilt : {0.5 * o.max_rope_angle, o.max_rope_angle}) {
     if (tilt <= 0.0) continue;
@@ -227,6 +218,24 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
       dirs.emplace_back(std::sin(tilt) * std::cos(phi), std::sin(tilt) * std::sin(phi), -std::cos(tilt));
     }
   }
+  return dirs;
+}
+
+// Random postures within the joint limits (seeded), each with the rope
+// directions whose pulley is feasible and their information (all masses
+// included); a posture with too few feasible directions or too low a load
+// point is dropped.
+std::vector<Candidate> SampleCandidates(const dynamics::RobotModel& model, const PlanOptions& o) {
+  const int n = model.num_joints();
+  const Eigen::VectorXd kq = model.joint_stiffness();
+  const double sigma = std::sqrt(2.0) * o.tracker_noise;
+  double sum_m2 = 0.0;
+  for (double mkg : o.masses_kg) sum_m2 += mkg * mkg;
+  // The displacement is linear in the force, so the masses of one direction
+  // add (m g)² times the unit-force information.
+  const double scale = kStandardGravity * kStandardGravity * sum_m2 / (sigma * sigma);
+  const Eigen::Vector3d tcp = TcpInTip(model);
+  const std::vector<Eigen::Vector3d> dirs = CandidateDirections(o);
 
   std::mt19937 rng(o.seed);
   std::vector<Candidate> cands;
@@ -266,26 +275,36 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
     if (static_cast<int>(c.directions.size()) < o.directions_per_posture) continue;
     cands.push_back(std::move(c));
   }
-  TestPlan plan;
-  plan.num_candidates = static_cast<int>(cands.size());
-  if (static_cast<int>(cands.size()) < o.num_postures) {
-    throw std::invalid_argument("PlanLoadTests: only " + std::to_string(cands.size()) +
-                                " feasible postures found for " + std::to_string(o.num_postures) +
-                                " requested: lower min_load_height or widen max_rope_angle");
-  }
+  return cands;
+}
 
+// The information of candidate c's directions ds.
+Eigen::MatrixXd Contribution(const Candidate& c, const std::vector<int>& ds, int n) {
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
+  for (int d : ds) M += c.info[d];
+  return M;
+}
+
+// The chosen postures (indices into the candidates), the directions chosen
+// in each, and the information of the plan.
+struct Selection {
+  std::vector<int> sel;
+  std::vector<std::vector<int>> sel_dirs;
+  Eigen::MatrixXd info;  // of the chosen loads, without the ridge
+};
+
+// Greedy selection of o.num_postures postures by the design criterion, then
+// exchange passes.
+Selection SelectPostures(const std::vector<Candidate>& cands, const PlanOptions& o, int n) {
   // A ridge of 1e-6 (a prior σ(θ) of 1000, i.e. no knowledge) keeps log det
   // finite while joints are still unseen; one load case adds ~1e3.
   const Eigen::MatrixXd ridge = 1e-6 * Eigen::MatrixXd::Identity(n, n);
   const Criterion criterion = DesignCriterion(o.design_for_targets ? EffectiveTargetGradients(o) : Eigen::MatrixXd());
-  std::vector<int> sel;
-  std::vector<std::vector<int>> sel_dirs;
+  Selection r;
+  std::vector<int>& sel = r.sel;
+  std::vector<std::vector<int>>& sel_dirs = r.sel_dirs;
   Eigen::MatrixXd I = ridge;
-  auto contribution = [&](int ci, const std::vector<int>& ds) {
-    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
-    for (int d : ds) M += cands[ci].info[d];
-    return M;
-  };
+  auto contribution = [&](int ci, const std::vector<int>& ds) { return Contribution(cands[ci], ds, n); };
   std::vector<int> chosen;
   for (int s = 0; s < o.num_postures; ++s) {
     int best = -1;
@@ -324,38 +343,51 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
     }
     if (!improved) break;
   }
+  r.info = I - ridge;
+  return r;
+}
 
-  const Eigen::MatrixXd info = I - ridge;
-  plan.log_det_information = LogDet(info);
-  plan.expected_relative_std = internal::MarginalStdFromInformation(info);
-  plan.expected_std_dev = kq.cwiseProduct(plan.expected_relative_std);
+// The plan's expected uncertainty per joint (and per target), with a
+// finding for each joint it cannot determine.
+void ExpectedUncertainty(const std::vector<Candidate>& cands, const Selection& s, const PlanOptions& o,
+                         const Eigen::VectorXd& kq, TestPlan* plan) {
+  const Eigen::MatrixXd& info = s.info;
+  const int n = static_cast<int>(info.rows());
+  plan->log_det_information = LogDet(info);
+  plan->expected_relative_std = internal::MarginalStdFromInformation(info);
+  plan->expected_std_dev = kq.cwiseProduct(plan->expected_relative_std);
   for (int j = 0; j < n; ++j) {
-    plan.expected_determination.push_back(
-        DeterminationFromRelativeStd(plan.expected_relative_std(j), o.weak_relative_std));
-    if (plan.expected_determination.back() == Determination::kNotDetermined && TargetsDependOnJoint(o, j)) {
+    plan->expected_determination.push_back(
+        DeterminationFromRelativeStd(plan->expected_relative_std(j), o.weak_relative_std));
+    if (plan->expected_determination.back() == Determination::kNotDetermined && TargetsDependOnJoint(o, j)) {
       // The last joint turns the tool about its own axis: only a load or a
       // target off that axis feels it.
-      plan.Flag("joint " + std::to_string(j + 1) + " cannot be determined with this set-up" +
-                    (j == n - 1 ? ": put the load point and the target off the tool axis" : ": allow more postures or rope directions"),
-                j);
+      plan->Flag("joint " + std::to_string(j + 1) + " cannot be determined with this set-up" +
+                     (j == n - 1 ? ": put the load point and the target off the tool axis" : ": allow more postures or rope directions"),
+                 j);
     }
   }
   if (o.target_gradients.size() > 0) {
-    TargetWidths(o, info, sel, sel_dirs, [&](int s, const std::vector<int>& ds) { return contribution(sel[s], ds); },
-                 &plan);
+    TargetWidths(o, info, s.sel, s.sel_dirs,
+                 [&](int k, const std::vector<int>& ds) { return Contribution(cands[s.sel[k]], ds, n); }, plan);
   }
+}
+
+// The planned loads (one per chosen posture and direction) and their load
+// cases (one per mass).
+void ListLoads(const std::vector<Candidate>& cands, const Selection& sl, const PlanOptions& o, TestPlan* plan) {
   for (int s = 0; s < o.num_postures; ++s) {
-    const Candidate& c = cands[sel[s]];
+    const Candidate& c = cands[sl.sel[s]];
     const std::string pose_id = "P" + std::to_string(s + 1);
-    for (size_t k = 0; k < sel_dirs[s].size(); ++k) {
-      const Eigen::Vector3d d = c.directions[sel_dirs[s][k]];
+    for (size_t k = 0; k < sl.sel_dirs[s].size(); ++k) {
+      const Eigen::Vector3d d = c.directions[sl.sel_dirs[s][k]];
       PlannedLoad pl;
       pl.pose_id = pose_id;
       pl.q = c.q;
       pl.rope_direction = d;
       pl.p_load = c.p_load;
       pl.p_pulley = c.p_load + d * ((c.p_load.z() - o.floor_z) / -d.z());
-      plan.loads.push_back(pl);
+      plan->loads.push_back(pl);
       for (double mkg : o.masses_kg) {
         LoadCase lc;
         std::ostringstream id;
@@ -366,10 +398,32 @@ TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) 
         lc.force = mkg * kStandardGravity * d;
         lc.p_load_tip = o.p_load_tip;
         lc.p_target_tip = o.p_target_tip;
-        plan.cases.push_back(lc);
+        plan->cases.push_back(lc);
       }
     }
   }
+}
+
+}  // namespace
+
+TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) {
+  CheckValid(o);
+  const int n = model.num_joints();
+  if (o.target_gradients.size() > 0 && o.target_gradients.rows() != n) {
+    throw std::invalid_argument("PlanOptions::target_gradients: expected " + std::to_string(n) +
+                                " rows (one per joint), got " + std::to_string(o.target_gradients.rows()));
+  }
+  const std::vector<Candidate> cands = SampleCandidates(model, o);
+  TestPlan plan;
+  plan.num_candidates = static_cast<int>(cands.size());
+  if (static_cast<int>(cands.size()) < o.num_postures) {
+    throw std::invalid_argument("PlanLoadTests: only " + std::to_string(cands.size()) +
+                                " feasible postures found for " + std::to_string(o.num_postures) +
+                                " requested: lower min_load_height or widen max_rope_angle");
+  }
+  const Selection selection = SelectPostures(cands, o, n);
+  ExpectedUncertainty(cands, selection, o, model.joint_stiffness(), &plan);
+  ListLoads(cands, selection, o, &plan);
   return plan;
 }
 

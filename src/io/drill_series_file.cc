@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "robomach/common/solver_status.h"
 #include "robomach/common/units.h"
 #include "robomach/drilling/controller_kinds.h"
 #include "robomach/io/number_format.h"
@@ -35,7 +36,8 @@ nlohmann::json DrillRunSummaryJson(const drilling::ControllerRun& run, const dri
   if (run.tuned) {
     j["tuning"] = {{"cost_rad_s2", run.tune.cost},
                    {"evaluations", run.tune.evaluations},
-                   {"status", run.tune.message}};
+                   {"status", robomach::ToString(run.tune.status)},
+                   {"stop_reason", run.tune.message}};
   }
   j["band_deg"] = RadToDeg(sc.process().error_band);
   j["settling_time_s"] = std::isnan(r.settling_time) ? nlohmann::json(nullptr) : nlohmann::json(r.settling_time);

@@ -209,7 +209,7 @@ std::string MaterialYaml(const drilling::ForceFitResult& fit, const drilling::Dr
     << "  kienzle_exponent: " << Sig(fit.std_dev_kienzle_exponent, 3) << "\n"
     << "fit:\n"
     << "  status: "
-    << SolverStatusName(fit.status)
+    << robomach::ToString(fit.status)
     << "\n"
     << "  solver: " << Quoted(fit.solver_message) << "\n"
     << "  max_rel_error_thrust: " << Sig(fit.max_rel_error_thrust) << "\n"

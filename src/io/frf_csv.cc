@@ -20,12 +20,14 @@ using frf_text::CheckLowFrequencyTrend;
 using frf_text::Fmt;
 using frf_text::ParseAxis;
 
-FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
-  const CsvTable t = CsvTable::ReadFile(path, kFrfFileFormat);
-  FrfReadResult out;
+namespace {
+
+// The metadata lines: `# quantity:` (the file's FRF quantity) and
+// `# averages:` (behind the coherence), each checked.
+void ReadFrfMetadata(const CsvTable& t, const std::string& path, FrfReadResult* out) {
   if (auto it = t.metadata().find("quantity"); it != t.metadata().end()) {
     try {
-      out.file_quantity = ParseQuantity(it->second);
+      out->file_quantity = ParseQuantity(it->second);
     } catch (const std::invalid_argument&) {
       throw InputError({path, 0, 0}, "metadata '# quantity: " + it->second +
                                          "': expected receptance, mobility or accelerance");
@@ -37,10 +39,22 @@ FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
     if (end == it->second.c_str() || *end != '\0' || n < 1 || n > 1000000) {
       throw InputError({path, 0, 0}, "metadata '# averages: " + it->second + "': expected a whole number >= 1");
     }
-    out.averages = static_cast<int>(n);
+    out->averages = static_cast<int>(n);
   }
+}
+
+// Which of the optional columns the file has.
+struct FrfColumns {
+  bool has_coherence{false};
+  const char* response_point_col{nullptr};  // "response_point", "point" or none
+  bool has_excitation_point{false};
+};
+
+// The header: the required columns, and the optional ones.
+FrfColumns ReadFrfColumns(const CsvTable& t, const std::string& path) {
   for (const char* c : {"pose_id", "response", "excitation", "freq_hz", "re", "im"}) t.RequireColumn(c, "frf");
-  const bool has_coherence = t.HasColumn("coherence");
+  FrfColumns cols;
+  cols.has_coherence = t.HasColumn("coherence");
   // Point numbers of a roving test (formats.md §3): `point` is the roving
   // transducer's point, read as the response point (by reciprocity a
   // roving hammer's point may go there too).
@@ -48,34 +62,49 @@ FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
     throw InputError({path, t.header_line(), 0},
                      "columns 'point' and 'response_point' are the same thing: give one of them");
   }
-  const char* response_point_col = t.HasColumn("response_point") ? "response_point"
-                                   : t.HasColumn("point")         ? "point"
-                                                                  : nullptr;
-  const bool has_excitation_point = t.HasColumn("excitation_point");
-  auto point_at = [&](int r, const char* col) {
-    const std::string text = t.Text(r, col);
-    int v = -1;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc() || end != text.data() + text.size() || v < 0) {
-      throw t.ErrorAt(r, col, "expected a point number (a whole number >= 0), got \"" + text + "\"");
-    }
-    return v;
-  };
-  if (t.num_rows() == 0) throw InputError({path, t.header_line(), 0}, "no FRF lines after the header");
+  cols.response_point_col = t.HasColumn("response_point") ? "response_point"
+                            : t.HasColumn("point")         ? "point"
+                                                           : nullptr;
+  cols.has_excitation_point = t.HasColumn("excitation_point");
+  return cols;
+}
 
-  struct Block {
-    FrfKey key;
-    int first_row{0}, last_row{0};
-    std::vector<double> f;
-    std::vector<std::complex<double>> h;
-    std::vector<double> coh;
-    double step{NAN};      // the step of an even grid, once established
-    int step_from_row{0};
-  };
-  std::map<FrfKey, std::pair<int, int>> seen;  // key -> first and last line of its block
-  Block cur;
+// A point number cell: a whole number >= 0.
+int PointAt(const CsvTable& t, int r, const char* col) {
+  const std::string text = t.Text(r, col);
+  int v = -1;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || v < 0) {
+    throw t.ErrorAt(r, col, "expected a point number (a whole number >= 0), got \"" + text + "\"");
+  }
+  return v;
+}
+
+// The contiguous lines of one FRF.
+struct Block {
+  FrfKey key;
+  int first_row{0}, last_row{0};
+  std::vector<double> f;
+  std::vector<std::complex<double>> h;
+  std::vector<double> coh;
+  double step{NAN};      // the step of an even grid, once established
+  int step_from_row{0};
+};
+
+// Reads the rows into FRFs, block by block: a block ends where the key
+// changes, and a key met again after its block is refused.
+struct FrfBlockReader {
+  const CsvTable& t;
+  const std::string& path;
+  const FrfColumns& cols;
+  FrfReadResult& out;
+  std::map<FrfKey, std::pair<int, int>> seen{};  // key -> first and last line of its block
+  Block cur{};
   bool open = false;
-  auto finish = [&]() {
+
+  // Closes the open block: its FRF into `out.frfs` (none for a block of
+  // skipped 0 Hz lines only).
+  void Finish() {
     if (!open) return;
     seen[cur.key] = {t.line(cur.first_row), t.line(cur.last_row)};
     if (cur.f.empty()) {
@@ -85,22 +114,20 @@ FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
     Eigen::VectorXd f = Eigen::Map<Eigen::VectorXd>(cur.f.data(), cur.f.size());
     Eigen::VectorXcd h = Eigen::Map<Eigen::VectorXcd>(cur.h.data(), cur.h.size());
     std::optional<Eigen::VectorXd> coh;
-    if (has_coherence) coh = Eigen::Map<Eigen::VectorXd>(cur.coh.data(), cur.coh.size());
-    try {
+    if (cols.has_coherence) coh = Eigen::Map<Eigen::VectorXd>(cur.coh.data(), cur.coh.size());
+    AtLocation({path, t.line(cur.first_row), 0}, "FRF " + cur.key.ToString() + ": ", [&] {
       Frf frf = Frf::FromSamples(f, h, coh);
       if (out.file_quantity == FrfQuantity::kReceptance) {
         CheckLowFrequencyTrend(cur.key, frf, path + ":" + std::to_string(t.line(cur.first_row)),
                                &out.warnings);
       }
       out.frfs.Insert(cur.key, std::move(frf));
-    } catch (const std::invalid_argument& e) {
-      throw InputError({path, t.line(cur.first_row), 0},
-                       "FRF " + cur.key.ToString() + ": " + e.what());
-    }
+    });
     open = false;
-  };
+  }
 
-  for (int r = 0; r < t.num_rows(); ++r) {
+  // The FRF a row belongs to: pose, directions and point numbers.
+  FrfKey KeyOfRow(int r) const {
     FrfKey key;
     key.pose_id = t.Text(r, "pose_id");
     if (!ParseAxis(t.Text(r, "response"), &key.response)) {
@@ -109,24 +136,14 @@ FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
     if (!ParseAxis(t.Text(r, "excitation"), &key.excitation)) {
       throw t.ErrorAt(r, "excitation", "expected x, y or z, got \"" + t.Text(r, "excitation") + "\"");
     }
-    if (response_point_col) key.response_point = point_at(r, response_point_col);
-    if (has_excitation_point) key.excitation_point = point_at(r, "excitation_point");
-    if (!open || !(key == cur.key)) {
-      finish();
-      if (auto it = seen.find(key); it != seen.end()) {
-        throw t.ErrorAtRow(
-            r, "mixed frequency grids: the lines of FRF " + key.ToString() + " resume here after "
-                   "another FRF (its first block is lines " + std::to_string(it->second.first) +
-                   "-" + std::to_string(it->second.second) +
-                   "); a duplicate FRF, or one FRF split into blocks: the lines of one FRF must be contiguous, "
-                   "on one strictly increasing grid");
-      }
-      cur = Block{};
-      cur.key = key;
-      cur.first_row = r;
-      open = true;
-    }
-    cur.last_row = r;
+    if (cols.response_point_col) key.response_point = PointAt(t, r, cols.response_point_col);
+    if (cols.has_excitation_point) key.excitation_point = PointAt(t, r, "excitation_point");
+    return key;
+  }
+
+  // A row's frequency: >= 0, above the previous line's, and on the block's
+  // grid once its first two steps agree.
+  double FrequencyOfRow(int r) {
     const double f = t.Number(r, "freq_hz");
     if (f < 0.0) throw t.ErrorAt(r, "freq_hz", "expected a frequency >= 0, got " + t.Text(r, "freq_hz"));
     if (!cur.f.empty()) {
@@ -152,9 +169,33 @@ FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
                             ", then " + Fmt(step) + " Hz here; one FRF must be on one grid");
       }
     }
+    return f;
+  }
+
+  // One row: starts a new block when the key changes, then adds the row's
+  // sample as receptance (a 0 Hz line of a mobility or accelerance is skipped).
+  void ReadRow(int r) {
+    const FrfKey key = KeyOfRow(r);
+    if (!open || !(key == cur.key)) {
+      Finish();
+      if (auto it = seen.find(key); it != seen.end()) {
+        throw t.ErrorAtRow(
+            r, "mixed frequency grids: the lines of FRF " + key.ToString() + " resume here after "
+                   "another FRF (its first block is lines " + std::to_string(it->second.first) +
+                   "-" + std::to_string(it->second.second) +
+                   "); a duplicate FRF, or one FRF split into blocks: the lines of one FRF must be contiguous, "
+                   "on one strictly increasing grid");
+      }
+      cur = Block{};
+      cur.key = key;
+      cur.first_row = r;
+      open = true;
+    }
+    cur.last_row = r;
+    const double f = FrequencyOfRow(r);
     const std::complex<double> v(t.Number(r, "re"), t.Number(r, "im"));
     double coh = NAN;
-    if (has_coherence) {
+    if (cols.has_coherence) {
       coh = t.Number(r, "coherence");
       if (coh < 0.0 || coh > 1.0) throw t.ErrorAt(r, "coherence", "expected a value in [0, 1], got " + t.Text(r, "coherence"));
     }
@@ -162,13 +203,26 @@ FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
       out.warnings.push_back(path + ":" + std::to_string(t.line(r)) + ": the 0 Hz line of " +
                              QuantityWithArticle(out.file_quantity) +
                              " FRF has no receptance equivalent; it is skipped");
-      continue;
+      return;
     }
     cur.f.push_back(f);
     cur.h.push_back(ToReceptance(out.file_quantity, f, v));
-    if (has_coherence) cur.coh.push_back(coh);
+    if (cols.has_coherence) cur.coh.push_back(coh);
   }
-  finish();
+};
+
+}  // namespace
+
+FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
+  const CsvTable t = CsvTable::ReadFile(path, kFrfFileFormat);
+  FrfReadResult out;
+  ReadFrfMetadata(t, path, &out);
+  const FrfColumns cols = ReadFrfColumns(t, path);
+  if (t.num_rows() == 0) throw InputError({path, t.header_line(), 0}, "no FRF lines after the header");
+
+  FrfBlockReader blocks{t, path, cols, out};
+  for (int r = 0; r < t.num_rows(); ++r) blocks.ReadRow(r);
+  blocks.Finish();
   if (!keep_points) DropPointNumbers(path, &out);
   return out;
 }

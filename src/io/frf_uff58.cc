@@ -113,11 +113,7 @@ std::string UnitOf(FrfQuantity q) {
 }
 
 UnitDimension ParseLabelAt(const std::string& path, const UffAxis& a, const std::string& record) {
-  try {
-    return ParseUnitLabel(a.units);
-  } catch (const std::invalid_argument& e) {
-    throw InputError({path, a.line, 48}, record + " units label: " + e.what());
-  }
+  return AtLocation({path, a.line, 48}, record + " units label: ", [&] { return ParseUnitLabel(a.units); });
 }
 
 struct RecordUnits {
@@ -270,33 +266,50 @@ std::string NodeText(int resp_node, Axis ra, int ref_node, Axis ea) {
          AxisName(ea);
 }
 
-}  // namespace
+// A coherence record kept until all records are read: it is attached to the
+// FRF of the same nodes and directions, which may come later in the file.
+struct Coherence {
+  const Uff58Record* r;
+  std::string pose;
+  int resp_node, ref_node;
+  Axis ra, ea;
+};
 
-FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose_id, bool keep_points) {
-  const UffFile file = ReadUffFile(path);
-  FrfReadResult out;
+// What is read of an FRF or coherence record before its ordinates: the
+// directions and nodes of record 6, the posture and the abscissa scale.
+struct RecordHead {
+  Direction rd, ed;
+  Axis ra{Axis::kX}, ea{Axis::kX};
+  int resp_node{0}, ref_node{0};
+  double hz{1.0};    // Hz per stored abscissa unit
+  std::string pose;  // pose=ID of ID line 1, else the default
+  std::string where; // "path:line" of the record, for notes
+};
+
+// Reads the records of one UFF file into `out`, stage by stage; the members
+// are what the stages hand each other (the FRFs read so far, coherence
+// records waiting for their FRF, records that are not FRFs).
+struct Uff58Reader {
+  const std::string& path;
+  const UffFile& file;
+  FrfReadResult& out;
   bool quantity_set = false;
-  static const std::regex pose_re(R"(pose=([^\s,]+))");
-  std::vector<FrfRecord> frf_records;
-  struct Coherence {
-    const Uff58Record* r;
-    std::string pose;
-    int resp_node, ref_node;
-    Axis ra, ea;
-  };
-  std::vector<Coherence> coherences;
-  std::map<std::string, std::vector<int>> not_frf;  // function name -> lines
-  for (size_t i = 0; i < file.records.size(); ++i) {
-    const Uff58Record& r = file.records[i];
-    const UffUnits* units = file.record_units[i] >= 0 ? &file.units[file.record_units[i]] : nullptr;
-    const std::string where = path + ":" + std::to_string(r.line);
-    if (r.function_type != 4 && r.function_type != 6) {
-      not_frf[UffFunctionTypeName(r.function_type) + " (function type " + std::to_string(r.function_type) + ")"]
-          .push_back(r.line);
-      continue;
-    }
-    const Direction rd = RecordDirection(path, r.record6_line, 52, r.response_direction, r.response_entity, "response");
-    const Direction ed = RecordDirection(path, r.record6_line, 77, r.reference_direction, r.reference_entity, "reference");
+  std::vector<FrfRecord> frf_records{};
+  std::vector<Coherence> coherences{};
+  std::map<std::string, std::vector<int>> not_frf{};  // function name -> lines
+
+  // Record 6's directions and nodes, record 8's abscissa and ID line 1's
+  // posture; a record with one direction or none is read as the direct FRF
+  // (warned), directions from entity names are noted.
+  RecordHead ReadHead(const Uff58Record& r, const std::string& default_pose_id) {
+    static const std::regex pose_re(R"(pose=([^\s,]+))");
+    RecordHead h;
+    h.where = path + ":" + std::to_string(r.line);
+    const std::string& where = h.where;
+    h.rd = RecordDirection(path, r.record6_line, 52, r.response_direction, r.response_entity, "response");
+    h.ed = RecordDirection(path, r.record6_line, 77, r.reference_direction, r.reference_entity, "reference");
+    const Direction& rd = h.rd;
+    const Direction& ed = h.ed;
     Axis ra = rd.axis, ea = ed.axis;
     if (!rd.known || !ed.known) {
       if (rd.known) ea = ra;
@@ -311,24 +324,27 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
                           std::to_string(r.reference_direction) + "): response " + (rd.sign < 0 ? "-" : "+") +
                           AxisName(ra) + ", reference " + (ed.sign < 0 ? "-" : "+") + AxisName(ea));
     }
-    const int resp_node = r.response_node != 0 ? r.response_node : rd.node;
-    const int ref_node = r.reference_node != 0 ? r.reference_node : ed.node;
-    const double hz = AbscissaToHz(path, r);
+    h.ra = ra;
+    h.ea = ea;
+    h.resp_node = r.response_node != 0 ? r.response_node : rd.node;
+    h.ref_node = r.reference_node != 0 ? r.reference_node : ed.node;
+    h.hz = AbscissaToHz(path, r);
     if (r.trailing_values > 0) {
       (r.trailing_all_zero ? out.notes : out.warnings)
           .push_back(where + ": " + std::to_string(r.trailing_values) + (r.trailing_all_zero ? " padding zeros" : " values") +
                      " after the " + std::to_string(r.num_points) + " points record 7 announces are ignored");
     }
-    std::string pose = default_pose_id;
-    if (std::smatch m; std::regex_search(r.id_lines[0], m, pose_re)) pose = m[1].str();
-    if (r.function_type == 6) {
-      if (r.complex()) {
-        throw InputError({path, r.record7_line, 0}, "record 7: coherence (function type 6) must be real (data type 2 or "
-                                                    "4), got " + std::to_string(r.ordinate_type));
-      }
-      coherences.push_back({&r, pose, resp_node, ref_node, ra, ea});
-      continue;
-    }
+    h.pose = default_pose_id;
+    if (std::smatch m; std::regex_search(r.id_lines[0], m, pose_re)) h.pose = m[1].str();
+    return h;
+  }
+
+  // An FRF record (function type 4): its quantity and units, a check that it
+  // is not the same FRF twice, and its ordinates as receptance in `out.frfs`.
+  void ReadFrf(const Uff58Record& r, const UffUnits* units, const RecordHead& h) {
+    const std::string& where = h.where;
+    const Axis ra = h.ra, ea = h.ea;
+    const int resp_node = h.resp_node, ref_node = h.ref_node;
     if (!r.complex()) {
       out.warnings.push_back(where + ": this FRF has real ordinates (record 7 data type " +
                              std::to_string(r.ordinate_type) + "): read with a zero imaginary part, so without phase");
@@ -339,7 +355,7 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
       quantity_set = true;
     }
     FrfKey key;
-    key.pose_id = pose;
+    key.pose_id = h.pose;
     key.response = ra;
     key.excitation = ea;
     key.response_point = resp_node;
@@ -352,12 +368,12 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
                              ": the same FRF twice; name the postures (or runs) with pose=ID in ID line 1");
       }
     }
-    const double sign = rd.sign * ed.sign;
+    const double sign = h.rd.sign * h.ed.sign;
     std::vector<double> fk;
     std::vector<std::complex<double>> hk;
     int zero_lines = 0;
     for (long p = 0; p < r.num_points; ++p) {
-      const double f = r.x(p) * hz;
+      const double f = r.x(p) * h.hz;
       if (f == 0.0 && u.quantity != FrfQuantity::kReceptance) {
         ++zero_lines;
         continue;
@@ -369,17 +385,39 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
       out.notes.push_back(where + ": the 0 Hz line of " + QuantityWithArticle(u.quantity) +
                           " FRF has no receptance equivalent; it is skipped");
     }
-    try {
+    AtLocation({path, r.line, 0}, "dataset 58 record: ", [&] {
       Frf frf = Frf::FromSamples(Eigen::Map<Eigen::VectorXd>(fk.data(), fk.size()),
                                  Eigen::Map<Eigen::VectorXcd>(hk.data(), hk.size()));
       if (u.quantity == FrfQuantity::kReceptance) CheckLowFrequencyTrend(key, frf, where, &out.warnings);
       out.frfs.Insert(key, std::move(frf));
-    } catch (const std::invalid_argument& e) {
-      throw InputError({path, r.line, 0}, "dataset 58 record: " + std::string(e.what()));
-    }
+    });
     frf_records.push_back({key, resp_node, ref_node, r.line});
   }
-  if (out.frfs.empty()) {
+
+  // One dataset 58 record: set aside when it is not an FRF, kept for later
+  // when it is a coherence, read when it is an FRF.
+  void ReadRecord(const Uff58Record& r, const UffUnits* units, const std::string& default_pose_id) {
+    if (r.function_type != 4 && r.function_type != 6) {
+      not_frf[UffFunctionTypeName(r.function_type) + " (function type " + std::to_string(r.function_type) + ")"]
+          .push_back(r.line);
+      return;
+    }
+    const RecordHead h = ReadHead(r, default_pose_id);
+    if (r.function_type == 6) {
+      if (r.complex()) {
+        throw InputError({path, r.record7_line, 0}, "record 7: coherence (function type 6) must be real (data type 2 or "
+                                                    "4), got " + std::to_string(r.ordinate_type));
+      }
+      coherences.push_back({&r, h.pose, h.resp_node, h.ref_node, h.ra, h.ea});
+      return;
+    }
+    ReadFrf(r, units, h);
+  }
+
+  // A file without a single FRF is refused, with what it holds instead (other
+  // function types, a lone coherence, other datasets).
+  void RefuseIfNoFrf() const {
+    if (!out.frfs.empty()) return;
     std::string held;
     for (const auto& [name, lines] : not_frf) {
       held += (held.empty() ? "" : "; ") + name + " at line" + (lines.size() > 1 ? "s " : " ");
@@ -407,25 +445,31 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
                                                                    "(docs/frf-estimate.md)")
                                                      : std::string()));
   }
-  for (const auto& [name, lines] : not_frf) {
-    out.notes.push_back(path + ": skipped " + std::to_string(lines.size()) + " record" + (lines.size() > 1 ? "s" : "") +
-                        " that are not FRFs: " + name + " at line " + std::to_string(lines[0]) +
-                        (lines.size() > 1 ? " and others" : ""));
-  }
-  if (!file.skipped.empty()) {
-    std::string s;
-    for (const auto& [n, lines] : file.skipped) {
-      s += (s.empty() ? "" : ", ") + n + " (" + std::to_string(lines.size()) + "x, first at line " + std::to_string(lines[0]) + ")";
+
+  // Notes for what was skipped (records that are not FRFs, other datasets)
+  // and for the units of dataset 164 applied.
+  void NoteSkippedAndUnits() {
+    for (const auto& [name, lines] : not_frf) {
+      out.notes.push_back(path + ": skipped " + std::to_string(lines.size()) + " record" + (lines.size() > 1 ? "s" : "") +
+                          " that are not FRFs: " + name + " at line " + std::to_string(lines[0]) +
+                          (lines.size() > 1 ? " and others" : ""));
     }
-    out.notes.push_back(path + ": skipped datasets other than 58 and 164: " + s);
+    if (!file.skipped.empty()) {
+      std::string s;
+      for (const auto& [n, lines] : file.skipped) {
+        s += (s.empty() ? "" : ", ") + n + " (" + std::to_string(lines.size()) + "x, first at line " + std::to_string(lines[0]) + ")";
+      }
+      out.notes.push_back(path + ": skipped datasets other than 58 and 164: " + s);
+    }
+    for (const UffUnits& u : file.units) {
+      out.notes.push_back(path + ":" + std::to_string(u.line) + ": units of dataset 164: " + u.description +
+                          " (length factor " + Fmt(u.length) + ", force factor " + Fmt(u.force) +
+                          "), applied to the records that follow it");
+    }
   }
-  for (const UffUnits& u : file.units) {
-    out.notes.push_back(path + ":" + std::to_string(u.line) + ": units of dataset 164: " + u.description +
-                        " (length factor " + Fmt(u.length) + ", force factor " + Fmt(u.force) +
-                        "), applied to the records that follow it");
-  }
-  // Attach coherence records to their FRFs (same nodes and directions, same grid).
-  for (const Coherence& c : coherences) {
+
+  // Attach a coherence record to its FRF (same nodes and directions, same grid).
+  void AttachCoherence(const Coherence& c) {
     const Uff58Record& r = *c.r;
     const std::string where = path + ":" + std::to_string(r.line);
     const FrfRecord* match = nullptr;
@@ -438,7 +482,7 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
     if (!match) {
       out.notes.push_back(where + ": coherence record (" + NodeText(c.resp_node, c.ra, c.ref_node, c.ea) +
                           ") has no FRF record with the same nodes and directions; skipped");
-      continue;
+      return;
     }
     const Frf& frf = out.frfs.at(match->key);
     if (frf.coherence()) {
@@ -459,15 +503,29 @@ FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose
       }
       coh(p) = r.y(j).real();
     }
-    try {
+    AtLocation({path, r.line, 0}, "coherence record for " + match->key.ToString() + ": ", [&] {
       Frf with = Frf::FromSamples(frf.freq_hz(), frf.receptance(), coh);
       FrfSet rebuilt;
       for (const auto& [k, g] : out.frfs) rebuilt.Insert(k, k == match->key ? with : g);
       out.frfs = std::move(rebuilt);
-    } catch (const std::invalid_argument& e) {
-      throw InputError({path, r.line, 0}, "coherence record for " + match->key.ToString() + ": " + e.what());
-    }
+    });
   }
+};
+
+}  // namespace
+
+FrfReadResult ReadUff58(const std::string& path, const std::string& default_pose_id, bool keep_points) {
+  const UffFile file = ReadUffFile(path);
+  FrfReadResult out;
+  Uff58Reader reader{path, file, out};
+  for (size_t i = 0; i < file.records.size(); ++i) {
+    const UffUnits* units = file.record_units[i] >= 0 ? &file.units[file.record_units[i]] : nullptr;
+    reader.ReadRecord(file.records[i], units, default_pose_id);
+  }
+  reader.RefuseIfNoFrf();
+  reader.NoteSkippedAndUnits();
+  // Attach coherence records to their FRFs, now that all FRFs are read.
+  for (const Coherence& c : reader.coherences) reader.AttachCoherence(c);
   if (!keep_points) DropPointNumbers(path, &out);
   return out;
 }

@@ -184,11 +184,7 @@ struct UffTimeRecord {
 };
 
 UnitDimension LabelAt(const std::string& path, const UffAxis& a, const std::string& record) {
-  try {
-    return ParseUnitLabel(a.units);
-  } catch (const std::invalid_argument& e) {
-    throw InputError({path, a.line, 48}, record + " units label: " + e.what());
-  }
+  return AtLocation({path, a.line, 48}, record + " units label: ", [&] { return ParseUnitLabel(a.units); });
 }
 
 UffTimeRecord ClassifyTimeRecord(const std::string& path, const Uff58Record& r, const UffUnits* units) {

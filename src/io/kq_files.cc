@@ -12,7 +12,7 @@ namespace robomach::io {
 
 nlohmann::json KqSummaryJson(const identification::JointStiffnessResult& r) {
   nlohmann::json j;
-  j["status"] = identification::ToString(r.status);
+  j["status"] = robomach::ToString(r.status);
   j["solver_message"] = r.solver_message;
   j["num_cases"] = r.num_cases;
   auto vec = [](const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); };

@@ -36,7 +36,7 @@ std::string JointStiffnessYaml(const identification::JointStiffnessResult& r,
   using identification::Determination;
   std::ostringstream s;
   for (const auto& c : o.header_comments) s << "# " << c << "\n";
-  s << "# status: " << identification::ToString(r.status) << "; " << r.num_cases
+  s << "# status: " << robomach::ToString(r.status) << "; " << r.num_cases
     << " load cases; RMS residual " << std::fixed << std::setprecision(4) << 1e3 * r.rms_residual
     << " mm; condition number " << std::setprecision(1) << r.condition_number << "\n";
   s << "# joint  stiffness [N·m/rad]  std dev      95 % interval                 determination\n";

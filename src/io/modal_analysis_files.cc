@@ -39,7 +39,7 @@ std::string ModalConstantsCsv(const std::vector<calibration::PoseModes>& poses) 
   for (const calibration::PoseModes& p : poses) {
     for (size_t g = 0; g < p.groups.size(); ++g) {
       const calibration::ModalGroup& grp = p.groups[g];
-      if (grp.fit.status != calibration::ModalFitStatus::kOk) continue;
+      if (grp.fit.status != SolverStatus::kConverged) continue;
       const Eigen::MatrixXcd shapes = grp.fit.ModeShapes();
       for (size_t r = 0; r < grp.fit.modes.size(); ++r) {
         for (size_t i = 0; i < grp.keys.size(); ++i) {
@@ -64,7 +64,7 @@ std::string ModeShapesCsv(const std::vector<calibration::PoseModes>& poses, std:
   for (const calibration::PoseModes& p : poses) {
     for (size_t g = 0; g < p.groups.size(); ++g) {
       const calibration::ModalGroup& grp = p.groups[g];
-      if (grp.fit.status != calibration::ModalFitStatus::kOk) continue;
+      if (grp.fit.status != SolverStatus::kConverged) continue;
       std::string why;
       const std::optional<calibration::RovingShapes> rs = calibration::ShapesOfRovingTest(grp, &why);
       if (!rs) {
@@ -118,9 +118,7 @@ nlohmann::json ModalAnalysisSummaryJson(const std::vector<calibration::PoseModes
         }
         jg["frfs"].push_back(jf);
       }
-      jg["status"] = g.fit.status == calibration::ModalFitStatus::kOk ? "ok"
-                     : g.fit.status == calibration::ModalFitStatus::kNoStableModes ? "no_stable_modes"
-                                                                                    : "failed";
+      jg["status"] = robomach::ToString(g.fit.status);
       jg["message"] = g.fit.message;
       jg["fmin_hz"] = g.fit.fmin_hz;
       jg["fmax_hz"] = g.fit.fmax_hz;

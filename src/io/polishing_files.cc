@@ -152,11 +152,7 @@ polishing::PolishingProcess ReadPolishingProcess(const std::string& path, std::v
     doc.MarkUsed("robot");
   }
   doc.RejectUnknownKeys();
-  try {
-    polishing::CheckValid(p);
-  } catch (const std::invalid_argument& e) {
-    throw InputError({path, 0, 0}, e.what());
-  }
+  AtLocation({path, 0, 0}, "", [&] { polishing::CheckValid(p); });
   return p;
 }
 

@@ -17,11 +17,7 @@ machine::ProgrammedPath ReadProgramFile(const std::string& path) {
     axes.push_back(k);
   }
   if (tips.size() < 2) throw InputError({path, t.header_line(), 0}, "expected at least 2 points of the path");
-  try {
-    return machine::ProgrammedPath(tips, axes);
-  } catch (const std::invalid_argument& e) {
-    throw InputError({path, 0, 0}, e.what());
-  }
+  return AtLocation({path, 0, 0}, "", [&] { return machine::ProgrammedPath(tips, axes); });
 }
 
 }  // namespace robomach::io

@@ -391,6 +391,161 @@ void CheckJointFrequencies(RobotConfig& cfg, const YamlDoc& doc, const YamlDoc& 
   }
 }
 
+// joint_stiffness_Nm_per_rad: one stiffness > 0 per joint of the chain, each
+// checked to be plausible. The node is returned for CheckJointFrequencies.
+YamlDoc ReadJointStiffness(const YamlDoc& doc, RobotConfig* cfg) {
+  dynamics::RobotDescription& d = cfg->description;
+  const int n = d.arm.num_joints();
+  const YamlDoc kq = doc["joint_stiffness_Nm_per_rad"];
+  const auto kv = kq.Numbers(n);
+  d.joint_stiffness = Eigen::Map<const Eigen::VectorXd>(kv.data(), n);
+  for (int j = 0; j < n; ++j) {
+    if (!(kv[j] > 0.0)) throw kq.at(j).Error("expected a joint stiffness > 0");
+    CheckPlausible(kq.at(j), kv[j],
+                   {kMinPlausibleJointStiffnessNmPerRad, kMaxPlausibleJointStiffnessNmPerRad, "N·m/rad",
+                    "robot joints (1e3 for a small wrist to 1e7 for a heavy robot's base)",
+                    "a stiffness in kN·m/rad typed in the N·m/rad field?",
+                    "a stiffness in N·mm/rad typed in the N·m/rad field?"},
+                   &cfg->implausible);
+  }
+  return kq;
+}
+
+// damping: the Rayleigh coefficients alpha_s and beta_per_s, each in its
+// range. The node is returned for CheckJointFrequencies.
+YamlDoc ReadDamping(const YamlDoc& doc, dynamics::RobotDescription* d) {
+  const YamlDoc damping = doc["damping"];
+  // alpha_s and beta_per_s swapped is the likely mistake behind an alpha
+  // beyond 0.1 s (the seed's are 1e-4 s and 5 /s): say so when refusing.
+  const YamlDoc a = damping["alpha_s"];
+  const YamlDoc b = damping["beta_per_s"];
+  const double av = a.Number(), bv = b.Number();
+  const bool swapped = av > 0.1 && bv >= 0.0 && bv <= 0.1 && av <= 1e3;
+  const std::string hint = swapped ? " (alpha_s and beta_per_s swapped? C = alpha K + beta M: alpha is a time of "
+                                     "about 1e-4 s, beta a rate of about 1-10 /s)"
+                                   : "";
+  if (!(av >= 0.0 && av <= 0.1)) {
+    throw a.Error("expected a number in [0, 0.1] s, got " + a.String() + hint +
+                  (swapped || av < 0.0 ? "" : " (alpha_s in ms? x1000)"));
+  }
+  if (!(bv >= 0.0 && bv <= 1e3)) throw b.Error("expected a number in [0, 1000] /s, got " + b.String() + hint);
+  d->alpha = av;
+  d->beta = bv;
+  damping.RejectUnknownKeys();
+  return damping;
+}
+
+// end_effector: its bodies, the TCP and spindle nose positions, and the
+// reference m6_kg / d6_m, which must agree with the geometry.
+void ReadEndEffector(const YamlDoc& doc, RobotConfig* cfg) {
+  dynamics::RobotDescription& d = cfg->description;
+  const YamlDoc ee = doc["end_effector"];
+  if (ee.Has("bodies")) {
+    const YamlDoc bodies = ee["bodies"];
+    for (int i = 0; i < bodies.size(); ++i) {
+      const YamlDoc b = bodies.at(i);
+      dynamics::EndEffectorBody body;
+      body.name = b["name"].String();
+      body.inertial = ReadInertial(b, &cfg->implausible);
+      b.RejectUnknownKeys();
+      d.end_effector.bodies.push_back(body);
+    }
+  }
+  ee.MarkUsed("bodies");
+  d.end_effector.p_tcp = Vec3(ee["tcp_m"]);
+  CheckLengths(ee["tcp_m"], d.end_effector.p_tcp, &cfg->implausible);
+  if (ee.Has("spindle_nose_m")) {
+    d.end_effector.p_spindle_nose = Vec3(ee["spindle_nose_m"]);
+    CheckLengths(ee["spindle_nose_m"], d.end_effector.p_spindle_nose, &cfg->implausible);
+  } else {
+    d.end_effector.p_spindle_nose = d.end_effector.p_tcp;
+  }
+  ee.MarkUsed("spindle_nose_m");
+  // m6_kg and d6_m document the reference values; they must match the
+  // geometry (a calibrated value goes under `parameters:` instead).
+  const double m6 = dynamics::ReferenceM6(d);
+  const double d6 = dynamics::ReferenceD6(d);
+  if (ee.Has("m6_kg")) {
+    const YamlDoc node = ee["m6_kg"];
+    if (std::abs(node.Number() - m6) > 1e-6 * std::max(1.0, m6)) {
+      throw node.Error(LikelyCause(cfg->implausible) + "the last link and the end-effector bodies weigh " +
+                       FormatNumber(m6) +
+                       " kg; m6_kg must state that reference (put a calibrated m6 under "
+                       "'parameters: m6_kg')" + ThousandHint(node.Number(), m6, "g", "kg"));
+    }
+  }
+  if (ee.Has("d6_m")) {
+    const YamlDoc node = ee["d6_m"];
+    if (std::abs(node.Number() - d6) > 1e-6) {
+      throw node.Error(LikelyCause(cfg->implausible) + "the geometry puts the tool tip " + FormatNumber(d6) +
+                       " m from the wrist centre along the last joint axis; d6_m must state "
+                       "that reference (put a calibrated d6 under 'parameters: d6_m')" +
+                       ThousandHint(node.Number(), d6, "mm", "m"));
+    }
+  }
+  ee.MarkUsed("m6_kg");
+  ee.MarkUsed("d6_m");
+  ee.RejectUnknownKeys();
+}
+
+// effects: each named effect from the registry, with the values of its
+// parameters.
+void ReadEffects(const YamlDoc& doc, dynamics::RobotDescription* d) {
+  if (doc.Has("effects")) {
+    const YamlDoc effects = doc["effects"];
+    for (int i = 0; i < effects.size(); ++i) {
+      const YamlDoc e = effects.at(i);
+      dynamics::EffectConfig ec;
+      const YamlDoc name = e["name"];
+      ec.name = name.String();
+      std::shared_ptr<const dynamics::Effect> effect;
+      try {
+        effect = dynamics::EffectRegistry::Instance().Create(ec.name);
+      } catch (const std::invalid_argument& ex) {
+        throw name.Error(ex.what());
+      }
+      for (const auto& spec : effect->parameters()) {
+        if (e.Has(spec.name)) ec.values[spec.name] = e[spec.name].Number();
+        e.MarkUsed(spec.name);
+      }
+      e.RejectUnknownKeys();
+      d->effects.push_back(ec);
+    }
+  }
+  doc.MarkUsed("effects");
+}
+
+// The model parameters: the defaults of the description, then the values
+// given under `parameters:`, each accepted by the parameter set.
+void ReadParameters(const YamlDoc& doc, const std::string& path, RobotConfig* cfg) {
+  cfg->parameters = AtLocation({path, 0, 0}, "", [&] { return dynamics::DefaultParameters(cfg->description); });
+  if (doc.Has("parameters")) {
+    const YamlDoc params = doc["parameters"];
+    for (const std::string& key : params.Keys()) {
+      const YamlDoc v = params[key];
+      try {
+        cfg->parameters.Set(key, v.Number());
+      } catch (const std::invalid_argument& ex) {
+        // A value 1000 times the configured one is a unit mistake more
+        // often than a calibration (g for kg, mm for m, N·mm for N·m).
+        const double reference = cfg->parameters.Has(key) ? cfg->parameters.Get(key) : 0.0;
+        std::string unit = "", small = "";
+        for (const auto& [suffix, u, su] : {std::tuple{"_Nm_per_rad", "N·m/rad", "N·mm/rad"}, {"_kg", "kg", "g"},
+                                            {"_per_s", "1/s", "1/ms"}, {"_m", "m", "mm"}, {"_s", "s", "ms"}}) {
+          const std::string sfx = suffix;
+          if (key.size() > sfx.size() && key.compare(key.size() - sfx.size(), sfx.size(), sfx) == 0) {
+            unit = u;
+            small = su;
+            break;
+          }
+        }
+        throw v.Error(ex.what() + (unit.empty() ? "" : ThousandHint(v.Number(), reference, small, unit)));
+      }
+    }
+  }
+  doc.MarkUsed("parameters");
+}
+
 }  // namespace
 
 kinematics::SerialChain ReadRobotChain(const YamlDoc& robot, const std::string& path,
@@ -445,89 +600,9 @@ RobotConfig LoadRobotConfig(const std::string& path) {
   d.source = path;
 
   d.arm = ReadRobotChain(doc["robot"], path, &cfg.implausible);
-  const int n = d.arm.num_joints();
-
-  const YamlDoc kq = doc["joint_stiffness_Nm_per_rad"];
-  const auto kv = kq.Numbers(n);
-  d.joint_stiffness = Eigen::Map<const Eigen::VectorXd>(kv.data(), n);
-  for (int j = 0; j < n; ++j) {
-    if (!(kv[j] > 0.0)) throw kq.at(j).Error("expected a joint stiffness > 0");
-    CheckPlausible(kq.at(j), kv[j],
-                   {kMinPlausibleJointStiffnessNmPerRad, kMaxPlausibleJointStiffnessNmPerRad, "N·m/rad",
-                    "robot joints (1e3 for a small wrist to 1e7 for a heavy robot's base)",
-                    "a stiffness in kN·m/rad typed in the N·m/rad field?",
-                    "a stiffness in N·mm/rad typed in the N·m/rad field?"},
-                   &cfg.implausible);
-  }
-
-  const YamlDoc damping = doc["damping"];
-  {
-    // alpha_s and beta_per_s swapped is the likely mistake behind an alpha
-    // beyond 0.1 s (the seed's are 1e-4 s and 5 /s): say so when refusing.
-    const YamlDoc a = damping["alpha_s"];
-    const YamlDoc b = damping["beta_per_s"];
-    const double av = a.Number(), bv = b.Number();
-    const bool swapped = av > 0.1 && bv >= 0.0 && bv <= 0.1 && av <= 1e3;
-    const std::string hint = swapped ? " (alpha_s and beta_per_s swapped? C = alpha K + beta M: alpha is a time of "
-                                       "about 1e-4 s, beta a rate of about 1-10 /s)"
-                                     : "";
-    if (!(av >= 0.0 && av <= 0.1)) {
-      throw a.Error("expected a number in [0, 0.1] s, got " + a.String() + hint +
-                    (swapped || av < 0.0 ? "" : " (alpha_s in ms? x1000)"));
-    }
-    if (!(bv >= 0.0 && bv <= 1e3)) throw b.Error("expected a number in [0, 1000] /s, got " + b.String() + hint);
-    d.alpha = av;
-    d.beta = bv;
-  }
-  damping.RejectUnknownKeys();
-
-  const YamlDoc ee = doc["end_effector"];
-  if (ee.Has("bodies")) {
-    const YamlDoc bodies = ee["bodies"];
-    for (int i = 0; i < bodies.size(); ++i) {
-      const YamlDoc b = bodies.at(i);
-      dynamics::EndEffectorBody body;
-      body.name = b["name"].String();
-      body.inertial = ReadInertial(b, &cfg.implausible);
-      b.RejectUnknownKeys();
-      d.end_effector.bodies.push_back(body);
-    }
-  }
-  ee.MarkUsed("bodies");
-  d.end_effector.p_tcp = Vec3(ee["tcp_m"]);
-  CheckLengths(ee["tcp_m"], d.end_effector.p_tcp, &cfg.implausible);
-  if (ee.Has("spindle_nose_m")) {
-    d.end_effector.p_spindle_nose = Vec3(ee["spindle_nose_m"]);
-    CheckLengths(ee["spindle_nose_m"], d.end_effector.p_spindle_nose, &cfg.implausible);
-  } else {
-    d.end_effector.p_spindle_nose = d.end_effector.p_tcp;
-  }
-  ee.MarkUsed("spindle_nose_m");
-  // m6_kg and d6_m document the reference values; they must match the
-  // geometry (a calibrated value goes under `parameters:` instead).
-  const double m6 = dynamics::ReferenceM6(d);
-  const double d6 = dynamics::ReferenceD6(d);
-  if (ee.Has("m6_kg")) {
-    const YamlDoc node = ee["m6_kg"];
-    if (std::abs(node.Number() - m6) > 1e-6 * std::max(1.0, m6)) {
-      throw node.Error(LikelyCause(cfg.implausible) + "the last link and the end-effector bodies weigh " +
-                       FormatNumber(m6) +
-                       " kg; m6_kg must state that reference (put a calibrated m6 under "
-                       "'parameters: m6_kg')" + ThousandHint(node.Number(), m6, "g", "kg"));
-    }
-  }
-  if (ee.Has("d6_m")) {
-    const YamlDoc node = ee["d6_m"];
-    if (std::abs(node.Number() - d6) > 1e-6) {
-      throw node.Error(LikelyCause(cfg.implausible) + "the geometry puts the tool tip " + FormatNumber(d6) +
-                       " m from the wrist centre along the last joint axis; d6_m must state "
-                       "that reference (put a calibrated d6 under 'parameters: d6_m')" +
-                       ThousandHint(node.Number(), d6, "mm", "m"));
-    }
-  }
-  ee.MarkUsed("m6_kg");
-  ee.MarkUsed("d6_m");
-  ee.RejectUnknownKeys();
+  const YamlDoc kq = ReadJointStiffness(doc, &cfg);
+  const YamlDoc damping = ReadDamping(doc, &d);
+  ReadEndEffector(doc, &cfg);
 
   for (const char* section : {"spindle_toolholder_interface", "hammer_test"}) {
     if (doc.Has(section)) ReadNumericSection(doc[section], section, &d.extra_values, &cfg.extra_value_locations);
@@ -538,59 +613,8 @@ RobotConfig LoadRobotConfig(const std::string& path) {
   }
   if (doc.Has("hammer_test")) CheckHammerTest(doc["hammer_test"], &cfg.implausible);
 
-  if (doc.Has("effects")) {
-    const YamlDoc effects = doc["effects"];
-    for (int i = 0; i < effects.size(); ++i) {
-      const YamlDoc e = effects.at(i);
-      dynamics::EffectConfig ec;
-      const YamlDoc name = e["name"];
-      ec.name = name.String();
-      std::shared_ptr<const dynamics::Effect> effect;
-      try {
-        effect = dynamics::EffectRegistry::Instance().Create(ec.name);
-      } catch (const std::invalid_argument& ex) {
-        throw name.Error(ex.what());
-      }
-      for (const auto& spec : effect->parameters()) {
-        if (e.Has(spec.name)) ec.values[spec.name] = e[spec.name].Number();
-        e.MarkUsed(spec.name);
-      }
-      e.RejectUnknownKeys();
-      d.effects.push_back(ec);
-    }
-  }
-  doc.MarkUsed("effects");
-
-  try {
-    cfg.parameters = dynamics::DefaultParameters(d);
-  } catch (const std::invalid_argument& ex) {
-    throw InputError({path, 0, 0}, ex.what());
-  }
-  if (doc.Has("parameters")) {
-    const YamlDoc params = doc["parameters"];
-    for (const std::string& key : params.Keys()) {
-      const YamlDoc v = params[key];
-      try {
-        cfg.parameters.Set(key, v.Number());
-      } catch (const std::invalid_argument& ex) {
-        // A value 1000 times the configured one is a unit mistake more
-        // often than a calibration (g for kg, mm for m, N·mm for N·m).
-        const double reference = cfg.parameters.Has(key) ? cfg.parameters.Get(key) : 0.0;
-        std::string unit = "", small = "";
-        for (const auto& [suffix, u, su] : {std::tuple{"_Nm_per_rad", "N·m/rad", "N·mm/rad"}, {"_kg", "kg", "g"},
-                                            {"_per_s", "1/s", "1/ms"}, {"_m", "m", "mm"}, {"_s", "s", "ms"}}) {
-          const std::string sfx = suffix;
-          if (key.size() > sfx.size() && key.compare(key.size() - sfx.size(), sfx.size(), sfx) == 0) {
-            unit = u;
-            small = su;
-            break;
-          }
-        }
-        throw v.Error(ex.what() + (unit.empty() ? "" : ThousandHint(v.Number(), reference, small, unit)));
-      }
-    }
-  }
-  doc.MarkUsed("parameters");
+  ReadEffects(doc, &d);
+  ReadParameters(doc, path, &cfg);
   // Parameter-uncertainty files (formats.md §12), relative to the config.
   if (doc.Has("uncertainty")) {
     const YamlDoc files = doc["uncertainty"];

@@ -112,11 +112,7 @@ dynamics::ParameterUncertainty ReadParameterUncertainties(const std::vector<std:
     parts.push_back(ReadParameterUncertainty(p));
     parts.back().source = p + " (" + parts.back().source + ")";
   }
-  try {
-    return dynamics::CombineIndependent(parts);
-  } catch (const std::invalid_argument& e) {
-    throw InputError({paths.back(), 0, 0}, e.what());
-  }
+  return AtLocation({paths.back(), 0, 0}, "", [&] { return dynamics::CombineIndependent(parts); });
 }
 
 nlohmann::json ParameterUncertaintyToJson(const dynamics::ParameterUncertainty& u) {

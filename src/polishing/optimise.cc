@@ -74,7 +74,8 @@ double NloptThunk(unsigned, const double* x, double*, void* data) {
   return v;
 }
 
-void RunNlopt(nlopt::algorithm alg, int budget, std::vector<double>* x, Tracker* t, std::string* status) {
+// Sets the result's status and stop reason (NLopt's word).
+void RunNlopt(nlopt::algorithm alg, int budget, std::vector<double>* x, Tracker* t, OptimiseResult* res) {
   nlopt::opt opt(alg, 3);
   opt.set_lower_bounds(std::vector<double>(3, 0.0));
   opt.set_upper_bounds(std::vector<double>(3, 1.0));
@@ -87,16 +88,23 @@ void RunNlopt(nlopt::algorithm alg, int budget, std::vector<double>* x, Tracker*
   double f = 0.0;
   try {
     const nlopt::result r = opt.optimize(*x, f);
-    *status = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : "converged";
+    const bool budget_out = r == nlopt::MAXEVAL_REACHED;
+    res->status = budget_out ? SolverStatus::kNotConverged : SolverStatus::kConverged;
+    res->stop_reason = budget_out ? "max_evaluations" : "converged";
   } catch (const nlopt::roundoff_limited&) {
-    *status = "roundoff_limited";
+    // At the objective's noise level (OptimisePlan's local searches take it
+    // as converged too).
+    res->status = SolverStatus::kConverged;
+    res->stop_reason = "roundoff_limited";
   } catch (const nlopt::forced_stop&) {
     if (t->error) std::rethrow_exception(t->error);
-    *status = "forced_stop";
+    res->status = SolverStatus::kFailed;
+    res->stop_reason = "forced_stop";
   } catch (const std::runtime_error& e) {
     // NLopt's own failure (NLOPT_FAILURE); the objective's exceptions are
     // rethrown above.
-    *status = std::string("failed: ") + e.what();
+    res->status = SolverStatus::kFailed;
+    res->stop_reason = std::string("failed: ") + e.what();
   }
 }
 
@@ -119,11 +127,10 @@ OptimiseResult OptimiseCycloid(const std::function<double(const PathParameters&)
     res.method = "NLopt GN_DIRECT_L (" + std::to_string(o.global_evaluations) + " evaluations) then LN_SBPLX (" +
                  std::to_string(o.local_evaluations) + ")";
     std::vector<double> x = ToUnit(start, o);
-    std::string status;
-    RunNlopt(nlopt::GN_DIRECT_L, o.global_evaluations, &x, &t, &status);
+    // The status is the local stage's (the global stage always spends its budget).
+    RunNlopt(nlopt::GN_DIRECT_L, o.global_evaluations, &x, &t, &res);
     x = t.best_x;
-    RunNlopt(nlopt::LN_SBPLX, o.local_evaluations, &x, &t, &status);
-    res.status = status;
+    RunNlopt(nlopt::LN_SBPLX, o.local_evaluations, &x, &t, &res);
   } else {
     res.method = "PSO with adaptive inertia (seed 004 eq. 18), " + std::to_string(o.pso_particles) + " particles";
     std::mt19937 rng(o.seed);
@@ -142,7 +149,8 @@ OptimiseResult OptimiseCycloid(const std::function<double(const PathParameters&)
     pbest_f = f;
     double best = res.best_value, last_improved = best;
     int stall = 0;
-    res.status = "max_iterations";
+    res.status = SolverStatus::kNotConverged;
+    res.stop_reason = "max_iterations";
     for (int it = 0; it < o.pso_max_iterations; ++it) {
       const double fmin = *std::min_element(f.begin(), f.end());
       double favg = 0;
@@ -170,7 +178,8 @@ OptimiseResult OptimiseCycloid(const std::function<double(const PathParameters&)
         last_improved = best;
         stall = 0;
       } else if (++stall >= o.pso_stall_iterations) {
-        res.status = "converged";
+        res.status = SolverStatus::kConverged;
+        res.stop_reason = "converged";
         break;
       }
     }
@@ -402,6 +411,221 @@ PlanEvaluation OptimiseParallel(const PlanProblem& pb, const PathParameters& sta
   return best;
 }
 
+// What the stages of OptimisePlan share: the problem, its options, the
+// user's start and the book of evaluations (which holds the result).
+struct PlanRun {
+  const PlanProblem& pb;
+  const PathParameters& start;
+  const PlanOptimiseOptions& o;
+  Book& book;
+};
+
+// The best evaluation seen so far over every stage (by Better).
+struct BestSoFar {
+  PlanEvaluation best;
+  bool have = false;
+  void Consider(const PlanEvaluation& e) {
+    if (!have || Better(e, best)) best = e, have = true;
+  }
+};
+
+// The seed's PSO over (d, r, pitch) on the first family, half-loop stagger,
+// the target as a penalty.
+void RunPsoPlan(const PlanRun& run, const GuideFamily& family, BestSoFar* best) {
+  const PlanProblem& pb = run.pb;
+  const PlanOptimiseOptions& o = run.o;
+  PlanOptimiseResult& res = run.book.result();
+  PathParameters base = run.start;
+  base.guides = family.guides;
+  base.line_angle = family.line_angle;
+  OptimiseOptions po;
+  po.method = Optimiser::kPso;
+  po.offset_min = o.offset_min;
+  po.offset_max = o.offset_max;
+  po.seed = o.seed;
+  OptimiseResult r = OptimiseCycloid(
+      [&](const PathParameters& p) {
+        const PlanEvaluation e = run.book.Evaluate(p);
+        best->Consider(e);
+        if (!e.valid) return 1e6;
+        return e.feasible ? e.cv : 10.0 + e.mean / pb.target;
+      },
+      base, po);
+  res.method = r.method + ", the target as a penalty, the best feasible point kept";
+  res.status = r.status;
+  res.stop_reason = r.stop_reason;
+}
+
+// 1. Coarse grid per family at the half-loop stagger, and the user's (or
+// default) start point; every point is considered for the best.
+std::vector<PlanEvaluation> CoarseGrid(const PlanRun& run, const std::vector<GuideFamily>& fams, BestSoFar* best) {
+  const double gd[] = {0.0, 0.2, 0.45}, gr[] = {0.3, 1.0}, gp[] = {0.15, 0.5, 0.85};
+  std::vector<PathParameters> grid_pts;
+  for (const GuideFamily& f : fams)
+    for (double a : gd)
+      for (double b : gr)
+        for (double c : gp) {
+          {
+            const double x[kDim] = {a, b, c, 0.5, 1.0};  // rows to the patch's edge
+            grid_pts.push_back(CycloidFromUnit(x, run.start, f, run.o, *run.pb.process));
+          }
+        }
+  std::vector<PlanEvaluation> ev = run.book.Batch(grid_pts);
+  {
+    PlanEvaluation s0 = run.book.Evaluate(run.start);  // the user's (or default) start point
+    if (s0.valid) ev.push_back(s0);
+  }
+  for (const auto& e : ev) best->Consider(e);
+  return ev;
+}
+
+// 2. Starts: the best of each family, then the next best overall (`ev`
+// sorted by Better), most promising first.
+std::vector<PlanEvaluation> ChooseStarts(const std::vector<PlanEvaluation>& ev, const std::vector<GuideFamily>& fams,
+                                         const PlanOptimiseOptions& o) {
+  // A family whose best grid point is far behind the best (cv > 1.5 x,
+  // or infeasible when a feasible point exists) gets no local search.
+  std::vector<PlanEvaluation> starts;
+  for (const GuideFamily& f : fams) {
+    for (const auto& e : ev)
+      if (e.valid && SameFamily(e.params, f)) {
+        const bool close = !ev[0].feasible || (e.feasible && e.cv <= 1.5 * ev[0].cv);
+        if (close && static_cast<int>(starts.size()) < std::max(o.starts, 1)) starts.push_back(e);
+        break;
+      }
+  }
+  for (const auto& e : ev) {
+    if (static_cast<int>(starts.size()) >= std::max<int>(o.starts, 1)) break;
+    if (!e.valid) continue;
+    bool dup = false;
+    for (const auto& s : starts) dup |= s.params.offset == e.params.offset && s.params.radius == e.params.radius &&
+                                        s.params.pitch == e.params.pitch && SameFamily(s.params, {e.params.guides, e.params.line_angle});
+    if (!dup) starts.push_back(e);
+  }
+  // Local searches, most promising first.
+  std::sort(starts.begin(), starts.end(), Better);
+  return starts;
+}
+
+// The COBYLA runs of the multi-start search, on the book's threads: how
+// many ran, how many met their tolerance and their statuses; each run's
+// best is considered and added to `ev` (for the best per family).
+class LocalSearches {
+ public:
+  LocalSearches(const PlanRun& run, BestSoFar* best, std::vector<PlanEvaluation>* ev)
+      : run_(run), best_(best), ev_(ev) {}
+
+  // One COBYLA run from `from`; records its status and its best.
+  void Run(const PathParameters& from) {
+    const PlanProblem& pb = run_.pb;
+    const PlanOptimiseOptions& o = run_.o;
+    Book& book = run_.book;
+    LocalRun run{&book, &run_.start, {from.guides, from.line_angle}, &o, &pb, {}, {}, {}, false};
+    nlopt::opt opt(nlopt::LN_COBYLA, kDim);
+    opt.set_lower_bounds(std::vector<double>(kDim, 0.0));
+    opt.set_upper_bounds(std::vector<double>(kDim, 1.0));
+    opt.set_min_objective(LocalRun::Objective, &run);
+    opt.add_inequality_constraint(LocalRun::Constraint, &run, 1e-4);
+    opt.add_inequality_constraint(LocalRun::CoverageConstraint, &run, 1e-4);
+    opt.set_ftol_rel(o.ftol_rel);
+    opt.set_xtol_abs(5e-3);  // 5e-3 of the box: ~1 % of d, below what the grid resolves
+    opt.set_maxeval(o.max_local_evaluations);
+    opt.set_maxtime(std::max(0.1, book.Remaining()));
+    opt.set_initial_step(std::vector<double>{0.08, 0.15, 0.1, 0.15, 0.25});
+    std::vector<double> x = CycloidToUnit(from, o, *pb.process);
+    double f = 0;
+    std::string st;
+    try {
+      const nlopt::result r = opt.optimize(x, f);
+      st = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : r == nlopt::MAXTIME_REACHED ? "max_time" : "converged";
+    } catch (const nlopt::roundoff_limited&) {
+      st = "converged";  // at the objective's noise level
+    } catch (const nlopt::forced_stop&) {
+      st = "max_time";
+    } catch (const std::invalid_argument&) {
+      st = "failed";
+    }
+    std::lock_guard<std::mutex> lock(mu_);
+    ++ran_;
+    converged_ += st == "converged";
+    statuses_.push_back(st);
+    if (run.have_best) {
+      best_->Consider(run.best);
+      ev_->push_back(run.best);
+    }
+  }
+  // Read once no run is going.
+  int ran() const { return ran_; }
+  int converged() const { return converged_; }
+  const std::vector<std::string>& statuses() const { return statuses_; }
+
+ private:
+  const PlanRun& run_;
+  BestSoFar* best_;
+  std::vector<PlanEvaluation>* ev_;
+  std::mutex mu_;
+  int converged_ = 0, ran_ = 0;
+  std::vector<std::string> statuses_;
+};
+
+// 3. Restarts from the best point (COBYLA's simplex shrinks early on a
+// sampled objective): a fresh run from it and one a quarter loop of
+// stagger away (the stagger's landscape has several valleys), repeated
+// while the best improves by more than ftol_rel.
+void Restarts(const PlanRun& run, const BestSoFar& best_so_far, LocalSearches* local) {
+  Book& book = run.book;
+  const PlanEvaluation& best = best_so_far.best;
+  for (int round = 0; round < 5 && best_so_far.have && best.feasible && !book.OutOfTime(); ++round) {
+    const double before = best.cv;
+    const PathParameters b = best.params;
+    book.RunParallel(2, [&](int i) {
+      if (book.OutOfTime()) return;
+      PathParameters from = b;
+      if (i == 1) from.stagger = std::fmod(b.stagger + (round % 2 ? 0.75 : 0.25), 1.0);
+      local->Run(from);
+    });
+    if (!(best.cv < before * (1 - run.o.ftol_rel))) break;
+  }
+}
+
+// The multi-start search: the coarse grid, local searches from the best
+// starts, restarts from the best point; then the status, the method and
+// the best per family into the book's result.
+void RunMultiStartPlan(const PlanRun& run, const std::vector<GuideFamily>& fams, BestSoFar* best) {
+  const PlanOptimiseOptions& o = run.o;
+  Book& book = run.book;
+  PlanOptimiseResult& res = book.result();
+  std::vector<PlanEvaluation> ev = CoarseGrid(run, fams, best);
+  std::sort(ev.begin(), ev.end(), Better);
+  const std::vector<PlanEvaluation> starts = ChooseStarts(ev, fams, o);
+  LocalSearches local(run, best, &ev);
+  book.RunParallel(static_cast<int>(starts.size()), [&](int i) {
+    if (!book.OutOfTime()) local.Run(starts[i].params);
+  });
+  Restarts(run, *best, &local);
+  const int ran = local.ran(), converged = local.converged();
+  res.local_searches = ran;
+  res.local_converged = converged;
+  res.stop_reason = ran == 0 ? "max_time" : converged == ran ? "converged" : "max_time";
+  for (const auto& s : local.statuses())
+    if (s == "max_evaluations") res.stop_reason = "max_evaluations";
+  if (ran < static_cast<int>(starts.size()) || book.OutOfTime()) res.stop_reason = "max_time";
+  // A budget ran out unless every local search met its tolerance.
+  res.status = res.stop_reason == "converged" ? SolverStatus::kConverged : SolverStatus::kNotConverged;
+  res.method = "NLopt: coarse grid over (d, r/d, pitch/r) for each guide family (" + std::to_string(fams.size()) +
+               "), then COBYLA from " + std::to_string(starts.size()) +
+               " starts over (d, r/d, pitch/r, stagger, edge overrun) with the target as a constraint, then restarts "
+               "from the best while it improves; ftol_rel " + io_ftol(o.ftol_rel);
+  // Best per family, from the grid and the local searches.
+  for (const GuideFamily& f : fams) {
+    PlanEvaluation fb;
+    bool h = false;
+    for (const auto& e : ev)
+      if (SameFamily(e.params, f) && (!h || Better(e, fb))) fb = e, h = true;
+    if (h) res.family_best.push_back(fb);
+  }
+}
+
 }  // namespace
 
 PlanOptimiseResult OptimisePlan(const PlanProblem& pb, const PathParameters& start, const PlanOptimiseOptions& o) {
@@ -413,159 +637,23 @@ PlanOptimiseResult OptimisePlan(const PlanProblem& pb, const PathParameters& sta
     res.best = res.best_parallel;
     res.method = "zig-zag: row spacing scanned on [0.3, 1.5] contact widths (13 points) x edge overrun (0, 0.5, 1 "
                  "margin) x rows along s and t, then golden-section refinement of the spacing";
-    res.status = book.OutOfTime() ? "max_time" : "converged";
+    const bool out_of_time = book.OutOfTime();
+    res.stop_reason = out_of_time ? "max_time" : "converged";
+    res.status = out_of_time ? SolverStatus::kNotConverged : SolverStatus::kConverged;
     res.seconds = book.Elapsed();
     return res;
   }
   std::vector<GuideFamily> fams = o.families;
   if (fams.empty()) fams = {{GuideLines::kBoundaryOffsets, 0.0}, {GuideLines::kParallelLines, 0.0},
                             {GuideLines::kParallelLines, kPi / 2}};
-  PlanEvaluation best;
-  bool have = false;
-  auto consider = [&](const PlanEvaluation& e) {
-    if (!have || Better(e, best)) best = e, have = true;
-  };
-
+  const PlanRun run{pb, start, o, book};
+  BestSoFar best;
   if (o.method == Optimiser::kPso) {
-    // The seed's PSO over (d, r, pitch) on the first family, half-loop stagger.
-    PathParameters base = start;
-    base.guides = fams[0].guides;
-    base.line_angle = fams[0].line_angle;
-    std::mutex mu;
-    OptimiseOptions po;
-    po.method = Optimiser::kPso;
-    po.offset_min = o.offset_min;
-    po.offset_max = o.offset_max;
-    po.seed = o.seed;
-    OptimiseResult r = OptimiseCycloid(
-        [&](const PathParameters& p) {
-          const PlanEvaluation e = book.Evaluate(p);
-          consider(e);
-          if (!e.valid) return 1e6;
-          return e.feasible ? e.cv : 10.0 + e.mean / pb.target;
-        },
-        base, po);
-    res.method = r.method + ", the target as a penalty, the best feasible point kept";
-    res.status = r.status;
+    RunPsoPlan(run, fams[0], &best);
   } else {
-    // 1. Coarse grid per family at the half-loop stagger.
-    const double gd[] = {0.0, 0.2, 0.45}, gr[] = {0.3, 1.0}, gp[] = {0.15, 0.5, 0.85};
-    std::vector<PathParameters> grid_pts;
-    for (const GuideFamily& f : fams)
-      for (double a : gd)
-        for (double b : gr)
-          for (double c : gp) {
-            {
-              const double x[kDim] = {a, b, c, 0.5, 1.0};  // rows to the patch's edge
-              grid_pts.push_back(CycloidFromUnit(x, start, f, o, *pb.process));
-            }
-          }
-    std::vector<PlanEvaluation> ev = book.Batch(grid_pts);
-    {
-      PlanEvaluation s0 = book.Evaluate(start);  // the user's (or default) start point
-      if (s0.valid) ev.push_back(s0);
-    }
-    for (const auto& e : ev) consider(e);
-    // 2. Starts: the best of each family, then the next best overall.
-    std::sort(ev.begin(), ev.end(), Better);
-    // A family whose best grid point is far behind the best (cv > 1.5 x,
-    // or infeasible when a feasible point exists) gets no local search.
-    std::vector<PlanEvaluation> starts;
-    for (const GuideFamily& f : fams) {
-      for (const auto& e : ev)
-        if (e.valid && SameFamily(e.params, f)) {
-          const bool close = !ev[0].feasible || (e.feasible && e.cv <= 1.5 * ev[0].cv);
-          if (close && static_cast<int>(starts.size()) < std::max(o.starts, 1)) starts.push_back(e);
-          break;
-        }
-    }
-    for (const auto& e : ev) {
-      if (static_cast<int>(starts.size()) >= std::max<int>(o.starts, 1)) break;
-      if (!e.valid) continue;
-      bool dup = false;
-      for (const auto& s : starts) dup |= s.params.offset == e.params.offset && s.params.radius == e.params.radius &&
-                                          s.params.pitch == e.params.pitch && SameFamily(s.params, {e.params.guides, e.params.line_angle});
-      if (!dup) starts.push_back(e);
-    }
-    // Local searches, most promising first.
-    std::sort(starts.begin(), starts.end(), Better);
-    std::mutex mu;
-    int converged = 0, ran = 0;
-    std::vector<std::string> statuses;
-    // One COBYLA run from `from`; returns its status and records its best.
-    auto local = [&](const PathParameters& from) {
-      LocalRun run{&book, &start, {from.guides, from.line_angle}, &o, &pb, {}, {}, {}, false};
-      nlopt::opt opt(nlopt::LN_COBYLA, kDim);
-      opt.set_lower_bounds(std::vector<double>(kDim, 0.0));
-      opt.set_upper_bounds(std::vector<double>(kDim, 1.0));
-      opt.set_min_objective(LocalRun::Objective, &run);
-      opt.add_inequality_constraint(LocalRun::Constraint, &run, 1e-4);
-      opt.add_inequality_constraint(LocalRun::CoverageConstraint, &run, 1e-4);
-      opt.set_ftol_rel(o.ftol_rel);
-      opt.set_xtol_abs(5e-3);  // 5e-3 of the box: ~1 % of d, below what the grid resolves
-      opt.set_maxeval(o.max_local_evaluations);
-      opt.set_maxtime(std::max(0.1, book.Remaining()));
-      opt.set_initial_step(std::vector<double>{0.08, 0.15, 0.1, 0.15, 0.25});
-      std::vector<double> x = CycloidToUnit(from, o, *pb.process);
-      double f = 0;
-      std::string st;
-      try {
-        const nlopt::result r = opt.optimize(x, f);
-        st = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : r == nlopt::MAXTIME_REACHED ? "max_time" : "converged";
-      } catch (const nlopt::roundoff_limited&) {
-        st = "converged";  // at the objective's noise level
-      } catch (const nlopt::forced_stop&) {
-        st = "max_time";
-      } catch (const std::invalid_argument&) {
-        st = "failed";
-      }
-      std::lock_guard<std::mutex> lock(mu);
-      ++ran;
-      converged += st == "converged";
-      statuses.push_back(st);
-      if (run.have_best) {
-        consider(run.best);
-        ev.push_back(run.best);
-      }
-    };
-    book.RunParallel(static_cast<int>(starts.size()), [&](int i) {
-      if (!book.OutOfTime()) local(starts[i].params);
-    });
-    // 3. Restarts from the best point (COBYLA's simplex shrinks early on a
-    // sampled objective): a fresh run from it and one a quarter loop of
-    // stagger away (the stagger's landscape has several valleys), repeated
-    // while the best improves by more than ftol_rel.
-    for (int round = 0; round < 5 && have && best.feasible && !book.OutOfTime(); ++round) {
-      const double before = best.cv;
-      const PathParameters b = best.params;
-      book.RunParallel(2, [&](int i) {
-        if (book.OutOfTime()) return;
-        PathParameters from = b;
-        if (i == 1) from.stagger = std::fmod(b.stagger + (round % 2 ? 0.75 : 0.25), 1.0);
-        local(from);
-      });
-      if (!(best.cv < before * (1 - o.ftol_rel))) break;
-    }
-    res.local_searches = ran;
-    res.local_converged = converged;
-    res.status = ran == 0 ? "max_time" : converged == ran ? "converged" : "max_time";
-    for (const auto& s : statuses)
-      if (s == "max_evaluations") res.status = "max_evaluations";
-    if (ran < static_cast<int>(starts.size()) || book.OutOfTime()) res.status = "max_time";
-    res.method = "NLopt: coarse grid over (d, r/d, pitch/r) for each guide family (" + std::to_string(fams.size()) +
-                 "), then COBYLA from " + std::to_string(starts.size()) +
-                 " starts over (d, r/d, pitch/r, stagger, edge overrun) with the target as a constraint, then restarts "
-                 "from the best while it improves; ftol_rel " + io_ftol(o.ftol_rel);
-    // Best per family, from the grid and the local searches.
-    for (const GuideFamily& f : fams) {
-      PlanEvaluation fb;
-      bool h = false;
-      for (const auto& e : ev)
-        if (SameFamily(e.params, f) && (!h || Better(e, fb))) fb = e, h = true;
-      if (h) res.family_best.push_back(fb);
-    }
+    RunMultiStartPlan(run, fams, &best);
   }
-  res.best = best;
+  res.best = best.best;
   res.seconds = book.Elapsed();
   return res;
 }

@@ -8,6 +8,7 @@
 
 #include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
+#include "robomach/common/option_checks.h"
 #include "robomach/common/units.h"
 #include "robomach/polishing/face_check.h"
 #include "robomach/polishing/path_patterns.h"
@@ -18,11 +19,9 @@ namespace {
 
 std::shared_ptr<const SampleGrid> BuildGrid(const NurbsSurface& surface, const PolishingProcess& process,
                                             double spacing, const std::string& surface_source) {
-  try {
+  return AtLocation<std::domain_error>({surface_source, 0, 0}, "", [&] {
     return std::make_shared<const SampleGrid>(SampleGrid::Build(surface, spacing, process.margin, process.flip_normal));
-  } catch (const std::domain_error& e) {
-    throw InputError({surface_source, 0, 0}, e.what());
-  }
+  });
 }
 
 // The pattern runs its tool around a circle (the cycloid): it needs room
@@ -108,16 +107,19 @@ std::vector<PlanOptionRange> PlanOptionRanges(const PlanOptions& o) {
 
 void CheckRanges(const PlanOptions& o) {
   for (const PlanOptionRange& r : PlanOptionRanges(o)) {
-    if (!(r.value >= r.lo && r.value <= r.hi)) {
-      std::ostringstream s;
-      s << r.name << ": expected a value in [" << r.lo << ", " << r.hi << "], got " << r.value;
-      throw std::invalid_argument(s.str());
-    }
+    CheckOptionRange(r.name, r.value, r.lo, r.hi);
   }
 }
 
 std::vector<std::string> ImplausiblePlanOptions(const PlanOptions& o) {
   std::vector<std::string> out;
+  // The one angle option: radians typed under _deg (1.5708 for 90 deg), as
+  // the files' _deg fields are checked (a value within one turn, not whole).
+  if (const double a = o.line_angle_deg; a != 0.0 && std::abs(a) <= 2 * kPi && a != std::floor(a)) {
+    out.push_back("implausible (unit mistake?): line_angle_deg " + FormatNumber(a, 7) +
+                  " deg is within 2 pi = 6.28 and not whole, as radians are: radians typed in the deg option? (" +
+                  FormatNumber(a, 7) + " rad is " + FormatNumber(a * 180.0 / kPi, 4) + " deg)");
+  }
   const double t = o.target_removal_um;
   if (t != 0.0 && !(t >= kMinPlausibleTargetRemovalUm && t <= kMaxPlausibleTargetRemovalUm)) {
     out.push_back("implausible (unit mistake?): target_removal_um " + FormatNumber(t, 7) +
@@ -173,11 +175,9 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
   if (!req.optimise && PathPatternCircles(params)) {
     // A face too narrow for the circle is an error in the input, never
     // rows clamped onto its edges (PlanPath checks it again).
-    try {
+    AtLocation<FaceTooNarrowError>({c.surface_source, 0, 0}, "", [&] {
       CheckCircleFits(surface, grid, DevelopedRegion::Build(surface, grid, c.process.margin), params, c.process);
-    } catch (const FaceTooNarrowError& e) {
-      throw InputError({c.surface_source, 0, 0}, e.what());
-    }
+    });
   }
 
   if (req.optimise) {
@@ -212,12 +212,8 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
     }
     out.opt_offset_min = oo.offset_min;
     out.opt_offset_max = oo.offset_max;
-    PlanOptimiseResult opt;
-    try {
-      opt = OptimisePlan(pb, base, oo);
-    } catch (const PathRowError& err) {
-      throw InputError({c.surface_source, 0, 0}, std::string("while optimising: ") + err.what());
-    }
+    PlanOptimiseResult opt = AtLocation<PathRowError>({c.surface_source, 0, 0}, "while optimising: ",
+                                                      [&] { return OptimisePlan(pb, base, oo); });
     if (!opt.best.valid) throw std::runtime_error("the optimiser found no plan that fits the region: " + opt.best.error);
     const double row_step = params.row_step;
     params = opt.best.params;

@@ -189,41 +189,40 @@ std::vector<unsigned char> ModeMapPng(const audit::ModeErrorMap& m, const std::s
                             make(m.peak_error, "peak amplitude, 100 (|H|_model / |H|_measured - 1)")});
 }
 
-}  // namespace
-
-AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, double noise_floor,
-                                            const std::string& title, const AuditPatternFiles& files) {
-  AuditPatternsReport out;
-  const audit::ErrorTrends& t = p.trends;
+// ---- trends: one row per descriptor, its correlation with the error per
+// posture before and after the best candidate (trends.csv and the JSON).
+void AddTrends(const audit::ErrorTrends& t, AuditPatternsReport* out) {
   const bool has_after = t.error_after.size() > 0;
-
-  // ---- trends
-  out.trends = json::array();
+  out->trends = json::array();
   std::ostringstream tcsv;
   tcsv << "descriptor,unit,n,critical_correlation,correlation_before,significant_before,correlation_after,"
           "significant_after\n";
   for (const audit::Trend& tr : t.trends) {
     const Shown s = Display(tr.descriptor, tr.unit);
-    out.trends.push_back({{"descriptor", tr.descriptor},
-                          {"unit", s.unit},
-                          {"correlation", JsonNumber(tr.correlation_before)},
-                          {"significant", tr.significant_before},
-                          {"n", t.n},
-                          {"critical_correlation", JsonNumber(t.critical_correlation)},
-                          {"correlation_after", JsonNumber(tr.correlation_after)},
-                          {"significant_after", has_after ? json(tr.significant_after) : json(nullptr)}});
+    out->trends.push_back({{"descriptor", tr.descriptor},
+                           {"unit", s.unit},
+                           {"correlation", JsonNumber(tr.correlation_before)},
+                           {"significant", tr.significant_before},
+                           {"n", t.n},
+                           {"critical_correlation", JsonNumber(t.critical_correlation)},
+                           {"correlation_after", JsonNumber(tr.correlation_after)},
+                           {"significant_after", has_after ? json(tr.significant_after) : json(nullptr)}});
     tcsv << tr.descriptor << ',' << s.unit << ',' << t.n << ',' << FormatCell(t.critical_correlation) << ','
          << FormatCell(tr.correlation_before) << ',' << (tr.significant_before ? "yes" : "no") << ','
          << FormatCell(tr.correlation_after) << ',' << (has_after ? (tr.significant_after ? "yes" : "no") : "") << '\n';
   }
-  out.trends_csv = tcsv.str();
+  out->trends_csv = tcsv.str();
+}
 
-  // ---- per-posture descriptors and errors
+// ---- per-posture descriptors and errors: the data each trend is computed
+// from, one row per posture.
+void AddPostureDescriptors(const audit::ErrorTrends& t, AuditPatternsReport* out) {
+  const bool has_after = t.error_after.size() > 0;
   std::ostringstream dcsv;
   dcsv << "pose_id,error_before,error_after";
   for (const audit::Trend& tr : t.trends) dcsv << ',' << Display(tr.descriptor, tr.unit).key();
   dcsv << '\n';
-  out.posture_descriptors = json::object();
+  out->posture_descriptors = json::object();
   for (int k = 0; k < t.n; ++k) {
     const std::string& id = t.pose_ids[k];
     dcsv << id << ',' << FormatCell(t.error_before(k)) << ',' << (has_after ? FormatCell(t.error_after(k)) : "");
@@ -234,12 +233,14 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
       d[s.key()] = JsonNumber(s.scale * tr.values(k));
     }
     dcsv << '\n';
-    out.posture_descriptors[id] = d;
+    out->posture_descriptors[id] = d;
   }
-  out.posture_descriptors_csv = dcsv.str();
+  out->posture_descriptors_csv = dcsv.str();
+}
 
-  // ---- mode error map
-  const audit::ModeErrorMap& m = p.mode_map;
+// ---- mode error map: the relative frequency and peak errors per posture
+// and model mode, with the matched pair behind each cell in the CSV.
+void AddModeErrorMap(const audit::ModeErrorMap& m, AuditPatternsReport* out) {
   json fe = json::array(), pe = json::array();
   std::ostringstream mcsv;
   mcsv << "pose_id,model_mode,response,excitation,model_freq_hz,measured_freq_hz,freq_error_rel,model_peak_m_per_N,"
@@ -264,39 +265,43 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
     fe.push_back(fr);
     pe.push_back(pr);
   }
-  out.mode_error_map = {{"poses", m.pose_ids}, {"modes", m.modes}, {"freq_error_rel", fe}, {"peak_error_rel", pe}};
-  out.mode_errors_csv = mcsv.str();
+  out->mode_error_map = {{"poses", m.pose_ids}, {"modes", m.modes}, {"freq_error_rel", fe}, {"peak_error_rel", pe}};
+  out->mode_errors_csv = mcsv.str();
+}
 
-  // ---- unmatched modes
-  out.unmatched_model_modes = json::array();
-  out.unmatched_measured_modes = json::array();
+// ---- unmatched modes: model modes and measured modes with no counterpart
+// (model ones first in the CSV).
+void AddUnmatchedModes(const audit::ErrorPatterns& p, AuditPatternsReport* out) {
+  out->unmatched_model_modes = json::array();
+  out->unmatched_measured_modes = json::array();
   std::ostringstream ucsv;
   ucsv << "side,pose_id,response,excitation,model_mode,freq_hz,damping_ratio,relative_visibility\n";
   for (const audit::UnmatchedMode& u : p.unmatched_model) {
-    out.unmatched_model_modes.push_back({{"pose", u.key.pose_id},
-                                         {"direction", Dir(u.key)},
-                                         {"frequency_hz", u.freq_hz},
-                                         {"model_mode", u.model_mode + 1},
-                                         {"damping_ratio", u.damping_ratio},
-                                         {"relative_visibility", JsonNumber(u.relative_visibility)}});
+    out->unmatched_model_modes.push_back({{"pose", u.key.pose_id},
+                                          {"direction", Dir(u.key)},
+                                          {"frequency_hz", u.freq_hz},
+                                          {"model_mode", u.model_mode + 1},
+                                          {"damping_ratio", u.damping_ratio},
+                                          {"relative_visibility", JsonNumber(u.relative_visibility)}});
     ucsv << "model," << u.key.pose_id << ',' << AxisName(u.key.response) << ',' << AxisName(u.key.excitation) << ','
          << u.model_mode + 1 << ',' << FormatCell(u.freq_hz) << ',' << FormatCell(u.damping_ratio) << ','
          << FormatCell(u.relative_visibility) << '\n';
   }
   for (const audit::UnmatchedMode& u : p.unmatched_measured) {
-    out.unmatched_measured_modes.push_back({{"pose", u.key.pose_id},
-                                            {"direction", Dir(u.key)},
-                                            {"frequency_hz", u.freq_hz},
-                                            {"damping_ratio", u.damping_ratio},
-                                            {"relative_visibility", JsonNumber(u.relative_visibility)}});
+    out->unmatched_measured_modes.push_back({{"pose", u.key.pose_id},
+                                             {"direction", Dir(u.key)},
+                                             {"frequency_hz", u.freq_hz},
+                                             {"damping_ratio", u.damping_ratio},
+                                             {"relative_visibility", JsonNumber(u.relative_visibility)}});
     ucsv << "measured," << u.key.pose_id << ',' << AxisName(u.key.response) << ',' << AxisName(u.key.excitation)
          << ",," << FormatCell(u.freq_hz) << ',' << FormatCell(u.damping_ratio) << ',' << FormatCell(u.relative_visibility) << '\n';
   }
-  out.unmatched_modes_csv = ucsv.str();
+  out->unmatched_modes_csv = ucsv.str();
+}
 
-  // ---- pictures
-  const std::vector<size_t> drawn = TrendsToDraw(t);
-  for (size_t i : drawn) out.trends_png_descriptors.push_back(t.trends[i].descriptor);
+// The title of trends.png: which descriptors it draws, n, and the
+// significance threshold (or that there are too few postures for one).
+std::string TrendsFigureTitle(const audit::ErrorTrends& t, const std::vector<size_t>& drawn, const std::string& title) {
   std::string figure_title = title + ": error per posture against the " +
                              (drawn.size() == 1 ? std::string("most correlated descriptor")
                                                 : std::to_string(drawn.size()) + " most correlated descriptors") +
@@ -307,11 +312,14 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
   } else {
     figure_title += "; too few postures for a test)";
   }
-  out.trends_png = TrendsPng(p, drawn, noise_floor, figure_title);
-  out.mode_error_map_png = ModeMapPng(m, title);
+  return figure_title;
+}
 
-  // ---- HTML
-  std::ostringstream h;
+// ---- HTML, first section: the correlations, their table and trends.png
+// with what it shows.
+void WriteTrendsHtml(std::ostringstream& h, const audit::ErrorTrends& t, const AuditPatternsReport& out,
+                     const AuditPatternFiles& files) {
+  const bool has_after = t.error_after.size() > 0;
   h << "<h2>Error against posture descriptors</h2>\n<p>Pearson correlation r of the rms log-magnitude error per "
        "posture with each posture descriptor over n = "
     << t.n << " postures. ";
@@ -357,7 +365,10 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
       << "each panel with its own error scale and the least-squares line whose fit r measures.";
   }
   h << "</p>\n";
+}
 
+// ---- HTML, second section: the error map (or that nothing matched).
+void WriteModeMapHtml(std::ostringstream& h, const AuditPatternsReport& out, const AuditPatternFiles& files) {
   h << "<h2>Error map: postures against model modes</h2>\n";
   if (out.mode_error_map_png.empty()) {
     h << "<p>No measured mode was matched to a model mode: nothing to map.</p>\n";
@@ -368,7 +379,11 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
       << HtmlEscape(files.mode_errors_csv) << "\">" << HtmlEscape(files.mode_errors_csv) << "</a>.</p>\n<p><img src=\""
       << HtmlEscape(files.mode_error_map_png) << "\" alt=\"error map postures x modes\"></p>\n";
   }
+}
 
+// ---- HTML, third section: the modes without a counterpart, measured ones
+// first, and the FRFs where the modal fit found none.
+void WriteUnmatchedHtml(std::ostringstream& h, const audit::ErrorPatterns& p, const AuditPatternFiles& files) {
   h << "<h2>Modes without a counterpart</h2>\n<p>Per FRF: measured modes with no model mode near them (the model "
        "lacks them), and model modes that should show in the FRF (peak contribution |p<sub>r</sub> p<sub>e</sub>|"
        "/(2ζω²) at least 10 % of the largest model mode in the FRF's band) with no measured mode near them. "
@@ -397,6 +412,31 @@ AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, doubl
     for (const auto& k : p.frfs_without_modal_fit) h << ' ' << HtmlEscape(k.pose_id) << " H" << Dir(k);
     h << "; model modes are not checked there.</p>\n";
   }
+}
+
+}  // namespace
+
+AuditPatternsReport MakeAuditPatternsReport(const audit::ErrorPatterns& p, double noise_floor,
+                                            const std::string& title, const AuditPatternFiles& files) {
+  AuditPatternsReport out;
+  const audit::ErrorTrends& t = p.trends;
+
+  AddTrends(t, &out);
+  AddPostureDescriptors(t, &out);
+  AddModeErrorMap(p.mode_map, &out);
+  AddUnmatchedModes(p, &out);
+
+  // ---- pictures
+  const std::vector<size_t> drawn = TrendsToDraw(t);
+  for (size_t i : drawn) out.trends_png_descriptors.push_back(t.trends[i].descriptor);
+  out.trends_png = TrendsPng(p, drawn, noise_floor, TrendsFigureTitle(t, drawn, title));
+  out.mode_error_map_png = ModeMapPng(p.mode_map, title);
+
+  // ---- HTML
+  std::ostringstream h;
+  WriteTrendsHtml(h, t, out, files);
+  WriteModeMapHtml(h, out, files);
+  WriteUnmatchedHtml(h, p, files);
   out.html = h.str();
   return out;
 }

@@ -163,7 +163,7 @@ nlohmann::json NoiseSummaryJson(const calibration::NoiseModels& noise, const std
                          {"usable_lines", n.usable_lines},
                          {"excluded_lines", excluded},
                          {"lines", static_cast<int>(n.usable.size())},
-                         {"converged", n.converged}});
+                         {"status", robomach::ToString(n.status)}});
   }
   return j;
 }
@@ -239,7 +239,7 @@ nlohmann::json CalibrationSummaryJson(const calibration::CalibrationResult& resu
   using nlohmann::json;
   json j;
   j["objective"] = calibration::ObjectiveName(options.objective);
-  j["status"] = calibration::FitStatusName(result.status);
+  j["status"] = robomach::ToString(result.status);
   j["message"] = result.message;
   j["weakly_identified"] = result.weakly_identified;
   j["parameters"] = json::array();
@@ -343,9 +343,7 @@ nlohmann::json CalibrationSummaryJson(const calibration::CalibrationResult& resu
         fits.push_back({{"pose_id", key.pose_id},
                         {"peak_picking", peaks},
                         {"direction", Dir(key)},
-                        {"status", fit.status == calibration::ModalFitStatus::kOk ? "ok"
-                                   : fit.status == calibration::ModalFitStatus::kNoStableModes ? "no_stable_modes"
-                                                                                                 : "failed"},
+                        {"status", robomach::ToString(fit.status)},
                         {"message", fit.message},
                         {"relative_rms_error", fit.relative_rms_error},
                         {"modes", modes}});
@@ -355,6 +353,21 @@ nlohmann::json CalibrationSummaryJson(const calibration::CalibrationResult& resu
     j["sets"][s.label] = set;
   }
   return j;
+}
+
+nlohmann::json FrfCalibrateSummaryJson(const calibration::CalibrationResult& result,
+                                       const calibration::CalibrationOptions& options,
+                                       const std::vector<TableSet>& sets, const nlohmann::json& misfit,
+                                       const calibration::NoiseModels& noise,
+                                       const calibration::NoiseModels& holdout_noise,
+                                       const std::string& noise_model, double min_snr,
+                                       const std::string& robot_path) {
+  nlohmann::json summary = CalibrationSummaryJson(result, options, sets);
+  summary["misfit"] = misfit;
+  summary["noise"] = NoiseSummaryJson(noise, noise_model, min_snr);
+  if (!holdout_noise.empty()) summary["holdout_noise"] = NoiseSummaryJson(holdout_noise, noise_model, min_snr);
+  summary["robot"] = robot_path;
+  return summary;
 }
 
 }  // namespace robomach::report

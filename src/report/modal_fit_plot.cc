@@ -166,7 +166,7 @@ void WriteModalAnalysisPng(const std::string& path, const calibration::PoseModes
   int rows = 0;
   for (const calibration::ModalGroup& g : pose.groups) {
     rows += 1 + 2 * static_cast<int>(FrfsDrawn(g).size());
-    if (g.fit.status == calibration::ModalFitStatus::kOk && calibration::ShapesOfRovingTest(g)) ++rows;
+    if (g.fit.status == SolverStatus::kConverged && calibration::ShapesOfRovingTest(g)) ++rows;
   }
   Figure fig(std::max(1, rows), 1, 1000, 320);
   fig.title = "robomach frf-modes: posture " + pose.pose_id;
@@ -196,7 +196,7 @@ void WriteModalAnalysisPng(const std::string& path, const calibration::PoseModes
       strength.push_back(s);
     }
     FillStabilisationPanel(g.fit.stabilisation, modes, g.fit.fmin_hz, g.fit.fmax_hz, &ax, strength);
-    if (g.fit.status == calibration::ModalFitStatus::kOk) {
+    if (g.fit.status == SolverStatus::kConverged) {
       if (const auto rs = calibration::ShapesOfRovingTest(g)) {
         // The shapes over the roving points: the component in phase with
         // the mode's largest, scaled so that the largest is 1.

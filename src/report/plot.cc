@@ -263,32 +263,58 @@ void PlaceLabels(const cv::Mat1b& ink, const cv::Rect& legend, const std::vector
   }
 }
 
-void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vector<PlacedLabel>* placed,
-                std::vector<PlacedLegend>* legends) {
-  const int left = 80, right = 20, top = 28, bottom = 48;
-  const cv::Rect plot(area.x + left, area.y + top, area.width - left - right,
-                      area.height - top - bottom);
-  Range xr = DataRange(ax, true), yr = DataRange(ax, false);
-  if (std::isfinite(ax.x_min)) xr.lo = ax.x_min;
-  if (std::isfinite(ax.x_max)) xr.hi = ax.x_max;
-  if (std::isfinite(ax.y_min)) yr.lo = ax.y_min;
-  if (std::isfinite(ax.y_max)) yr.hi = ax.y_max;
-  auto tx = [&](double v) {
-    const double t = ax.log_x ? (std::log10(v) - std::log10(xr.lo)) / (std::log10(xr.hi) - std::log10(xr.lo))
-                              : (v - xr.lo) / (xr.hi - xr.lo);
+// The plot area of a panel and its data-to-pixel mapping: every stage of
+// RenderAxes maps through the same ranges, so they are fixed once here.
+struct PlotFrame {
+  cv::Rect plot;
+  Range xr, yr;
+  bool log_x = false, log_y = false;
+  // Image column of the data value v (not rounded).
+  double Tx(double v) const {
+    const double t = log_x ? (std::log10(v) - std::log10(xr.lo)) / (std::log10(xr.hi) - std::log10(xr.lo))
+                           : (v - xr.lo) / (xr.hi - xr.lo);
     return plot.x + t * plot.width;
-  };
-  auto ty = [&](double v) {
-    const double t = ax.log_y ? (std::log10(v) - std::log10(yr.lo)) / (std::log10(yr.hi) - std::log10(yr.lo))
-                              : (v - yr.lo) / (yr.hi - yr.lo);
+  }
+  // Image row of the data value v (not rounded).
+  double Ty(double v) const {
+    const double t = log_y ? (std::log10(v) - std::log10(yr.lo)) / (std::log10(yr.hi) - std::log10(yr.lo))
+                           : (v - yr.lo) / (yr.hi - yr.lo);
     return plot.y + plot.height - t * plot.height;
-  };
-  // Grid and ticks.
+  }
+  // A data point's pixel in the plot area, clamped far outside it.
+  cv::Point ToPx(double x, double y) const {
+    return cv::Point(static_cast<int>(std::lround(std::clamp(Tx(x) - plot.x, -1e4, 1e4))),
+                     static_cast<int>(std::lround(std::clamp(Ty(y) - plot.y, -1e4, 1e4))));
+  }
+};
+
+// The plot area inside `area` (margins for the ticks, labels and title) and
+// the axis ranges: the data's, unless the axes fix them.
+PlotFrame MakePlotFrame(const Axes& ax, cv::Rect area) {
+  const int left = 80, right = 20, top = 28, bottom = 48;
+  PlotFrame f;
+  f.plot = cv::Rect(area.x + left, area.y + top, area.width - left - right, area.height - top - bottom);
+  f.xr = DataRange(ax, true);
+  f.yr = DataRange(ax, false);
+  if (std::isfinite(ax.x_min)) f.xr.lo = ax.x_min;
+  if (std::isfinite(ax.x_max)) f.xr.hi = ax.x_max;
+  if (std::isfinite(ax.y_min)) f.yr.lo = ax.y_min;
+  if (std::isfinite(ax.y_max)) f.yr.hi = ax.y_max;
+  f.log_x = ax.log_x;
+  f.log_y = ax.log_y;
+  return f;
+}
+
+// Grid lines and tick labels of both axes (drawn first: all else goes over
+// them).
+void DrawGridAndTicks(cv::Mat& img, const Axes& ax, const PlotFrame& f) {
+  const cv::Rect& plot = f.plot;
+  const Range &xr = f.xr, &yr = f.yr;
   const auto xt = ax.log_x ? LogTicks(xr.lo, xr.hi) : LinearTicks(xr.lo, xr.hi);
   const auto yt = !ax.y_ticks.empty() ? ax.y_ticks : ax.log_y ? LogTicks(yr.lo, yr.hi)
                                                                : LinearTicks(yr.lo, yr.hi, 5);
   for (double v : xt) {
-    const int x = static_cast<int>(std::lround(tx(v)));
+    const int x = static_cast<int>(std::lround(f.Tx(v)));
     if (x < plot.x - 1 || x > plot.x + plot.width + 1) continue;
     cv::line(img, {x, plot.y}, {x, plot.y + plot.height}, kGrid, 1);
     const std::string s = TickLabel(v, ax.log_x);
@@ -297,22 +323,17 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
   }
   for (double v : yt) {
     if (v < std::min(yr.lo, yr.hi) - 1e-12 * std::abs(yr.hi) || v > std::max(yr.lo, yr.hi) + 1e-12 * std::abs(yr.hi)) continue;
-    const int y = static_cast<int>(std::lround(ty(v)));
+    const int y = static_cast<int>(std::lround(f.Ty(v)));
     cv::line(img, {plot.x, y}, {plot.x + plot.width, y}, kGrid, 1);
     const std::string s = TickLabel(v, ax.log_y);
     const cv::Size sz = TextSize(s);
     PutText(img, s, {plot.x - sz.width - 6, y + sz.height / 2});
   }
-  // Curves, clipped to the plot area. `ink` marks every pixel a curve
-  // covers, widened by a pixel on each side for the antialiased edge: the
-  // marker labels are placed where it is clear (PlaceLabels).
-  cv::Mat roi = img(plot);
-  cv::Mat1b ink(plot.size(), static_cast<unsigned char>(0));
-  // Bands first, blended under the curves.
-  auto to_px = [&](double x, double y) {
-    return cv::Point(static_cast<int>(std::lround(std::clamp(tx(x) - plot.x, -1e4, 1e4))),
-                     static_cast<int>(std::lround(std::clamp(ty(y) - plot.y, -1e4, 1e4))));
-  };
+}
+
+// The series with a y_fill_to: bands between two curves, blended into the
+// plot area `roi` before the curves so that they lie under them.
+void DrawBands(cv::Mat& roi, const Axes& ax, const PlotFrame& f) {
   for (const Series& s : ax.series) {
     if (s.y_fill_to.empty()) continue;
     cv::Mat overlay = roi.clone();
@@ -334,12 +355,19 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
         fill();
         continue;
       }
-      top.push_back(to_px(s.x[i], s.y[i]));
-      bottom.push_back(to_px(s.x[i], s.y_fill_to[i]));
+      top.push_back(f.ToPx(s.x[i], s.y[i]));
+      bottom.push_back(f.ToPx(s.x[i], s.y_fill_to[i]));
     }
     fill();
     cv::addWeighted(overlay, 0.25, roi, 0.75, 0.0, roi);
   }
+}
+
+// The lines and point markers of the other series into the plot area `roi`,
+// each also into `ink` (widened for the antialiased edge) for the placing of
+// the legend and the marker labels.
+void DrawCurves(cv::Mat& roi, cv::Mat1b& ink, const Axes& ax, const PlotFrame& f) {
+  const cv::Rect& plot = f.plot;
   for (const Series& s : ax.series) {
     if (!s.y_fill_to.empty()) continue;  // a band only
     std::vector<cv::Point> pts;
@@ -362,8 +390,8 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
         flush();
         continue;
       }
-      const double px = std::clamp(tx(s.x[i]) - plot.x, -1e4, 1e4);
-      const double py = std::clamp(ty(s.y[i]) - plot.y, -1e4, 1e4);
+      const double px = std::clamp(f.Tx(s.x[i]) - plot.x, -1e4, 1e4);
+      const double py = std::clamp(f.Ty(s.y[i]) - plot.y, -1e4, 1e4);
       const cv::Point p(static_cast<int>(std::lround(px)), static_cast<int>(std::lround(py)));
       if (s.markers) {
         cv::circle(roi, p, 3, ToCv(s.color), cv::FILLED, cv::LINE_AA);
@@ -373,12 +401,24 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
     }
     flush();
   }
-  // The legend's box in a corner inside the plot (drawn last, reserved now
-  // so that no label is put under it): the preferred corner unless it hides
-  // curves or points, else the corner that hides the fewest. Only series
-  // with a point to draw are listed ("measured, not used" when every line
-  // was used would name a curve that is not there).
+}
+
+// The legend of a panel: its entries and its box in image coordinates.
+struct LegendLayout {
   std::vector<const Series*> listed;
+  int count = 0;
+  cv::Rect box;
+};
+
+// The legend's box in a corner inside the plot (drawn last, reserved now
+// so that no label is put under it): the preferred corner unless it hides
+// curves or points, else the corner that hides the fewest. Only series
+// with a point to draw are listed ("measured, not used" when every line
+// was used would name a curve that is not there).
+LegendLayout PlaceLegend(const Axes& ax, const PlotFrame& f, cv::Mat1b& ink) {
+  const cv::Rect& plot = f.plot;
+  LegendLayout lg;
+  std::vector<const Series*>& listed = lg.listed;
   for (const Series& s : ax.series) {
     if (s.label.empty()) continue;
     bool any = false;
@@ -390,6 +430,7 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
   int legend_width = 0;
   for (const Series* s : listed) legend_width = std::max(legend_width, TextSize(s->label).width);
   const int count = static_cast<int>(listed.size());
+  lg.count = count;
   using LP = Axes::LegendPosition;
   const auto legend_box_at = [&](LP corner) {
     const bool at_right = corner == LP::kTopRight || corner == LP::kBottomRight;
@@ -398,7 +439,8 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
     const int y = at_top ? plot.y + 8 : plot.y + plot.height - 18 * count - 10;
     return cv::Rect(x - 6, y - 2, legend_width + 54, 18 * count + 6);
   };
-  cv::Rect legend_box = legend_box_at(ax.legend);
+  cv::Rect& legend_box = lg.box;
+  legend_box = legend_box_at(ax.legend);
   if (count > 0) {
     const auto hidden = [&](const cv::Rect& box) {
       const cv::Rect r = (box - plot.tl()) & cv::Rect(0, 0, ink.cols, ink.rows);
@@ -412,19 +454,40 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
     }
     cv::rectangle(ink, legend_box - plot.tl(), cv::Scalar(255), cv::FILLED);
   }
-  const int legend_x = legend_box.x + 6, legend_y = legend_box.y + 2;
-  // Vertical markers: the dashed lines, then their labels where they cross
-  // no curve, no other label and, if possible, no other marker line.
+  return lg;
+}
+
+// Where RenderAxes reports what it placed: the panel's index and the
+// caller's lists (either may be null).
+struct PanelSink {
+  int panel;
+  std::vector<PlacedLabel>* placed;
+  std::vector<PlacedLegend>* legends;
+};
+
+// How many marker labels a panel had, and how many found no room (the
+// title says so).
+struct MarkerLabelCount {
+  size_t total = 0;
+  int left_out = 0;
+};
+
+// Vertical markers: the dashed lines, then their labels where they cross
+// no curve, no other label and, if possible, no other marker line.
+MarkerLabelCount DrawMarkers(cv::Mat& img, const Axes& ax, const PlotFrame& f, const cv::Mat1b& ink,
+                             const LegendLayout& legend, const PanelSink& out) {
+  const cv::Rect& plot = f.plot;
+  const Range& xr = f.xr;
   std::vector<MarkerLabel> labels;
   std::vector<int> line_x;
   for (const auto& m : ax.markers) {
     if (!std::isfinite(m.x) || m.x < std::min(xr.lo, xr.hi) || m.x > std::max(xr.lo, xr.hi)) continue;
-    const int x = static_cast<int>(std::lround(tx(m.x)));
+    const int x = static_cast<int>(std::lround(f.Tx(m.x)));
     DashedLine(img, {x, plot.y}, {x, plot.y + plot.height}, ToCv(m.color), 1);
     line_x.push_back(x - plot.x);
     if (!m.label.empty()) labels.push_back({m.label, m.x, x - plot.x, ToCv(m.color), m.priority, {}, true, false, true});
   }
-  PlaceLabels(ink, count > 0 ? legend_box - plot.tl() : cv::Rect(), line_x, &labels);
+  PlaceLabels(ink, legend.count > 0 ? legend.box - plot.tl() : cv::Rect(), line_x, &labels);
   int left_out = 0;
   for (MarkerLabel& l : labels) {
     if (!l.placed) {
@@ -438,33 +501,43 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
     if (!l.clear || l.over_line) cv::rectangle(img, box, cv::Scalar(255, 255, 255), cv::FILLED);
     PutText(img, l.text, {box.x + kLabelPad, box.y + box.height - kLabelPad - TextBaseline(l.text, kLabelScale)},
             kLabelScale, l.color);
-    if (placed) placed->push_back({panel, l.text, l.data_x, box.x, box.y, box.width, box.height, l.line_x + plot.x, l.clear,
-                                 l.over_line});
+    if (out.placed) out.placed->push_back({out.panel, l.text, l.data_x, box.x, box.y, box.width, box.height,
+                                           l.line_x + plot.x, l.clear, l.over_line});
   }
-  cv::rectangle(img, plot, kBlack, 1);
-  // Labels and title.
+  return {labels.size(), left_out};
+}
+
+// The axis labels and the panel's title (which counts the marker labels
+// left out for want of room).
+void DrawAxisLabelsAndTitle(cv::Mat& img, const Axes& ax, cv::Rect area, const PlotFrame& f,
+                            const MarkerLabelCount& marks) {
+  const cv::Rect& plot = f.plot;
   const cv::Size xs = TextSize(ax.x_label);
   PutText(img, ax.x_label, {plot.x + plot.width / 2 - xs.width / 2, area.y + area.height - 8});
   PutVerticalText(img, ax.y_label, {area.x + 14, plot.y + plot.height / 2});
   std::string title = ax.title;
-  if (left_out > 0) {
-    title += std::string(title.empty() ? "" : " ") + "(" + std::to_string(left_out) + " of " +
-             std::to_string(labels.size()) + " line labels left out: no room)";
+  if (marks.left_out > 0) {
+    title += std::string(title.empty() ? "" : " ") + "(" + std::to_string(marks.left_out) + " of " +
+             std::to_string(marks.total) + " line labels left out: no room)";
   }
   if (!title.empty()) {
     PutText(img, title, {plot.x, area.y + 19}, 0.55, kBlack, 1);
   }
-  // Legend.
-  int lx = legend_x, ly = legend_y;
-  if (count > 0) {
-    if (legends) {
-      PlacedLegend pl{panel, {}, legend_box.x, legend_box.y, legend_box.width, legend_box.height};
-      for (const Series* s : listed) pl.entries.push_back(s->label);
-      legends->push_back(std::move(pl));
+}
+
+// The legend, drawn last over everything in the box PlaceLegend chose.
+void DrawLegend(cv::Mat& img, const LegendLayout& legend, const PanelSink& out) {
+  const cv::Rect& legend_box = legend.box;
+  int lx = legend_box.x + 6, ly = legend_box.y + 2;
+  if (legend.count > 0) {
+    if (out.legends) {
+      PlacedLegend pl{out.panel, {}, legend_box.x, legend_box.y, legend_box.width, legend_box.height};
+      for (const Series* s : legend.listed) pl.entries.push_back(s->label);
+      out.legends->push_back(std::move(pl));
     }
     cv::rectangle(img, legend_box, cv::Scalar(255, 255, 255), cv::FILLED);
     cv::rectangle(img, legend_box, cv::Scalar(180, 180, 180), 1);
-    for (const Series* sp : listed) {
+    for (const Series* sp : legend.listed) {
       const Series& s = *sp;
       if (s.dashed) DashedLine(img, {lx, ly + 9}, {lx + 36, ly + 9}, ToCv(s.color), s.thickness);
       else if (s.markers) cv::circle(img, {lx + 18, ly + 9}, 3, ToCv(s.color), cv::FILLED);
@@ -473,6 +546,29 @@ void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vec
       ly += 18;
     }
   }
+}
+
+void RenderAxes(cv::Mat& img, const Axes& ax, cv::Rect area, int panel, std::vector<PlacedLabel>* placed,
+                std::vector<PlacedLegend>* legends) {
+  const PlotFrame f = MakePlotFrame(ax, area);
+  // Grid and ticks.
+  DrawGridAndTicks(img, ax, f);
+  // Curves, clipped to the plot area. `ink` marks every pixel a curve
+  // covers, widened by a pixel on each side for the antialiased edge: the
+  // marker labels are placed where it is clear (PlaceLabels).
+  cv::Mat roi = img(f.plot);
+  cv::Mat1b ink(f.plot.size(), static_cast<unsigned char>(0));
+  // Bands first, blended under the curves.
+  DrawBands(roi, ax, f);
+  DrawCurves(roi, ink, ax, f);
+  const LegendLayout legend = PlaceLegend(ax, f, ink);
+  const PanelSink out{panel, placed, legends};
+  const MarkerLabelCount marks = DrawMarkers(img, ax, f, ink, legend, out);
+  cv::rectangle(img, f.plot, kBlack, 1);
+  // Labels and title.
+  DrawAxisLabelsAndTitle(img, ax, area, f, marks);
+  // Legend.
+  DrawLegend(img, legend, out);
 }
 
 }  // namespace

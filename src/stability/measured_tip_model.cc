@@ -44,7 +44,7 @@ DirectFrfFit FitDirectFrf(const dynamics::Frf& measured, const DirectFrfFitOptio
   out.active_fraction = positive_f > 0 ? static_cast<double>(active) / positive_f : 0.0;
   out.not_driving_point = out.active_fraction > o.max_active_fraction;
   out.fit = calibration::FitOneFrf(usable, o.fit);
-  if (out.fit.status != calibration::ModalFitStatus::kOk || out.fit.modes.empty()) {
+  if (out.fit.status != SolverStatus::kConverged || out.fit.modes.empty()) {
     out.problem = "modal fit: " + out.fit.message;
     return out;
   }

@@ -65,13 +65,26 @@ struct Worker {
 
 }  // namespace
 
-std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::RobotModel> model,
-                                           const std::vector<ToolPoseTarget>& targets, int rows,
-                                           int cols, const MillingProcess& process,
-                                           const MapOptions& options) {
-  process.Validate();
-  const int n = model->num_joints();
-  if (rows < 1 || cols < 1 || static_cast<size_t>(rows) * cols != targets.size()) {
+namespace {
+
+// What the stages of EvaluateStabilityMap share: the grid of targets, the
+// process and options, and the points being filled in (references to the
+// caller's arguments and locals, which outlive the stages).
+struct MapGrid {
+  const std::vector<ToolPoseTarget>& targets;
+  int rows;
+  int cols;
+  const MillingProcess& process;
+  const MapOptions& options;
+  const kinematics::SerialChain& chain;  // the shared model's: its joint limits only
+  int n;                                 // joints
+  double rot0;                           // the rotation every point starts from
+  std::vector<MapPoint>& out;            // row-major, rows x cols
+};
+
+// The arguments' checks (a robot of n joints), before any work.
+void CheckMapArguments(int n, size_t targets, int rows, int cols, const MapOptions& options) {
+  if (rows < 1 || cols < 1 || static_cast<size_t>(rows) * cols != targets) {
     throw std::invalid_argument("stability map: rows x cols must equal the number of targets");
   }
   if (options.seed_q.size() != n) {
@@ -86,170 +99,201 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
     throw std::invalid_argument("stability map: threads: expected >= 0 (0 = all cores), got " +
                                 std::to_string(options.threads));
   }
+}
+
+// IK of point i at rot0 from `seed`, with its status; false if unreachable.
+bool IkPoint(const MapGrid& g, IkSolver& ik, long i, const Eigen::VectorXd& seed) {
+  MapPoint& p = g.out[i];
+  p.rotation = g.rot0;
+  Eigen::VectorXd q;
+  const bool reached = ik.Solve(g.targets[i].Pose(g.rot0), seed, &q);
+  p.q = q;
+  if (!reached) {
+    p.status = PointStatus::kUnreachable;
+  } else if (!g.chain.JointsOutsideLimits(q).empty()) {
+    p.status = PointStatus::kJointLimits;
+  } else if (g.n >= 5 && q(4) * g.options.seed_q(4) < 0.0) {
+    // The sign of the wrist bend q5 tells the wrist configuration.
+    p.status = PointStatus::kOtherConfiguration;
+  } else {
+    p.status = PointStatus::kOk;
+  }
+  return p.status != PointStatus::kUnreachable;
+}
+
+// Every point's IK posture and status into g.out: the first column
+// top-down from the seed, then the rows in parallel, each from the posture
+// of its first point (each row continues from its last solved point).
+void SolveIk(const MapGrid& g, const dynamics::RobotModel& model, int threads) {
+  const int rows = g.rows, cols = g.cols;
+  {
+    IkSolver ik(g.chain);
+    Eigen::VectorXd seed = g.options.seed_q;
+    for (int r = 0; r < rows; ++r) {
+      if (IkPoint(g, ik, static_cast<long>(r) * cols, seed) &&
+          g.out[static_cast<long>(r) * cols].status == PointStatus::kOk) {
+        seed = g.out[static_cast<long>(r) * cols].q;
+      }
+    }
+  }
+  // Rows in parallel, each from its first point (one IK solver per thread,
+  // each on its own copy of the chain).
+  const int t_ik = std::min(threads, rows);
+  std::vector<std::shared_ptr<const dynamics::RobotModel>> copies;
+  std::vector<std::unique_ptr<IkSolver>> solvers;
+  for (int t = 0; t < t_ik; ++t) {
+    copies.push_back(PrivateCopy(model));
+    solvers.push_back(std::make_unique<IkSolver>(copies.back()->chain()));
+  }
+  ParallelForOptions po;
+  po.threads = t_ik;
+  po.chunk_size = 1;
+  ParallelFor(
+      0, rows,
+      [&](long r, int t) {
+        const long first = r * cols;
+        Eigen::VectorXd seed = g.out[first].status == PointStatus::kOk ? g.out[first].q : g.options.seed_q;
+        for (int c = 1; c < cols; ++c) {
+          if (IkPoint(g, *solvers[t], first + c, seed) && g.out[first + c].status == PointStatus::kOk) {
+            seed = g.out[first + c].q;
+          }
+        }
+      },
+      po);
+}
+
+// The stability of point i at posture q and tool rotation `rotation` into
+// *s and cond(J) into *cond; returns whether the posture is near singular.
+bool EvaluateAt(const MapGrid& g, Worker& w, long i, const Eigen::VectorXd& q, double rotation,
+                PostureStability* s, double* cond) {
+  const dynamics::PostureDynamics d = w.evaluator.Evaluate(q, dynamics::PostureOptions{false, true});
+  *cond = d.jacobian_condition;
+  *s = AnalysePosture(d, CuttingFrameAtPosture(g.targets[i].Pose(rotation), g.targets[i].feed_B), g.process,
+                      g.options.analysis);
+  return d.near_singular;
+}
+
+// The tool rotation of point i with the deepest critical depth in
+// [rotation_min, rotation_max]: a coarse scan, then NLopt around its best.
+// A better rotation replaces the point's posture, stability and condition,
+// and *singular with its own.
+void OptimiseRotation(const MapGrid& g, Worker& w, long i, bool* singular) {
+  const MapOptions& options = g.options;
+  MapPoint& p = g.out[i];
+  const Eigen::VectorXd q_start = p.q;
+  auto depth_at = [&](double rot, Eigen::VectorXd* q_out, PostureStability* s, double* cond,
+                      bool* sing) -> double {
+    Eigen::VectorXd q;
+    if (!w.ik.Solve(g.targets[i].Pose(rot), q_start, &q)) return 0.0;
+    if (!g.chain.JointsOutsideLimits(q).empty()) return 0.0;
+    *sing = EvaluateAt(g, w, i, q, rot, s, cond);
+    *q_out = q;
+    return std::isfinite(s->critical_depth) ? s->critical_depth : 0.0;
+  };
+  double best = std::isfinite(p.stability.critical_depth) ? p.stability.critical_depth : 0.0;
+  double best_rot = p.rotation;
+  auto consider = [&](double rot) {
+    Eigen::VectorXd q;
+    PostureStability s;
+    double cond = NAN;
+    bool sing = false;
+    const double v = depth_at(rot, &q, &s, &cond, &sing);
+    if (v > best) {
+      best = v;
+      best_rot = rot;
+      p.q = q;
+      p.stability = s;
+      p.jacobian_condition = cond;
+      *singular = sing;
+    }
+    return v;
+  };
+  // Coarse scan: the depth is not unimodal in the rotation.
+  constexpr int kScan = 7;
+  for (int j = 0; j < kScan; ++j) {
+    consider(options.rotation_min + (options.rotation_max - options.rotation_min) * j / (kScan - 1));
+  }
+  // Local refinement with NLopt around the best scan point.
+  nlopt::opt opt(nlopt::LN_COBYLA, 1);
+  const double h = (options.rotation_max - options.rotation_min) / (kScan - 1);
+  opt.set_lower_bounds(std::max(options.rotation_min, best_rot - h));
+  opt.set_upper_bounds(std::min(options.rotation_max, best_rot + h));
+  opt.set_maxeval(std::max(1, options.rotation_evaluations - kScan));
+  opt.set_xtol_abs(1e-3);
+  opt.set_initial_step(0.25 * h);
+  // An exception in the objective is kept and rethrown after the run, as
+  // in the scan above: NLopt's wrapper would report it as a generic
+  // "nlopt failure" status.
+  struct Objective {
+    decltype(consider)* f;
+    std::exception_ptr error;
+  } objective{&consider, nullptr};
+  opt.set_max_objective(
+      [](unsigned, const double* x, double*, void* data) {
+        auto* o = static_cast<Objective*>(data);
+        try {
+          return (*o->f)(x[0]);
+        } catch (...) {
+          o->error = std::current_exception();
+          throw nlopt::forced_stop();
+        }
+      },
+      &objective);
+  std::vector<double> x{best_rot};
+  double fx = 0.0;
+  try {
+    const nlopt::result r = opt.optimize(x, fx);
+    p.optimiser_status = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : "converged";
+  } catch (const nlopt::roundoff_limited&) {
+    p.optimiser_status = "roundoff_limited";
+  } catch (const nlopt::forced_stop&) {
+    if (objective.error) std::rethrow_exception(objective.error);
+    p.optimiser_status = "forced_stop";
+  } catch (const std::runtime_error& e) {
+    p.optimiser_status = std::string("failed: ") + e.what();  // NLopt's own failure
+  }
+  p.rotation = best_rot;
+}
+
+// 2. Stability of point i (if its IK found a posture), with the worker of
+// the calling thread.
+void AnalysePoint(const MapGrid& g, Worker& w, long i) {
+  MapPoint& p = g.out[i];
+  if (p.status != PointStatus::kOk && p.status != PointStatus::kOtherConfiguration) return;
+  bool singular = EvaluateAt(g, w, i, p.q, p.rotation, &p.stability, &p.jacobian_condition);
+  if (g.options.optimise_rotation) OptimiseRotation(g, w, i, &singular);
+  if (singular) p.status = PointStatus::kNearSingular;
+}
+
+}  // namespace
+
+std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::RobotModel> model,
+                                           const std::vector<ToolPoseTarget>& targets, int rows,
+                                           int cols, const MillingProcess& process,
+                                           const MapOptions& options) {
+  process.Validate();
+  const int n = model->num_joints();
+  CheckMapArguments(n, targets.size(), rows, cols, options);
   const int threads = ResolveThreadCount(options.threads);
   const long total = static_cast<long>(targets.size());
   std::vector<MapPoint> out(total);
   const double rot0 = options.optimise_rotation
                           ? std::clamp(options.rotation, options.rotation_min, options.rotation_max)
                           : options.rotation;
-  const auto& chain = model->chain();
-
-  auto ik_point = [&](IkSolver& ik, long i, const Eigen::VectorXd& seed) {
-    MapPoint& p = out[i];
-    p.rotation = rot0;
-    Eigen::VectorXd q;
-    const bool reached = ik.Solve(targets[i].Pose(rot0), seed, &q);
-    p.q = q;
-    if (!reached) {
-      p.status = PointStatus::kUnreachable;
-    } else if (!chain.JointsOutsideLimits(q).empty()) {
-      p.status = PointStatus::kJointLimits;
-    } else if (n >= 5 && q(4) * options.seed_q(4) < 0.0) {
-      // The sign of the wrist bend q5 tells the wrist configuration.
-      p.status = PointStatus::kOtherConfiguration;
-    } else {
-      p.status = PointStatus::kOk;
-    }
-    return p.status != PointStatus::kUnreachable;
-  };
+  const MapGrid g{targets, rows, cols, process, options, model->chain(), n, rot0, out};
 
   // 1. IK: the first column top-down, then every row from its first point.
-  {
-    IkSolver ik(chain);
-    Eigen::VectorXd seed = options.seed_q;
-    for (int r = 0; r < rows; ++r) {
-      if (ik_point(ik, static_cast<long>(r) * cols, seed) &&
-          out[static_cast<long>(r) * cols].status == PointStatus::kOk) {
-        seed = out[static_cast<long>(r) * cols].q;
-      }
-    }
-  }
-  {
-    // Rows in parallel, each from its first point (one IK solver per thread,
-    // each on its own copy of the chain).
-    const int t_ik = std::min(threads, rows);
-    std::vector<std::shared_ptr<const dynamics::RobotModel>> copies;
-    std::vector<std::unique_ptr<IkSolver>> solvers;
-    for (int t = 0; t < t_ik; ++t) {
-      copies.push_back(PrivateCopy(*model));
-      solvers.push_back(std::make_unique<IkSolver>(copies.back()->chain()));
-    }
-    ParallelForOptions po;
-    po.threads = t_ik;
-    po.chunk_size = 1;
-    ParallelFor(
-        0, rows,
-        [&](long r, int t) {
-          const long first = r * cols;
-          Eigen::VectorXd seed = out[first].status == PointStatus::kOk ? out[first].q : options.seed_q;
-          for (int c = 1; c < cols; ++c) {
-            if (ik_point(*solvers[t], first + c, seed) && out[first + c].status == PointStatus::kOk) {
-              seed = out[first + c].q;
-            }
-          }
-        },
-        po);
-  }
+  SolveIk(g, *model, threads);
 
   // 2. Stability per point, one evaluator per thread.
   std::vector<std::unique_ptr<Worker>> workers;
   for (int t = 0; t < threads; ++t) workers.push_back(std::make_unique<Worker>(*model));
 
-  auto analyse = [&](Worker& w, long i) {
-    MapPoint& p = out[i];
-    if (p.status != PointStatus::kOk && p.status != PointStatus::kOtherConfiguration) return;
-    auto evaluate = [&](const Eigen::VectorXd& q, double rotation, PostureStability* s,
-                        double* cond) -> bool {
-      const dynamics::PostureDynamics d = w.evaluator.Evaluate(q, dynamics::PostureOptions{false, true});
-      *cond = d.jacobian_condition;
-      *s = AnalysePosture(d, CuttingFrameAtPosture(targets[i].Pose(rotation), targets[i].feed_B),
-                          process, options.analysis);
-      return d.near_singular;
-    };
-    bool singular = evaluate(p.q, p.rotation, &p.stability, &p.jacobian_condition);
-    if (options.optimise_rotation) {
-      const Eigen::VectorXd q_start = p.q;
-      auto depth_at = [&](double rot, Eigen::VectorXd* q_out, PostureStability* s, double* cond,
-                          bool* sing) -> double {
-        Eigen::VectorXd q;
-        if (!w.ik.Solve(targets[i].Pose(rot), q_start, &q)) return 0.0;
-        if (!chain.JointsOutsideLimits(q).empty()) return 0.0;
-        *sing = evaluate(q, rot, s, cond);
-        *q_out = q;
-        return std::isfinite(s->critical_depth) ? s->critical_depth : 0.0;
-      };
-      double best = std::isfinite(p.stability.critical_depth) ? p.stability.critical_depth : 0.0;
-      double best_rot = p.rotation;
-      auto consider = [&](double rot) {
-        Eigen::VectorXd q;
-        PostureStability s;
-        double cond = NAN;
-        bool sing = false;
-        const double v = depth_at(rot, &q, &s, &cond, &sing);
-        if (v > best) {
-          best = v;
-          best_rot = rot;
-          p.q = q;
-          p.stability = s;
-          p.jacobian_condition = cond;
-          singular = sing;
-        }
-        return v;
-      };
-      // Coarse scan: the depth is not unimodal in the rotation.
-      constexpr int kScan = 7;
-      for (int j = 0; j < kScan; ++j) {
-        consider(options.rotation_min + (options.rotation_max - options.rotation_min) * j / (kScan - 1));
-      }
-      // Local refinement with NLopt around the best scan point.
-      nlopt::opt opt(nlopt::LN_COBYLA, 1);
-      const double h = (options.rotation_max - options.rotation_min) / (kScan - 1);
-      opt.set_lower_bounds(std::max(options.rotation_min, best_rot - h));
-      opt.set_upper_bounds(std::min(options.rotation_max, best_rot + h));
-      opt.set_maxeval(std::max(1, options.rotation_evaluations - kScan));
-      opt.set_xtol_abs(1e-3);
-      opt.set_initial_step(0.25 * h);
-      // An exception in the objective is kept and rethrown after the run, as
-      // in the scan above: NLopt's wrapper would report it as a generic
-      // "nlopt failure" status.
-      struct Objective {
-        decltype(consider)* f;
-        std::exception_ptr error;
-      } objective{&consider, nullptr};
-      opt.set_max_objective(
-          [](unsigned, const double* x, double*, void* data) {
-            auto* o = static_cast<Objective*>(data);
-            try {
-              return (*o->f)(x[0]);
-            } catch (...) {
-              o->error = std::current_exception();
-              throw nlopt::forced_stop();
-            }
-          },
-          &objective);
-      std::vector<double> x{best_rot};
-      double fx = 0.0;
-      try {
-        const nlopt::result r = opt.optimize(x, fx);
-        p.optimiser_status = r == nlopt::MAXEVAL_REACHED ? "max_evaluations" : "converged";
-      } catch (const nlopt::roundoff_limited&) {
-        p.optimiser_status = "roundoff_limited";
-      } catch (const nlopt::forced_stop&) {
-        if (objective.error) std::rethrow_exception(objective.error);
-        p.optimiser_status = "forced_stop";
-      } catch (const std::runtime_error& e) {
-        p.optimiser_status = std::string("failed: ") + e.what();  // NLopt's own failure
-      }
-      p.rotation = best_rot;
-    }
-    if (singular) p.status = PointStatus::kNearSingular;
-  };
-
   ParallelForOptions po;
   po.threads = threads;
   po.chunk_size = 1;  // a point costs 0.1-5 ms (more with optimise_rotation): no need to batch
   po.progress = options.progress;
-  ParallelFor(0, total, [&](long i, int t) { analyse(*workers[t], i); }, po);
+  ParallelFor(0, total, [&](long i, int t) { AnalysePoint(g, *workers[t], i); }, po);
   return out;
 }
 

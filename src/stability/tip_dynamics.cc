@@ -215,36 +215,274 @@ TipDynamics TipFromModes(const std::string& id, const TipModalModel& modes_B, co
   return t;
 }
 
-std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, const std::vector<TipFrfs>& ysets,
-                                              const MeasuredTipOptions& o, const MessageSink& on_message) {
-  auto tell = [&](Message::Kind kind, const std::string& text) {
-    if (on_message) on_message({kind, text});
-  };
-  auto frame = [&]() -> Eigen::Matrix3d {
-    if (!o.cutting_frame) throw std::invalid_argument("TipsFromMeasuredFrfs: the FRFs need a cutting frame, and none was given");
-    return o.cutting_frame();
-  };
-  auto only_direct = [](const TipFrfs& s, const std::string& path, const std::string& id, const std::string& option) {
-    int total = 0;
-    const std::vector<int> d = DirectFrfs(s, &total);
-    if (d.size() != 1 || total != 1) {
-      throw InputError({path, 0, 0}, "posture " + id + ": with --frf-y, " + option + " must give exactly one direct FRF; it gives " +
-                                         std::to_string(total) + " FRFs, " + std::to_string(d.size()) + " of them direct");
-    }
-    return d[0];
-  };
-  std::vector<TipDynamics> tips;
-  bool noted = false;
-  // A unit finding is said before the fits' reports (a kHz axis came after
-  // 60 lines of fits in kHz); ComputeLobes flags it without saying it again.
-  auto say_units = [&](TipDynamics* t) {
-    if (t->unit_finding.empty()) return;
-    tell(Message::Kind::kWarning, "implausible (unit mistake?): " + t->unit_finding);
-    t->unit_finding_said = static_cast<bool>(on_message);  // else ComputeLobes says it
-  };
+namespace {
+
+// What the postures of one TipsFromMeasuredFrfs call share: the files, the
+// options, the message sink, and what is said once for all postures.
+struct MeasuredTipsContext {
+  const std::vector<TipFrfs>& sets;   // --frf
+  const std::vector<TipFrfs>& ysets;  // --frf-y (empty: none)
+  const MeasuredTipOptions& o;
+  const MessageSink& on_message;
+  bool noted = false;  // the note of a symmetric tool said
   // Missing cross FRFs, said once for the file (a direct-only test of five
   // postures gave ten warnings).
   std::map<std::string, std::string> no_cross;  // posture -> its missing pairs ("xy, yx")
+
+  void Tell(Message::Kind kind, const std::string& text) const {
+    if (on_message) on_message({kind, text});
+  }
+  // The cutting frame; the FRFs of a posture with more than one direction need it.
+  Eigen::Matrix3d Frame() const {
+    if (!o.cutting_frame) throw std::invalid_argument("TipsFromMeasuredFrfs: the FRFs need a cutting frame, and none was given");
+    return o.cutting_frame();
+  }
+  // A unit finding is said before the fits' reports (a kHz axis came after
+  // 60 lines of fits in kHz); ComputeLobes flags it without saying it again.
+  void SayUnits(TipDynamics* t) const {
+    if (t->unit_finding.empty()) return;
+    Tell(Message::Kind::kWarning, "implausible (unit mistake?): " + t->unit_finding);
+    t->unit_finding_said = static_cast<bool>(on_message);  // else ComputeLobes says it
+  }
+};
+
+// The one direct FRF of posture `id` of a file given with --frf-y (`option`
+// names the file's flag); throws an InputError if it gives anything else.
+int OnlyDirect(const TipFrfs& s, const std::string& path, const std::string& id, const std::string& option) {
+  int total = 0;
+  const std::vector<int> d = DirectFrfs(s, &total);
+  if (d.size() != 1 || total != 1) {
+    throw InputError({path, 0, 0}, "posture " + id + ": with --frf-y, " + option + " must give exactly one direct FRF; it gives " +
+                                       std::to_string(total) + " FRFs, " + std::to_string(d.size()) + " of them direct");
+  }
+  return d[0];
+}
+
+// t->Phi_C diagonal, hx along x_C and hy along y_C, from line `first` on
+// (t->freq_hz's lines).
+void SetDiagonal(TipDynamics* t, Eigen::Index first, const Eigen::VectorXcd& hx, const Eigen::VectorXcd& hy) {
+  t->Phi_C.assign(t->freq_hz.size(), Eigen::Matrix2cd::Zero());
+  for (Eigen::Index k = 0; k < t->freq_hz.size(); ++k) {
+    t->Phi_C[k](0, 0) = hx(k + first);
+    t->Phi_C[k](1, 1) = hy(k + first);
+  }
+}
+
+// The tip of posture s from two files, one direct FRF each: along the feed
+// (x_C, --frf) and normal to it (y_C, --frf-y). `first`: the first line kept.
+void TipFromTwoFiles(const MeasuredTipsContext& c, const TipFrfs& s, Eigen::Index first, TipDynamics* t_ptr) {
+  TipDynamics& t = *t_ptr;
+  const MeasuredTipOptions& o = c.o;
+  const std::string& id = t.id;
+  const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY();
+  const int a = OnlyDirect(s, o.frf_path, id, "--frf");
+  const TipFrfs* y = nullptr;
+  for (const TipFrfs& yc : c.ysets) {
+    if (ShownId(yc.pose_id, o.frf_y_path) == id || (yc.pose_id == s.pose_id)) y = &yc;
+  }
+  if (!y && c.sets.size() == 1 && c.ysets.size() == 1) y = &c.ysets.front();
+  if (!y) throw InputError({o.frf_y_path, 0, 0}, "no posture " + id + " in the file (--frf-y)");
+  const int b = OnlyDirect(*y, o.frf_y_path, id, "--frf-y");
+  if (y->freq_hz.size() != s.freq_hz.size() || y->freq_hz != s.freq_hz) {
+    throw InputError({o.frf_y_path, 0, 0}, "posture " + id + ": the FRF of --frf-y uses another frequency grid than "
+                                               "the one of --frf; both must use the same lines");
+  }
+  if (const std::string fy = TipFrfsUnitFinding(*y); !fy.empty()) {
+    t.unit_finding += (t.unit_finding.empty() ? "" : "; ") + fy;
+  }
+  const dynamics::Frf hx = DirectFrf(s, a), hy = DirectFrf(*y, b);
+  SetDiagonal(&t, first, hx.receptance(), hy.receptance());
+  c.SayUnits(&t);
+  if (o.fit) {
+    t.fits.push_back(FitOne(id + " " + Hname(a, a) + " (feed, x of the cut)", hx, c.on_message));
+    t.fits.push_back(FitOrReuse(id + " " + Hname(b, b) + " (normal to the feed, y of the cut)", hy, t.fits,
+                                c.on_message));
+    t.fit_C = Concatenate({ModesAlong(t.fits[0].fit.fit, ex), ModesAlong(t.fits[1].fit.fit, ey)});
+    t.modes_C = Concatenate({DominantModes(ModesAlong(t.fits[0].fit.fit, ex), o.sd_modes),
+                             DominantModes(ModesAlong(t.fits[1].fit.fit, ey), o.sd_modes)});
+  }
+  t.R_BC = c.Frame();
+}
+
+// The tip of posture s from its one direct FRF (direction a): a symmetric
+// tool (issue #18). `first`: the first line kept.
+void TipFromOneDirect(MeasuredTipsContext& c, const TipFrfs& s, int a, Eigen::Index first, TipDynamics* t_ptr) {
+  TipDynamics& t = *t_ptr;
+  const MeasuredTipOptions& o = c.o;
+  const std::string& id = t.id;
+  const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY();
+  const dynamics::Frf h = DirectFrf(s, a);
+  SetDiagonal(&t, first, h.receptance(), h.receptance());
+  if (!c.noted) {
+    c.Tell(Message::Kind::kNote, id + " has one direct FRF (" + Hname(a, a) +
+                                     "): the tool is taken as symmetric, this FRF in both in-plane directions of "
+                                     "the cut and no cross terms; --tool-axis does not apply");
+    c.noted = true;
+  }
+  c.SayUnits(&t);
+  if (o.fit) {
+    t.fits.push_back(FitOne(id + " " + Hname(a, a), h, c.on_message));
+    const TipModalModel mx = DominantModes(ModesAlong(t.fits[0].fit.fit, ex), o.sd_modes);
+    const TipModalModel my = DominantModes(ModesAlong(t.fits[0].fit.fit, ey), o.sd_modes);
+    t.modes_C = Concatenate({mx, my});
+    t.fit_C = Concatenate({ModesAlong(t.fits[0].fit.fit, ex), ModesAlong(t.fits[0].fit.fit, ey)});
+  }
+  // The modal table is written for the default tool axis (z) unless one is given.
+  if (o.cutting_frame) {
+    try {
+      t.R_BC = o.cutting_frame();
+    } catch (const InputError&) {
+      t.R_BC = Eigen::Matrix3d::Identity();
+    }
+  }
+}
+
+// The modes of a tip of several FRFs in the base frame: a fit of each
+// direct FRF of the base directions `dirs` that span the cutting plane
+// (frame R), and, where a cross FRF couples two of them, one model of the
+// two directions.
+void FitBaseFrameModes(const MeasuredTipsContext& ctx, const TipFrfs& s, const std::vector<int>& dirs,
+                       const Eigen::Matrix3d& R, TipDynamics* t_ptr) {
+  TipDynamics& t = *t_ptr;
+  const MeasuredTipOptions& o = ctx.o;
+  const std::string& id = t.id;
+  std::vector<TipModalModel> parts, all;
+  for (int a : dirs) {
+    t.fits.push_back(FitOrReuse(id + " " + Hname(a, a), DirectFrf(s, a), t.fits, ctx.on_message));
+    all.push_back(ModesAlong(t.fits.back().fit.fit, Eigen::Vector3d::Unit(a)).Rotated(R));
+    parts.push_back(DominantModes(all.back(), o.sd_modes));
+  }
+  t.modes_C = Concatenate(parts);
+  t.fit_C = Concatenate(all);
+  bool two_dir_model = false;  // the modes of two directions coupled by the cross FRF
+  bool cross = false;
+  for (int a : dirs) {
+    for (int b : dirs) cross |= a != b && s.present[a][b];
+  }
+  if (cross && dirs.size() == 2) {
+    // Two base directions span the cutting plane: a mode seen in both
+    // direct FRFs is one mode whose shape's sign the cross FRF gives.
+    const int a = dirs[0], b = dirs[1];
+    const int r = s.present[a][b] ? a : b, c = s.present[a][b] ? b : a;
+    const auto [lo, hi] = CommonUsableBand(t.fits);
+    std::vector<int> lines;
+    for (Eigen::Index k = 0; k < s.freq_hz.size(); ++k) {
+      if (s.freq_hz(k) >= lo && s.freq_hz(k) <= hi) lines.push_back(static_cast<int>(k));
+    }
+    if (lines.size() >= 8) {
+      Eigen::VectorXcd h(s.freq_hz.size());
+      for (Eigen::Index k = 0; k < h.size(); ++k) h(k) = s.H[k](r, c);
+      const dynamics::Frf cross_frf = dynamics::Frf::FromSamples(s.freq_hz, h).Select(lines);
+      t.fit_C = ModesOfTwoDirections(t.fits[0].fit.fit, Eigen::Vector3d::Unit(a), t.fits[1].fit.fit,
+                                     Eigen::Vector3d::Unit(b), cross_frf)
+                    .Rotated(R);
+      t.modes_C = DominantModes(t.fit_C, 2 * o.sd_modes);
+      two_dir_model = true;
+      ctx.Tell(Message::Kind::kNote, id + ": a mode found in both " + Hname(a, a) + " and " + Hname(b, b) +
+                                         " is one mode of the SD's model, its shape's sign from the cross FRF " +
+                                         Hname(r, c));
+    }
+  } else if (cross) {
+    ctx.Tell(Message::Kind::kNote, id + ": the SD's modal model is fitted to the direct FRFs; the cross FRFs "
+                                       "of the file are used by the ZOA only");
+  }
+  t.fit_lacks_cross = cross && !two_dir_model;
+}
+
+// The tip of posture s from several FRFs in the base frame, oriented by the
+// tool axis; a missing cross FRF is noted in c.no_cross. `first`: the
+// first line kept.
+void TipFromBaseFrame(MeasuredTipsContext& c, const TipFrfs& s, Eigen::Index first, TipDynamics* t_ptr) {
+  TipDynamics& t = *t_ptr;
+  const MeasuredTipOptions& o = c.o;
+  const std::string& id = t.id;
+  const Eigen::Matrix3d R = c.Frame();
+  t.R_BC = R;
+  std::vector<int> dirs;
+  for (int a = 0; a < 3; ++a) {
+    if (R.col(0).cwiseAbs()(a) > 1e-9 || R.col(1).cwiseAbs()(a) > 1e-9) dirs.push_back(a);
+  }
+  for (int a : dirs) {
+    for (int b : dirs) {
+      if (!s.present[a][b]) {
+        if (a == b) {
+          throw InputError({o.frf_path, 0, 0}, "posture " + id + ": the cutting plane (" + o.tool_axis_source +
+                                                   ") needs FRF " + "xyz"[a] + "xyz"[b] +
+                                                   ", which the file does not give; give a --tool-axis whose "
+                                                   "cutting plane the file's directions span, or the second "
+                                                   "direction with --frf-y from a file of one direct FRF");
+        }
+        std::string& pairs = c.no_cross[id];
+        pairs += (pairs.empty() ? "" : ", ") + std::string(1, "xyz"[a]) + "xyz"[b];
+      }
+    }
+  }
+  std::vector<Eigen::Matrix3cd> H(s.H.begin() + first, s.H.end());
+  t.Phi_C = OrientInCuttingPlane(H, R);
+  c.SayUnits(&t);
+  if (o.fit) FitBaseFrameModes(c, s, dirs, R, &t);
+}
+
+// After the fits: the ZOA's lines limited to the common usable band, then
+// refined between the measured lines (RefineBetweenLines), each told.
+void FitToUsableBand(const MeasuredTipsContext& c, TipDynamics* t_ptr) {
+  TipDynamics& t = *t_ptr;
+  const std::string& id = t.id;
+  t.modes_fitted = true;
+  t.no_modes = t.modes_C.num_modes() == 0;
+  // The ZOA uses the measured FRF where the noise model finds it usable
+  // in every fitted direction: below that (the drift of an integrated
+  // accelerometer signal) and above it (the floor) a line says nothing
+  // of the structure, and a drift 5x the resonance makes spurious
+  // lobes of a few hertz.
+  const auto [lo, hi] = CommonUsableBand(t.fits);
+  if (std::isfinite(lo) && std::isfinite(hi) && hi > lo) {
+    std::vector<Eigen::Matrix2cd> phi;
+    std::vector<double> f;
+    for (Eigen::Index k = 0; k < t.freq_hz.size(); ++k) {
+      if (t.freq_hz(k) >= lo && t.freq_hz(k) <= hi) {
+        f.push_back(t.freq_hz(k));
+        phi.push_back(t.Phi_C[k]);
+      }
+    }
+    if (f.size() >= 3 && static_cast<Eigen::Index>(f.size()) < t.freq_hz.size()) {
+      c.Tell(Message::Kind::kInfo, id + ": the ZOA uses the measured FRF in its usable band, " + FormatDouble(lo) +
+                                       " to " + FormatDouble(hi) + " Hz");
+      t.freq_hz = Eigen::Map<Eigen::VectorXd>(f.data(), static_cast<Eigen::Index>(f.size()));
+      t.Phi_C = std::move(phi);
+    }
+  }
+  const int added = RefineBetweenLines(&t);
+  if (added > 0) {
+    c.Tell(Message::Kind::kInfo, id + ": between the measured lines the ZOA follows the modal fit's shape (" +
+                                     std::to_string(added) + " lines added; the measured lines are kept as " +
+                                     "they are)");
+  }
+}
+
+// The missing cross FRFs of c.no_cross: one warning per set of missing
+// pairs, naming its postures (in the order of `tips`).
+void WarnMissingCross(const MeasuredTipsContext& c, const std::vector<TipDynamics>& tips) {
+  std::map<std::string, std::vector<std::string>> by_pairs;  // "xy, yx" -> postures
+  for (const TipDynamics& t : tips) {
+    if (const auto it = c.no_cross.find(t.id); it != c.no_cross.end()) by_pairs[it->second].push_back(t.id);
+  }
+  for (const auto& [pairs, ids] : by_pairs) {
+    std::string postures;
+    for (const std::string& id : ids) postures += (postures.empty() ? "" : ", ") + id;
+    c.Tell(Message::Kind::kWarning, c.o.frf_path + ": no cross FRF " + pairs + " at " +
+                                        (ids.size() == 1 ? "posture " : std::to_string(ids.size()) + " postures (") +
+                                        postures + (ids.size() == 1 ? "" : ")") +
+                                        "; taken as zero (the directions uncoupled)");
+  }
+}
+
+}  // namespace
+
+std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, const std::vector<TipFrfs>& ysets,
+                                              const MeasuredTipOptions& o, const MessageSink& on_message) {
+  MeasuredTipsContext c{sets, ysets, o, on_message, false, {}};
+  std::vector<TipDynamics> tips;
   for (const TipFrfs& s : sets) {
     const std::string id = ShownId(s.pose_id, o.frf_path);
     if (!o.pose_ids.empty() && std::find(o.pose_ids.begin(), o.pose_ids.end(), id) == o.pose_ids.end()) continue;
@@ -256,188 +494,18 @@ std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, 
     // Drop a 0 Hz line (the ZOA needs ω > 0); the fit keeps every line.
     const Eigen::Index first = s.freq_hz.size() > 0 && s.freq_hz(0) == 0.0 ? 1 : 0;
     t.freq_hz = s.freq_hz.tail(s.freq_hz.size() - first);
-    auto diagonal = [&](const Eigen::VectorXcd& hx, const Eigen::VectorXcd& hy) {
-      t.Phi_C.assign(t.freq_hz.size(), Eigen::Matrix2cd::Zero());
-      for (Eigen::Index k = 0; k < t.freq_hz.size(); ++k) {
-        t.Phi_C[k](0, 0) = hx(k + first);
-        t.Phi_C[k](1, 1) = hy(k + first);
-      }
-    };
-    const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY();
     if (!ysets.empty()) {
-      // Two files, one direct FRF each: along the feed (x_C) and normal to it (y_C).
-      const int a = only_direct(s, o.frf_path, id, "--frf");
-      const TipFrfs* y = nullptr;
-      for (const TipFrfs& c : ysets) {
-        if (ShownId(c.pose_id, o.frf_y_path) == id || (c.pose_id == s.pose_id)) y = &c;
-      }
-      if (!y && sets.size() == 1 && ysets.size() == 1) y = &ysets.front();
-      if (!y) throw InputError({o.frf_y_path, 0, 0}, "no posture " + id + " in the file (--frf-y)");
-      const int b = only_direct(*y, o.frf_y_path, id, "--frf-y");
-      if (y->freq_hz.size() != s.freq_hz.size() || y->freq_hz != s.freq_hz) {
-        throw InputError({o.frf_y_path, 0, 0}, "posture " + id + ": the FRF of --frf-y uses another frequency grid than "
-                                                   "the one of --frf; both must use the same lines");
-      }
-      if (const std::string fy = TipFrfsUnitFinding(*y); !fy.empty()) {
-        t.unit_finding += (t.unit_finding.empty() ? "" : "; ") + fy;
-      }
-      const dynamics::Frf hx = DirectFrf(s, a), hy = DirectFrf(*y, b);
-      diagonal(hx.receptance(), hy.receptance());
-      say_units(&t);
-      if (o.fit) {
-        t.fits.push_back(FitOne(id + " " + Hname(a, a) + " (feed, x of the cut)", hx, on_message));
-        t.fits.push_back(FitOrReuse(id + " " + Hname(b, b) + " (normal to the feed, y of the cut)", hy, t.fits,
-                                    on_message));
-        t.fit_C = Concatenate({ModesAlong(t.fits[0].fit.fit, ex), ModesAlong(t.fits[1].fit.fit, ey)});
-        t.modes_C = Concatenate({DominantModes(ModesAlong(t.fits[0].fit.fit, ex), o.sd_modes),
-                                 DominantModes(ModesAlong(t.fits[1].fit.fit, ey), o.sd_modes)});
-      }
-      t.R_BC = frame();
+      TipFromTwoFiles(c, s, first, &t);
     } else if (direct.size() == 1 && total == 1) {
-      // One direct FRF: a symmetric tool (issue #18).
-      const int a = direct[0];
-      const dynamics::Frf h = DirectFrf(s, a);
-      diagonal(h.receptance(), h.receptance());
-      if (!noted) {
-        tell(Message::Kind::kNote, id + " has one direct FRF (" + Hname(a, a) +
-                                          "): the tool is taken as symmetric, this FRF in both in-plane directions of "
-                                          "the cut and no cross terms; --tool-axis does not apply");
-        noted = true;
-      }
-      say_units(&t);
-      if (o.fit) {
-        t.fits.push_back(FitOne(id + " " + Hname(a, a), h, on_message));
-        const TipModalModel mx = DominantModes(ModesAlong(t.fits[0].fit.fit, ex), o.sd_modes);
-        const TipModalModel my = DominantModes(ModesAlong(t.fits[0].fit.fit, ey), o.sd_modes);
-        t.modes_C = Concatenate({mx, my});
-        t.fit_C = Concatenate({ModesAlong(t.fits[0].fit.fit, ex), ModesAlong(t.fits[0].fit.fit, ey)});
-      }
-      // The modal table is written for the default tool axis (z) unless one is given.
-      if (o.cutting_frame) {
-        try {
-          t.R_BC = o.cutting_frame();
-        } catch (const InputError&) {
-          t.R_BC = Eigen::Matrix3d::Identity();
-        }
-      }
+      TipFromOneDirect(c, s, direct[0], first, &t);
     } else {
-      // Several FRFs in the base frame: oriented by the tool axis.
-      const Eigen::Matrix3d R = frame();
-      t.R_BC = R;
-      std::vector<int> dirs;
-      for (int a = 0; a < 3; ++a) {
-        if (R.col(0).cwiseAbs()(a) > 1e-9 || R.col(1).cwiseAbs()(a) > 1e-9) dirs.push_back(a);
-      }
-      for (int a : dirs) {
-        for (int b : dirs) {
-          if (!s.present[a][b]) {
-            if (a == b) {
-              throw InputError({o.frf_path, 0, 0}, "posture " + id + ": the cutting plane (" + o.tool_axis_source +
-                                                       ") needs FRF " + "xyz"[a] + "xyz"[b] +
-                                                       ", which the file does not give; give a --tool-axis whose "
-                                                       "cutting plane the file's directions span, or the second "
-                                                       "direction with --frf-y from a file of one direct FRF");
-            }
-            std::string& pairs = no_cross[id];
-            pairs += (pairs.empty() ? "" : ", ") + std::string(1, "xyz"[a]) + "xyz"[b];
-          }
-        }
-      }
-      std::vector<Eigen::Matrix3cd> H(s.H.begin() + first, s.H.end());
-      t.Phi_C = OrientInCuttingPlane(H, R);
-      say_units(&t);
-      if (o.fit) {
-        std::vector<TipModalModel> parts, all;
-        for (int a : dirs) {
-          t.fits.push_back(FitOrReuse(id + " " + Hname(a, a), DirectFrf(s, a), t.fits, on_message));
-          all.push_back(ModesAlong(t.fits.back().fit.fit, Eigen::Vector3d::Unit(a)).Rotated(R));
-          parts.push_back(DominantModes(all.back(), o.sd_modes));
-        }
-        t.modes_C = Concatenate(parts);
-        t.fit_C = Concatenate(all);
-        bool two_dir_model = false;  // the modes of two directions coupled by the cross FRF
-        bool cross = false;
-        for (int a : dirs) {
-          for (int b : dirs) cross |= a != b && s.present[a][b];
-        }
-        if (cross && dirs.size() == 2) {
-          // Two base directions span the cutting plane: a mode seen in both
-          // direct FRFs is one mode whose shape's sign the cross FRF gives.
-          const int a = dirs[0], b = dirs[1];
-          const int r = s.present[a][b] ? a : b, c = s.present[a][b] ? b : a;
-          const auto [lo, hi] = CommonUsableBand(t.fits);
-          std::vector<int> lines;
-          for (Eigen::Index k = 0; k < s.freq_hz.size(); ++k) {
-            if (s.freq_hz(k) >= lo && s.freq_hz(k) <= hi) lines.push_back(static_cast<int>(k));
-          }
-          if (lines.size() >= 8) {
-            Eigen::VectorXcd h(s.freq_hz.size());
-            for (Eigen::Index k = 0; k < h.size(); ++k) h(k) = s.H[k](r, c);
-            const dynamics::Frf cross_frf = dynamics::Frf::FromSamples(s.freq_hz, h).Select(lines);
-            t.fit_C = ModesOfTwoDirections(t.fits[0].fit.fit, Eigen::Vector3d::Unit(a), t.fits[1].fit.fit,
-                                           Eigen::Vector3d::Unit(b), cross_frf)
-                          .Rotated(R);
-            t.modes_C = DominantModes(t.fit_C, 2 * o.sd_modes);
-            two_dir_model = true;
-            tell(Message::Kind::kNote, id + ": a mode found in both " + Hname(a, a) + " and " + Hname(b, b) +
-                                              " is one mode of the SD's model, its shape's sign from the cross FRF " +
-                                              Hname(r, c));
-          }
-        } else if (cross) {
-          tell(Message::Kind::kNote, id + ": the SD's modal model is fitted to the direct FRFs; the cross FRFs "
-                                             "of the file are used by the ZOA only");
-        }
-        t.fit_lacks_cross = cross && !two_dir_model;
-      }
+      TipFromBaseFrame(c, s, first, &t);
     }
-    if (o.fit) {
-      t.modes_fitted = true;
-      t.no_modes = t.modes_C.num_modes() == 0;
-      // The ZOA uses the measured FRF where the noise model finds it usable
-      // in every fitted direction: below that (the drift of an integrated
-      // accelerometer signal) and above it (the floor) a line says nothing
-      // of the structure, and a drift 5x the resonance makes spurious
-      // lobes of a few hertz.
-      const auto [lo, hi] = CommonUsableBand(t.fits);
-      if (std::isfinite(lo) && std::isfinite(hi) && hi > lo) {
-        std::vector<Eigen::Matrix2cd> phi;
-        std::vector<double> f;
-        for (Eigen::Index k = 0; k < t.freq_hz.size(); ++k) {
-          if (t.freq_hz(k) >= lo && t.freq_hz(k) <= hi) {
-            f.push_back(t.freq_hz(k));
-            phi.push_back(t.Phi_C[k]);
-          }
-        }
-        if (f.size() >= 3 && static_cast<Eigen::Index>(f.size()) < t.freq_hz.size()) {
-          tell(Message::Kind::kInfo, id + ": the ZOA uses the measured FRF in its usable band, " + FormatDouble(lo) +
-                                           " to " + FormatDouble(hi) + " Hz");
-          t.freq_hz = Eigen::Map<Eigen::VectorXd>(f.data(), static_cast<Eigen::Index>(f.size()));
-          t.Phi_C = std::move(phi);
-        }
-      }
-      const int added = RefineBetweenLines(&t);
-      if (added > 0) {
-        tell(Message::Kind::kInfo, id + ": between the measured lines the ZOA follows the modal fit's shape (" +
-                                         std::to_string(added) + " lines added; the measured lines are kept as " +
-                                         "they are)");
-      }
-    }
+    if (o.fit) FitToUsableBand(c, &t);
     tips.push_back(std::move(t));
   }
   if (tips.empty()) throw InputError({o.frf_path, 0, 0}, "none of the requested postures is in the file");
-  // One warning per set of missing pairs, naming its postures.
-  std::map<std::string, std::vector<std::string>> by_pairs;  // "xy, yx" -> postures
-  for (const TipDynamics& t : tips) {
-    if (const auto it = no_cross.find(t.id); it != no_cross.end()) by_pairs[it->second].push_back(t.id);
-  }
-  for (const auto& [pairs, ids] : by_pairs) {
-    std::string postures;
-    for (const std::string& id : ids) postures += (postures.empty() ? "" : ", ") + id;
-    tell(Message::Kind::kWarning, o.frf_path + ": no cross FRF " + pairs + " at " +
-                                      (ids.size() == 1 ? "posture " : std::to_string(ids.size()) + " postures (") +
-                                      postures + (ids.size() == 1 ? "" : ")") +
-                                      "; taken as zero (the directions uncoupled)");
-  }
+  WarnMissingCross(c, tips);
   return tips;
 }
 

@@ -42,6 +42,36 @@ nlohmann::json FrfEstimateRun::Summary(const std::string& estimator) const {
   return j;
 }
 
+std::string FrfEstimateRun::Outcome() const {
+  const calibration::FrfEstimateResult& r = result;
+  std::ostringstream m;
+  m << r.averages << " of " << r.hits.size() << " hits averaged";
+  std::vector<std::string> rejected;
+  for (const auto& h : r.hits) {
+    if (h.status != calibration::HitStatus::kAccepted) {
+      rejected.push_back(h.id + " (" + calibration::HitStatusName(h.status) + ")");
+    }
+  }
+  if (!rejected.empty()) {
+    m << " (rejected: ";
+    for (size_t i = 0; i < rejected.size(); ++i) m << (i ? ", " : "") << rejected[i];
+    m << ")";
+  }
+  m << "; " << (frfs ? frfs->frfs.size() : 0) << " FRF(s) of " << r.freq_hz.size() << " lines, "
+    << FormatNumber(r.freq_hz(0)) << " to " << FormatNumber(r.freq_hz(r.freq_hz.size() - 1), 6) << " Hz";
+  return m.str();
+}
+
+std::map<std::string, std::string> ParseDirections(const std::vector<std::string>& texts) {
+  std::map<std::string, std::string> out;
+  for (const std::string& d : texts) {
+    const size_t eq = d.find('=');
+    if (eq == std::string::npos || eq == 0) throw OptionError("directions", "directions: expected NAME=AXIS, got '" + d + "'");
+    out[d.substr(0, eq)] = d.substr(eq + 1);
+  }
+  return out;
+}
+
 FrfEstimateRun RunFrfEstimate(const FrfEstimateRunOptions& o, const MessageSink& on_message) {
   o.Validate();
   const Axis exc = ParseExcitation(o.excitation);

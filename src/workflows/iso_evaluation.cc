@@ -12,12 +12,8 @@ IsoEvaluation EvaluateIsoRunsFile(const std::string& path) {
   e.runs = io::ReadIsoRuns(path);
   e.min_runs = 1 << 30;
   for (const std::string& axis : e.runs.axis_order) {
-    machine::Iso230Result r;
-    try {
-      r = machine::EvaluateIso230(e.runs.approaches.at(axis));
-    } catch (const std::invalid_argument& err) {
-      throw InputError({path, 0, 0}, "axis " + axis + ": " + err.what());
-    }
+    machine::Iso230Result r = AtLocation({path, 0, 0}, "axis " + axis + ": ",
+                                         [&] { return machine::EvaluateIso230(e.runs.approaches.at(axis)); });
     for (const auto& t : r.targets) e.min_runs = std::min({e.min_runs, t.runs_up, t.runs_down});
     for (const std::string& f : machine::Iso230UnitFindings(axis, r, e.runs.rotary)) {
       e.unit_findings.push_back(f);

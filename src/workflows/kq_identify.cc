@@ -13,6 +13,8 @@
 #include "robomach/dynamics/uncertainty.h"
 #include "robomach/io/cut_file.h"
 #include "robomach/io/kq_files.h"
+#include "robomach/io/kq_yaml.h"
+#include "robomach/io/number_format.h"
 #include "robomach/stability/lobe_uncertainty.h"
 #include "robomach/workflows/stability_lobes.h"
 
@@ -39,12 +41,48 @@ void KqIdentifyOptions::Validate() const {
   }
 }
 
-nlohmann::json KqIdentifyResult::Summary() const {
+identification::JointStiffnessResult KqIdentifyResult::NotedFit() const {
   identification::JointStiffnessResult f = fit;
   f.advice.insert(f.advice.begin(), unit_findings.begin(), unit_findings.end());
-  nlohmann::json j = io::KqSummaryJson(f);
+  return f;
+}
+
+nlohmann::json KqIdentifyResult::Summary() const {
+  nlohmann::json j = io::KqSummaryJson(NotedFit());
   j["flagged"] = flagged();
   return j;
+}
+
+std::vector<std::string> KqOutputHeader(const KqIdentifyOptions& o) {
+  return {"kq-identify: joint stiffness identified from " + o.tracker_path + " with robot " + o.robot_path,
+          "tracker noise " + io::FormatDouble(o.noise_mm) + " mm (1 sigma per coordinate); loss " +
+              (o.robust.empty() ? std::string("least squares") : o.robust)};
+}
+
+std::string KqIdentifyResult::KqYamlText(const KqIdentifyOptions& o, bool as_parameters) const {
+  io::KqYamlOptions ko;
+  ko.as_parameters = as_parameters;
+  ko.header_comments = KqOutputHeader(o);
+  return io::JointStiffnessYaml(NotedFit(), ko);
+}
+
+std::string KqIdentifyResult::MergedConfigText(const KqIdentifyOptions& o, const std::string& out_path,
+                                               const std::string& uncertainty_path) const {
+  std::vector<std::string> h = KqOutputHeader(o);
+  for (const std::string& a : NotedFit().advice) h.push_back("NOTE: " + a);
+  return io::MergeJointStiffness(o.robot_path, fit.joint_stiffness, out_path, h, uncertainty_path);
+}
+
+dynamics::ParameterUncertainty KqIdentifyResult::Uncertainty(const KqIdentifyOptions& o) const {
+  const std::vector<std::string> header = KqOutputHeader(o);
+  return identification::StiffnessUncertainty(fit, header[0] + "; " + header[1]);
+}
+
+std::string KqIdentifyResult::IgnoredColumnsMessage(const KqIdentifyOptions& o) const {
+  if (tracker.unknown_columns.empty()) return "";
+  std::string cols;
+  for (const std::string& c : tracker.unknown_columns) cols += (cols.empty() ? "" : ", ") + c;
+  return o.tracker_path + ": ignored columns: " + cols;
 }
 
 KqIdentifyResult RunKqIdentify(const KqIdentifyOptions& o, const MessageSink& on_message,
@@ -96,7 +134,7 @@ KqIdentifyResult RunKqIdentify(const KqIdentifyOptions& o, const MessageSink& on
 std::vector<std::string> KqReportLines(const identification::JointStiffnessResult& r) {
   std::vector<std::string> out;
   std::ostringstream head;
-  head << r.num_cases << " load cases, fit " << identification::ToString(r.status) << " (" << r.iterations
+  head << r.num_cases << " load cases, fit " << robomach::ToString(r.status) << " (" << r.iterations
        << " iterations): " << r.solver_message;
   out.push_back(head.str());
   out.push_back("joint  stiffness [N·m/rad]  std dev    rel.    95 % interval             determination");
@@ -257,38 +295,41 @@ std::vector<TargetLinearity> CheckTargetLinearity(const io::RobotConfig& config,
   return out;
 }
 
-KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
-  o.Validate();
-  KqPlanResult r;
-  r.config = io::LoadRobotConfig(o.robot_path);
-  for (const std::string& w : r.config.implausible) Tell(on_message, Message::Kind::kWarning, w);
-  r.model = r.config.Build();
-  // The options' units, as kq-identify checks a tracker file's and
-  // tracker-synth its options (docs/plausibility.md): a plan is made before
-  // the campaign, and a wrong one wastes it.
+namespace {
+
+// The options' units, as kq-identify checks a tracker file's and
+// tracker-synth its options (docs/plausibility.md): a plan is made before
+// the campaign, and a wrong one wastes it. Findings go to
+// r->option_findings.
+void CheckOptionUnits(const KqPlanOptions& o, KqPlanResult* r) {
   if (std::string w = io::TrackerNoiseUnitFinding(o.noise_mm_name, o.noise_mm); !w.empty()) {
-    r.option_findings.push_back(std::move(w));
+    r->option_findings.push_back(std::move(w));
   }
   for (double m : o.masses_kg) {
     if (m >= io::kMinPlausibleLoadMassKg && m <= io::kMaxPlausibleLoadMassKg) continue;
-    r.option_findings.push_back("implausible (unit mistake?): " + o.masses_name + " " + FormatNumber(m, 7) +
-                                " kg is outside the " + FormatNumber(io::kMinPlausibleLoadMassKg, 3) + " to " +
-                                FormatNumber(io::kMaxPlausibleLoadMassKg, 3) + " kg of load-test masses (5 - 300 kg): " +
-                                (m > io::kMaxPlausibleLoadMassKg ? "a mass in g typed in the kg option, or a weight in N?"
-                                                                 : "a mass in t typed in the kg option?"));
+    r->option_findings.push_back("implausible (unit mistake?): " + o.masses_name + " " + FormatNumber(m, 7) +
+                                 " kg is outside the " + FormatNumber(io::kMinPlausibleLoadMassKg, 3) + " to " +
+                                 FormatNumber(io::kMaxPlausibleLoadMassKg, 3) + " kg of load-test masses (5 - 300 kg): " +
+                                 (m > io::kMaxPlausibleLoadMassKg ? "a mass in g typed in the kg option, or a weight in N?"
+                                                                  : "a mass in t typed in the kg option?"));
     break;
   }
   for (const auto& [name, point] : {std::pair{o.load_point_name, o.load_point_m}, std::pair{o.target_name, o.target_m}}) {
     // No load or target fits within 1 mm of the flange's origin but on it.
     if (point && point->norm() > 0.0 && point->norm() < 1e-3) {
-      r.option_findings.push_back("implausible (unit mistake?): " + name + " " + FormatNumber(1e3 * point->x(), 4) +
-                                  "," + FormatNumber(1e3 * point->y(), 4) + "," + FormatNumber(1e3 * point->z(), 4) +
-                                  " mm is within 1 mm of the flange's origin: metres typed in the mm option? (" +
-                                  FormatNumber(1e6 * point->norm(), 4) + " mm from the origin if so)");
+      r->option_findings.push_back("implausible (unit mistake?): " + name + " " + FormatNumber(1e3 * point->x(), 4) +
+                                   "," + FormatNumber(1e3 * point->y(), 4) + "," + FormatNumber(1e3 * point->z(), 4) +
+                                   " mm is within 1 mm of the flange's origin: metres typed in the mm option? (" +
+                                   FormatNumber(1e6 * point->norm(), 4) + " mm from the origin if so)");
     }
   }
-  for (const std::string& w : r.option_findings) Tell(on_message, Message::Kind::kWarning, w);
-  identification::PlanOptions& p = r.planner;
+}
+
+// The planner's options (r->planner) from the workflow's, with the target
+// postures' gradients for a targeted plan; returns the target postures
+// (empty for a D-optimal plan).
+std::vector<io::Posture> SetUpPlanner(const KqPlanOptions& o, const MessageSink& on_message, KqPlanResult* r) {
+  identification::PlanOptions& p = r->planner;
   p.num_postures = o.num_postures;
   p.tracker_noise = MmToM(o.noise_mm);
   p.seed = o.seed;
@@ -299,20 +340,150 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
   std::vector<io::Posture> targets;
   if (!o.target_postures_path.empty()) {
     std::vector<std::string> units;
-    targets = io::ReadPostureFile(o.target_postures_path, r.model->num_joints(), &units);
+    targets = io::ReadPostureFile(o.target_postures_path, r->model->num_joints(), &units);
     for (const std::string& w : units) {
       Tell(on_message, Message::Kind::kWarning, w);
-      r.config.implausible.push_back(w);  // flags the plan (exit 3) like the config's own findings
+      r->config.implausible.push_back(w);  // flags the plan (exit 3) like the config's own findings
     }
     Tell(on_message, Message::Kind::kNote,
          "targeted plan: the " + std::string(o.target_quantity == "frequency" ? "lowest natural frequency"
                                                                                 : "smallest ZOA critical depth") +
              " at " + std::to_string(targets.size()) + " postures");
-    p.target_gradients = TargetGradients(r.config, targets, o.target_quantity, o.cut_path);
-    r.target_quantity = o.target_quantity;
+    p.target_gradients = TargetGradients(r->config, targets, o.target_quantity, o.cut_path);
+    r->target_quantity = o.target_quantity;
     p.target_half_width = o.target_half_width;
   }
-  r.plan = identification::PlanLoadTests(*r.model, p);
+  return targets;
+}
+
+// The plan's size and each joint's expected standard deviation, as lines.
+void AddExpectedStdLines(const KqPlanOptions& o, KqPlanResult* r) {
+  const identification::PlanOptions& p = r->planner;
+  const int n = r->model->num_joints();
+  std::ostringstream head;
+  head << "plan of " << o.num_postures << " postures x " << p.directions_per_posture << " rope directions x "
+       << o.masses_kg.size() << " masses = " << r->plan.cases.size()
+       << " load cases; expected standard deviations for a tracker noise of " << o.noise_mm << " mm:";
+  r->lines.push_back(head.str());
+  for (int j = 0; j < n; ++j) {
+    std::ostringstream rel, row;
+    if (std::isfinite(r->plan.expected_relative_std(j))) {
+      rel << std::fixed << std::setprecision(2) << 100 * r->plan.expected_relative_std(j) << " %";
+    } else {
+      rel << "not determined";
+    }
+    row << "  joint " << j + 1 << ": k = " << Sci(r->model->joint_stiffness()(j)) << " N·m/rad, std dev "
+        << Sci(r->plan.expected_std_dev(j), 2) << " N·m/rad (" << rel.str() << ")";
+    r->lines.push_back(row.str());
+  }
+}
+
+// A warning for each target that bends within its band (r->target_linearity
+// against the tolerance); r->band_uncertain where that puts the band asked
+// for in doubt.
+void WarnWhereTargetsBend(const KqPlanOptions& o, KqPlanResult* r) {
+  for (size_t t = 0; t < r->target_linearity.size(); ++t) {
+    const TargetLinearity& c = r->target_linearity[t];
+    if (c.departure <= kTargetNonlinearityTolerance) continue;
+    const bool frequency = o.target_quantity == "frequency";
+    std::ostringstream w;
+    // "target P2": the plan's own postures are P1..PN too.
+    w << "target " << c.id << ": the " << (frequency ? "lowest natural frequency" : "smallest ZOA critical depth")
+      << " bends within its band (at kq" << c.joint << " " << std::showpos << std::setprecision(3)
+      << 100 * (std::exp(c.step) - 1.0) << std::noshowpos << " %, the edge of that joint's expected interval, it is "
+      << (std::isfinite(c.departure) ? FormatNumber(100 * c.departure, 3) + " %" : std::string("an undefined amount"))
+      << " of the half-width off the first-order prediction), so the promised ±"
+      << FormatNumber(100 * r->target_half_widths[t].second, 3)
+      << " % is first order only and the campaign's band there can be wider; check it after the campaign with "
+      << (frequency ? "frf-predict --uncertainty" : "stability-lobes --uncertainty");
+    // The band asked for is in doubt when the bend, in ln y, is more than
+    // the tolerance's part of it (a bend of 86 % of a ±1 % promise does
+    // not threaten a ±50 % band; one of 560 % of ±13.5 % threatens ±15 %).
+    if (o.target_half_width > 0.0 &&
+        c.departure * r->target_half_widths[t].second > kTargetNonlinearityTolerance * o.target_half_width) {
+      r->band_uncertain = true;
+      w << "; the bend is more than a tenth of the ±" << FormatNumber(100 * o.target_half_width, 3) << " % asked for ("
+        << o.target_half_width_name << "), so the plan cannot promise that band here (exit 3)";
+    }
+    r->warnings.push_back(w.str());
+  }
+}
+
+// A targeted plan's promise: the expected 95 % half-width at each target
+// (against a D-optimal plan of the same size), where it is first order
+// only, and how many postures reach the band asked for.
+void ReportTargets(const KqPlanOptions& o, const std::vector<io::Posture>& targets, KqPlanResult* r) {
+  const identification::PlanOptions& p = r->planner;
+  std::ostringstream m;
+  m << "expected 95 % half-width of the " << (o.target_quantity == "frequency" ? "lowest natural frequency"
+                                                                             : "smallest ZOA critical depth")
+    << ":";
+  const double z = dynamics::NormalQuantile(0.5 * (1.0 + p.target_confidence));
+  for (size_t t = 0; t < targets.size(); ++t) {
+    const double hw = z * r->plan.expected_target_relative_std(static_cast<Eigen::Index>(t));
+    r->target_half_widths.push_back({targets[t].id, hw});
+    m << (t ? "," : "") << " target " << targets[t].id << " ±" << std::setprecision(3) << 100 * hw << " %";
+  }
+  {
+    // The same targets with the D-optimal plan of the same size: what targeting gains.
+    identification::PlanOptions d = p;
+    d.design_for_targets = false;
+    d.target_half_width = 0.0;
+    const identification::TestPlan dp = identification::PlanLoadTests(*r->model, d);
+    r->d_optimal_target_half_width = z * dp.expected_target_relative_std.maxCoeff();
+    m << " (worst ±" << 100 * z * r->plan.expected_target_relative_std.maxCoeff() << " %; a D-optimal plan of "
+      << o.num_postures << " postures: ±" << 100 * r->d_optimal_target_half_width << " %)";
+  }
+  r->lines.push_back(m.str());
+  // The promise is first order: where a target bends within its band
+  // (the smallest depth switching to another lobe or speed), the band of
+  // the campaign will be wider.
+  r->target_linearity = CheckTargetLinearity(r->config, targets, o.target_quantity, o.cut_path,
+                                             p.target_gradients, r->plan.expected_relative_std,
+                                             r->plan.expected_target_relative_std, z);
+  WarnWhereTargetsBend(o, r);
+  if (o.target_half_width > 0.0 && r->plan.postures_for_target_width > 0) {
+    std::ostringstream w;
+    w << "the first " << r->plan.postures_for_target_width << " postures of the plan ("
+      << r->plan.postures_for_target_width * p.directions_per_posture * static_cast<int>(p.masses_kg.size())
+      << " load cases) bring every target within ±" << 100 * o.target_half_width << " %"
+      << (r->band_uncertain ? " to first order (not where a target bends: see the warnings)" : "");
+    r->lines.push_back(w.str());
+  }
+}
+
+// The planner's findings, and a warning for each joint the plan would
+// determine only weakly where it matters.
+void AddPlanWarnings(const KqPlanOptions& o, KqPlanResult* r) {
+  const identification::PlanOptions& p = r->planner;
+  const int n = r->model->num_joints();
+  for (const Finding& f : r->plan.findings) {
+    r->warnings.push_back(f.message + (f.input_index == n - 1 ? " (" + o.points_name + ")" : ""));
+  }
+  for (int j = 0; j < n; ++j) {
+    if (r->plan.expected_determination[j] != identification::Determination::kWeak) continue;
+    if (!identification::TargetsDependOnJoint(p, j)) continue;  // a targeted plan need not determine it
+    std::ostringstream m;
+    // Four digits: 10.02 % rounded to "10 %" read as the threshold it exceeds.
+    m << "joint " << j + 1 << " would be weakly determined (±" << FormatNumber(100 * r->plan.expected_relative_std(j), 4)
+      << " % at 1 sigma, over the 10 % of a determined joint): plan more postures (" << o.num_postures_name << ")"
+      << (j == n - 1 ? " or put the load point and the target farther off the tool axis" : "");
+    r->warnings.push_back(m.str());
+  }
+}
+
+}  // namespace
+
+KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
+  o.Validate();
+  KqPlanResult r;
+  r.config = io::LoadRobotConfig(o.robot_path);
+  for (const std::string& w : r.config.implausible) Tell(on_message, Message::Kind::kWarning, w);
+  r.model = r.config.Build();
+  CheckOptionUnits(o, &r);
+  for (const std::string& w : r.option_findings) Tell(on_message, Message::Kind::kWarning, w);
+  const std::vector<io::Posture> targets = SetUpPlanner(o, on_message, &r);
+  r.plan = identification::PlanLoadTests(*r.model, r.planner);
   // A band the plan does not reach and narrower than 0.5 %: most likely a
   // fraction typed for a percentage (0.05 for 5 %); the finding says so.
   if (o.target_half_width > 0.0 && o.target_half_width < 0.005 && r.plan.postures_for_target_width == 0) {
@@ -322,98 +493,9 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
     Tell(on_message, Message::Kind::kWarning, w);
     r.option_findings.push_back(w);
   }
-  const int n = r.model->num_joints();
-  std::ostringstream head;
-  head << "plan of " << o.num_postures << " postures x " << p.directions_per_posture << " rope directions x "
-       << o.masses_kg.size() << " masses = " << r.plan.cases.size()
-       << " load cases; expected standard deviations for a tracker noise of " << o.noise_mm << " mm:";
-  r.lines.push_back(head.str());
-  for (int j = 0; j < n; ++j) {
-    std::ostringstream rel, row;
-    if (std::isfinite(r.plan.expected_relative_std(j))) {
-      rel << std::fixed << std::setprecision(2) << 100 * r.plan.expected_relative_std(j) << " %";
-    } else {
-      rel << "not determined";
-    }
-    row << "  joint " << j + 1 << ": k = " << Sci(r.model->joint_stiffness()(j)) << " N·m/rad, std dev "
-        << Sci(r.plan.expected_std_dev(j), 2) << " N·m/rad (" << rel.str() << ")";
-    r.lines.push_back(row.str());
-  }
-  if (!targets.empty()) {
-    std::ostringstream m;
-    m << "expected 95 % half-width of the " << (o.target_quantity == "frequency" ? "lowest natural frequency"
-                                                                               : "smallest ZOA critical depth")
-      << ":";
-    const double z = dynamics::NormalQuantile(0.5 * (1.0 + p.target_confidence));
-    for (size_t t = 0; t < targets.size(); ++t) {
-      const double hw = z * r.plan.expected_target_relative_std(static_cast<Eigen::Index>(t));
-      r.target_half_widths.push_back({targets[t].id, hw});
-      m << (t ? "," : "") << " target " << targets[t].id << " ±" << std::setprecision(3) << 100 * hw << " %";
-    }
-    {
-      // The same targets with the D-optimal plan of the same size: what targeting gains.
-      identification::PlanOptions d = p;
-      d.design_for_targets = false;
-      d.target_half_width = 0.0;
-      const identification::TestPlan dp = identification::PlanLoadTests(*r.model, d);
-      r.d_optimal_target_half_width = z * dp.expected_target_relative_std.maxCoeff();
-      m << " (worst ±" << 100 * z * r.plan.expected_target_relative_std.maxCoeff() << " %; a D-optimal plan of "
-        << o.num_postures << " postures: ±" << 100 * r.d_optimal_target_half_width << " %)";
-    }
-    r.lines.push_back(m.str());
-    // The promise is first order: where a target bends within its band
-    // (the smallest depth switching to another lobe or speed), the band of
-    // the campaign will be wider.
-    r.target_linearity = CheckTargetLinearity(r.config, targets, o.target_quantity, o.cut_path,
-                                              p.target_gradients, r.plan.expected_relative_std,
-                                              r.plan.expected_target_relative_std, z);
-    for (size_t t = 0; t < r.target_linearity.size(); ++t) {
-      const TargetLinearity& c = r.target_linearity[t];
-      if (c.departure <= kTargetNonlinearityTolerance) continue;
-      const bool frequency = o.target_quantity == "frequency";
-      std::ostringstream w;
-      // "target P2": the plan's own postures are P1..PN too.
-      w << "target " << c.id << ": the " << (frequency ? "lowest natural frequency" : "smallest ZOA critical depth")
-        << " bends within its band (at kq" << c.joint << " " << std::showpos << std::setprecision(3)
-        << 100 * (std::exp(c.step) - 1.0) << std::noshowpos << " %, the edge of that joint's expected interval, it is "
-        << (std::isfinite(c.departure) ? FormatNumber(100 * c.departure, 3) + " %" : std::string("an undefined amount"))
-        << " of the half-width off the first-order prediction), so the promised ±"
-        << FormatNumber(100 * r.target_half_widths[t].second, 3)
-        << " % is first order only and the campaign's band there can be wider; check it after the campaign with "
-        << (frequency ? "frf-predict --uncertainty" : "stability-lobes --uncertainty");
-      // The band asked for is in doubt when the bend, in ln y, is more than
-      // the tolerance's part of it (a bend of 86 % of a ±1 % promise does
-      // not threaten a ±50 % band; one of 560 % of ±13.5 % threatens ±15 %).
-      if (o.target_half_width > 0.0 &&
-          c.departure * r.target_half_widths[t].second > kTargetNonlinearityTolerance * o.target_half_width) {
-        r.band_uncertain = true;
-        w << "; the bend is more than a tenth of the ±" << FormatNumber(100 * o.target_half_width, 3) << " % asked for ("
-          << o.target_half_width_name << "), so the plan cannot promise that band here (exit 3)";
-      }
-      r.warnings.push_back(w.str());
-    }
-    if (o.target_half_width > 0.0 && r.plan.postures_for_target_width > 0) {
-      std::ostringstream w;
-      w << "the first " << r.plan.postures_for_target_width << " postures of the plan ("
-        << r.plan.postures_for_target_width * p.directions_per_posture * static_cast<int>(p.masses_kg.size())
-        << " load cases) bring every target within ±" << 100 * o.target_half_width << " %"
-        << (r.band_uncertain ? " to first order (not where a target bends: see the warnings)" : "");
-      r.lines.push_back(w.str());
-    }
-  }
-  for (const Finding& f : r.plan.findings) {
-    r.warnings.push_back(f.message + (f.input_index == n - 1 ? " (" + o.points_name + ")" : ""));
-  }
-  for (int j = 0; j < n; ++j) {
-    if (r.plan.expected_determination[j] != identification::Determination::kWeak) continue;
-    if (!identification::TargetsDependOnJoint(p, j)) continue;  // a targeted plan need not determine it
-    std::ostringstream m;
-    // Four digits: 10.02 % rounded to "10 %" read as the threshold it exceeds.
-    m << "joint " << j + 1 << " would be weakly determined (±" << FormatNumber(100 * r.plan.expected_relative_std(j), 4)
-      << " % at 1 sigma, over the 10 % of a determined joint): plan more postures (" << o.num_postures_name << ")"
-      << (j == n - 1 ? " or put the load point and the target farther off the tool axis" : "");
-    r.warnings.push_back(m.str());
-  }
+  AddExpectedStdLines(o, &r);
+  if (!targets.empty()) ReportTargets(o, targets, &r);
+  AddPlanWarnings(o, &r);
   return r;
 }
 

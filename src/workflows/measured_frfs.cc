@@ -155,12 +155,8 @@ calibration::NoiseModels EstimateNoiseModels(const MeasuredFrfs& data, const Mea
                " does not give the number of averages ('# averages: N'; or --averages N); the noise is estimated "
                "from the scatter");
     }
-    calibration::FrfNoise n;
-    try {
-      n = calibration::EstimateFrfNoise(frf, no);
-    } catch (const std::invalid_argument& e) {
-      throw InputError({file, 0, 0}, key.ToString() + ": " + e.what());
-    }
+    calibration::FrfNoise n =
+        AtLocation({file, 0, 0}, key.ToString() + ": ", [&] { return calibration::EstimateFrfNoise(frf, no); });
     const bool points = key.response_point != 0 || key.excitation_point != 0;
     Tell(on_message, Message::Kind::kInfo,
          key.pose_id + " " + (points ? key.Label() : std::string{AxisName(key.response), AxisName(key.excitation)}) +

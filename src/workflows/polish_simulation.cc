@@ -18,12 +18,10 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
                                         const std::string& process_source) {
   PolishSimulation s;
   s.file = io::ReadPolishPath(path_file);
-  try {
-    s.grid = std::make_shared<const polishing::SampleGrid>(
+  s.grid = AtLocation<std::domain_error>({surface_source, 0, 0}, "", [&] {
+    return std::make_shared<const polishing::SampleGrid>(
         polishing::SampleGrid::Build(surface, sample_spacing, process.margin, process.flip_normal));
-  } catch (const std::domain_error& e) {
-    throw InputError({surface_source, 0, 0}, e.what());
-  }
+  });
   if (s.grid->num_in_region() == 0) {
     throw InputError({process_source, 0, 0}, "process.margin_mm leaves no polished region on the patch");
   }

@@ -1,12 +1,17 @@
 #include "robomach/workflows/stability_lobes.h"
 
+#include <cmath>
 #include <optional>
+#include <sstream>
 #include <string>
 
+#include "robomach/calibration/frf_noise.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
+#include "robomach/io/csv_table.h"
 #include "robomach/io/lobes_file.h"
+#include "robomach/io/number_format.h"
 #include "robomach/io/robot_config.h"
 #include "robomach/io/uncertainty_file.h"
 #include "robomach/workflows/frf_predict.h"
@@ -94,6 +99,29 @@ stability::LobesOptions MakeLobesOptions(const io::CutSpec& cut, const Stability
   return lo;
 }
 
+std::optional<Eigen::Vector3d> ParseToolAxis(const std::string& text) {
+  std::stringstream ss(text);
+  std::string item;
+  std::vector<double> v;
+  while (std::getline(ss, item, ',')) {
+    double x = 0.0;
+    if (!io::ParseFiniteNumber(item, &x)) break;
+    v.push_back(x);
+  }
+  if (v.size() != 3 || Eigen::Vector3d(v[0], v[1], v[2]).norm() == 0.0) return std::nullopt;
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+std::string FitPanelTitle(const stability::DirectionFit& d) {
+  std::ostringstream title;
+  title << d.label << ": " << d.fit.fit.modes.size() << " modes";
+  if (std::isfinite(d.fit.noise_rms)) {
+    title << ", rms misfit " << io::FormatDouble(std::round(d.fit.noise_rms * 100.0) / 100.0) << " x noise";
+  }
+  title << "; " << calibration::DescribeUsable(d.fit.noise);
+  return title.str();
+}
+
 StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const MessageSink& tell,
                                     const stability::SdProgressSink& progress) {
   o.Validate();
@@ -176,6 +204,53 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const Messag
     }
   }
   return run;
+}
+
+std::vector<LobeDiagramCurve> StabilityLobesRun::DiagramCurves() const {
+  std::vector<LobeDiagramCurve> curves;
+  for (const stability::TipDynamics& t : tips) {
+    for (const std::string m : {"zoa", "sd"}) {
+      LobeDiagramCurve c;
+      for (const stability::LobeRow& r : lobes.rows) {
+        if (r.id != t.id || r.method != m) continue;
+        c.speed_rpm.push_back(RadPerSecToRpm(r.point.spindle_speed_rad_s));
+        c.depth_mm.push_back(r.point.status == stability::LobeStatus::kOk ? MToMm(r.point.critical_depth) : NAN);
+        if (!bands.empty() && m == "zoa") {
+          c.lower_mm.push_back(MToMm(r.depth_lower));
+          c.upper_mm.push_back(MToMm(r.depth_upper));
+        }
+      }
+      if (c.speed_rpm.empty()) continue;
+      c.label = t.id + " " + (m == "zoa" ? "ZOA" : "SD");
+      c.markers = m == "sd";
+      curves.push_back(std::move(c));
+    }
+  }
+  return curves;
+}
+
+std::string StabilityLobesRun::CutDescription() const {
+  const stability::MillingProcess& mp = cut.process;
+  return std::to_string(mp.teeth) + " teeth, a_e/D = " + io::FormatDouble(mp.radial_immersion) +
+         (mp.direction == stability::MillingDirection::kUp ? ", up-milling" : ", down-milling");
+}
+
+std::string StabilityLobesRun::BandNote(const StabilityLobesOptions& o) const {
+  if (bands.empty()) return "";
+  const dynamics::PropagationMethod m = bands.front().propagation.method_used;
+  std::string method = m == dynamics::PropagationMethod::kMonteCarlo ? "Monte Carlo" : "first order";
+  for (const stability::ZoaBand& b : bands) {
+    if (b.propagation.method_used != m) method = "method per posture in the notes";
+  }
+  return FormatNumber(100.0 * o.uncertainty.confidence, 3) + " %, " + method;
+}
+
+void StabilityLobesRun::ModesInSourceFrame(std::vector<std::string>* ids,
+                                           std::vector<std::vector<dynamics::Mode>>* modes) const {
+  for (const stability::TipDynamics& t : tips) {
+    ids->push_back(t.id);
+    modes->push_back(stability::ModesInSourceFrame(t));
+  }
 }
 
 nlohmann::json StabilityLobesRun::Summary(const StabilityLobesOptions& o) const {

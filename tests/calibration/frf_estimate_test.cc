@@ -287,7 +287,7 @@ TEST_F(FrfEstimateCampaign, ExponentialWindowAndDampingCorrection) {
   ModalFitOptions fo;
   fo.fmax_hz = 600.0;
   ModalFitResult fit = FitModes(frf, fo);
-  ASSERT_EQ(fit.status, ModalFitStatus::kOk) << fit.message;
+  ASSERT_EQ(fit.status, SolverStatus::kConverged) << fit.message;
   const auto truth = sys_->Modes();
   ASSERT_EQ(fit.modes.size(), truth.size());
   std::vector<FittedMode> corrected = fit.modes;

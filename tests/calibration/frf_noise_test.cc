@@ -80,7 +80,7 @@ TEST(FrfNoise, ScatterEstimateRecoversRelativeNoiseAndShapedFloor) {
     const dynamics::Frf frf = Noisy(t, 0.02, seed);
     const FrfNoise n = EstimateFrfNoise(frf);
     EXPECT_EQ(n.source, NoiseSource::kScatter);
-    EXPECT_TRUE(n.converged);
+    EXPECT_EQ(n.status, SolverStatus::kConverged);
     EXPECT_TRUE(n.modal_refined);
     EXPECT_NEAR(n.relative, 0.02, 0.25 * 0.02) << "seed " << seed;
     rel_sum += n.relative;
@@ -244,7 +244,7 @@ TEST(FrfNoise, ModalFitOnTheUsableLinesFindsEveryMode) {
     set.Insert({"P1", Axis::kX, Axis::kX}, Noisy(t, 0.02, seed));
     const dynamics::FrfSet usable = UsableData(set, EstimateNoise(set));
     const ModalFitResult fit = FitModes(usable.at({"P1", Axis::kX, Axis::kX}));
-    ASSERT_EQ(fit.status, ModalFitStatus::kOk) << fit.message;
+    ASSERT_EQ(fit.status, SolverStatus::kConverged) << fit.message;
     for (double fn : {12.0, 45.0, 180.0}) {
       double best = 1e9;
       for (const auto& m : fit.modes) best = std::min(best, std::abs(m.freq_hz / fn - 1.0));

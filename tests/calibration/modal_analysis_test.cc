@@ -44,7 +44,7 @@ TEST(ModalAnalysis, Kr210HammerTestGivesTheModelsModes) {
   ASSERT_EQ(poses.size(), 1u);
   const PoseModes& pm = poses.front();
   ASSERT_EQ(pm.groups.size(), 1u) << "the three FRFs fitted together";
-  ASSERT_EQ(pm.groups[0].fit.status, ModalFitStatus::kOk) << pm.groups[0].fit.message;
+  ASSERT_EQ(pm.groups[0].fit.status, SolverStatus::kConverged) << pm.groups[0].fit.message;
 
   dynamics::PostureEvaluator ev(model);
   const dynamics::PostureDynamics d = ev.Evaluate(q);
@@ -235,7 +235,7 @@ TEST(ModalAnalysis, RovingSensorOnAChainGivesItsMassNormalisedShapes) {
   ASSERT_EQ(poses.size(), 1u);
   ASSERT_EQ(poses[0].groups.size(), 1u);
   const ModalGroup& grp = poses[0].groups[0];
-  ASSERT_EQ(grp.fit.status, ModalFitStatus::kOk) << grp.fit.message;
+  ASSERT_EQ(grp.fit.status, SolverStatus::kConverged) << grp.fit.message;
   ASSERT_EQ(grp.fit.modes.size(), 4u) << grp.fit.message;
   std::string why;
   const auto rs = ShapesOfRovingTest(grp, &why);

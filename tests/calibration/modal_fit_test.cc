@@ -67,7 +67,7 @@ TEST(ModalFit, RecoversCloseModesWithoutNoise) {
   const std::vector<TrueMode> truth = {{40.0, 0.02, 2.0e-3}, {41.2, 0.025, 1.5e-3}, {120.0, 0.03, 4.0e-3}};
   const dynamics::Frf frf = Synthetic(truth, 0.25, 250.0);
   const ModalFitResult r = FitModes(frf);
-  ASSERT_EQ(r.status, ModalFitStatus::kOk) << r.message;
+  ASSERT_EQ(r.status, SolverStatus::kConverged) << r.message;
   ASSERT_EQ(r.modes.size(), 3u) << r.message;
   EXPECT_LT(r.relative_rms_error, 1e-6);
   for (size_t k = 0; k < 3; ++k) {
@@ -91,7 +91,7 @@ TEST(ModalFit, RecoversCloseModesWithTwoPercentNoise) {
   for (unsigned seed : {1u, 2u, 3u}) {
     const dynamics::Frf frf = Synthetic(truth, 0.25, 250.0, 0.02, seed);
     const ModalFitResult r = FitModes(frf);
-    ASSERT_EQ(r.status, ModalFitStatus::kOk) << r.message;
+    ASSERT_EQ(r.status, SolverStatus::kConverged) << r.message;
     ASSERT_EQ(r.modes.size(), 3u) << "seed " << seed << ": " << r.message;
     // The fit residual is the noise: 2 % rms.
     EXPECT_LT(r.relative_rms_error, 0.03);
@@ -113,7 +113,7 @@ TEST(ModalFit, PeakOfFittedCurveMatchesTruePeak) {
   const std::vector<TrueMode> truth = {{40.0, 0.02, 2.0e-3}, {120.0, 0.03, 4.0e-3}};
   const dynamics::Frf frf = Synthetic(truth, 0.25, 250.0);
   const ModalFitResult r = FitModes(frf);
-  ASSERT_EQ(r.status, ModalFitStatus::kOk);
+  ASSERT_EQ(r.status, SolverStatus::kConverged);
   const auto [fp, ap] = r.PeakIn(35.0, 45.0);
   const dynamics::Frf fine = Synthetic(truth, 1e-4, 45.0);
   double best = 0, f_best = 0;
@@ -130,7 +130,7 @@ TEST(ModalFit, PeakOfFittedCurveMatchesTruePeak) {
 TEST(ModalFit, ReportsStatusInsteadOfThrowing) {
   const dynamics::Frf tiny = Synthetic({{40.0, 0.02, 1.0}}, 10.0, 50.0);
   const ModalFitResult r = FitModes(tiny);
-  EXPECT_EQ(r.status, ModalFitStatus::kFailed);
+  EXPECT_EQ(r.status, SolverStatus::kFailed);
   EXPECT_NE(r.message.find("too few lines"), std::string::npos);
 }
 

@@ -44,7 +44,7 @@ FitOfTap FitTap(const testing::TapTest& t) {
 // constant 1/m (measured on the acceptance case: 1.5e-5, 1e-3 and 2e-4).
 void ExpectModes(const ModalFitResult& fit, const std::vector<testing::TapMode>& truth, double f_tol,
                  double rel_tol) {
-  ASSERT_EQ(fit.status, ModalFitStatus::kOk) << fit.message;
+  ASSERT_EQ(fit.status, SolverStatus::kConverged) << fit.message;
   ASSERT_EQ(fit.modes.size(), truth.size()) << fit.message;
   for (size_t k = 0; k < truth.size(); ++k) {
     const FittedMode& m = fit.modes[k];

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <stdexcept>
 
 #include "robomach/common/errors.h"
 #include "robomach/common/units.h"
@@ -37,6 +38,23 @@ TEST(Units, ConversionsAreExactInverses) {
   EXPECT_DOUBLE_EQ(RpmToRadPerSec(60.0), 2 * kPi);
   EXPECT_DOUBLE_EQ(RadPerSecToHz(HzToRadPerSec(922.0)), 922.0);
   EXPECT_DOUBLE_EQ(MmToM(12.5), 0.0125);
+}
+
+// AtLocation: the check's message after the file location and the prefix;
+// other exceptions pass untouched; the value comes back.
+TEST(AtLocation, GivesTheChecksErrorItsFileLocation) {
+  const SourceLocation where{"cut.yaml", 7, 18};
+  EXPECT_EQ(AtLocation(where, "feed_direction: ", [] { return 42; }), 42);
+  try {
+    AtLocation(where, "feed_direction: ", []() -> int { throw std::invalid_argument("expected x, y or z"); });
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "cut.yaml:7:18: feed_direction: expected x, y or z");
+    EXPECT_EQ(e.where().line, 7);
+  }
+  // Another type than the one asked for is not the check's: it passes.
+  EXPECT_THROW(AtLocation(where, "", [] { throw std::domain_error("elsewhere"); }), std::domain_error);
+  EXPECT_THROW(AtLocation<std::domain_error>(where, "", [] { throw std::domain_error("x"); }), InputError);
 }
 
 }  // namespace

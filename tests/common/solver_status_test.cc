@@ -14,7 +14,7 @@ TEST(SolverStatus, EachStatusHasItsOwnName) {
   std::set<std::string> names;
   for (SolverStatus s : {SolverStatus::kConverged, SolverStatus::kNotConverged, SolverStatus::kFailed,
                          SolverStatus::kNotImproved}) {
-    const std::string n = SolverStatusName(s);
+    const std::string n = ToString(s);
     EXPECT_EQ(n.find(' '), std::string::npos) << n;
     names.insert(n);
   }

@@ -94,6 +94,38 @@ TEST(ControllerRun, TdeConditionFailsOnNaNOnlyForKindsThatUseIt) {
   EXPECT_TRUE(r.tde_condition_fails());
 }
 
+// How a tuning ended (issue #36, one SolverStatus): BOBYQA's first
+// simulation is at the start (pid's defaults lie well inside the bounds),
+// whose cost is computed here by hand with the tuning's substep rule; the
+// tuned cost is below it (kConverged, or kNotConverged at the evaluation
+// limit, as the message says) or equal to it (kNotImproved, the start
+// returned). Equal to 1e-9: the optimiser's rescaling of the logarithms may
+// move the start by an ulp. Every run diverging would be kFailed.
+TEST(TuneController, StatusSaysHowTheTuningEndedAgainstTheStartsCost) {
+  FlexibleJointRobot robot(PlanarRodArm(true), SeedDrives(5.0));
+  DrillingScenario sc(&robot, DrillGeometry{}, Q235Like(), SeedProcess(0.2));
+  SimOptions so;
+  so.motor_torque_limit = Eigen::VectorXd::Constant(3, 10.0);
+  const ControllerParameters start = DefaultParameters("pid");
+  SimOptions ranking = so;
+  ranking.record = false;
+  ranking.max_omega_h = 0.2;
+  const double start_cost = sc.Run(*MakeController(start, sc, so.motor_torque_limit), ranking).cost;
+  ASSERT_LT(start_cost, 1e6);  // the start does not diverge
+  for (int evaluations : {5, 40}) {
+    SCOPED_TRACE(evaluations);
+    const TuneResult t = TuneController(start, sc, so, evaluations);
+    ASSERT_NE(t.status, SolverStatus::kFailed);
+    if (t.status == SolverStatus::kNotImproved) {
+      EXPECT_NEAR(t.cost, start_cost, 1e-9 * start_cost);
+      continue;
+    }
+    EXPECT_LT(t.cost, start_cost);
+    EXPECT_EQ(t.status, t.message == "converged" ? SolverStatus::kConverged : SolverStatus::kNotConverged);
+    if (t.message == "max_evaluations") EXPECT_EQ(t.evaluations, evaluations);
+  }
+}
+
 // --gains KIND=OMEGA,ZETA[,THIRD[,FILTER_S]]: the numbers given replace the
 // kind's defaults in that order; a missing, extra, negative, zero or NaN
 // value is refused (the filter time constant may be 0: no filter).

@@ -236,7 +236,7 @@ Outcome RunCase(const std::string& name, NurbsSurface surface) {
             << ", d " << 1e3 * best.params.offset << " r " << 1e3 * best.params.radius << " pitch "
             << 1e3 * best.params.pitch << " mm, stagger " << best.params.stagger << ", overrun "
             << 1e3 * best.params.edge_overrun << " mm; removes " << 1e6 * best.mean
-            << " um at the limit, " << r.evaluations << " evaluations, " << secs << " s, " << r.status
+            << " um at the limit, " << r.evaluations << " evaluations, " << secs << " s, " << ToString(r.status) << " (" << r.stop_reason << ")"
             << "), zig-zag cv " << par << ", grid search cv " << grid_best << " (" << pts.size()
             << " feasible points); zig-zag scan " << std::chrono::duration<double>(t2 - t1).count()
             << " s, grid search " << std::chrono::duration<double>(t3 - t2).count() << " s\n";

@@ -156,7 +156,8 @@ TEST(Optimise, NloptAndPsoFindAKnownMinimum) {
     for (size_t i = 1; i < r.history.size(); ++i) EXPECT_LE(r.history[i], r.history[i - 1]);
     if (m == Optimiser::kPso) {
       EXPECT_LE(r.history.size(), 100u);
-      EXPECT_EQ(r.status, "converged");
+      EXPECT_EQ(r.status, SolverStatus::kConverged);
+      EXPECT_EQ(r.stop_reason, "converged");
     }
   }
 }

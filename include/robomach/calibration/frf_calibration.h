@@ -249,8 +249,6 @@ struct CalibrationOptions {
 /// kNotImproved: no start lowered the whole-curve misfit below that of the
 /// start values, which the result keeps.
 using FitStatus = SolverStatus;  // the library's one solver status
-/// SolverStatusName.
-std::string FitStatusName(FitStatus s);
 
 struct ParameterEstimate {
   std::string name;

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include "robomach/common/solver_status.h"
 #include "robomach/dynamics/measured_frf.h"
 
 namespace robomach::calibration {
@@ -137,9 +138,10 @@ struct FrfNoise {
   /// The usable stretches [f_lo, f_hi] in Hz, ascending.
   std::vector<std::pair<double, double>> usable_bands;
   int usable_lines{0};
-  /// Iterations of the scatter fit, and whether it converged.
+  /// Iterations of the scatter fit, and how it ended (kConverged, or
+  /// kNotConverged at its iteration limit: the estimate is the last step's).
   int iterations{0};
-  bool converged{true};
+  SolverStatus status{SolverStatus::kConverged};
   bool modal_refined{false};  // the scatter about the modal fit was used
   /// Isolated outlier lines in the usable band, ascending in frequency;
   /// their `usable` is 0 (they are not counted in usable_lines, and the

@@ -118,7 +118,7 @@ struct GlobalMode {
 };
 
 struct GlobalModalFitResult {
-  ModalFitStatus status{ModalFitStatus::kFailed};
+  SolverStatus status{SolverStatus::kFailed};
   std::string message;
   std::vector<GlobalMode> modes;  // ascending frequency
   /// Per FRF, in the order given: the modes with the common poles and the

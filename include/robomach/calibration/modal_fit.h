@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "robomach/common/solver_status.h"
 #include "robomach/dynamics/measured_frf.h"
 
 namespace robomach::calibration {
@@ -97,14 +98,9 @@ struct StabilisationPole {
   bool stable{false};  // matched a pole of order − 1 within the tolerances
 };
 
-enum class ModalFitStatus {
-  kOk,             // at least one stable physical mode
-  kNoStableModes,  // the band has data, but no pole was stable
-  kFailed,         // too few lines for the orders asked, or a singular fit
-};
 
 struct ModalFitResult {
-  ModalFitStatus status{ModalFitStatus::kFailed};
+  SolverStatus status{SolverStatus::kFailed};
   std::string message;
   std::vector<FittedMode> modes;       // ascending frequency
   std::complex<double> upper_residual{0.0};  // constant term [m/N]

@@ -70,6 +70,23 @@ class OptionError : public std::invalid_argument {
   std::string field_;
 };
 
+/// Runs `f` and returns what it returns; an exception of type E it throws
+/// (std::invalid_argument by default: a check that knows no file) becomes an
+/// InputError at `where` whose message is `prefix` followed by the
+/// exception's. The one way to attach a file location to an error (issue
+/// #36), instead of a try/catch that rethrows at each site:
+///
+///   const Axis axis = AtLocation({path, line, column}, "feed_direction: ",
+///                                [&] { return ParseAxis(text); });
+template <class E = std::invalid_argument, class F>
+decltype(auto) AtLocation(const SourceLocation& where, const std::string& prefix, F&& f) {
+  try {
+    return std::forward<F>(f)();
+  } catch (const E& e) {
+    throw InputError(where, prefix + e.what());
+  }
+}
+
 }  // namespace robomach
 
 /// Debug-only check of an internal invariant (a robomach bug, not bad input).

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "robomach/common/progress.h"
+#include "robomach/common/solver_status.h"
 #include "robomach/drilling/controllers.h"
 #include "robomach/drilling/drill_forces.h"
 #include "robomach/drilling/drilling_process.h"
@@ -145,7 +146,11 @@ struct TuneResult {
   ControllerParameters parameters;
   double cost{NAN};
   int evaluations{0};
-  std::string message;     // NLopt's result code
+  /// How the tuning ended (TuneController says when each applies).
+  SolverStatus status{SolverStatus::kFailed};
+  /// NLopt's reason for stopping beside the status: "converged",
+  /// "max_evaluations" or "roundoff_limited".
+  std::string message;
 };
 
 /// Tunes the three parameters with NLopt (derivative-free BOBYQA on their
@@ -153,6 +158,13 @@ struct TuneResult {
 /// tuning runs use RK4 substeps with omega_max h <= 0.2 (enough to rank
 /// gains, 3x faster); the filter time constant is kept.
 /// `start` gives the kind and the starting point.
+/// The status: kFailed when every simulation diverged (the best cost is
+/// the divergence cost, or not finite: no usable gains); else kNotImproved
+/// when the best cost is no lower than that of the first simulation (the
+/// start as BOBYQA places it within the bounds; it is then returned); else
+/// kConverged when BOBYQA met its tolerance on the parameters, and
+/// kNotConverged when it stopped at max_evaluations or on round-off (the
+/// best parameters so far).
 TuneResult TuneController(const ControllerParameters& start, DrillingScenario& scenario,
                           const SimOptions& options, int max_evaluations = 60);
 

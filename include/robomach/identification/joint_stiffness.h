@@ -50,8 +50,6 @@ using FitStatus = SolverStatus;
 /// How well the data determine one joint's stiffness.
 enum class Determination { kDetermined, kWeak, kNotDetermined };
 
-/// SolverStatusName.
-const char* ToString(FitStatus s);
 const char* ToString(Determination d);
 
 /// The rule from a joint's relative standard deviation σ_k/k (of a fit, or

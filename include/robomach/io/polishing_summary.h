@@ -34,7 +34,8 @@ nlohmann::json RegionSummaryJson(const polishing::SampleGrid& grid, const polish
 /// polish-plan's summary of a plan made with `options` on `context`:
 /// removal_um, path, parameters, region (with the trimmed face and its rows
 /// off the face), contact, and when there are target, optimisation (method,
-/// budget, status, the best plan and the best of each family, the
+/// budget, status (robomach::ToString(SolverStatus)) and stop_reason (the
+/// optimiser's word: "converged", "max_time", ...), the best plan and the best of each family, the
 /// history) and comparison (the optimised cycloid against the optimised
 /// zig-zag).
 nlohmann::json PolishPlanSummaryJson(const polishing::PlanOutcome& outcome, const polishing::PlanningContext& context,

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "robomach/common/solver_status.h"
 #include "robomach/polishing/paths.h"
 
 namespace robomach::polishing {
@@ -53,7 +54,15 @@ struct OptimiseResult {
   double best_value{0.0};
   std::vector<double> history;  // best value after each iteration (PSO) or evaluation (NLopt)
   int evaluations{0};
-  std::string status;           // "converged", "max_iterations", "max_evaluations", ...
+  /// kConverged: NLopt met its tolerance (or stopped at roundoff, the
+  /// objective's noise level), the PSO stalled within pso_tolerance;
+  /// kNotConverged: an evaluation or iteration budget ran out (the best so
+  /// far is returned); kFailed: NLopt failed.
+  SolverStatus status{SolverStatus::kConverged};
+  /// The optimiser's own word: "converged", "roundoff_limited",
+  /// "max_evaluations" (NLopt), "max_iterations" (PSO), "forced_stop",
+  /// "failed: <NLopt's message>".
+  std::string stop_reason;
   std::string method;           // human-readable description
 };
 
@@ -170,7 +179,14 @@ struct PlanOptimiseResult {
   std::vector<char> history_parallel;
   int evaluations{0};
   int local_searches{0}, local_converged{0};
-  std::string status;  // "converged" (every local search met ftol_rel), "max_time", "max_evaluations"
+  /// kConverged when every local search met ftol_rel (the zig-zag: within
+  /// the time budget; the PSO: OptimiseResult's), kNotConverged when the
+  /// time budget or a local search's evaluation budget ran out (the best so
+  /// far is returned), kFailed as OptimiseResult's.
+  SolverStatus status{SolverStatus::kConverged};
+  /// Why it stopped, in the optimiser's words: "converged", "max_time",
+  /// "max_evaluations" (and the PSO's, OptimiseResult::stop_reason).
+  std::string stop_reason;
   std::string method;
   double seconds{0.0};
 };

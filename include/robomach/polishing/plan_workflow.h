@@ -108,7 +108,8 @@ inline constexpr double kMaxPlausibleTargetRemovalUm = 1000.0;
 
 /// Sense checks of the options a user types (issue #35): one message per
 /// value outside its plausible range, "implausible (unit mistake?): ..."
-/// naming the likely unit mistake, for polish-plan to warn and flag (exit
+/// naming the likely unit mistake (line_angle_deg in radians, then
+/// target_removal_um), for polish-plan to warn and flag (exit
 /// 3) and for Python to issue as UnitWarnings. Empty when all are plausible.
 std::vector<std::string> ImplausiblePlanOptions(const PlanOptions& options);
 

@@ -88,4 +88,18 @@ nlohmann::json CalibrationSummaryJson(const calibration::CalibrationResult& resu
                                       const calibration::CalibrationOptions& options,
                                       const std::vector<TableSet>& sets);
 
+/// frf-calibrate's summary.json but for the keys only the tool knows
+/// (calibrated_config, uncertainty_out): CalibrationSummaryJson with the
+/// run's misfit (workflows::FrfCalibrateRun::Misfit), the noise models of
+/// the fit and held-out FRFs (holdout_noise only when there are some) and
+/// the robot config's path. The tool and Python's run_frf_calibrate both
+/// call it, so their summaries cannot drift apart.
+nlohmann::json FrfCalibrateSummaryJson(const calibration::CalibrationResult& result,
+                                       const calibration::CalibrationOptions& options,
+                                       const std::vector<TableSet>& sets, const nlohmann::json& misfit,
+                                       const calibration::NoiseModels& noise,
+                                       const calibration::NoiseModels& holdout_noise,
+                                       const std::string& noise_model, double min_snr,
+                                       const std::string& robot_path);
+
 }  // namespace robomach::report

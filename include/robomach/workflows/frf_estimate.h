@@ -50,7 +50,15 @@ struct FrfEstimateRun {
   /// The tool's --summary but for tool, records and exit_code:
   /// io::FrfEstimateSummaryJson with the estimator and the verdict's flags.
   nlohmann::json Summary(const std::string& estimator) const;
+  /// What was estimated, for the tool's last line: "4 of 5 hits averaged
+  /// (rejected: hit3 (double_hit)); 2 FRF(s) of 801 lines, 0 to 500 Hz".
+  /// Only with FRFs (not every_hit_rejected()).
+  std::string Outcome() const;
 };
+
+/// "NAME=AXIS" each (the tool's --direction) -> FrfEstimateRunOptions::directions.
+/// @throws OptionError "directions" for a text without a name and '='.
+std::map<std::string, std::string> ParseDirections(const std::vector<std::string>& texts);
 
 /// Reads the records, names each channel's key, checks the options the
 /// sample rate decides, estimates and judges. Messages: kInfo the records

@@ -17,6 +17,7 @@
 #include "robomach/common/messages.h"
 #include "robomach/common/run_status.h"
 #include "robomach/dynamics/robot_model.h"
+#include "robomach/dynamics/uncertainty.h"
 #include "robomach/identification/joint_stiffness.h"
 #include "robomach/identification/test_plan.h"
 #include "robomach/io/kq_files.h"
@@ -62,7 +63,30 @@ struct KqIdentifyResult {
   /// exit_code, warnings, robomach_version): io::KqSummaryJson of the fit
   /// with the unit findings first in its advice, and `flagged`.
   nlohmann::json Summary() const;
+  /// The fit with the unit findings in front of its advice: the notes of
+  /// the kq.yaml and of the summary.
+  identification::JointStiffnessResult NotedFit() const;
+  /// kq-identify's --out: the kq.yaml block to paste into the robot config
+  /// (io::JointStiffnessYaml of NotedFit, KqOutputHeader first; a
+  /// `parameters:` block with `as_parameters`).
+  std::string KqYamlText(const KqIdentifyOptions& options, bool as_parameters) const;
+  /// kq-identify --merge: the robot config with the identified stiffness
+  /// (io::MergeJointStiffness), to be written to `out_path`, with
+  /// KqOutputHeader and every note of NotedFit as "NOTE: " comments; it
+  /// names `uncertainty_path` (may be empty) as its uncertainty file.
+  std::string MergedConfigText(const KqIdentifyOptions& options, const std::string& out_path,
+                               const std::string& uncertainty_path) const;
+  /// The fitted stiffnesses' estimates and covariance (formats.md §12),
+  /// their source the two lines of KqOutputHeader.
+  dynamics::ParameterUncertainty Uncertainty(const KqIdentifyOptions& options) const;
+  /// "TRACKER: ignored columns: a, b" (what --verbose tells), or "" when
+  /// the tracker file has no unknown column.
+  std::string IgnoredColumnsMessage(const KqIdentifyOptions& options) const;
 };
+
+/// The comment lines kq-identify's outputs start with: where the stiffness
+/// came from (tracker file and robot config), the tracker noise and the loss.
+std::vector<std::string> KqOutputHeader(const KqIdentifyOptions& options);
 
 /// Loads the config and the tracker file, checks them (the config's units,
 /// effects the load-test model does not have, the file's and the noise's

@@ -6,6 +6,7 @@
 // StabilityLobesOptions and writes what RunStabilityLobes returns; Python's
 // run_stability_lobes binds the same call.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,25 @@ struct StabilityLobesOptions {
 /// the cut's range).
 stability::LobesOptions MakeLobesOptions(const io::CutSpec& cut, const StabilityLobesOptions& o);
 
+/// "x,y,z" (as --tool-axis takes it) -> the vector, or nullopt unless the
+/// text starts with three numbers (the reading stops at the first item that
+/// is not one; a fourth number is refused) and they are not all zero.
+std::optional<Eigen::Vector3d> ParseToolAxis(const std::string& text);
+
+/// One curve of the lobe diagram: a tip's lobes by one method, speed in
+/// rpm against depth in mm (NaN where a speed has no boundary), with the
+/// ZOA band's bounds [mm] when the run has bands (else empty).
+struct LobeDiagramCurve {
+  std::string label;  // "P1 ZOA", "P1 SD"
+  std::vector<double> speed_rpm, depth_mm;
+  bool markers{false};  // the SD's points (a coarser grid)
+  std::vector<double> lower_mm, upper_mm;
+};
+
+/// The title of a fitted direct FRF's panel: its label, number of modes,
+/// rms misfit in noise units (when known) and usable band.
+std::string FitPanelTitle(const stability::DirectionFit& fit);
+
 struct StabilityLobesRun {
   io::CutSpec cut;
   std::vector<stability::TipDynamics> tips;
@@ -86,6 +106,17 @@ struct StabilityLobesRun {
 
   /// stability-lobes' exit 3: the lobes are flagged or an input was implausible.
   bool flagged() const { return lobes.flagged() || !input_findings.empty(); }
+  /// The curves of the lobe diagram: per tip, its ZOA then its SD lobes
+  /// (a method without rows is left out).
+  std::vector<LobeDiagramCurve> DiagramCurves() const;
+  /// What the cut is, for the diagram: "3 teeth, a_e/D = 0.5, down-milling".
+  std::string CutDescription() const;
+  /// What the diagram's bands are, "95 %, first order" (the level of
+  /// o.uncertainty and how they were computed); "" without bands.
+  std::string BandNote(const StabilityLobesOptions& o) const;
+  /// Each tip's id and modes in the frame of its source file (the modal
+  /// table --modes-out writes).
+  void ModesInSourceFrame(std::vector<std::string>* ids, std::vector<std::vector<dynamics::Mode>>* modes) const;
   /// The summary JSON of docs/formats.md §4.1 as the tool writes it, but for
   /// the keys only the tool knows (tool, lobes_csv, exit_code).
   nlohmann::json Summary(const StabilityLobesOptions& o) const;

@@ -1,0 +1,33 @@
+#pragma once
+// The checks of an options struct's fields (issue #36: a validator for every
+// options struct that names field, value and bound, used by the tools and
+// Python alike). The workflows' Validate() call these with the field's name;
+// a tool words the same message with its option (apps::FromFields,
+// apps::CheckOptionRange), so a range or a sense finding reads the same
+// whichever layer makes it.
+
+#include <string>
+
+namespace robomach {
+
+/// @throws OptionError(field, "FIELD: expected a value in [LO, HI], got
+/// VALUE") unless lo <= value <= hi (a NaN is outside). The numbers as a
+/// stream writes them.
+void CheckOptionRange(const std::string& field, double value, double lo, double hi);
+
+/// Sense check of a typed value (docs/plausibility.md): "" when lo <= value
+/// <= hi, else "implausible (unit mistake?): NAME VALUE UNIT is outside the
+/// LO to HI UNIT of PRACTICE: HINT" (low_hint below lo, high_hint above hi),
+/// a finding for the caller to warn about and flag its result with.
+std::string ImplausibleOption(const std::string& name, double value, double lo, double hi, const std::string& unit,
+                              const std::string& practice, const std::string& low_hint,
+                              const std::string& high_hint);
+
+/// Sense check of an angle typed in degrees: "" unless the value looks like
+/// radians, i.e. is within one turn in radians (|v| <= 2 pi = 6.28) and not
+/// whole (-1.5708 for -90 deg; 5 deg is degrees), the rule of the files'
+/// _deg fields (io::CheckDegreesNotRadians). The finding names the angle
+/// the value is in degrees.
+std::string RadiansInDegreeOption(const std::string& name, double value_deg);
+
+}  // namespace robomach

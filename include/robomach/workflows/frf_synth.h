@@ -1,0 +1,104 @@
+#pragma once
+// frf-synth as library calls (issue #36): a robot config (effects added,
+// parameters set) and a posture file -> a virtual hammer test, the "measured"
+// tool-tip FRFs on a hammer-test grid with seeded noise, and its verdict.
+// The tool parses its options into FrfSynthOptions and writes the FRFs and
+// the summary of the run. Two calls, because the sample rate may come from
+// the config: PrepareFrfSynth says where it came from, so that the tool can
+// name the config's value when the grid does not fit it (RunFrfSynth).
+
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "robomach/calibration/virtual_hammer_test.h"
+#include "robomach/common/messages.h"
+#include "robomach/common/run_status.h"
+#include "robomach/dynamics/measured_frf.h"
+#include "robomach/io/robot_config.h"
+
+namespace robomach::workflows {
+
+/// --noise-rel is a fraction of |H| (docs/plausibility.md): hammer tests show
+/// 0.1 to 10 %; above 50 % it is flagged (a percentage typed for a fraction),
+/// above 10 (1000 %) nothing of the FRF is left: refused.
+inline constexpr double kMaxPlausibleRelativeNoise = 0.5;
+inline constexpr double kMaxRelativeNoise = 10.0;
+
+/// frf-synth's options (the tool's option for each field: robot_path is
+/// --robot, postures_path --postures, adds --add, sets --set; the test's
+/// fields those of calibration::VirtualHammerOptions, relative_noise
+/// --noise-rel, absolute_noise_m_per_N --noise-abs-m-per-N, ...).
+struct FrfSynthOptions {
+  std::string robot_path;     // robot config YAML
+  std::string postures_path;  // posture file (formats.md §1)
+  std::vector<std::string> adds;  // effects switched on with their default parameters
+  std::vector<std::string> sets;  // "NAME=VALUE" in the parameter's unit
+  /// The test's grid, noise, directions and seed. sample_rate_hz not finite:
+  /// the config's hammer_test.sample_rate_hz, else 5120 Hz.
+  calibration::VirtualHammerOptions hammer{.sample_rate_hz = NAN};
+  /// How the unit findings name the fields (the tool: its options,
+  /// "--fmax-hz"); a field not in it goes by its own name. The errors name
+  /// the fields themselves, for the caller to map (apps::FromFields).
+  std::map<std::string, std::string> names;
+
+  /// The options alone, before any file is read.
+  /// @throws OptionError naming the field: block_samples outside
+  ///   [2, 2^22], averages outside [1 (2 with coherence), 100000],
+  ///   relative_noise infinite or above kMaxRelativeNoise, fmax_hz or
+  ///   hammer_cutoff_hz outside [0, 1e9] Hz, a finite sample_rate_hz outside
+  ///   (0, 1e9] Hz, an absolute noise negative or not finite.
+  void Validate() const;
+  /// The options that look like a unit mistake (docs/plausibility.md),
+  /// "implausible (unit mistake?): ..." each: they flag the run.
+  std::vector<std::string> UnitFindings() const;
+  std::string Name(const std::string& field) const;
+};
+
+/// The robot and the test as they will be used.
+struct FrfSynthSetup {
+  io::RobotConfig config;  // effects added and parameters set
+  calibration::VirtualHammerOptions hammer;  // with the sample rate resolved
+  /// "kr210.yaml:70:19" when the sample rate is the config's
+  /// hammer_test.sample_rate_hz; empty when it is the options' or 5120 Hz.
+  std::string sample_rate_at;
+};
+
+struct FrfSynthRun {
+  io::RobotConfig config;
+  calibration::VirtualHammerOptions hammer;  // as used (the sample rate resolved)
+  dynamics::FrfSet frfs;
+  /// The options' unit findings (FrfSynthOptions::UnitFindings), the
+  /// config's and the posture file's: each told as a warning.
+  std::vector<std::string> unit_findings;
+
+  bool flagged() const { return !unit_findings.empty(); }
+  RunStatus status() const { return flagged() ? RunStatus::kFlagged : RunStatus::kOk; }
+  /// frf-synth --summary (formats.md §4.1) but for the keys only the tool
+  /// knows (tool, out, format, quantity, exit_code, warnings): the inputs,
+  /// the grid, the noise, per FRF its peak (receptance, with the noise),
+  /// and `flagged`.
+  nlohmann::json Summary(const FrfSynthOptions& options) const;
+};
+
+/// Validates, loads the config (its unit findings are warnings), applies
+/// adds and sets and resolves the sample rate.
+/// @throws OptionError (Validate; "adds", "sets"), InputError for the config.
+FrfSynthSetup PrepareFrfSynth(const FrfSynthOptions& options, const MessageSink& tell = {});
+
+/// Checks the test's options against the resolved sample rate, reads the
+/// postures (their unit findings are warnings, then the options' findings
+/// are) and synthesizes the FRFs.
+/// @throws OptionError naming the VirtualHammerOptions field that fails
+///   calibration::CheckValid, with the options' unit findings as its likely
+///   cause; InputError for the posture file.
+FrfSynthRun RunFrfSynth(const FrfSynthOptions& options, FrfSynthSetup setup, const MessageSink& tell = {});
+
+/// Both calls in one.
+FrfSynthRun RunFrfSynth(const FrfSynthOptions& options, const MessageSink& tell = {});
+
+}  // namespace robomach::workflows
