@@ -92,47 +92,15 @@ int Run(int argc, char** argv) {
         FromFields(fields, [&] { return workflows::RunAxisSynth(o, MessagePrinter(kTool)); });
     const io::MachineFile& mf = run.machine;
     const machine::CountsRecord& rec = run.record;
-    const size_t n = mf.machine.axes.size();
-    const double rate_hz = o.sample_rate_hz;
-    const int capture_every = o.capture_every;
-    std::vector<std::pair<std::string, std::string>> meta{
-        {"generator", "axis-synth (robomach)"},
-        {"machine", machine_out.empty() ? o.machine_path : machine_out},
-        {"program", o.program_path},
-        {"sample_rate_hz", io::FormatDouble(rate_hz)}};
     // Capture first (it can fail on too fast a move), then the counts.
     if (!capture_path.empty()) {
-      machine::CaptureSynthesizer cap = run.Capture(o);
-      io::WriteFileAtomically(capture_path, [&](std::ostream& out) {
-        std::vector<std::uint16_t> words;
-        auto flush = [&]() {
-          if constexpr (std::endian::native == std::endian::big) {
-            for (auto& w : words) w = static_cast<std::uint16_t>((w >> 8) | (w << 8));
-          }
-          out.write(reinterpret_cast<const char*>(words.data()), static_cast<std::streamsize>(words.size() * 2));
-          words.clear();
-        };
-        cap.Start(rec.counts.data(), &words);
-        for (long r = 1; r < rec.rows(); ++r) {
-          try {
-            cap.Next(rec.counts.data() + r * n, &words);
-          } catch (const std::invalid_argument& e) {
-            throw UsageError(std::string("--capture-every ") + std::to_string(capture_every) + ": " + e.what() +
-                             "; raise --capture-every or lower --feed-mm-min");
-          }
-          if (words.size() > (1u << 16)) flush();
-        }
-        flush();
-      });
-      std::cerr << kTool << ": capture of " << (rec.rows() - 1) * capture_every + 1 << " samples at "
-                << io::FormatDouble(rate_hz * capture_every) << " Hz (--every " << capture_every << " gives back the counts), "
-                << cap.glitches() << " glitches\n";
+      const auto written = FromFields(fields, [&] { return run.WriteCapture(o, capture_path); });
+      std::cerr << kTool << ": capture of " << written.samples << " samples at "
+                << io::FormatDouble(o.sample_rate_hz * o.capture_every) << " Hz (--every " << o.capture_every
+                << " gives back the counts), " << written.glitches << " glitches\n";
     }
     if (!machine_out.empty()) io::WriteMachineFile(machine_out, mf);
-    io::WriteFileAtomically(out_path, [&](std::ostream& out) {
-      io::CountsWriter w(out, mf.machine.axes, meta);
-      for (long r = 0; r < rec.rows(); ++r) w.Row(rec.t_s[r], rec.counts.data() + r * n);
-    });
+    run.WriteCounts(o, out_path, machine_out);
     std::cerr << kTool << ": " << rec.rows() << " rows, " << io::FormatDouble(rec.t_s.back()) << " s\n";
     return ExitCodeFor(run.status());
   });

@@ -31,7 +31,7 @@ void SavePlot(const std::string& path, const workflows::FrfEstimateRun& run, io:
   }
   report::Axes& mag = fig.at(0, 0);
   report::Axes& coh = fig.at(1, 0);
-  mag.title = "|" + estimator + "| (" + io::QuantityName(quantity) + ")";
+  mag.title = "|" + estimator + "| (" + io::ToString(quantity) + ")";
   mag.x_label = "frequency [Hz]";
   mag.y_label = "|H| [" + io::QuantityUnit(quantity) + "]";
   mag.log_y = true;

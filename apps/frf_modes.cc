@@ -102,7 +102,7 @@ int Run(int argc, char** argv) {
     std::string quantity = "receptance";
     if (!all.file_power.empty()) {
       power = all.file_power.begin()->second;
-      quantity = io::QuantityName(static_cast<io::FrfQuantity>(power));
+      quantity = io::ToString(static_cast<io::FrfQuantity>(power));
       for (const auto& [key, p] : all.file_power) {
         if (p != power) {
           Warn(kTool, "the files hold different quantities; misfits are reported as " + quantity);

@@ -150,7 +150,7 @@ int Run(int argc, char** argv) {
                                   .mostly_explained_fraction = run.audit_options.mostly_explained_fraction,
                                   .clear_bic_gap = run.audit_options.clear_bic_gap, .previous = previous,
                                   .compare_dir = compare_dir, .progress = progress};
-    const std::string no_change = " not written: the audit names no change (" + audit::AuditGradeName(r.grade) + ")";
+    const std::string no_change = " not written: the audit names no change (" + audit::ToString(r.grade) + ")";
     if (!o.write_config.empty()) {
       if (run.change) ro.written_config = o.write_config;
       else Warn(kTool, "--write-config " + o.write_config + no_change);

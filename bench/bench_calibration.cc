@@ -50,7 +50,7 @@ void BM_Calibration_5Postures_2Directions_2000Lines(benchmark::State& state) {
     const CalibrationResult r = Calibrate(d.cfg.description, d.cfg.parameters, d.postures, d.measured, f, o);
     benchmark::DoNotOptimize(r.parameters.values().data());
   }
-  state.SetLabel(ObjectiveName(o.objective));
+  state.SetLabel(ToString(o.objective));
 }
 BENCHMARK(BM_Calibration_5Postures_2Directions_2000Lines)
     ->Arg(static_cast<int>(Objective::kModalTwoStage))

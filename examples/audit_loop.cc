@@ -77,7 +77,7 @@ int main(int argc, char** argv) try {
   options.candidates = {"tip_mass", "flange_compliance", "tool_flexibility"};
   const rm::audit::AuditResult audit =
       rm::audit::RunAudit(config.description, config.parameters, postures, measured, options);
-  std::printf("verdict: %s (%s)\n", rm::audit::AuditGradeName(audit.grade).c_str(), audit.headline.c_str());
+  std::printf("verdict: %s (%s)\n", rm::audit::ToString(audit.grade).c_str(), audit.headline.c_str());
   std::printf("  rank  candidate            BIC change  error [noise units]\n");
   for (std::size_t i = 0; i < audit.candidates.size(); ++i) {
     const rm::audit::CandidateResult& c = audit.candidates[i];

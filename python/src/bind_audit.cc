@@ -22,7 +22,7 @@ namespace {
 py::dict ResultDict(const audit::AuditResult& r) {
   auto number = [](double v) -> py::object { return std::isfinite(v) ? py::object(py::float_(v)) : py::none(); };
   py::dict d;
-  d["grade"] = audit::AuditGradeName(r.grade);
+  d["grade"] = audit::ToString(r.grade);
   d["headline"] = r.headline;
   d["verdict"] = r.verdict;
   d["pattern"] = r.pattern;
@@ -93,7 +93,7 @@ py::dict ResultDict(const audit::AuditResult& r) {
     d["parameter_uncertainty"] = py::none();
   }
   const RunFindings verdict = audit::JudgeAudit(r);
-  d["status"] = RunStatusName(verdict.status());
+  d["status"] = robomach::ToString(verdict.status());
   d["findings"] = FindingMessages(verdict);
   py::list cands;
   for (const auto& c : r.candidates) {
@@ -254,7 +254,7 @@ void BindAudit(py::module_& m) {
           d["config_text"] = run.config_text;
           d["messages"] = said.List();
           d["unit_findings"] = run.measured_read.unit_findings;
-          d["status"] = RunStatusName(run.status());
+          d["status"] = robomach::ToString(run.status());
           d["findings"] = FindingMessages(run.verdict);
           d["flagged"] = run.flagged();
           if (report_dir) {

@@ -3,7 +3,9 @@
 // (identification/joint_stiffness.h, io/tracker_file.h) and its D-optimal
 // test plan (identification/test_plan.h, io/kq_files.h). Results are plain
 // objects with read-only attributes.
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 
 #include <optional>
@@ -28,6 +30,8 @@
 #include "robomach/workflows/frf_calibrate.h"
 #include "robomach/workflows/kq_identify.h"
 #include "robomach/workflows/tracker_synth.h"
+#include "robomach/workflows/frf_synth.h"
+#include "robomach/io/frf_files.h"
 
 namespace robomach::python {
 namespace {
@@ -359,7 +363,7 @@ void BindCalibration(py::module_& m) {
     o.fmax_hz = fmax_hz;
     const calibration::CalibrationVerdict v = calibration::JudgeCalibration(result, measured, o);
     py::dict d;
-    d["status"] = RunStatusName(v.status());
+    d["status"] = robomach::ToString(v.status());
     d["findings"] = FindingMessages(v);
     d["residuals"] = v.residuals;
     d["rms_per_residual_in_noise_units"] = v.rms_per_residual_in_noise_units;
@@ -592,7 +596,7 @@ void BindCalibration(py::module_& m) {
           d["messages"] = said.List();
           d["flags"] = run.flags;
           d["findings"] = FindingMessages(run.verdict);
-          d["status"] = RunStatusName(run.status());
+          d["status"] = robomach::ToString(run.status());
           d["flagged"] = run.status() == RunStatus::kFlagged;
           d["summary"] = py::module_::import("json").attr("loads")(summary.dump());
           return d;
@@ -663,7 +667,7 @@ void BindCalibration(py::module_& m) {
           d["counts"] = run.CountsLine();
           d["messages"] = said.List();
           d["unit_findings"] = run.unit_findings;
-          d["status"] = RunStatusName(run.status());
+          d["status"] = robomach::ToString(run.status());
           d["flagged"] = run.flagged();
           d["summary"] = py::module_::import("json").attr("loads")(run.Summary(o).dump());
           return d;
@@ -684,6 +688,114 @@ void BindCalibration(py::module_& m) {
         "(also as UnitWarning, with the config's), status, flagged (the tool's exit 3) and summary (the tool's "
         "--summary but for tool, out and warnings). ValueError naming the option; FileNotFoundError, InputError for "
         "files. Releases the GIL.");
+
+  const workflows::FrfSynthOptions kFrfSynth;  // frf-synth's defaults
+  std::string frf_synth_directions;  // "xx,yy": the default directions as --directions spells them
+  for (const auto& [r, e] : kFrfSynth.hammer.directions) {
+    frf_synth_directions += (frf_synth_directions.empty() ? "" : ",") + AxisString(r) + AxisString(e);
+  }
+  m.def("run_frf_synth",
+        [](const std::string& robot, const std::string& postures, const std::optional<std::string>& out,
+           const std::map<std::string, double>& sets, const std::vector<std::string>& adds,
+           const std::string& directions, const std::optional<double>& sample_rate_hz, int block_samples,
+           double fmin_hz, double fmax_hz, double noise_rel, double noise_abs_m_per_N,
+           double noise_abs_m_per_s_per_N, double noise_abs_m_per_s2_per_N, double hammer_cutoff_hz, int averages,
+           unsigned seed, bool coherence, const std::string& quantity) {
+          workflows::FrfSynthOptions o;
+          o.robot_path = robot;
+          o.postures_path = postures;
+          for (const auto& [name, value] : sets) o.sets.push_back(name + "=" + FormatNumber(value, 17));
+          o.adds = adds;
+          calibration::VirtualHammerOptions& h = o.hammer;
+          if (sample_rate_hz) h.sample_rate_hz = *sample_rate_hz;  // None: the config's, else 5120 Hz
+          h.block_samples = block_samples;
+          h.fmin_hz = fmin_hz;
+          h.fmax_hz = fmax_hz;
+          h.relative_noise = noise_rel;
+          h.absolute_noise_m_per_N = noise_abs_m_per_N;
+          h.absolute_noise_m_per_s_per_N = noise_abs_m_per_s_per_N;
+          h.absolute_noise_m_per_s2_per_N = noise_abs_m_per_s2_per_N;
+          h.hammer_cutoff_hz = hammer_cutoff_hz;
+          h.averages = averages;
+          h.seed = seed;
+          h.coherence = coherence;
+          // The unit findings name the keywords whose names are not the fields'.
+          o.names = {{"relative_noise", "noise_rel"},
+                     {"absolute_noise_m_per_N", "noise_abs_m_per_N"},
+                     {"absolute_noise_m_per_s_per_N", "noise_abs_m_per_s_per_N"},
+                     {"absolute_noise_m_per_s2_per_N", "noise_abs_m_per_s2_per_N"}};
+          o.Validate();
+          h.directions.clear();
+          for (const auto& [r, e] : io::ParseDirectionPairs(directions)) {
+            h.directions.emplace_back(static_cast<Axis>(r), static_cast<Axis>(e));
+          }
+          const io::FrfQuantity q = io::ParseQuantity(quantity);
+          // The format follows out's extension, as the tool's --out.
+          bool uff = false;
+          if (out) {
+            std::string ext = std::filesystem::path(*out).extension().string();
+            for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+            uff = ext == ".uff" || ext == ".unv" || ext == ".uf";
+            if (!uff && ext != ".csv") {
+              throw py::value_error("out " + *out + ": expected a file name ending in .csv (the FRF CSV of "
+                                    "docs/formats.md §3) or .uff, .unv (UFF58)");
+            }
+          }
+          RequireReadableFile(o.robot_path);
+          RequireReadableFile(o.postures_path);
+          CollectedMessages said;
+          workflows::FrfSynthRun run;
+          std::string sample_rate_at;
+          {
+            py::gil_scoped_release release;
+            workflows::FrfSynthSetup setup = workflows::PrepareFrfSynth(o, said.Sink());
+            sample_rate_at = setup.sample_rate_at;
+            run = workflows::RunFrfSynth(o, std::move(setup), said.Sink());
+            if (out && uff) {
+              if (h.coherence && h.averages > 1) {
+                said.messages.push_back({Message::Kind::kWarning,
+                                         "UFF58 has no field for the number of averages: give averages " +
+                                             std::to_string(h.averages) + " to the tools that read " + *out});
+              }
+              io::WriteUff58(*out, run.frfs, q);
+            } else if (out) {
+              io::WriteFrfCsv(*out, run.frfs, q, h.coherence ? h.averages : 0);
+            }
+          }
+          for (const std::string& f : run.unit_findings) WarnUnit(f);  // the config's among them
+          py::dict d;
+          d["frfs"] = run.frfs;
+          d["sample_rate_hz"] = run.hammer.sample_rate_hz;
+          d["sample_rate_at"] = sample_rate_at;
+          d["lines"] = calibration::HammerTestGrid(run.hammer).size();
+          d["messages"] = said.List();
+          d["unit_findings"] = run.unit_findings;
+          d["status"] = robomach::ToString(run.status());
+          d["flagged"] = run.flagged();
+          d["summary"] = py::module_::import("json").attr("loads")(run.Summary(o).dump());
+          return d;
+        },
+        py::arg("robot"), py::arg("postures"), py::arg("out") = py::none(),
+        py::arg("sets") = std::map<std::string, double>{}, py::arg("adds") = kFrfSynth.adds,
+        py::arg("directions") = frf_synth_directions, py::arg("sample_rate_hz") = py::none(),
+        py::arg("block_samples") = kFrfSynth.hammer.block_samples, py::arg("fmin_hz") = kFrfSynth.hammer.fmin_hz,
+        py::arg("fmax_hz") = kFrfSynth.hammer.fmax_hz, py::arg("noise_rel") = kFrfSynth.hammer.relative_noise,
+        py::arg("noise_abs_m_per_N") = kFrfSynth.hammer.absolute_noise_m_per_N,
+        py::arg("noise_abs_m_per_s_per_N") = kFrfSynth.hammer.absolute_noise_m_per_s_per_N,
+        py::arg("noise_abs_m_per_s2_per_N") = kFrfSynth.hammer.absolute_noise_m_per_s2_per_N,
+        py::arg("hammer_cutoff_hz") = kFrfSynth.hammer.hammer_cutoff_hz,
+        py::arg("averages") = kFrfSynth.hammer.averages, py::arg("seed") = kFrfSynth.hammer.seed,
+        py::arg("coherence") = kFrfSynth.hammer.coherence,
+        py::arg("quantity") = io::ToString(io::FrfQuantity::kReceptance),
+        "frf-synth as one call (workflows::PrepareFrfSynth, RunFrfSynth): a virtual hammer test of a robot config "
+        "(adds, sets {name: value} applied) at the postures of a posture file, the tool's options under their names "
+        "without dashes (defaults: FrfSynthOptions; sample_rate_hz None: the config's hammer_test.sample_rate_hz, "
+        "else 5120 Hz); out: write the FRFs there as the tool's --out (.csv, or .uff/.unv for UFF58) in `quantity`. "
+        "Returns a dict: frfs (FrfSet, receptance [m/N]), sample_rate_hz (as used), sample_rate_at (the config's "
+        "file:line:col when it came from there, else ''), lines (of the grid), messages ({kind, text}), "
+        "unit_findings (also as UnitWarning, with the config's and the posture file's), status, flagged (the tool's "
+        "exit 3) and summary (the tool's --summary but for tool, out, format, quantity, exit_code and warnings). "
+        "ValueError naming the option; FileNotFoundError, InputError for files. Releases the GIL.");
 
   py::class_<identification::PlannedLoad>(m, "PlannedLoad", "One planned rope direction at one posture [SI, in B].")
       .def_readonly("pose_id", &identification::PlannedLoad::pose_id)

@@ -140,7 +140,7 @@ void BindDrilling(py::module_& m) {
           d["unit_findings"] = run.setup.unit_findings;
           d["messages"] = said.List();
           d["findings"] = FindingMessages(run.verdict);
-          d["status"] = RunStatusName(run.status());
+          d["status"] = robomach::ToString(run.status());
           d["flagged"] = run.status() == RunStatus::kFlagged;
           d["summaries"] = summaries;
           return d;

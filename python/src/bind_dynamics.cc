@@ -377,7 +377,7 @@ void BindDynamics(py::module_& m) {
       r = dynamics::PredictFrfs(model, named, freq_hz, o);
     }
     py::dict out;
-    out["status"] = RunStatusName(r.status());
+    out["status"] = robomach::ToString(r.status());
     py::list findings, results;
     for (const Finding& f : r.findings) {
       // The posture file's line in front, as frf-predict prints it.

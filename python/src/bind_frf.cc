@@ -42,7 +42,7 @@ py::list TextLines(const std::vector<std::string>& lines) {
 py::dict ReadResultDict(const io::FrfReadResult& r) {
   py::dict d;
   d["frfs"] = r.frfs;
-  d["quantity"] = io::QuantityName(r.file_quantity);
+  d["quantity"] = io::ToString(r.file_quantity);
   d["averages"] = r.averages;
   d["warnings"] = TextLines(r.warnings);
   d["notes"] = TextLines(r.notes);
@@ -112,7 +112,7 @@ py::dict EstimateFrfs(const std::vector<std::string>& records, const std::string
   const calibration::FrfEstimateResult& r = run.result;
   py::dict d;
   const bool estimated = !run.every_hit_rejected();
-  d["status"] = estimated ? RunStatusName(run.verdict.status()) : "no_estimate";
+  d["status"] = estimated ? robomach::ToString(run.verdict.status()) : "no_estimate";
   std::vector<std::string> findings = FindingMessages(run.verdict);
   if (!estimated) findings.insert(findings.begin(), "every hit was rejected: no estimate (summary['hits'] says why)");
   d["findings"] = findings;
@@ -249,7 +249,7 @@ void BindFrf(py::module_& m) {
 
   py::class_<FrfNoise>(m, "FrfNoise",
                        "The noise model of one FRF, sigma(f)^2 = (rel |H|)^2 + floor(f)^2 [m/N]^2, per line.")
-      .def_property_readonly("source", [](const FrfNoise& n) { return calibration::NoiseSourceName(n.source); },
+      .def_property_readonly("source", [](const FrfNoise& n) { return calibration::ToString(n.source); },
                              "'coherence' or 'scatter'")
       .def_readonly("averages", &FrfNoise::averages)
       .def_readonly("relative", &FrfNoise::relative, "rel [-]")

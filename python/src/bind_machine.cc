@@ -2,7 +2,9 @@
 // acquisition of axis-acquire (counts -> compensated axes -> tool pose, the
 // contour error against a programmed path) and the ISO 230-2 evaluation of
 // axis-accuracy.
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,10 +20,106 @@
 #include "robomach/io/machine_file.h"
 #include "robomach/workflows/iso_evaluation.h"
 #include "robomach/machine/iso230.h"
+#include "robomach/workflows/axis_synth.h"
 
 namespace robomach::python {
 
 void BindMachine(py::module_& m) {
+  const workflows::AxisSynthOptions kAxisSynth;  // axis-synth's defaults
+  m.def("run_axis_synth",
+        [](const std::string& machine_path, const std::string& program, const std::optional<std::string>& out,
+           const std::optional<std::string>& compensation, const std::optional<std::string>& temperature,
+           double feed_mm_min, double sample_rate_hz, double dwell_s, double start_b_deg,
+           const std::optional<std::string>& machine_out, const std::optional<std::string>& capture,
+           int capture_every, int capture_settle, double glitch_probability, unsigned seed, long max_rows) {
+          workflows::AxisSynthOptions o;
+          o.machine_path = machine_path;
+          o.program_path = program;
+          o.compensation_path = compensation.value_or("");
+          o.temperature_path = temperature.value_or("");
+          o.feed_mm_min = feed_mm_min;
+          o.sample_rate_hz = sample_rate_hz;
+          o.dwell_s = dwell_s;
+          o.start_b_deg = start_b_deg;
+          o.origins_at_start = machine_out.has_value();  // as the tool: --machine-out
+          o.capture_every = capture_every;
+          o.capture_settle = capture_settle;
+          o.glitch_probability = glitch_probability;
+          o.seed = seed;
+          o.max_rows = max_rows;
+          // The messages name the keywords whose names are not the fields'.
+          o.names = {{"compensation_path", "compensation"}, {"origins_at_start", "machine_out"}};
+          o.Validate();
+          for (const std::string* p : {&o.machine_path, &o.program_path, &o.compensation_path, &o.temperature_path}) {
+            if (!p->empty()) RequireReadableFile(*p);
+          }
+          CollectedMessages said;
+          // Said before the files are read, as the tool does; the run flags them.
+          for (const std::string& w : o.UnitFindings()) said.messages.push_back({Message::Kind::kWarning, w});
+          workflows::AxisSynthRun run;
+          long capture_samples = 0, capture_glitches = 0;
+          {
+            py::gil_scoped_release release;
+            run = workflows::RunAxisSynth(o, said.Sink());
+            // The tool's outputs, in its order: the capture (it can fail on too
+            // fast a move), the machine file, the counts.
+            if (capture) {
+              const auto written = run.WriteCapture(o, *capture);
+              capture_samples = written.samples;
+              capture_glitches = written.glitches;
+            }
+            if (machine_out) io::WriteMachineFile(*machine_out, run.machine);
+            if (out) run.WriteCounts(o, *out, machine_out.value_or(""));
+          }
+          for (const std::string& f : run.unit_findings) WarnUnit(f);
+          const machine::CountsRecord& rec = run.record;
+          const int n = static_cast<int>(run.machine.machine.axes.size());
+          Eigen::Matrix<std::int64_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> counts(rec.rows(), n);
+          for (long r = 0; r < rec.rows(); ++r) {
+            for (int a = 0; a < n; ++a) counts(r, a) = rec.counts[r * n + a];
+          }
+          std::vector<std::string> names;
+          std::vector<double> origins;
+          for (const auto& a : run.machine.machine.axes) {
+            names.push_back(a.name);
+            origins.push_back(a.origin);
+          }
+          py::dict d;
+          d["axis_names"] = names;
+          d["t_s"] = rec.t_s;
+          d["counts"] = counts;
+          d["origins_si"] = origins;
+          d["rows"] = rec.rows();
+          d["duration_s"] = rec.t_s.empty() ? 0.0 : rec.t_s.back();
+          if (capture) {
+            d["capture_samples"] = capture_samples;
+            d["capture_glitches"] = capture_glitches;
+          }
+          d["messages"] = said.List();
+          d["unit_findings"] = run.unit_findings;
+          d["status"] = robomach::ToString(run.status());
+          d["flagged"] = run.flagged();
+          return d;
+        },
+        py::arg("machine"), py::arg("program"), py::arg("out") = py::none(), py::arg("compensation") = py::none(),
+        py::arg("temperature") = py::none(), py::arg("feed_mm_min") = kAxisSynth.feed_mm_min,
+        py::arg("sample_rate_hz") = kAxisSynth.sample_rate_hz, py::arg("dwell_s") = kAxisSynth.dwell_s,
+        py::arg("start_b_deg") = kAxisSynth.start_b_deg, py::arg("machine_out") = py::none(),
+        py::arg("capture") = py::none(), py::arg("capture_every") = kAxisSynth.capture_every,
+        py::arg("capture_settle") = kAxisSynth.capture_settle,
+        py::arg("glitch_probability") = kAxisSynth.glitch_probability, py::arg("seed") = kAxisSynth.seed,
+        py::arg("max_rows") = kAxisSynth.max_rows,
+        "axis-synth as one call (workflows::RunAxisSynth): a machine file, a programmed path and optionally the "
+        "controller's compensation tables and temperature log -> the encoder counts the machine would record, the "
+        "tool's options under their names without dashes (defaults: AxisSynthOptions). out, machine_out, capture: "
+        "write the tool's --out (counts, docs/formats.md §8.1), --machine-out (the machine file with the measured "
+        "start as origins; given, the origins are that start, as the tool's) and --capture (the raw quadrature "
+        "capture, §8.2). Returns a dict: axis_names, t_s, counts (rows × axes, int64; the first row all zero), "
+        "origins_si (per axis, [m, rad], as used), rows, duration_s, with capture capture_samples and "
+        "capture_glitches, messages ({kind, text}), unit_findings (the options' then the files'; also as "
+        "UnitWarning), status and flagged (the tool's exit 3). ValueError naming the option; FileNotFoundError, "
+        "InputError for files. Releases the GIL.");
+
   m.def("acquire", [](const std::string& machine_path, const std::string& counts_path,
                       const std::optional<std::string>& compensation, const std::optional<std::string>& temperature,
                       const std::optional<std::string>& program, const std::optional<std::string>& out) {
@@ -142,7 +240,7 @@ void BindMachine(py::module_& m) {
     res["samples"] = d.samples;
     res["error_events"] = d.error_events;
     res["final_counts"] = d.final_counts;
-    res["status"] = RunStatusName(d.status());
+    res["status"] = robomach::ToString(d.status());
     res["findings"] = FindingMessages(d);
     return res;
   }, py::arg("machine"), py::arg("capture"), py::arg("sample_rate_hz"), py::arg("every") = 1, py::arg("glitch_filter") = 0,
@@ -194,7 +292,7 @@ void BindMachine(py::module_& m) {
     d["axes"] = axes;
     d["unit_findings"] = eval.unit_findings;
     d["min_runs"] = eval.min_runs;
-    d["status"] = RunStatusName(eval.status());
+    d["status"] = robomach::ToString(eval.status());
     d["findings"] = FindingMessages(eval);
     return d;
   }, py::arg("runs"),

@@ -138,7 +138,7 @@ void BindPolishing(py::module_& m) {
       .def_property_readonly("rows_off_face", [](const PyPlan& p) { return p.outcome.rows_off_face; })
       .def_property_readonly("flagged", [](const PyPlan& p) { return p.outcome.flagged(); },
                              "polish-plan exits 3: a target out of reach, no feasible plan, a better zig-zag, rows off the face")
-      .def_property_readonly("status", [](const PyPlan& p) { return RunStatusName(p.outcome.status()); },
+      .def_property_readonly("status", [](const PyPlan& p) { return robomach::ToString(p.outcome.status()); },
                              "'ok' or 'flagged'")
       .def_property_readonly("findings", [](const PyPlan& p) { return FindingMessages(p.outcome); },
                              "why it is flagged, one sentence each (polish-plan's warnings)")
@@ -240,7 +240,7 @@ void BindPolishing(py::module_& m) {
       .def_readonly("max_speed_m_per_s", &workflows::PolishSimulation::max_speed)
       .def_readonly("speed_limit_exceeded", &workflows::PolishSimulation::speed_limit_exceeded,
                     "polish-sim exits 3: a segment faster than the process's max_speed beyond the file's rounding")
-      .def_property_readonly("status", [](const workflows::PolishSimulation& r) { return RunStatusName(r.status()); },
+      .def_property_readonly("status", [](const workflows::PolishSimulation& r) { return robomach::ToString(r.status()); },
                              "'ok' or 'flagged'")
       .def_property_readonly("findings", [](const workflows::PolishSimulation& r) { return FindingMessages(r); },
                              "why it is flagged (polish-sim's warnings)")
@@ -322,7 +322,7 @@ void BindPolishing(py::module_& m) {
           d["messages"] = said.List();
           d["input_findings"] = run.input_findings;
           d["findings"] = FindingMessages(run.outcome);
-          d["status"] = RunStatusName(run.status());
+          d["status"] = robomach::ToString(run.status());
           d["flagged"] = run.flagged();
           d["summary"] = py::module_::import("json").attr("loads")(run.Summary(o).dump());
           auto plan = std::make_unique<PyPlan>();

@@ -252,7 +252,7 @@ void BindStability(py::module_& m) {
       .def_property_readonly("flagged", &stability::LobesResult::flagged,
                              "stability-lobes' exit 3: a modal fit that does not describe a tool tip, ZOA and SD "
                              "more than 10 % apart, or speeds without a boundary")
-      .def_property_readonly("run_status", [](const stability::LobesResult& r) { return RunStatusName(r.status()); },
+      .def_property_readonly("run_status", [](const stability::LobesResult& r) { return robomach::ToString(r.status()); },
                              "'ok' or 'flagged' (`status` is each row's)")
       .def_property_readonly("findings", [](const stability::LobesResult& r) { return FindingMessages(r); },
                              "why it is flagged, one sentence each (also among the messages, as warnings)")

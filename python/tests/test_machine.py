@@ -69,6 +69,59 @@ def test_decode_equals_axis_decode(tmp):
     np.testing.assert_array_equal(d['counts'], np.array([[int(x) for x in r[1:]] for r in rows], dtype=np.int64))
 
 
+def test_run_axis_synth_equals_the_tools_summary(tmp):
+    """Issue #36 acceptance for axis-synth, which has no --summary: what it
+    writes (the counts, the machine file with the measured start as origins,
+    the raw capture) and the Python call's (workflows::RunAxisSynth), on the
+    shipped machine, path, tables and temperature log (feed and rate as
+    test_acquire_equals_axis_acquire's, to keep it fast). The tool, then the
+    call, write to the same paths (the counts file names the machine file)."""
+    out, machine_out = tmp / 'counts.csv', tmp / 'machine.yaml'
+    r = run_tool('axis-synth', '--machine', MACHINE, '--program', PROGRAM, '--compensation', COMP, '--temperature', TEMP,
+                 '--feed-mm-min', 20000, '--sample-rate-hz', 2000, '--out', out, '--machine-out', machine_out,
+                 expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool_counts, tool_machine = out.read_text(), machine_out.read_text()
+    out.unlink()
+    machine_out.unlink()
+    run = rm.run_axis_synth(MACHINE, PROGRAM, out=str(out), machine_out=str(machine_out), compensation=COMP,
+                            temperature=TEMP, feed_mm_min=20000, sample_rate_hz=2000)
+    assert run['flagged'] == (r.returncode == 3)
+    assert run['status'] == ('flagged' if r.returncode == 3 else 'ok')
+    assert out.read_text() == tool_counts
+    assert machine_out.read_text() == tool_machine
+    # The values of the tool's counts file are the call's.
+    lines = [line for line in tool_counts.splitlines() if not line.startswith('#')]
+    assert lines[0].split(',') == ['t_s'] + [f'{a}_count' for a in run['axis_names']]
+    rows = [line.split(',') for line in lines[1:]]
+    assert run['rows'] == len(rows) and f"axis-synth: {run['rows']} rows, " in r.stderr
+    assert run['t_s'] == [float(row[0]) for row in rows]  # written shortest round-trip: exact
+    np.testing.assert_array_equal(run['counts'], np.array([[int(x) for x in row[1:]] for row in rows], dtype=np.int64))
+    assert not run['counts'][0].any()  # the first row is the reference
+    assert len(run['origins_si']) == len(run['axis_names'])
+
+    # The raw capture (with glitches) on the path and options of
+    # test_decode_equals_axis_decode, which the tool is known to capture.
+    arc = os.path.join(DATA, 'machine', 'cone_arc.csv')
+    opts = ['--feed-mm-min', 2000, '--sample-rate-hz', 8000, '--capture-every', 100, '--glitch-probability', 0.01,
+            '--seed', 3]
+    r = run_tool('axis-synth', '--machine', MACHINE, '--program', arc, *opts, '--capture', tmp / 'capture.bin',
+                 '--machine-out', machine_out, '--out', out, expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool_capture, tool_counts = (tmp / 'capture.bin').read_bytes(), out.read_text()
+    for p in (tmp / 'capture.bin', out, machine_out):
+        p.unlink()
+    run = rm.run_axis_synth(MACHINE, arc, feed_mm_min=2000, sample_rate_hz=8000, capture_every=100,
+                            glitch_probability=0.01, seed=3, capture=str(tmp / 'capture.bin'),
+                            machine_out=str(machine_out), out=str(out))
+    assert run['flagged'] == (r.returncode == 3)
+    assert (tmp / 'capture.bin').read_bytes() == tool_capture
+    assert out.read_text() == tool_counts
+    assert run['capture_samples'] == (run['rows'] - 1) * 100 + 1 == len(tool_capture) // 2
+    assert f"capture of {run['capture_samples']} samples" in r.stderr
+    assert f", {run['capture_glitches']} glitches" in r.stderr
+
+
 def test_iso230_equals_axis_accuracy(tmp):
     runs = os.path.join(DATA, 'machine', 'x_runs_hand.csv')
     rc = run_tool('axis-accuracy', '--runs', runs, '--out', tmp / 'tool.json', expect_rc=None).returncode

@@ -51,6 +51,26 @@ def test_analyse_modes_equals_the_tool_and_the_model(tap):
                 assert frf['misfit_noise_sigmas'] < 1.5
 
 
+def test_run_frf_synth_equals_the_tools_summary(tmp_path):
+    """Issue #36 acceptance: frf-synth's JSON summary and FRF file and the
+    Python call's (workflows::PrepareFrfSynth, RunFrfSynth) on the shipped
+    robot with the tool's defaults (the two postures of the fixture above, to
+    keep it fast)."""
+    r = run_tool('frf-synth', '--robot', KR210, '--postures', POSTURES, '--out', tmp_path / 'tool.csv',
+                 '--summary', tmp_path / 'tool.json', expect_rc=None)
+    assert r.returncode in (0, 3), r.stderr
+    tool = json.loads((tmp_path / 'tool.json').read_text())
+    run = rm.run_frf_synth(KR210, POSTURES, out=str(tmp_path / 'py.csv'))
+    assert run['flagged'] == (r.returncode == 3)
+    assert run['status'] == ('flagged' if r.returncode == 3 else 'ok')
+    for key in ('tool', 'out', 'format', 'quantity', 'exit_code', 'warnings', 'robomach_version'):  # only the tool's
+        tool.pop(key, None)
+    assert run['summary'] == tool
+    assert (tmp_path / 'py.csv').read_text() == (tmp_path / 'tool.csv').read_text()
+    assert f"frf-synth: wrote {len(run['frfs'])} FRFs of {run['lines']} lines" in r.stderr
+    assert run['sample_rate_hz'] == tool['sample_rate_hz']
+
+
 def test_mac_of_known_vectors():
     a = np.array([[1, 0], [2, 1], [3, 0]], dtype=complex)
     mac = rm.modal_assurance_criterion(a, -2j * a[:, :1])

@@ -11,11 +11,12 @@
 #include "audit/internal/verdict.h"
 #include "robomach/audit/error_patterns.h"
 #include "robomach/audit/model_audit.h"
+#include "robomach/common/enum_names.h"
 #include "robomach/dynamics/effect.h"
 
 namespace robomach::audit {
 
-std::string AuditGradeName(AuditGrade grade) {
+std::string ToString(AuditGrade grade) {
   switch (grade) {
     case AuditGrade::kNoFailure:
       return "no_failure";
@@ -27,6 +28,12 @@ std::string AuditGradeName(AuditGrade grade) {
       return "unexplained";
   }
   return "unexplained";
+}
+
+AuditGrade ParseAuditGrade(const std::string& name) {
+  constexpr AuditGrade kAll[] = {AuditGrade::kNoFailure, AuditGrade::kExplained, AuditGrade::kMostlyExplained,
+                                 AuditGrade::kUnexplained};
+  return ParseByName("audit grade", name, kAll);
 }
 
 double FractionRemoved(double before, double after, double noise_floor) {

@@ -14,6 +14,7 @@
 
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/calibration/global_modal_fit.h"
+#include "robomach/common/enum_names.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/golden_section.h"
 #include "robomach/common/units.h"
@@ -301,7 +302,7 @@ Comparison CompareWithMeasurement(const std::shared_ptr<const dynamics::RobotMod
 
 // ---------------------------------------------------------- calibration --
 
-std::string ObjectiveName(Objective o) {
+std::string ToString(Objective o) {
   switch (o) {
     case Objective::kModalTwoStage: return "modal-two-stage";
     case Objective::kModalJoint: return "modal-joint";
@@ -311,10 +312,8 @@ std::string ObjectiveName(Objective o) {
 }
 
 Objective ParseObjective(const std::string& name) {
-  if (name == "modal-two-stage") return Objective::kModalTwoStage;
-  if (name == "modal-joint") return Objective::kModalJoint;
-  if (name == "whole-curve") return Objective::kWholeCurve;
-  throw std::invalid_argument("objective '" + name + "': expected modal-two-stage, modal-joint or whole-curve");
+  constexpr Objective kAll[] = {Objective::kModalTwoStage, Objective::kModalJoint, Objective::kWholeCurve};
+  return ParseByName("objective", name, kAll);
 }
 
 

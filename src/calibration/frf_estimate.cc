@@ -12,6 +12,7 @@
 #include <unsupported/Eigen/FFT>
 
 #include "robomach/calibration/frf_noise.h"
+#include "robomach/common/enum_names.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 
@@ -100,13 +101,18 @@ void CheckValid(const FrfEstimateOptions& o) {
           "in (0, 1)");
 }
 
-std::string HitStatusName(HitStatus s) {
+std::string ToString(HitStatus s) {
   switch (s) {
     case HitStatus::kAccepted: return "accepted";
     case HitStatus::kDoubleHit: return "double hit";
     case HitStatus::kOverload: return "overload";
   }
   return "?";
+}
+
+HitStatus ParseHitStatus(const std::string& name) {
+  constexpr HitStatus kAll[] = {HitStatus::kAccepted, HitStatus::kDoubleHit, HitStatus::kOverload};
+  return ParseByName("hit status", name, kAll);
 }
 
 int DetectFlatTop(const Eigen::VectorXd& x, int min_run) {

@@ -12,6 +12,7 @@
 
 #include "robomach/calibration/global_modal_fit.h"
 #include "robomach/calibration/modal_fit.h"
+#include "robomach/common/enum_names.h"
 
 namespace robomach::calibration {
 namespace {
@@ -583,7 +584,12 @@ void CheckValid(const NoiseOptions& o) {
   if (o.max_outlier_run_lines < 1) fail("max_outlier_run_lines must be >= 1");
 }
 
-std::string NoiseSourceName(NoiseSource s) { return s == NoiseSource::kCoherence ? "coherence" : "scatter"; }
+std::string ToString(NoiseSource s) { return s == NoiseSource::kCoherence ? "coherence" : "scatter"; }
+
+NoiseSource ParseNoiseSource(const std::string& name) {
+  constexpr NoiseSource kAll[] = {NoiseSource::kCoherence, NoiseSource::kScatter};
+  return ParseByName("noise source", name, kAll);
+}
 
 namespace {
 

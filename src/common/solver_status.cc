@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "robomach/common/run_status.h"
+#include "robomach/common/enum_names.h"
 
 namespace robomach {
 
@@ -29,6 +30,11 @@ SolverStatus ParseSolverStatus(const std::string& name) {
                               "': expected converged, not_converged, failed or not_improved");
 }
 
-const char* RunStatusName(RunStatus s) { return s == RunStatus::kOk ? "ok" : "flagged"; }
+const char* ToString(RunStatus s) { return s == RunStatus::kOk ? "ok" : "flagged"; }
+
+RunStatus ParseRunStatus(const std::string& name) {
+  constexpr RunStatus kAll[] = {RunStatus::kOk, RunStatus::kFlagged};
+  return ParseByName("run status", name, kAll);
+}
 
 }  // namespace robomach

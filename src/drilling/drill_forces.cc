@@ -68,6 +68,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "robomach/common/enum_names.h"
+
 namespace robomach::drilling {
 namespace {
 
@@ -285,11 +287,18 @@ DrillForces ComputeDrillForces(const DrillGeometry& d, const DrillingMaterial& m
   return out;
 }
 
+const char* ToString(ChiselModel m) {
+  switch (m) {
+    case ChiselModel::kSeedScaling: return "seed_scaling";
+    case ChiselModel::kOrthogonal: return "orthogonal";
+    case ChiselModel::kNone: return "none";
+  }
+  return "?";
+}
+
 ChiselModel ParseChiselModel(const std::string& name) {
-  if (name == "seed_scaling") return ChiselModel::kSeedScaling;
-  if (name == "orthogonal") return ChiselModel::kOrthogonal;
-  if (name == "none") return ChiselModel::kNone;
-  throw std::invalid_argument("expected a chisel model seed_scaling, orthogonal or none, got '" + name + "'");
+  constexpr ChiselModel kAll[] = {ChiselModel::kSeedScaling, ChiselModel::kOrthogonal, ChiselModel::kNone};
+  return ParseByName("chisel model", name, kAll);
 }
 
 }  // namespace robomach::drilling

@@ -4,16 +4,18 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "robomach/common/enum_names.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 
 namespace robomach::dynamics {
 
+const char* ToString(ReceptanceMethod m) { return m == ReceptanceMethod::kDirect ? "direct" : "modal"; }
+
 ReceptanceMethod ParseReceptanceMethod(const std::string& name) {
-  if (name == "modal") return ReceptanceMethod::kModal;
-  if (name == "direct") return ReceptanceMethod::kDirect;
-  throw std::invalid_argument("method '" + name + "': expected 'modal' or 'direct'");
+  constexpr ReceptanceMethod kAll[] = {ReceptanceMethod::kModal, ReceptanceMethod::kDirect};
+  return ParseByName("method", name, kAll);
 }
 
 std::vector<Eigen::Matrix3cd> ReceptanceBy(ReceptanceMethod method, const PostureDynamics& dynamics,

@@ -13,6 +13,7 @@
 
 #include "identification/internal/information.h"
 #include "identification/internal/tracker_residual.h"
+#include "robomach/common/enum_names.h"
 #include "robomach/identification/compliance_model.h"
 
 namespace robomach::identification {
@@ -71,6 +72,12 @@ const char* ToString(Determination d) {
     case Determination::kNotDetermined: return "not determined";
   }
   return "?";
+}
+
+Determination ParseDetermination(const std::string& name) {
+  constexpr Determination kAll[] = {Determination::kDetermined, Determination::kWeak,
+                                    Determination::kNotDetermined};
+  return ParseByName("determination", name, kAll);
 }
 
 void CheckValid(const IdentificationOptions& o) {

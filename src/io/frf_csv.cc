@@ -230,7 +230,7 @@ FrfReadResult ReadFrfCsv(const std::string& path, bool keep_points) {
 void WriteFrfCsv(std::ostream& os, const FrfSet& frfs, FrfQuantity quantity, int averages) {
   bool coherence = !frfs.empty();
   for (const auto& [k, f] : frfs) coherence = coherence && f.coherence().has_value();
-  os << "# quantity: " << QuantityName(quantity) << '\n';
+  os << "# quantity: " << ToString(quantity) << '\n';
   if (averages > 0) os << "# averages: " << averages << '\n';
   os << "# written by robomach; tool-tip FRFs in the robot base frame B, SI units\n";
   bool points = false;

@@ -21,7 +21,7 @@ std::string QuantityUnit(FrfQuantity q) {
   return "?";
 }
 
-std::string QuantityName(FrfQuantity q) {
+std::string ToString(FrfQuantity q) {
   switch (q) {
     case FrfQuantity::kReceptance: return "receptance";
     case FrfQuantity::kMobility: return "mobility";
@@ -31,14 +31,14 @@ std::string QuantityName(FrfQuantity q) {
 }
 
 std::string QuantityWithArticle(FrfQuantity q) {
-  return (q == FrfQuantity::kAccelerance ? "an " : "a ") + QuantityName(q);
+  return (q == FrfQuantity::kAccelerance ? "an " : "a ") + ToString(q);
 }
 
 FrfQuantity ParseQuantity(const std::string& name) {
   const std::string n = Lower(Trim(name));
-  if (n == "receptance") return FrfQuantity::kReceptance;
-  if (n == "mobility") return FrfQuantity::kMobility;
-  if (n == "accelerance") return FrfQuantity::kAccelerance;
+  for (FrfQuantity q : {FrfQuantity::kReceptance, FrfQuantity::kMobility, FrfQuantity::kAccelerance}) {
+    if (n == ToString(q)) return q;
+  }
   throw std::invalid_argument("quantity '" + name +
                               "': expected receptance, mobility or accelerance");
 }

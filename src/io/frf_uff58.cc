@@ -185,9 +185,9 @@ RecordUnits FrfRecordUnits(const std::string& path, const Uff58Record& r, const 
   }
   if (by_code && by_unit && *by_code != *by_unit) {
     throw InputError({path, r.ordinate.line, 1},
-                     "record 9 says " + QuantityName(*by_code) + " (specific data type " +
+                     "record 9 says " + ToString(*by_code) + " (specific data type " +
                          std::to_string(r.ordinate.specific_type) + ") but the unit labels say " +
-                         QuantityName(*by_unit) + " (" + UnitOf(*by_unit) + "); correct one of them in the export");
+                         ToString(*by_unit) + " (" + UnitOf(*by_unit) + "); correct one of them in the export");
   }
   RecordUnits out;
   if (by_unit && units && exponents && std::abs(f164 / label_factor - 1.0) > 1e-6) {
@@ -211,12 +211,12 @@ RecordUnits FrfRecordUnits(const std::string& path, const Uff58Record& r, const 
                                   : std::string("(specific data type)")) +
            " makes it " + QuantityWithArticle(out.quantity);
       if (word_differs) n += ", although its axis label says \"" + r.ordinate.label + "\"";
-      notes->push_back(n + "; read as " + QuantityName(out.quantity));
+      notes->push_back(n + "; read as " + ToString(out.quantity));
     }
   } else if (by_word) {
     out.quantity = *by_word;
     warnings->push_back(at + ": record 9 gives neither a physical ordinate type nor a unit; read as " +
-                        QuantityName(out.quantity) + " [" + UnitOf(out.quantity) + "] from its axis label \"" +
+                        ToString(out.quantity) + " [" + UnitOf(out.quantity) + "] from its axis label \"" +
                         r.ordinate.label + "\", in SI units");
   } else {
     out.quantity = FrfQuantity::kReceptance;
@@ -568,7 +568,7 @@ void WriteUff58(std::ostream& os, const FrfSet& frfs, FrfQuantity quantity) {
     }
     os << "    -1\n    58\n";
     os << Pad80("pose=" + k.pose_id + " tool-tip " +
-                (coherence_record ? std::string("coherence") : QuantityName(quantity))) << '\n';
+                (coherence_record ? std::string("coherence") : ToString(quantity))) << '\n';
     os << Pad80(std::string(coherence_record ? "C" : "H") + AxisName(k.response) + AxisName(k.excitation)) << '\n';
     os << Pad80("robomach") << '\n' << Pad80("NONE") << '\n' << Pad80("NONE") << '\n';
     char buf[256];

@@ -520,7 +520,7 @@ EstimatedFrfs ToEstimatedFrfs(const calibration::FrfEstimateResult& r, const Ham
   std::string rejected;
   for (const auto& hit : r.hits) {
     if (hit.status == calibration::HitStatus::kAccepted) continue;
-    rejected += (rejected.empty() ? "" : ", ") + hit.id + " (" + calibration::HitStatusName(hit.status) + ")";
+    rejected += (rejected.empty() ? "" : ", ") + hit.id + " (" + calibration::ToString(hit.status) + ")";
   }
   auto& meta = out.metadata;
   meta.push_back({"estimator", h2 ? "H2" : "H1"});
@@ -607,7 +607,7 @@ nlohmann::json FrfEstimateSummaryJson(const calibration::FrfEstimateResult& r, c
   for (const auto& h : r.hits) {
     hits.push_back({{"id", h.id},
                     {"source", h.source},
-                    {"status", calibration::HitStatusName(h.status)},
+                    {"status", calibration::ToString(h.status)},
                     {"hit_time_s", h.hit_time_s},
                     {"peak_force_N", h.peak_force_N},
                     {"pulse_duration_s", h.pulse_duration_s},
@@ -618,7 +618,7 @@ nlohmann::json FrfEstimateSummaryJson(const calibration::FrfEstimateResult& r, c
   for (size_t c = 0; c < rec.channels.size(); ++c) {
     nlohmann::json cj = {{"name", rec.channels[c].name},
                          {"column", rec.channel_columns[c]},
-                         {"quantity", QuantityName(QuantityOf(rec.channels[c].quantity))},
+                         {"quantity", ToString(QuantityOf(rec.channels[c].quantity))},
                          {"response", std::string(1, AxisName(keys.at(c).response))},
                          {"excitation", std::string(1, AxisName(keys.at(c).excitation))}};
     if (r.status == calibration::FrfEstimateStatus::kOk) {

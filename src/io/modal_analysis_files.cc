@@ -114,7 +114,7 @@ nlohmann::json ModalAnalysisSummaryJson(const std::vector<calibration::PoseModes
         // τ in the file's quantity (the summary's `quantity`), its unit beside it.
         jf["model_error_rms"] = i < g.fit.model_error.size() ? g.fit.model_error[i] : 0.0;
         for (FrfQuantity q : {FrfQuantity::kReceptance, FrfQuantity::kMobility, FrfQuantity::kAccelerance}) {
-          if (QuantityName(q) == quantity) jf["model_error_unit"] = QuantityUnit(q);
+          if (ToString(q) == quantity) jf["model_error_unit"] = QuantityUnit(q);
         }
         jg["frfs"].push_back(jf);
       }

@@ -246,7 +246,7 @@ json CandidatesJson(const audit::AuditResult& r) {
 
 // summary.json's `verdict`, with the parameter changes.
 json VerdictJson(const audit::AuditResult& r, const std::string& headline) {
-  json v = {{"grade", audit::AuditGradeName(r.grade)},
+  json v = {{"grade", audit::ToString(r.grade)},
             {"missing_effects", r.missing_effects},
             {"explained", r.explained},
             {"headline", headline},

@@ -154,7 +154,7 @@ nlohmann::json NoiseSummaryJson(const calibration::NoiseModels& noise, const std
     j["frfs"].push_back({{"pose_id", key.pose_id},
                          {"response", std::string(1, AxisName(key.response))},
                          {"excitation", std::string(1, AxisName(key.excitation))},
-                         {"source", calibration::NoiseSourceName(n.source)},
+                         {"source", calibration::ToString(n.source)},
                          {"averages", n.averages},
                          {"relative", n.relative},
                          {"floor_min_m_per_N", n.floor_m_per_N.minCoeff()},
@@ -238,7 +238,7 @@ nlohmann::json CalibrationSummaryJson(const calibration::CalibrationResult& resu
                                       const std::vector<TableSet>& sets) {
   using nlohmann::json;
   json j;
-  j["objective"] = calibration::ObjectiveName(options.objective);
+  j["objective"] = calibration::ToString(options.objective);
   j["status"] = robomach::ToString(result.status);
   j["message"] = result.message;
   j["weakly_identified"] = result.weakly_identified;

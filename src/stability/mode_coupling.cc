@@ -10,6 +10,7 @@
 #include <Eigen/LU>
 
 #include "robomach/common/units.h"
+#include "robomach/common/enum_names.h"
 
 namespace robomach::stability {
 
@@ -20,6 +21,12 @@ const char* ToString(ModeCouplingStatus s) {
     case ModeCouplingStatus::kUnstableAtZero: return "unstable_at_zero";
   }
   return "?";
+}
+
+ModeCouplingStatus ParseModeCouplingStatus(const std::string& name) {
+  constexpr ModeCouplingStatus kAll[] = {ModeCouplingStatus::kFound, ModeCouplingStatus::kStableUpToMax,
+                                         ModeCouplingStatus::kUnstableAtZero};
+  return ParseByName("mode-coupling status", name, kAll);
 }
 
 std::complex<double> RightmostEigenvalue(const Eigen::MatrixXd& M, const Eigen::MatrixXd& C,

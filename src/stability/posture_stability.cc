@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "robomach/common/units.h"
+#include "robomach/common/enum_names.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/stability/tool_tip_model.h"
 
@@ -17,6 +18,11 @@ const char* ToString(Mechanism m) {
     case Mechanism::kNone: return "none";
   }
   return "?";
+}
+
+Mechanism ParseMechanism(const std::string& name) {
+  constexpr Mechanism kAll[] = {Mechanism::kModeCoupling, Mechanism::kRegenerative, Mechanism::kNone};
+  return ParseByName("mechanism", name, kAll);
 }
 
 PostureStability AnalysePosture(const dynamics::PostureDynamics& d, const Eigen::Matrix3d& R_BC,

@@ -8,6 +8,7 @@
 #include <nlopt.hpp>
 
 #include "robomach/common/parallel.h"
+#include "robomach/common/enum_names.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/kinematics/inverse_kinematics.h"
 #include "robomach/kinematics/serial_chain.h"
@@ -24,6 +25,12 @@ const char* ToString(PointStatus s) {
     case PointStatus::kOtherConfiguration: return "other_configuration";
   }
   return "?";
+}
+
+PointStatus ParsePointStatus(const std::string& name) {
+  constexpr PointStatus kAll[] = {PointStatus::kOk, PointStatus::kUnreachable, PointStatus::kJointLimits,
+                                  PointStatus::kNearSingular, PointStatus::kOtherConfiguration};
+  return ParseByName("point status", name, kAll);
 }
 
 Eigen::Isometry3d ToolPoseTarget::Pose(double rotation) const {

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "robomach/common/units.h"
+#include "robomach/common/enum_names.h"
 #include "stability/internal/batch_atan2.h"
 
 namespace robomach::stability {
@@ -18,6 +19,12 @@ const char* ToString(LobeStatus s) {
     case LobeStatus::kUnstableAtZero: return "unstable_at_zero";
   }
   return "?";
+}
+
+LobeStatus ParseLobeStatus(const std::string& name) {
+  constexpr LobeStatus kAll[] = {LobeStatus::kOk, LobeStatus::kNotCovered, LobeStatus::kStableUpToMax,
+                                 LobeStatus::kUnstableAtZero};
+  return ParseByName("lobe status", name, kAll);
 }
 
 namespace {

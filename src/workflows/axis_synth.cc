@@ -1,13 +1,18 @@
 #include "robomach/workflows/axis_synth.h"
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 
 #include "robomach/common/errors.h"
 #include "robomach/common/option_checks.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
+#include "robomach/io/atomic_file.h"
 #include "robomach/io/compensation_file.h"
+#include "robomach/io/counts_file.h"
+#include "robomach/io/number_format.h"
 #include "robomach/io/program_file.h"
 #include "robomach/io/temperature_log.h"
 #include "robomach/machine/compensation.h"
@@ -67,6 +72,49 @@ machine::CaptureSynthesizer AxisSynthRun::Capture(const AxisSynthOptions& o) con
   for (const auto& a : machine.machine.axes) names.push_back(a.name);
   return machine::CaptureSynthesizer(static_cast<int>(machine.machine.axes.size()), o.capture_every, o.capture_settle,
                                      o.glitch_probability, o.seed, names);
+}
+
+AxisSynthRun::CaptureCounts AxisSynthRun::WriteCapture(const AxisSynthOptions& o, const std::string& path) const {
+  machine::CaptureSynthesizer cap = Capture(o);
+  const size_t n = machine.machine.axes.size();
+  io::WriteFileAtomically(path, [&](std::ostream& out) {
+    std::vector<std::uint16_t> words;
+    auto flush = [&]() {
+      if constexpr (std::endian::native == std::endian::big) {
+        for (auto& w : words) w = static_cast<std::uint16_t>((w >> 8) | (w << 8));
+      }
+      out.write(reinterpret_cast<const char*>(words.data()), static_cast<std::streamsize>(words.size() * 2));
+      words.clear();
+    };
+    cap.Start(record.counts.data(), &words);
+    for (long r = 1; r < record.rows(); ++r) {
+      try {
+        cap.Next(record.counts.data() + r * n, &words);
+      } catch (const std::invalid_argument& e) {
+        // The fields by their own names: a tool's FromFields words them as
+        // its options (and decides the exit code by them).
+        throw OptionError("capture_every", "capture_every " + std::to_string(o.capture_every) + ": " + e.what() +
+                                               "; raise capture_every or lower feed_mm_min");
+      }
+      if (words.size() > (1u << 16)) flush();
+    }
+    flush();
+  });
+  return {(record.rows() - 1) * o.capture_every + 1, cap.glitches()};
+}
+
+void AxisSynthRun::WriteCounts(const AxisSynthOptions& o, const std::string& path,
+                               const std::string& machine_out) const {
+  const std::vector<std::pair<std::string, std::string>> meta{
+      {"generator", "axis-synth (robomach)"},
+      {"machine", machine_out.empty() ? o.machine_path : machine_out},
+      {"program", o.program_path},
+      {"sample_rate_hz", io::FormatDouble(o.sample_rate_hz)}};
+  const size_t n = machine.machine.axes.size();
+  io::WriteFileAtomically(path, [&](std::ostream& out) {
+    io::CountsWriter w(out, machine.machine.axes, meta);
+    for (long r = 0; r < record.rows(); ++r) w.Row(record.t_s[r], record.counts.data() + r * n);
+  });
 }
 
 AxisSynthRun RunAxisSynth(const AxisSynthOptions& o, const MessageSink& tell) {

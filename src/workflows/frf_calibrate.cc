@@ -169,7 +169,7 @@ FrfCalibrateRun RunFrfCalibrate(const FrfCalibrateOptions& o, const MessageSink&
       Tell(tell, Message::Kind::kWarning, "modal fit of " + key.ToString() + ": " + fit.message);
     }
   }
-  std::string line = "calibrating (" + calibration::ObjectiveName(opt.objective) + ") ";
+  std::string line = "calibrating (" + calibration::ToString(opt.objective) + ") ";
   for (const auto& n : opt.free_parameters) line += n + ' ';
   Tell(tell, Message::Kind::kInfo, line);
   r.result = calibration::Calibrate(r.config.description, r.config.parameters, r.postures, r.measured, r.features, opt);

@@ -49,7 +49,7 @@ std::string FrfEstimateRun::Outcome() const {
   std::vector<std::string> rejected;
   for (const auto& h : r.hits) {
     if (h.status != calibration::HitStatus::kAccepted) {
-      rejected.push_back(h.id + " (" + calibration::HitStatusName(h.status) + ")");
+      rejected.push_back(h.id + " (" + calibration::ToString(h.status) + ")");
     }
   }
   if (!rejected.empty()) {

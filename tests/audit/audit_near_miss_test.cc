@@ -268,7 +268,7 @@ TEST_P(EffectNotOfLibraryForm, IsNamedMostlyExplainedWithTheRemainder) {
   const auto t0 = std::chrono::steady_clock::now();
   const AuditResult r = RunAudit(c.cfg.description, c.cfg.parameters, c.postures, measured, o);
   testing::PrintAudit(r, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  std::cout << k.name << ": grade " << AuditGradeName(r.grade) << ", before " << r.error_before_noise_units
+  std::cout << k.name << ": grade " << ToString(r.grade) << ", before " << r.error_before_noise_units
             << ", after " << r.remainder_noise_units << " x the noise, fraction removed " << r.fraction_removed
             << ", BIC gap " << r.bic_gap << " to " << r.runner_up << "\n";
 
@@ -360,7 +360,7 @@ TEST(AuditGrade, FractionRemovedIsTheShareOfTheExcessMisfit) {
   EXPECT_LT(FractionRemoved(5.0, 6.0, 1.0), 0.0);              // worse
   EXPECT_TRUE(std::isnan(FractionRemoved(0.9, 0.8, 1.0)));     // within the noise: no excess
   EXPECT_TRUE(std::isnan(FractionRemoved(5.0, NAN, 1.0)));
-  EXPECT_EQ(AuditGradeName(AuditGrade::kMostlyExplained), "mostly_explained");
+  EXPECT_EQ(ToString(AuditGrade::kMostlyExplained), "mostly_explained");
   AuditOptions bad;
   bad.mostly_explained_fraction = 1.5;
   EXPECT_THROW(CheckValid(bad), std::invalid_argument);

@@ -126,5 +126,15 @@ TEST(ModelAudit, RejectsBadOptionsAndUnknownCandidates) {
                std::invalid_argument);
 }
 
+// One vocabulary (issue #36): every grade goes through its name and back,
+// and a name that is not one is refused.
+TEST(AuditGrade, RoundTripsThroughItsName) {
+  for (AuditGrade g : {AuditGrade::kNoFailure, AuditGrade::kExplained, AuditGrade::kMostlyExplained,
+                       AuditGrade::kUnexplained}) {
+    EXPECT_EQ(ParseAuditGrade(ToString(g)), g) << ToString(g);
+  }
+  EXPECT_THROW(ParseAuditGrade("mostly explained"), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace robomach::audit

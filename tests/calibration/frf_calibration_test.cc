@@ -10,6 +10,7 @@
 #include <set>
 
 #include "robomach/calibration/frf_calibration.h"
+#include "robomach/calibration/frf_estimate.h"
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/calibration/virtual_hammer_test.h"
 #include "robomach/common/golden_section.h"
@@ -210,7 +211,7 @@ TEST(FrfCalibration, AcceptanceJointAndWholeCurveObjectives) {
     CalibrationOptions o;
     o.objective = obj;
     const CalibrationResult r = Calibrate(s.cfg.description, s.cfg.parameters, s.postures, measured, features, o);
-    ExpectAcceptance(s, r, holdout, ObjectiveName(obj));
+    ExpectAcceptance(s, r, holdout, ToString(obj));
   }
 }
 
@@ -578,6 +579,23 @@ TEST(ExtractFeatures, PeakOfAWeakModeIsItsOwnNotItsStrongNeighbours) {
   const auto [a, b] = PeakSearchWindow(2617.0, 0.03, {1180.0, 2753.0});
   EXPECT_DOUBLE_EQ(a, 2617.0 * 0.97);
   EXPECT_DOUBLE_EQ(b, 0.5 * (2617.0 + 2753.0));
+}
+
+// One vocabulary (issue #36): every value of the calibration's enums goes
+// through its name and back, and a name that is not one is refused.
+TEST(CalibrationNames, RoundTripThroughTheirNames) {
+  for (Objective o : {Objective::kModalTwoStage, Objective::kModalJoint, Objective::kWholeCurve}) {
+    EXPECT_EQ(ParseObjective(ToString(o)), o) << ToString(o);
+  }
+  EXPECT_THROW(ParseObjective("modal_joint"), std::invalid_argument);
+  for (NoiseSource s : {NoiseSource::kCoherence, NoiseSource::kScatter}) {
+    EXPECT_EQ(ParseNoiseSource(ToString(s)), s) << ToString(s);
+  }
+  EXPECT_THROW(ParseNoiseSource("spread"), std::invalid_argument);
+  for (HitStatus s : {HitStatus::kAccepted, HitStatus::kDoubleHit, HitStatus::kOverload}) {
+    EXPECT_EQ(ParseHitStatus(ToString(s)), s) << ToString(s);
+  }
+  EXPECT_THROW(ParseHitStatus("double_hit"), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
 #include "robomach/common/solver_status.h"
 
 #include <set>
+#include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "robomach/common/run_status.h"
 
 namespace robomach {
 namespace {
@@ -19,6 +22,20 @@ TEST(SolverStatus, EachStatusHasItsOwnName) {
     names.insert(n);
   }
   EXPECT_EQ(names, (std::set<std::string>{"converged", "not_converged", "failed", "not_improved"}));
+}
+
+// One vocabulary (issue #36): each status goes through its name and back, and
+// a name that is not one is refused.
+TEST(SolverStatus, RoundTripsThroughItsName) {
+  for (SolverStatus s : {SolverStatus::kConverged, SolverStatus::kNotConverged, SolverStatus::kFailed,
+                         SolverStatus::kNotImproved}) {
+    EXPECT_EQ(ParseSolverStatus(ToString(s)), s) << ToString(s);
+  }
+  EXPECT_THROW(ParseSolverStatus("converged "), std::invalid_argument);
+  for (RunStatus s : {RunStatus::kOk, RunStatus::kFlagged}) {
+    EXPECT_EQ(ParseRunStatus(ToString(s)), s) << ToString(s);
+  }
+  EXPECT_THROW(ParseRunStatus("OK"), std::invalid_argument);
 }
 
 }  // namespace

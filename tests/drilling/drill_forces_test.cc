@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <complex>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -218,6 +219,15 @@ TEST(DrillForces, RejectsInvalidInputWithFieldName) {
   DrillingMaterial m = TestMaterial();
   m.kienzle_exponent = 1.2;
   EXPECT_THROW(ComputeDrillForces(DrillGeometry{}, m, {}), std::invalid_argument);
+}
+
+// One vocabulary (issue #36): each chisel model goes through its name and
+// back, and a name that is not one is refused.
+TEST(ChiselModel, RoundTripsThroughItsName) {
+  for (ChiselModel m : {ChiselModel::kSeedScaling, ChiselModel::kOrthogonal, ChiselModel::kNone}) {
+    EXPECT_EQ(ParseChiselModel(ToString(m)), m) << ToString(m);
+  }
+  EXPECT_THROW(ParseChiselModel("seed-scaling"), std::invalid_argument);
 }
 
 }  // namespace

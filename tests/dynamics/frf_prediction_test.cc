@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <stdexcept>
 
 #include "robomach/dynamics/tool_tip_frf.h"
 #include "test_models.h"
@@ -88,6 +89,15 @@ TEST(FrfPrediction, BadFrequencyAndMethodAreRefused) {
   EXPECT_THROW(PredictFrfs(model, {{"p", RandomPosture(*model, rng)}}, f), std::invalid_argument);
   EXPECT_THROW(ParseReceptanceMethod("modes"), std::invalid_argument);
   EXPECT_EQ(ParseReceptanceMethod("direct"), ReceptanceMethod::kDirect);
+}
+
+// One vocabulary (issue #36): each method goes through its name and back, and
+// a name that is not one is refused.
+TEST(ReceptanceMethod, RoundTripsThroughItsName) {
+  for (ReceptanceMethod m : {ReceptanceMethod::kModal, ReceptanceMethod::kDirect}) {
+    EXPECT_EQ(ParseReceptanceMethod(ToString(m)), m) << ToString(m);
+  }
+  EXPECT_THROW(ParseReceptanceMethod("Modal"), std::invalid_argument);
 }
 
 }  // namespace

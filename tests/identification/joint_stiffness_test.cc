@@ -452,5 +452,14 @@ TEST(DeterminationFromRelativeStd, ClassifiesAtTheBound) {
   EXPECT_EQ(DeterminationFromRelativeStd(std::numeric_limits<double>::quiet_NaN(), weak), Determination::kNotDetermined);
 }
 
+// One vocabulary (issue #36): each determination goes through its name and
+// back, and a name that is not one is refused.
+TEST(Determination, RoundTripsThroughItsName) {
+  for (Determination d : {Determination::kDetermined, Determination::kWeak, Determination::kNotDetermined}) {
+    EXPECT_EQ(ParseDetermination(ToString(d)), d) << ToString(d);
+  }
+  EXPECT_THROW(ParseDetermination("weak"), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace robomach::identification

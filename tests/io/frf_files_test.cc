@@ -91,7 +91,7 @@ TEST(FrfCsv, RoundTripsAllQuantitiesWithCoherence) {
   const std::string dir = TempDir("frf_csv_roundtrip");
   const FrfSet s = SampleSet(true);
   for (FrfQuantity q : {FrfQuantity::kReceptance, FrfQuantity::kMobility, FrfQuantity::kAccelerance}) {
-    const std::string path = dir + "/frf_" + QuantityName(q) + ".csv";
+    const std::string path = dir + "/frf_" + ToString(q) + ".csv";
     WriteFrfCsv(path, s, q);
     const FrfReadResult r = ReadFrfCsv(path);
     EXPECT_EQ(r.file_quantity, q);
@@ -101,7 +101,7 @@ TEST(FrfCsv, RoundTripsAllQuantitiesWithCoherence) {
     for (const auto& [k, f] : s) {
       const Frf& g = r.frfs.at(k);
       EXPECT_EQ(g.freq_hz(), f.freq_hz());
-      EXPECT_LE(MaxRelDiff(g, f), tol) << QuantityName(q) << " " << k.ToString();
+      EXPECT_LE(MaxRelDiff(g, f), tol) << ToString(q) << " " << k.ToString();
       ASSERT_TRUE(g.coherence().has_value());
       EXPECT_EQ(*g.coherence(), *f.coherence());
     }
@@ -428,6 +428,15 @@ TEST(FrfUff58, NegativeDirectionCodesFlipTheSign) {
     EXPECT_LE(std::abs(h1(i) + h(i)), 5e-13 * std::abs(h(i)));
     EXPECT_LE(std::abs(h2(i) - h(i)), 5e-13 * std::abs(h(i)));
   }
+}
+
+// One vocabulary (issue #36): each quantity goes through its name and back,
+// and a name that is not one is refused.
+TEST(FrfQuantity, RoundTripsThroughItsName) {
+  for (FrfQuantity q : {FrfQuantity::kReceptance, FrfQuantity::kMobility, FrfQuantity::kAccelerance}) {
+    EXPECT_EQ(ParseQuantity(ToString(q)), q) << ToString(q);
+  }
+  EXPECT_THROW(ParseQuantity("inertance"), std::invalid_argument);
 }
 
 }  // namespace

@@ -5,11 +5,16 @@
 #include <iostream>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "robomach/common/units.h"
+#include "robomach/stability/lobes_workflow.h"
+#include "robomach/stability/mode_coupling.h"
+#include "robomach/stability/posture_stability.h"
+#include "robomach/stability/stability_map.h"
 #include "robomach/stability/tool_tip_model.h"
 #include "stability/internal/batch_atan2.h"
 
@@ -143,6 +148,35 @@ TEST(ZoaLobes, EnvelopeAtCurveSpeedsReturnsTheLowestCurve) {
   // A speed no lobe of the grid reaches is reported, not invented.
   const LobePoint none = lobes.At(1e-3);
   EXPECT_EQ(none.status, LobeStatus::kNotCovered);
+}
+
+// One vocabulary (issue #36): every value of the stability enums the files
+// and summaries name goes through its name and back, and a name that is not
+// one is refused.
+TEST(StabilityNames, RoundTripThroughTheirNames) {
+  for (LobeStatus s : {LobeStatus::kOk, LobeStatus::kNotCovered, LobeStatus::kStableUpToMax,
+                       LobeStatus::kUnstableAtZero}) {
+    EXPECT_EQ(ParseLobeStatus(ToString(s)), s) << ToString(s);
+  }
+  EXPECT_THROW(ParseLobeStatus("not covered"), std::invalid_argument);
+  for (ModeCouplingStatus s : {ModeCouplingStatus::kFound, ModeCouplingStatus::kStableUpToMax,
+                               ModeCouplingStatus::kUnstableAtZero}) {
+    EXPECT_EQ(ParseModeCouplingStatus(ToString(s)), s) << ToString(s);
+  }
+  EXPECT_THROW(ParseModeCouplingStatus("found"), std::invalid_argument);
+  for (Mechanism m : {Mechanism::kModeCoupling, Mechanism::kRegenerative, Mechanism::kNone}) {
+    EXPECT_EQ(ParseMechanism(ToString(m)), m) << ToString(m);
+  }
+  EXPECT_THROW(ParseMechanism("chatter"), std::invalid_argument);
+  for (PointStatus s : {PointStatus::kOk, PointStatus::kUnreachable, PointStatus::kJointLimits,
+                        PointStatus::kNearSingular, PointStatus::kOtherConfiguration}) {
+    EXPECT_EQ(ParsePointStatus(ToString(s)), s) << ToString(s);
+  }
+  EXPECT_THROW(ParsePointStatus("singular"), std::invalid_argument);
+  for (LobeMethod m : {LobeMethod::kZoa, LobeMethod::kSd, LobeMethod::kBoth}) {
+    EXPECT_EQ(ParseLobeMethod(ToString(m)), m) << ToString(m);
+  }
+  EXPECT_THROW(ParseLobeMethod("ZOA"), std::invalid_argument);
 }
 
 }  // namespace

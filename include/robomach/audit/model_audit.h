@@ -187,7 +187,9 @@ enum class AuditGrade {
 
 /// "no_failure", "explained", "mostly_explained", "unexplained" (the JSON
 /// summary's verdict.grade).
-std::string AuditGradeName(AuditGrade grade);
+std::string ToString(AuditGrade grade);
+/// The inverse of ToString. @throws std::invalid_argument naming the four.
+AuditGrade ParseAuditGrade(const std::string& name);
 
 /// The fraction of the excess misfit a model with error `after` removes
 /// from one with error `before`: (b − a) / (b − 1) with b, a the errors in

@@ -202,7 +202,7 @@ enum class Objective {
   kModalJoint,     // both feature kinds in one problem
   kWholeCurve,     // log-magnitude and phase residuals per line over a band
 };
-std::string ObjectiveName(Objective o);
+std::string ToString(Objective o);
 /// "modal-two-stage", "modal-joint", "whole-curve"; @throws std::invalid_argument.
 Objective ParseObjective(const std::string& name);
 

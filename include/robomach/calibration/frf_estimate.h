@@ -100,7 +100,9 @@ void CheckValid(const FrfEstimateOptions& options);
 
 enum class HitStatus { kAccepted, kDoubleHit, kOverload };
 /// "accepted", "double hit", "overload".
-std::string HitStatusName(HitStatus s);
+std::string ToString(HitStatus s);
+/// The inverse of ToString. @throws std::invalid_argument naming the three.
+HitStatus ParseHitStatus(const std::string& name);
 
 struct HitReport {
   std::string id;

@@ -107,7 +107,9 @@ struct NoiseOptions {
 void CheckValid(const NoiseOptions& options);
 
 enum class NoiseSource { kCoherence, kScatter };
-std::string NoiseSourceName(NoiseSource s);  // "coherence", "scatter"
+std::string ToString(NoiseSource s);  // "coherence", "scatter"
+/// The inverse of ToString. @throws std::invalid_argument naming the two.
+NoiseSource ParseNoiseSource(const std::string& name);
 
 /// One line left out of every fit as an isolated outlier (see
 /// NoiseOptions::exclude_outlier_lines).

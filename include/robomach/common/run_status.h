@@ -17,7 +17,9 @@ namespace robomach {
 enum class RunStatus { kOk, kFlagged };
 
 /// "ok", "flagged": the spelling of the tools' summaries and of Python.
-const char* RunStatusName(RunStatus s);
+const char* ToString(RunStatus s);
+/// The inverse of ToString. @throws std::invalid_argument naming the two.
+RunStatus ParseRunStatus(const std::string& name);
 
 /// One reason a result is flagged.
 struct Finding {

@@ -42,6 +42,8 @@ enum class ChiselModel {
 };
 
 /// "seed_scaling", "orthogonal", "none" (drill-force-fit's --chisel).
+const char* ToString(ChiselModel m);
+/// The inverse of ToString.
 /// @throws std::invalid_argument naming the three for anything else.
 ChiselModel ParseChiselModel(const std::string& name);
 

@@ -19,7 +19,9 @@ enum class ReceptanceMethod {
   kDirect,  // solve (K - w^2 M + i w C) x = f per line
 };
 
-/// "modal" or "direct". @throws std::invalid_argument for anything else.
+/// "modal" or "direct" (frf-predict's --method).
+const char* ToString(ReceptanceMethod m);
+/// The inverse of ToString. @throws std::invalid_argument for anything else.
 ReceptanceMethod ParseReceptanceMethod(const std::string& name);
 
 /// H(f) [m/N] by `method` (Receptance or ReceptanceDirect).

@@ -51,6 +51,8 @@ using FitStatus = SolverStatus;
 enum class Determination { kDetermined, kWeak, kNotDetermined };
 
 const char* ToString(Determination d);
+/// The inverse of ToString. @throws std::invalid_argument naming the three.
+Determination ParseDetermination(const std::string& name);
 
 /// The rule from a joint's relative standard deviation σ_k/k (of a fit, or
 /// expected by a test plan): not determined where it is infinite or NaN

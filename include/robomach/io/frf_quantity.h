@@ -17,7 +17,7 @@ namespace robomach::io {
 enum class FrfQuantity { kReceptance, kMobility, kAccelerance };
 
 /// "receptance", "mobility", "accelerance".
-std::string QuantityName(FrfQuantity q);
+std::string ToString(FrfQuantity q);
 /// Its SI unit: "m/N", "(m/s)/N", "(m/s^2)/N".
 std::string QuantityUnit(FrfQuantity q);
 /// The name with its article, for messages: "a receptance", "a mobility",

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <string>
+
 #include <Eigen/Core>
 
 #include "robomach/common/eigen_types.h"
@@ -14,6 +16,8 @@ enum class ModeCouplingStatus {
   kUnstableAtZero,   // the structure alone is unstable (a bad model)
 };
 const char* ToString(ModeCouplingStatus s);
+/// The inverse of ToString. @throws std::invalid_argument naming the three.
+ModeCouplingStatus ParseModeCouplingStatus(const std::string& name);
 
 struct ModeCouplingOptions {
   double max_depth{0.05};    // [m]

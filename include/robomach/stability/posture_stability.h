@@ -25,6 +25,8 @@ struct PostureStabilityOptions {
 
 enum class Mechanism { kModeCoupling, kRegenerative, kNone };
 const char* ToString(Mechanism m);
+/// The inverse of ToString. @throws std::invalid_argument naming the three.
+Mechanism ParseMechanism(const std::string& name);
 
 /// Chatter limits of one posture for one cut (both mechanisms).
 struct PostureStability {

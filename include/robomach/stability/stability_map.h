@@ -35,6 +35,8 @@ enum class PointStatus {
   kOtherConfiguration, // reached on another arm configuration than the seed's (wrist flip)
 };
 const char* ToString(PointStatus s);
+/// The inverse of ToString. @throws std::invalid_argument naming the five.
+PointStatus ParsePointStatus(const std::string& name);
 
 struct MapOptions {
   Eigen::VectorXd seed_q;            // preferred arm configuration [rad]

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <complex>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -17,6 +18,8 @@ enum class LobeStatus {
   kUnstableAtZero, // SD: unstable without cutting (a non-physical model)
 };
 const char* ToString(LobeStatus s);
+/// The inverse of ToString. @throws std::invalid_argument naming the four.
+LobeStatus ParseLobeStatus(const std::string& name);
 
 /// One point of the stability boundary.
 struct LobePoint {

@@ -76,6 +76,22 @@ struct AxisSynthRun {
   /// The synthesizer of the raw capture behind the counts (the options'
   /// capture_every, capture_settle, glitch_probability and seed).
   machine::CaptureSynthesizer Capture(const AxisSynthOptions& options) const;
+  /// Writes the raw capture behind the counts (formats.md §8.2: 16-bit
+  /// little-endian words, one per capture sample) to `path`, complete or not
+  /// at all, and returns its sample and glitch counts.
+  /// @throws OptionError("capture_every", "capture_every N: ...; raise
+  ///   capture_every or lower feed_mm_min") when a move is too fast for the
+  ///   capture rate (an edge per sample at most).
+  struct CaptureCounts {
+    long samples{0};
+    long glitches{0};
+  };
+  CaptureCounts WriteCapture(const AxisSynthOptions& options, const std::string& path) const;
+  /// Writes the counts (formats.md §8.1) with axis-synth's header: the
+  /// generator, the machine file the counts are measured from (machine_out
+  /// when the machine file with the start as origins is written, else the
+  /// options' machine_path), the program and the sample rate.
+  void WriteCounts(const AxisSynthOptions& options, const std::string& path, const std::string& machine_out) const;
 };
 
 /// Reads the machine file, the path, the compensation tables and the
