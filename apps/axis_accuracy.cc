@@ -109,7 +109,7 @@ int Run(int argc, char** argv) {
     }
     // Warned before the summary is made: its `warnings` lists them.
     if (min_runs < 5) Warn(kTool, "fewer than the 5 runs per target and direction ISO 230-2 asks for (" + std::to_string(min_runs) + ")");
-    for (const Finding& f : eval.findings) Warn(kTool, f.message);
+    for (const Finding& f : eval.verdict.findings) Warn(kTool, f.message);
     const std::string text = SummaryText(j);
     io::WriteFileAtomically(out_path.empty() ? "-" : out_path, text);
     return ExitCodeFor(eval.status());

@@ -97,7 +97,7 @@ int Run(int argc, char** argv) {
     // (formatting 17-digit numbers is most of the work).
     std::vector<machine::ContourError> contour;
     io::WriteFileAtomically(out_path, [&](std::ostream& out) {
-      contour = io::WriteAcquiredPath(out, rec, mf.machine.axes, &acq, tracker ? &*tracker : nullptr);
+      contour = workflows::WriteAcquiredPath(out, rec, mf.machine.axes, &acq, tracker ? &*tracker : nullptr);
     });
     nlohmann::json j;
     j["rows"] = rec.rows();
@@ -107,7 +107,7 @@ int Run(int argc, char** argv) {
                          {"cross_axis_tables", tables.cross_axis.size()},
                          {"temperature_axes", temps.size()}};
     if (path) {
-      j.update(io::ContourSummaryJson(contour, *path));
+      j.update(io::ContourSummaryJson(workflows::ContourFiguresOf(contour, *path)));
       if (!plot_path.empty()) {
         std::vector<double> d_um, a_deg, s_mm;
         for (const machine::ContourError& c : contour) {

@@ -81,7 +81,7 @@ int Run(int argc, char** argv) {
     progress.Finish();
     const nlohmann::json j = workflows::CaptureDecodingSummaryJson(d, axes, rate_hz, every, filter);
     if (!summary_path.empty()) io::WriteFileAtomically(summary_path, SummaryText(j));
-    for (const Finding& f : d.findings) Warn(kTool, f.message);
+    for (const Finding& f : d.verdict.findings) Warn(kTool, f.message);
     return mf.implausible.empty() && rate_w.empty() ? ExitCodeFor(d.status()) : kExitFlagged;
   });
 }

@@ -156,7 +156,7 @@ int RunDrillForceFit(int argc, char** argv) {
               << io::FormatDouble(std::round(fit.material.kienzle_exponent * 1e4) / 1e4)
               << "; largest error thrust " << io::FormatDouble(std::round(fit.max_rel_error_thrust * 1e3) / 10)
               << " %, torque " << io::FormatDouble(std::round(fit.max_rel_error_torque * 1e3) / 10) << " %\n";
-    for (const Finding& f : run.findings) Warn(kTool, f.message);
+    for (const Finding& f : run.verdict.findings) Warn(kTool, f.message);
     return ExitCodeFor(run.status());
   });
 }

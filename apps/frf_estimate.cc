@@ -160,7 +160,7 @@ int Run(int argc, char** argv) {
       inputs.push_back({"records", r});
     }
     CheckDistinctPaths(inputs, {{"--out", out_path}, {"--summary", summary_path}, {"--plot", plot_path}});
-    const io::FrfQuantity out_q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
+    const io::FrfQuantity out_q = FromOption("--quantity", [&] { return io::ParseFrfQuantity(quantity); });
     // An OptionError's field as the option (exit 64).
     const workflows::FrfEstimateRun run = FromFields(fields, [&] { return workflows::RunFrfEstimate(w, MessagePrinter(kTool)); });
     const calibration::FrfEstimateResult& r = run.result;

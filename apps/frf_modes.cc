@@ -84,6 +84,7 @@ int Run(int argc, char** argv) {
     if (measured_files.empty() && pose_files.empty()) throw UsageError("give at least one --measured or --pose file");
     CheckOptionRange("--fmin-hz", opt.fit.fmin_hz, 0.0, 1e7);
     if (!std::isinf(opt.fit.fmax_hz)) CheckOptionRange("--fmax-hz", opt.fit.fmax_hz, opt.fit.fmin_hz, 1e7);
+    if (!(opt.fit.fmax_hz > opt.fit.fmin_hz)) throw UsageError("--fmax-hz: expected a value above --fmin-hz");
     CheckOptionRange("--max-order", opt.fit.max_order, 8, 400);
     std::vector<std::pair<std::string, std::string>> inputs;
     for (const auto& f : measured_files) inputs.push_back({"--measured", f});
@@ -166,7 +167,7 @@ int Run(int argc, char** argv) {
     if (!constants_path.empty()) io::WriteFileAtomically(constants_path, io::ModalConstantsCsv(poses));
     if (!shapes_path.empty()) {
       std::vector<std::string> why;
-      const std::string csv = io::ModeShapesCsv(poses, &why);
+      const std::string csv = io::ModeShapesCsv(poses, calibration::ShapesOfRovingTests(poses, &why));
       for (const std::string& w : why) Note(kTool, w);
       io::WriteFileAtomically(shapes_path, csv);
     }

@@ -4,8 +4,6 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <cctype>
-#include <filesystem>
 #include <sstream>
 
 #include "cli_support.h"
@@ -75,15 +73,14 @@ int Run(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   return RunGuarded(kTool, [&]() -> int {
-    // The format follows --out's extension: refuse one we do not write (a
-    // .png would get CSV text).
-    std::string ext = std::filesystem::path(out_path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    const bool uff = ext == ".uff" || ext == ".unv" || ext == ".uf";
-    if (out_path != "-" && !uff && ext != ".csv") {
-      throw UsageError("--out " + out_path + ": expected a file name ending in .csv (the FRF CSV of docs/formats.md "
-                       "§3) or .uff, .unv (UFF58), or '-' for standard output (CSV)");
-    }
+    // The format follows --out's extension (a command-line mistake: exit 64).
+    const workflows::FrfFileFormat format = [&] {
+      try {
+        return workflows::FrfSynthOutputFormat(out_path, "--out", /*allow_stdout=*/true);
+      } catch (const OptionError& e) {
+        throw UsageError(e.what());
+      }
+    }();
     // The options through the library's checks, named as the user gave them.
     std::vector<FieldSource> fields = {
         {"sample_rate_hz", "--sample-rate-hz"}, {"block_samples", "--block-samples"}, {"fmin_hz", "--fmin-hz"},
@@ -117,21 +114,13 @@ int Run(int argc, char** argv) {
         FromFields(fields, [&] { return workflows::RunFrfSynth(w, std::move(setup), tell); });
     const dynamics::FrfSet& frfs = run.frfs;
     const int exit_code = ExitCodeFor(run.status());
-    const io::FrfQuantity q = FromOption("--quantity", [&] { return io::ParseQuantity(quantity); });
-    if (uff && out_path != "-") {
-      if (o.coherence && o.averages > 1) {
-        Warn(kTool, "UFF58 has no field for the number of averages: give --averages " +
-                        std::to_string(o.averages) + " to the tools that read " + out_path);
-      }
-      io::WriteUff58(out_path, frfs, q);
-    } else {
-      io::WriteFrfCsv(out_path, frfs, q, o.coherence ? o.averages : 0);
-    }
+    const io::FrfQuantity q = FromOption("--quantity", [&] { return io::ParseFrfQuantity(quantity); });
+    workflows::WriteFrfSynthOutput(run, w, out_path, format, q, tell);
     if (!summary_path.empty()) {
       nlohmann::json j = run.Summary(w);
       j["tool"] = kTool;
       j["out"] = out_path;
-      j["format"] = out_path != "-" && uff ? "uff58" : "csv";
+      j["format"] = format == workflows::FrfFileFormat::kUff58 ? "uff58" : "csv";
       j["quantity"] = quantity;
       j["exit_code"] = exit_code;
       io::WriteFileAtomically(summary_path, SummaryText(j));

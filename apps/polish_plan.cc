@@ -18,6 +18,7 @@
 #include "robomach/io/polishing_files.h"
 #include "robomach/polishing/path_patterns.h"
 #include "robomach/workflows/polish_plan.h"
+#include "robomach/workflows/polish_simulation.h"
 
 namespace robomach::apps {
 namespace {
@@ -176,7 +177,7 @@ int Run(int argc, char** argv) {
     const polishing::EvaluatedPlan& e = run.outcome.plan;
     nlohmann::json summary = run.Summary(o);
     const bool flagged = robot.Check(kTool, run.process, e.path.rows, &summary) || run.flagged();
-    const auto meta = io::PlannedPathMetadata(run.outcome.params, run.process);
+    const auto meta = workflows::PlannedPathMetadata(run.outcome.params, run.process);
     if (!path_out.empty()) io::WritePolishPath(path_out, e.path.rows, meta);
     if (!removal_out.empty()) io::WriteRemovalMap(removal_out, *run.context.grid, e.removal);
     robot.WriteJoints(e.path.rows);

@@ -82,8 +82,8 @@ int Run(int argc, char** argv) {
     const polishing::SampleGrid& grid = *sim.grid;
     const std::vector<double>& removal = sim.removal;
     const polishing::RemovalStats& stats = sim.stats;
-    for (const Finding& f : sim.findings) Warn(kTool, f.message);
-    bool flagged = sim.flagged() || !implausible.empty();
+    for (const Finding& f : sim.verdict.findings) Warn(kTool, f.message);
+    bool flagged = sim.verdict.flagged() || !implausible.empty();
     const std::string unpolished = polishing::DescribeUnpolished(
         stats, grid.region_area(), file.metadata.count("pattern") > 0 ? file.metadata.at("pattern") : std::string());
     if (!unpolished.empty()) Warn(kTool, unpolished);

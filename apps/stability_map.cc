@@ -137,7 +137,7 @@ int Run(int argc, char** argv) {
     if (!plot_path.empty() && grid) heat_map(plot_path, false);
     if (!safe_plot_path.empty() && grid) heat_map(safe_plot_path, true);
     // Warned before the summary is written: its `warnings` lists them.
-    for (const Finding& f : run.map.findings) Warn(kTool, f.message);
+    for (const Finding& f : run.map.verdict.findings) Warn(kTool, f.message);
     const int exit_code = ExitCodeFor(run.status());
     if (!summary_path.empty()) {
       nlohmann::json j = run.Summary(o);

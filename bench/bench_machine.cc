@@ -14,6 +14,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/machine_files.h"
 #include "robomach/machine/synthesis.h"
+#include "robomach/workflows/acquisition_inputs.h"
 
 namespace {
 
@@ -116,7 +117,7 @@ void BM_AcquirePipeline_60s_8kHz(benchmark::State& state) {
     // As axis-acquire does it: rows computed in order while earlier chunks
     // are formatted and written, on two threads.
     io::WriteFileAtomically(f.out_path, [&](std::ostream& out) {
-      benchmark::DoNotOptimize(io::WriteAcquiredPath(out, rec, f.mf.machine.axes, &acq, &tracker));
+      benchmark::DoNotOptimize(workflows::WriteAcquiredPath(out, rec, f.mf.machine.axes, &acq, &tracker));
     });
     rows = rec.rows();
   }

@@ -72,7 +72,7 @@ int main(int argc, char** argv) try {
     // A plan that ran but is doubtful is flagged, one finding each (the tool
     // prints them as warnings and exits 3): a target the speed limit does
     // not allow, rows off a trimmed face, a zig-zag that would do better.
-    for (const rm::Finding& f : outcome.findings) std::printf("  finding: %s\n", f.message.c_str());
+    for (const rm::Finding& f : outcome.verdict.findings) std::printf("  finding: %s\n", f.message.c_str());
     const std::string unpolished = rm::polishing::DescribeUnpolished(s, context.grid->region_area());
     if (!unpolished.empty()) std::printf("  %s\n", unpolished.c_str());
   }

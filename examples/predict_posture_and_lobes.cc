@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 
 #include "robomach/common/units.h"
+#include "robomach/dynamics/joint_plausibility.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/io/cut_file.h"
@@ -38,9 +39,16 @@ int main(int argc, char** argv) try {
   // 1. The config file speaks the user's units (mm, deg, rpm in the key
   // names); the library sees SI and radians only. LoadRobotConfig checks
   // every key (file:line:col errors) and lists values that look like unit
-  // mistakes in `implausible` instead of refusing them.
+  // mistakes in `implausible` instead of refusing them. The model's own
+  // sense checks (joint frequencies, sag under the robot's weight, damping
+  // ratio) are dynamics::JointPlausibilityFindings; the tools read a config
+  // with both (workflows::LoadRobotConfigChecked).
   const rm::io::RobotConfig config = rm::io::LoadRobotConfig(robot_path);
   for (const std::string& w : config.implausible) std::printf("warning: %s\n", w.c_str());
+  for (const std::string& w :
+       rm::dynamics::JointPlausibilityFindings(config.description, config.parameters, config.joint_value_locations)) {
+    std::printf("warning: %s\n", w.c_str());
+  }
   // The model is immutable and shared (std::shared_ptr<const RobotModel>);
   // everything that depends on the posture lives in PostureDynamics.
   const auto model = config.Build();

@@ -39,22 +39,17 @@ ALLOWED = [
     r'dynamics::CombineIndependent$',        # several uncertainty files read as one
     r'machine::WrapDeviationDeg$',           # a rotary deviation as the file means it
     r'machine::MapKinematicAxes$',           # the machine file's axes to its kinematics
+    r'machine::KinematicsKinds$',            # the registry of kinematics type names
 ]
 
-# Algorithms io still runs, to move (issue #36).
-PENDING = {
-    'dynamics::EvaluatePosture': 'robot_config.cc: the gravity plausibility of a config',
-    'dynamics::GravityTorque': 'robot_config.cc: the gravity plausibility of a config',
-    'machine::Acquisition::Process': 'acquired_path_file.cc: the acquisition streamed into the CSV writer (one '
-                                     'pipeline for speed)',
-    'machine::ContourTracker::Next': 'acquired_path_file.cc: the contour error streamed into the CSV writer',
-    'machine::Stats': "acquired_path_file.cc: axis-acquire's contour summary",
-    'calibration::ShapesOfRovingTest': "modal_analysis_files.cc: frf-modes' mode-shape CSV",
-    'polishing::ContactLength': "polishing_summary.cc: polish-plan's summary",
-    'polishing::CountLifts': "polishing_summary.cc: polish-plan's summary",
-    'polishing::MaxEdgeOverrun': 'polishing_files.cc, polishing_summary.cc: the planned path header',
-    'polishing::MaxSpeed': "polishing_summary.cc: polish-plan's summary",
-}
+# Algorithms io still runs, to move (issue #36), each as 'name': 'file: why'.
+# Empty since 2026-12-02: the config's joint plausibility is
+# dynamics::JointPlausibilityFindings (workflows::LoadRobotConfigChecked),
+# axis-acquire's loop and contour figures workflows::WriteAcquiredPath and
+# ContourFiguresOf, the mode shapes calibration::ShapesOfRovingTests, the
+# polishing path figures workflows::PathFiguresOf, PlanFiguresOf and
+# PlannedPathMetadata; io's writers take what they computed.
+PENDING = {}
 
 
 def called_domain_functions(lib):

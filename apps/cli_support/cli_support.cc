@@ -29,6 +29,7 @@
 #include "robomach/report/json.h"
 #include "robomach/workflows/frf_predict.h"
 #include "robomach/workflows/option_text.h"
+#include "robomach/workflows/robot_config.h"
 
 namespace robomach::apps {
 
@@ -178,7 +179,7 @@ void WriteToolSummary(const std::string& path, const std::string& tool, nlohmann
 }
 
 io::RobotConfig LoadRobotConfigWarned(const std::string& tool, const std::string& path) {
-  io::RobotConfig cfg = io::LoadRobotConfig(path);
+  io::RobotConfig cfg = workflows::LoadRobotConfigChecked(path);
   for (const std::string& w : cfg.implausible) Warn(tool, w);
   return cfg;
 }
@@ -424,7 +425,7 @@ void UncertaintyCli::Finish() {
   // The method and options also serve a robot config's `uncertainty:` files.
   propagation.method = dynamics::ParsePropagationMethod(method);
   ValidateOptions({{"confidence", "--confidence"}, {"samples", "--samples"}},
-                  [&] { dynamics::CheckValid(propagation); });
+                  [&] { propagation.Validate(); });
   for (const std::string& p : paths) {
     RequireInputFile("--uncertainty", p, "parameter-uncertainty file", {io::FileKind::kYaml},
                      io::kUncertaintyFileFormat);

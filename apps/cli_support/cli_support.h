@@ -74,7 +74,7 @@ struct FieldSource {
   bool from_input{false};    // the value came from an input file, not the command line
 };
 
-/// Runs a library options check (`calibration::CheckValid(o)`, ...): the
+/// Runs a library options check (`o.Validate()`, ...): the
 /// one mechanism by which the tools validate their options. The library's
 /// std::invalid_argument names the failing field first ("VirtualHammerOptions:
 /// fmax_hz 500000: above the Nyquist frequency 2560 Hz of sample_rate_hz
@@ -213,7 +213,8 @@ std::string SummaryText(const nlohmann::json& summary);
 /// SummaryText) with the keys only the tool knows added: `tool` and
 /// `exit_code`.
 void WriteToolSummary(const std::string& path, const std::string& tool, nlohmann::json summary, int exit_code);
-/// LoadRobotConfig with its unit findings (RobotConfig::implausible,
+/// workflows::LoadRobotConfigChecked (the reader, then the joints'
+/// plausibility) with its unit findings (RobotConfig::implausible,
 /// docs/plausibility.md) given to Warn(): the tool flags its result (exit 3)
 /// when the returned config's `implausible` is not empty.
 io::RobotConfig LoadRobotConfigWarned(const std::string& tool, const std::string& path);

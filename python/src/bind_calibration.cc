@@ -334,7 +334,7 @@ void BindCalibration(py::module_& m) {
           o.averages = averages;
           o.seed = seed;
           o.coherence = coherence;
-          calibration::CheckValid(o);
+          o.Validate();
           const auto model = config.Build();
           std::vector<calibration::NamedPosture> named;
           for (const io::Posture& p : postures) named.push_back({p.id, p.q});
@@ -364,7 +364,7 @@ void BindCalibration(py::module_& m) {
     const calibration::CalibrationVerdict v = calibration::JudgeCalibration(result, measured, o);
     py::dict d;
     d["status"] = robomach::ToString(v.status());
-    d["findings"] = FindingMessages(v);
+    d["findings"] = FindingMessages(v.verdict);
     d["residuals"] = v.residuals;
     d["rms_per_residual_in_noise_units"] = v.rms_per_residual_in_noise_units;
     return d;
@@ -471,20 +471,12 @@ void BindCalibration(py::module_& m) {
                                        double weak_relative_std, int max_iterations) {
     identification::IdentificationOptions o;
     o.tracker_noise = tracker_noise_m;
-    if (loss == "none" || loss.empty()) {
-      o.loss = identification::RobustLoss::kNone;
-    } else if (loss == "huber") {
-      o.loss = identification::RobustLoss::kHuber;
-    } else if (loss == "cauchy") {
-      o.loss = identification::RobustLoss::kCauchy;
-    } else {
-      throw std::invalid_argument("loss '" + loss + "': expected 'none', 'huber' or 'cauchy'");
-    }
+    o.loss = identification::ParseRobustLoss(loss.empty() ? "none" : loss);
     o.loss_scale = loss_scale;
     o.outlier_false_alarm = outlier_false_alarm;
     o.weak_relative_std = weak_relative_std;
     o.max_iterations = max_iterations;
-    identification::CheckValid(o);
+    o.Validate();
     py::gil_scoped_release release;
     return identification::IdentifyJointStiffness(*model, cases, o);
   }, py::arg("model"), py::arg("cases"), py::arg("tracker_noise_m") = id_defaults.tracker_noise,
@@ -595,7 +587,7 @@ void BindCalibration(py::module_& m) {
           d["result_lines"] = run.ResultLines();
           d["messages"] = said.List();
           d["flags"] = run.flags;
-          d["findings"] = FindingMessages(run.verdict);
+          d["findings"] = FindingMessages(run.verdict.verdict);
           d["status"] = robomach::ToString(run.status());
           d["flagged"] = run.status() == RunStatus::kFlagged;
           d["summary"] = py::module_::import("json").attr("loads")(summary.dump());
@@ -729,18 +721,10 @@ void BindCalibration(py::module_& m) {
           for (const auto& [r, e] : io::ParseDirectionPairs(directions)) {
             h.directions.emplace_back(static_cast<Axis>(r), static_cast<Axis>(e));
           }
-          const io::FrfQuantity q = io::ParseQuantity(quantity);
-          // The format follows out's extension, as the tool's --out.
-          bool uff = false;
-          if (out) {
-            std::string ext = std::filesystem::path(*out).extension().string();
-            for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-            uff = ext == ".uff" || ext == ".unv" || ext == ".uf";
-            if (!uff && ext != ".csv") {
-              throw py::value_error("out " + *out + ": expected a file name ending in .csv (the FRF CSV of "
-                                    "docs/formats.md §3) or .uff, .unv (UFF58)");
-            }
-          }
+          const io::FrfQuantity q = io::ParseFrfQuantity(quantity);
+          // The format follows out's extension, as the tool's --out (OptionError: ValueError).
+          const workflows::FrfFileFormat format =
+              out ? workflows::FrfSynthOutputFormat(*out, "out", /*allow_stdout=*/false) : workflows::FrfFileFormat::kCsv;
           RequireReadableFile(o.robot_path);
           RequireReadableFile(o.postures_path);
           CollectedMessages said;
@@ -751,16 +735,7 @@ void BindCalibration(py::module_& m) {
             workflows::FrfSynthSetup setup = workflows::PrepareFrfSynth(o, said.Sink());
             sample_rate_at = setup.sample_rate_at;
             run = workflows::RunFrfSynth(o, std::move(setup), said.Sink());
-            if (out && uff) {
-              if (h.coherence && h.averages > 1) {
-                said.messages.push_back({Message::Kind::kWarning,
-                                         "UFF58 has no field for the number of averages: give averages " +
-                                             std::to_string(h.averages) + " to the tools that read " + *out});
-              }
-              io::WriteUff58(*out, run.frfs, q);
-            } else if (out) {
-              io::WriteFrfCsv(*out, run.frfs, q, h.coherence ? h.averages : 0);
-            }
+            if (out) workflows::WriteFrfSynthOutput(run, o, *out, format, q, said.Sink());
           }
           for (const std::string& f : run.unit_findings) WarnUnit(f);  // the config's among them
           py::dict d;
@@ -825,9 +800,9 @@ void BindCalibration(py::module_& m) {
       }, "per joint: 'determined', 'weak' or 'not determined'")
       .def_property_readonly("num_candidates", [](const PyTestPlan& p) { return p.plan.num_candidates; },
                              "feasible candidate postures found")
-      .def_property_readonly("findings", [](const PyTestPlan& p) { return FindingMessages(p.plan); },
+      .def_property_readonly("findings", [](const PyTestPlan& p) { return FindingMessages(p.plan.verdict); },
                              "one sentence per joint the plan cannot determine")
-      .def_property_readonly("flagged", [](const PyTestPlan& p) { return p.plan.flagged(); },
+      .def_property_readonly("flagged", [](const PyTestPlan& p) { return p.plan.verdict.flagged(); },
                              "kq-identify --plan's exit 3: a joint the plan cannot determine, or a target band "
                              "out of reach")
       .def_property_readonly("expected_target_relative_std", [](const PyTestPlan& p) {
@@ -870,7 +845,7 @@ void BindCalibration(py::module_& m) {
     o.num_candidate_postures = num_candidate_postures;
     if (target_gradients) o.target_gradients = *target_gradients;
     o.target_half_width = target_half_width;
-    identification::CheckValid(o);
+    o.Validate();
     py::gil_scoped_release release;
     p.plan = identification::PlanLoadTests(*model, o);
     return p;

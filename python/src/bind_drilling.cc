@@ -184,8 +184,8 @@ void BindDrilling(py::module_& m) {
     d["kienzle_exponent_at_bound"] = f.kienzle_exponent_at_bound;
     d["material_yaml"] = run.material_yaml;
     d["unit_findings"] = run.unit_findings;
-    d["flagged"] = run.flagged();
-    d["findings"] = FindingMessages(run);
+    d["flagged"] = run.verdict.flagged();
+    d["findings"] = FindingMessages(run.verdict);
     return d;
   }, py::arg("table"), py::arg("drill"), py::arg("chisel") = "seed_scaling",
      "drill-force-fit's call: K_TH, K_TQ [Pa] and the Kienzle exponent fitted to a measured force table "

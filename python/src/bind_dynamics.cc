@@ -18,6 +18,7 @@
 #include "robomach/io/robot_config.h"
 #include "robomach/common/number_format.h"
 #include "robomach/workflows/frf_predict.h"
+#include "robomach/workflows/robot_config.h"
 
 namespace robomach::python {
 namespace {
@@ -55,7 +56,7 @@ RobotConfig LoadConfig(const std::string& path, const std::vector<std::string>& 
   RobotConfig cfg;
   {
     py::gil_scoped_release release;
-    cfg = io::LoadRobotConfig(path);
+    cfg = workflows::LoadRobotConfigChecked(path);
   }
   // The tools' exit 3 (docs/plausibility.md): a UnitWarning per finding.
   for (const std::string& w : cfg.implausible) WarnUnit(w);
@@ -379,7 +380,7 @@ void BindDynamics(py::module_& m) {
     py::dict out;
     out["status"] = robomach::ToString(r.status());
     py::list findings, results;
-    for (const Finding& f : r.findings) {
+    for (const Finding& f : r.verdict.findings) {
       // The posture file's line in front, as frf-predict prints it.
       const int line = f.input_index >= 0 ? postures[f.input_index].line : 0;
       findings.append(line > 0 ? "line " + std::to_string(line) + ": " + f.message : f.message);

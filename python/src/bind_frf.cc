@@ -82,7 +82,7 @@ NoiseOptions MakeNoiseOptions(double min_snr, int averages, bool use_coherence, 
   o.refine_with_modal_fit = refine_with_modal_fit;
   o.wide_floor = wide_floor;
   o.global_modal_fit = global_modal_fit;
-  calibration::CheckValid(o);
+  o.Validate();
   return o;
 }
 
@@ -207,7 +207,7 @@ void BindFrf(py::module_& m) {
                   "frf-modes reads it; without it a posture must hold one point pair (the tool-tip tools).") +
       kReadResultDoc).c_str());
   m.def("write_frf_csv", [](const std::string& path, const FrfSet& frfs, const std::string& quantity, int averages) {
-    const io::FrfQuantity q = io::ParseQuantity(quantity);
+    const io::FrfQuantity q = io::ParseFrfQuantity(quantity);
     py::gil_scoped_release release;
     io::WriteFrfCsv(path, frfs, q, averages);
   }, py::arg("path"), py::arg("frfs"), py::arg("quantity") = "receptance", py::arg("averages") = 0,
@@ -216,7 +216,7 @@ void BindFrf(py::module_& m) {
      "every FRF has one and '# averages: N' if averages > 0. Numbers read back exactly. Atomic; "
      "OutputError if it cannot be written.");
   m.def("write_uff58", [](const std::string& path, const FrfSet& frfs, const std::string& quantity) {
-    const io::FrfQuantity q = io::ParseQuantity(quantity);
+    const io::FrfQuantity q = io::ParseFrfQuantity(quantity);
     py::gil_scoped_release release;
     io::WriteUff58(path, frfs, q);
   }, py::arg("path"), py::arg("frfs"), py::arg("quantity") = "receptance",

@@ -157,7 +157,7 @@ void BindMachine(py::module_& m) {
         std::optional<machine::ContourTracker> t2;
         if (path) t2.emplace(*path);
         io::WriteFileAtomically(*out, [&](std::ostream& os) {
-          io::WriteAcquiredPath(os, rec, mf.machine.axes, &again, t2 ? &*t2 : nullptr);
+          workflows::WriteAcquiredPath(os, rec, mf.machine.axes, &again, t2 ? &*t2 : nullptr);
         });
       }
     }
@@ -241,7 +241,7 @@ void BindMachine(py::module_& m) {
     res["error_events"] = d.error_events;
     res["final_counts"] = d.final_counts;
     res["status"] = robomach::ToString(d.status());
-    res["findings"] = FindingMessages(d);
+    res["findings"] = FindingMessages(d.verdict);
     return res;
   }, py::arg("machine"), py::arg("capture"), py::arg("sample_rate_hz"), py::arg("every") = 1, py::arg("glitch_filter") = 0,
      py::arg("out") = py::none(),
@@ -293,7 +293,7 @@ void BindMachine(py::module_& m) {
     d["unit_findings"] = eval.unit_findings;
     d["min_runs"] = eval.min_runs;
     d["status"] = robomach::ToString(eval.status());
-    d["findings"] = FindingMessages(eval);
+    d["findings"] = FindingMessages(eval.verdict);
     return d;
   }, py::arg("runs"),
      "axis-accuracy's evaluation: ISO 230-2 accuracy A, systematic error E, mean error M, repeatability R, "

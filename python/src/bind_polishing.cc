@@ -46,7 +46,7 @@ py::dict StatsDict(const polishing::RemovalStats& s) {
 py::dict ParamsDict(const polishing::PathParameters& p) {
   py::dict d;
   d["pattern"] = polishing::PathPatternOf(p.pattern).name();
-  d["guides"] = p.guides == polishing::GuideLines::kBoundaryOffsets ? "offsets" : "parallel";
+  d["guides"] = polishing::ToString(p.guides);
   d["offset_mm"] = 1e3 * p.offset;
   d["radius_mm"] = 1e3 * p.radius;
   d["pitch_mm"] = 1e3 * p.pitch;
@@ -136,11 +136,11 @@ void BindPolishing(py::module_& m) {
       .def_property_readonly("target_message", [](const PyPlan& p) { return p.outcome.target.message; })
       .def_property_readonly("infeasible_message", [](const PyPlan& p) { return p.outcome.infeasible_message; })
       .def_property_readonly("rows_off_face", [](const PyPlan& p) { return p.outcome.rows_off_face; })
-      .def_property_readonly("flagged", [](const PyPlan& p) { return p.outcome.flagged(); },
+      .def_property_readonly("flagged", [](const PyPlan& p) { return p.outcome.verdict.flagged(); },
                              "polish-plan exits 3: a target out of reach, no feasible plan, a better zig-zag, rows off the face")
       .def_property_readonly("status", [](const PyPlan& p) { return robomach::ToString(p.outcome.status()); },
                              "'ok' or 'flagged'")
-      .def_property_readonly("findings", [](const PyPlan& p) { return FindingMessages(p.outcome); },
+      .def_property_readonly("findings", [](const PyPlan& p) { return FindingMessages(p.outcome.verdict); },
                              "why it is flagged, one sentence each (polish-plan's warnings)")
       .def_property_readonly("optimisation", [](const PyPlan& p) -> py::object {
         if (!p.outcome.optimisation) return py::none();
@@ -242,7 +242,7 @@ void BindPolishing(py::module_& m) {
                     "polish-sim exits 3: a segment faster than the process's max_speed beyond the file's rounding")
       .def_property_readonly("status", [](const workflows::PolishSimulation& r) { return robomach::ToString(r.status()); },
                              "'ok' or 'flagged'")
-      .def_property_readonly("findings", [](const workflows::PolishSimulation& r) { return FindingMessages(r); },
+      .def_property_readonly("findings", [](const workflows::PolishSimulation& r) { return FindingMessages(r.verdict); },
                              "why it is flagged (polish-sim's warnings)")
       .def_property_readonly("rows", [](const workflows::PolishSimulation& r) { return r.file.rows.size(); })
       .def("__repr__", [](const workflows::PolishSimulation& r) {
@@ -263,7 +263,7 @@ void BindPolishing(py::module_& m) {
   }, py::arg("path"), py::arg("simulation"), "polish-sim's --removal, atomic.");
 
   m.def("write_polish_path", [](const std::string& path, const PyPlan& plan) {
-    io::WritePolishPath(path, plan.outcome.plan.path.rows, io::PlannedPathMetadata(plan.outcome.params, plan.context.process));
+    io::WritePolishPath(path, plan.outcome.plan.path.rows, workflows::PlannedPathMetadata(plan.outcome.params, plan.context.process));
   }, py::arg("path"), py::arg("plan"), "polish-plan's --path (docs/formats.md §6), atomic.");
   m.def("write_removal_map", [](const std::string& path, const PyPlan& plan) {
     io::WriteRemovalMap(path, *plan.context.grid, plan.outcome.plan.removal);
@@ -321,7 +321,7 @@ void BindPolishing(py::module_& m) {
           d["parameters"] = ParamsDict(run.outcome.params);
           d["messages"] = said.List();
           d["input_findings"] = run.input_findings;
-          d["findings"] = FindingMessages(run.outcome);
+          d["findings"] = FindingMessages(run.outcome.verdict);
           d["status"] = robomach::ToString(run.status());
           d["flagged"] = run.flagged();
           d["summary"] = py::module_::import("json").attr("loads")(run.Summary(o).dump());

@@ -136,7 +136,6 @@ void BindStability(py::module_& m) {
                                  int sd_modes) {
     RequireReadableFile(path);
     if (frf_y) RequireReadableFile(*frf_y);
-    if (sd_modes < 1) throw std::invalid_argument("sd_modes: expected >= 1");
     stability::MeasuredTipOptions o;
     o.frf_path = path;
     o.frf_y_path = frf_y.value_or("");
@@ -144,6 +143,7 @@ void BindStability(py::module_& m) {
     o.cutting_frame = [&cut, tool_axis] { return FrameOf(cut, tool_axis); };
     o.tool_axis_source = AxisText(tool_axis);
     o.sd_modes = sd_modes;
+    o.Validate();  // before the files are read (ValueError naming sd_modes)
     CollectedMessages said;
     std::vector<TipDynamics> tips;
     {
@@ -249,12 +249,12 @@ void BindStability(py::module_& m) {
         "option for a bad value; FileNotFoundError, InputError for files. Releases the GIL.");
 
   py::class_<stability::LobesResult>(m, "Lobes", "The lobes of every tool tip: one row per speed, tip and method.")
-      .def_property_readonly("flagged", &stability::LobesResult::flagged,
+      .def_property_readonly("flagged", [](const stability::LobesResult& r) { return r.verdict.flagged(); },
                              "stability-lobes' exit 3: a modal fit that does not describe a tool tip, ZOA and SD "
                              "more than 10 % apart, or speeds without a boundary")
       .def_property_readonly("run_status", [](const stability::LobesResult& r) { return robomach::ToString(r.status()); },
                              "'ok' or 'flagged' (`status` is each row's)")
-      .def_property_readonly("findings", [](const stability::LobesResult& r) { return FindingMessages(r); },
+      .def_property_readonly("findings", [](const stability::LobesResult& r) { return FindingMessages(r.verdict); },
                              "why it is flagged, one sentence each (also among the messages, as warnings)")
       .def_readonly("no_boundary", &stability::LobesResult::no_boundary, "some speeds have no stability boundary")
       .def_property_readonly("pose_id", [](const stability::LobesResult& r) {
@@ -294,7 +294,7 @@ void BindStability(py::module_& m) {
       }, "-1 where none")
       .def("__len__", [](const stability::LobesResult& r) { return r.rows.size(); })
       .def("__repr__", [](const stability::LobesResult& r) {
-        return "<Lobes " + std::to_string(r.rows.size()) + " rows" + (r.flagged() ? ", flagged" : "") + ">";
+        return "<Lobes " + std::to_string(r.rows.size()) + " rows" + (r.verdict.flagged() ? ", flagged" : "") + ">";
       });
   m.def("write_lobes_csv", [](const std::string& path, const stability::LobesResult& r) {
     io::WriteLobesCsv(path, r.rows);
@@ -422,11 +422,13 @@ void BindStability(py::module_& m) {
                        "feed_direction is parallel to the tool axis of target " + std::to_string(bad) +
                            "; choose a feed in the work plane");
     }
-    if (speeds < 0 || speeds > 100000 || threads < 0 || threads > 256 || rotation_evaluations < 8 ||
-        !(max_depth_mm > 0.0)) {
-      throw std::invalid_argument("expected speeds in [0, 100000], threads in [0, 256], rotation_evaluations >= 8, "
-                                  "max_depth_mm > 0");
-    }
+    // The tool's checks of these settings (ValueError naming the keyword).
+    workflows::StabilityMapOptions settings;
+    settings.speeds = speeds;
+    settings.max_depth_mm = max_depth_mm;
+    settings.rotation_evaluations = rotation_evaluations;
+    settings.threads = threads;
+    settings.ValidateSettings();
     stability::MapOptions o;
     o.seed_q = seed_q;
     o.rotation = rotation_rad;

@@ -47,7 +47,7 @@ inline dynamics::PropagationOptions PropagationFrom(double confidence, const std
   o.method = dynamics::ParsePropagationMethod(method);
   o.samples = samples;
   o.seed = seed;
-  dynamics::CheckValid(o);
+  o.Validate();
   return o;
 }
 

@@ -27,14 +27,9 @@ py::array_t<std::complex<double>> ToArray(const std::vector<Eigen::Matrix3cd>& h
   return out;
 }
 
-Axis ParseAxis(const std::string& name) {
-  if (name == "x" || name == "X") return Axis::kX;
-  if (name == "y" || name == "Y") return Axis::kY;
-  if (name == "z" || name == "Z") return Axis::kZ;
-  throw std::invalid_argument("direction '" + name + "': expected x, y or z");
-}
+Axis ParseAxis(const std::string& name) { return robomach::ParseAxis(name); }
 
-std::string AxisString(Axis a) { return std::string(1, AxisName(a)); }
+std::string AxisString(Axis a) { return ToString(a); }
 
 
 namespace {

@@ -140,7 +140,7 @@ def test_response_range_rejects_the_hits_that_reach_it_as_the_tool_does(records,
 def test_bad_input_raises_with_the_message(records):
     with pytest.raises(ValueError, match="acc=z: no response channel 'acc'"):
         rm.estimate_frf([str(records / 'hits.csv')], directions={'acc': 'z'})
-    with pytest.raises(ValueError, match="tip_x: expected x, y or z, got 'w'"):
+    with pytest.raises(ValueError, match="tip_x: direction 'w': expected x, y or z"):
         rm.estimate_frf([str(records / 'hits.csv')], directions={'tip_x': 'w'})
     with pytest.raises(FileNotFoundError):
         rm.estimate_frf([str(records / 'no_such.csv')])

@@ -545,6 +545,14 @@ void JudgeBounds(const CandidateFitter& f, CandidateResult& c) {
 
 }  // namespace
 
+void MarkFitFailed(const NumericalError& e, CandidateResult* c) {
+  c->fit.status = calibration::FitStatus::kFailed;
+  c->fit.message = e.what();
+  c->note = std::string("fit failed: ") + e.what();
+  c->bic = c->bic_change = std::numeric_limits<double>::infinity();
+  c->errors.total_rms_log_mag = NAN;
+}
+
 // Fits `effect` on top of the model: the identifiability screen, a start
 // from the best-first scan (or, with `resume`, from an earlier fit of the
 // same candidate), and with `more_starts` the further starts where
@@ -566,15 +574,9 @@ CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const 
   try {
     FitFromStarts(fitter, more_starts, resume, c);
   } catch (const NumericalError& e) {
-    // Numerical trouble in one candidate (an eigensolver failing at an
-    // extreme parameter value) is that candidate's status, reported in its
-    // row, not the audit's end: the other candidates and everything already
-    // computed are kept. Bad input and bugs propagate.
-    c.fit.status = calibration::FitStatus::kFailed;
-    c.fit.message = e.what();
-    c.note = std::string("fit failed: ") + e.what();
-    c.bic = c.bic_change = std::numeric_limits<double>::infinity();
-    c.errors.total_rms_log_mag = NAN;
+    // The candidate's row says so; the other candidates and everything
+    // already computed are kept. Bad input and bugs propagate.
+    MarkFitFailed(e, &c);
     return c;
   }
   c.plausible = c.fit.status == calibration::FitStatus::kConverged;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "robomach/audit/correlation.h"
+#include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/gravity_torque.h"
 #include "robomach/dynamics/posture_dynamics.h"
@@ -105,28 +106,23 @@ ModeErrorMap BuildModeErrorMap(const calibration::Comparison& comparison, const 
   return m;
 }
 
-void CheckValid(const ErrorPatternOptions& o) {
-  if (!(o.fmin_hz >= 0.0) || !(o.fmax_hz > o.fmin_hz)) {
-    throw std::invalid_argument("ErrorPatternOptions: need 0 <= fmin_hz < fmax_hz, got fmin_hz = " +
-                                std::to_string(o.fmin_hz) + ", fmax_hz = " + std::to_string(o.fmax_hz));
+void ErrorPatternOptions::Validate() const {
+  const auto fail = [](const std::string& field, const std::string& bound, double value) {
+    throw OptionError(field, "ErrorPatternOptions: " + field + " must be " + bound + ", got " + std::to_string(value));
+  };
+  if (!(fmin_hz >= 0.0) || !(fmax_hz > fmin_hz)) {
+    throw OptionError(fmin_hz >= 0.0 ? "fmax_hz" : "fmin_hz",
+                      "ErrorPatternOptions: need 0 <= fmin_hz < fmax_hz, got fmin_hz = " + std::to_string(fmin_hz) +
+                          ", fmax_hz = " + std::to_string(fmax_hz));
   }
-  if (!(o.matching.min_relative_visibility > 0.0 && o.matching.min_relative_visibility <= 1.0)) {
-    throw std::invalid_argument("ErrorPatternOptions: matching.min_relative_visibility must be in (0, 1], got " +
-                                std::to_string(o.matching.min_relative_visibility));
+  if (!(matching.min_relative_visibility > 0.0 && matching.min_relative_visibility <= 1.0)) {
+    fail("matching.min_relative_visibility", "in (0, 1]", matching.min_relative_visibility);
   }
-  if (!(o.matching.max_log_freq_ratio > 0.0) || !(o.matching.direction_weight >= 0.0)) {
-    throw std::invalid_argument("ErrorPatternOptions: need matching.max_log_freq_ratio > 0 and "
-                                "matching.direction_weight >= 0, got " +
-                                std::to_string(o.matching.max_log_freq_ratio) + " and " +
-                                std::to_string(o.matching.direction_weight));
-  }
-  if (!(o.significance_factor >= 1.0)) {
-    throw std::invalid_argument("ErrorPatternOptions: significance_factor must be >= 1, got " +
-                                std::to_string(o.significance_factor));
-  }
-  if (!(o.significance_level > 0.0 && o.significance_level < 1.0)) {
-    throw std::invalid_argument("ErrorPatternOptions: significance_level must be in (0, 1), got " +
-                                std::to_string(o.significance_level));
+  if (!(matching.max_log_freq_ratio > 0.0)) fail("matching.max_log_freq_ratio", "> 0", matching.max_log_freq_ratio);
+  if (!(matching.direction_weight >= 0.0)) fail("matching.direction_weight", ">= 0", matching.direction_weight);
+  if (!(significance_factor >= 1.0)) fail("significance_factor", ">= 1", significance_factor);
+  if (!(significance_level > 0.0 && significance_level < 1.0)) {
+    fail("significance_level", "in (0, 1)", significance_level);
   }
 }
 
@@ -343,7 +339,7 @@ ErrorPatterns AnalyzeErrorPatterns(const AuditResult& result,
                                    const calibration::PostureMap& postures, const dynamics::FrfSet& measured,
                                    const calibration::MeasuredFeatures& features,
                                    const ErrorPatternOptions& options) {
-  CheckValid(options);
+  options.Validate();
   if (!model) throw std::invalid_argument("AnalyzeErrorPatterns: no model");
   const calibration::Comparison& cmp = result.modes_before;
   CheckFeaturesOfResult(cmp, features);

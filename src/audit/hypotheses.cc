@@ -48,11 +48,7 @@ CandidateResult FitParameterHypothesis(const dynamics::RobotDescription& desc, c
     c.start = "scan";
     c.fit = CalibrateWithRetry(desc, from, free, x);
   } catch (const NumericalError& e) {
-    c.fit.status = calibration::FitStatus::kFailed;
-    c.fit.message = e.what();
-    c.note = std::string("fit failed: ") + e.what();
-    c.bic = c.bic_change = std::numeric_limits<double>::infinity();
-    c.errors.total_rms_log_mag = NAN;
+    MarkFitFailed(e, &c);  // this hypothesis's row, not the audit's end
     return c;
   }
   c.errors = ComputeErrors(dynamics::RobotModel::Build(desc, c.fit.parameters), x.postures, x.measured, o.fmin_hz,

@@ -30,35 +30,46 @@
 
 namespace robomach::audit {
 
-void CheckValid(const AuditOptions& o) {
-  if (o.calibration_parameters.empty()) throw std::invalid_argument("AuditOptions::calibration_parameters is empty");
-  if (!(o.fmin_hz >= 0.0) || !(o.fmax_hz > o.fmin_hz)) {
-    throw std::invalid_argument("AuditOptions: need 0 <= fmin_hz < fmax_hz, got fmin_hz = " +
-                                std::to_string(o.fmin_hz) + ", fmax_hz = " + std::to_string(o.fmax_hz));
+void AuditOptions::Validate() const {
+  // "AuditOptions::FIELD must be BOUND, got VALUE": a tool's ValidateOptions
+  // puts its option in the field's place.
+  const auto fail = [](const std::string& field, const std::string& bound, const std::string& value) {
+    throw OptionError(field, "AuditOptions::" + field + " must be " + bound + ", got " + value);
+  };
+  const auto num = [](double v) { return std::to_string(v); };
+  if (calibration_parameters.empty()) {
+    throw OptionError("calibration_parameters",
+                      "AuditOptions::calibration_parameters is empty: expected at least one parameter");
   }
-  if (o.num_bands < 1) throw std::invalid_argument("AuditOptions::num_bands must be >= 1, got " +
-                                                   std::to_string(o.num_bands));
-  if (!(o.significance_factor > 1.0) || !(o.explained_factor > 1.0)) {
-    throw std::invalid_argument("AuditOptions: significance_factor and explained_factor must be > 1");
+  if (!(fmin_hz >= 0.0) || !(fmax_hz > fmin_hz)) {
+    throw OptionError(fmin_hz >= 0.0 ? "fmax_hz" : "fmin_hz",
+                      "AuditOptions: need 0 <= fmin_hz < fmax_hz, got fmin_hz = " + std::to_string(fmin_hz) +
+                          ", fmax_hz = " + std::to_string(fmax_hz));
   }
-  if (!(o.mostly_explained_fraction > 0.0) || !(o.mostly_explained_fraction <= 1.0)) {
-    throw std::invalid_argument("AuditOptions::mostly_explained_fraction must be in (0, 1], got " +
-                                std::to_string(o.mostly_explained_fraction));
+  if (num_bands < 1) fail("num_bands", ">= 1", std::to_string(num_bands));
+  if (!(significance_factor > 1.0)) fail("significance_factor", "> 1", num(significance_factor));
+  if (!(explained_factor > 1.0)) fail("explained_factor", "> 1", num(explained_factor));
+  if (!(mostly_explained_fraction > 0.0) || !(mostly_explained_fraction <= 1.0)) {
+    fail("mostly_explained_fraction", "in (0, 1]", num(mostly_explained_fraction));
   }
-  if (!(o.clear_bic_gap >= 0.0)) {
-    throw std::invalid_argument("AuditOptions::clear_bic_gap must be >= 0, got " + std::to_string(o.clear_bic_gap));
+  if (!(clear_bic_gap >= 0.0)) fail("clear_bic_gap", ">= 0", num(clear_bic_gap));
+  if (max_iterations < 1) fail("max_iterations", ">= 1", std::to_string(max_iterations));
+  if (fit_line_stride < 0) fail("fit_line_stride", ">= 0 (0: automatic)", std::to_string(fit_line_stride));
+  if (!(identifiable_chi2 >= 0.0) || !std::isfinite(identifiable_chi2)) {
+    fail("identifiable_chi2", "finite and >= 0", num(identifiable_chi2));
   }
-  if (o.max_iterations < 1) throw std::invalid_argument("AuditOptions::max_iterations must be >= 1");
-  if (o.fit_line_stride < 0) throw std::invalid_argument("AuditOptions::fit_line_stride must be >= 0 (0: automatic)");
-  if (o.threads < 1) throw std::invalid_argument("AuditOptions::threads must be >= 1");
-  if (!(o.robust_scale >= 0.0) || !std::isfinite(o.robust_scale)) {
-    throw std::invalid_argument("AuditOptions::robust_scale must be >= 0 (0: none), got " + std::to_string(o.robust_scale));
+  if (parameter_pairs_from < 0) fail("parameter_pairs_from", ">= 0", std::to_string(parameter_pairs_from));
+  if (virtual_joints_fitted < 0) {
+    fail("virtual_joints_fitted", ">= 0 (0: no virtual joints)", std::to_string(virtual_joints_fitted));
   }
-  if (!(o.uncertainty_confidence > 0.0 && o.uncertainty_confidence < 1.0)) {
-    throw std::invalid_argument("AuditOptions::uncertainty_confidence must be in (0, 1), got " +
-                                std::to_string(o.uncertainty_confidence));
+  if (threads < 1) fail("threads", ">= 1", std::to_string(threads));
+  if (!(robust_scale >= 0.0) || !std::isfinite(robust_scale)) {
+    fail("robust_scale", ">= 0 (0: none)", num(robust_scale));
   }
-  if (!o.parameter_uncertainty.parameters.empty()) dynamics::CheckValid(o.parameter_uncertainty);
+  if (!(uncertainty_confidence > 0.0 && uncertainty_confidence < 1.0)) {
+    fail("uncertainty_confidence", "in (0, 1)", num(uncertainty_confidence));
+  }
+  if (!parameter_uncertainty.parameters.empty()) dynamics::CheckValid(parameter_uncertainty);
 }
 
 double Bic(double rss, int n, int k) {
@@ -833,7 +844,7 @@ void NoteUncertainty(AuditResult* r_out) {
 AuditResult RunAudit(const dynamics::RobotDescription& description, const dynamics::ParameterSet& parameters,
                      const calibration::PostureMap& postures, const dynamics::FrfSet& measured,
                      const AuditOptions& options) {
-  CheckValid(options);
+  options.Validate();
   CheckUncertaintyEstimates(parameters, options);
   AuditOptions o = options;  // fit_line_stride 0 is resolved below
   CandidateLists lists = ResolveCandidates(description, parameters, &o);

@@ -17,6 +17,8 @@
 #include "robomach/common/enum_names.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/golden_section.h"
+#include "robomach/common/option_checks.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 
@@ -185,8 +187,35 @@ std::pair<double, double> ModelPeak(const PostureDynamics& d, const FrfKey& key,
   return {p.freq_hz, p.magnitude};
 }
 
+void MatchOptions::Validate() const {
+  CheckOptionAbove("min_relative_visibility", min_relative_visibility, 0.0);
+  CheckOptionRange("min_relative_visibility", min_relative_visibility, 0.0, 1.0);
+  CheckOptionAbove("max_log_freq_ratio", max_log_freq_ratio, 0.0);
+  CheckOptionAtLeast("direction_weight", direction_weight, 0.0);
+  CheckOptionFinite("direction_weight", direction_weight);
+}
+
+void CalibrationOptions::Validate() const {
+  if (free_parameters.empty()) {
+    throw OptionError("free_parameters", "free_parameters: expected at least one parameter, got none");
+  }
+  ValidateNested("matching", matching);
+  ValidateNested("modal_fit", modal_fit);
+  CheckOptionAbove("freq_sigma", freq_sigma, 0.0);
+  CheckOptionAbove("peak_sigma", peak_sigma, 0.0);
+  CheckOptionBand("fmin_hz", fmin_hz, "fmax_hz", fmax_hz);
+  CheckOptionAtLeast("max_iterations", max_iterations, 1);
+  CheckOptionAtLeast("max_match_rounds", max_match_rounds, 1);
+  CheckOptionAbove("weak_relative_std", weak_relative_std, 0.0);
+  if (!(robust_scale >= 0.0) || !std::isfinite(robust_scale)) {
+    throw OptionError("robust_scale", "CalibrationOptions::robust_scale must be >= 0 (0: no robust loss), got " +
+                                          std::to_string(robust_scale));
+  }
+}
+
 std::vector<ModeMatch> MatchModes(const std::map<std::string, PostureDynamics>& model,
                                   const MeasuredFeatures& features, const MatchOptions& o) {
+  o.Validate();
   std::vector<ModeMatch> out;
   for (const auto& [key, fit] : features.fits) {
     auto pit = model.find(key.pose_id);
@@ -321,10 +350,10 @@ CalibrationVerdict JudgeCalibration(const CalibrationResult& result, const dynam
                                     const CalibrationOptions& options) {
   CalibrationVerdict v;
   if (result.status == FitStatus::kNotImproved) {
-    v.Flag("the calibration did not improve on the start values; the calibrated config keeps them. " +
+    v.verdict.Flag("the calibration did not improve on the start values; the calibrated config keeps them. " +
            result.message);
   } else if (result.status != FitStatus::kConverged || !result.weakly_identified.empty()) {
-    v.Flag(result.message);
+    v.verdict.Flag(result.message);
   }
   // Goodness of fit against the noise: a model that represents the data
   // leaves a misfit of about one noise variance per residual (two residuals
@@ -345,7 +374,7 @@ CalibrationVerdict JudgeCalibration(const CalibrationResult& result, const dynam
       m << "the calibrated model misses the data by " << v.rms_per_residual_in_noise_units
         << " times the noise (rms over " << v.residuals << " residuals): it cannot represent these data with "
         << "the free parameters (another effect, another robot?); see the overlays and model-audit";
-      v.Flag(m.str());
+      v.verdict.Flag(m.str());
     }
   }
   return v;
@@ -959,10 +988,7 @@ double WholeCurveMisfit(const dynamics::RobotDescription& description, const dyn
 CalibrationResult Calibrate(const dynamics::RobotDescription& description, const dynamics::ParameterSet& initial,
                             const PostureMap& postures, const dynamics::FrfSet& measured,
                             const MeasuredFeatures& features, const CalibrationOptions& o) {
-  if (!(o.robust_scale >= 0.0) || !std::isfinite(o.robust_scale)) {
-    throw std::invalid_argument("CalibrationOptions::robust_scale must be >= 0 (0: no robust loss), got " +
-                                std::to_string(o.robust_scale));
-  }
+  o.Validate();
   const double misfit_start =
       WholeCurveMisfit(description, initial, postures, measured, o.fmin_hz, o.fmax_hz, o.robust_scale);
   const auto misfit_of = [&](const CalibrationResult& r) {

@@ -13,6 +13,7 @@
 
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/common/enum_names.h"
+#include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 
@@ -21,7 +22,8 @@ namespace {
 
 void Require(bool ok, const std::string& field, double value, const std::string& rule) {
   if (!ok) {
-    throw std::invalid_argument("FrfEstimateOptions::" + field + " = " + FormatNumber(value, 6) + ": expected " + rule);
+    throw OptionError(field.substr(0, field.find('[')),
+                      "FrfEstimateOptions::" + field + " = " + FormatNumber(value, 6) + ": expected " + rule);
   }
 }
 
@@ -77,7 +79,8 @@ int FastFftLength(int n) {
 
 }  // namespace
 
-void CheckValid(const FrfEstimateOptions& o) {
+void FrfEstimateOptions::Validate() const {
+  const FrfEstimateOptions& o = *this;
   Require(std::isfinite(o.force_window_s), "force_window_s", o.force_window_s, "a finite width [s] (0 = automatic, < 0 = off)");
   Require(o.force_window_pre_s >= 0.0 && std::isfinite(o.force_window_pre_s), "force_window_pre_s",
           o.force_window_pre_s, ">= 0 [s] (0 = automatic)");
@@ -509,7 +512,7 @@ void CheckForceRollOff(int lines, FrfEstimateResult* result) {
 
 FrfEstimateResult EstimateFrf(const std::vector<ImpactRecord>& hits, const std::vector<ResponseChannel>& channels,
                               const FrfEstimateOptions& o) {
-  CheckValid(o);
+  o.Validate();
   FrfEstimateResult result;
   result.exponential_tau_s = o.exponential_tau_s;
   const int nc = static_cast<int>(channels.size());

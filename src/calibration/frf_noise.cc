@@ -13,6 +13,8 @@
 #include "robomach/calibration/global_modal_fit.h"
 #include "robomach/calibration/modal_fit.h"
 #include "robomach/common/enum_names.h"
+#include "robomach/common/errors.h"
+#include "robomach/common/number_format.h"
 
 namespace robomach::calibration {
 namespace {
@@ -463,7 +465,7 @@ double MainsMultiple(double f_hz, double spacing_hz) {
 
 std::vector<ExcludedLine> FindOutlierLines(const dynamics::Frf& frf, const Eigen::VectorXd& sigma,
                                            const std::vector<char>& candidate, const NoiseOptions& o) {
-  CheckValid(o);
+  o.Validate();
   const int n = frf.size();
   if (sigma.size() != n || static_cast<int>(candidate.size()) != n) {
     throw std::invalid_argument("FindOutlierLines: sigma and candidate need one entry per line (" +
@@ -567,21 +569,29 @@ std::string DescribeExcludedLine(const ExcludedLine& e) {
   return d.str();
 }
 
-void CheckValid(const NoiseOptions& o) {
-  auto fail = [](const std::string& m) { throw std::invalid_argument("NoiseOptions: " + m); };
-  if (!(o.min_snr > 0.0 && std::isfinite(o.min_snr))) fail("min_snr must be finite and > 0");
-  if (o.averages < 0) fail("averages must be >= 0 (0: unknown)");
-  if (!(o.knots_per_octave > 0.0 && o.knots_per_octave <= 8.0)) fail("knots_per_octave must be in (0, 8]");
-  if (o.max_gap_lines < 0) fail("max_gap_lines must be >= 0");
-  if (o.min_run_lines < 1) fail("min_run_lines must be >= 1");
-  if (!(o.outlier_threshold_off_mains >= o.outlier_threshold && std::isfinite(o.outlier_threshold_off_mains))) {
-    fail("outlier_threshold_off_mains must be finite and >= outlier_threshold (15 by default)");
+void NoiseOptions::Validate() const {
+  // "NoiseOptions: FIELD must be BOUND, got VALUE": the field is the first
+  // word, as a tool's ValidateOptions puts its option in its place.
+  auto fail = [](const std::string& field, const std::string& bound, double value) {
+    throw OptionError(field, "NoiseOptions: " + field + " must be " + bound + ", got " + FormatNumber(value, 7));
+  };
+  if (!(min_snr > 0.0 && std::isfinite(min_snr))) fail("min_snr", "finite and > 0", min_snr);
+  if (averages < 0) fail("averages", ">= 0 (0: unknown)", averages);
+  if (!(knots_per_octave > 0.0 && knots_per_octave <= 8.0)) fail("knots_per_octave", "in (0, 8]", knots_per_octave);
+  if (max_gap_lines < 0) fail("max_gap_lines", ">= 0", max_gap_lines);
+  if (min_run_lines < 1) fail("min_run_lines", ">= 1", min_run_lines);
+  if (!(outlier_threshold_off_mains >= outlier_threshold && std::isfinite(outlier_threshold_off_mains))) {
+    fail("outlier_threshold_off_mains",
+         "finite and >= outlier_threshold " + FormatNumber(outlier_threshold, 7) + " (15 by default)",
+         outlier_threshold_off_mains);
   }
-  if (!(o.outlier_threshold >= 3.0 && std::isfinite(o.outlier_threshold))) {
-    fail("outlier_threshold must be finite and >= 3 (standard deviations of the noise; 6 by default)");
+  if (!(outlier_threshold >= 3.0 && std::isfinite(outlier_threshold))) {
+    fail("outlier_threshold", "finite and >= 3 (standard deviations of the noise; 6 by default)", outlier_threshold);
   }
-  if (o.outlier_window_lines < 4 || o.outlier_window_lines > 64) fail("outlier_window_lines must be in [4, 64]");
-  if (o.max_outlier_run_lines < 1) fail("max_outlier_run_lines must be >= 1");
+  if (outlier_window_lines < 4 || outlier_window_lines > 64) {
+    fail("outlier_window_lines", "in [4, 64]", outlier_window_lines);
+  }
+  if (max_outlier_run_lines < 1) fail("max_outlier_run_lines", ">= 1", max_outlier_run_lines);
 }
 
 std::string ToString(NoiseSource s) { return s == NoiseSource::kCoherence ? "coherence" : "scatter"; }
@@ -838,7 +848,7 @@ std::string DescribeNoise(const FrfNoise& out, const NoiseState& s) {
 }  // namespace
 
 FrfNoise EstimateFrfNoise(const dynamics::Frf& frf, const NoiseOptions& o) {
-  CheckValid(o);
+  o.Validate();
   const int n = frf.size();
   if (n < 8) {
     throw std::invalid_argument("noise model: an FRF needs at least 8 lines, this one has " + std::to_string(n));

@@ -10,6 +10,9 @@
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
 
+#include "robomach/common/errors.h"
+#include "robomach/common/option_checks.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 #include "internal/lscf_poles.h"
 
@@ -1017,7 +1020,32 @@ std::string SummaryMessage(const GlobalModalFitResult& result, size_t frfs, cons
 
 }  // namespace
 
+void GlobalModalFitOptions::Validate() const {
+  CheckOptionBand("fmin_hz", fmin_hz, "fmax_hz", fmax_hz);
+  CheckOptionAtLeast("min_order", min_order, 2);
+  if (max_order < min_order + 2) {
+    throw OptionError("max_order", "max_order: expected a value >= min_order + 2 = " + std::to_string(min_order + 2) +
+                                       ", got " + std::to_string(max_order));
+  }
+  CheckOptionAbove("stable_freq_tol", stable_freq_tol, 0.0);
+  CheckOptionAbove("stable_damping_tol", stable_damping_tol, 0.0);
+  CheckOptionAbove("cluster_freq_tol", cluster_freq_tol, 0.0);
+  CheckOptionAtLeast("min_stable_orders", min_stable_orders, 1);
+  CheckOptionRange("min_cluster_fraction", min_cluster_fraction, 0.0, 1.0);
+  CheckOptionAbove("max_damping_ratio", max_damping_ratio, 0.0);
+  CheckOptionRange("max_damping_ratio", max_damping_ratio, 0.0, 1.0);
+  CheckOptionAtLeast("min_relative_contribution", min_relative_contribution, 0.0);
+  CheckOptionAtLeast("max_added_modes", max_added_modes, 0);
+  CheckOptionRange("uniform_weights_power", uniform_weights_power, -1, 2);
+  CheckOptionAtLeast("dense_modes", dense_modes, 0);
+  CheckOptionAtLeast("max_modes_per_band", max_modes_per_band, 0);
+  CheckOptionAtLeast("driving_point", driving_point, -1);
+  CheckOptionRange("model_error_power", model_error_power, -1, 2);
+  CheckOptionAbove("model_error_ratio", model_error_ratio, 0.0);
+}
+
 GlobalModalFitResult FitModesGlobal(const std::vector<dynamics::Frf>& all, const GlobalModalFitOptions& o) {
+  o.Validate();
   if (all.empty()) throw std::invalid_argument("FitModesGlobal: no FRFs given");
   GlobalModalFitResult result;
   const std::vector<dynamics::Frf> frfs = CommonBand(all, o);

@@ -4,8 +4,10 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "robomach/common/frames.h"
+#include "robomach/common/option_validate.h"
 
 namespace robomach::calibration {
 namespace {
@@ -66,6 +68,24 @@ std::optional<RovingShapes> ShapesOfRovingTest(const ModalGroup& group, std::str
   s.shapes = group.fit.ModeShapes(driving);
   s.mass_normalised = driving >= 0;
   return s;
+}
+
+std::vector<FitRovingShapes> ShapesOfRovingTests(const std::vector<PoseModes>& poses, std::vector<std::string>* notes) {
+  std::vector<FitRovingShapes> out;
+  for (size_t p = 0; p < poses.size(); ++p) {
+    for (size_t g = 0; g < poses[p].groups.size(); ++g) {
+      const ModalGroup& grp = poses[p].groups[g];
+      if (grp.fit.status != SolverStatus::kConverged) continue;
+      std::string why;
+      std::optional<RovingShapes> rs = ShapesOfRovingTest(grp, &why);
+      if (!rs) {
+        if (notes) notes->push_back("posture " + poses[p].pose_id + ", fit " + std::to_string(g + 1) + ": no mode shapes: " + why);
+        continue;
+      }
+      out.push_back({p, g, std::move(*rs)});
+    }
+  }
+  return out;
 }
 
 std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>* warnings) {
@@ -174,8 +194,14 @@ std::vector<TipMode> TipModes(const ModalGroup& group, std::vector<std::string>*
   return out;
 }
 
+void ModalAnalysisOptions::Validate() const {
+  ValidateNested("fit", fit);
+  CheckOptionAtLeast("min_common_lines", min_common_lines, 0);
+}
+
 std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const NoiseModels& noise,
                                     const ModalAnalysisOptions& options, int file_power) {
+  options.Validate();
   std::vector<PoseModes> out;
   for (const std::string& pose : measured.pose_ids()) {
     PoseModes pm;

@@ -8,7 +8,10 @@
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
 
+#include "robomach/common/errors.h"
 #include "robomach/common/golden_section.h"
+#include "robomach/common/option_checks.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 #include "internal/lscf_poles.h"
 
@@ -51,7 +54,29 @@ Eigen::VectorXd ModalFitWeights(const dynamics::Frf& frf) {
   return w;
 }
 
+void PeakPickOptions::Validate() const {
+  CheckOptionRange("min_relative_height", min_relative_height, 0.0, 1.0);
+  CheckOptionAtLeast("half_window_lines", half_window_lines, 1);
+}
+
+void ModalFitOptions::Validate() const {
+  CheckOptionBand("fmin_hz", fmin_hz, "fmax_hz", fmax_hz);
+  CheckOptionAtLeast("min_order", min_order, 1);
+  if (max_order < min_order) {
+    throw OptionError("max_order", "max_order: expected a value >= min_order " + std::to_string(min_order) +
+                                       ", got " + std::to_string(max_order));
+  }
+  CheckOptionAbove("stable_freq_tol", stable_freq_tol, 0.0);
+  CheckOptionAbove("stable_damping_tol", stable_damping_tol, 0.0);
+  CheckOptionAtLeast("min_stable_orders", min_stable_orders, 1);
+  CheckOptionAbove("max_damping_ratio", max_damping_ratio, 0.0);
+  CheckOptionRange("max_damping_ratio", max_damping_ratio, 0.0, 1.0);
+  CheckOptionAtLeast("min_relative_contribution", min_relative_contribution, 0.0);
+  CheckOptionAtLeast("max_added_modes", max_added_modes, 0);
+}
+
 std::vector<PeakEstimate> PickPeaks(const dynamics::Frf& frf, const PeakPickOptions& options) {
+  options.Validate();
   const Eigen::VectorXd& f = frf.freq_hz();
   const Eigen::VectorXd mag = frf.receptance().cwiseAbs();
   const Eigen::VectorXd p2 = mag.cwiseAbs2();
@@ -691,6 +716,7 @@ void EliminateWeakModes(const PoleSetFitter& fitter, const ModalFitResult& base,
 }  // namespace
 
 ModalFitResult FitModes(const dynamics::Frf& full, const ModalFitOptions& o) {
+  o.Validate();
   ModalFitResult result;
   const dynamics::Frf frf = full.Band(o.fmin_hz, o.fmax_hz);
   const int N = frf.size();

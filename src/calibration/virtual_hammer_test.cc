@@ -6,6 +6,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/posture_dynamics.h"
@@ -25,8 +26,12 @@ double Round13(double v) {
 
 // Each message starts with the field and its value, so that a tool can put
 // its option's name in the field's place (apps' ValidateOptions).
-void CheckValid(const VirtualHammerOptions& o) {
-  auto fail = [](const std::string& m) { throw std::invalid_argument("VirtualHammerOptions: " + m); };
+void VirtualHammerOptions::Validate() const {
+  const VirtualHammerOptions& o = *this;
+  // The field is the message's first word.
+  auto fail = [](const std::string& m) {
+    throw OptionError(m.substr(0, m.find_first_of(" :")), "VirtualHammerOptions: " + m);
+  };
   const auto num = [](double v) { return FormatNumber(v, 7); };
   if (!(o.sample_rate_hz > 0.0) || !std::isfinite(o.sample_rate_hz)) {
     fail("sample_rate_hz " + num(o.sample_rate_hz) + ": expected a rate > 0 Hz");
@@ -61,7 +66,7 @@ void CheckValid(const VirtualHammerOptions& o) {
   if (o.coherence && o.averages < 2) {
     fail("averages " + std::to_string(o.averages) + ": a coherence needs at least 2 (one impact's coherence is 1)");
   }
-  if (o.directions.empty()) fail("directions: no direction pair given");
+  if (o.directions.empty()) fail("directions: no direction pair given, expected at least one");
 }
 
 double ConfiguredSampleRateHz(const dynamics::RobotDescription& description, double fallback) {
@@ -79,7 +84,7 @@ double SynthNoiseFloor(const VirtualHammerOptions& o, double freq_hz) {
 }
 
 Eigen::VectorXd HammerTestGrid(const VirtualHammerOptions& o) {
-  CheckValid(o);
+  o.Validate();
   const double df = o.sample_rate_hz / o.block_samples;
   const long k0 = static_cast<long>(std::ceil(o.fmin_hz / df - 1e-9));
   const long k1 = static_cast<long>(std::floor(o.fmax_hz / df + 1e-9));

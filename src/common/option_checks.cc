@@ -8,6 +8,11 @@
 
 namespace robomach {
 
+std::string FieldNames::Name(const std::string& field) const {
+  const auto it = names.find(field);
+  return it == names.end() ? field : it->second;
+}
+
 void CheckOptionRange(const std::string& field, double value, double lo, double hi) {
   if (value >= lo && value <= hi) return;
   std::ostringstream s;

@@ -10,12 +10,17 @@
 #include <thread>
 #include <vector>
 
+#include "robomach/common/errors.h"
+
 namespace robomach {
 
-std::string ParallelForOptions::Validate() const {
-  if (threads < 0) return "threads: expected >= 0 (0 = all cores), got " + std::to_string(threads);
-  if (chunk_size < 0) return "chunk_size: expected >= 0 (0 = automatic), got " + std::to_string(chunk_size);
-  return {};
+void ParallelForOptions::Validate() const {
+  if (threads < 0) {
+    throw OptionError("threads", "threads: expected >= 0 (0 = all cores), got " + std::to_string(threads));
+  }
+  if (chunk_size < 0) {
+    throw OptionError("chunk_size", "chunk_size: expected >= 0 (0 = automatic), got " + std::to_string(chunk_size));
+  }
 }
 
 int ResolveThreadCount(int threads) {
@@ -26,8 +31,10 @@ int ResolveThreadCount(int threads) {
 void ParallelForChunks(long begin, long end,
                        const std::function<void(long first, long last, int thread)>& body,
                        const ParallelForOptions& options) {
-  if (const std::string why = options.Validate(); !why.empty()) {
-    throw std::invalid_argument("ParallelFor: " + why);
+  try {
+    options.Validate();
+  } catch (const OptionError& e) {
+    throw OptionError(e.field(), std::string("ParallelFor: ") + e.what());
   }
   if (end <= begin) return;
   const long n = end - begin;

@@ -1,7 +1,5 @@
 #include "robomach/drilling/controller_kinds.h"
 
-#include <stdexcept>
-
 #include "robomach/drilling/drilling_sim.h"
 
 namespace robomach::drilling {
@@ -59,25 +57,28 @@ class PdTdcKind final : public ControllerKind {
 
 }  // namespace
 
-const std::vector<const ControllerKind*>& ControllerKinds() {
+const NamedRegistry<const ControllerKind*>& ControllerKindRegistry() {
   static const PidKind pid(true), pd(false);
   static const PdTdcKind pd_tdc;
-  static const std::vector<const ControllerKind*> kinds = {&pid, &pd, &pd_tdc};
+  static const NamedRegistry<const ControllerKind*> registry = [] {
+    NamedRegistry<const ControllerKind*> r("unknown controller kind");
+    r.Add(pid.name(), &pid).Add(pd.name(), &pd).Add(pd_tdc.name(), &pd_tdc);
+    return r;
+  }();
+  return registry;
+}
+
+const std::vector<const ControllerKind*>& ControllerKinds() {
+  static const std::vector<const ControllerKind*> kinds = [] {
+    std::vector<const ControllerKind*> v;
+    for (const auto& [name, k] : ControllerKindRegistry().entries()) v.push_back(k);
+    return v;
+  }();
   return kinds;
 }
 
-std::string ControllerKindList() {
-  const auto& k = ControllerKinds();
-  std::string s;
-  for (size_t i = 0; i < k.size(); ++i) s += (i == 0 ? "" : i + 1 == k.size() ? " or " : ", ") + k[i]->name();
-  return s;
-}
+std::string ControllerKindList() { return ControllerKindRegistry().NameList(); }
 
-const ControllerKind& FindControllerKind(const std::string& name) {
-  for (const ControllerKind* k : ControllerKinds()) {
-    if (k->name() == name) return *k;
-  }
-  throw std::invalid_argument("unknown controller kind \"" + name + "\"; expected " + ControllerKindList());
-}
+const ControllerKind& FindControllerKind(const std::string& name) { return *ControllerKindRegistry().Find(name); }
 
 }  // namespace robomach::drilling

@@ -2,20 +2,37 @@
 
 #include <stdexcept>
 
+#include "robomach/common/errors.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/drilling/controller_kinds.h"
 #include "robomach/drilling/controllers.h"
 
 namespace robomach::drilling {
 
+void ControllerRunOptions::Validate() const {
+  for (const std::string& kind : kinds) {
+    try {
+      FindControllerKind(kind);
+    } catch (const std::invalid_argument& e) {
+      throw OptionError("kinds", e.what());
+    }
+  }
+  if (tune) CheckOptionAtLeast("tune_evaluations", tune_evaluations, 1);
+  for (Eigen::Index j = 0; j < motor_torque_limit.size(); ++j) {
+    CheckOptionAtLeast("motor_torque_limit", motor_torque_limit(j), 0.0);
+    CheckOptionFinite("motor_torque_limit", motor_torque_limit(j));
+  }
+}
+
 std::vector<ControllerRun> RunControllers(DrillingScenario& scenario, const ControllerRunOptions& o,
                                           const std::function<void(const ControllerRunProgress&)>& progress) {
+  o.Validate();  // all names checked before any work
   const Eigen::Index n = scenario.effective_inertia().rows();
   if (o.motor_torque_limit.size() != n) {
     throw std::invalid_argument("RunControllers: expected one motor torque limit per joint (" +
                                 std::to_string(n) + "), got " +
                                 std::to_string(o.motor_torque_limit.size()));
   }
-  for (const std::string& kind : o.kinds) FindControllerKind(kind);  // all names checked before any work
   SimOptions options;
   options.motor_torque_limit = o.motor_torque_limit;
   std::vector<ControllerRun> runs;

@@ -69,6 +69,7 @@
 #include <stdexcept>
 
 #include "robomach/common/enum_names.h"
+#include "robomach/common/option_validate.h"
 
 namespace robomach::drilling {
 namespace {
@@ -178,9 +179,13 @@ LipIntegrand LipForcePerRadius(const DrillGeometry& d, const DrillingMaterial& m
   return out;
 }
 
+void ForceModelOptions::Validate() const {
+  CheckOptionAtLeast("num_elements", num_elements, 1);
+}
+
 LipIntegrand IntegrateLip(const DrillGeometry& d, const DrillingMaterial& m, double f,
                           double r_outer, const ForceModelOptions& options) {
-  if (options.num_elements < 1) throw std::invalid_argument("num_elements: expected >= 1");
+  options.Validate();
   const double rc = d.chisel_half_length();
   const double R = d.radius();
   const double dr = (R - rc) / options.num_elements;
@@ -227,6 +232,7 @@ LipIntegrand ChiselOrthogonal(const DrillGeometry& d, const DrillingMaterial& m,
 
 DrillForces ComputeDrillForces(const DrillGeometry& d, const DrillingMaterial& m,
                                const DrillState& s, const ForceModelOptions& options) {
+  options.Validate();
   CheckValid(d);
   CheckValid(m);
   if (!(std::isfinite(s.feed_per_rev) && s.feed_per_rev > 0.0)) {

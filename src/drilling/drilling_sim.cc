@@ -9,6 +9,8 @@
 #include <Eigen/QR>
 #include <nlopt.hpp>
 
+#include "robomach/common/option_checks.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 #include "robomach/drilling/controller_kinds.h"
 
@@ -127,7 +129,17 @@ DrillingScenario::DrillingScenario(FlexibleJointRobot* robot, DrillGeometry dril
   t_full_ = d_full / v;
 }
 
+void SimOptions::Validate() const {
+  for (Eigen::Index j = 0; j < motor_torque_limit.size(); ++j) {
+    CheckOptionAtLeast("motor_torque_limit", motor_torque_limit(j), 0.0);
+    CheckOptionFinite("motor_torque_limit", motor_torque_limit(j));
+  }
+  CheckOptionAbove("max_omega_h", max_omega_h, 0.0);
+  CheckOptionRange("max_omega_h", max_omega_h, 0.0, 2.8);
+}
+
 SimResult DrillingScenario::Run(JointController& controller, const SimOptions& options) {
+  options.Validate();
   const int n = robot_->num_joints();
   const int N = num_samples();
   const double L = process_.control_period;
@@ -244,6 +256,7 @@ ControllerParameters DefaultParameters(const std::string& kind) { return FindCon
 
 TuneResult TuneController(const ControllerParameters& start, DrillingScenario& scenario,
                           const SimOptions& options, int max_evaluations) {
+  options.Validate();
   ControllerParameters p = start;
   const ControllerKind& kind = FindControllerKind(p.kind);
   const bool third = !kind.third_parameter().empty();

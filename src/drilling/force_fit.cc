@@ -7,6 +7,8 @@
 
 #include <ceres/ceres.h>
 
+#include "robomach/common/option_validate.h"
+
 namespace robomach::drilling {
 namespace {
 
@@ -56,8 +58,14 @@ DrillForces PredictRow(const DrillGeometry& drill, const DrillingMaterial& mater
   return ComputeDrillForces(d, material, st, options);
 }
 
+void ForceFitOptions::Validate() const {
+  CheckOptionAtLeast("max_iterations", max_iterations, 1);
+  ValidateNested("model", model);
+}
+
 ForceFitResult FitDrillingForces(const DrillGeometry& drill, const std::vector<ForceTableRow>& rows,
                                  const ForceFitOptions& options) {
+  options.Validate();
   const int n_par = options.fit_kienzle_exponent ? 3 : 2;
   if (static_cast<int>(rows.size()) * 2 <= n_par) {
     throw std::invalid_argument("force table: expected at least 2 rows to fit the coefficients");

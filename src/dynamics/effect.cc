@@ -17,10 +17,8 @@ EffectRegistry& EffectRegistry::Instance() {
 
 void EffectRegistry::Register(Factory factory) {
   const std::string name = factory()->name();
-  for (const auto& [n, f] : factories_) {
-    if (n == name) throw std::logic_error("effect '" + name + "' registered twice");
-  }
-  factories_.emplace_back(name, std::move(factory));
+  if (factories_.Contains(name)) throw std::logic_error("effect '" + name + "' registered twice");
+  factories_.Add(name, std::move(factory));
 }
 
 void EffectRegistry::RegisterFamily(std::string pattern, FamilyFactory factory) {
@@ -28,9 +26,7 @@ void EffectRegistry::RegisterFamily(std::string pattern, FamilyFactory factory) 
 }
 
 std::shared_ptr<const Effect> EffectRegistry::Create(std::string_view name) const {
-  for (const auto& [n, f] : factories_) {
-    if (n == name) return f();
-  }
+  if (const Factory* f = factories_.Get(std::string(name))) return (*f)();
   for (const auto& [pattern, f] : families_) {
     if (auto e = f(name)) return e;
   }
@@ -46,10 +42,6 @@ std::vector<std::string> EffectRegistry::FamilyPatterns() const {
   return out;
 }
 
-std::vector<std::string> EffectRegistry::Names() const {
-  std::vector<std::string> names;
-  for (const auto& [n, f] : factories_) names.push_back(n);
-  return names;
-}
+std::vector<std::string> EffectRegistry::Names() const { return factories_.Names(); }
 
 }  // namespace robomach::dynamics

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "robomach/common/enum_names.h"
+#include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -24,9 +25,17 @@ std::vector<Eigen::Matrix3cd> ReceptanceBy(ReceptanceMethod method, const Postur
                                              : Receptance(dynamics, freq_hz);
 }
 
+void PredictOptions::Validate() const {
+  if (method != ReceptanceMethod::kModal && method != ReceptanceMethod::kDirect) {
+    throw OptionError("method", "method: expected modal (0) or direct (1), got " +
+                                    std::to_string(static_cast<int>(method)));
+  }
+}
+
 FrfPredictionResult PredictFrfs(const std::shared_ptr<const RobotModel>& model,
                                 const std::vector<NamedPosture>& postures, const Eigen::VectorXd& freq_hz,
                                 const PredictOptions& options) {
+  options.Validate();
   for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
     if (!std::isfinite(freq_hz(i)) || freq_hz(i) < 0.0) {
       throw std::invalid_argument("freq_hz[" + std::to_string(i) + "] is not a finite frequency >= 0");
@@ -46,14 +55,14 @@ FrfPredictionResult PredictFrfs(const std::shared_ptr<const RobotModel>& model,
       std::ostringstream msg;
       msg << "posture " << pose.id << ": joint " << j + 1 << " at " << RadToDeg(pose.q(j))
           << " deg is outside its limits [" << RadToDeg(lim.lower) << ", " << RadToDeg(lim.upper) << "] deg";
-      result.Flag(msg.str(), static_cast<int>(p));
+      result.verdict.Flag(msg.str(), static_cast<int>(p));
     }
     if (out.dynamics.near_singular) {
       std::ostringstream msg;
       msg << "posture " << pose.id << " is near a singularity (condition number of J "
           << out.dynamics.jacobian_condition
           << "); the FRF is computed in joint space and stays valid, but the Cartesian M, K, C are not reported";
-      result.Flag(msg.str(), static_cast<int>(p));
+      result.verdict.Flag(msg.str(), static_cast<int>(p));
     }
     {
       int rigid = 0;
@@ -67,7 +76,7 @@ FrfPredictionResult PredictFrfs(const std::shared_ptr<const RobotModel>& model,
             << " Hz): the stiffness matrix is singular, a part of the model is held by no spring (an effect's "
                "stiffness made negligible, e.g. by a unit mistake in its config section); the FRF is that of a "
                "free body";
-        result.Flag(msg.str(), static_cast<int>(p));
+        result.verdict.Flag(msg.str(), static_cast<int>(p));
       }
     }
     out.H = ReceptanceBy(options.method, out.dynamics, freq_hz);

@@ -310,6 +310,10 @@ void PostureEvaluator::Evaluate(const Eigen::VectorXd& q, const PostureOptions& 
   }
 }
 
+// Nothing to check (see the header); not called by Evaluate, the maps'
+// per-posture inner loop.
+void PostureOptions::Validate() const {}
+
 PostureDynamics EvaluatePosture(std::shared_ptr<const RobotModel> model, const Eigen::VectorXd& q,
                                 const PostureOptions& options) {
   PostureEvaluator e(std::move(model));

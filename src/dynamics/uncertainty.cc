@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -234,18 +235,19 @@ PropagationMethod ParsePropagationMethod(const std::string& name) {
   throw std::invalid_argument("unknown propagation method '" + name + "'; expected auto, first-order or monte-carlo");
 }
 
-void CheckValid(const PropagationOptions& o) {
-  if (!(o.confidence > 0.0 && o.confidence < 1.0)) {
-    throw std::invalid_argument("confidence: expected a level in (0, 1), got " + FormatNumber(o.confidence, 7) +
-                                (o.confidence > 1.0 && o.confidence < 100.0 ? " (a percentage? 95 % is 0.95)" : ""));
+void PropagationOptions::Validate() const {
+  if (!(confidence > 0.0 && confidence < 1.0)) {
+    const bool percent = confidence > 1.0 && confidence < 100.0;
+    throw OptionError("confidence", "confidence: expected a level in (0, 1), got " + FormatNumber(confidence, 7) +
+                                        (percent ? " (a percentage? 95 % is 0.95)" : ""));
   }
-  if (o.samples < 100 || o.samples > 10000000) {
-    throw std::invalid_argument("samples: expected 100 - 10 000 000 Monte Carlo samples, got " +
-                                std::to_string(o.samples));
+  if (samples < 100 || samples > 10000000) {
+    throw OptionError("samples", "samples: expected 100 - 10 000 000 Monte Carlo samples, got " +
+                                     std::to_string(samples));
   }
-  if (!(o.nonlinearity_tolerance > 0.0 && o.nonlinearity_tolerance <= 1.0)) {
-    throw std::invalid_argument("nonlinearity_tolerance: expected (0, 1], got " +
-                                FormatNumber(o.nonlinearity_tolerance, 7));
+  if (!(nonlinearity_tolerance > 0.0 && nonlinearity_tolerance <= 1.0)) {
+    throw OptionError("nonlinearity_tolerance",
+                      "nonlinearity_tolerance: expected (0, 1], got " + FormatNumber(nonlinearity_tolerance, 7));
   }
 }
 
@@ -441,7 +443,7 @@ void MonteCarloIntervals(const PropagationBase& b, const PropagationOptions& o, 
 PropagationResult Propagate(const ParameterUncertainty& u, const OutputFunction& f, const PropagationOptions& o,
                             const std::vector<std::string>& output_names, const OutputFunction& linearisation) {
   CheckValid(u);
-  CheckValid(o);
+  o.Validate();
   const int n = static_cast<int>(u.parameters.size());
   Eigen::VectorXd values(n);
   for (int i = 0; i < n; ++i) values(i) = u.parameters[i].value;

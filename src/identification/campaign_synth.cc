@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "robomach/common/errors.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 #include "robomach/identification/compliance_model.h"
 
@@ -22,8 +24,29 @@ Eigen::Vector3d Noise(std::mt19937& rng, double sigma) {
 
 }  // namespace
 
+void CampaignOptions::Validate() const {
+  if (masses_kg.empty()) throw OptionError("masses_kg", "masses_kg: expected at least one mass, got none");
+  for (const double m : masses_kg) {
+    CheckOptionAbove("masses_kg", m, 0.0);
+    CheckOptionFinite("masses_kg", m);
+  }
+  CheckOptionAtLeast("tracker_noise", tracker_noise, 0.0);
+  CheckOptionFinite("tracker_noise", tracker_noise);
+  CheckOptionAtLeast("num_outliers", num_outliers, 0);
+  CheckOptionAtLeast("outlier_size", outlier_size, 0.0);
+  CheckOptionFinite("outlier_size", outlier_size);
+  CheckOptionAtLeast("rope_A_distance", rope_A_distance, 0.0);
+  if (!(rope_B_distance > rope_A_distance) || !std::isfinite(rope_B_distance)) {
+    std::ostringstream s;
+    s << "rope_B_distance: expected a value > rope_A_distance " << rope_A_distance << ", got " << rope_B_distance;
+    throw OptionError("rope_B_distance", s.str());
+  }
+  CheckOptionAtLeast("min_reach", min_reach, 0.0);
+}
+
 std::vector<Eigen::VectorXd> CampaignPostures(const dynamics::RobotModel& model, int count,
                                               const CampaignOptions& options, unsigned seed) {
+  options.Validate();
   const int n = model.num_joints();
   const auto& limits = model.chain().limits();
   const Eigen::Vector3d tcp = TcpInTip(model);
@@ -86,6 +109,7 @@ std::vector<TrackerMeasurement> SimulateCampaign(
     const std::vector<Eigen::VectorXd>& postures,
     const std::vector<std::vector<Eigen::Vector3d>>& pulleys, const Eigen::VectorXd& kq,
     const CampaignOptions& o, std::vector<int>* outlier_cases) {
+  o.Validate();
   if (pose_ids.size() != postures.size() || pulleys.size() != postures.size()) {
     throw std::invalid_argument("SimulateCampaign: pose_ids and postures differ in size");
   }

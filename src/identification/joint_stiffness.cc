@@ -14,6 +14,7 @@
 #include "identification/internal/information.h"
 #include "identification/internal/tracker_residual.h"
 #include "robomach/common/enum_names.h"
+#include "robomach/common/errors.h"
 #include "robomach/identification/compliance_model.h"
 
 namespace robomach::identification {
@@ -74,17 +75,32 @@ const char* ToString(Determination d) {
   return "?";
 }
 
+const char* ToString(RobustLoss l) {
+  switch (l) {
+    case RobustLoss::kNone: return "none";
+    case RobustLoss::kHuber: return "huber";
+    case RobustLoss::kCauchy: return "cauchy";
+  }
+  return "?";
+}
+
+RobustLoss ParseRobustLoss(const std::string& name) {
+  constexpr RobustLoss kAll[] = {RobustLoss::kNone, RobustLoss::kHuber, RobustLoss::kCauchy};
+  return ParseByName("robust loss", name, kAll);
+}
+
 Determination ParseDetermination(const std::string& name) {
   constexpr Determination kAll[] = {Determination::kDetermined, Determination::kWeak,
                                     Determination::kNotDetermined};
   return ParseByName("determination", name, kAll);
 }
 
-void CheckValid(const IdentificationOptions& o) {
+void IdentificationOptions::Validate() const {
+  const IdentificationOptions& o = *this;
   auto fail = [](const std::string& field, double v, const std::string& bound) {
     std::ostringstream s;
     s << "IdentificationOptions::" << field << ": expected " << bound << ", got " << v;
-    throw std::invalid_argument(s.str());
+    throw OptionError(field, s.str());
   };
   if (!(o.tracker_noise > 0.0) || !std::isfinite(o.tracker_noise)) {
     fail("tracker_noise", o.tracker_noise, "a finite value > 0 m");
@@ -795,7 +811,7 @@ JointStiffnessResult IdentifyJointStiffness(const dynamics::RobotModel& model,
                                             const std::vector<LoadCase>& cases,
                                             const IdentificationOptions& options,
                                             const ProgressCallback& progress) {
-  CheckValid(options);
+  options.Validate();
   if (cases.empty()) throw std::invalid_argument("IdentifyJointStiffness: no load cases");
   JointStiffnessResult res;
   res.num_cases = static_cast<int>(cases.size());

@@ -11,6 +11,7 @@
 
 #include <Eigen/Dense>
 
+#include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/uncertainty.h"
 #include "robomach/identification/compliance_model.h"
@@ -146,7 +147,7 @@ void TargetWidths(const PlanOptions& o, const Eigen::MatrixXd& info, const std::
       }
       if (!joints.empty()) m << joints << ")";
     }
-    plan->Flag(m.str());
+    plan->verdict.Flag(m.str());
   }
 }
 
@@ -170,15 +171,18 @@ bool TargetsDependOnJoint(const PlanOptions& o, int joint) {
   return o.target_gradients.row(joint).cwiseAbs().maxCoeff() > 1e-3 * o.target_gradients.cwiseAbs().maxCoeff();
 }
 
-void CheckValid(const PlanOptions& o) {
+void PlanOptions::Validate() const {
+  const PlanOptions& o = *this;
   auto fail = [](const std::string& field, double v, const std::string& bound) {
     std::ostringstream s;
     s << "PlanOptions::" << field << ": expected " << bound << ", got " << v;
-    throw std::invalid_argument(s.str());
+    throw OptionError(field, s.str());
   };
   if (o.num_postures < 1) fail("num_postures", o.num_postures, "at least 1");
   if (o.directions_per_posture < 1) fail("directions_per_posture", o.directions_per_posture, "at least 1");
-  if (o.masses_kg.empty()) throw std::invalid_argument("PlanOptions::masses_kg: expected at least one mass");
+  if (o.masses_kg.empty()) {
+    throw OptionError("masses_kg", "PlanOptions::masses_kg: expected at least one mass, got none");
+  }
   for (double mkg : o.masses_kg) {
     if (!(mkg > 0.0)) fail("masses_kg", mkg, "masses > 0 kg");
   }
@@ -191,8 +195,9 @@ void CheckValid(const PlanOptions& o) {
   }
   if (o.num_azimuths < 1) fail("num_azimuths", o.num_azimuths, "at least 1");
   if (!(o.joint_limit_margin >= 0.0)) fail("joint_limit_margin", o.joint_limit_margin, "a value >= 0 rad");
+  if (!(o.weak_relative_std > 0.0)) fail("weak_relative_std", o.weak_relative_std, "a value > 0");
   if (o.target_gradients.size() > 0 && !o.target_gradients.allFinite()) {
-    throw std::invalid_argument("PlanOptions::target_gradients: expected finite numbers");
+    throw OptionError("target_gradients", "PlanOptions::target_gradients: expected finite numbers, got a NaN or inf");
   }
   if (!(o.target_half_width >= 0.0 && std::isfinite(o.target_half_width))) {
     fail("target_half_width", o.target_half_width, "a relative half-width >= 0 (0: none)");
@@ -362,7 +367,7 @@ void ExpectedUncertainty(const std::vector<Candidate>& cands, const Selection& s
     if (plan->expected_determination.back() == Determination::kNotDetermined && TargetsDependOnJoint(o, j)) {
       // The last joint turns the tool about its own axis: only a load or a
       // target off that axis feels it.
-      plan->Flag("joint " + std::to_string(j + 1) + " cannot be determined with this set-up" +
+      plan->verdict.Flag("joint " + std::to_string(j + 1) + " cannot be determined with this set-up" +
                      (j == n - 1 ? ": put the load point and the target off the tool axis" : ": allow more postures or rope directions"),
                  j);
     }
@@ -407,7 +412,7 @@ void ListLoads(const std::vector<Candidate>& cands, const Selection& sl, const P
 }  // namespace
 
 TestPlan PlanLoadTests(const dynamics::RobotModel& model, const PlanOptions& o) {
-  CheckValid(o);
+  o.Validate();
   const int n = model.num_joints();
   if (o.target_gradients.size() > 0 && o.target_gradients.rows() != n) {
     throw std::invalid_argument("PlanOptions::target_gradients: expected " + std::to_string(n) +

@@ -1,12 +1,10 @@
 #include "robomach/io/acquired_path_file.h"
 
-#include <algorithm>
 #include <charconv>
 
 #include "machine_text.h"
 #include "robomach/common/units.h"
 #include "robomach/io/format17.h"
-#include "robomach/io/parallel_rows.h"
 
 namespace robomach::io {
 
@@ -58,41 +56,6 @@ void AcquiredPathWriter::AppendRow(std::string* buffer, double t_s, const machin
   buffer->append(row, p);
 }
 
-std::vector<machine::ContourError> WriteAcquiredPath(std::ostream& out, const machine::CountsRecord& record,
-                                                     const std::vector<AxisScale>& axes,
-                                                     machine::Acquisition* acquisition,
-                                                     machine::ContourTracker* tracker, int threads) {
-  const AcquiredPathWriter w(out, axes, tracker != nullptr);
-  const long rows = record.rows();
-  const size_t n = axes.size();
-  std::vector<machine::ContourError> contour(tracker != nullptr ? static_cast<size_t>(rows) : 0);
-  // 4096 rows are ~1.1 MB of text: small enough for the pipeline to start
-  // formatting early, large enough that the hand-offs cost nothing.
-  constexpr long kChunk = 4096;
-  const int slots = 2 * std::max(1, threads) + 2;
-  std::vector<std::vector<machine::AcquiredSample>> samples(static_cast<size_t>(slots),
-                                                             std::vector<machine::AcquiredSample>(kChunk));
-  WritePipelined(
-      out, rows, kChunk, slots,
-      [&](long first, long last, int slot) {
-        auto& s = samples[static_cast<size_t>(slot)];
-        for (long r = first; r < last; ++r) {
-          s[static_cast<size_t>(r - first)] = acquisition->Process(record.t_s[r], record.counts.data() + r * n);
-          if (tracker != nullptr) contour[static_cast<size_t>(r)] = tracker->Next(s[static_cast<size_t>(r - first)].pose);
-        }
-      },
-      [&](long first, long last, int slot, std::string* text) {
-        const auto& s = samples[static_cast<size_t>(slot)];
-        text->reserve(static_cast<size_t>(last - first) * 320);
-        for (long r = first; r < last; ++r) {
-          w.AppendRow(text, record.t_s[r], s[static_cast<size_t>(r - first)],
-                      tracker != nullptr ? &contour[static_cast<size_t>(r)] : nullptr);
-        }
-      },
-      threads);
-  return contour;
-}
-
 namespace {
 
 nlohmann::json StatsJson(const machine::SeriesStats& s) {
@@ -101,20 +64,12 @@ nlohmann::json StatsJson(const machine::SeriesStats& s) {
 
 }  // namespace
 
-nlohmann::json ContourSummaryJson(const std::vector<machine::ContourError>& contour,
-                                  const machine::ProgrammedPath& path) {
-  std::vector<double> d_um(contour.size()), a_deg(contour.size()), s_mm(contour.size());
-  for (size_t i = 0; i < contour.size(); ++i) {
-    d_um[i] = contour[i].distance * 1e6;
-    a_deg[i] = RadToDeg(contour[i].axis_angle);
-    s_mm[i] = MToMm(contour[i].s);
-  }
+nlohmann::json ContourSummaryJson(const ContourFigures& f) {
   nlohmann::json j;
-  j["contour_error_um"] = StatsJson(machine::Stats(d_um));
-  j["axis_error_deg"] = StatsJson(machine::Stats(a_deg));
-  j["path_length_mm"] = MToMm(path.length());
-  j["covered_mm"] = {s_mm.empty() ? 0.0 : *std::min_element(s_mm.begin(), s_mm.end()),
-                     s_mm.empty() ? 0.0 : *std::max_element(s_mm.begin(), s_mm.end())};
+  j["contour_error_um"] = StatsJson(f.contour_error_um);
+  j["axis_error_deg"] = StatsJson(f.axis_error_deg);
+  j["path_length_mm"] = f.path_length_mm;
+  j["covered_mm"] = {f.covered_min_mm, f.covered_max_mm};
   return j;
 }
 

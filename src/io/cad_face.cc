@@ -538,14 +538,25 @@ int LargestFace(const TopTools_IndexedMapOfShape& faces) {
   return index;
 }
 
+// CadReadOptions::Validate, worded as the polishing tools have always said
+// it (their option, the file).
 void CheckScale(const std::string& path, const CadReadOptions& options) {
-  if (!(options.unit_scale > 0) || !std::isfinite(options.unit_scale)) {
+  try {
+    options.Validate();
+  } catch (const OptionError&) {
     throw std::invalid_argument("--cad-unit-scale: expected a number > 0, got " + FormatNumber(options.unit_scale, 3) +
                                 " (for " + path + ")");
   }
 }
 
 }  // namespace
+
+void CadReadOptions::Validate() const {
+  if (unit_scale > 0.0 && std::isfinite(unit_scale)) return;
+  std::ostringstream s;
+  s << "unit_scale: expected a finite value > 0, got " << unit_scale;
+  throw OptionError("unit_scale", s.str());
+}
 
 polishing::NurbsSurface ReadCadFace(const std::string& path, int face, const CadReadOptions& options, CadPartInfo* info) {
   CheckScale(path, options);

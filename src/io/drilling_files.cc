@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <stdexcept>
 
 #include "plausible.h"
 #include "robomach/common/solver_status.h"
@@ -131,11 +132,7 @@ DrillFile ReadDrillFile(const std::string& path) {
   g.chisel_edge_angle = DegToRad(DegreesInRange(d["chisel_edge_angle_deg"], 90.0, 180.0, false, false));
   g.lip_relief_angle = DegToRad(DegreesInRange(d["lip_relief_angle_deg"], 0.0, 45.0, true, false));
   d.RejectUnknownKeys();
-  try {
-    drilling::CheckValid(g);
-  } catch (const std::invalid_argument& e) {
-    throw d.Error(e.what());
-  }
+  d.Checked([&] { drilling::CheckValid(g); });
 
   drilling::DrillingProcess& p = out.process;
   if (doc.Has("process")) {
@@ -154,10 +151,7 @@ DrillFile ReadDrillFile(const std::string& path) {
     out.initial_posture_at = q0.location();
     const YamlDoc axis = pr["hole_axis"];
     const std::string a = axis.String();
-    if (a == "tip_x") p.hole_axis = drilling::HoleAxis::kTipX;
-    else if (a == "tip_y") p.hole_axis = drilling::HoleAxis::kTipY;
-    else if (a == "tip_z") p.hole_axis = drilling::HoleAxis::kTipZ;
-    else throw axis.Error("expected tip_x, tip_y or tip_z, got \"" + a + "\"");
+    p.hole_axis = axis.Checked([&] { return drilling::ParseHoleAxis(a); });
     out.hole_axis_at = axis.location();
     pr.RejectUnknownKeys();
   }

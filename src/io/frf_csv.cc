@@ -18,7 +18,6 @@ using dynamics::FrfKey;
 using dynamics::FrfSet;
 using frf_text::CheckLowFrequencyTrend;
 using frf_text::Fmt;
-using frf_text::ParseAxis;
 
 namespace {
 
@@ -27,7 +26,7 @@ namespace {
 void ReadFrfMetadata(const CsvTable& t, const std::string& path, FrfReadResult* out) {
   if (auto it = t.metadata().find("quantity"); it != t.metadata().end()) {
     try {
-      out->file_quantity = ParseQuantity(it->second);
+      out->file_quantity = ParseFrfQuantity(it->second);
     } catch (const std::invalid_argument&) {
       throw InputError({path, 0, 0}, "metadata '# quantity: " + it->second +
                                          "': expected receptance, mobility or accelerance");
@@ -126,16 +125,21 @@ struct FrfBlockReader {
     open = false;
   }
 
+  // A direction column's value (ParseAxis), its error at the cell.
+  Axis AxisAt(int r, const std::string& column) const {
+    try {
+      return ParseAxis(t.Text(r, column));
+    } catch (const std::invalid_argument& e) {
+      throw t.ErrorAt(r, column, e.what());
+    }
+  }
+
   // The FRF a row belongs to: pose, directions and point numbers.
   FrfKey KeyOfRow(int r) const {
     FrfKey key;
     key.pose_id = t.Text(r, "pose_id");
-    if (!ParseAxis(t.Text(r, "response"), &key.response)) {
-      throw t.ErrorAt(r, "response", "expected x, y or z, got \"" + t.Text(r, "response") + "\"");
-    }
-    if (!ParseAxis(t.Text(r, "excitation"), &key.excitation)) {
-      throw t.ErrorAt(r, "excitation", "expected x, y or z, got \"" + t.Text(r, "excitation") + "\"");
-    }
+    key.response = AxisAt(r, "response");
+    key.excitation = AxisAt(r, "excitation");
     if (cols.response_point_col) key.response_point = PointAt(t, r, cols.response_point_col);
     if (cols.has_excitation_point) key.excitation_point = PointAt(t, r, "excitation_point");
     return key;

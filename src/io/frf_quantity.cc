@@ -34,7 +34,7 @@ std::string QuantityWithArticle(FrfQuantity q) {
   return (q == FrfQuantity::kAccelerance ? "an " : "a ") + ToString(q);
 }
 
-FrfQuantity ParseQuantity(const std::string& name) {
+FrfQuantity ParseFrfQuantity(const std::string& name) {
   const std::string n = Lower(Trim(name));
   for (FrfQuantity q : {FrfQuantity::kReceptance, FrfQuantity::kMobility, FrfQuantity::kAccelerance}) {
     if (n == ToString(q)) return q;

@@ -19,15 +19,6 @@ std::string Fmt(double v) {
   return o.str();
 }
 
-bool ParseAxis(const std::string& text, Axis* axis) {
-  const std::string t = Lower(text);
-  if (t == "x") *axis = Axis::kX;
-  else if (t == "y") *axis = Axis::kY;
-  else if (t == "z") *axis = Axis::kZ;
-  else return false;
-  return true;
-}
-
 // Log-log slope of |H| over the lowest lines. A receptance tends to the static compliance below the first
 // resonance (slope ~0), a mobility grows like f (slope 1), an accelerance
 // like f² (slope 2). Returns NaN if there are too few usable lines.

@@ -12,8 +12,6 @@ namespace robomach::io::frf_text {
 
 /// Ten significant digits, for messages.
 std::string Fmt(double v);
-/// "x", "y", "z" (any case) to an axis; false for anything else.
-bool ParseAxis(const std::string& text, Axis* axis);
 /// A warning when an FRF declared as receptance grows like f (mobility) or
 /// f² (accelerance) over its lowest lines.
 void CheckLowFrequencyTrend(const dynamics::FrfKey& key, const dynamics::Frf& frf, const std::string& where,

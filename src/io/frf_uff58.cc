@@ -25,7 +25,6 @@ using frf_text::CheckLowFrequencyTrend;
 using frf_text::Fmt;
 using frf_text::Pad80;
 using frf_text::PadTo;
-using frf_text::ParseAxis;
 using frf_text::Printf;
 
 namespace {
@@ -82,7 +81,7 @@ Direction RecordDirection(const std::string& path, int line, int column, int cod
   if (name_has_axis) {
     d.known = true;
     d.from_name = true;
-    d.axis = ParseAxis(m[3].str(), &d.axis) ? d.axis : Axis::kX;
+    d.axis = ParseAxis(m[3].str());
     d.sign = (m[2].str() == "-") != (m[4].str() == "-") ? -1 : 1;
   }
   return d;

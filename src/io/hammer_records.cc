@@ -565,10 +565,11 @@ std::vector<dynamics::FrfKey> ChannelKeys(const HammerRecords& rec, const std::s
     const std::string& name = ch.name;
     Axis response = Axis::kX;
     if (const auto it = directions.find(name); it != directions.end()) {
-      if (it->second != "x" && it->second != "y" && it->second != "z") {
-        throw std::invalid_argument(name + ": expected x, y or z, got '" + it->second + "'");
+      try {
+        response = ParseAxis(it->second);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(name + ": " + e.what());
       }
-      response = static_cast<Axis>(it->second[0] - 'x');
     } else {
       const char last = name.empty() ? '\0' : name.back();
       const bool suffix = name.size() == 1 || (name.size() >= 2 && name[name.size() - 2] == '_');

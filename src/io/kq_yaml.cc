@@ -31,8 +31,18 @@ std::string Value(double v) {
 
 }  // namespace
 
+void KqYamlOptions::Validate() const {
+  for (const std::string& c : header_comments) {
+    if (c.find_first_of("\r\n") != std::string::npos) {
+      throw OptionError("header_comments", "header_comments: expected one line per comment (no line break), got \"" +
+                                               EscapeInvalidUtf8(c) + "\"");
+    }
+  }
+}
+
 std::string JointStiffnessYaml(const identification::JointStiffnessResult& r,
                                const KqYamlOptions& o) {
+  o.Validate();
   using identification::Determination;
   std::ostringstream s;
   for (const auto& c : o.header_comments) s << "# " << c << "\n";

@@ -116,7 +116,7 @@ nlohmann::json LobesSummaryJson(const std::vector<stability::TipDynamics>& tips,
   j["lobes"] = results;
   j["tips"] = tip_list;
   j["no_boundary_at_some_speeds"] = lobes.no_boundary;
-  j["flagged"] = lobes.flagged();
+  j["flagged"] = lobes.verdict.flagged();
   return j;
 }
 

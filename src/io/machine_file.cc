@@ -9,6 +9,7 @@
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/yaml_doc.h"
+#include "robomach/machine/kinematics_kinds.h"
 
 namespace robomach::io {
 
@@ -133,9 +134,9 @@ MachineFile ReadMachineFile(const std::string& path) {
   }
   const YamlDoc k = doc["kinematics"];
   const std::string type = k["type"].String();
-  if (type != "nutating_head_rotary_table") {
-    throw k["type"].Error("unknown kinematics type '" + type + "'; known: nutating_head_rotary_table");
-  }
+  // The message's words as before the registry ("; known:"), the names from it.
+  const auto& kinds = machine::KinematicsKinds();
+  if (!kinds.Contains(type)) throw k["type"].Error("unknown kinematics type '" + type + "'; known: " + kinds.NameList());
   machine::NutatingHeadGeometry& g = f.geometry;
   const double nutation_deg = DegreesInRange(k["nutation_deg"], 0.0, 90.0, false, true);
   if (nutation_deg < kMinPlausibleNutationDeg) {
@@ -171,12 +172,9 @@ MachineFile ReadMachineFile(const std::string& path) {
     k.MarkUsed("errors");
   }
   k.RejectUnknownKeys();
-  f.machine.kinematics = std::make_shared<machine::NutatingHeadRotaryTable>(g);
-  try {
-    f.machine.kinematic_axis = machine::MapKinematicAxes(f.machine.axes, *f.machine.kinematics);
-  } catch (const std::invalid_argument& e) {
-    throw axes.Error(e.what());
-  }
+  f.machine.kinematics = kinds.Find(type)(g);
+  f.machine.kinematic_axis =
+      axes.Checked([&] { return machine::MapKinematicAxes(f.machine.axes, *f.machine.kinematics); });
   if (doc.Has("controller_axes")) {
     const YamlDoc ca = doc["controller_axes"];
     for (const std::string& name : ca.Keys()) {

@@ -1,7 +1,6 @@
 #include "robomach/io/modal_analysis_files.h"
 
 #include <cmath>
-#include <optional>
 #include <sstream>
 
 #include "robomach/common/frames.h"
@@ -57,28 +56,22 @@ std::string ModalConstantsCsv(const std::vector<calibration::PoseModes>& poses) 
   return os.str();
 }
 
-std::string ModeShapesCsv(const std::vector<calibration::PoseModes>& poses, std::vector<std::string>* notes) {
+std::string ModeShapesCsv(const std::vector<calibration::PoseModes>& poses,
+                          const std::vector<calibration::FitRovingShapes>& shapes) {
   std::ostringstream os;
   os << "pose_id,fit,mode,freq_hz,damping_ratio,point,direction,shape_re,shape_im,shape_unit,roving,fixed_point,"
         "fixed_direction\n";
-  for (const calibration::PoseModes& p : poses) {
-    for (size_t g = 0; g < p.groups.size(); ++g) {
-      const calibration::ModalGroup& grp = p.groups[g];
-      if (grp.fit.status != SolverStatus::kConverged) continue;
-      std::string why;
-      const std::optional<calibration::RovingShapes> rs = calibration::ShapesOfRovingTest(grp, &why);
-      if (!rs) {
-        if (notes) notes->push_back("posture " + p.pose_id + ", fit " + std::to_string(g + 1) + ": no mode shapes: " + why);
-        continue;
-      }
-      for (size_t r = 0; r < grp.fit.modes.size(); ++r) {
-        for (size_t i = 0; i < rs->points.size(); ++i) {
-          os << p.pose_id << ',' << g + 1 << ',' << r + 1 << ',' << FormatDouble(grp.fit.modes[r].freq_hz) << ','
-             << FormatDouble(grp.fit.modes[r].damping_ratio) << ',' << rs->points[i] << ','
-             << AxisName(rs->directions[i]) << ',' << FormatDouble(rs->shapes(i, r).real()) << ','
-             << FormatDouble(rs->shapes(i, r).imag()) << ',' << (rs->mass_normalised ? "1/sqrt(kg)" : "1") << ','
-             << rs->roving << ',' << rs->fixed_point << ',' << AxisName(rs->fixed_direction) << '\n';
-        }
+  for (const calibration::FitRovingShapes& f : shapes) {
+    const calibration::PoseModes& p = poses.at(f.pose);
+    const calibration::ModalGroup& grp = p.groups.at(f.fit);
+    const calibration::RovingShapes& rs = f.shapes;
+    for (size_t r = 0; r < grp.fit.modes.size(); ++r) {
+      for (size_t i = 0; i < rs.points.size(); ++i) {
+        os << p.pose_id << ',' << f.fit + 1 << ',' << r + 1 << ',' << FormatDouble(grp.fit.modes[r].freq_hz) << ','
+           << FormatDouble(grp.fit.modes[r].damping_ratio) << ',' << rs.points[i] << ','
+           << AxisName(rs.directions[i]) << ',' << FormatDouble(rs.shapes(i, r).real()) << ','
+           << FormatDouble(rs.shapes(i, r).imag()) << ',' << (rs.mass_normalised ? "1/sqrt(kg)" : "1") << ','
+           << rs.roving << ',' << rs.fixed_point << ',' << AxisName(rs.fixed_direction) << '\n';
       }
     }
   }

@@ -82,11 +82,8 @@ polishing::NurbsSurface ReadNurbsYaml(const std::string& path) {
     root.MarkUsed("weights");
   }
   root.RejectUnknownKeys();
-  try {
-    return polishing::NurbsSurface::Create(p, q, std::move(ku), std::move(kv), std::move(P), std::move(W));
-  } catch (const std::invalid_argument& e) {
-    throw root.Error(e.what());
-  }
+  return root.Checked(
+      [&] { return polishing::NurbsSurface::Create(p, q, std::move(ku), std::move(kv), std::move(P), std::move(W)); });
 }
 
 polishing::PolishingProcess ReadPolishingProcess(const std::string& path, std::vector<std::string>* implausible) {
@@ -265,14 +262,13 @@ void WriteRemovalMap(const std::string& path, const polishing::SampleGrid& grid,
 }
 
 std::vector<std::pair<std::string, std::string>> PlannedPathMetadata(const polishing::PathParameters& params,
-                                                                     const polishing::PolishingProcess& process) {
+                                                                     double edge_overrun_m) {
   const bool cyc = params.pattern == polishing::Pattern::kCycloid;
   const std::string guides_used =
-      !cyc ? "parallel" : params.guides == polishing::GuideLines::kBoundaryOffsets ? "offsets" : "parallel";
+      ToString(cyc ? params.guides : polishing::GuideLines::kParallelLines);  // the zig-zag's rows: "parallel"
   std::vector<std::pair<std::string, std::string>> meta = {{"pattern", polishing::PathPatternOf(params.pattern).name()}};
   meta.push_back({"offset_mm", FormatDouble(1e3 * params.offset)});
-  meta.push_back(
-      {"edge_overrun_mm", FormatDouble(1e3 * std::min(params.edge_overrun, polishing::MaxEdgeOverrun(params, process)))});
+  meta.push_back({"edge_overrun_mm", FormatDouble(1e3 * edge_overrun_m)});
   if (cyc) {
     meta.push_back({"guides", guides_used});
     meta.push_back({"radius_mm", FormatDouble(1e3 * params.radius)});

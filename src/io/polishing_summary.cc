@@ -11,7 +11,8 @@
 namespace robomach::io {
 namespace {
 
-nlohmann::json FamilyJson(const polishing::PlanEvaluation& ev, const polishing::PolishingProcess& process) {
+// `edge_overrun_m`: the one the evaluation's plan used (PlanFigures).
+nlohmann::json FamilyJson(const polishing::PlanEvaluation& ev, double edge_overrun_m) {
   const bool c = ev.params.pattern == polishing::Pattern::kCycloid;
   nlohmann::json j = {
       {"pattern", polishing::PathPatternOf(ev.params.pattern).name()},
@@ -19,7 +20,7 @@ nlohmann::json FamilyJson(const polishing::PlanEvaluation& ev, const polishing::
                    : polishing::FamilyName({polishing::GuideLines::kParallelLines, ev.params.line_angle})},
       {"offset_mm", 1e3 * ev.params.offset},
       {"line_angle_deg", ev.params.line_angle * 180.0 / kPi},
-      {"edge_overrun_mm", 1e3 * std::min(ev.params.edge_overrun, polishing::MaxEdgeOverrun(ev.params, process))},
+      {"edge_overrun_mm", 1e3 * edge_overrun_m},
       {"cv", ev.cv},
       {"mean_at_max_speed_um", 1e6 * ev.mean},
       {"coverage", ev.coverage},
@@ -32,7 +33,7 @@ nlohmann::json FamilyJson(const polishing::PlanEvaluation& ev, const polishing::
   return j;
 }
 
-nlohmann::json OptimisationJson(const polishing::PlanOutcome& outcome, const polishing::PolishingProcess& process,
+nlohmann::json OptimisationJson(const polishing::PlanOutcome& outcome, const PlanFigures& figures,
                                 const polishing::PlanOptions& options) {
   const polishing::PlanOptimiseResult& opt = *outcome.optimisation;
   nlohmann::json j = {{"method", opt.method},
@@ -46,7 +47,7 @@ nlohmann::json OptimisationJson(const polishing::PlanOutcome& outcome, const pol
                       {"sample_mm", options.opt_sample_mm},
                       {"best_cv", opt.best.cv},
                       {"feasible", opt.best.feasible},
-                      {"best", FamilyJson(opt.best, process)}};
+                      {"best", FamilyJson(opt.best, figures.best_edge_overrun_m)}};
   j["history"] = outcome.history_best;   // best feasible cv so far (null before the first)
   j["history_cv"] = outcome.history_cv;  // each evaluation's cv (null: infeasible)
   if (outcome.params.pattern == polishing::Pattern::kCycloid) {
@@ -56,9 +57,11 @@ nlohmann::json OptimisationJson(const polishing::PlanOutcome& outcome, const pol
                    {"stagger_loops", {0.0, 1.0}},
                    {"edge_overrun_over_its_largest", {0.0, 1.0}}};
     nlohmann::json fams = nlohmann::json::array();
-    for (const auto& f : opt.family_best) fams.push_back(FamilyJson(f, process));
+    for (size_t i = 0; i < opt.family_best.size(); ++i) {
+      fams.push_back(FamilyJson(opt.family_best[i], figures.family_edge_overrun_m.at(i)));
+    }
     j["families"] = fams;
-    if (opt.best_parallel.valid) j["parallel"] = FamilyJson(opt.best_parallel, process);
+    if (opt.best_parallel.valid) j["parallel"] = FamilyJson(opt.best_parallel, figures.parallel_edge_overrun_m);
   }
   if (!outcome.infeasible_message.empty()) j["message"] = outcome.infeasible_message;
   return j;
@@ -72,12 +75,12 @@ nlohmann::json RemovalSummaryJson(const polishing::RemovalStats& s) {
           {"coverage", s.coverage}};
 }
 
-nlohmann::json PathSummaryJson(const std::vector<polishing::PathRow>& rows) {
-  return {{"length_mm", 1e3 * polishing::ContactLength(rows)},
-          {"lifts", polishing::CountLifts(rows)},
-          {"time_s", rows.empty() ? 0.0 : rows.back().t - rows.front().t},
-          {"rows", rows.size()},
-          {"max_speed_mm_per_s", 1e3 * polishing::MaxSpeed(rows)}};
+nlohmann::json PathSummaryJson(const PathFigures& f) {
+  return {{"length_mm", 1e3 * f.contact_length_m},
+          {"lifts", f.lifts},
+          {"time_s", f.time_s},
+          {"rows", f.rows},
+          {"max_speed_mm_per_s", 1e3 * f.max_speed_m_per_s}};
 }
 
 nlohmann::json RegionSummaryJson(const polishing::SampleGrid& grid, const polishing::RemovalStats& stats,
@@ -89,7 +92,7 @@ nlohmann::json RegionSummaryJson(const polishing::SampleGrid& grid, const polish
 }
 
 nlohmann::json PolishPlanSummaryJson(const polishing::PlanOutcome& outcome, const polishing::PlanningContext& ctx,
-                                     const polishing::PlanOptions& options) {
+                                     const polishing::PlanOptions& options, const PlanFigures& figures) {
   const polishing::PathParameters& params = outcome.params;
   const polishing::PolishingProcess& process = ctx.process;
   const polishing::EvaluatedPlan& e = outcome.plan;
@@ -106,15 +109,15 @@ nlohmann::json PolishPlanSummaryJson(const polishing::PlanOutcome& outcome, cons
                              {"better", cmp.zigzag_better ? "parallel" : "cycloid"}};
   }
   summary["removal_um"] = RemovalSummaryJson(e.stats);
-  summary["path"] = PathSummaryJson(e.path.rows);
-  const std::string guides_used =
-      !cyc ? "parallel" : params.guides == polishing::GuideLines::kBoundaryOffsets ? "offsets" : "parallel";
+  summary["path"] = PathSummaryJson(figures.path);
+  // The zig-zag's rows are parallel lines whatever guides says.
+  const std::string guides_used = polishing::ToString(cyc ? params.guides : polishing::GuideLines::kParallelLines);
   summary["parameters"] = {
       {"pattern", options.pattern},
       {"guides", guides_used},
       {"line_angle_deg", params.line_angle * 180.0 / kPi},
       {"stagger_loops", cyc ? params.stagger : 0.0},
-      {"edge_overrun_mm", 1e3 * std::min(params.edge_overrun, polishing::MaxEdgeOverrun(params, process))},
+      {"edge_overrun_mm", 1e3 * figures.edge_overrun_m},
       {"offset_mm", 1e3 * params.offset},
       {"radius_mm", cyc ? 1e3 * params.radius : 0.0},
       {"pitch_mm", cyc ? 1e3 * params.pitch : 0.0},
@@ -135,7 +138,7 @@ nlohmann::json PolishPlanSummaryJson(const polishing::PlanOutcome& outcome, cons
     if (!outcome.target.reached) target["message"] = outcome.target.message;
     summary["target"] = target;
   }
-  if (outcome.optimisation) summary["optimisation"] = OptimisationJson(outcome, process, options);
+  if (outcome.optimisation) summary["optimisation"] = OptimisationJson(outcome, figures, options);
   return summary;
 }
 

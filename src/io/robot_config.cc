@@ -11,8 +11,6 @@
 #include "plausible.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/effect.h"
-#include "robomach/dynamics/gravity_torque.h"
-#include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/io/file_kind.h"
 #include "robomach/io/number_format.h"
 #include "robomach/io/urdf_loader.h"
@@ -274,125 +272,9 @@ void CheckHammerTest(const YamlDoc& section, std::vector<std::string>* implausib
                  implausible);
 }
 
-// The decoupled frequency of each joint, f_j = sqrt(kq_j / M_q(j,j)) / 2 pi,
-// at q = 0 (the middle of the limits where they exclude 0), and the damping
-// ratio zeta_j = (alpha w_j + beta / w_j) / 2 it gets: a stiffness or a mass
-// 1000 times off moves f_j by a factor of 31.6, out of what robots have
-// (docs/plausibility.md). Named per joint, with the likely mistakes.
-void CheckJointFrequencies(RobotConfig& cfg, const YamlDoc& doc, const YamlDoc& kq, const YamlDoc& damping) {
-  const kinematics::SerialChain& arm = cfg.description.arm;
-  const int n = arm.num_joints();
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
-  for (int j = 0; j < n; ++j) {
-    const auto& lim = arm.limits()[j];
-    if (lim.bounded && (lim.lower > 0.0 || lim.upper < 0.0)) q(j) = 0.5 * (lim.lower + lim.upper);
-  }
-  Eigen::MatrixXd M;
-  double alpha = 0.0, beta = 0.0;
-  Eigen::VectorXd k(n), gravity_torque;
-  try {
-    const auto model = cfg.Build();
-    M = dynamics::EvaluatePosture(model, q).M_q();
-    // The largest weight each joint holds: each joint swept through its
-    // range (9 angles, the others at q), so that the arm is near horizontal
-    // once (RNE, microseconds each).
-    // (Its own try: a failure leaves the sag unjudged, not the frequencies.)
-    try {
-      gravity_torque = dynamics::GravityTorque(*model, q).cwiseAbs();
-      for (int i = 0; i < n; ++i) {
-        const auto& lim = arm.limits()[i];
-        const double lo = lim.bounded ? lim.lower : -kPi, hi = lim.bounded ? lim.upper : kPi;
-        for (int s = 0; s <= 8; ++s) {
-          Eigen::VectorXd qs = q;
-          qs(i) = lo + (hi - lo) * s / 8.0;
-          gravity_torque = gravity_torque.cwiseMax(dynamics::GravityTorque(*model, qs).cwiseAbs());
-        }
-      }
-    } catch (const std::exception&) {
-      gravity_torque = Eigen::VectorXd::Zero(n);
-    }
-    for (int j = 0; j < n; ++j) k(j) = model->joint_stiffness()(j);
-    alpha = model->alpha();
-    beta = model->beta();
-  } catch (const std::exception&) {
-    return;  // a model that does not build is reported by the tool that builds it
-  }
-  (void)doc;
-  // Whole hertz from 10 Hz up (7895 Hz, not 7.9e+03), 3 digits below.
-  const auto hz = [](double f) {
-    return f >= 10.0 ? std::to_string(std::lround(f)) : robomach::FormatNumber(f, 3);
-  };
-  const bool have_damping = alpha > 0.0 || beta > 0.0;
-  bool frequency_found = false;
-  double zeta_max = 0.0;
-  int zeta_joint = -1;
-  for (int j = 0; j < n; ++j) {
-    if (!(M(j, j) > 0.0)) continue;
-    const double w = std::sqrt(k(j) / M(j, j));
-    const double f_hz = w / (2.0 * kPi);
-    if (f_hz < kMinPlausibleJointFrequencyHz || f_hz > kMaxPlausibleJointFrequencyHz) {
-      const bool low = f_hz < kMinPlausibleJointFrequencyHz;
-      frequency_found = true;
-      cfg.implausible.push_back(
-          "implausible (unit mistake?): " + kq.at(j).location().ToString() + ": joint " + std::to_string(j + 1) +
-          " (" + arm.joint_names()[j] + "): its stiffness " + FormatNumber(k(j)) + " N·m/rad on the inertia " +
-          robomach::FormatNumber(M(j, j), 4) + " kg·m² it moves at q = 0 makes a joint frequency sqrt(kq/M)/2pi of " +
-          hz(f_hz) + " Hz, outside the " + robomach::FormatNumber(kMinPlausibleJointFrequencyHz, 4) +
-          " to " + robomach::FormatNumber(kMaxPlausibleJointFrequencyHz, 4) + " Hz of robots: " +
-          (low ? "a stiffness in kN·m/rad, or masses in g (x1000)?" : "a stiffness in N·mm/rad (x1000)?"));
-    }
-    if (have_damping) {
-      const double zeta = 0.5 * (alpha * w + beta / w);
-      if (zeta > zeta_max) {
-        zeta_max = zeta;
-        zeta_joint = j;
-      }
-    }
-  }
-  // The robot's own weight against the stiffness: a stiffness per degree
-  // (/57.3) keeps the joint frequencies in range but turns the joints by
-  // degrees (docs/plausibility.md).
-  if (!frequency_found) {
-    int worst = -1;
-    double worst_sag = 0.0;
-    for (int j = 0; j < n; ++j) {
-      const double sag = k(j) > 0.0 ? gravity_torque(j) / k(j) : 0.0;
-      if (sag > worst_sag) {
-        worst_sag = sag;
-        worst = j;
-      }
-    }
-    if (worst >= 0 && worst_sag > kMaxPlausibleGravitySagRad) {
-      frequency_found = true;
-      const double deg = worst_sag * 180.0 / kPi;
-      cfg.implausible.push_back(
-          "implausible (unit mistake?): " + kq.at(worst).location().ToString() + ": joint " +
-          std::to_string(worst + 1) + " (" + arm.joint_names()[worst] + "): the robot's own weight (" +
-          robomach::FormatNumber(gravity_torque(worst), 4) + " N·m at most, the joints swept through their limits) "
-          "turns it by " +
-          robomach::FormatNumber(deg, 3) + " deg against its stiffness " + FormatNumber(k(worst)) +
-          " N·m/rad; robot gearboxes turn by a few arc-minutes under their rated torque (plausible up to " +
-          robomach::FormatNumber(kMaxPlausibleGravitySagRad * 180.0 / kPi, 3) +
-          " deg): a stiffness per degree typed in the N·m/rad field (N·m/rad = N·m/deg x 57.3: " +
-          robomach::FormatNumber(k(worst) * 180.0 / kPi, 5) + "), or a stiffness in kN·m/rad (x1000)?");
-    }
-  }
-  // A joint frequency off by 31.6 explains any damping ratio: say it once.
-  if (!frequency_found && zeta_joint >= 0 && zeta_max > kMaxPlausibleDampingRatio) {
-    const double w = std::sqrt(k(zeta_joint) / M(zeta_joint, zeta_joint));
-    const bool alpha_term = alpha * w > beta / w;
-    cfg.implausible.push_back(
-        "implausible (unit mistake?): " + damping.location().ToString() + ": damping: alpha_s " +
-        FormatNumber(alpha) + " s and beta_per_s " + FormatNumber(beta) + " /s give joint " +
-        std::to_string(zeta_joint + 1) + " a damping ratio of " + robomach::FormatNumber(zeta_max, 3) +
-        " at its frequency " + hz(w / (2.0 * kPi)) + " Hz, more than the " +
-        robomach::FormatNumber(kMaxPlausibleDampingRatio, 3) + " robots have (0.01 to 0.1 measured): " +
-        (alpha_term ? "alpha_s in ms typed in the s field?" : "beta_per_s 1000 times too large?"));
-  }
-}
-
 // joint_stiffness_Nm_per_rad: one stiffness > 0 per joint of the chain, each
-// checked to be plausible. The node is returned for CheckJointFrequencies.
+// checked to be plausible. The node is returned for where each was typed
+// (RobotConfig::joint_value_locations).
 YamlDoc ReadJointStiffness(const YamlDoc& doc, RobotConfig* cfg) {
   dynamics::RobotDescription& d = cfg->description;
   const int n = d.arm.num_joints();
@@ -412,7 +294,7 @@ YamlDoc ReadJointStiffness(const YamlDoc& doc, RobotConfig* cfg) {
 }
 
 // damping: the Rayleigh coefficients alpha_s and beta_per_s, each in its
-// range. The node is returned for CheckJointFrequencies.
+// range. The node is returned for where it was typed.
 YamlDoc ReadDamping(const YamlDoc& doc, dynamics::RobotDescription* d) {
   const YamlDoc damping = doc["damping"];
   // alpha_s and beta_per_s swapped is the likely mistake behind an alpha
@@ -498,12 +380,8 @@ void ReadEffects(const YamlDoc& doc, dynamics::RobotDescription* d) {
       dynamics::EffectConfig ec;
       const YamlDoc name = e["name"];
       ec.name = name.String();
-      std::shared_ptr<const dynamics::Effect> effect;
-      try {
-        effect = dynamics::EffectRegistry::Instance().Create(ec.name);
-      } catch (const std::invalid_argument& ex) {
-        throw name.Error(ex.what());
-      }
+      const std::shared_ptr<const dynamics::Effect> effect =
+          name.Checked([&] { return dynamics::EffectRegistry::Instance().Create(ec.name); });
       for (const auto& spec : effect->parameters()) {
         if (e.Has(spec.name)) ec.values[spec.name] = e[spec.name].Number();
         e.MarkUsed(spec.name);
@@ -622,7 +500,8 @@ RobotConfig LoadRobotConfig(const std::string& path) {
   }
   doc.MarkUsed("uncertainty");
   doc.RejectUnknownKeys();
-  CheckJointFrequencies(cfg, doc, kq, damping);
+  for (int j = 0; j < d.arm.num_joints(); ++j) cfg.joint_value_locations.joint_stiffness.push_back(kq.at(j).location());
+  cfg.joint_value_locations.damping = damping.location();
   return cfg;
 }
 

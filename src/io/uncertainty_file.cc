@@ -75,11 +75,7 @@ dynamics::ParameterUncertainty ReadParameterUncertainty(const std::string& path)
     up.name = p["name"].String();
     up.value = p["value"].Number();
     const YamlDoc scale = p["scale"];
-    try {
-      up.scale = dynamics::ParseUncertainScale(scale.String());
-    } catch (const std::invalid_argument& e) {
-      throw scale.Error(e.what());
-    }
+    up.scale = scale.Checked([&] { return dynamics::ParseUncertainScale(scale.String()); });
     if (up.scale != dynamics::UncertainScale::kLinear && !(up.value > 0.0)) {
       throw p["value"].Error("expected a value > 0 on the " + std::string(dynamics::ToString(up.scale)) + " scale");
     }
@@ -97,11 +93,7 @@ dynamics::ParameterUncertainty ReadParameterUncertainty(const std::string& path)
     for (int j = 0; j < n; ++j) u.covariance(i, j) = row[j];
   }
   top.RejectUnknownKeys();
-  try {
-    dynamics::CheckValid(u);
-  } catch (const std::invalid_argument& e) {
-    throw cov.Error(e.what());
-  }
+  cov.Checked([&] { dynamics::CheckValid(u); });
   if (u.source.empty()) u.source = path;
   return u;
 }

@@ -10,6 +10,7 @@
 #include <kdl/chainjnttojacsolver.hpp>
 
 #include "kinematics/internal/kdl_status.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 
 namespace robomach::kinematics {
@@ -47,13 +48,17 @@ struct IkSolver::Kdl {
   KDL::ChainJntToJacSolver jac;
 };
 
+void IkOptions::Validate() const {
+  CheckOptionAbove("position_tolerance_m", position_tolerance_m, 0.0);
+  CheckOptionAbove("rotation_tolerance_rad", rotation_tolerance_rad, 0.0);
+  CheckOptionAbove("converged_position_m", converged_position_m, 0.0);
+  CheckOptionAbove("converged_rotation_rad", converged_rotation_rad, 0.0);
+  CheckOptionAtLeast("max_iterations", max_iterations, 1);
+}
+
 IkSolver::IkSolver(const SerialChain& chain, IkOptions options)
     : n_(chain.num_joints()), options_(options), kdl_(std::make_unique<Kdl>(chain.kdl())) {
-  if (!(options_.position_tolerance_m > 0.0 && options_.rotation_tolerance_rad > 0.0 &&
-        options_.converged_position_m > 0.0 && options_.converged_rotation_rad > 0.0 &&
-        options_.max_iterations >= 1)) {
-    throw std::invalid_argument("inverse kinematics: tolerances must be > 0 and max_iterations >= 1");
-  }
+  options_.Validate();
 }
 
 IkSolver::~IkSolver() = default;

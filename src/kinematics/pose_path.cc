@@ -8,12 +8,19 @@
 
 #include <Eigen/SVD>
 
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 
 namespace robomach::kinematics {
 
+void PosePathOptions::Validate() const {
+  ValidateNested("ik", ik);
+  CheckOptionAbove("max_joint_step_rad", max_joint_step_rad, 0.0);
+}
+
 PosePathCheck CheckPosePath(const SerialChain& chain, const std::vector<Eigen::Isometry3d>& X_BT,
                             const Eigen::VectorXd& seed, const PosePathOptions& options) {
+  options.Validate();
   const int n = chain.num_joints();
   if (seed.size() != n) {
     throw std::invalid_argument("CheckPosePath: the seed has " + std::to_string(seed.size()) + " joints, the chain " +

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "robomach/common/option_checks.h"
+
 namespace robomach::machine {
 namespace {
 
@@ -48,20 +50,13 @@ constexpr PackedTable kPacked = MakePacked();
 
 }  // namespace
 
-void CheckValid(const QuadratureOptions& options) {
-  if (options.num_axes < 1 || options.num_axes > kMaxQuadratureAxes) {
-    throw std::invalid_argument("QuadratureOptions::num_axes: expected 1.." +
-                                std::to_string(kMaxQuadratureAxes) + ", got " +
-                                std::to_string(options.num_axes));
-  }
-  if (options.glitch_filter_samples < 0 || options.glitch_filter_samples > 1000000) {
-    throw std::invalid_argument("QuadratureOptions::glitch_filter_samples: expected 0..1000000, got " +
-                                std::to_string(options.glitch_filter_samples));
-  }
+void QuadratureOptions::Validate() const {
+  CheckOptionRange("num_axes", num_axes, 1, kMaxQuadratureAxes);
+  CheckOptionRange("glitch_filter_samples", glitch_filter_samples, 0, 1000000);
 }
 
 QuadratureDecoder::QuadratureDecoder(const QuadratureOptions& options) : options_(options) {
-  CheckValid(options);
+  options.Validate();
   mask_ = (options.num_axes == 8) ? 0xFFFFu : ((1u << (2 * options.num_axes)) - 1u);
   counts_.assign(options.num_axes, 0);
   errors_.assign(options.num_axes, 0);

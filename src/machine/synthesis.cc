@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "robomach/common/option_validate.h"
+
 namespace robomach::machine {
 namespace {
 
@@ -53,7 +55,17 @@ std::vector<double> StartMeasured(const Machine& machine, const Compensation* co
   return measured;
 }
 
+void SynthesisOptions::Validate() const {
+  CheckOptionFinite("feed", feed);
+  CheckOptionAbove("feed", feed, 0.0);
+  CheckOptionFinite("sample_rate_hz", sample_rate_hz);
+  CheckOptionAbove("sample_rate_hz", sample_rate_hz, 0.0);
+  CheckOptionFinite("dwell", dwell);
+  CheckOptionAtLeast("dwell", dwell, 0.0);
+}
+
 long SynthesisRows(const ProgrammedPath& path, const SynthesisOptions& o) {
+  o.Validate();
   const double duration = o.dwell + path.length() / o.feed;
   const double rows = std::ceil(duration * o.sample_rate_hz) + 1.0;
   // Beyond a long's range the cast is undefined: saturate (callers refuse it).
@@ -63,9 +75,7 @@ long SynthesisRows(const ProgrammedPath& path, const SynthesisOptions& o) {
 SynthesisResult SynthesizeCounts(const Machine& machine, const Compensation* compensation,
                                  const ProgrammedPath& path, const SynthesisOptions& o,
                                  const std::vector<double>& origin) {
-  if (!(o.feed > 0.0) || !(o.sample_rate_hz > 0.0) || !(o.dwell >= 0.0)) {
-    throw std::invalid_argument("SynthesisOptions: expected feed > 0, sample_rate_hz > 0, dwell >= 0");
-  }
+  o.Validate();
   const size_t n = machine.axes.size();
   if (origin.size() != n) throw std::invalid_argument("SynthesizeCounts: one origin per axis expected");
   SynthesisResult res;

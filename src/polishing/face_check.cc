@@ -1,6 +1,7 @@
 #include "robomach/polishing/face_check.h"
 
 #include "robomach/common/errors.h"
+#include "robomach/common/option_validate.h"
 
 #include <algorithm>
 #include <cmath>
@@ -62,8 +63,16 @@ double EstimatePathRows(double area, const PathParameters& params) {
   return area / params.offset * factor / params.row_step;
 }
 
+void PolishableOptions::Validate() const {
+  CheckOptionAbove("sample_spacing", sample_spacing, 0.0);
+  CheckOptionAtLeast("max_grid_points", max_grid_points, 1);
+  CheckOptionAtLeast("max_path_rows", max_path_rows, 1);
+  CheckOptionAtLeast("check_grid_points", check_grid_points, 1);
+}
+
 Polishability CheckPolishable(const NurbsSurface& surface, const PolishingProcess& process,
                               const PathParameters& params, const PolishableOptions& options) {
+  options.Validate();
   Polishability p;
   const std::string name = SurfaceName(surface);
   try {
@@ -124,6 +133,7 @@ Polishability CheckPolishable(const NurbsSurface& surface, const PolishingProces
 
 PlanSize EstimatePlanSize(const NurbsSurface& surface, double sample_spacing, const PathParameters& params,
                           const PolishableOptions& limits) {
+  limits.Validate();
   PlanSize out;
   const SurfaceSize size = MeasureSurface(surface);
   out.grid_points = EstimateGridPoints(size, sample_spacing);

@@ -11,7 +11,10 @@
 #include <nlopt.hpp>
 
 #include "robomach/common/golden_section.h"
+#include "robomach/common/enum_names.h"
 #include "robomach/common/number_format.h"
+#include "robomach/common/option_checks.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/parallel.h"
 #include "robomach/common/units.h"
 #include "robomach/polishing/process.h"
@@ -113,14 +116,24 @@ void RunNlopt(nlopt::algorithm alg, int budget, std::vector<double>* x, Tracker*
 std::string ToString(Optimiser o) { return o == Optimiser::kNlopt ? "nlopt" : "pso"; }
 
 Optimiser ParseOptimiser(const std::string& name) {
-  for (Optimiser o : {Optimiser::kNlopt, Optimiser::kPso}) {
-    if (name == ToString(o)) return o;
-  }
-  throw std::invalid_argument("optimiser '" + name + "': expected nlopt or pso");
+  static constexpr Optimiser kAll[] = {Optimiser::kNlopt, Optimiser::kPso};
+  return ParseByName("optimiser", name, kAll);
+}
+
+void OptimiseOptions::Validate() const {
+  CheckOptionAbove("offset_min", offset_min, 0.0);
+  CheckOptionBand("offset_min", offset_min, "offset_max", offset_max);
+  CheckOptionAtLeast("global_evaluations", global_evaluations, 1);
+  CheckOptionAtLeast("local_evaluations", local_evaluations, 1);
+  CheckOptionAtLeast("pso_particles", pso_particles, 1);
+  CheckOptionAtLeast("pso_max_iterations", pso_max_iterations, 0);
+  CheckOptionAtLeast("pso_stall_iterations", pso_stall_iterations, 1);
+  CheckOptionAtLeast("pso_tolerance", pso_tolerance, 0.0);
 }
 
 OptimiseResult OptimiseCycloid(const std::function<double(const PathParameters&)>& objective,
                                const PathParameters& start, const OptimiseOptions& o) {
+  o.Validate();
   OptimiseResult res;
   Tracker t{&objective, &start, &o, &res, {}, {}};
   if (o.method == Optimiser::kNlopt) {
@@ -212,7 +225,7 @@ PlanEvaluation EvaluatePlan(const PlanProblem& pb, const PathParameters& p, doub
 }
 
 std::string FamilyName(const GuideFamily& f) {
-  if (f.guides == GuideLines::kBoundaryOffsets) return "offsets";
+  if (f.guides == GuideLines::kBoundaryOffsets) return ToString(GuideLines::kBoundaryOffsets);
   const double deg = f.line_angle * 180.0 / kPi;
   if (std::abs(deg) < 1e-9) return "parallel lines along s";
   if (std::abs(deg - 90.0) < 1e-9) return "parallel lines along t";
@@ -628,7 +641,18 @@ void RunMultiStartPlan(const PlanRun& run, const std::vector<GuideFamily>& fams,
 
 }  // namespace
 
+void PlanOptimiseOptions::Validate() const {
+  CheckOptionAbove("offset_min", offset_min, 0.0);
+  CheckOptionBand("offset_min", offset_min, "offset_max", offset_max);
+  CheckOptionAbove("feasibility_margin", feasibility_margin, 0.0);
+  CheckOptionRange("feasibility_margin", feasibility_margin, 0.0, 1.0);
+  CheckOptionRange("ftol_rel", ftol_rel, 0.0, 1.0);
+  CheckOptionAtLeast("max_local_evaluations", max_local_evaluations, 1);
+  CheckOptionAtLeast("max_time_s", max_time_s, 0.0);
+}
+
 PlanOptimiseResult OptimisePlan(const PlanProblem& pb, const PathParameters& start, const PlanOptimiseOptions& o) {
+  o.Validate();
   Book book(pb, o);
   PlanOptimiseResult& res = book.result();
   const bool cyc = o.pattern == Pattern::kCycloid;

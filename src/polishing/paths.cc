@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "robomach/common/enum_names.h"
 #include "robomach/common/units.h"
 #include "robomach/polishing/face_check.h"
 #include "robomach/polishing/path_patterns.h"
@@ -504,26 +505,55 @@ class ParallelPattern final : public PathPattern {
 
 }  // namespace
 
-const std::vector<const PathPattern*>& PathPatterns() {
+std::string ToString(Pattern p) {
+  switch (p) {
+    case Pattern::kCycloid: return "cycloid";
+    case Pattern::kParallel: return "parallel";
+  }
+  return "?";
+}
+
+Pattern ParsePattern(const std::string& name) {
+  static constexpr Pattern kAll[] = {Pattern::kCycloid, Pattern::kParallel};
+  return ParseByName("unknown path pattern", name, kAll);
+}
+
+std::string ToString(GuideLines g) {
+  switch (g) {
+    case GuideLines::kBoundaryOffsets: return "offsets";
+    case GuideLines::kParallelLines: return "parallel";
+  }
+  return "?";
+}
+
+GuideLines ParseGuideLines(const std::string& name) {
+  static constexpr GuideLines kAll[] = {GuideLines::kBoundaryOffsets, GuideLines::kParallelLines};
+  return ParseByName("guides", name, kAll);
+}
+
+const NamedRegistry<const PathPattern*>& PathPatternRegistry() {
   static const CycloidPattern cycloid;
   static const ParallelPattern parallel;
-  static const std::vector<const PathPattern*> all{&cycloid, &parallel};
+  static const NamedRegistry<const PathPattern*> registry = [] {
+    NamedRegistry<const PathPattern*> r("unknown path pattern");
+    r.Add(cycloid.name(), &cycloid).Add(parallel.name(), &parallel);
+    return r;
+  }();
+  return registry;
+}
+
+const std::vector<const PathPattern*>& PathPatterns() {
+  static const std::vector<const PathPattern*> all = [] {
+    std::vector<const PathPattern*> v;
+    for (const auto& [name, p] : PathPatternRegistry().entries()) v.push_back(p);
+    return v;
+  }();
   return all;
 }
 
-std::string PathPatternList() {
-  std::string s;
-  const auto& all = PathPatterns();
-  for (size_t i = 0; i < all.size(); ++i) s += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + all[i]->name();
-  return s;
-}
+std::string PathPatternList() { return PathPatternRegistry().NameList(); }
 
-const PathPattern& FindPathPattern(const std::string& name) {
-  for (const PathPattern* p : PathPatterns()) {
-    if (p->name() == name) return *p;
-  }
-  throw std::invalid_argument("unknown path pattern '" + name + "': expected " + PathPatternList());
-}
+const PathPattern& FindPathPattern(const std::string& name) { return *PathPatternRegistry().Find(name); }
 
 const PathPattern& PathPatternOf(Pattern id) {
   for (const PathPattern* p : PathPatterns()) {

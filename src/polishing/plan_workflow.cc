@@ -132,20 +132,32 @@ std::vector<std::string> ImplausiblePlanOptions(const PlanOptions& o) {
   return out;
 }
 
+void PlanOptions::Validate() const {
+  // A name parser's refusal as the option's error (the same message).
+  const auto as_option = [](const std::string& field, const auto& parse) {
+    try {
+      parse();
+    } catch (const std::invalid_argument& e) {
+      throw OptionError(field, e.what());
+    }
+  };
+  as_option("guides", [&] { ParseGuideLines(guides); });
+  if (optimise != "none" && !(optimise == ToString(Optimiser::kNlopt) || optimise == ToString(Optimiser::kPso))) {
+    throw OptionError("optimise", "optimise: expected none, nlopt or pso, got " + optimise);
+  }
+  as_option("pattern", [&] { ParsePattern(pattern); });
+  if (optimise == ToString(Optimiser::kPso) && ParsePattern(pattern) != Pattern::kCycloid) {
+    throw OptionError("optimise", "optimise pso applies to the cycloid; the parallel pattern is optimised with nlopt");
+  }
+  CheckRanges(*this);
+}
+
 PlanRequest ToPlanRequest(const PlanOptions& o, const PlanningContext& c) {
-  if (o.guides != "offsets" && o.guides != "parallel") {
-    throw std::invalid_argument("guides: expected offsets or parallel, got " + o.guides);
-  }
-  if (o.optimise != "none" && o.optimise != "nlopt" && o.optimise != "pso") {
-    throw std::invalid_argument("optimise: expected none, nlopt or pso, got " + o.optimise);
-  }
+  o.Validate();
   PlanRequest req;
   PathParameters& params = req.params;
-  params.pattern = FindPathPattern(o.pattern).id();
-  if (o.optimise == "pso" && params.pattern != Pattern::kCycloid) {
-    throw std::invalid_argument("optimise pso applies to the cycloid; the parallel pattern is optimised with nlopt");
-  }
-  params.guides = o.guides == "offsets" ? GuideLines::kBoundaryOffsets : GuideLines::kParallelLines;
+  params.pattern = ParsePattern(o.pattern);
+  params.guides = ParseGuideLines(o.guides);
   params.offset = o.offset_mm ? MmToM(*o.offset_mm) : params.pattern == Pattern::kParallel ? c.contact_width : MmToM(8.0);
   params.radius = MmToM(o.radius_mm);
   params.pitch = MmToM(o.pitch_mm);
@@ -237,7 +249,7 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
                     "limit (written: the least infeasible, " + FormatDouble(1e6 * opt.best.mean) +
                     " um at the limit, coverage " + FormatDouble(opt.best.coverage) + ")"
               : "the optimiser found no feasible plan";
-      out.Flag(out.infeasible_message);
+      out.verdict.Flag(out.infeasible_message);
     }
     out.optimisation = std::move(opt);
   }
@@ -249,7 +261,7 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
     out.target = ScaleToTargetRemoval(*c.simulator, grid, req.target_removal, c.process.max_speed, &out.plan.path);
     out.plan.removal = out.target.removal;
     out.plan.stats = ComputeRemovalStats(out.plan.removal, grid.areas(), grid.in_region());
-    if (!out.target.reached) out.Flag(out.target.message);
+    if (!out.target.reached) out.verdict.Flag(out.target.message);
   }
   if (PathPatternCircles(params) && out.optimisation && out.optimisation->best_parallel.valid) {
     // The cycloid against the optimised zig-zag, both on the final grid
@@ -269,7 +281,7 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
                         (cmp.parallel_reaches_target == cycloid_ok && cmp.parallel_stats.cv < out.plan.stats.cv);
     if (cmp.zigzag_better) {
       const polishing::PathParameters& pp = cmp.parallel;
-      out.Flag("the optimised zig-zag is better than the optimised cycloid: cv " + FormatDouble(cmp.parallel_stats.cv) +
+      out.verdict.Flag("the optimised zig-zag is better than the optimised cycloid: cv " + FormatDouble(cmp.parallel_stats.cv) +
                (cmp.parallel_reaches_target ? "" : " (target not reached)") + " against " +
                FormatDouble(out.plan.stats.cv) + (cycloid_ok ? "" : " (target not reached)") +
                "; plan it as pattern parallel, offset " + FormatDouble(1e3 * pp.offset) + " mm, line angle " +
@@ -281,7 +293,7 @@ PlanOutcome PlanPolishing(const PlanningContext& c, const PlanRequest& req) {
   if (surface.trim()) {
     out.rows_off_face = RowsOffFace(surface, out.plan.path.rows);
     if (out.rows_off_face > 0) {
-      out.Flag(std::to_string(out.rows_off_face) +
+      out.verdict.Flag(std::to_string(out.rows_off_face) +
                " path rows lie off the trimmed face (in a hole or outside its boundary)");
     }
   }

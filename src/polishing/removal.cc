@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "robomach/polishing/hertz_contact.h"
+#include "robomach/polishing/paths.h"
 
 namespace robomach::polishing {
 
@@ -274,10 +275,10 @@ std::string DescribeUnpolished(const RemovalStats& stats, double region_area, co
   std::ostringstream m;
   m << 1e6 * stats.unpolished_area << " mm^2 of the region (" << 100 * stats.unpolished_area / region_area
     << " %) gets less than 1 % of the mean removal: gaps between rows, or necks and lobes of a trimmed face ";
-  if (pattern == "cycloid") {
+  if (pattern == ToString(Pattern::kCycloid)) {
     m << "too narrow for the cycloid's circle to enter without leaving the face (a smaller radius or row "
          "spacing reaches them)";
-  } else if (pattern == "parallel") {
+  } else if (pattern == ToString(Pattern::kParallel)) {
     m << "that the parallel rows do not enter (a smaller row spacing, --offset-mm, or a line angle along the "
          "neck reaches them)";
   } else {

@@ -10,6 +10,7 @@
 
 #include "robomach/audit/error_patterns.h"
 #include "robomach/common/number_format.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/dynamics/tool_tip_frf.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/file_names.h"
@@ -735,10 +736,15 @@ void WriteFiles(const fs::path& dir, const ReportBasis& b, const ReportTexts& t)
 
 }  // namespace
 
+void AuditReportOptions::Validate() const {
+  CheckOptionBand("fmin_hz", fmin_hz, "fmax_hz", fmax_hz);
+}
+
 AuditReport WriteAuditReport(const std::string& dir_path, const audit::AuditResult& r,
                              const dynamics::RobotDescription& description, const calibration::PostureMap& postures,
                              const dynamics::FrfSet& measured_fit, const dynamics::FrfSet& measured_all,
                              const calibration::NoiseModels& noise, const AuditReportOptions& ro) {
+  ro.Validate();
   const ReportInputs in{r, description, postures, measured_fit, measured_all, noise, ro};
   const ReportBasis b = MakeBasis(in);
   ReportTexts t;

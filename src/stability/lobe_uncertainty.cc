@@ -146,7 +146,7 @@ MapDepthIntervals StabilityMapIntervals(const dynamics::RobotDescription& descri
                                         const ProgressCallback& progress) {
   if (targets.size() != points.size()) throw std::invalid_argument("StabilityMapIntervals: one point per target");
   dynamics::CheckValid(u);
-  dynamics::CheckValid(propagation);
+  propagation.Validate();
   MapDepthIntervals out;
   dynamics::OutputInterval none;
   none.value = none.std_dev = none.lower = none.upper = NAN;

@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include "robomach/calibration/frf_noise.h"
+#include "robomach/common/enum_names.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
@@ -27,10 +29,12 @@ const char* ToString(LobeMethod m) {
 }
 
 LobeMethod ParseLobeMethod(const std::string& name) {
-  for (LobeMethod m : {LobeMethod::kZoa, LobeMethod::kSd, LobeMethod::kBoth}) {
-    if (name == ToString(m)) return m;
+  static constexpr LobeMethod kAll[] = {LobeMethod::kZoa, LobeMethod::kSd, LobeMethod::kBoth};
+  try {
+    return ParseByName("method", name, kAll);
+  } catch (const std::invalid_argument& e) {
+    throw OptionError("method", e.what());  // the option's field, for the tools and Python
   }
-  throw OptionError("method", "method '" + name + "': expected zoa, sd or both");
 }
 
 namespace {
@@ -106,7 +110,7 @@ void CompareZoaAndSd(const std::vector<TipDynamics>& tips, const std::vector<Lob
                             (t.fits.empty() ? std::string("") : "the modal fit (--fit-plot), ") +
                             "the modes the SD keeps (--sd-modes) and its steps per tooth period (--sd-steps)";
       if (tell) tell({Message::Kind::kWarning, w});
-      findings->Flag(w);
+      findings->verdict.Flag(w);
     } else if (tell) {
       tell({Message::Kind::kInfo, m.str() + " (they agree within 10 %)"});
     }
@@ -144,7 +148,7 @@ void CheckZoaAgainstFit(const TipDynamics& t, const LobesOptions& o, const ZoaOp
       "misplaced (see --fit-plot), or a resonance too narrow for the line spacing (a longer record gives finer "
       "lines); compare --method sd, which uses the fitted modes";
   tell(Message::Kind::kWarning, w);
-  result->Flag(w);
+  result->verdict.Flag(w);
 }
 
 }  // namespace
@@ -176,8 +180,22 @@ std::vector<std::string> TipFitWarnings(const TipDynamics& t, bool sd) {
   return w;
 }
 
+void LobesOptions::Validate() const {
+  CheckOptionAtLeast("min_speed_rad_s", min_speed_rad_s, 0.0);
+  CheckOptionAtLeast("max_speed_rad_s", max_speed_rad_s, min_speed_rad_s);
+  for (const double speed : method == LobeMethod::kZoa ? Eigen::VectorXd() : sd_speeds_rad_s) {
+    CheckOptionFinite("sd_speeds_rad_s", speed);
+    CheckOptionAbove("sd_speeds_rad_s", speed, 0.0);
+  }
+  CheckOptionAtLeast("max_lobe_index", max_lobe_index, 0);
+  CheckOptionAtLeast("sd_modes", sd_modes, 1);
+  CheckOptionAtLeast("threads", threads, 0);
+  ValidateNested("sd", sd);
+}
+
 LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOptions& o, const MessageSink& on_message,
                          const SdProgressSink& on_progress) {
+  o.Validate();
   auto tell = [&](Message::Kind kind, const std::string& text) {
     if (on_message) on_message({kind, text});
   };
@@ -189,7 +207,7 @@ LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOption
       if (!(t.unit_finding_said && w == "implausible (unit mistake?): " + t.unit_finding)) {
         tell(Message::Kind::kWarning, w);
       }
-      result.Flag(w);
+      result.verdict.Flag(w);
     }
   }
   for (const TipDynamics& t : tips) {
@@ -258,7 +276,7 @@ LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOption
   if (result.no_boundary) {
     const std::string w = "some speeds have no boundary (status column): widen the FRF band or the lobe range";
     tell(Message::Kind::kWarning, w);
-    result.Flag(w);
+    result.verdict.Flag(w);
   }
   return result;
 }

@@ -5,24 +5,22 @@
 #include <stdexcept>
 
 #include "robomach/calibration/global_modal_fit.h"
+#include "robomach/common/option_checks.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 
 namespace robomach::stability {
 
-void CheckValid(const DirectFrfFitOptions& o) {
-  calibration::CheckValid(o.noise);
-  if (!(o.max_active_fraction >= 0.0 && o.max_active_fraction <= 1.0)) {
-    throw std::invalid_argument("DirectFrfFitOptions: max_active_fraction must be in [0, 1], got " +
-                                std::to_string(o.max_active_fraction));
-  }
-  if (!(o.max_noise_rms >= 1.0) || !std::isfinite(o.max_noise_rms)) {
-    throw std::invalid_argument("DirectFrfFitOptions: max_noise_rms must be finite and >= 1, got " +
-                                std::to_string(o.max_noise_rms));
-  }
+void DirectFrfFitOptions::Validate() const {
+  ValidateNested("noise", noise);
+  ValidateNested("fit", fit);
+  CheckOptionRange("max_active_fraction", max_active_fraction, 0.0, 1.0);
+  CheckOptionFinite("max_noise_rms", max_noise_rms);
+  CheckOptionAtLeast("max_noise_rms", max_noise_rms, 1.0);
 }
 
 DirectFrfFit FitDirectFrf(const dynamics::Frf& measured, const DirectFrfFitOptions& o) {
-  CheckValid(o);
+  o.Validate();
   DirectFrfFit out{measured, calibration::EstimateFrfNoise(measured, o.noise), {}, NAN, true, "", 0.0, false, {}};
   std::vector<int> lines;
   for (int i = 0; i < measured.size(); ++i) {

@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 #include "robomach/common/enum_names.h"
 
@@ -45,6 +46,14 @@ std::complex<double> RightmostEigenvalue(const Eigen::MatrixXd& M, const Eigen::
   return ev(imax);
 }
 
+void ModeCouplingOptions::Validate() const {
+  CheckOptionFinite("max_depth", max_depth);
+  CheckOptionAbove("max_depth", max_depth, 0.0);
+  CheckOptionAtLeast("scan_points", scan_points, 1);
+  CheckOptionFinite("depth_tolerance", depth_tolerance);
+  CheckOptionAbove("depth_tolerance", depth_tolerance, 0.0);
+}
+
 namespace {
 
 // Smallest depth in (0, max_depth] where the rightmost eigenvalue crosses
@@ -59,10 +68,7 @@ namespace {
 template <class Rightmost>
 ModeCouplingResult SearchCriticalDepth(const Rightmost& rightmost, const ModeCouplingOptions& options,
                                        double stable_below = 0.0) {
-  if (!(options.max_depth > 0.0) || options.scan_points < 1 || !(options.depth_tolerance > 0.0)) {
-    throw std::invalid_argument("mode coupling: need max_depth > 0, scan_points >= 1, tolerance > 0");
-  }
-  ModeCouplingResult out;
+  ModeCouplingResult out;  // options: validated by the public callers
   // An undamped stable system has Re λ = 0 up to rounding, ~eps·|λ|;
   // 1e-9 |λ| is far above that and, since Re λ grows like √(a − a_c)
   // past a flutter point, moves the crossing by only ~1e-18 relative.
@@ -225,6 +231,7 @@ ModeCouplingResult CriticalDepthModeCoupling(const Eigen::MatrixXd& M, const Eig
                                              const Eigen::MatrixXd& K, const Matrix3Xd& B,
                                              const Eigen::Matrix3d& Kc_B,
                                              const ModeCouplingOptions& options) {
+  options.Validate();
   const Eigen::Index n = M.rows();
   if (M.cols() != n || C.rows() != n || C.cols() != n || K.rows() != n || K.cols() != n ||
       B.cols() != n) {
@@ -248,6 +255,7 @@ ModeCouplingResult CriticalDepthModeCoupling(const Eigen::MatrixXd& M, const Eig
 ModeCouplingResult CriticalDepthModeCouplingModal(const TipModalModel& modes, const Eigen::Matrix3d& Kc,
                                                   const ModeCouplingOptions& options) {
   modes.Validate();
+  options.Validate();
   const int n = modes.num_modes();
   const Eigen::MatrixXd Kc_q = modes.p.transpose() * Kc * modes.p;
   // Six modes (a six-joint robot): fixed-size matrices, no heap at all.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 #include "robomach/common/enum_names.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -25,12 +26,23 @@ Mechanism ParseMechanism(const std::string& name) {
   return ParseByName("mechanism", name, kAll);
 }
 
+void PostureStabilityOptions::Validate() const {
+  if (spindle_speed_rad_s.size() == 0) {
+    throw OptionError("spindle_speed_rad_s", "spindle_speed_rad_s: expected at least one spindle speed, got none");
+  }
+  for (const double speed : spindle_speed_rad_s) {
+    CheckOptionFinite("spindle_speed_rad_s", speed);
+    CheckOptionAbove("spindle_speed_rad_s", speed, 0.0);
+  }
+  CheckOptionAtLeast("freq_lines", freq_lines, 2);
+  ValidateNested("zoa", zoa);
+  ValidateNested("mode_coupling", mode_coupling);
+}
+
 PostureStability AnalysePosture(const dynamics::PostureDynamics& d, const Eigen::Matrix3d& R_BC,
                                 const MillingProcess& process, const PostureStabilityOptions& options) {
   process.Validate();
-  if (options.spindle_speed_rad_s.size() == 0 || !(options.spindle_speed_rad_s.minCoeff() > 0.0)) {
-    throw std::invalid_argument("posture stability: need at least one spindle speed > 0");
-  }
+  options.Validate();
   PostureStability out;
   const Eigen::Matrix3d Kc_C = CuttingStiffnessPerDepth(process);
   const Eigen::Matrix3d Kc_B = R_BC * Kc_C * R_BC.transpose();
@@ -103,6 +115,7 @@ LocalCriticalDepth::LocalCriticalDepth(const dynamics::PostureDynamics& d, const
                                        const MillingProcess& process, const PostureStabilityOptions& options,
                                        const PostureStability& analysis)
     : Kc_B_(R_BC * CuttingStiffnessPerDepth(process) * R_BC.transpose()) {
+  // `options` are those `analysis` came from: AnalysePosture validated them.
   if (analysis.limiting == Mechanism::kNone || !std::isfinite(analysis.critical_depth)) {
     why_not_ = "no critical depth at the estimates";
     return;

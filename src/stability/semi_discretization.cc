@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "robomach/common/option_validate.h"
 #include "robomach/common/parallel.h"
 #include "robomach/common/units.h"
 
@@ -170,15 +171,24 @@ double ChatterFrequencyHz(const TipModalModel& m, std::complex<double> mu, doubl
 
 }  // namespace
 
+void SdOptions::Validate() const {
+  CheckOptionAtLeast("steps_per_period", steps_per_period, 0);
+  CheckOptionFinite("steps_per_mode_period", steps_per_mode_period);
+  CheckOptionAbove("steps_per_mode_period", steps_per_mode_period, 0.0);
+  CheckOptionAtLeast("min_steps_per_period", min_steps_per_period, 1);
+  CheckOptionAtLeast("max_monodromy_dimension", max_monodromy_dimension, 1);
+  CheckOptionFinite("max_depth", max_depth);
+  CheckOptionAbove("max_depth", max_depth, 0.0);
+  CheckOptionAtLeast("depth_scan_points", depth_scan_points, 1);
+  CheckOptionFinite("depth_tolerance", depth_tolerance);
+  CheckOptionAbove("depth_tolerance", depth_tolerance, 0.0);
+}
+
 int SdStepsPerPeriod(const TipModalModel& modes_C, const MillingProcess& process, double spindle_speed_rad_s,
                      const SdOptions& options, bool* capped) {
   if (capped) *capped = false;
+  options.Validate();
   if (options.steps_per_period > 0) return options.steps_per_period;
-  if (!(options.steps_per_mode_period > 0.0) || options.min_steps_per_period < 1 ||
-      options.max_monodromy_dimension < 1) {
-    throw std::invalid_argument(
-        "SD steps: need steps_per_mode_period > 0, min_steps_per_period >= 1 and max_monodromy_dimension >= 1");
-  }
   if (!(spindle_speed_rad_s > 0.0) || process.teeth < 1) {
     throw std::invalid_argument("SD steps: need a spindle speed > 0 and at least one tooth");
   }
@@ -199,9 +209,8 @@ LobePoint SdCriticalDepth(const TipModalModel& modes_C, const MillingProcess& pr
                           double spindle_speed_rad_s, const SdOptions& options) {
   process.Validate();
   modes_C.Validate();
-  if (!(spindle_speed_rad_s > 0.0) || !(options.max_depth > 0.0) || options.depth_scan_points < 1) {
-    throw std::invalid_argument("SD critical depth: need a speed > 0, max_depth > 0, scan points >= 1");
-  }
+  options.Validate();
+  if (!(spindle_speed_rad_s > 0.0)) throw std::invalid_argument("SD critical depth: need a speed > 0");
   LobePoint out;
   out.spindle_speed_rad_s = spindle_speed_rad_s;
   const double tau = 2.0 * kPi / (process.teeth * spindle_speed_rad_s);
@@ -283,6 +292,7 @@ std::vector<LobePoint> SdLobes(const TipModalModel& modes_C, const MillingProces
                                const ProgressCallback& progress) {
   process.Validate();
   modes_C.Validate();
+  options.Validate();  // before the threads: SdCriticalDepth's check would throw from each
   const long n = speeds.size();
   std::vector<LobePoint> out(n);
   ParallelForOptions po;

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <sstream>
 #include <stdexcept>
 
 #include <nlopt.hpp>
 
+#include "robomach/common/option_validate.h"
 #include "robomach/common/parallel.h"
 #include "robomach/common/enum_names.h"
 #include "robomach/dynamics/posture_dynamics.h"
@@ -99,14 +101,12 @@ void CheckMapArguments(int n, size_t targets, int rows, int cols, const MapOptio
                                 std::to_string(options.seed_q.size()) + " joints, the robot " +
                                 std::to_string(n));
   }
-  if (options.optimise_rotation && !(options.rotation_max > options.rotation_min)) {
-    throw std::invalid_argument("stability map: rotation_max must exceed rotation_min");
-  }
-  if (options.threads < 0) {
-    throw std::invalid_argument("stability map: threads: expected >= 0 (0 = all cores), got " +
-                                std::to_string(options.threads));
-  }
+  options.Validate();
 }
+
+// The rotation search's coarse scan (OptimiseRotation): the depth is not
+// unimodal in the rotation.
+constexpr int kRotationScan = 7;
 
 // IK of point i at rot0 from `seed`, with its status; false if unreachable.
 bool IkPoint(const MapGrid& g, IkSolver& ik, long i, const Eigen::VectorXd& seed) {
@@ -215,8 +215,7 @@ void OptimiseRotation(const MapGrid& g, Worker& w, long i, bool* singular) {
     }
     return v;
   };
-  // Coarse scan: the depth is not unimodal in the rotation.
-  constexpr int kScan = 7;
+  constexpr int kScan = kRotationScan;
   for (int j = 0; j < kScan; ++j) {
     consider(options.rotation_min + (options.rotation_max - options.rotation_min) * j / (kScan - 1));
   }
@@ -274,6 +273,22 @@ void AnalysePoint(const MapGrid& g, Worker& w, long i) {
 
 }  // namespace
 
+void MapOptions::Validate() const {
+  CheckOptionFinite("rotation", rotation);
+  if (optimise_rotation) {
+    CheckOptionFinite("rotation_min", rotation_min);
+    CheckOptionFinite("rotation_max", rotation_max);
+    if (!(rotation_max > rotation_min)) {
+      std::ostringstream s;
+      s << "rotation_max: expected a value > rotation_min " << rotation_min << " [rad], got " << rotation_max;
+      throw OptionError("rotation_max", s.str());
+    }
+    CheckOptionAtLeast("rotation_evaluations", rotation_evaluations, kRotationScan + 1);
+  }
+  CheckOptionAtLeast("threads", threads, 0);
+  ValidateNested("analysis", analysis);
+}
+
 std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::RobotModel> model,
                                            const std::vector<ToolPoseTarget>& targets, int rows,
                                            int cols, const MillingProcess& process,
@@ -323,7 +338,7 @@ StabilityMapResult ComputeStabilityMap(std::shared_ptr<const dynamics::RobotMode
     r.flagged_points += p.status != PointStatus::kOk;
   }
   if (r.flagged_points > 0) {
-    r.Flag(std::to_string(r.flagged_points) + " of " + std::to_string(r.points.size()) +
+    r.verdict.Flag(std::to_string(r.flagged_points) + " of " + std::to_string(r.points.size()) +
            " points are flagged (status column: unreachable, joint_limits, near_singular, other_configuration)");
   }
   return r;

@@ -8,6 +8,7 @@
 
 #include "robomach/calibration/frf_noise.h"
 #include "robomach/common/errors.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/frf_prediction.h"
@@ -479,8 +480,11 @@ void WarnMissingCross(const MeasuredTipsContext& c, const std::vector<TipDynamic
 
 }  // namespace
 
+void MeasuredTipOptions::Validate() const { CheckOptionAtLeast("sd_modes", sd_modes, 1); }
+
 std::vector<TipDynamics> TipsFromMeasuredFrfs(const std::vector<TipFrfs>& sets, const std::vector<TipFrfs>& ysets,
                                               const MeasuredTipOptions& o, const MessageSink& on_message) {
+  o.Validate();
   MeasuredTipsContext c{sets, ysets, o, on_message, false, {}};
   std::vector<TipDynamics> tips;
   for (const TipFrfs& s : sets) {

@@ -5,6 +5,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 #include "robomach/common/enum_names.h"
 #include "stability/internal/batch_atan2.h"
@@ -60,9 +61,15 @@ std::pair<cd, cd> Eigenvalues2(const Eigen::Matrix2cd& A) {
 
 }  // namespace
 
+void ZoaOptions::Validate() const {
+  CheckOptionAtLeast("max_lobe_index", max_lobe_index, 0);
+  CheckOptionAtLeast("min_spindle_speed_rad_s", min_spindle_speed_rad_s, 0.0);
+}
+
 ZoaLobes ComputeZoaLobes(const Eigen::VectorXd& freq_hz, const std::vector<Eigen::Matrix2cd>& Phi_C,
                          const MillingProcess& process, const ZoaOptions& options) {
   process.Validate();
+  options.Validate();
   if (static_cast<size_t>(freq_hz.size()) != Phi_C.size() || freq_hz.size() < 2) {
     throw std::invalid_argument("ZOA lobes: need at least 2 frequency lines and one FRF per line");
   }

@@ -18,10 +18,6 @@
 #include "robomach/machine/compensation.h"
 
 namespace robomach::workflows {
-std::string AxisSynthOptions::Name(const std::string& field) const {
-  const auto it = names.find(field);
-  return it == names.end() ? field : it->second;
-}
 
 void AxisSynthOptions::Validate() const {
   CheckOptionRange("feed_mm_min", feed_mm_min, 1e-3, 1e6);
@@ -30,11 +26,10 @@ void AxisSynthOptions::Validate() const {
   CheckOptionRange("start_b_deg", start_b_deg, -720.0, 720.0);
   CheckOptionRange("glitch_probability", glitch_probability, 0.0, 1.0);
   CheckOptionRange("max_rows", static_cast<double>(max_rows), 2.0, 1e9);
-  if (capture_every < 1 || capture_every > 100000) {
-    throw OptionError("capture_every", "capture_every: expected 1..100000");
-  }
+  CheckOptionRange("capture_every", capture_every, 1, 100000);
   if (capture_settle < 0 || capture_settle >= capture_every) {
-    throw OptionError("capture_settle", "capture_settle: expected 0 <= settle < capture_every");
+    throw OptionError("capture_settle", "capture_settle: expected a value in [0, capture_every " +
+                                            std::to_string(capture_every) + "), got " + std::to_string(capture_settle));
   }
 }
 

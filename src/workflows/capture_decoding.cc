@@ -67,7 +67,7 @@ CaptureDecoding DecodeCaptureFile(const std::string& capture_path, const io::Mac
     if (out.error_events[a] > 0) per += " " + mf.machine.axes[a].name + ": " + std::to_string(out.error_events[a]);
   }
   if (events > 0) {
-    out.Flag(std::to_string(events) + " error events (A and B changed in one sample; each leaves the position "
+    out.verdict.Flag(std::to_string(events) + " error events (A and B changed in one sample; each leaves the position "
              "uncertain by 2 counts):" + per + ". Raise the sample rate or use --glitch-filter.");
   }
   return out;

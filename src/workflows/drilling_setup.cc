@@ -183,16 +183,16 @@ ForceFitRun FitForceTableFiles(const std::string& table_path, const std::string&
   for (const auto& more : {drilling::MaterialFindings(r.fit.material), drilling::ToolingFindings(r.drill.drill, nullptr)}) {
     r.unit_findings.insert(r.unit_findings.end(), more.begin(), more.end());
   }
-  if (r.fit.status != drilling::FitStatus::kConverged) r.Flag("the fit did not converge: " + r.fit.solver_message);
+  if (r.fit.status != drilling::FitStatus::kConverged) r.verdict.Flag("the fit did not converge: " + r.fit.solver_message);
   if (r.fit.kienzle_exponent_at_bound) {
-    r.Flag("the Kienzle exponent ended on its bound (" + FormatDouble(r.fit.material.kienzle_exponent) +
+    r.verdict.Flag("the Kienzle exponent ended on its bound (" + FormatDouble(r.fit.material.kienzle_exponent) +
            ", range 0..0.95): the forces do not grow with the feed as a size effect can; check the units of "
            "feed_mm_per_rev, thrust_N and torque_Nm");
   }
   if (r.fit.max_rel_error_thrust > 0.10 || r.fit.max_rel_error_torque > 0.10) {
-    r.Flag("the model misses a row by more than 10 %; check the table and the drill geometry");
+    r.verdict.Flag("the model misses a row by more than 10 %; check the table and the drill geometry");
   }
-  for (const std::string& f : r.unit_findings) r.Flag("implausible (unit mistake?): " + f);
+  for (const std::string& f : r.unit_findings) r.verdict.Flag("implausible (unit mistake?): " + f);
   return r;
 }
 

@@ -8,6 +8,7 @@
 #include "robomach/common/option_checks.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/workflows/frf_predict.h"
+#include "robomach/workflows/robot_config.h"
 
 namespace robomach::workflows {
 MeasuredFrfOptions MeasuredFilesRoute(const std::vector<std::string>& files,
@@ -28,10 +29,15 @@ MeasuredFrfOptions MeasuredFilesRoute(const std::vector<std::string>& files,
   return o;
 }
 
+void FrfNoiseOptions::Validate() const {
+  CheckOptionRange("min_snr", min_snr, 1e-3, 1e6);
+  CheckOptionRange("averages", averages, 0, 1e6);
+  ParseNoiseModelChoice(noise_model);  // OptionError("noise_model", ...) naming the four
+}
+
 calibration::NoiseModels EstimateNoise(const MeasuredFrfs& data, const FrfNoiseOptions& noise,
                                        const MessageSink& tell) {
-  CheckOptionRange("min_snr", noise.min_snr, 1e-3, 1e6);
-  CheckOptionRange("averages", noise.averages, 0, 1e6);
+  noise.Validate();
   MeasuredFrfOptions w;
   w.noise_model = ParseNoiseModelChoice(noise.noise_model);
   w.min_snr = noise.min_snr;
@@ -54,6 +60,9 @@ void FrfCalibrateOptions::Validate() const {
     throw OptionError("objective", std::string("objective: ") + e.what());
   }
   if (only_free && frees.empty()) throw OptionError("only_free", "no free parameters (only_free without frees)");
+  // The noise fields are the tools' own options (--min-snr ...): their
+  // fields stay unprefixed, as the tools map them.
+  noise.Validate();
 }
 
 calibration::CalibrationOptions FrfCalibrateOptions::Calibration() const {
@@ -116,7 +125,7 @@ FrfCalibrateRun RunFrfCalibrate(const FrfCalibrateOptions& o, const MessageSink&
   o.Validate();
   FrfCalibrateRun r;
   r.options = o.Calibration();
-  r.config = io::LoadRobotConfig(o.robot_path);
+  r.config = workflows::LoadRobotConfigChecked(o.robot_path);
   for (const std::string& w : r.config.implausible) Tell(tell, Message::Kind::kWarning, w);
   ApplyAddsAndSets(o.adds, o.sets, &r.config);
   for (const std::string& name : r.options.free_parameters) {
@@ -205,7 +214,7 @@ FrfCalibrateRun RunFrfCalibrate(const FrfCalibrateOptions& o, const MessageSink&
     Tell(tell, Message::Kind::kWarning, w);
     r.flags.push_back(w);
   }
-  for (const Finding& f : r.verdict.findings) {
+  for (const Finding& f : r.verdict.verdict.findings) {
     Tell(tell, Message::Kind::kWarning, f.message);
     r.flags.push_back(f.message);
   }

@@ -11,12 +11,12 @@
 namespace robomach::workflows {
 namespace {
 
-Axis ParseExcitation(std::string text) {
-  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));  // "X" as Python took it
-  if (text == "x") return Axis::kX;
-  if (text == "y") return Axis::kY;
-  if (text == "z") return Axis::kZ;
-  throw OptionError("excitation", "excitation: expected x, y or z, got '" + text + "'");
+Axis ParseExcitation(const std::string& text) {
+  try {
+    return ParseAxis(text);
+  } catch (const std::invalid_argument& e) {
+    throw OptionError("excitation", std::string("excitation: ") + e.what());
+  }
 }
 
 }  // namespace
@@ -30,7 +30,7 @@ void FrfEstimateRunOptions::Validate() const {
   if (!(min_hits >= 1 && min_hits <= 1000000)) {
     throw OptionError("min_hits", "min_hits " + std::to_string(min_hits) + " is outside [1, 1000000]");
   }
-  calibration::CheckValid(estimate);
+  estimate.Validate();
 }
 
 nlohmann::json FrfEstimateRun::Summary(const std::string& estimator) const {

@@ -10,6 +10,7 @@
 #include "robomach/common/number_format.h"
 #include "robomach/io/csv_table.h"
 #include "robomach/io/uncertainty_file.h"
+#include "robomach/workflows/robot_config.h"
 
 namespace robomach::workflows {
 void ApplyAddsAndSets(const std::vector<std::string>& adds, const std::vector<std::string>& sets,
@@ -98,13 +99,15 @@ void FrfPredictOptions::Validate() const {
   if (freq_hz.size() == 0) throw OptionError("freq_hz", "freq_hz: expected at least one frequency line");
   for (Eigen::Index i = 0; i < freq_hz.size(); ++i) {
     if (!(freq_hz(i) >= 0.0) || !std::isfinite(freq_hz(i)) || (i > 0 && !(freq_hz(i) > freq_hz(i - 1)))) {
-      throw OptionError("freq_hz", "freq_hz: expected finite lines >= 0, strictly increasing");
+      throw OptionError("freq_hz", "freq_hz: expected finite lines >= 0, strictly increasing, got " +
+                                       FormatNumber(freq_hz(i)) + " at line " + std::to_string(i + 1) +
+                                       (i > 0 ? " after " + FormatNumber(freq_hz(i - 1)) : std::string()));
     }
   }
   if (method != "modal" && method != "direct") {
     throw OptionError("method", "method: expected modal or direct, got '" + method + "'");
   }
-  dynamics::CheckValid(uncertainty);
+  uncertainty.Validate();  // its fields are the tool's (confidence ...): unprefixed
 }
 
 nlohmann::json FrfPredictRun::Summary(const FrfPredictOptions& o, const std::string& method_name) const {
@@ -130,7 +133,7 @@ nlohmann::json FrfPredictRun::Summary(const FrfPredictOptions& o, const std::str
 FrfPredictRun RunFrfPredict(const FrfPredictOptions& o, const MessageSink& tell, const StageProgress& progress) {
   o.Validate();
   FrfPredictRun r;
-  r.config = io::LoadRobotConfig(o.robot_path);
+  r.config = workflows::LoadRobotConfigChecked(o.robot_path);
   for (const std::string& w : r.config.implausible) {
     Tell(tell, Message::Kind::kWarning, w);
     r.unit_findings.push_back(w);
@@ -167,7 +170,7 @@ FrfPredictRun RunFrfPredict(const FrfPredictOptions& o, const MessageSink& tell,
   if (progress) po.progress = [&](long done, long total) { progress("postures", done, total); };
   dynamics::FrfPredictionResult result = dynamics::PredictFrfs(r.model, named, o.freq_hz, po);
   r.prediction_status = result.status();
-  for (const Finding& f : result.findings) {
+  for (const Finding& f : result.verdict.findings) {
     r.warnings.push_back(o.postures_path + ":" + std::to_string(r.postures[f.input_index].line) + ": " + f.message);
     Tell(tell, Message::Kind::kWarning, r.warnings.back());
   }

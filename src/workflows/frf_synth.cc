@@ -1,5 +1,7 @@
 #include "robomach/workflows/frf_synth.h"
 
+#include <cctype>
+#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -8,8 +10,10 @@
 #include "robomach/common/option_checks.h"
 #include "robomach/common/number_format.h"
 #include "robomach/dynamics/frf_prediction.h"
+#include "robomach/io/frf_files.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/workflows/frf_predict.h"
+#include "robomach/workflows/robot_config.h"
 
 namespace robomach::workflows {
 namespace {
@@ -29,11 +33,6 @@ constexpr double kMaxPlausibleNoiseMPerS2PerN = 10.0;  // accelerance floor
 constexpr double kMaxFrequencyHz = 1e9;                // refused above
 
 }  // namespace
-
-std::string FrfSynthOptions::Name(const std::string& field) const {
-  const auto it = names.find(field);
-  return it == names.end() ? field : it->second;
-}
 
 void FrfSynthOptions::Validate() const {
   const calibration::VirtualHammerOptions& h = hammer;
@@ -110,7 +109,7 @@ std::vector<std::string> FrfSynthOptions::UnitFindings() const {
 FrfSynthSetup PrepareFrfSynth(const FrfSynthOptions& o, const MessageSink& tell) {
   o.Validate();
   FrfSynthSetup s;
-  s.config = io::LoadRobotConfig(o.robot_path);
+  s.config = workflows::LoadRobotConfigChecked(o.robot_path);
   for (const std::string& w : s.config.implausible) Tell(tell, Message::Kind::kWarning, w);
   ApplyAddsAndSets(o.adds, o.sets, &s.config);
   s.hammer = o.hammer;
@@ -128,7 +127,7 @@ FrfSynthRun RunFrfSynth(const FrfSynthOptions& o, FrfSynthSetup setup, const Mes
   r.hammer = std::move(setup.hammer);
   std::vector<std::string> option_findings = o.UnitFindings();  // not const: listed with posture_units below
   try {
-    calibration::CheckValid(r.hammer);
+    r.hammer.Validate();
   } catch (const std::invalid_argument& e) {
     // "VirtualHammerOptions: fmax_hz ...": the field is the first word. An
     // implausible option (a rate in kHz) is the likely cause: say so.
@@ -155,6 +154,37 @@ FrfSynthRun RunFrfSynth(const FrfSynthOptions& o, FrfSynthSetup setup, const Mes
 
 FrfSynthRun RunFrfSynth(const FrfSynthOptions& o, const MessageSink& tell) {
   return RunFrfSynth(o, PrepareFrfSynth(o, tell), tell);
+}
+
+FrfFileFormat FrfSynthOutputFormat(const std::string& path, const std::string& name, bool allow_stdout) {
+  if (allow_stdout && path == "-") return FrfFileFormat::kCsv;
+  // The format follows the extension: refuse one we do not write (a .png
+  // would get CSV text).
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".uff" || ext == ".unv" || ext == ".uf") return FrfFileFormat::kUff58;
+  if (ext != ".csv") {
+    throw OptionError(name, name + " " + path +
+                                ": expected a file name ending in .csv (the FRF CSV of docs/formats.md §3) or .uff, "
+                                ".unv (UFF58)" +
+                                (allow_stdout ? ", or '-' for standard output (CSV)" : ""));
+  }
+  return FrfFileFormat::kCsv;
+}
+
+void WriteFrfSynthOutput(const FrfSynthRun& run, const FrfSynthOptions& o, const std::string& path,
+                         FrfFileFormat format, io::FrfQuantity quantity, const MessageSink& tell) {
+  const calibration::VirtualHammerOptions& h = run.hammer;
+  if (format == FrfFileFormat::kUff58 && path != "-") {
+    if (h.coherence && h.averages > 1) {
+      Tell(tell, Message::Kind::kWarning,
+           "UFF58 has no field for the number of averages: give " + o.Name("averages") + " " +
+               std::to_string(h.averages) + " to the tools that read " + path);
+    }
+    io::WriteUff58(path, run.frfs, quantity);
+  } else {
+    io::WriteFrfCsv(path, run.frfs, quantity, h.coherence ? h.averages : 0);
+  }
 }
 
 nlohmann::json FrfSynthRun::Summary(const FrfSynthOptions& o) const {

@@ -17,7 +17,7 @@ IsoEvaluation EvaluateIsoRunsFile(const std::string& path) {
     for (const auto& t : r.targets) e.min_runs = std::min({e.min_runs, t.runs_up, t.runs_down});
     for (const std::string& f : machine::Iso230UnitFindings(axis, r, e.runs.rotary)) {
       e.unit_findings.push_back(f);
-      e.Flag("implausible (unit mistake?): " + f);
+      e.verdict.Flag("implausible (unit mistake?): " + f);
     }
     e.results.emplace_back(axis, std::move(r));
   }

@@ -17,6 +17,7 @@
 #include "robomach/io/number_format.h"
 #include "robomach/stability/lobe_uncertainty.h"
 #include "robomach/workflows/stability_lobes.h"
+#include "robomach/workflows/robot_config.h"
 
 namespace robomach::workflows {
 namespace {
@@ -36,8 +37,12 @@ void KqIdentifyOptions::Validate() const {
   if (!(noise_mm > 0.0) || !std::isfinite(noise_mm)) {
     throw OptionError("noise_mm", "noise_mm: expected a finite noise > 0 mm, got " + FormatNumber(noise_mm, 6));
   }
-  if (!robust.empty() && robust != "none" && robust != "cauchy" && robust != "huber") {
-    throw OptionError("robust", "robust: expected cauchy or huber (or none for least squares), got " + robust);
+  if (!robust.empty()) {
+    try {
+      identification::ParseRobustLoss(robust);
+    } catch (const std::invalid_argument& e) {
+      throw OptionError("robust", std::string("robust: ") + e.what() + " (none: least squares)");
+    }
   }
 }
 
@@ -89,7 +94,7 @@ KqIdentifyResult RunKqIdentify(const KqIdentifyOptions& o, const MessageSink& on
                                const std::function<void(long, long)>& progress) {
   o.Validate();
   KqIdentifyResult r;
-  r.config = io::LoadRobotConfig(o.robot_path);
+  r.config = workflows::LoadRobotConfigChecked(o.robot_path);
   for (const std::string& w : r.config.implausible) Tell(on_message, Message::Kind::kWarning, w);
   r.model = r.config.Build();
   if (!r.model->effects().empty()) {
@@ -125,8 +130,7 @@ KqIdentifyResult RunKqIdentify(const KqIdentifyOptions& o, const MessageSink& on
   }
   identification::IdentificationOptions opt;
   opt.tracker_noise = MmToM(o.noise_mm);
-  if (o.robust == "cauchy") opt.loss = identification::RobustLoss::kCauchy;
-  if (o.robust == "huber") opt.loss = identification::RobustLoss::kHuber;
+  opt.loss = identification::ParseRobustLoss(o.robust.empty() ? "none" : o.robust);  // Validate checked it
   r.fit = identification::IdentifyJointStiffness(*r.model, r.cases, opt, progress);
   return r;
 }
@@ -457,7 +461,7 @@ void ReportTargets(const KqPlanOptions& o, const std::vector<io::Posture>& targe
 void AddPlanWarnings(const KqPlanOptions& o, KqPlanResult* r) {
   const identification::PlanOptions& p = r->planner;
   const int n = r->model->num_joints();
-  for (const Finding& f : r->plan.findings) {
+  for (const Finding& f : r->plan.verdict.findings) {
     r->warnings.push_back(f.message + (f.input_index == n - 1 ? " (" + o.points_name + ")" : ""));
   }
   for (int j = 0; j < n; ++j) {
@@ -477,7 +481,7 @@ void AddPlanWarnings(const KqPlanOptions& o, KqPlanResult* r) {
 KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
   o.Validate();
   KqPlanResult r;
-  r.config = io::LoadRobotConfig(o.robot_path);
+  r.config = workflows::LoadRobotConfigChecked(o.robot_path);
   for (const std::string& w : r.config.implausible) Tell(on_message, Message::Kind::kWarning, w);
   r.model = r.config.Build();
   CheckOptionUnits(o, &r);

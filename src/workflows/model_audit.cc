@@ -10,6 +10,7 @@
 #include "robomach/dynamics/effect.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/io/uncertainty_file.h"
+#include "robomach/workflows/robot_config.h"
 
 namespace robomach::workflows {
 namespace {
@@ -57,6 +58,7 @@ void ModelAuditOptions::Validate() const {
       throw OptionError("candidates", std::string("candidates: ") + e.what());
     }
   }
+  noise.Validate();  // the tool's own --min-snr ...: unprefixed fields, as the tool maps them
 }
 
 ModelAuditRun RunModelAudit(const ModelAuditOptions& o, const MessageSink& tell,
@@ -74,7 +76,7 @@ ModelAuditRun RunModelAudit(const ModelAuditOptions& o, const MessageSink& tell,
   opt.uncertainty_confidence = o.confidence;
   opt.progress = progress;
 
-  r.config = io::LoadRobotConfig(o.robot_path);
+  r.config = workflows::LoadRobotConfigChecked(o.robot_path);
   for (const std::string& w : r.config.implausible) Tell(tell, Message::Kind::kWarning, w);
   io::RobotConfig& cfg = r.config;
   for (const std::string& name : o.adds) {

@@ -16,6 +16,7 @@
 #include "robomach/polishing/face_check.h"
 #include "robomach/polishing/path_patterns.h"
 #include "robomach/polishing/removal.h"
+#include "robomach/workflows/polish_simulation.h"
 
 namespace robomach::workflows {
 namespace {
@@ -25,7 +26,7 @@ namespace {
 // checks and the size estimate take.
 polishing::PathParameters CheckParameters(const PolishPlanOptions& o) {
   polishing::PathParameters p;
-  p.pattern = polishing::FindPathPattern(o.pattern).id();
+  p.pattern = polishing::ParsePattern(o.pattern);
   p.offset = MmToM(o.offset_mm.value_or(8.0));
   p.radius = MmToM(o.radius_mm);
   p.pitch = MmToM(o.pitch_mm);
@@ -76,14 +77,9 @@ polishing::NurbsSurface LoadPolishSurface(const std::string& path, const Surface
 }
 
 void PolishPlanOptions::Validate() const {
-  // The ranges keep a typo from hours of work or an allocation failure.
-  for (const polishing::PlanOptionRange& r : polishing::PlanOptionRanges(*this)) {
-    CheckOptionRange(r.name, r.value, r.lo, r.hi);
-  }
-  if (optimise == "pso" && pattern == "parallel") {
-    throw OptionError("optimise", "optimise pso applies to the cycloid; the parallel pattern is optimised with "
-                                  "optimise nlopt");
-  }
+  // The planning options' checks are PlanOptions'; the files and the face
+  // are checked where they are read.
+  polishing::PlanOptions::Validate();
 }
 
 std::vector<io::CadFaceRow> ListPolishFaces(const PolishPlanOptions& o, const MessageSink& tell,
@@ -113,7 +109,7 @@ std::vector<io::CadFaceRow> ListPolishFaces(const PolishPlanOptions& o, const Me
 }
 
 nlohmann::json PolishPlanRun::Summary(const PolishPlanOptions& options) const {
-  return io::PolishPlanSummaryJson(outcome, context, options);
+  return io::PolishPlanSummaryJson(outcome, context, options, PlanFiguresOf(outcome, context.process));
 }
 
 PolishPlanRun RunPolishPlan(const PolishPlanOptions& o, const MessageSink& tell, const PlanProgress& progress) {
@@ -141,7 +137,7 @@ PolishPlanRun RunPolishPlan(const PolishPlanOptions& o, const MessageSink& tell,
   run.outcome = polishing::PlanPolishing(run.context, req);
   const polishing::PlanOutcome& outcome = run.outcome;
   const polishing::EvaluatedPlan& e = outcome.plan;
-  for (const Finding& f : outcome.findings) warn(f.message);
+  for (const Finding& f : outcome.verdict.findings) warn(f.message);
   if (outcome.optimisation && outcome.optimisation->stop_reason == "max_time") {
     note("the optimiser stopped at --max-time-s " + io::FormatDouble(o.max_time_s) +
          " before its local searches converged; the best plan so far is written");

@@ -8,6 +8,7 @@
 
 #include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
+#include "robomach/polishing/optimise.h"
 #include "robomach/polishing/paths.h"
 
 namespace robomach::workflows {
@@ -45,7 +46,7 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
   }
   s.speed_limit_exceeded = v_sure > process.max_speed * (1 + 1e-6);
   if (s.speed_limit_exceeded) {
-    s.Flag("the path's traverse speed reaches " + FormatDouble(1e3 * s.max_speed) + " mm/s, above max_speed_mm_per_s " +
+    s.verdict.Flag("the path's traverse speed reaches " + FormatDouble(1e3 * s.max_speed) + " mm/s, above max_speed_mm_per_s " +
            FormatDouble(1e3 * process.max_speed));
   }
   // Times in milliseconds under the t_s header (issue #35: the planner's
@@ -53,7 +54,7 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
   // moves faster than a thousandth of what the process allows.
   if (s.max_speed > 0.0 && s.max_speed < 1e-2 * process.max_speed &&
       1e3 * s.max_speed <= process.max_speed * (1 + 1e-6)) {
-    s.Flag("implausible (unit mistake?): " + s.file.path + ": the tool never moves faster than " +
+    s.verdict.Flag("implausible (unit mistake?): " + s.file.path + ": the tool never moves faster than " +
            FormatNumber(1e3 * s.max_speed, 3) + " mm/s, under 1 % of max_speed_mm_per_s " +
            FormatNumber(1e3 * process.max_speed, 3) + " (the path takes " + FormatNumber(s.file.rows.back().t, 4) +
            " s): times in ms under the t_s header? (A deliberately slow path is flagged too.)");
@@ -76,15 +77,49 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
   }
   const double path_span = s.file.rows.empty() ? 0.0 : (hi - lo).norm(), region_span = (ghi - glo).norm();
   if (s.file.rows.size() >= 2 && region_span > 0.0 && path_span < 0.01 * region_span) {
-    s.Flag("implausible (unit mistake?): " + s.file.path + ": the path spans " + FormatNumber(1e3 * path_span, 3) +
+    s.verdict.Flag("implausible (unit mistake?): " + s.file.path + ": the path spans " + FormatNumber(1e3 * path_span, 3) +
            " mm, under 1 % of the " + FormatNumber(1e3 * region_span, 4) + " mm across the surface " + surface_source +
            ": positions in m under the _mm headers (or a path for another part)? (A spot or dwell test this "
            "small is flagged too.)");
   } else if (!(s.stats.coverage > 0.0)) {
-    s.Flag(s.file.path + ": the path polishes none of the region of " + surface_source +
+    s.verdict.Flag(s.file.path + ": the path polishes none of the region of " + surface_source +
            " (coverage 0): a path for another part, or in another frame?");
   }
   return s;
+}
+
+io::PathFigures PathFiguresOf(const std::vector<polishing::PathRow>& rows) {
+  io::PathFigures f;
+  f.contact_length_m = polishing::ContactLength(rows);
+  f.lifts = polishing::CountLifts(rows);
+  f.time_s = rows.empty() ? 0.0 : rows.back().t - rows.front().t;
+  f.rows = rows.size();
+  f.max_speed_m_per_s = polishing::MaxSpeed(rows);
+  return f;
+}
+
+double EdgeOverrunUsed(const polishing::PathParameters& params, const polishing::PolishingProcess& process) {
+  return std::min(params.edge_overrun, polishing::MaxEdgeOverrun(params, process));
+}
+
+io::PlanFigures PlanFiguresOf(const polishing::PlanOutcome& outcome, const polishing::PolishingProcess& process) {
+  io::PlanFigures f;
+  f.path = PathFiguresOf(outcome.plan.path.rows);
+  f.edge_overrun_m = EdgeOverrunUsed(outcome.params, process);
+  if (outcome.optimisation) {
+    const polishing::PlanOptimiseResult& opt = *outcome.optimisation;
+    f.best_edge_overrun_m = EdgeOverrunUsed(opt.best.params, process);
+    for (const polishing::PlanEvaluation& e : opt.family_best) {
+      f.family_edge_overrun_m.push_back(EdgeOverrunUsed(e.params, process));
+    }
+    if (opt.best_parallel.valid) f.parallel_edge_overrun_m = EdgeOverrunUsed(opt.best_parallel.params, process);
+  }
+  return f;
+}
+
+std::vector<std::pair<std::string, std::string>> PlannedPathMetadata(const polishing::PathParameters& params,
+                                                                     const polishing::PolishingProcess& process) {
+  return io::PlannedPathMetadata(params, EdgeOverrunUsed(params, process));
 }
 
 nlohmann::json PolishSimSummaryJson(const PolishSimulation& sim, const polishing::PolishingProcess& process,
@@ -92,7 +127,7 @@ nlohmann::json PolishSimSummaryJson(const PolishSimulation& sim, const polishing
   const io::PolishPathFile& file = sim.file;
   nlohmann::json summary;
   summary["removal_um"] = io::RemovalSummaryJson(sim.stats);
-  summary["path"] = io::PathSummaryJson(file.rows);
+  summary["path"] = io::PathSummaryJson(PathFiguresOf(file.rows));
   auto meta = [&](const char* k) {
     const auto it = file.metadata.find(k);
     double v = 0;

@@ -16,6 +16,7 @@
 #include "robomach/io/uncertainty_file.h"
 #include "robomach/workflows/frf_predict.h"
 #include "robomach/workflows/tip_sources.h"
+#include "robomach/workflows/robot_config.h"
 
 namespace robomach::workflows {
 namespace {
@@ -55,11 +56,7 @@ void StabilityLobesOptions::Validate() const {
       throw OptionError("uncertainty_paths", "uncertainty_paths bands the ZOA lobes: use method zoa or both "
                                              "(the SD's band would take hundreds of SD runs)");
     }
-    try {
-      dynamics::CheckValid(uncertainty);
-    } catch (const std::invalid_argument& e) {
-      throw OptionError("uncertainty", e.what());
-    }
+    uncertainty.Validate();  // OptionError naming its field (confidence ...), as the tool's own options
   }
   if (!(tool_axis.allFinite() && tool_axis.norm() > 0.0)) {
     throw OptionError("tool_axis", AxisSource(*this) + ": expected a non-zero vector x,y,z");
@@ -133,7 +130,7 @@ StabilityLobesRun RunStabilityLobes(const StabilityLobesOptions& o, const Messag
   }
   const std::string axis_source = AxisSource(o);
   if (!o.robot_path.empty()) {
-    io::RobotConfig cfg = io::LoadRobotConfig(o.robot_path);
+    io::RobotConfig cfg = workflows::LoadRobotConfigChecked(o.robot_path);
     for (const std::string& w : cfg.implausible) {
       Tell(tell, Message::Kind::kWarning, w);
       run.input_findings.push_back(w);

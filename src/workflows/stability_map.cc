@@ -6,6 +6,7 @@
 #include "robomach/common/errors.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/units.h"
+#include "robomach/workflows/robot_config.h"
 
 namespace robomach::workflows {
 
@@ -13,6 +14,10 @@ void StabilityMapOptions::Validate() const {
   if (region_path.empty()) {
     throw OptionError("region_path", "region_path is required (with path_path it gives the seed posture and rotation)");
   }
+  ValidateSettings();
+}
+
+void StabilityMapOptions::ValidateSettings() const {
   if (!(max_depth_mm > 0.0) || !std::isfinite(max_depth_mm)) {
     throw OptionError("max_depth_mm", "max_depth_mm " + FormatNumber(max_depth_mm) + ": expected > 0");
   }
@@ -27,7 +32,7 @@ void StabilityMapOptions::Validate() const {
   if (threads < 0 || threads > 256) {
     throw OptionError("threads", "threads " + std::to_string(threads) + ": expected 0 to 256");
   }
-  dynamics::CheckValid(uncertainty);
+  uncertainty.Validate();  // its fields are the tool's (confidence ...): unprefixed
 }
 
 std::string StabilityMapRun::Where(long k) const {
@@ -38,7 +43,7 @@ std::string StabilityMapRun::Where(long k) const {
 StabilityMapRun RunStabilityMap(const StabilityMapOptions& o, const MessageSink& tell, const StageProgress& progress) {
   o.Validate();
   StabilityMapRun r;
-  r.config = io::LoadRobotConfig(o.robot_path);
+  r.config = workflows::LoadRobotConfigChecked(o.robot_path);
   for (const std::string& w : r.config.implausible) {
     Tell(tell, Message::Kind::kWarning, w);
     r.input_findings.push_back(w);

@@ -15,6 +15,7 @@
 #include "robomach/io/posture_file.h"
 #include "robomach/io/tracker_file.h"
 #include "robomach/workflows/option_text.h"
+#include "robomach/workflows/robot_config.h"
 
 namespace robomach::workflows {
 namespace {
@@ -24,17 +25,15 @@ constexpr double kMinPlausiblePulleyDistanceMm = 100.0, kMaxPlausiblePulleyDista
 
 }  // namespace
 
-std::string TrackerSynthOptions::Name(const std::string& field) const {
-  const auto it = names.find(field);
-  return it == names.end() ? field : it->second;
-}
-
 void TrackerSynthOptions::Validate() const {
-  if (!(noise_mm >= 0.0)) throw OptionError("noise_mm", "noise_mm: expected a noise >= 0 mm");
-  if (outliers < 0) throw OptionError("outliers", "outliers: expected a count >= 0");
-  if (num_postures < 1) throw OptionError("num_postures", "num_postures: expected at least 1");
   CheckOptionRange("noise_mm", noise_mm, 0.0, 1e3);
+  if (outliers < 0) throw OptionError("outliers", "outliers: expected a count >= 0, got " + std::to_string(outliers));
+  if (num_postures < 1) {
+    throw OptionError("num_postures", "num_postures: expected at least 1, got " + std::to_string(num_postures));
+  }
   CheckOptionRange("outlier_mm", outlier_mm, 0.0, 1e4);
+  // A distance from the base axis; 0 lets the postures come anywhere.
+  CheckOptionRange("min_reach_mm", min_reach_mm, 0.0, 1e5);
   if (form != "rope" && form != "force") {
     throw OptionError("form", "form: expected rope or force, got '" + form + "'");
   }
@@ -55,7 +54,7 @@ TrackerSynthRun RunTrackerSynth(const TrackerSynthOptions& o, const MessageSink&
   // API Radian data sheets): a noise over 1 mm is um typed in the mm
   // option, one under 0.1 um is m (docs/plausibility.md).
   finding(io::TrackerNoiseUnitFinding(o.Name("noise_mm"), o.noise_mm));
-  r.config = io::LoadRobotConfig(o.robot_path);
+  r.config = workflows::LoadRobotConfigChecked(o.robot_path);
   for (const std::string& w : r.config.implausible) Tell(tell, Message::Kind::kWarning, w);
   for (const std::string& s : o.sets) {
     const size_t eq = s.find('=');

@@ -363,10 +363,10 @@ TEST(AuditGrade, FractionRemovedIsTheShareOfTheExcessMisfit) {
   EXPECT_EQ(ToString(AuditGrade::kMostlyExplained), "mostly_explained");
   AuditOptions bad;
   bad.mostly_explained_fraction = 1.5;
-  EXPECT_THROW(CheckValid(bad), std::invalid_argument);
+  EXPECT_THROW(bad.Validate(), std::invalid_argument);
   bad.mostly_explained_fraction = 0.8;
   bad.clear_bic_gap = -1.0;
-  EXPECT_THROW(CheckValid(bad), std::invalid_argument);
+  EXPECT_THROW(bad.Validate(), std::invalid_argument);
 }
 
 }  // namespace

@@ -378,7 +378,7 @@ TEST(ErrorPatterns, RejectsFeaturesThatAreNotTheAuditsAndBadOptions) {
   EXPECT_NE(msg.find("not those of the audit result"), std::string::npos) << msg;
   ErrorPatternOptions bad;
   bad.matching.min_relative_visibility = 0.0;
-  EXPECT_THROW(CheckValid(bad), std::invalid_argument);
+  EXPECT_THROW(bad.Validate(), std::invalid_argument);
   // Two postures: no correlation is defined (n − 2 = 0 degrees of freedom).
   const ErrorPatterns p = AnalyzeErrorPatterns(r, c.model, c.postures, measured, features);
   EXPECT_TRUE(std::isnan(p.trends.critical_correlation));

@@ -119,7 +119,7 @@ TEST(ModelAudit, RejectsBadOptionsAndUnknownCandidates) {
   const Campaign c = MakeCampaign();
   AuditOptions o;
   o.fmax_hz = -1.0;
-  EXPECT_THROW(CheckValid(o), std::invalid_argument);
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
   AuditOptions u;
   u.candidates = {"warp_drive"};
   EXPECT_THROW(RunAudit(c.cfg.description, c.cfg.parameters, c.postures, dynamics::FrfSet{}, u),

@@ -346,7 +346,7 @@ TEST(FrfCalibration, AcceptanceRealisticHammerDataWithAndWithoutCoherence) {
     const CalibrationVerdict v = JudgeCalibration(r, measured, CalibrationOptions{});
     EXPECT_EQ(v.residuals, 2 * lines) << what;
     EXPECT_NEAR(v.rms_per_residual_in_noise_units, std::sqrt(r.misfit_final / (2.0 * lines)), 1e-12) << what;
-    for (const Finding& f : v.findings) EXPECT_EQ(f.message.find("misses the data"), std::string::npos) << what;
+    for (const Finding& f : v.verdict.findings) EXPECT_EQ(f.message.find("misses the data"), std::string::npos) << what;
   }
 }
 
@@ -389,14 +389,14 @@ TEST(FrfCalibration, NeverWorseThanTheStart) {
     const CalibrationVerdict v = JudgeCalibration(r, measured, CalibrationOptions{});
     EXPECT_EQ(v.status(), RunStatus::kFlagged) << label;
     EXPECT_NEAR(v.rms_per_residual_in_noise_units, std::sqrt(m1 / (2.0 * lines)), 1e-12 * std::sqrt(m1)) << label;
-    ASSERT_FALSE(v.findings.empty()) << label;
-    EXPECT_NE(v.findings.back().message.find("misses the data by"), std::string::npos) << v.findings.back().message;
+    ASSERT_FALSE(v.verdict.findings.empty()) << label;
+    EXPECT_NE(v.verdict.findings.back().message.find("misses the data by"), std::string::npos) << v.verdict.findings.back().message;
     // Without noise models the misfit is no chi^2: no rms, no misfit finding.
     dynamics::FrfSet bare;
     for (const auto& [k, f] : measured) bare.Insert(k, dynamics::Frf::FromSamples(f.freq_hz(), f.receptance()));
     const CalibrationVerdict b = JudgeCalibration(r, bare, CalibrationOptions{});
     EXPECT_TRUE(std::isnan(b.rms_per_residual_in_noise_units)) << label;
-    for (const Finding& f : b.findings) EXPECT_EQ(f.message.find("misses the data"), std::string::npos) << label;
+    for (const Finding& f : b.verdict.findings) EXPECT_EQ(f.message.find("misses the data"), std::string::npos) << label;
   }
 }
 

@@ -536,7 +536,7 @@ TEST(FrfEstimateOptions, ValidationNamesTheField) {
   FrfEstimateOptions o;
   o.exponential_tau_s = -1;
   try {
-    CheckValid(o);
+    o.Validate();
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_THAT(e.what(), HasSubstr("exponential_tau_s = -1"));

@@ -229,7 +229,7 @@ TEST(FrfNoise, NoiseFreeDataGetTheSmallestRelativeNoiseNotInfiniteWeights) {
 TEST(FrfNoise, RejectsBadOptionsAndTooFewLines) {
   NoiseOptions o;
   o.min_snr = 0.0;
-  EXPECT_THROW(CheckValid(o), std::invalid_argument);
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
   const dynamics::Frf tiny =
       dynamics::Frf::FromSamples(Eigen::VectorXd::LinSpaced(5, 1, 5), Eigen::VectorXcd::Ones(5));
   EXPECT_THROW(EstimateFrfNoise(tiny), std::invalid_argument);

@@ -183,13 +183,13 @@ TEST(FrfOutlierLines, NoiseFreeDataGetNoFlagsEither) {
 TEST(FrfOutlierLines, OptionsAndTheSwitch) {
   NoiseOptions o;
   o.outlier_threshold = 2.0;
-  EXPECT_THROW(CheckValid(o), std::invalid_argument);
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
   o = {};
   o.outlier_threshold_off_mains = 5.0;  // below outlier_threshold
-  EXPECT_THROW(CheckValid(o), std::invalid_argument);
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
   o = {};
   o.outlier_window_lines = 2;
-  EXPECT_THROW(CheckValid(o), std::invalid_argument);
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
   o = {};
   o.exclude_outlier_lines = false;
   const FrfNoise n = EstimateFrfNoise(Measure(1, true).frf, o);

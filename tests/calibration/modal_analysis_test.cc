@@ -164,6 +164,14 @@ TEST(ModalAnalysis, OneTransferFrfGivesNoModalTableAndSaysWhy) {
             w.find("--modal-constants") != std::string::npos;
   }
   EXPECT_TRUE(said);
+  // One FRF is no roving test: no mode shapes (frf-modes' --shapes has no
+  // rows), and a note naming the posture and the fit when the fit converged.
+  std::vector<std::string> notes;
+  EXPECT_TRUE(ShapesOfRovingTests(poses, &notes).empty());
+  if (poses[0].groups[0].fit.status == SolverStatus::kConverged) {
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_EQ(notes[0].rfind("posture P, fit 1: no mode shapes: ", 0), 0u) << notes[0];
+  }
 }
 
 TEST(ModalAnalysis, FrfsOnDifferentGridsAreFittedAloneWithAWarning) {
@@ -243,6 +251,16 @@ TEST(ModalAnalysis, RovingSensorOnAChainGivesItsMassNormalisedShapes) {
   EXPECT_EQ(rs->roving, "response");
   EXPECT_EQ(rs->fixed_point, hammer + 1);
   EXPECT_TRUE(rs->mass_normalised);
+  // frf-modes' --shapes (what io::ModeShapesCsv writes): this fit's shapes,
+  // and no note.
+  std::vector<std::string> notes;
+  const std::vector<FitRovingShapes> all = ShapesOfRovingTests(poses, &notes);
+  EXPECT_TRUE(notes.empty());
+  ASSERT_EQ(all.size(), 1u);
+  EXPECT_EQ(all[0].pose, 0u);
+  EXPECT_EQ(all[0].fit, 0u);
+  EXPECT_EQ(all[0].shapes.points, rs->points);
+  EXPECT_TRUE(all[0].shapes.shapes.isApprox(rs->shapes));
   for (int r = 0; r < 4; ++r) {
     const double fn = std::sqrt(w2(r)) / (2.0 * kPi);
     EXPECT_NEAR(grp.fit.modes[r].freq_hz, fn, 0.002 * fn) << "mode " << r + 1;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "robomach/calibration/virtual_hammer_test.h"
+#include "robomach/common/errors.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/posture_dynamics.h"
 #include "robomach/dynamics/tool_tip_frf.h"
@@ -21,7 +22,7 @@ TEST(VirtualHammerTest, DefaultGridIsTheDocumentedHammerGrid) {
   EXPECT_EQ(f(1) - f(0), 0.25);
   VirtualHammerOptions bad;
   bad.fmax_hz = 3000.0;
-  EXPECT_THROW(CheckValid(bad), std::invalid_argument);  // above Nyquist (2560 Hz)
+  EXPECT_THROW(bad.Validate(), OptionError);  // above Nyquist (2560 Hz)
 }
 
 // Noise-free output equals the model's receptance up to the 13-digit

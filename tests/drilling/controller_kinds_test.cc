@@ -35,7 +35,7 @@ TEST(ControllerKinds, NamesDefaultsAndList) {
     FindControllerKind("lqr");
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown controller kind \"lqr\"; expected pid, pd or pd-tdc"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("unknown controller kind 'lqr': expected pid, pd or pd-tdc"), std::string::npos) << e.what();
   }
 }
 

@@ -1,6 +1,9 @@
 #include "robomach/io/drilling_files.h"
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -107,6 +110,22 @@ TEST(DrillingFiles, ReadsDrillFileAndRejectsUnknownKeys) {
                                     "  helix_angle_deg: 30\n  web_thickness_ratio: 0.18\n"
                                     "  chisel_edge_angle_deg: 125\n  lip_relief_angle_deg: 12\n  colour: red\n");
   EXPECT_THAT(CaptureError([&] { ReadDrillFile(bad); }), HasSubstr("drill.yaml:9:3"));
+}
+
+// The hole axis is read with its enum's parser (issue #36): an unknown name
+// is refused at its place, naming the three.
+TEST(DrillingFiles, RefusesAnUnknownHoleAxisNamingTheKnownOnes) {
+  std::ifstream in(SourcePath("config/drilling/drill_5mm.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const size_t at = yaml.find("hole_axis: tip_z");
+  ASSERT_NE(at, std::string::npos);
+  yaml.replace(at, 16, "hole_axis: tip_w");
+  const std::string bad = WriteText(TempDir("drilling_files_axis") + "/drill.yaml", yaml);
+  const std::string what = CaptureError([&] { ReadDrillFile(bad); });
+  EXPECT_THAT(what, HasSubstr("drill.yaml:19:"));
+  EXPECT_THAT(what, HasSubstr(": process.hole_axis: hole axis 'tip_w': expected tip_x, tip_y or tip_z"));
 }
 
 const char* kRobotHead =

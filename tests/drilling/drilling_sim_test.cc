@@ -1,6 +1,8 @@
 #include "robomach/drilling/drilling_sim.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -65,6 +67,20 @@ TEST(DrillingScenario, ThrustLoadsTheJointsThroughTheJacobianTranspose) {
   const double actual = a.dot(robot.TipPose(r.series.q.col(k)).translation());
   const double desired = a.dot(robot.TipPose(sc.desired().col(k)).translation());
   EXPECT_LT(actual, desired);
+}
+
+// Issue #36: every HoleAxis goes through its name (a drill file's
+// process.hole_axis) and back; another name is refused naming all three.
+TEST(HoleAxis, RoundTripsThroughItsName) {
+  for (HoleAxis a : {HoleAxis::kTipX, HoleAxis::kTipY, HoleAxis::kTipZ}) {
+    EXPECT_EQ(ParseHoleAxis(ToString(a)), a) << ToString(a);
+  }
+  try {
+    ParseHoleAxis("z");
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "hole axis 'z': expected tip_x, tip_y or tip_z");
+  }
 }
 
 }  // namespace

@@ -42,7 +42,7 @@ TEST(FrfPrediction, ModalEqualsDirectSolveAndPosturesInsideLimitsAreOk) {
   const FrfPredictionResult direct = PredictFrfs(model, postures, Lines(), direct_options);
   EXPECT_EQ(calls, 3);
   EXPECT_EQ(modal.status(), RunStatus::kOk);
-  EXPECT_TRUE(modal.findings.empty());
+  EXPECT_TRUE(modal.verdict.findings.empty());
   ASSERT_EQ(modal.postures.size(), 3u);
   for (size_t p = 0; p < 3; ++p) {
     EXPECT_EQ(modal.postures[p].id, postures[p].id);
@@ -66,12 +66,12 @@ TEST(FrfPrediction, JointOutsideLimitsAndSingularPostureAreFlaggedNotRefused) {
   const FrfPredictionResult r =
       PredictFrfs(model, {{"in", inside}, {"out", outside}, {"wrist", singular}}, Lines());
   EXPECT_EQ(r.status(), RunStatus::kFlagged);
-  ASSERT_EQ(r.findings.size(), 2u);
-  EXPECT_EQ(r.findings[0].input_index, 1);
-  EXPECT_NE(r.findings[0].message.find("posture out: joint 2"), std::string::npos) << r.findings[0].message;
-  EXPECT_NE(r.findings[0].message.find("outside its limits"), std::string::npos);
-  EXPECT_EQ(r.findings[1].input_index, 2);
-  EXPECT_NE(r.findings[1].message.find("near a singularity"), std::string::npos) << r.findings[1].message;
+  ASSERT_EQ(r.verdict.findings.size(), 2u);
+  EXPECT_EQ(r.verdict.findings[0].input_index, 1);
+  EXPECT_NE(r.verdict.findings[0].message.find("posture out: joint 2"), std::string::npos) << r.verdict.findings[0].message;
+  EXPECT_NE(r.verdict.findings[0].message.find("outside its limits"), std::string::npos);
+  EXPECT_EQ(r.verdict.findings[1].input_index, 2);
+  EXPECT_NE(r.verdict.findings[1].message.find("near a singularity"), std::string::npos) << r.verdict.findings[1].message;
   EXPECT_EQ(r.postures[1].joints_outside_limits, std::vector<int>{1});
   // Flagged, still computed: every posture has its finite FRF.
   for (const auto& p : r.postures) {

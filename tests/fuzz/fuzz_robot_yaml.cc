@@ -11,7 +11,10 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = robomach::fuzz::WriteInput(data, size, ".yaml");
   try {
-    robomach::io::LoadRobotConfig(path);
+    const robomach::io::RobotConfig cfg = robomach::io::LoadRobotConfig(path);
+    // The model's sense checks of what the reader accepted (the tools run
+    // both: workflows::LoadRobotConfigChecked).
+    robomach::dynamics::JointPlausibilityFindings(cfg.description, cfg.parameters, cfg.joint_value_locations);
   } catch (const robomach::InputError& e) {
     robomach::fuzz::Rejected(e);
   }

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -436,7 +438,7 @@ TEST(IdentifyJointStiffness, NearTradeOffNamesThePartners) {
 TEST(IdentifyJointStiffness, InvalidOptionsNameTheField) {
   IdentificationOptions o;
   o.tracker_noise = -1.0;
-  EXPECT_THAT(testing::CaptureError([&] { CheckValid(o); }), HasSubstr("tracker_noise"));
+  EXPECT_THAT(testing::CaptureError([&] { o.Validate(); }), HasSubstr("tracker_noise"));
 }
 
 // One rule for a fit's and a plan's joints: rank-deficient (inf, NaN) is
@@ -459,6 +461,20 @@ TEST(Determination, RoundTripsThroughItsName) {
     EXPECT_EQ(ParseDetermination(ToString(d)), d) << ToString(d);
   }
   EXPECT_THROW(ParseDetermination("weak"), std::invalid_argument);
+}
+
+// Issue #36: every RobustLoss goes through its name (kq-identify's --robust)
+// and back; another name is refused naming all three.
+TEST(RobustLoss, RoundTripsThroughItsName) {
+  for (RobustLoss l : {RobustLoss::kNone, RobustLoss::kHuber, RobustLoss::kCauchy}) {
+    EXPECT_EQ(ParseRobustLoss(ToString(l)), l) << ToString(l);
+  }
+  try {
+    ParseRobustLoss("lts");
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "robust loss 'lts': expected none, huber or cauchy");
+  }
 }
 
 }  // namespace

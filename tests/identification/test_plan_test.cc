@@ -101,10 +101,10 @@ TEST(PlanLoadTests, AutomaticCandidateCount) {
   o.num_postures = 2;
   o.directions_per_posture = 1;
   o.masses_kg = {20.0};
-  EXPECT_NO_THROW(CheckValid(o));
+  EXPECT_NO_THROW(o.Validate());
   EXPECT_EQ(PlanLoadTests(*model, o).num_candidates, 400);
   o.num_candidate_postures = 1;
-  EXPECT_THROW(CheckValid(o), std::invalid_argument);
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
 }
 
 // A targeted plan (issue #37 §5): with the gradients of a quantity the user
@@ -124,7 +124,7 @@ TEST(PlanLoadTests, TargetedPlanNarrowsItsTargetMoreThanTheDOptimalOne) {
   Eigen::VectorXd g(6);
   g << 0.0, 0.35, -0.25, 0.0, 0.4, 0.0;
   const TestPlan d_optimal = PlanLoadTests(*model, o);
-  EXPECT_TRUE(d_optimal.flagged());  // joint 6 on the tool axis
+  EXPECT_TRUE(d_optimal.verdict.flagged());  // joint 6 on the tool axis
   o.target_gradients = g;
   o.target_half_width = 0.01;  // out of reach of 6 postures (±2.9 %)
   const TestPlan targeted = PlanLoadTests(*model, o);
@@ -146,13 +146,13 @@ TEST(PlanLoadTests, TargetedPlanNarrowsItsTargetMoreThanTheDOptimalOne) {
   // Variance as 1/k: 6 (2.85 / 1)² ≈ 49 postures.
   EXPECT_NEAR(targeted.postures_for_target_width_estimate,
               6 * std::pow(targeted.target_half_width_by_postures.back() / 0.01, 2), 1.0);
-  ASSERT_EQ(targeted.findings.size(), 1u);  // the band, not joint 6
-  EXPECT_NE(targeted.findings[0].message.find("postures would reach it"), std::string::npos)
-      << targeted.findings[0].message;
+  ASSERT_EQ(targeted.verdict.findings.size(), 1u);  // the band, not joint 6
+  EXPECT_NE(targeted.verdict.findings[0].message.find("postures would reach it"), std::string::npos)
+      << targeted.verdict.findings[0].message;
   // A band within reach: the first k postures reach it, no finding.
   o.target_half_width = targeted.target_half_width_by_postures[3] * 1.0001;
   const TestPlan reached = PlanLoadTests(*model, o);
-  EXPECT_FALSE(reached.flagged());
+  EXPECT_FALSE(reached.verdict.flagged());
   EXPECT_GE(reached.postures_for_target_width, 1);
   EXPECT_LE(reached.postures_for_target_width, 4);
   // Gradients of the wrong size are refused.

@@ -333,7 +333,7 @@ TEST(FrfCsv, RejectsNanAndBadDirectionAndQuantity) {
   const std::string dirn = WriteText(dir + "/dir.csv",
                                      "pose_id,response,excitation,freq_hz,re,im\nP1,q,x,1.0,1,0\n");
   EXPECT_THAT(CaptureError([&] { ReadFrfCsv(dirn); }),
-              HasSubstr("dir.csv:2: column response: expected x, y or z, got \"q\""));
+              HasSubstr("dir.csv:2: column response: direction 'q': expected x, y or z"));
   const std::string qty = WriteText(dir + "/q.csv",
                                     "# quantity: compliance\npose_id,response,excitation,freq_hz,re,im\n"
                                     "P1,x,x,1.0,1,0\n");
@@ -434,9 +434,9 @@ TEST(FrfUff58, NegativeDirectionCodesFlipTheSign) {
 // and a name that is not one is refused.
 TEST(FrfQuantity, RoundTripsThroughItsName) {
   for (FrfQuantity q : {FrfQuantity::kReceptance, FrfQuantity::kMobility, FrfQuantity::kAccelerance}) {
-    EXPECT_EQ(ParseQuantity(ToString(q)), q) << ToString(q);
+    EXPECT_EQ(ParseFrfQuantity(ToString(q)), q) << ToString(q);
   }
-  EXPECT_THROW(ParseQuantity("inertance"), std::invalid_argument);
+  EXPECT_THROW(ParseFrfQuantity("inertance"), std::invalid_argument);
 }
 
 }  // namespace

@@ -52,7 +52,17 @@ struct NamedReader {
 
 const std::vector<NamedReader>& Readers() {
   static const std::vector<NamedReader> readers = {
-      {"robot_config", [](const std::string& p) { return LoadRobotConfig(p).implausible; }},
+      {"robot_config",
+       [](const std::string& p) {
+         // The reader's findings, then the model's (joint frequencies, sag,
+         // damping), as the tools read a config (workflows::LoadRobotConfigChecked).
+         RobotConfig cfg = LoadRobotConfig(p);
+         for (const std::string& f : dynamics::JointPlausibilityFindings(cfg.description, cfg.parameters,
+                                                                         cfg.joint_value_locations)) {
+           cfg.implausible.push_back(f);
+         }
+         return cfg.implausible;
+       }},
       {"flexible_robot", [](const std::string& p) { return ReadFlexibleRobotFile(p).implausible; }},
       {"drill_file", [](const std::string& p) { return ReadDrillFile(p).implausible; }},
       {"cut_file", [](const std::string& p) { return ReadCutFile(p).implausible; }},

@@ -6,9 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <memory>
 #include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "robomach/common/units.h"
+#include "robomach/machine/kinematics_kinds.h"
 
 namespace robomach::machine {
 namespace {
@@ -150,6 +155,24 @@ TEST(NutatingHeadRotaryTable, RejectsBadGeometry) {
   NutatingHeadGeometry g;
   g.nutation = 0.0;
   EXPECT_THROW(NutatingHeadRotaryTable{g}, std::invalid_argument);
+}
+
+// Issue #36: the machine file's kinematics types are one registry; its one
+// kind builds this class from the geometry, and an unknown type is refused
+// naming the known ones.
+TEST(KinematicsKinds, BuildTheNutatingHeadByName) {
+  EXPECT_EQ(KinematicsKinds().Names(), (std::vector<std::string>{"nutating_head_rotary_table"}));
+  const NutatingHeadGeometry g = SeedLike(true);
+  const std::shared_ptr<const MachineKinematics> k = KinematicsKinds().Find("nutating_head_rotary_table")(g);
+  const auto* head = dynamic_cast<const NutatingHeadRotaryTable*>(k.get());
+  ASSERT_NE(head, nullptr);
+  EXPECT_EQ(head->geometry().pivot_length_error, g.pivot_length_error);
+  try {
+    KinematicsKinds().Find("table_table");
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "unknown kinematics type 'table_table': expected nutating_head_rotary_table");
+  }
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <set>
+#include <string>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -82,6 +84,26 @@ TEST(PathPatterns, CycloidRateKeepsTheFastestPointAtTheLimit) {
   EXPECT_EQ(z.MaxEdgeOverrun(p, process), 0.010);
   p.pattern = Pattern::kCycloid;
   EXPECT_EQ(MaxEdgeOverrun(p, process), c.MaxEdgeOverrun(p, process));
+}
+
+// Issue #36: every Pattern and GuideLines value goes through its name and
+// back; the registry's names are the enum's (a pattern's name() is
+// ToString of its id()); a name that is not one is refused naming them all.
+TEST(PathPatterns, EnumNamesRoundTripAndAgreeWithTheRegistry) {
+  for (Pattern p : {Pattern::kCycloid, Pattern::kParallel}) {
+    EXPECT_EQ(ParsePattern(ToString(p)), p) << ToString(p);
+    EXPECT_EQ(PathPatternOf(p).name(), ToString(p));
+    EXPECT_TRUE(PathPatternRegistry().Contains(ToString(p)));
+  }
+  EXPECT_EQ(PathPatternRegistry().Names(), (std::vector<std::string>{"cycloid", "parallel"}));
+  EXPECT_THAT(testing::CaptureError([] { ParsePattern("zigzag"); }),
+              HasSubstr("unknown path pattern 'zigzag': expected cycloid or parallel"));
+  for (GuideLines g : {GuideLines::kBoundaryOffsets, GuideLines::kParallelLines}) {
+    EXPECT_EQ(ParseGuideLines(ToString(g)), g) << ToString(g);
+  }
+  EXPECT_EQ(ToString(GuideLines::kBoundaryOffsets), "offsets");
+  EXPECT_THAT(testing::CaptureError([] { ParseGuideLines("lines"); }),
+              HasSubstr("guides 'lines': expected offsets or parallel"));
 }
 
 }  // namespace

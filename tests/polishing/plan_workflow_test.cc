@@ -38,7 +38,7 @@ TEST(PlanPolishing, ZigZagOnAPlateReachesItsTargetMean) {
   const PlanOutcome out = PlanPolishing(ctx, req);
   ASSERT_TRUE(out.target_given);
   EXPECT_TRUE(out.target.reached) << out.target.message;
-  EXPECT_FALSE(out.flagged());
+  EXPECT_FALSE(out.verdict.flagged());
   EXPECT_EQ(out.status(), RunStatus::kOk);
   EXPECT_FALSE(out.optimisation.has_value());
   EXPECT_FALSE(out.comparison.has_value());
@@ -77,8 +77,8 @@ TEST(PlanPolishing, TargetOutOfReachIsAFindingNotAnError) {
   const PlanOutcome low = PlanPolishing(ctx, req);
   EXPECT_FALSE(low.target.reached);
   EXPECT_EQ(low.status(), RunStatus::kFlagged);
-  ASSERT_EQ(low.findings.size(), 1u);
-  EXPECT_EQ(low.findings[0].message, low.target.message);
+  ASSERT_EQ(low.verdict.findings.size(), 1u);
+  EXPECT_EQ(low.verdict.findings[0].message, low.target.message);
   EXPECT_FALSE(low.target.message.empty());
   req.target_removal = 1.01 * at_limit;
   const PlanOutcome ok = PlanPolishing(ctx, req);

@@ -275,8 +275,8 @@ TEST(ComputeLobes, TapTestZoaAndSdAgreeAndTheCsvHoldsTheRows) {
   long progress_ends = 0;
   const LobesResult r = ComputeLobes(tips, o, [&](const Message& m) { said.push_back(m); },
                                      [&](const SdProgress& p) { progress_ends += p.finished; });
-  EXPECT_FALSE(r.flagged());
-  EXPECT_TRUE(r.findings.empty());
+  EXPECT_FALSE(r.verdict.flagged());
+  EXPECT_TRUE(r.verdict.findings.empty());
   EXPECT_EQ(progress_ends, 1);
   int zoa = 0, sd = 0;
   for (const LobeRow& row : r.rows) {
@@ -400,7 +400,7 @@ TEST(ComputeLobes, ZoaOnAHammerTestsLinesFindsTheLobeBetweenThem) {
   ASSERT_EQ(r.zoa_fit_checks.size(), 1u);
   EXPECT_TRUE(r.zoa_fit_checks[0].agree) << r.zoa_fit_checks[0].relative_difference;
   EXPECT_NEAR(r.zoa_fit_checks[0].fit_min_depth, reference, 0.02 * reference);
-  EXPECT_FALSE(r.flagged()) << (r.findings.empty() ? std::string() : r.findings[0].message);
+  EXPECT_FALSE(r.verdict.flagged()) << (r.verdict.findings.empty() ? std::string() : r.verdict.findings[0].message);
 }
 
 // The check of the ZOA on the measured FRF against the ZOA on its fitted
@@ -437,7 +437,7 @@ TEST(ComputeLobes, ZoaOnMeasuredAndOnFitDisagreeingIsAFinding) {
   ASSERT_EQ(r.zoa_fit_checks.size(), 1u);
   EXPECT_FALSE(r.zoa_fit_checks[0].agree);
   EXPECT_GT(r.zoa_fit_checks[0].relative_difference, 1.0);
-  EXPECT_TRUE(r.flagged());
+  EXPECT_TRUE(r.verdict.flagged());
   bool warned = false;
   for (const Message& m : said) {
     warned |= m.kind == Message::Kind::kWarning && m.text.find("fitted modes") != std::string::npos &&

@@ -134,10 +134,14 @@ struct ErrorPatternOptions {
   /// A posture fails if its error exceeds this factor × AuditResult::noise_floor
   /// (AuditOptions::significance_factor, same default).
   double significance_factor{AuditOptions{}.significance_factor};
-};
 
-/// @throws std::invalid_argument naming the field for a bad option.
-void CheckValid(const ErrorPatternOptions& options);
+  /// 0 <= fmin_hz < fmax_hz; matching.min_relative_visibility in (0, 1];
+  /// matching.max_log_freq_ratio > 0; matching.direction_weight >= 0;
+  /// significance_factor >= 1; significance_level in (0, 1).
+  /// @throws OptionError naming the field ("matching.direction_weight"), its
+  ///   value and the bound.
+  void Validate() const;
+};
 
 /// Everything of this header for one audit.
 struct ErrorPatterns {

@@ -118,10 +118,18 @@ struct AuditOptions {
   double uncertainty_confidence{0.95};
   /// Called with one line per step (for progress on stderr); may be empty.
   std::function<void(const std::string&)> progress;
-};
 
-/// @throws std::invalid_argument naming the field for a bad option.
-void CheckValid(const AuditOptions& options);
+  /// calibration_parameters not empty; 0 <= fmin_hz < fmax_hz; num_bands,
+  /// max_iterations and threads >= 1; significance_factor and
+  /// explained_factor > 1; mostly_explained_fraction in (0, 1];
+  /// clear_bic_gap >= 0; fit_line_stride, parameter_pairs_from and
+  /// virtual_joints_fitted >= 0; identifiable_chi2 finite and >= 0;
+  /// robust_scale finite and >= 0; uncertainty_confidence in (0, 1); the
+  /// parameter_uncertainty (if any) valid (dynamics::CheckValid).
+  /// @throws OptionError naming the field, its value and the bound
+  ///   ("AuditOptions::num_bands must be >= 1, got 0").
+  void Validate() const;
+};
 
 /// Band of one FRF with its rms log-magnitude error.
 struct BandError {

@@ -99,6 +99,11 @@ struct MatchOptions {
   /// Weight of |ln(visibility ratio)| (the tool-tip direction term) against
   /// |ln(frequency ratio)| in the matching cost.
   double direction_weight{0.25};
+
+  /// min_relative_visibility in (0, 1]; max_log_freq_ratio > 0;
+  /// direction_weight finite and >= 0.
+  /// @throws OptionError naming the field, its value and the bound.
+  void Validate() const;
 };
 
 /// A measured mode paired with a model mode of the same posture.
@@ -244,6 +249,15 @@ struct CalibrationOptions {
   /// - [Huber 1964] P. J. Huber, Robust estimation of a location parameter,
   ///   Ann. Math. Statist. 35(1), 73-101, 1964.
   double robust_scale{0.0};
+
+  /// free_parameters not empty (their names are checked against the model
+  /// by Calibrate); matching and modal_fit valid (their fields named
+  /// "matching.direction_weight", "modal_fit.max_order"); freq_sigma and
+  /// peak_sigma > 0; 0 <= fmin_hz < fmax_hz; max_iterations and
+  /// max_match_rounds >= 1; weak_relative_std > 0; robust_scale finite and
+  /// >= 0 (0: no robust loss).
+  /// @throws OptionError naming the field, its value and the bound.
+  void Validate() const;
 };
 
 /// kNotImproved: no start lowered the whole-curve misfit below that of the
@@ -370,8 +384,12 @@ inline constexpr double kCalibrationMisfitFlagNoiseUnits = 1.3;
 /// parameter is weakly identified, or - when every measured FRF carries a
 /// noise model, so that the misfit is a chi^2 - the rms residual exceeds
 /// kCalibrationMisfitFlagNoiseUnits (the model cannot represent the data with
-/// its free parameters: another effect, another robot).
-struct CalibrationVerdict : RunFindings {
+/// its free parameters: another effect, another robot). The findings are in
+/// `verdict` (as in every result, issue #36); beside them, the misfit they
+/// were judged on.
+struct CalibrationVerdict {
+  RunFindings verdict;
+  RunStatus status() const { return verdict.status(); }
   int residuals{0};  // two per measured line in the band
   /// sqrt(misfit_final / residuals) with noise models; NaN without.
   double rms_per_residual_in_noise_units{NAN};

@@ -93,10 +93,16 @@ struct FrfEstimateOptions {
   /// Truncating a decay that is still at a fraction ε of its start changes
   /// the FRF at its resonance by about ε.
   double leakage_fraction{0.005};
-};
 
-/// @throws std::invalid_argument naming the field, its value and the bound.
-void CheckValid(const FrfEstimateOptions& options);
+  /// force_window_s finite; force_window_pre_s, force_window_taper_s,
+  /// exponential_tau_s, fmax_hz, force_range_N and each response_range
+  /// finite and >= 0; trigger_fraction in (0, 1); double_hit_fraction in
+  /// [trigger_fraction, 1); flat_top_samples >= 2; leakage_fraction in (0, 1).
+  /// @throws OptionError naming the field, its value and the bound
+  ///   ("FrfEstimateOptions::exponential_tau_s = -1: expected >= 0 [s] ...";
+  ///   field() "response_range" for an entry of it).
+  void Validate() const;
+};
 
 enum class HitStatus { kAccepted, kDoubleHit, kOverload };
 /// "accepted", "double hit", "overload".

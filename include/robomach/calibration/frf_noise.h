@@ -101,10 +101,15 @@ struct NoiseOptions {
   /// whose neighbours the local model does not describe (reduced χ² above
   /// 4) is not judged at all.
   int max_outlier_run_lines{3};
-};
 
-/// @throws std::invalid_argument naming the field for a bad option.
-void CheckValid(const NoiseOptions& options);
+  /// min_snr finite and > 0; averages >= 0; knots_per_octave in (0, 8];
+  /// max_gap_lines >= 0; min_run_lines >= 1; outlier_threshold finite and
+  /// >= 3; outlier_threshold_off_mains finite and >= outlier_threshold;
+  /// outlier_window_lines in [4, 64]; max_outlier_run_lines >= 1.
+  /// @throws OptionError naming the field first, with the bound and the
+  ///   value ("NoiseOptions: min_snr must be finite and > 0, got -1").
+  void Validate() const;
+};
 
 enum class NoiseSource { kCoherence, kScatter };
 std::string ToString(NoiseSource s);  // "coherence", "scatter"

@@ -105,6 +105,18 @@ struct GlobalModalFitOptions {
   /// soft-mounted structure, or modes below the band) only if the Bayesian
   /// information criterion falls with it; above a fifth it always has one.
   bool lower_residual_by_bic{true};
+
+  /// The bounds: 0 <= fmin_hz < fmax_hz (fmax_hz may be inf); min_order >=
+  /// 2 and max_order >= min_order + 2 (the diagram's fewest orders; a band
+  /// with too few lines for them is the data's, a status of the fit);
+  /// stable_freq_tol, stable_damping_tol and cluster_freq_tol > 0;
+  /// min_stable_orders >= 1; min_cluster_fraction in [0, 1];
+  /// max_damping_ratio in (0, 1]; min_relative_contribution >= 0;
+  /// max_added_modes, dense_modes and max_modes_per_band >= 0;
+  /// uniform_weights_power and model_error_power in [-1, 2]; driving_point
+  /// >= -1; model_error_ratio > 0.
+  /// @throws OptionError naming the field, its value and the bound.
+  void Validate() const;
 };
 
 /// One mode of the global fit.

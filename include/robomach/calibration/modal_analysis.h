@@ -37,8 +37,13 @@ struct ModalAnalysisOptions {
   /// quantity added to σ (GlobalModalFitOptions::model_error_power).
   bool model_error{true};
   /// A posture's FRFs are fitted together only if at least this many lines
-  /// are usable in all of them; else each alone, with a warning.
+  /// are usable in all of them; else each alone, with a warning. >= 0.
   int min_common_lines{40};
+
+  /// fit valid (GlobalModalFitOptions::Validate, its fields named
+  /// "fit.max_order", ...); min_common_lines >= 0.
+  /// @throws OptionError naming the field, its value and the bound.
+  void Validate() const;
 };
 
 /// One tool-tip mode of a posture from the direct FRFs' modal constants:
@@ -100,6 +105,20 @@ struct RovingShapes {
 /// The shapes of `group` if it is a roving test (several FRFs with one end
 /// in common); otherwise nullopt with the reason in `why`.
 std::optional<RovingShapes> ShapesOfRovingTest(const ModalGroup& group, std::string* why = nullptr);
+
+/// The shapes of one fit of a posture that is a roving test.
+struct FitRovingShapes {
+  size_t pose{0};  // index in the postures
+  size_t fit{0};   // index in that posture's groups
+  RovingShapes shapes;
+};
+
+/// The shapes of every converged fit of `poses` that is a roving test
+/// (ShapesOfRovingTest), posture by posture and fit by fit: frf-modes'
+/// --shapes. A converged fit that is no roving test adds "posture P, fit N:
+/// no mode shapes: why" (N from 1) to `notes`.
+std::vector<FitRovingShapes> ShapesOfRovingTests(const std::vector<PoseModes>& poses,
+                                                 std::vector<std::string>* notes = nullptr);
 
 /// The tool-tip modes from one fit's direct and cross FRFs (see TipMode).
 /// With point numbers, only the FRFs between the driving point's point and

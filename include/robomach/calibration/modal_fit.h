@@ -20,10 +20,14 @@ namespace robomach::calibration {
 // ------------------------------------------------------------ peak picking --
 
 struct PeakPickOptions {
-  /// A peak must reach this fraction of the largest |H| in the FRF.
+  /// A peak must reach this fraction of the largest |H| in the FRF, in [0, 1].
   double min_relative_height{0.05};
-  /// A peak must be the largest |H| within ± this many lines.
+  /// A peak must be the largest |H| within ± this many lines, >= 1.
   int half_window_lines{3};
+
+  /// @throws OptionError naming the field, its value and the bound
+  ///   ("min_relative_height: expected a value in [0, 1], got 2").
+  void Validate() const;
 };
 
 /// One resonance found by peak picking.
@@ -71,6 +75,14 @@ struct ModalFitOptions {
   /// At most this many modes are added where the refined fit's residual is
   /// structured rather than noise (see FitModes).
   int max_added_modes{4};
+
+  /// The bounds: 0 <= fmin_hz < fmax_hz (fmax_hz may be inf); min_order
+  /// >= 1 and max_order >= min_order (a band with too few lines for the
+  /// orders is the data's, a status of the fit); stable_freq_tol and
+  /// stable_damping_tol > 0; min_stable_orders >= 1; max_damping_ratio in
+  /// (0, 1]; min_relative_contribution >= 0; max_added_modes >= 0.
+  /// @throws OptionError naming the field, its value and the bound.
+  void Validate() const;
 };
 
 /// One identified mode of a single FRF H_re, with the pole λ and residue R

@@ -65,10 +65,17 @@ struct VirtualHammerOptions {
   /// Round values to 13 significant digits (UFF58's E20.12) so CSV and UFF58
   /// copies of the data hold identical numbers.
   bool round_to_uff_precision{true};
-};
 
-/// @throws std::invalid_argument naming the field for a bad option.
-void CheckValid(const VirtualHammerOptions& options);
+  /// sample_rate_hz > 0; block_samples >= 2; 0 < fmin_hz < fmax_hz <=
+  /// sample_rate_hz / 2 with at least one line of spacing sample_rate_hz /
+  /// block_samples between them; the noise rms values and hammer_cutoff_hz
+  /// finite and >= 0; averages >= 1 (>= 2 with coherence); directions not
+  /// empty.
+  /// @throws OptionError naming the field first, with its value and the
+  ///   bound ("VirtualHammerOptions: fmax_hz 500000: above the Nyquist
+  ///   frequency 2560 Hz of sample_rate_hz 5120").
+  void Validate() const;
+};
 
 /// The sample rate a robot config gives its hammer tests (the value
 /// `hammer_test.sample_rate_hz`), else `fallback` [Hz]: frf-synth's default.

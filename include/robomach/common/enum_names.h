@@ -3,11 +3,15 @@
 // file, a summary, a message or a tool's option names has one printer
 // `ToString(E)` and one parser `ParseE(name)` in its module's header. The
 // parsers are written with ParseByName below, so they accept exactly the
-// printer's spellings and name them all when they refuse one.
+// printer's spellings and name them all when they refuse one. It is the
+// enum case of the name-keyed registry (named_registry.h): the same refusal,
+// "<what> '<name>': expected a, b or c" (ThrowUnknownName).
 
 #include <cstddef>
-#include <stdexcept>
 #include <string>
+#include <vector>
+
+#include "robomach/common/named_registry.h"
 
 namespace robomach {
 
@@ -19,11 +23,9 @@ E ParseByName(const std::string& what, const std::string& name, const E (&all)[N
   for (E e : all) {
     if (name == ToString(e)) return e;
   }
-  std::string expected;
-  for (std::size_t i = 0; i < N; ++i) {
-    expected += (i == 0 ? "" : (i + 1 == N ? " or " : ", ")) + std::string(ToString(all[i]));
-  }
-  throw std::invalid_argument(what + " '" + name + "': expected " + expected);
+  std::vector<std::string> names;
+  for (E e : all) names.emplace_back(ToString(e));
+  ThrowUnknownName(what, name, NameListOf(names));
 }
 
 }  // namespace robomach

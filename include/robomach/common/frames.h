@@ -17,10 +17,34 @@
 // Every 6-vector of the library (twists, wrenches, Jacobian rows) is ordered
 // [linear; angular].
 
+#include <cctype>
+#include <string>
+#include <vector>
+
+#include "robomach/common/named_registry.h"
+
 namespace robomach {
 
 enum class Axis { kX = 0, kY = 1, kZ = 2 };
 
 inline char AxisName(Axis a) { return "xyz"[static_cast<int>(a)]; }
+
+/// The one printer and parser of a direction's name (issue #36 "one
+/// vocabulary"): "x", "y", "z", as every file, option and Python names it.
+inline std::string ToString(Axis a) { return std::string(1, AxisName(a)); }
+
+/// "x", "y" or "z"; a capital too ("X", as UFF58 and users write it).
+/// @throws std::invalid_argument "direction 'w': expected x, y or z".
+inline Axis ParseAxis(const std::string& name) {
+  static constexpr Axis kAll[] = {Axis::kX, Axis::kY, Axis::kZ};
+  std::string key = name;
+  if (key.size() == 1) key[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(key[0])));
+  std::vector<std::string> names;
+  for (Axis a : kAll) {
+    if (key == ToString(a)) return a;
+    names.push_back(ToString(a));
+  }
+  ThrowUnknownName("direction", name, NameListOf(names));
+}
 
 }  // namespace robomach

@@ -6,9 +6,26 @@
 // apps::CheckOptionRange), so a range or a sense finding reads the same
 // whichever layer makes it.
 
+#include <map>
 #include <string>
 
 namespace robomach {
+
+/// How an options struct's findings and messages name its fields: a tool
+/// puts its options in `names` ("fmax_hz" -> "--fmax-hz"), Python the
+/// keywords that differ from the fields; a field not in it goes by its own
+/// name. The errors (OptionError) name the fields themselves, for the caller
+/// to map (apps::FromFields). The options structs derive from it
+/// (workflows::FrfSynthOptions, TrackerSynthOptions, AxisSynthOptions):
+///
+///   struct FooOptions : FieldNames { double fmax_hz{5000.0}; ... };
+///   finding(ImplausibleOption(o.Name("fmax_hz"), o.fmax_hz, ...));
+struct FieldNames {
+  std::map<std::string, std::string> names;  // field -> how the messages name it
+
+  /// names[field], or `field` itself when it has no entry.
+  std::string Name(const std::string& field) const;
+};
 
 /// @throws OptionError(field, "FIELD: expected a value in [LO, HI], got
 /// VALUE") unless lo <= value <= hi (a NaN is outside). The numbers as a

@@ -23,8 +23,10 @@ struct ParallelForOptions {
   /// about every 20 ms while the loop runs, and once with (total, total) at
   /// the end of a loop that did not throw.
   ProgressCallback progress;
-  /// "threads: expected >= 0, got -1" style message, or empty if valid.
-  std::string Validate() const;
+  /// @throws OptionError naming the field, its value and the bound
+  /// ("threads: expected >= 0 (0 = all cores), got -1"): threads >= 0,
+  /// chunk_size >= 0.
+  void Validate() const;
 };
 
 /// The thread count `threads` stands for (0 = hardware_concurrency, at least 1).
@@ -49,7 +51,8 @@ int ResolveThreadCount(int threads);
 /// evaluations, audit candidate fits, row formatting), so no global state is
 /// worth it. A body may itself call ParallelFor (the threads multiply; no
 /// pool to deadlock on).
-/// @throws std::invalid_argument if the options are invalid (see Validate).
+/// @throws OptionError if the options are invalid (Validate's, its message
+///   prefixed with "ParallelFor: ").
 void ParallelForChunks(long begin, long end,
                        const std::function<void(long first, long last, int thread)>& body,
                        const ParallelForOptions& options = {});

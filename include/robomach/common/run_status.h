@@ -4,9 +4,10 @@
 // that cannot run throws (InputError, std::invalid_argument, ...); one that
 // ran returns its best answer with a status:
 //   kOk       every check the workflow makes passed;
-//   kFlagged  the result is there but doubtful, and `findings` says why, one
-//             sentence each (a posture outside its joint limits, a fit that
-//             misses the data, a value in an implausible unit, ...).
+//   kFlagged  the result is there but doubtful, and its `verdict.findings`
+//             (RunFindings below) say why, one sentence each (a posture
+//             outside its joint limits, a fit that misses the data, a value
+//             in an implausible unit, ...).
 // The tools print each finding as a warning and exit 3 when flagged
 // (apps/cli_support: ExitCodeFor).
 #include <string>
@@ -30,7 +31,13 @@ struct Finding {
   int input_index{-1};
 };
 
-/// The status part of a workflow's Result.
+/// The verdict on a result: its findings and so its status. The one way to
+/// carry findings (issue #36): a verdict is a value. A result that can be
+/// flagged holds it as a member `RunFindings verdict;` (never as a base), with
+/// `status()` forwarding to `verdict.status()` for its callers; a Judge*()
+/// function returns a RunFindings, which the workflow stores in its
+/// `verdict`. Code adds a finding with `result.verdict.Flag(...)` and reads
+/// them in `result.verdict.findings`.
 struct RunFindings {
   std::vector<Finding> findings;
 

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "robomach/common/named_registry.h"
 #include "robomach/drilling/controllers.h"
 
 namespace robomach::drilling {
@@ -38,13 +39,18 @@ class ControllerKind {
   virtual bool uses_time_delay_estimation() const { return false; }
 };
 
+/// Every kind by name, in a fixed order (pid, pd, pd-tdc); the functions
+/// below are this registry's.
+const NamedRegistry<const ControllerKind*>& ControllerKindRegistry();
+
 /// Every kind, in a fixed order (pid, pd, pd-tdc).
 const std::vector<const ControllerKind*>& ControllerKinds();
 
 /// "pid, pd or pd-tdc".
 std::string ControllerKindList();
 
-/// The kind called `name`. @throws std::invalid_argument naming the known kinds.
+/// The kind called `name`. @throws std::invalid_argument "unknown controller
+/// kind 'NAME': expected pid, pd or pd-tdc".
 const ControllerKind& FindControllerKind(const std::string& name);
 
 }  // namespace robomach::drilling

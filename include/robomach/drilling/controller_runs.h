@@ -28,6 +28,15 @@ struct ControllerRunOptions {
   int tune_evaluations{30};  // drill-sim's default
   /// Per joint [N·m].
   Eigen::VectorXd motor_torque_limit;
+
+  /// The bounds (issue #36); the size of motor_torque_limit is
+  /// RunControllers' check (it needs the scenario):
+  /// - kinds: each a ControllerKinds() name (OptionError "kinds", "unknown
+  ///   controller kind 'NAME': expected pid, pd or pd-tdc").
+  /// - tune_evaluations >= 1 when tune: NLopt takes a budget <= 0 as none.
+  /// - motor_torque_limit, each >= 0 and finite [N m] (SimOptions::Validate's).
+  /// @throws OptionError(field, "FIELD: expected ..., got VALUE") naming the bound.
+  void Validate() const;
 };
 
 /// One controller's run.

@@ -73,6 +73,11 @@ void CheckValid(const DrillingMaterial& material);
 struct ForceModelOptions {
   int num_elements{100};      // oblique-cutting elements per lip (midpoint rule in r)
   bool dynamic_rake{true};   // add the feed-velocity angle to the rake (Minukhin 2013)
+
+  /// The bounds (issue #36):
+  /// - num_elements >= 1: the midpoint rule needs one element.
+  /// @throws OptionError(field, "FIELD: expected a value >= LO, got VALUE").
+  void Validate() const;
 };
 
 /// The oblique-cutting quantities of one lip element at radius r (seed 003

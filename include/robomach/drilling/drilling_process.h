@@ -1,5 +1,7 @@
 #pragma once
 
+#include <string>
+
 #include <Eigen/Core>
 
 #include "robomach/common/units.h"
@@ -8,6 +10,12 @@ namespace robomach::drilling {
 
 /// Which axis of the tool-tip frame (at the initial posture) the hole runs along.
 enum class HoleAxis { kTipX, kTipY, kTipZ };
+
+/// "tip_x", "tip_y", "tip_z" (a drill file's process.hole_axis, formats.md §9.2).
+const char* ToString(HoleAxis a);
+/// The inverse of ToString. @throws std::invalid_argument "hole axis
+/// 'NAME': expected tip_x, tip_y or tip_z".
+HoleAxis ParseHoleAxis(const std::string& name);
 
 /// The drilling scenario of formats.md §9.2 (`process:`, `offset:`,
 /// `simulation:`), SI and radians.

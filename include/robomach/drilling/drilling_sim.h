@@ -58,6 +58,15 @@ struct SimOptions {
   double max_omega_h{0.07};             // RK4 substep rule (Rk4Integrator)
   bool record{true};                   // keep the time series (tuning does not need it)
   ProgressCallback progress;           // called every ~1 % of the run
+
+  /// The bounds (issue #36); the size of motor_torque_limit is the run's
+  /// check (it needs the robot):
+  /// - motor_torque_limit, each >= 0 and finite [N m]: the controllers
+  ///   saturate at it.
+  /// - max_omega_h in (0, 2.8]: it divides the substep count, and RK4 is
+  ///   stable on an undamped mode up to omega h = 2 sqrt 2 = 2.83.
+  /// @throws OptionError(field, "FIELD: expected ..., got VALUE") naming the bound.
+  void Validate() const;
 };
 
 /// The seed's scenario: the robot starts at rest in static equilibrium at

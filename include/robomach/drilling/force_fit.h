@@ -40,6 +40,12 @@ struct ForceFitOptions {
   bool fit_kienzle_exponent{true};   // false: keep initial.kienzle_exponent
   int max_iterations{200};
   ForceModelOptions model;
+
+  /// The bounds (issue #36):
+  /// - max_iterations >= 1: Ceres' iteration budget, 0 fits nothing.
+  /// - model: ForceModelOptions::Validate, its fields named "model.FIELD".
+  /// @throws OptionError(field, "FIELD: expected a value >= LO, got VALUE").
+  void Validate() const;
 };
 
 struct ForceFitResult {

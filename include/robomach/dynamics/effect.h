@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "robomach/common/eigen_types.h"
+#include "robomach/common/named_registry.h"
 #include "robomach/dynamics/parameters.h"
 
 namespace robomach::dynamics {
@@ -123,7 +124,9 @@ class EffectRegistry {
   std::vector<std::string> FamilyPatterns() const;
 
  private:
-  std::vector<std::pair<std::string, Factory>> factories_;
+  // The single effects by name (the one registry idiom, named_registry.h);
+  // the families, which match a name by pattern, stay a list.
+  NamedRegistry<Factory> factories_{"unknown effect"};
   std::vector<std::pair<std::string, FamilyFactory>> families_;
 };
 

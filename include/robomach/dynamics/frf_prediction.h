@@ -34,9 +34,14 @@ struct NamedPosture {
 };
 
 struct PredictOptions {
+  /// kModal or kDirect (a value cast from another integer is refused).
   ReceptanceMethod method{ReceptanceMethod::kModal};
   /// Called after each posture with (postures done, postures in all).
   std::function<void(long, long)> progress;
+
+  /// @throws OptionError("method", "method: expected modal (0) or direct
+  ///   (1), got N") for a method that is neither.
+  void Validate() const;
 };
 
 struct PosturePredictionResult {
@@ -63,7 +68,9 @@ inline constexpr double kMaxPlausibleFmaxHz = 50000.0;
 /// postures x 800 000 lines made a 2.28 GB CSV).
 inline constexpr double kMaxFrequencyLines = 200000.0;
 
-struct FrfPredictionResult : RunFindings {
+struct FrfPredictionResult {
+  RunFindings verdict;
+  RunStatus status() const { return verdict.status(); }
   std::vector<PosturePredictionResult> postures;  // in the order given
 };
 

@@ -56,6 +56,14 @@ struct PostureOptions {
   /// Mode::damping_ratio (with modes), and complex_modes when the damping is
   /// not proportional. ReceptanceModal needs them.
   bool damping_ratios{true};
+
+  /// Every combination of the flags is valid (an output that needs another,
+  /// modal_masses without modes, is simply not computed; ReceptanceModal
+  /// refuses dynamics without damping ratios where it is called): nothing
+  /// to check. Declared so that every options struct has a Validate()
+  /// (issue #36); PostureEvaluator::Evaluate, called per posture in the
+  /// maps' inner loops, does not call it.
+  void Validate() const;
 };
 
 /// Everything that depends on the posture q. Plain data, cheap to copy.

@@ -103,10 +103,13 @@ struct PropagationOptions {
   /// `linearisation` (Propagate) it applies to that; f's own differences,
   /// where the local model does not reach, are always central.
   bool central_differences{true};
-};
 
-/// @throws std::invalid_argument naming the field and its bound.
-void CheckValid(const PropagationOptions& o);
+  /// confidence in (0, 1); samples in [100, 10 000 000];
+  /// nonlinearity_tolerance in (0, 1].
+  /// @throws OptionError naming the field, its bound and value
+  ///   ("confidence: expected a level in (0, 1), got 95 (a percentage? ...)").
+  void Validate() const;
+};
 
 /// One output's value at the estimate and its interval.
 struct OutputInterval {

@@ -16,6 +16,12 @@ namespace robomach::identification {
 
 enum class RobustLoss { kNone, kHuber, kCauchy };
 
+/// "none", "huber", "cauchy" (kq-identify's --robust).
+const char* ToString(RobustLoss l);
+/// The inverse of ToString. @throws std::invalid_argument "robust loss
+/// 'NAME': expected none, huber or cauchy".
+RobustLoss ParseRobustLoss(const std::string& name);
+
 /// Options of IdentifyJointStiffness. Defaults in the header (style §2.2).
 struct IdentificationOptions {
   /// Tracker noise, 1 sigma per measured coordinate [m]. A displacement is
@@ -39,10 +45,14 @@ struct IdentificationOptions {
   /// IdentifyJointStiffness), never a large but finite uncertainty.
   double weak_relative_std{0.1};
   int max_iterations{100};
-};
 
-/// @throws std::invalid_argument naming the field and the violated bound.
-void CheckValid(const IdentificationOptions& options);
+  /// tracker_noise finite and > 0; loss_scale > 0; outlier_false_alarm in
+  /// (0, 1); weak_relative_std > 0; max_iterations >= 1.
+  /// @throws OptionError naming the field, the violated bound and the value
+  ///   ("IdentificationOptions::tracker_noise: expected a finite value > 0
+  ///   m, got -1").
+  void Validate() const;
+};
 
 /// Outcome of the solver (style §2.9): the library's one solver status
 /// (kNotImproved does not occur here).

@@ -57,10 +57,16 @@ struct PlanOptions {
   /// how many of its postures reach it.
   double target_half_width{0.0};
   double target_confidence{0.95};
-};
 
-/// @throws std::invalid_argument naming the field and the violated bound.
-void CheckValid(const PlanOptions& options);
+  /// num_postures, directions_per_posture and num_azimuths >= 1; masses_kg
+  /// not empty, each > 0; tracker_noise > 0; max_rope_angle in [0, pi/2);
+  /// num_candidate_postures 0 or >= num_postures; joint_limit_margin >= 0;
+  /// weak_relative_std > 0; target_gradients finite; target_half_width
+  /// finite and >= 0; target_confidence in (0, 1).
+  /// @throws OptionError naming the field, the violated bound and the value
+  ///   ("PlanOptions::num_postures: expected at least 1, got 0").
+  void Validate() const;
+};
 
 /// Whether a plan must determine `joint` (0-based): always for a D-optimal
 /// plan; for a targeted one when some target's gradient on it exceeds 1e-3
@@ -76,10 +82,12 @@ struct PlannedLoad {
   Eigen::Vector3d p_pulley;            // where the rope meets the floor, in B [m]
 };
 
-/// Flagged (RunFindings, kq-identify --plan's exit 3) with one finding per
+/// Flagged (its `verdict`, kq-identify --plan's exit 3) with one finding per
 /// joint the planned tests cannot determine; weakly determined joints are in
 /// expected_determination, not findings (more postures fix them).
-struct TestPlan : RunFindings {
+struct TestPlan {
+  RunFindings verdict;
+  RunStatus status() const { return verdict.status(); }
   std::vector<PlannedLoad> loads;        // num_postures × directions_per_posture
   std::vector<LoadCase> cases;           // the loads with every mass (no displacement)
   double log_det_information{NAN};       // D-optimality index, log det I (θ = log k)

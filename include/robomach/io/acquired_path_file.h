@@ -1,6 +1,8 @@
 #pragma once
-// Acquired path (formats.md §8.5): rows, and axis-acquire's pipelined main loop.
-// The writer converts back for the file: m -> mm, rad -> deg.
+// Acquired path (formats.md §8.5): the header and one row at a time (the
+// acquisition that computes the rows is workflows::WriteAcquiredPath), and
+// axis-acquire's contour summary. The writer converts back for the file: m
+// -> mm, rad -> deg.
 
 #include <ostream>
 #include <string>
@@ -9,11 +11,13 @@
 #include <nlohmann/json.hpp>
 
 #include "robomach/machine/acquisition.h"
-#include "robomach/machine/synthesis.h"
 
 namespace robomach::io {
 
-/// Acquired path rows (formats.md §8.5), 17 significant digits.
+/// Acquired path rows (formats.md §8.5), 17 significant digits: the
+/// constructor writes the header (with the contour columns if
+/// `contour_columns`), Row one row; all or nothing is the caller's stream
+/// (io::WriteFileAtomically).
 class AcquiredPathWriter {
  public:
   AcquiredPathWriter(std::ostream& out, const std::vector<machine::AxisScale>& axes,
@@ -30,22 +34,19 @@ class AcquiredPathWriter {
   std::string buffer_;
 };
 
-/// axis-acquire's main loop: every row of `record` through `acquisition`
-/// (and `tracker`, if not null) to the acquired path (formats.md §8.5,
-/// header included) on `out`. Rows are computed in order (the tracker follows
-/// the path) while earlier chunks are formatted and written on `threads`
-/// threads (io::WritePipelined). With a tracker, the contour error of every
-/// row is returned (for the statistics and the plot).
-std::vector<machine::ContourError> WriteAcquiredPath(std::ostream& out, const machine::CountsRecord& record,
-                                                     const std::vector<machine::AxisScale>& axes,
-                                                     machine::Acquisition* acquisition,
-                                                     machine::ContourTracker* tracker, int threads = 2);
+/// The contour figures of axis-acquire's summary, computed by the caller
+/// (workflows::ContourFiguresOf; issue #36: io writes them).
+struct ContourFigures {
+  machine::SeriesStats contour_error_um;  // of the contour error [um]
+  machine::SeriesStats axis_error_deg;    // of the tool axis error [deg]
+  double path_length_mm{0.0};             // the programmed path's length
+  double covered_min_mm{0.0}, covered_max_mm{0.0};  // the part of it the run covered (0, 0 without rows)
+};
 
 /// The contour part of axis-acquire's summary (docs/formats.md §4.1): the
 /// statistics (max, mean, rms, std) of the contour error [um] and of the
 /// tool axis error [deg], the programmed path's length and the part of it
 /// the run covered [mm].
-nlohmann::json ContourSummaryJson(const std::vector<machine::ContourError>& contour,
-                                  const machine::ProgrammedPath& path);
+nlohmann::json ContourSummaryJson(const ContourFigures& figures);
 
 }  // namespace robomach::io

@@ -21,6 +21,10 @@ struct CadReadOptions {
   /// Multiplies every length as read (after OpenCASCADE's conversion of the
   /// file's unit to mm): 1000 for a file that says mm but holds metres.
   double unit_scale{1.0};
+
+  /// @throws OptionError naming the field, its value and the bound:
+  /// unit_scale finite > 0 (a length scale).
+  void Validate() const;
 };
 
 /// What the reader saw of the whole file (for the units plausibility check).

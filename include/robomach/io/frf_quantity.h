@@ -24,7 +24,7 @@ std::string QuantityUnit(FrfQuantity q);
 /// "an accelerance".
 std::string QuantityWithArticle(FrfQuantity q);
 /// @throws std::invalid_argument for anything else.
-FrfQuantity ParseQuantity(const std::string& name);
+FrfQuantity ParseFrfQuantity(const std::string& name);
 
 /// Converts one line of `quantity` to receptance and back.
 /// ω = 2π f must be > 0 for mobility and accelerance.

@@ -12,11 +12,17 @@ struct KqYamlOptions {
   /// `joint_stiffness_Nm_per_rad: [...]` line.
   bool as_parameters{false};
   std::vector<std::string> header_comments;   // written first, each prefixed by "# "
+
+  /// @throws OptionError naming the field and the value: every
+  /// header_comments entry is one line (no line break: the text after one
+  /// would not be a comment, and the YAML would not parse).
+  void Validate() const;
 };
 
 /// The identified stiffness as YAML that can be pasted into a robot config,
 /// with the uncertainty, determination and correlation as comments. Joints
 /// that are not determined keep their prior value and say so in a comment.
+/// @throws OptionError for bad options (KqYamlOptions::Validate).
 std::string JointStiffnessYaml(const identification::JointStiffnessResult& result,
                                const KqYamlOptions& options = {});
 

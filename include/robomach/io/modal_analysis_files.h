@@ -26,12 +26,14 @@ std::string ModalTableCsv(const std::vector<calibration::PoseModes>& poses);
 std::string ModalConstantsCsv(const std::vector<calibration::PoseModes>& poses);
 
 /// `pose_id,fit,mode,freq_hz,damping_ratio,point,direction,shape_re,
-/// shape_im,shape_unit,roving,fixed_point,fixed_direction`: the mode shape
-/// of every fit that is a roving test (calibration::ShapesOfRovingTest), one
-/// row per mode and point; shape_unit `1/sqrt(kg)` (mass-normalised, the
-/// test has a driving point) or `1` (largest component 1). A fit that is no
-/// roving test gets a note in `notes` and no rows.
-std::string ModeShapesCsv(const std::vector<calibration::PoseModes>& poses, std::vector<std::string>* notes = nullptr);
+/// shape_im,shape_unit,roving,fixed_point,fixed_direction`: the mode shapes
+/// `shapes` of the fits of `poses` that are roving tests (computed by the
+/// caller: calibration::ShapesOfRovingTests, which notes the fits that are
+/// none), one row per mode and point, in the order of `shapes`; shape_unit
+/// `1/sqrt(kg)` (mass-normalised, the test has a driving point) or `1`
+/// (largest component 1).
+std::string ModeShapesCsv(const std::vector<calibration::PoseModes>& poses,
+                          const std::vector<calibration::FitRovingShapes>& shapes);
 
 /// The summary (formats.md §4.2).
 nlohmann::json ModalAnalysisSummaryJson(const std::vector<calibration::PoseModes>& poses,

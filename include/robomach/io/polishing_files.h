@@ -66,11 +66,12 @@ void WritePolishPath(const std::string& path, const std::vector<polishing::PathR
                      const std::vector<std::pair<std::string, std::string>>& metadata);
 
 /// The `# key: value` lines polish-plan writes at the top of a planned path
-/// (formats.md §6): pattern, offset_mm, edge_overrun_mm (the one used); for
+/// (formats.md §6): pattern, offset_mm, edge_overrun_mm (`edge_overrun_m`,
+/// the one the plan used: workflows::PlannedPathMetadata computes it); for
 /// the cycloid guides, radius_mm, pitch_mm, stagger_loops; line_angle_deg
 /// where guide lines are parallel.
 std::vector<std::pair<std::string, std::string>> PlannedPathMetadata(const polishing::PathParameters& params,
-                                                                     const polishing::PolishingProcess& process);
+                                                                     double edge_overrun_m);
 
 /// Removal map CSV x_mm,y_mm,z_mm,u,v,removal_um of the region's points. Atomic.
 void WriteRemovalMap(const std::string& path, const polishing::SampleGrid& grid, const std::vector<double>& removal_m);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "robomach/common/errors.h"
+#include "robomach/dynamics/joint_plausibility.h"
 #include "robomach/dynamics/parameters.h"
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/io/yaml_doc.h"
@@ -19,8 +20,14 @@ struct RobotConfig {
   std::string path;
   /// "implausible (unit mistake?): file:line:col: ..." for each value outside
   /// its plausible range below (docs/plausibility.md): a tool prints them and
-  /// flags its result (exit 3).
+  /// flags its result (exit 3). The joints' plausibility (frequencies, sag
+  /// under the robot's weight, damping ratio) is the model's, not the
+  /// reader's: workflows::LoadRobotConfigChecked appends it
+  /// (dynamics::JointPlausibilityFindings).
   std::vector<std::string> implausible;
+  /// Where the joint stiffnesses and the damping were typed, for the joints'
+  /// plausibility findings.
+  dynamics::JointValueLocations joint_value_locations;
   /// Where each of `description.extra_values` was typed (the numbers of
   /// `spindle_toolholder_interface` and `hammer_test`), so that a tool that
   /// refuses one of them can name its file:line:col.
@@ -47,24 +54,8 @@ inline constexpr double kMaxPlausibleBodyMassKg = 5000.0;      // a link or end-
 inline constexpr double kMaxPlausibleRobotLengthM = 10.0;      // |each component| of a length
 inline constexpr double kMinPlausibleJointStiffnessNmPerRad = 100.0;
 inline constexpr double kMaxPlausibleJointStiffnessNmPerRad = 1e9;
-/// sqrt(kq_j / M_q(j,j)) / 2 pi at q = 0 (mid-limits where they exclude 0):
-/// x1000 in kq or /1000 in the masses moves it by 31.6 (the KR 210's are
-/// 10 to 250 Hz). Below 1 Hz a joint that carries its links' weight would
-/// let them sag by g / w² = 25 cm (a link of mass m at radius r: torque
-/// m g r over kq = m r² w² turns it by g / (w² r)).
-inline constexpr double kMinPlausibleJointFrequencyHz = 1.0;
-inline constexpr double kMaxPlausibleJointFrequencyHz = 2000.0;
-/// The turn of a joint under the robot's own weight, |G_j(q)| / kq_j, at the
-/// same posture: robot gearboxes (RV and harmonic reducers) deflect by 1 - 5
-/// arc-minutes under their rated torque (Nabtesco RV-E, Harmonic Drive CSG
-/// catalogues), and the KR 210's joints turn by at most 0.05 deg under its
-/// weight. Over 1 deg (20 times the catalogues) the tool would sag by
-/// centimetres: a stiffness typed per degree (N·m/deg, the value / 57.3) or
-/// in kN·m/rad. Frequencies alone miss the first: /57.3 moves them by only
-/// 7.6 (the KR 210's lowest to 1.3 Hz, inside the range above).
-inline constexpr double kMaxPlausibleGravitySagRad = 0.017453292519943295;  // 1 deg
-/// Rayleigh damping ratio (alpha w + beta / w) / 2 at each joint frequency.
-inline constexpr double kMaxPlausibleDampingRatio = 0.5;
+// The joints' frequency, sag and damping ranges are the model's
+// (dynamics/joint_plausibility.h).
 
 // Plausible ranges of the `spindle_toolholder_interface` section (the
 // spindle_interface effect, docs/model.md) and of `hammer_test`. Practice:
@@ -114,8 +105,9 @@ inline constexpr double kMaxPlausibleHammerSampleRateHz = 1e6;
 /// `parameters` (values by parameter name, as calibration writes them).
 /// Unknown keys are rejected. Paths are relative to the config's folder.
 /// Values outside the plausible ranges above (masses, lengths, joint
-/// stiffnesses, joint frequencies, damping ratios; DH angles that look like
-/// radians) are listed in RobotConfig::implausible.
+/// stiffnesses; DH angles that look like radians) are listed in
+/// RobotConfig::implausible; the joints' frequencies, sag and damping ratios
+/// are not judged here (workflows::LoadRobotConfigChecked does).
 /// @throws InputError with `file:line:col` for any problem; a refused value
 ///   1000 times its reference (m6_kg, d6_m, a `parameters:` value) names the
 ///   unit mistake.

@@ -1,7 +1,9 @@
 #pragma once
 
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
@@ -27,7 +29,22 @@ class YamlDoc {
   SourceLocation location() const;
   /// Dotted key path from the document root, for messages ("robot.urdf").
   const std::string& key_path() const { return key_path_; }
+  /// An InputError at this node: "file:line:col: key.path: message".
   InputError Error(const std::string& message) const;
+  /// Runs `f` and returns what it returns; an exception of type E it throws
+  /// (std::invalid_argument by default: a check that knows no file) becomes
+  /// Error(e.what()), at this node with its key path. AtLocation's form for
+  /// a YAML node (common/errors.h), instead of a try/catch at each site:
+  ///
+  ///   p.hole_axis = axis.Checked([&] { return drilling::ParseHoleAxis(a); });
+  template <class E = std::invalid_argument, class F>
+  decltype(auto) Checked(F&& f) const {
+    try {
+      return std::forward<F>(f)();
+    } catch (const E& e) {
+      throw Error(e.what());
+    }
+  }
 
   bool IsMap() const { return node_.IsMap(); }
   bool IsSequence() const { return node_.IsSequence(); }

@@ -22,14 +22,20 @@
 namespace robomach::kinematics {
 
 struct IkOptions {
-  /// A solution is accepted when the tip is this close to the target.
+  /// A solution is accepted when the tip is this close to the target (> 0).
   double position_tolerance_m{1e-5};
   double rotation_tolerance_rad{1e-4};
   /// Newton iterations stop below these errors (far below the tolerances:
-  /// a map's dynamics then do not depend on where the iteration stopped).
+  /// a map's dynamics then do not depend on where the iteration stopped);
+  /// > 0.
   double converged_position_m{1e-12};
   double converged_rotation_rad{1e-12};
-  int max_iterations{100};
+  int max_iterations{100};  // >= 1
+
+  /// The bounds above.
+  /// @throws OptionError naming the field, its value and the bound
+  ///   ("position_tolerance_m: expected a value > 0, got 0").
+  void Validate() const;
 };
 
 /// Solves X_BT(q) = X from a seed. One solver per thread: it binds KDL

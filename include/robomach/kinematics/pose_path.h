@@ -19,10 +19,15 @@ struct PosePathOptions {
   /// Tolerances of a reached pose (IkSolver's defaults: 1e-5 m, 1e-4 rad,
   /// far below what a process path needs).
   IkOptions ik;
-  /// Largest change of any joint between consecutive reached poses [rad];
-  /// a larger one (another IK branch, a 2π branch change to stay inside
+  /// Largest change of any joint between consecutive reached poses [rad],
+  /// > 0; a larger one (another IK branch, a 2π branch change to stay inside
   /// the limits) is a jump.
   double max_joint_step_rad{0.5};
+
+  /// ik valid (IkOptions::Validate, its fields named "ik.max_iterations",
+  /// ...); max_joint_step_rad > 0.
+  /// @throws OptionError naming the field, its value and the bound.
+  void Validate() const;
 };
 
 struct PosePathCheck {

@@ -19,10 +19,14 @@ struct QuadratureOptions {
   /// been seen on N consecutive samples (it then takes effect at the N-th of
   /// them, i.e. N - 1 samples late). 0 or 1 switches the filter off.
   int glitch_filter_samples{0};
-};
 
-/// @throws std::invalid_argument naming the field and its bound.
-void CheckValid(const QuadratureOptions& options);
+  /// @throws OptionError naming the field, its value and the bound:
+  /// num_axes in [1, kMaxQuadratureAxes] (two channel bits per axis of a
+  /// 16-bit word), glitch_filter_samples in [0, 1000000] (the filter keeps
+  /// one run counter per channel; a million samples is seconds of a
+  /// capture at MHz rates, far past any glitch).
+  void Validate() const;
+};
 
 /// Signed 4x count of every axis since the first sample (formats.md §8.2):
 /// each edge of A or B counts one; (A,B) = 00 -> 10 -> 11 -> 01 -> 00 is +1
@@ -35,6 +39,7 @@ void CheckValid(const QuadratureOptions& options);
 /// not depend on how the capture is split.
 class QuadratureDecoder {
  public:
+  /// @throws OptionError for bad options (QuadratureOptions::Validate).
   explicit QuadratureDecoder(const QuadratureOptions& options = {});
 
   /// Decodes `n` consecutive samples.

@@ -19,6 +19,12 @@ struct SynthesisOptions {
   /// Where the first sample's inverse kinematics starts looking (kinematic
   /// axis order, SI); empty = all zero. Picks the B solution of the first point.
   std::vector<double> initial_guess;
+
+  /// @throws OptionError naming the field, its value and the bound: feed
+  /// finite > 0 and sample_rate_hz finite > 0 (the rows are (dwell +
+  /// length / feed) · rate), dwell finite >= 0. initial_guess's size is
+  /// checked against the machine by SynthesizeCounts.
+  void Validate() const;
 };
 
 struct CountsRecord {
@@ -41,12 +47,14 @@ struct SynthesisResult {
 /// relative to `origin` (one value per axis: counts = round((measured -
 /// origin) / resolution)). Pass start_measured of a first call, or the
 /// machine file's origins. Axes the kinematics does not use stay at origin.
+/// @throws OptionError for bad options (SynthesisOptions::Validate).
 SynthesisResult SynthesizeCounts(const Machine& machine, const Compensation* compensation,
                                  const ProgrammedPath& path, const SynthesisOptions& options,
                                  const std::vector<double>& origin);
 
 /// The rows SynthesizeCounts writes: ceil((dwell + length / feed) * rate) + 1
 /// (LONG_MAX when that is beyond a long).
+/// @throws OptionError for bad options (SynthesisOptions::Validate).
 long SynthesisRows(const ProgrammedPath& path, const SynthesisOptions& options);
 
 /// Measured start positions only (the first sample of SynthesizeCounts).

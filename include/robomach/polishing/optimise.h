@@ -47,6 +47,18 @@ struct OptimiseOptions {
   /// Called after each evaluation (NLopt) or iteration (PSO) with the count
   /// so far and the best value; may be empty.
   std::function<void(int, double)> progress;
+
+  /// The bounds (issue #36), for either method:
+  /// - offset_min > 0 [m]: a guide-line spacing.
+  /// - offset_max > offset_min: the search maps [offset_min, offset_max] onto
+  ///   [0, 1] ("offset_max: expected a value > offset_min MIN, got VALUE").
+  /// - global_evaluations, local_evaluations >= 1: NLopt takes a budget <= 0
+  ///   as none.
+  /// - pso_particles >= 1: the start is particle 0.
+  /// - pso_max_iterations >= 0; pso_stall_iterations >= 1.
+  /// - pso_tolerance >= 0: an improvement is compared with it.
+  /// @throws OptionError(field, "FIELD: expected ..., got VALUE") naming the bound.
+  void Validate() const;
 };
 
 struct OptimiseResult {
@@ -166,6 +178,17 @@ struct PlanOptimiseOptions {
   /// After each evaluation (from any thread, serialised): the count, the
   /// best feasible cv so far (NaN before the first), elapsed seconds.
   std::function<void(int, double, double)> progress;
+
+  /// The bounds (issue #36); starts and threads below 1 are taken as 1:
+  /// - offset_min > 0 [m] and offset_max > offset_min: the search is on
+  ///   log(d / offset_min) / log(offset_max / offset_min).
+  /// - feasibility_margin in (0, 1]: the target is divided by it; above 1
+  ///   the optimiser would hold its plans to more than the target.
+  /// - ftol_rel in [0, 1]: a relative change of the cv (0: none, the budgets stop).
+  /// - max_local_evaluations >= 1: NLopt takes a budget <= 0 as none.
+  /// - max_time_s >= 0 [s]: a NaN would never run out.
+  /// @throws OptionError(field, "FIELD: expected ..., got VALUE") naming the bound.
+  void Validate() const;
 };
 
 struct PlanOptimiseResult {

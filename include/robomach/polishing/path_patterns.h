@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "robomach/common/named_registry.h"
 #include "robomach/polishing/paths.h"
 
 namespace robomach::polishing {
@@ -44,6 +45,11 @@ class PathPattern {
   /// Appends the rows (with their time stamps) along one guide line.
   virtual void Follow(internal::GuideWalk& walk) const = 0;
 };
+
+/// Every pattern by name, in a fixed order (cycloid, parallel): the
+/// functions below are this registry's. A name is ToString of the
+/// pattern's id().
+const NamedRegistry<const PathPattern*>& PathPatternRegistry();
 
 /// Every pattern, in a fixed order (cycloid, parallel).
 const std::vector<const PathPattern*>& PathPatterns();

@@ -34,6 +34,18 @@ namespace robomach::polishing {
 enum class Pattern { kCycloid, kParallel };
 enum class GuideLines { kBoundaryOffsets, kParallelLines };
 
+/// "cycloid", "parallel": the name of the pattern's PathPattern (polish-plan's
+/// --pattern, summaries).
+std::string ToString(Pattern p);
+/// @throws std::invalid_argument "unknown path pattern 'NAME': expected
+/// cycloid or parallel".
+Pattern ParsePattern(const std::string& name);
+
+/// "offsets", "parallel" (PlanOptions::guides, polish-plan's --guides).
+std::string ToString(GuideLines g);
+/// @throws std::invalid_argument "guides 'NAME': expected offsets or parallel".
+GuideLines ParseGuideLines(const std::string& name);
+
 struct PathParameters {
   Pattern pattern{Pattern::kCycloid};
   GuideLines guides{GuideLines::kBoundaryOffsets};  // cycloid only

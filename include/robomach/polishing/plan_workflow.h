@@ -82,6 +82,20 @@ struct PlanOptions {
   int threads{2};
   unsigned seed{20240404};
   double sample_mm{0.5};  // the region's sampling, PreparePlanning's spacing
+
+  /// The checks (issue #36), in this order:
+  /// - guides: ParseGuideLines's names (OptionError "guides", "guides
+  ///   'NAME': expected offsets or parallel").
+  /// - optimise: none or a ParseOptimiser name (OptionError "optimise",
+  ///   "optimise: expected none, nlopt or pso, got NAME").
+  /// - pattern: a PathPatterns() name (OptionError "pattern", "unknown path
+  ///   pattern 'NAME': expected cycloid or parallel").
+  /// - optimise pso only with the cycloid (OptionError "optimise").
+  /// - the numeric options within PlanOptionRanges: the ranges keep a typo
+  ///   from hours of work or an allocation failure (a 1e-6 mm sampling).
+  /// @throws OptionError(field, message); a range's "FIELD: expected a value
+  ///   in [LO, HI], got VALUE".
+  void Validate() const;
 };
 
 /// One numeric option with the range it must lie in: the limits keep a typo
@@ -127,10 +141,12 @@ struct EvaluatedPlan {
   RemovalStats stats;
 };
 
-/// Flagged (RunFindings; exit 3 in the tool) with one finding for each
+/// Flagged (its `verdict`; exit 3 in the tool) with one finding for each
 /// thing the user should act on: no feasible plan, a target out of reach, a
 /// better zig-zag, rows off the face.
-struct PlanOutcome : RunFindings {
+struct PlanOutcome {
+  RunFindings verdict;
+  RunStatus status() const { return verdict.status(); }
   PathParameters params;  // what was planned (the optimum with optimise)
   EvaluatedPlan plan;
   /// With optimise: the optimiser's result, the bounds it searched, and

@@ -40,6 +40,11 @@ struct AuditReportOptions {
   /// What model-audit --uncertainty-out wrote ({"file", "parameters",
   /// "left_out"}; null: not asked), for summary.json.
   nlohmann::json uncertainty_out;
+
+  /// @throws OptionError naming the field, its value and the bound:
+  /// fmin_hz >= 0 and fmax_hz > fmin_hz (the band the error patterns are
+  /// analysed in). The other numbers are only quoted in the report.
+  void Validate() const;
 };
 
 struct AuditReport {
@@ -54,6 +59,7 @@ struct AuditReport {
 /// audited (added effects included); `measured_fit` the lines the fits
 /// used, `measured_all` every measured line (the overlays show both);
 /// `noise` the noise model of each FRF (empty: none).
+/// @throws OptionError for bad options (AuditReportOptions::Validate).
 AuditReport WriteAuditReport(const std::string& dir, const audit::AuditResult& result,
                              const dynamics::RobotDescription& description, const calibration::PostureMap& postures,
                              const dynamics::FrfSet& measured_fit, const dynamics::FrfSet& measured_all,

@@ -46,6 +46,16 @@ struct LobesOptions {
   SdOptions sd;
   int sd_modes{3};  // stability-lobes' default: dominant modes of a model (not fitted) tip the SD keeps
   int threads{0};   // SD threads (0 = all cores)
+
+  /// @throws OptionError naming the field, its value and the bound:
+  /// min_speed_rad_s >= 0 and max_speed_rad_s >= min_speed_rad_s (the cut's
+  /// range), with the SD every sd_speeds_rad_s finite > 0 (its tooth period
+  /// 2π/(NΩ)), max_lobe_index >= 0, sd_modes >= 1, threads >= 0, and the
+  /// nested sd.* fields (SdOptions::Validate, field prefixed). The process
+  /// is checked by MillingProcess::Validate (std::invalid_argument).
+  /// stability-lobes and Python check their own options first
+  /// (workflows::StabilityLobesOptions::ValidateSettings, narrower ranges).
+  void Validate() const;
 };
 
 /// What the run has to say as it goes (kInfo: the SD's discretisation), and
@@ -93,13 +103,15 @@ struct ZoaFitCheck {
   bool agree{true};                                    // relative_difference <= 0.10
 };
 
-/// Flagged (RunFindings; stability-lobes' exit 3), one finding each, for a
+/// Flagged (its `verdict`; stability-lobes' exit 3), one finding each, for a
 /// modal fit that does not describe a tool tip (TipFitWarnings: an
 /// implausible unit, not a driving point, a mode at the edge of the usable
 /// band, a poor fit, no mode for the SD), the ZOA and the SD more than 10 %
 /// apart where they should agree, and speeds without a boundary. Each
 /// finding is also told to the message sink as a warning when it is found.
-struct LobesResult : RunFindings {
+struct LobesResult {
+  RunFindings verdict;
+  RunStatus status() const { return verdict.status(); }
   std::vector<LobeRow> rows;  // per tip: the ZOA's rows, then the SD's
   /// Some speeds have no boundary (a ZOA point that is not ok, an SD point
   /// unstable at depth zero).
@@ -122,6 +134,7 @@ std::vector<std::string> TipFitWarnings(const TipDynamics& tip, bool sd);
 /// also searched on 7 speeds within ±4 % of the bottom of each of the (at
 /// most 4) lowest ZOA lobes. A measured tip's ZOA is checked against the
 /// ZOA on its fitted modes (ZoaFitCheck; flagged beyond 10 %).
+/// @throws OptionError for bad options (LobesOptions::Validate).
 LobesResult ComputeLobes(const std::vector<TipDynamics>& tips, const LobesOptions& options,
                          const MessageSink& on_message = {}, const SdProgressSink& on_progress = {});
 

@@ -39,10 +39,14 @@ struct DirectFrfFitOptions {
   /// alone puts about 2 % of the lines of a lightly damped receptance above
   /// it (Im H ≈ 0 only far from the modes; P(N(0,1) > 2) = 2.3 %).
   double max_active_fraction{0.05};
-};
 
-/// @throws std::invalid_argument naming the field for a bad option.
-void CheckValid(const DirectFrfFitOptions& options);
+  /// @throws OptionError naming the field, its value and the bound:
+  /// max_active_fraction in [0, 1] (a fraction of lines), max_noise_rms
+  /// finite >= 1 (1 is a perfect model), and the nested noise.* and fit.*
+  /// fields (calibration::NoiseOptions::Validate,
+  /// calibration::ModalFitOptions::Validate, field prefixed).
+  void Validate() const;
+};
 
 /// One direct FRF, its noise model and its modal fit.
 struct DirectFrfFit {
@@ -75,7 +79,8 @@ struct DirectFrfFit {
 /// with their σ (the drift of an integrated accelerometer signal and the
 /// floor are outside that band). Numerical trouble is in the result
 /// (`poor`, `problem`), not an exception.
-/// @throws std::invalid_argument for bad options or an FRF of fewer than 8 lines.
+/// @throws OptionError for bad options (DirectFrfFitOptions::Validate);
+///   std::invalid_argument for an FRF of fewer than 8 lines.
 DirectFrfFit FitDirectFrf(const dynamics::Frf& measured, const DirectFrfFitOptions& options = {});
 
 /// The real modes of a direct (driving-point) FRF H_aa, as tool-tip modes

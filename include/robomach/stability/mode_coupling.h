@@ -23,6 +23,12 @@ struct ModeCouplingOptions {
   double max_depth{0.05};    // [m]
   int scan_points{12};       // geometric scan max_depth·2^(j−scan_points), j = 1..scan_points
   double depth_tolerance{1e-4};  // relative bracket width at the end
+
+  /// @throws OptionError naming the field, its value and the bound:
+  /// max_depth finite > 0 (the scan's top, halved scan_points times),
+  /// scan_points >= 1, depth_tolerance finite > 0 (the bisection stops at a
+  /// bracket that narrow; 0 would never stop).
+  void Validate() const;
 };
 
 struct ModeCouplingResult {

@@ -21,6 +21,14 @@ struct PostureStabilityOptions {
   int freq_lines{1200};  // lines of the log grid of the ZOA (LobeFrequencyGrid)
   ZoaOptions zoa;
   ModeCouplingOptions mode_coupling;
+
+  /// @throws OptionError naming the field, its value and the bound:
+  /// spindle_speed_rad_s at least one speed, each finite > 0 (the tooth
+  /// period 2π/(NΩ) and the ZOA's grid need it), freq_lines >= 2 (a grid of
+  /// one line has no spacing), and the nested zoa.* and mode_coupling.*
+  /// fields (their Validate, field prefixed). The default has no speed and
+  /// is not valid: the caller gives the speeds.
+  void Validate() const;
 };
 
 enum class Mechanism { kModeCoupling, kRegenerative, kNone };

@@ -85,6 +85,15 @@ struct SdOptions {
   double max_depth{0.02};     // [m] search range of the depth
   int depth_scan_points{20};  // coarse scan of [0, max_depth] before the bracketing search
   double depth_tolerance{1e-3};  // relative width of the final bracket
+
+  /// @throws OptionError naming the field, its value and the bound:
+  /// steps_per_period >= 0 (0: automatic), steps_per_mode_period finite
+  /// > 0, min_steps_per_period >= 1, max_monodromy_dimension >= 1 (the
+  /// automatic choice's terms), max_depth finite > 0, depth_scan_points
+  /// >= 1 (the scan of [0, max_depth] in that many steps), depth_tolerance
+  /// finite > 0 (the search stops at a bracket that narrow; 0 would never
+  /// stop).
+  void Validate() const;
 };
 
 /// The steps per tooth period SdCriticalDepth uses at one spindle speed:

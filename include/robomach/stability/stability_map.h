@@ -47,6 +47,15 @@ struct MapOptions {
   PostureStabilityOptions analysis;
   int threads{0};                    // 0 = all cores
   ProgressCallback progress;         // called from the calling thread
+
+  /// @throws OptionError naming the field, its value and the bound:
+  /// rotation finite; with optimise_rotation, rotation_min, rotation_max
+  /// finite and rotation_max > rotation_min (the search interval), and
+  /// rotation_evaluations >= 8 (the coarse scan takes 7, NLopt at least one
+  /// more); threads >= 0; the nested analysis.* fields
+  /// (PostureStabilityOptions::Validate, so at least one speed). seed_q's
+  /// size is checked against the robot by EvaluateStabilityMap.
+  void Validate() const;
 };
 
 struct MapPoint {
@@ -74,7 +83,7 @@ int FirstFeedAlongToolAxis(const std::vector<ToolPoseTarget>& targets);
 /// the rotation about the tool axis with NLopt (LN_COBYLA after a coarse
 /// scan), re-solving the IK from the point's solution each time.
 /// @throws std::invalid_argument if rows·cols != targets.size() or the seed
-///   has the wrong size.
+///   has the wrong size; OptionError for bad options (MapOptions::Validate).
 std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::RobotModel> model,
                                            const std::vector<ToolPoseTarget>& targets, int rows,
                                            int cols, const MillingProcess& process,
@@ -82,7 +91,9 @@ std::vector<MapPoint> EvaluateStabilityMap(std::shared_ptr<const dynamics::Robot
 
 /// stability-map's run: the points of EvaluateStabilityMap and its verdict,
 /// flagged (exit 3) with one finding when any point is not kOk.
-struct StabilityMapResult : RunFindings {
+struct StabilityMapResult {
+  RunFindings verdict;
+  RunStatus status() const { return verdict.status(); }
   std::vector<MapPoint> points;
   /// Points the IK reached within the joint limits (ok, near singular,
   /// other configuration); none is an error of the caller's region or path.

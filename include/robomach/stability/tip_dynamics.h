@@ -102,6 +102,11 @@ struct MeasuredTipOptions {
   std::string tool_axis_source;
   bool fit{true};    // fit modes to the direct FRFs (for the SD and the usable band)
   int sd_modes{3};   // dominant modes kept per direct FRF (stability-lobes' default)
+
+  /// @throws OptionError naming the field, its value and the bound:
+  /// sd_modes >= 1 (a tip of no mode has no SD lobes). The paths are for
+  /// messages only and may be empty.
+  void Validate() const;
 };
 
 // What building the tool tips has to say, as it happens, is a Message

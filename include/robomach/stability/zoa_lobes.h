@@ -46,6 +46,11 @@ struct ZoaOptions {
   /// If > 0, lobes that cannot reach this speed within the grid are skipped:
   /// lobe k chatters above k N Ω / 2π, so k < f_max 2π / (N Ω_min).
   double min_spindle_speed_rad_s{0.0};
+
+  /// @throws OptionError naming the field, its value and the bound:
+  /// max_lobe_index >= 0 (a lobe index k counts waves between two teeth),
+  /// min_spindle_speed_rad_s >= 0 (0: no speed to reach; a NaN is refused).
+  void Validate() const;
 };
 
 /// The zero-order (Altintas-Budak) lobes.
@@ -90,7 +95,8 @@ class ZoaLobes {
 /// Traces (2) on the grid `freq_hz` (strictly increasing, > 0) of the
 /// oriented FRF `Phi_C` [m/N].
 /// @throws std::invalid_argument if sizes differ, the grid is not
-///   increasing or the process is invalid.
+///   increasing or the process is invalid; OptionError for bad options
+///   (ZoaOptions::Validate).
 ZoaLobes ComputeZoaLobes(const Eigen::VectorXd& freq_hz, const std::vector<Eigen::Matrix2cd>& Phi_C,
                          const MillingProcess& process, const ZoaOptions& options = {});
 

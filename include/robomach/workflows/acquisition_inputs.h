@@ -5,9 +5,11 @@
 
 #include <memory>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
+#include "robomach/io/acquired_path_file.h"
 #include "robomach/io/compensation_file.h"
 #include "robomach/io/machine_file.h"
 #include "robomach/machine/acquisition.h"
@@ -50,5 +52,24 @@ AcquisitionInputs ReadAcquisitionInputs(const std::string& machine_path, const s
                                         const std::string& temperature_path = "",
                                         const std::string& program_path = "",
                                         const std::string& compensation_option = "");
+
+/// axis-acquire's main loop: every row of `record` through `acquisition`
+/// (and `tracker`, if not null) to the acquired path (formats.md §8.5,
+/// header included; io::AcquiredPathWriter) on `out`, in one pass. Rows are
+/// computed in order (the tracker follows the path) while earlier chunks
+/// are formatted and written on `threads` threads (io::WritePipelined):
+/// only a few chunks of samples are held at a time. With a tracker, the
+/// contour error of every row is returned (for the statistics and the plot).
+std::vector<machine::ContourError> WriteAcquiredPath(std::ostream& out, const machine::CountsRecord& record,
+                                                     const std::vector<machine::AxisScale>& axes,
+                                                     machine::Acquisition* acquisition,
+                                                     machine::ContourTracker* tracker, int threads = 2);
+
+/// axis-acquire's contour figures (io::ContourSummaryJson): the statistics
+/// (machine::Stats) of the contour error [um] and of the tool axis error
+/// [deg], the programmed path's length and the part of it the run covered
+/// [mm].
+io::ContourFigures ContourFiguresOf(const std::vector<machine::ContourError>& contour,
+                                    const machine::ProgrammedPath& path);
 
 }  // namespace robomach::workflows

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "robomach/common/messages.h"
+#include "robomach/common/option_checks.h"
 #include "robomach/common/run_status.h"
 #include "robomach/io/machine_file.h"
 #include "robomach/machine/synthesis.h"
@@ -22,7 +23,7 @@ namespace robomach::workflows {
 /// axis-synth's options (the tool's option for each field: machine_path is
 /// --machine, program_path --program, compensation_path --compensation,
 /// temperature_path --temperature, origins_at_start --machine-out, ...).
-struct AxisSynthOptions {
+struct AxisSynthOptions : FieldNames {
   std::string machine_path;       // machine file YAML (formats.md §8.3)
   std::string program_path;       // programmed path CSV x_mm,y_mm,z_mm,i,j,k (workpiece coordinates)
   std::string compensation_path;  // Siemens 840D sl tables (formats.md §8.4) the controller applies; empty: none
@@ -43,10 +44,8 @@ struct AxisSynthOptions {
   int capture_settle{2};
   double glitch_probability{0.0};
   unsigned seed{1};
-  /// How the findings and messages name the fields (the tool: its options,
-  /// "--feed-mm-min"); a field not in it goes by its own name. The errors
-  /// name the fields themselves, for the caller to map (apps::FromFields).
-  std::map<std::string, std::string> names;
+  // names, Name(field): how the findings and messages name the fields
+  // (FieldNames; the tool: its options, "--feed-mm-min").
 
   /// The options alone, before any file is read.
   /// @throws OptionError naming the field: feed_mm_min outside [1e-3, 1e6],
@@ -60,7 +59,6 @@ struct AxisSynthOptions {
   /// a turn. RunAxisSynth puts them in its unit_findings without telling
   /// them: a caller that checks its files first tells them before that.
   std::vector<std::string> UnitFindings() const;
-  std::string Name(const std::string& field) const;
 };
 
 struct AxisSynthRun {

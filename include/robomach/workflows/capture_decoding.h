@@ -16,9 +16,11 @@
 
 namespace robomach::workflows {
 
-/// Flagged (RunFindings; axis-decode's exit 3) when any axis has error
+/// Flagged (its `verdict`; axis-decode's exit 3) when any axis has error
 /// events: each leaves its position uncertain by 2 counts.
-struct CaptureDecoding : RunFindings {
+struct CaptureDecoding {
+  RunFindings verdict;
+  RunStatus status() const { return verdict.status(); }
   std::int64_t samples{0};
   std::vector<std::int64_t> error_events;  // per axis: both channels changed in one sample
   std::vector<std::int64_t> final_counts;  // per axis

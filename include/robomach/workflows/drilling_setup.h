@@ -100,10 +100,12 @@ DrillSimRun RunDrillSim(const DrillSimOptions& options, const MessageSink& tell 
 
 /// drill-force-fit's run on its two files: the measured force table and
 /// the drill, the fit, the material file's text, and the unit findings.
-/// Flagged (RunFindings; the tool's exit 3), one finding each, when the fit
+/// Flagged (its `verdict`; the tool's exit 3), one finding each, when the fit
 /// did not converge, the Kienzle exponent ended on its bound, the model
 /// misses a row by more than 10 %, or a unit is implausible.
-struct ForceFitRun : RunFindings {
+struct ForceFitRun {
+  RunFindings verdict;
+  RunStatus status() const { return verdict.status(); }
   io::ForceTableFile table;
   io::DrillFile drill;
   drilling::ForceFitResult fit;

@@ -32,6 +32,11 @@ struct FrfNoiseOptions {
   double min_snr{calibration::NoiseOptions{}.min_snr};
   int averages{0};  // 0: from each file's '# averages: N'
   bool drift_floor{false};
+
+  /// @throws OptionError naming the field, its value and the bound:
+  /// noise_model one of auto, coherence, scatter, none; min_snr in
+  /// [0.001, 1e6] and averages in [0, 1e6] (MeasuredFrfOptions' bounds).
+  void Validate() const;
 };
 
 /// The measured-FRF route's options (measured_frfs.h) for `files` and

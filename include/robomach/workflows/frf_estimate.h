@@ -34,8 +34,8 @@ struct FrfEstimateRunOptions {
   calibration::FrfEstimateOptions estimate;        // windows, fmax_hz, detection thresholds
 
   /// @throws OptionError naming the field: excitation, estimator, min_hits
-  ///   [1, 1e6], no record_paths; std::invalid_argument naming the field of
-  ///   `estimate` (calibration::CheckValid).
+  ///   [1, 1e6], no record_paths; OptionError naming the field of
+  ///   `estimate` (FrfEstimateOptions::Validate).
   void Validate() const;
 };
 

@@ -17,8 +17,10 @@
 
 #include "robomach/calibration/virtual_hammer_test.h"
 #include "robomach/common/messages.h"
+#include "robomach/common/option_checks.h"
 #include "robomach/common/run_status.h"
 #include "robomach/dynamics/measured_frf.h"
+#include "robomach/io/frf_quantity.h"
 #include "robomach/io/robot_config.h"
 
 namespace robomach::workflows {
@@ -33,7 +35,7 @@ inline constexpr double kMaxRelativeNoise = 10.0;
 /// --robot, postures_path --postures, adds --add, sets --set; the test's
 /// fields those of calibration::VirtualHammerOptions, relative_noise
 /// --noise-rel, absolute_noise_m_per_N --noise-abs-m-per-N, ...).
-struct FrfSynthOptions {
+struct FrfSynthOptions : FieldNames {
   std::string robot_path;     // robot config YAML
   std::string postures_path;  // posture file (formats.md §1)
   std::vector<std::string> adds;  // effects switched on with their default parameters
@@ -41,10 +43,8 @@ struct FrfSynthOptions {
   /// The test's grid, noise, directions and seed. sample_rate_hz not finite:
   /// the config's hammer_test.sample_rate_hz, else 5120 Hz.
   calibration::VirtualHammerOptions hammer{.sample_rate_hz = NAN};
-  /// How the unit findings name the fields (the tool: its options,
-  /// "--fmax-hz"); a field not in it goes by its own name. The errors name
-  /// the fields themselves, for the caller to map (apps::FromFields).
-  std::map<std::string, std::string> names;
+  // names, Name(field): how the unit findings name the fields (FieldNames;
+  // the tool: its options, "--fmax-hz").
 
   /// The options alone, before any file is read.
   /// @throws OptionError naming the field: block_samples outside
@@ -56,7 +56,6 @@ struct FrfSynthOptions {
   /// The options that look like a unit mistake (docs/plausibility.md),
   /// "implausible (unit mistake?): ..." each: they flag the run.
   std::vector<std::string> UnitFindings() const;
-  std::string Name(const std::string& field) const;
 };
 
 /// The robot and the test as they will be used.
@@ -94,11 +93,35 @@ FrfSynthSetup PrepareFrfSynth(const FrfSynthOptions& options, const MessageSink&
 /// postures (their unit findings are warnings, then the options' findings
 /// are) and synthesizes the FRFs.
 /// @throws OptionError naming the VirtualHammerOptions field that fails
-///   calibration::CheckValid, with the options' unit findings as its likely
+///   VirtualHammerOptions::Validate, with the options' unit findings as its likely
 ///   cause; InputError for the posture file.
 FrfSynthRun RunFrfSynth(const FrfSynthOptions& options, FrfSynthSetup setup, const MessageSink& tell = {});
 
 /// Both calls in one.
 FrfSynthRun RunFrfSynth(const FrfSynthOptions& options, const MessageSink& tell = {});
+
+/// The formats frf-synth writes its FRFs in: the CSV of formats.md §3 or
+/// UFF58 ASCII (formats.md §4).
+enum class FrfFileFormat { kCsv, kUff58 };
+
+/// The format of frf-synth's output file `path`, by its extension (any
+/// case): .csv is CSV, .uff, .unv and .uf are UFF58; with `allow_stdout`,
+/// "-" (standard output) is CSV. `name` is how the messages name the file's
+/// option (the tool: "--out").
+/// @throws OptionError on `name` for another extension ("--out f.png:
+///   expected a file name ending in .csv (the FRF CSV of docs/formats.md §3)
+///   or .uff, .unv (UFF58), or '-' for standard output (CSV)"; without
+///   `allow_stdout` the message ends at "(UFF58)").
+FrfFileFormat FrfSynthOutputFormat(const std::string& path, const std::string& name, bool allow_stdout);
+
+/// Writes the run's FRFs to `path` ("-": standard output, CSV) in `format`
+/// as `quantity`: CSV with '# averages: N' when the test gave the coherence,
+/// UFF58 without it. UFF58 has no field for the number of averages: with
+/// coherence of more than one impact, a warning through `tell` says so before
+/// the file is written ("UFF58 has no field for the number of averages: give
+/// --averages 8 to the tools that read PATH", the option as
+/// options.Name("averages")).
+void WriteFrfSynthOutput(const FrfSynthRun& run, const FrfSynthOptions& options, const std::string& path,
+                         FrfFileFormat format, io::FrfQuantity quantity, const MessageSink& tell = {});
 
 }  // namespace robomach::workflows

@@ -18,7 +18,9 @@ namespace robomach::workflows {
 /// order, with the unit plausibility findings and the fewest runs any target
 /// has in a direction (ISO 230-2 asks for 5). Flagged (RunFindings;
 /// axis-accuracy's exit 3) with one finding per implausible unit.
-struct IsoEvaluation : RunFindings {
+struct IsoEvaluation {
+  RunFindings verdict;
+  RunStatus status() const { return verdict.status(); }
   io::IsoRuns runs;
   std::vector<std::pair<std::string, machine::Iso230Result>> results;
   std::vector<std::string> unit_findings;

@@ -38,7 +38,8 @@ struct KqIdentifyOptions {
   std::string noise_mm_name{"noise_mm"};
 
   /// @throws OptionError naming the field: noise_mm not finite > 0, robust
-  ///   not one of "", cauchy, huber, a path empty.
+  ///   neither "" nor an identification::ParseRobustLoss name (none,
+  ///   huber, cauchy), a path empty.
   void Validate() const;
 };
 
@@ -201,7 +202,7 @@ struct KqPlanResult {
   /// finding. A joint left weakly determined or a target that bends within
   /// its band (without a band asked for) is a warning only.
   bool flagged() const {
-    return plan.flagged() || band_uncertain || !config.implausible.empty() || !option_findings.empty();
+    return plan.verdict.flagged() || band_uncertain || !config.implausible.empty() || !option_findings.empty();
   }
   /// kq-identify --plan --summary (formats.md §4.1): the plan's size, each
   /// joint's expected standard deviation, the targets' promised half-widths

@@ -52,9 +52,10 @@ struct PolishPlanOptions : polishing::PlanOptions {
   std::string process_path;  // process YAML (formats.md §7); may be empty for ListPolishFaces
   SurfaceChoice surface_choice;
 
-  /// @throws OptionError naming the field: a value outside its range
-  ///   (polishing::PlanOptionRanges: "opt_sample_mm: expected a value in
-  ///   [0.1, 5], got 10"), or "optimise" pso with the parallel pattern.
+  /// polishing::PlanOptions::Validate (names, then the ranges of
+  /// PlanOptionRanges: "opt_sample_mm: expected a value in [0.1, 5], got
+  /// 10"); the files and the face are checked where they are read.
+  /// @throws OptionError naming the field.
   void Validate() const;
 };
 
@@ -84,7 +85,7 @@ struct PolishPlanRun {
   /// warnings in that order: they flag the run.
   std::vector<std::string> input_findings;
 
-  bool flagged() const { return outcome.flagged() || !input_findings.empty(); }
+  bool flagged() const { return outcome.verdict.flagged() || !input_findings.empty(); }
   RunStatus status() const { return flagged() ? RunStatus::kFlagged : RunStatus::kOk; }
   /// polish-plan's summary (formats.md §7; io::PolishPlanSummaryJson),
   /// without the robot block and the warnings.

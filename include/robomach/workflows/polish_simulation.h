@@ -5,22 +5,28 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "robomach/common/run_status.h"
 #include "robomach/io/polishing_files.h"
+#include "robomach/io/polishing_summary.h"
 #include "robomach/polishing/nurbs_surface.h"
+#include "robomach/polishing/paths.h"
+#include "robomach/polishing/plan_workflow.h"
 #include "robomach/polishing/process.h"
 #include "robomach/polishing/removal.h"
 #include "robomach/polishing/surface_grid.h"
 
 namespace robomach::workflows {
 
-/// Flagged (RunFindings; polish-sim's exit 3) when the path is faster than
+/// Flagged (its `verdict`; polish-sim's exit 3) when the path is faster than
 /// the process allows.
-struct PolishSimulation : RunFindings {
+struct PolishSimulation {
+  RunFindings verdict;
+  RunStatus status() const { return verdict.status(); }
   io::PolishPathFile file;      // the rows attached to the surface (u, v filled)
   std::shared_ptr<const polishing::SampleGrid> grid;
   std::vector<double> removal;  // at every grid point [m]
@@ -40,6 +46,26 @@ PolishSimulation SimulatePolishPathFile(const polishing::NurbsSurface& surface,
                                         const polishing::PolishingProcess& process, const std::string& path_file,
                                         double sample_spacing, const std::string& surface_source,
                                         const std::string& process_source);
+
+/// A path's figures for the summaries (io::PathSummaryJson): contact length
+/// (polishing::ContactLength), lifts (CountLifts), time, rows, largest
+/// speed (MaxSpeed).
+io::PathFigures PathFiguresOf(const std::vector<polishing::PathRow>& rows);
+
+/// The edge overrun a plan with `params` uses [m]: the parameters' own, at
+/// most the largest its pattern allows with `process`
+/// (polishing::MaxEdgeOverrun).
+double EdgeOverrunUsed(const polishing::PathParameters& params, const polishing::PolishingProcess& process);
+
+/// The figures of polish-plan's summary (io::PolishPlanSummaryJson): the
+/// planned path's, and the edge overrun of the plan and of each plan the
+/// optimisation reports.
+io::PlanFigures PlanFiguresOf(const polishing::PlanOutcome& outcome, const polishing::PolishingProcess& process);
+
+/// io::PlannedPathMetadata with the edge overrun the plan used: the `# key:
+/// value` lines polish-plan writes at the top of its path.
+std::vector<std::pair<std::string, std::string>> PlannedPathMetadata(const polishing::PathParameters& params,
+                                                                     const polishing::PolishingProcess& process);
 
 /// polish-sim's summary of a simulated path file: removal_um, path,
 /// parameters (from the file's header), region, speed_limit_exceeded.

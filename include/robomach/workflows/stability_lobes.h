@@ -105,7 +105,7 @@ struct StabilityLobesRun {
   std::vector<std::string> uncertainty_files;  // the files the bands came from
 
   /// stability-lobes' exit 3: the lobes are flagged or an input was implausible.
-  bool flagged() const { return lobes.flagged() || !input_findings.empty(); }
+  bool flagged() const { return lobes.verdict.flagged() || !input_findings.empty(); }
   /// The curves of the lobe diagram: per tip, its ZOA then its SD lobes
   /// (a method without rows is left out).
   std::vector<LobeDiagramCurve> DiagramCurves() const;

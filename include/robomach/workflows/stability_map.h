@@ -40,6 +40,9 @@ struct StabilityMapOptions {
   ///   not > 0, speeds outside [0, 100000], rotation_evaluations under 8,
   ///   threads outside [0, 256], the uncertainty's options.
   void Validate() const;
+  /// Validate's checks but region_path's: those of the settings, which
+  /// Python's stability_map (no region file, its own targets) shares.
+  void ValidateSettings() const;
 };
 
 struct StabilityMapRun {

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "robomach/common/messages.h"
+#include "robomach/common/option_checks.h"
 #include "robomach/common/run_status.h"
 #include "robomach/dynamics/robot_model.h"
 #include "robomach/identification/campaign_synth.h"
@@ -27,7 +28,7 @@ namespace robomach::workflows {
 /// --robot, postures_path --postures, plan_path --plan-file, sets --set,
 /// pulley_mm --pulley-mm, ...). The points and masses are the texts the
 /// tool's options take, in mm and kg, so that a finding quotes what was typed.
-struct TrackerSynthOptions {
+struct TrackerSynthOptions : FieldNames {
   std::string robot_path;     // robot config YAML; its joint stiffness is the truth
   std::string postures_path;  // posture file (formats.md §1); empty: random postures
   std::string plan_path;      // a plan of kq-identify --plan: its postures and pulleys
@@ -45,17 +46,15 @@ struct TrackerSynthOptions {
   std::string form{"rope"};  // load columns: rope (mass_kg + rope points) or force (fx_N..fz_N)
   unsigned seed{1};          // postures, noise, outliers
   std::vector<std::string> sets;  // "NAME=VALUE": parameters of the truth
-  /// How the findings and warnings name the fields (the tool: its options,
-  /// "--noise-mm"); a field not in it goes by its own name. The errors name
-  /// the fields themselves, for the caller to map (apps::FromFields).
-  std::map<std::string, std::string> names;
+  // names, Name(field): how the findings and warnings name the fields
+  // (FieldNames; the tool: its options, "--noise-mm").
 
   /// The options alone, before any file is read.
   /// @throws OptionError naming the field: noise_mm outside [0, 1000],
   ///   outliers negative, num_postures under 1, outlier_mm outside
-  ///   [0, 10000], form not rope or force.
+  ///   [0, 10000], min_reach_mm outside [0, 100000], form not rope or
+  ///   force.
   void Validate() const;
-  std::string Name(const std::string& field) const;
 };
 
 inline constexpr char kDefaultLoadPointMm[] = "150,0,100";

@@ -13,6 +13,7 @@
 
 #include "robomach/audit/model_audit.h"
 #include "robomach/calibration/frf_calibration.h"
+#include "robomach/common/errors.h"
 #include "robomach/dynamics/measured_frf.h"
 #include "robomach/dynamics/parameters.h"
 #include "robomach/dynamics/robot_model.h"
@@ -92,6 +93,12 @@ bool Doubtful(const CandidateResult& cand);
 /// Whether `challenger` (another start of the same candidate) replaces `incumbent`.
 bool Replaces(const CandidateResult& challenger, const CandidateResult& incumbent);
 bool NeedsMoreStarts(const CandidateResult& c, const FitContext& x);
+/// Marks `c`'s fit failed with `e`'s message (its status, message and note
+/// "fit failed: ...", infinite BIC and BIC change, a NaN error): numerical
+/// trouble in one candidate (an eigensolver failing at an extreme parameter
+/// value) is that candidate's status, reported in its row, not the audit's
+/// end. FitCandidate and FitParameterHypothesis catch NumericalError with it.
+void MarkFitFailed(const NumericalError& e, CandidateResult* c);
 /// Fits `effect` on top of the model (see candidate_fit.cc).
 CandidateResult FitCandidate(const dynamics::RobotDescription& base_desc, const dynamics::ParameterSet& start,
                              const std::vector<std::string>& base_effects_added, const std::string& effect,
