@@ -92,8 +92,8 @@ int RunDrillSim(int argc, char** argv) {
                "(time-weighted absolute joint error, motor torque limits); otherwise tuned defaults");
   app.add_option("--tune-evaluations", tune_evaluations, "simulations per controller when tuning")
       ->check(CLI::Range(5, 1000))->capture_default_str();
-  app.add_option("--motor-torque-limit-Nm", limit_Nm, "motor torque limit, every joint [N m]")
-      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--motor-torque-limit-Nm", limit_Nm, "motor torque limit, every joint [N m], > 0")
+      ->capture_default_str();
   std::vector<std::string> gain_texts;
   app.add_option("--gains", gain_texts,
                  "gain parameters KIND=OMEGA,ZETA[,THIRD[,FILTER_S]] (repeatable): OMEGA [rad/s] and ZETA set "

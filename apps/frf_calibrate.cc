@@ -80,7 +80,8 @@ int Run(int argc, char** argv) {
         {"robot_path", "--robot"},   {"postures_path", "--postures"}, {"measured_files", "--measured"},
         {"pose_files", "--pose"},    {"validate_pose_files", "--validate-pose"}, {"frees", "--free"},
         {"only_free", "--only-free"}, {"sets", "--set"}, {"adds", "--add"}, {"objective", "--objective"},
-        {"max_iterations", "--max-iterations"}, {"robust_loss_sigma", "--robust-loss-sigma"}, {"min_snr", "--min-snr"}};
+        {"max_iterations", "--max-iterations"}, {"robust_loss_sigma", "--robust-loss-sigma"}, {"min_snr", "--min-snr"},
+        {"fmin_hz", "--fmin-hz"}, {"fmax_hz", "--fmax-hz"}};
     FromFields(fields, [&] { o.Validate(); });  // the option values, with the options' names
     {
       std::vector<std::pair<std::string, std::string>> inputs = {{"--robot", o.robot_path},

@@ -35,9 +35,9 @@ int Run(int argc, char** argv) {
       "(mode shapes), and per posture a picture of the stabilisation diagram and the fits (docs/frf-modes.md)."};
   AddVersionFlag(app, kTool);
   app.footer(ExitCodeHelp() +
-             "\nExit 3: outputs written, but flagged: a fit found no stable mode, an FRF is fitted worse than "
-             "3 x its noise, a measured receptance is outside the plausible range, or the FRFs of a posture "
-             "could not be fitted together (see the warnings, also in the summary).");
+             "\nExit 3: outputs written, but flagged: a fit found no stable mode, the band holds no usable line "
+             "of an FRF, an FRF is fitted worse than 3 x its noise, a measured receptance is outside the plausible "
+             "range, or the FRFs of a posture could not be fitted together (see the warnings, also in the summary).");
   std::vector<std::string> measured_files, pose_files;
   std::string out_path, constants_path, shapes_path, summary_path, plot_dir;
   calibration::ModalAnalysisOptions opt;
@@ -84,7 +84,7 @@ int Run(int argc, char** argv) {
     if (measured_files.empty() && pose_files.empty()) throw UsageError("give at least one --measured or --pose file");
     CheckOptionRange("--fmin-hz", opt.fit.fmin_hz, 0.0, 1e7);
     if (!std::isinf(opt.fit.fmax_hz)) CheckOptionRange("--fmax-hz", opt.fit.fmax_hz, opt.fit.fmin_hz, 1e7);
-    if (!(opt.fit.fmax_hz > opt.fit.fmin_hz)) throw UsageError("--fmax-hz: expected a value above --fmin-hz");
+    if (!(opt.fit.fmax_hz > opt.fit.fmin_hz)) throw UsageError("--fmax-hz " + FormatDouble(opt.fit.fmax_hz) + ": expected a value above --fmin-hz " + FormatDouble(opt.fit.fmin_hz));
     CheckOptionRange("--max-order", opt.fit.max_order, 8, 400);
     std::vector<std::pair<std::string, std::string>> inputs;
     for (const auto& f : measured_files) inputs.push_back({"--measured", f});

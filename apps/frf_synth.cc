@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <sstream>
 
 #include "cli_support.h"
@@ -89,6 +90,10 @@ int Run(int argc, char** argv) {
         {"absolute_noise_m_per_s2_per_N", "--noise-abs-m-per-s2-per-N"}, {"hammer_cutoff_hz", "--hammer-cutoff-hz"},
         {"averages", "--averages"}, {"directions", "--directions"}};
     for (const FieldSource& f : fields) w.names[f.field] = f.name;
+    // NaN is the library's "the config's rate": one typed is refused here.
+    if (app.count("--sample-rate-hz") > 0 && std::isnan(o.sample_rate_hz)) {
+      throw UsageError("--sample-rate-hz nan: expected a rate in (0, 1e9] Hz");
+    }
     FromFields(fields, [&] { w.Validate(); });
     RequireInputFile("--robot", w.robot_path, "robot config", {io::FileKind::kYaml}, io::kRobotConfigFormat);
     RequireInputFile("--postures", w.postures_path, "posture file", {io::FileKind::kCsv}, io::kPostureCsvFormat);

@@ -64,7 +64,7 @@ int Run(int argc, char** argv) {
   app.add_option("--target-mm", target, "--plan: tracker target x,y,z in the tip frame [mm], or tcp")
       ->capture_default_str();
   app.add_option("--masses-kg", masses, "--plan: masses hung at every direction [kg]")->capture_default_str();
-  app.add_option("--max-rope-angle-deg", rope_angle_deg, "--plan: largest rope angle from vertical [deg]")
+  app.add_option("--max-rope-angle-deg", rope_angle_deg, "--plan: largest rope angle from vertical [deg], in (0, 90)")
       ->capture_default_str();
   app.add_option("--seed", seed, "--plan: seed of the candidate postures")->capture_default_str();
   app.add_option("--target-postures", target_postures, "--plan: a targeted plan (not D-optimal): the postures of the work region (posture CSV) whose --target-quantity must be known well");
@@ -117,6 +117,7 @@ int Run(int argc, char** argv) {
           .masses_kg = ParseNumberList("--masses-kg", masses), .max_rope_angle_deg = rope_angle_deg,
           .num_postures_name = "--plan N", .points_name = "--load-point-mm, --target-mm", .noise_mm_name = "--noise-mm",
           .masses_name = "--masses-kg", .load_point_name = "--load-point-mm", .target_name = "--target-mm",
+          .max_rope_angle_name = "--max-rope-angle-deg",
           .target_postures_path = target_postures, .target_quantity = target_quantity, .cut_path = cut_path,
           .target_half_width = target_band_pct / 100.0, .target_half_width_name = "--target-band-pct"};
       if (std::ranges::any_of(po.masses_kg, [](double m) { return !(m > 0.0); })) {
@@ -139,7 +140,8 @@ int Run(int argc, char** argv) {
                          "±5 %), got " + io::FormatDouble(target_band_pct));
       }
       ValidateOptions({{"num_postures", "--plan"}, {"noise_mm", "--noise-mm"}, {"masses_kg", "--masses-kg"},
-                       {"target_quantity", "--target-quantity"}, {"cut_path", "--cut"}, {"target_half_width", "--target-band-pct"}},
+                       {"target_quantity", "--target-quantity"}, {"cut_path", "--cut"}, {"target_half_width", "--target-band-pct"},
+                       {"max_rope_angle_deg", "--max-rope-angle-deg"}},
                       [&] { po.Validate(); });
       const workflows::KqPlanResult plan = workflows::RunKqPlan(po, MessagePrinter(kTool));
       io::WriteLoadTestPlanCsv(out_path, plan.plan, plan.PlanHeader(po));

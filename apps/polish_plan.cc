@@ -89,7 +89,7 @@ int Run(int argc, char** argv) {
   app.add_option("--radius-mm", o.radius_mm, "cycloid radius r [mm]")->capture_default_str();
   app.add_option("--pitch-mm", o.pitch_mm, "advance of the cycloid centre per loop [mm] (= 2 pi v / omega)")->capture_default_str();
   app.add_option("--edge-inset-mm", o.edge_inset_mm, "cycloid on offsets: distance of the outermost guide loop from the "
-                                                   "region boundary [mm] (< 0: on it, or r - margin_mm inside if the margin is narrower than r)")
+                                                   "region boundary [mm], at most 10000 either way (< 0: on it, or r - margin_mm inside if the margin is narrower than r)")
       ->capture_default_str();
   app.add_option("--sample-mm", o.sample_mm, "removal map sampling in arc length [mm], <= 0.5")->capture_default_str();
   app.add_option("--row-step-mm", o.row_step_mm, "largest distance between path rows [mm]")->capture_default_str();
@@ -125,13 +125,14 @@ int Run(int argc, char** argv) {
 
   return RunGuarded(kTool, [&]() -> int {
     // The library's ranges, under the command line's names.
-    std::vector<FieldSource> fields = {{"optimise", "--optimise"}};
+    std::vector<FieldSource> fields = {{"optimise", "--optimise"}, {"cad_face", "--face"}, {"cad_unit_scale", "--cad-unit-scale"}};
     for (const polishing::PlanOptionRange& r : polishing::PlanOptionRanges(o)) {
       std::string option = "--" + r.name;
       std::replace(option.begin(), option.end(), '_', '-');
       fields.push_back({r.name, option});
     }
-    FromFields(fields, [&] { o.Validate(); });
+    FromFields(fields, [&] { o.Validate(); o.surface_choice.Validate(); });
+    CheckOptionRange("--edge-inset-mm", o.edge_inset_mm, -1e4, 1e4);  // a finite inset, < 10 m: any part
     RequireReadableFile(surface_path, "surface");
     if (process_path.empty() && !list_faces) throw UsageError("--process is required (except with --list-faces)");
     if (!process_path.empty()) RequireReadableFile(process_path, "process file");

@@ -59,6 +59,7 @@ int Run(int argc, char** argv) {
   choice.cad_face_given = app.count("--face") > 0;
   return RunGuarded(kTool, [&]() -> int {
     CheckOptionRange("--sample-mm", sample_mm, 0.05, 0.5);
+    FromFields({{"cad_face", "--face"}, {"cad_unit_scale", "--cad-unit-scale"}}, [&] { choice.Validate(); });
     RequireReadableFile(surface_path, "surface");
     RequireReadableFile(process_path, "process file");
     RequireReadableFile(path_in, "tool path");

@@ -54,7 +54,7 @@ int Run(int argc, char** argv) {
                  "critical depth and where; '-' = stdout");
   app.add_option("--threads", threads, "worker threads, 0 = all cores")->capture_default_str();
   app.add_option("--speeds", speeds, "speeds scanned for the best one (default: the cut file's spindle_speed_count)");
-  app.add_option("--max-depth-mm", max_depth_mm, "largest depth searched for mode coupling [mm]")->capture_default_str();
+  app.add_option("--max-depth-mm", max_depth_mm, "largest depth searched for mode coupling [mm], at most 10000")->capture_default_str();
   app.add_option("--rotation-evals", rotation_evals, "evaluations per point when the rotation is free")->capture_default_str();
   UncertaintyCli unc;
   AddUncertaintyOptions(app, &unc,

@@ -66,7 +66,8 @@ int Run(int argc, char** argv) {
         {"noise_mm", "--noise-mm"},       {"outliers", "--outliers"},           {"num_postures", "--num-postures"},
         {"outlier_mm", "--outlier-mm"},   {"sets", "--set"},                    {"masses_kg", "--masses-kg"},
         {"pulley_mm", "--pulley-mm"},     {"load_point_mm", "--load-point-mm"}, {"target_mm", "--target-mm"},
-        {"plan_path", "--plan-file"},     {"postures_path", "--postures"},      {"form", "--form"}};
+        {"plan_path", "--plan-file"},     {"postures_path", "--postures"},      {"form", "--form"},
+        {"min_reach_mm", "--min-reach-mm"}};
     for (const FieldSource& f : fields) o.names[f.field] = f.name;
     FromFields(fields, [&] { o.Validate(); });
     RequireReadableFile(o.robot_path, "robot config");

@@ -23,7 +23,7 @@ void AddSurfaceChoiceOptions(CLI::App* app, SurfaceChoice* choice) {
                   "0 or not given: the largest by area (named on stderr). An error with a YAML surface")
       ->capture_default_str();
   app->add_option("--cad-unit-scale", choice->cad_unit_scale,
-                  "multiply a STEP/IGES file's lengths (as read in mm) by this: 1000 for a file that says mm but "
+                  "multiply a STEP/IGES file's lengths (as read in mm) by this (> 0): 1000 for a file that says mm but "
                   "holds metres (the reader warns when a part is under 1 mm or over 10 m)")
       ->capture_default_str();
 }

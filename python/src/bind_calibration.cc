@@ -131,10 +131,10 @@ void BindCalibration(py::module_& m) {
               py::dict sd;
               sd["roving"] = rs->roving;
               sd["fixed_point"] = rs->fixed_point;
-              sd["fixed_direction"] = AxisString(rs->fixed_direction);
+              sd["fixed_direction"] = robomach::ToString(rs->fixed_direction);
               sd["points"] = rs->points;
               std::vector<std::string> dirs;
-              for (Axis a : rs->directions) dirs.push_back(AxisString(a));
+              for (Axis a : rs->directions) dirs.push_back(robomach::ToString(a));
               sd["directions"] = dirs;
               sd["shapes"] = Eigen::MatrixXcd(rs->shapes);
               sd["mass_normalised"] = rs->mass_normalised;
@@ -684,7 +684,7 @@ void BindCalibration(py::module_& m) {
   const workflows::FrfSynthOptions kFrfSynth;  // frf-synth's defaults
   std::string frf_synth_directions;  // "xx,yy": the default directions as --directions spells them
   for (const auto& [r, e] : kFrfSynth.hammer.directions) {
-    frf_synth_directions += (frf_synth_directions.empty() ? "" : ",") + AxisString(r) + AxisString(e);
+    frf_synth_directions += (frf_synth_directions.empty() ? "" : ",") + robomach::ToString(r) + robomach::ToString(e);
   }
   m.def("run_frf_synth",
         [](const std::string& robot, const std::string& postures, const std::optional<std::string>& out,

@@ -2,7 +2,9 @@
 // tool tips of stability-lobes' three sources, its lobes (ComputeLobes, the
 // call the tool makes) and the lobes CSV; stability-map's per-point analysis
 // (EvaluateStabilityMap) on targets the caller gives or a region file makes.
+#include <cctype>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -37,6 +39,29 @@ std::string AxisText(const Eigen::Vector3d& a) {
 Eigen::Matrix3d FrameOf(const io::CutSpec& cut, const Eigen::Vector3d& tool_axis) {
   if (!(tool_axis.norm() > 0.0)) throw std::invalid_argument("tool_axis: expected a non-zero vector");
   return workflows::CutFrame(cut, tool_axis, AxisText(tool_axis));
+}
+
+// An options struct's OptionError with its fields named as a call's keywords
+// (`keywords`: field -> keyword, e.g. MapOptions' "rotation_min" ->
+// "rotation_min_rad"), in field() and in the message, whole words only: the
+// ValueError names what the caller typed.
+OptionError WithKeywords(const OptionError& e, const std::map<std::string, std::string>& keywords) {
+  const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  const std::string msg = e.what();
+  std::string out;
+  for (size_t i = 0; i < msg.size();) {
+    size_t j = i;
+    while (j < msg.size() && word(msg[j])) ++j;
+    if (j == i) {
+      out += msg[i++];
+      continue;
+    }
+    const auto it = keywords.find(msg.substr(i, j - i));
+    out += it == keywords.end() ? msg.substr(i, j - i) : it->second;
+    i = j;
+  }
+  const auto f = keywords.find(e.field());
+  return OptionError(f == keywords.end() ? e.field() : f->second, out);
 }
 
 py::array_t<std::complex<double>> ToArray2(const std::vector<Eigen::Matrix2cd>& phi) {
@@ -441,9 +466,13 @@ void BindStability(py::module_& m) {
         cut.spindle_speed_rad_s ? cut.SpeedGrid() : cut.SpeedRange(speeds);
     o.analysis.mode_coupling.max_depth = MmToM(max_depth_mm);
     std::vector<stability::MapPoint> pts;
-    {
+    try {
       py::gil_scoped_release release;
       pts = stability::EvaluateStabilityMap(model, targets, rows, cols, cut.process, o);
+    } catch (const OptionError& e) {
+      // MapOptions names its fields rotation...; the keywords carry the unit.
+      throw WithKeywords(e, {{"rotation", "rotation_rad"}, {"rotation_min", "rotation_min_rad"},
+                             {"rotation_max", "rotation_max_rad"}});
     }
     return PointDicts(pts);
   }, py::arg("model").none(false), py::arg("targets"), py::arg("rows"), py::arg("cols"), py::arg("cut"), py::arg("seed_q"),

@@ -80,10 +80,6 @@ struct CollectedMessages {
   }
 };
 
-/// 'x', 'y', 'z' <-> Axis; @throws std::invalid_argument for anything else.
-Axis ParseAxis(const std::string& name);
-std::string AxisString(Axis a);
-
 /// Python spells an FRF key as a tuple (pose_id, response, excitation), e.g.
 /// ("P1", "x", "x") for the direct FRF Hxx of posture P1, and, when the file
 /// numbers its points (a roving test read with keep_points=True), as
@@ -131,8 +127,8 @@ struct type_caster<robomach::dynamics::FrfKey> {
     if (!isinstance<str>(t[0]) || !isinstance<str>(t[1]) || !isinstance<str>(t[2])) return false;
     value.pose_id = t[0].cast<std::string>();
     // A direction other than x, y, z is a ValueError naming it.
-    value.response = robomach::python::ParseAxis(t[1].cast<std::string>());
-    value.excitation = robomach::python::ParseAxis(t[2].cast<std::string>());
+    value.response = robomach::ParseAxis(t[1].cast<std::string>());
+    value.excitation = robomach::ParseAxis(t[2].cast<std::string>());
     value.response_point = 0;
     value.excitation_point = 0;
     if (t.size() == 5) {
@@ -144,8 +140,8 @@ struct type_caster<robomach::dynamics::FrfKey> {
   }
 
   static handle cast(const robomach::dynamics::FrfKey& k, return_value_policy, handle) {
-    const std::string r = robomach::python::AxisString(k.response);
-    const std::string e = robomach::python::AxisString(k.excitation);
+    const std::string r = robomach::ToString(k.response);
+    const std::string e = robomach::ToString(k.excitation);
     if (k.response_point == 0 && k.excitation_point == 0) return pybind11::make_tuple(k.pose_id, r, e).release();
     return pybind11::make_tuple(k.pose_id, r, e, k.response_point, k.excitation_point).release();
   }

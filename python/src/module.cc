@@ -27,11 +27,6 @@ py::array_t<std::complex<double>> ToArray(const std::vector<Eigen::Matrix3cd>& h
   return out;
 }
 
-Axis ParseAxis(const std::string& name) { return robomach::ParseAxis(name); }
-
-std::string AxisString(Axis a) { return ToString(a); }
-
-
 namespace {
 PyObject* g_unit_warning = nullptr;  // robomach.UnitWarning, made at import
 }  // namespace

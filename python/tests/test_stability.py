@@ -120,6 +120,19 @@ def test_region_map_equals_stability_map(tmp):
         assert np.all(np.abs(np.degrees(p['q']) - q_deg) <= 1e-12 * np.maximum(1.0, np.abs(q_deg)))
 
 
+def test_stability_map_names_the_keywords():
+    """The ValueError names stability_map's keywords (rotation_min_rad), not
+    the library's fields (rotation_min)."""
+    model = rm.RobotConfig(KR210).build()
+    cut = rm.read_cut_file(CUT)
+    region = rm.region_targets(REGION, model.num_joints, cut)
+    args = (model, region['targets'], region['rows'], region['cols'], cut, region['seed_q'])
+    with pytest.raises(ValueError, match=r'^rotation_max_rad: expected a value > rotation_min_rad 1 \[rad\], got 0.5$'):
+        rm.stability_map(*args, optimise_rotation=True, rotation_min_rad=1.0, rotation_max_rad=0.5)
+    with pytest.raises(ValueError, match=r'^rotation_rad: expected a finite value, got nan$'):
+        rm.stability_map(*args, rotation_rad=math.nan)
+
+
 def test_bad_input():
     cut = rm.read_cut_file(CUT)
     with pytest.raises(FileNotFoundError):
@@ -202,7 +215,7 @@ def test_run_stability_map_equals_the_tools_summary(tmp, uncertain):
 
 
 def test_run_stability_map_names_the_option():
-    with pytest.raises(ValueError, match=r'max_depth_mm 0: expected > 0'):
+    with pytest.raises(ValueError, match=r'max_depth_mm 0: expected a depth > 0 and at most 10000 mm'):
         rm.run_stability_map(KR210, CUT, REGION, max_depth_mm=0)
     with pytest.raises(ValueError, match=r'rotation_evaluations 3: expected >= 8'):
         rm.run_stability_map(KR210, CUT, REGION, rotation_evaluations=3)

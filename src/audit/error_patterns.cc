@@ -9,6 +9,7 @@
 
 #include "robomach/audit/correlation.h"
 #include "robomach/common/errors.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/common/units.h"
 #include "robomach/dynamics/gravity_torque.h"
 #include "robomach/dynamics/posture_dynamics.h"
@@ -115,11 +116,9 @@ void ErrorPatternOptions::Validate() const {
                       "ErrorPatternOptions: need 0 <= fmin_hz < fmax_hz, got fmin_hz = " + std::to_string(fmin_hz) +
                           ", fmax_hz = " + std::to_string(fmax_hz));
   }
-  if (!(matching.min_relative_visibility > 0.0 && matching.min_relative_visibility <= 1.0)) {
-    fail("matching.min_relative_visibility", "in (0, 1]", matching.min_relative_visibility);
-  }
-  if (!(matching.max_log_freq_ratio > 0.0)) fail("matching.max_log_freq_ratio", "> 0", matching.max_log_freq_ratio);
-  if (!(matching.direction_weight >= 0.0)) fail("matching.direction_weight", ">= 0", matching.direction_weight);
+  // MatchOptions' own checks (direction_weight finite too), its fields named
+  // "matching.direction_weight".
+  ValidateNested("matching", matching);
   if (!(significance_factor >= 1.0)) fail("significance_factor", ">= 1", significance_factor);
   if (!(significance_level > 0.0 && significance_level < 1.0)) {
     fail("significance_level", "in (0, 1)", significance_level);

@@ -69,7 +69,15 @@ void AuditOptions::Validate() const {
   if (!(uncertainty_confidence > 0.0 && uncertainty_confidence < 1.0)) {
     fail("uncertainty_confidence", "in (0, 1)", num(uncertainty_confidence));
   }
-  if (!parameter_uncertainty.parameters.empty()) dynamics::CheckValid(parameter_uncertainty);
+  if (!parameter_uncertainty.parameters.empty()) {
+    try {
+      dynamics::CheckValid(parameter_uncertainty);
+    } catch (const OptionError&) {
+      throw;
+    } catch (const std::invalid_argument& e) {
+      throw OptionError("parameter_uncertainty", e.what());  // its text as it was
+    }
+  }
 }
 
 double Bic(double rss, int n, int k) {

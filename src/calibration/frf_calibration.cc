@@ -202,7 +202,9 @@ void CalibrationOptions::Validate() const {
   ValidateNested("matching", matching);
   ValidateNested("modal_fit", modal_fit);
   CheckOptionAbove("freq_sigma", freq_sigma, 0.0);
+  CheckOptionFinite("freq_sigma", freq_sigma);
   CheckOptionAbove("peak_sigma", peak_sigma, 0.0);
+  CheckOptionFinite("peak_sigma", peak_sigma);
   CheckOptionBand("fmin_hz", fmin_hz, "fmax_hz", fmax_hz);
   CheckOptionAtLeast("max_iterations", max_iterations, 1);
   CheckOptionAtLeast("max_match_rounds", max_match_rounds, 1);

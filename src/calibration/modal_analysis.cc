@@ -30,6 +30,35 @@ dynamics::Frf Prepared(const dynamics::Frf& frf, const FrfNoise* noise, const st
   return f.Select(lines);
 }
 
+// The warning of an FRF none of whose usable lines lies in the band to fit:
+// where its lines and its usable lines are, so that the band can be chosen.
+std::string NoLineInBand(const std::string& pose, const dynamics::FrfKey& key, const dynamics::Frf& frf,
+                         const FrfNoise* noise, const GlobalModalFitOptions& fit) {
+  std::ostringstream w;
+  w.precision(6);
+  w << "posture " << pose << ", " << key.Label() << ": no usable line in the band to fit (fmin_hz " << fit.fmin_hz
+    << ", fmax_hz " << fit.fmax_hz << "): ";
+  if (frf.size() == 0) {
+    w << "the FRF has no line";
+    return w.str();
+  }
+  w << "its lines span " << frf.freq_hz().minCoeff() << "-" << frf.freq_hz().maxCoeff() << " Hz";
+  const std::vector<char> mask = UsableMask(frf, noise);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int k = 0; k < frf.size(); ++k) {
+    if (mask[k]) {
+      lo = std::min(lo, frf.freq_hz()(k));
+      hi = std::max(hi, frf.freq_hz()(k));
+    }
+  }
+  if (lo <= hi) {
+    w << ", usable " << lo << "-" << hi << " Hz; choose a band that overlaps them";
+  } else {
+    w << ", none of them usable (|H| under the noise floor everywhere)";
+  }
+  return w.str();
+}
+
 }  // namespace
 
 std::optional<RovingShapes> ShapesOfRovingTest(const ModalGroup& group, std::string* why) {
@@ -235,6 +264,11 @@ std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const Nois
       }
     }
     bool together = !options.per_frf && keys.size() > 1;
+    // A band that holds no line at all is said per FRF below (NoLineInBand),
+    // not as FRFs with too few common lines.
+    const Eigen::VectorXd& f0 = first.freq_hz();
+    const bool band_has_lines = ((f0.array() >= options.fit.fmin_hz) && (f0.array() <= options.fit.fmax_hz)).any();
+    if (together && same_grid && !band_has_lines) together = false;
     if (together && (!same_grid || static_cast<int>(common.size()) < options.min_common_lines)) {
       pm.warnings.push_back("posture " + pose + ": its FRFs " +
                             (same_grid ? "have only " + std::to_string(common.size()) +
@@ -260,9 +294,10 @@ std::vector<PoseModes> AnalyseModes(const dynamics::FrfSet& measured, const Nois
         g.keys.push_back(keys[i]);
         g.data.push_back(Prepared(set.at(keys[i]), noises[i], lines));
       }
-      for (const dynamics::Frf& f : g.data) {
-        if (f.size() == 0) {
+      for (size_t j = 0; j < g.data.size(); ++j) {
+        if (g.data[j].size() == 0) {
           g.fit.message = "no usable line in the band";
+          pm.warnings.push_back(NoLineInBand(pose, g.keys[j], set.at(g.keys[j]), noises[members[j]], options.fit));
           return g;
         }
       }

@@ -23,20 +23,30 @@ function(robomach_add_module)
           LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endfunction()
 
-# robomach_add_test(NAME <exe> SOURCES ... LIBS ... [LABELS ...]): a gtest
-# executable registered case by case with ctest. LABELS become ctest labels
-# of every case (`ctest -L readers`: the file readers' tests, which CI also
-# runs under the sanitizers).
+# robomach_add_test(NAME <exe> SOURCES ... LIBS ... [LABELS ...] [COST s]): a
+# gtest executable registered case by case with ctest. LABELS become ctest
+# labels of every case (`ctest -L readers`: the file readers' tests, which CI
+# also runs under the sanitizers). COST (seconds, a rough figure) is ctest's
+# COST of every case: a parallel run starts the costly ones first, so that a
+# fresh checkout (no CTestCostData.txt yet, as in CI) does not end on a
+# two-minute test started last on one core.
 function(robomach_add_test)
-  cmake_parse_arguments(ARG "" "NAME" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;COST" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SOURCES})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LIBS} GTest::gmock GTest::gtest_main)
   target_include_directories(${ARG_NAME} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   target_compile_definitions(${ARG_NAME} PRIVATE
     ROBOMACH_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     ROBOMACH_TEST_TMP_DIR="${PROJECT_BINARY_DIR}/test_tmp")
+  set(props)
   if(ARG_LABELS)
-    gtest_discover_tests(${ARG_NAME} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "${ARG_LABELS}")
+    list(APPEND props LABELS "${ARG_LABELS}")
+  endif()
+  if(ARG_COST)
+    list(APPEND props COST ${ARG_COST})
+  endif()
+  if(props)
+    gtest_discover_tests(${ARG_NAME} DISCOVERY_TIMEOUT 60 PROPERTIES ${props})
   else()
     gtest_discover_tests(${ARG_NAME} DISCOVERY_TIMEOUT 60)
   endif()

@@ -69,11 +69,7 @@ const NamedRegistry<const ControllerKind*>& ControllerKindRegistry() {
 }
 
 const std::vector<const ControllerKind*>& ControllerKinds() {
-  static const std::vector<const ControllerKind*> kinds = [] {
-    std::vector<const ControllerKind*> v;
-    for (const auto& [name, k] : ControllerKindRegistry().entries()) v.push_back(k);
-    return v;
-  }();
+  static const std::vector<const ControllerKind*> kinds = ControllerKindRegistry().Values();
   return kinds;
 }
 

@@ -17,8 +17,7 @@ EffectRegistry& EffectRegistry::Instance() {
 
 void EffectRegistry::Register(Factory factory) {
   const std::string name = factory()->name();
-  if (factories_.Contains(name)) throw std::logic_error("effect '" + name + "' registered twice");
-  factories_.Add(name, std::move(factory));
+  factories_.Add(name, std::move(factory));  // throws std::logic_error for a name added twice
 }
 
 void EffectRegistry::RegisterFamily(std::string pattern, FamilyFactory factory) {
@@ -30,10 +29,11 @@ std::shared_ptr<const Effect> EffectRegistry::Create(std::string_view name) cons
   for (const auto& [pattern, f] : families_) {
     if (auto e = f(name)) return e;
   }
-  std::string known;
-  for (const auto& n : Names()) known += (known.empty() ? "" : ", ") + n;
-  for (const auto& p : FamilyPatterns()) known += (known.empty() ? "" : ", ") + p;
-  throw std::invalid_argument("unknown effect '" + std::string(name) + "'; available: " + known);
+  // The registry's refusal, with the families' name patterns after the list.
+  std::string families;
+  for (const auto& p : FamilyPatterns()) families += (families.empty() ? "" : ", ") + p;
+  ThrowUnknownName(factories_.what(), std::string(name),
+                   factories_.NameList() + (families.empty() ? "" : "; or of a family: " + families));
 }
 
 std::vector<std::string> EffectRegistry::FamilyPatterns() const {

@@ -85,10 +85,13 @@ std::vector<Eigen::VectorXd> CampaignPostures(const dynamics::RobotModel& model,
   }
   if (static_cast<int>(out.size()) < count) {
     // The count first, so that a tool can name its option in its place.
-    throw std::invalid_argument("count " + std::to_string(count) + ": only " + std::to_string(out.size()) + " of " +
-                                std::to_string(tries) +
-                                " random postures reach every pulley within 60 degrees of vertical; ask for at most " +
-                                std::to_string(out.size()) + ", or place the pulleys elsewhere");
+    std::ostringstream m;
+    m << "count " << count << ": only " << out.size() << " of " << tries
+      << " random postures hold the load point 0.3 m above the floor and at least " << options.min_reach
+      << " m from the base axis (the least reach), with every pulley within 60 degrees of vertical; ";
+    if (!out.empty()) m << "ask for at most " << out.size() << ", ";
+    m << "lower the least reach, or place the pulleys elsewhere";
+    throw std::invalid_argument(m.str());
   }
   return out;
 }

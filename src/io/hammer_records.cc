@@ -571,14 +571,21 @@ std::vector<dynamics::FrfKey> ChannelKeys(const HammerRecords& rec, const std::s
         throw std::invalid_argument(name + ": " + e.what());
       }
     } else {
-      const char last = name.empty() ? '\0' : name.back();
+      // The suffix through the one axis parser (a capital too, "acc_X").
       const bool suffix = name.size() == 1 || (name.size() >= 2 && name[name.size() - 2] == '_');
-      if (!suffix || (last != 'x' && last != 'y' && last != 'z')) {
+      bool named = false;
+      if (suffix) {
+        try {
+          response = ParseAxis(name.substr(name.size() - 1));
+          named = true;
+        } catch (const std::invalid_argument&) {
+        }
+      }
+      if (!named) {
         throw std::invalid_argument(name + ": response channel '" + name +
                                     "' has no direction in its name (…_x, …_y, …_z); give " + name +
                                     "=x (or y, z)");
       }
-      response = static_cast<Axis>(last - 'x');
     }
     const dynamics::FrfKey key{pose_id, response, excitation};
     for (size_t k = 0; k < keys.size(); ++k) {

@@ -134,9 +134,10 @@ MachineFile ReadMachineFile(const std::string& path) {
   }
   const YamlDoc k = doc["kinematics"];
   const std::string type = k["type"].String();
-  // The message's words as before the registry ("; known:"), the names from it.
+  // The registry's refusal ("unknown kinematics type 'x': expected a or b"),
+  // at the type's file:line:col; checked before the geometry is read.
   const auto& kinds = machine::KinematicsKinds();
-  if (!kinds.Contains(type)) throw k["type"].Error("unknown kinematics type '" + type + "'; known: " + kinds.NameList());
+  k["type"].Checked([&] { kinds.Find(type); });
   machine::NutatingHeadGeometry& g = f.geometry;
   const double nutation_deg = DegreesInRange(k["nutation_deg"], 0.0, 90.0, false, true);
   if (nutation_deg < kMinPlausibleNutationDeg) {

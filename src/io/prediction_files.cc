@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "robomach/common/frames.h"
 #include "robomach/io/atomic_file.h"
 #include "robomach/io/number_format.h"
 
@@ -26,12 +27,14 @@ DirectionPairs ParseDirectionPairs(const std::string& text) {
     size_t comma = text.find(',', pos);
     if (comma == std::string::npos) comma = text.size();
     const std::string item = text.substr(pos, comma - pos);
+    // The one axis parser (a capital too); the pair's message for a bad one.
     auto axis = [&](char c) {
-      if (c < 'x' || c > 'z') {
+      try {
+        return static_cast<int>(ParseAxis(std::string(1, c)));
+      } catch (const std::invalid_argument&) {
         throw std::invalid_argument("direction pair '" + item +
                                     "': expected two of x, y, z such as xx or xy");
       }
-      return c - 'x';
     };
     if (item.size() != 2) {
       throw std::invalid_argument("direction pair '" + item +

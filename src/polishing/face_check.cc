@@ -65,6 +65,7 @@ double EstimatePathRows(double area, const PathParameters& params) {
 
 void PolishableOptions::Validate() const {
   CheckOptionAbove("sample_spacing", sample_spacing, 0.0);
+  CheckOptionFinite("sample_spacing", sample_spacing);
   CheckOptionAtLeast("max_grid_points", max_grid_points, 1);
   CheckOptionAtLeast("max_path_rows", max_path_rows, 1);
   CheckOptionAtLeast("check_grid_points", check_grid_points, 1);

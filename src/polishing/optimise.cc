@@ -116,13 +116,13 @@ void RunNlopt(nlopt::algorithm alg, int budget, std::vector<double>* x, Tracker*
 std::string ToString(Optimiser o) { return o == Optimiser::kNlopt ? "nlopt" : "pso"; }
 
 Optimiser ParseOptimiser(const std::string& name) {
-  static constexpr Optimiser kAll[] = {Optimiser::kNlopt, Optimiser::kPso};
-  return ParseByName("optimiser", name, kAll);
+  return ParseByName("optimiser", name, kOptimisers);
 }
 
 void OptimiseOptions::Validate() const {
   CheckOptionAbove("offset_min", offset_min, 0.0);
   CheckOptionBand("offset_min", offset_min, "offset_max", offset_max);
+  CheckOptionFinite("offset_max", offset_max);  // the band helper lets +inf through (open Hz bands)
   CheckOptionAtLeast("global_evaluations", global_evaluations, 1);
   CheckOptionAtLeast("local_evaluations", local_evaluations, 1);
   CheckOptionAtLeast("pso_particles", pso_particles, 1);
@@ -644,6 +644,7 @@ void RunMultiStartPlan(const PlanRun& run, const std::vector<GuideFamily>& fams,
 void PlanOptimiseOptions::Validate() const {
   CheckOptionAbove("offset_min", offset_min, 0.0);
   CheckOptionBand("offset_min", offset_min, "offset_max", offset_max);
+  CheckOptionFinite("offset_max", offset_max);  // the band helper lets +inf through (open Hz bands)
   CheckOptionAbove("feasibility_margin", feasibility_margin, 0.0);
   CheckOptionRange("feasibility_margin", feasibility_margin, 0.0, 1.0);
   CheckOptionRange("ftol_rel", ftol_rel, 0.0, 1.0);

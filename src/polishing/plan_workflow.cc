@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "robomach/common/errors.h"
+#include "robomach/common/named_registry.h"
 #include "robomach/common/number_format.h"
 #include "robomach/common/option_checks.h"
 #include "robomach/common/units.h"
@@ -142,8 +143,11 @@ void PlanOptions::Validate() const {
     }
   };
   as_option("guides", [&] { ParseGuideLines(guides); });
-  if (optimise != "none" && !(optimise == ToString(Optimiser::kNlopt) || optimise == ToString(Optimiser::kPso))) {
-    throw OptionError("optimise", "optimise: expected none, nlopt or pso, got " + optimise);
+  // "none" or a name of the enum's one list (optimise.h: kOptimisers).
+  std::vector<std::string> optimisers{"none"};
+  for (Optimiser m : kOptimisers) optimisers.push_back(ToString(m));
+  if (std::find(optimisers.begin(), optimisers.end(), optimise) == optimisers.end()) {
+    throw OptionError("optimise", "optimise: expected " + NameListOf(optimisers) + ", got " + optimise);
   }
   as_option("pattern", [&] { ParsePattern(pattern); });
   if (optimise == ToString(Optimiser::kPso) && ParsePattern(pattern) != Pattern::kCycloid) {

@@ -101,7 +101,7 @@ void DrillSimOptions::Validate() const {
   }
   if (!(motor_torque_limit_Nm > 0.0 && std::isfinite(motor_torque_limit_Nm))) {
     throw OptionError("motor_torque_limit_Nm",
-                      "motor_torque_limit_Nm " + FormatNumber(motor_torque_limit_Nm) + ": expected a finite value > 0");
+                      "motor_torque_limit_Nm " + FormatNumber(motor_torque_limit_Nm) + ": expected a finite value > 0 N·m");
   }
 }
 

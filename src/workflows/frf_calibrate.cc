@@ -6,6 +6,7 @@
 
 #include "robomach/common/errors.h"
 #include "robomach/common/option_checks.h"
+#include "robomach/common/option_validate.h"
 #include "robomach/io/posture_file.h"
 #include "robomach/workflows/frf_predict.h"
 #include "robomach/workflows/robot_config.h"
@@ -51,6 +52,9 @@ void FrfCalibrateOptions::Validate() const {
   if (postures_path.empty()) throw OptionError("postures_path", "postures_path: a posture file is required");
   CheckOptionRange("max_iterations", max_iterations, 1, 100000);
   CheckOptionRange("robust_loss_sigma", robust_loss_sigma, 0.0, 1e6);
+  // The band before the files are read: 0 <= fmin_hz < fmax_hz (fmax_hz may
+  // be +inf, all lines), naming both values.
+  CheckOptionBand("fmin_hz", fmin_hz, "fmax_hz", fmax_hz);
   if (measured_files.empty() && pose_files.empty()) {
     throw OptionError("measured_files", "no measured FRFs: give measured_files FILE or pose_files ID=file.uff");
   }

@@ -76,6 +76,13 @@ Eigen::VectorXd FrequencyGrid(double fmin_hz, double fmax_hz, double df_hz) {
                                      " allowed (FFT analysers give 400 - 25 600)" + why +
                                      ": raise df_hz or lower fmax_hz");
   }
+  // One line is no FRF (nothing to plot, no peak, no mode to fit).
+  if (lines < 2.0) {
+    throw OptionError("df_hz", "df_hz " + FormatNumber(df_hz, 7) + ": leaves 1 frequency line in fmin_hz " +
+                                   FormatNumber(fmin_hz, 7) + " to fmax_hz " + FormatNumber(fmax_hz, 7) +
+                                   " Hz; expected a step of at most " + FormatNumber(fmax_hz - fmin_hz, 7) +
+                                   " Hz (2 lines or more)");
+  }
   const long n = static_cast<long>(lines);
   return Eigen::VectorXd::LinSpaced(n, fmin_hz, fmin_hz + static_cast<double>(n - 1) * df_hz);
 }

@@ -55,7 +55,18 @@ void FrfSynthOptions::Validate() const {
       throw OptionError(name, std::string(name) + " " + num(v) + ": expected a frequency in [0, 1e9] Hz");
     }
   }
-  if (std::isfinite(h.sample_rate_hz) && !(h.sample_rate_hz > 0.0 && h.sample_rate_hz <= kMaxFrequencyHz)) {
+  // fmin_hz against the band here, where both are the options' (the Nyquist
+  // check of fmax_hz needs the config's rate: VirtualHammerOptions').
+  if (!(h.fmin_hz > 0.0 && h.fmin_hz <= kMaxFrequencyHz)) {
+    throw OptionError("fmin_hz", "fmin_hz " + num(h.fmin_hz) + ": expected a frequency in (0, 1e9] Hz (the 0 Hz line is "
+                                                               "not measured)");
+  }
+  if (!(h.fmin_hz < h.fmax_hz)) {
+    throw OptionError("fmin_hz", "fmin_hz " + num(h.fmin_hz) + ": expected a frequency below fmax_hz " +
+                                     num(h.fmax_hz) + " Hz");
+  }
+  // NaN: the config's rate; infinity is a value given (and refused).
+  if (!std::isnan(h.sample_rate_hz) && !(h.sample_rate_hz > 0.0 && h.sample_rate_hz <= kMaxFrequencyHz)) {
     throw OptionError("sample_rate_hz", "sample_rate_hz " + num(h.sample_rate_hz) + ": expected a rate in (0, 1e9] Hz");
   }
   for (const auto& [name, v] : {std::pair{"absolute_noise_m_per_N", h.absolute_noise_m_per_N},

@@ -175,6 +175,13 @@ void KqPlanOptions::Validate() const {
       throw OptionError("masses_kg", "masses_kg: expected masses > 0 kg, got " + FormatNumber(m, 6));
     }
   }
+  // A posture needs two rope directions (PlanOptions::directions_per_posture):
+  // at 0 only the vertical one is left, and no posture is feasible.
+  if (!(max_rope_angle_deg > 0.0 && max_rope_angle_deg < 90.0)) {
+    throw OptionError("max_rope_angle_deg", "max_rope_angle_deg: expected a rope angle from vertical in (0, 90) deg "
+                                            "(0 leaves only the vertical rope), got " +
+                                                FormatNumber(max_rope_angle_deg, 6));
+  }
   if (target_quantity != "frequency" && target_quantity != "safe-depth") {
     throw OptionError("target_quantity", "target_quantity: expected frequency or safe-depth, got '" +
                                              target_quantity + "'");
@@ -487,7 +494,20 @@ KqPlanResult RunKqPlan(const KqPlanOptions& o, const MessageSink& on_message) {
   CheckOptionUnits(o, &r);
   for (const std::string& w : r.option_findings) Tell(on_message, Message::Kind::kWarning, w);
   const std::vector<io::Posture> targets = SetUpPlanner(o, on_message, &r);
-  r.plan = identification::PlanLoadTests(*r.model, r.planner);
+  try {
+    r.plan = identification::PlanLoadTests(*r.model, r.planner);
+  } catch (const std::invalid_argument& e) {
+    // "PlanLoadTests: only 0 feasible postures found for 4 requested: lower
+    // min_load_height or widen max_rope_angle": named as the options are.
+    const std::string m = e.what();
+    const size_t colon = m.find(": lower min_load_height");
+    if (m.rfind("PlanLoadTests: only ", 0) != 0 || colon == std::string::npos) throw;
+    throw std::invalid_argument(
+        m.substr(15, colon - 15) + ": widen " + o.max_rope_angle_name + " (now " +
+        FormatNumber(o.max_rope_angle_deg, 6) + " deg), or move the load point (" + o.load_point_name +
+        ") where the robot holds it at least " + FormatNumber(r.planner.min_load_height, 3) +
+        " m above the floor");
+  }
   // A band the plan does not reach and narrower than 0.5 %: most likely a
   // fraction typed for a percentage (0.05 for 5 %); the finding says so.
   if (o.target_half_width > 0.0 && o.target_half_width < 0.005 && r.plan.postures_for_target_width == 0) {

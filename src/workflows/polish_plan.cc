@@ -50,7 +50,19 @@ void CheckFaceSize(const polishing::NurbsSurface& surface, const PolishPlanOptio
 
 }  // namespace
 
+void SurfaceChoice::Validate() const {
+  if (cad_face < 0) {
+    throw OptionError("cad_face", "cad_face " + std::to_string(cad_face) +
+                                      ": expected a face number >= 1 (1-based), or 0 for the largest face");
+  }
+  if (!(cad_unit_scale > 0.0) || !std::isfinite(cad_unit_scale)) {
+    throw OptionError("cad_unit_scale", "cad_unit_scale: expected a finite factor > 0 (1000 for a file in metres, "
+                                        "25.4 in inches), got " + FormatNumber(cad_unit_scale, 6));
+  }
+}
+
 polishing::NurbsSurface LoadPolishSurface(const std::string& path, const SurfaceChoice& choice, const MessageSink& tell) {
+  choice.Validate();
   if (!io::IsCadFile(path)) {
     if (choice.cad_face_given) {
       throw OptionError("cad_face", "cad_face " + std::to_string(choice.cad_face) + ": " + path +

@@ -18,8 +18,11 @@ void StabilityMapOptions::Validate() const {
 }
 
 void StabilityMapOptions::ValidateSettings() const {
-  if (!(max_depth_mm > 0.0) || !std::isfinite(max_depth_mm)) {
-    throw OptionError("max_depth_mm", "max_depth_mm " + FormatNumber(max_depth_mm) + ": expected > 0");
+  // 10 m of depth of cut is no cut (and a search up to 1e30 mm loses the
+  // boundary in its bisection); stability-lobes bounds sd_max_depth_mm alike.
+  if (!(max_depth_mm > 0.0 && max_depth_mm <= 1e4)) {
+    throw OptionError("max_depth_mm", "max_depth_mm " + FormatNumber(max_depth_mm) +
+                                          ": expected a depth > 0 and at most 10000 mm");
   }
   // Bounds that keep a typo from spawning 1e5 threads or hours of work.
   if (speeds < 0 || speeds > 100000) {

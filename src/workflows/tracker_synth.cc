@@ -145,7 +145,8 @@ TrackerSynthRun RunTrackerSynth(const TrackerSynthOptions& o, const MessageSink&
       // "count 40: only ...": the library's count is num_postures.
       const std::string m = e.what();
       if (m.rfind("count ", 0) != 0) throw;
-      throw OptionError("num_postures", "num_postures" + m.substr(5));
+      throw OptionError("num_postures", "num_postures" + m.substr(5) + " (the least reach is " +
+                                            o.Name("min_reach_mm") + " " + FormatNumber(o.min_reach_mm, 6) + ")");
     }
     for (size_t p = 0; p < qs.size(); ++p) r.pose_ids.push_back("P" + std::to_string(p + 1));
   }

@@ -54,6 +54,15 @@ TEST(OptionsValidate, AuditOptionsNameFieldValueAndBound) {
   ExpectRefused<O>(d, [](O& o) { o.robust_scale = -1; }, "robust_scale", {"must be >= 0", "got -1.0"});
   ExpectRefused<O>(d, [](O& o) { o.uncertainty_confidence = 1; }, "uncertainty_confidence",
                    {"in (0, 1)", "got 1.0"});
+  // dynamics::CheckValid's std::invalid_argument, as an OptionError with its text.
+  ExpectRefused<O>(d, [](O& o) {
+    o.parameter_uncertainty.parameters = {{"m6_kg", std::numeric_limits<double>::infinity()}};
+    o.parameter_uncertainty.covariance = Eigen::MatrixXd::Identity(1, 1);
+  }, "parameter_uncertainty", {"parameter uncertainty: m6_kg has the non-finite value inf"});
+  ExpectRefused<O>(d, [](O& o) {
+    o.parameter_uncertainty.parameters = {{"m6_kg", 20.0}, {"m6_kg", 21.0}};
+    o.parameter_uncertainty.covariance = Eigen::MatrixXd::Identity(2, 2);
+  }, "parameter_uncertainty", {"parameter uncertainty: parameter 'm6_kg' given twice"});
 }
 
 TEST(OptionsValidate, ErrorPatternOptionsNameFieldValueAndBound) {
@@ -63,11 +72,16 @@ TEST(OptionsValidate, ErrorPatternOptionsNameFieldValueAndBound) {
   ExpectRefused<O>(d, [](O& o) { o.fmin_hz = 5; o.fmax_hz = 5; }, "fmax_hz",
                    {"0 <= fmin_hz < fmax_hz", "fmax_hz = 5.0"});
   ExpectRefused<O>(d, [](O& o) { o.matching.min_relative_visibility = 0; }, "matching.min_relative_visibility",
-                   {"matching.min_relative_visibility must be in (0, 1]", "got 0.0"});
+                   {"matching.min_relative_visibility: expected a value > 0", "got 0"});
+  ExpectRefused<O>(d, [](O& o) { o.matching.min_relative_visibility = 2; }, "matching.min_relative_visibility",
+                   {"matching.min_relative_visibility: expected a value in [0, 1]", "got 2"});
   ExpectRefused<O>(d, [](O& o) { o.matching.max_log_freq_ratio = 0; }, "matching.max_log_freq_ratio",
-                   {"matching.max_log_freq_ratio must be > 0", "got 0.0"});
+                   {"matching.max_log_freq_ratio: expected a value > 0", "got 0"});
   ExpectRefused<O>(d, [](O& o) { o.matching.direction_weight = -1; }, "matching.direction_weight",
-                   {"matching.direction_weight must be >= 0", "got -1.0"});
+                   {"matching.direction_weight: expected a value >= 0", "got -1"});
+  // MatchOptions::Validate's own checks: an infinite weight is refused too.
+  ExpectRefused<O>(d, [](O& o) { o.matching.direction_weight = std::numeric_limits<double>::infinity(); },
+                   "matching.direction_weight", {"matching.direction_weight: expected a finite value", "got inf"});
   ExpectRefused<O>(d, [](O& o) { o.significance_factor = 0.5; }, "significance_factor",
                    {"significance_factor must be >= 1", "got 0.5"});
   ExpectRefused<O>(d, [](O& o) { o.significance_level = 0; }, "significance_level", {"in (0, 1)", "got 0.0"});

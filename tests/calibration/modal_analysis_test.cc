@@ -194,6 +194,33 @@ TEST(ModalAnalysis, FrfsOnDifferentGridsAreFittedAloneWithAWarning) {
   EXPECT_NE(poses[0].warnings[0].find("different frequency lines"), std::string::npos) << poses[0].warnings[0];
 }
 
+// A band to fit above the measured lines (a user's --fmin-hz beyond the
+// file's band): no fit, and a warning that says where the lines are, so
+// that the posture is flagged rather than silently empty.
+TEST(ModalAnalysis, BandWithoutAMeasuredLineIsAWarningNamingTheLines) {
+  const io::RobotConfig cfg = io::LoadRobotConfig(SourcePath("config/kr210.yaml"));
+  const auto model = dynamics::RobotModel::Build(cfg.description, cfg.parameters);
+  Eigen::VectorXd q(6);
+  q << 0.2, -1.0, 1.5, 0.2, 0.8, -0.3;
+  VirtualHammerOptions h;
+  h.directions = {{Axis::kX, Axis::kX}};
+  h.relative_noise = 0.01;
+  const dynamics::FrfSet set = SynthesizeHammerTest(model, {{"P", q}}, h);
+  const double top_hz = set.begin()->second.freq_hz().maxCoeff();
+  ModalAnalysisOptions o;
+  o.fit.fmin_hz = 2.0 * top_hz;
+  const auto poses = AnalyseModes(set, EstimateNoise(set), o);
+  ASSERT_EQ(poses.size(), 1u);
+  ASSERT_EQ(poses[0].groups.size(), 1u);
+  EXPECT_NE(poses[0].groups[0].fit.status, SolverStatus::kConverged);
+  EXPECT_TRUE(poses[0].tip_modes.empty());
+  ASSERT_EQ(poses[0].warnings.size(), 1u);
+  const std::string& w = poses[0].warnings[0];
+  EXPECT_NE(w.find("no usable line in the band to fit"), std::string::npos) << w;
+  EXPECT_NE(w.find("its lines span"), std::string::npos) << w;
+  EXPECT_NE(w.find("usable "), std::string::npos) << w;
+}
+
 // A roving-sensor test of a 4-DOF chain (ground-k-m-k-m-k-m-k-m, masses
 // and stiffnesses unequal, Rayleigh damping): the hammer stays at mass 2,
 // the sensor roves over masses 1-4, with 1 % noise. The reference is the

@@ -182,6 +182,8 @@ TEST(OptionsValidate, CalibrationOptionsNameFieldValueAndBound) {
                    {"modal_fit.min_order: expected a value >= 1, got 0"});
   ExpectRefused<O>(d, [](O& o) { o.freq_sigma = 0; }, "freq_sigma", {"> 0", "got 0"});
   ExpectRefused<O>(d, [](O& o) { o.peak_sigma = -1; }, "peak_sigma", {"> 0", "got -1"});
+  ExpectRefused<O>(d, [](O& o) { o.freq_sigma = kInf; }, "freq_sigma", {"freq_sigma: expected a finite value", "got inf"});
+  ExpectRefused<O>(d, [](O& o) { o.peak_sigma = kInf; }, "peak_sigma", {"peak_sigma: expected a finite value", "got inf"});
   ExpectRefused<O>(d, [](O& o) { o.fmin_hz = -1; }, "fmin_hz", {">= 0", "got -1"});
   ExpectRefused<O>(d, [](O& o) { o.fmax_hz = 0; }, "fmax_hz", {"> fmin_hz 0", "got 0"});
   ExpectRefused<O>(d, [](O& o) { o.max_iterations = 0; }, "max_iterations", {">= 1", "got 0"});

@@ -45,6 +45,7 @@ TEST(NamedRegistry, FindsEveryEntryByNameInTheOrderAdded) {
   const NamedRegistry<int> r = Sizes();
   EXPECT_EQ(r.size(), 3u);
   EXPECT_EQ(r.Names(), (std::vector<std::string>{"small", "medium", "large"}));
+  EXPECT_EQ(r.Values(), (std::vector<int>{1, 2, 3}));
   EXPECT_EQ(r.Find("small"), 1);
   EXPECT_EQ(r.Find("medium"), 2);
   EXPECT_EQ(r.Find("large"), 3);

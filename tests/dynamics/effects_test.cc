@@ -19,7 +19,10 @@ TEST(EffectRegistry, ListsTheTipMassAndNamesAlternativesForUnknownEffects) {
   const auto names = EffectRegistry::Instance().Names();
   EXPECT_THAT(names, ::testing::Contains("tip_mass"));
   EXPECT_THAT(CaptureError([] { EffectRegistry::Instance().Create("tip_mas"); }),
-              HasSubstr("unknown effect 'tip_mas'; available: "));
+              ::testing::AllOf(HasSubstr("unknown effect 'tip_mas': expected "), HasSubstr("tip_mass"),
+                               HasSubstr("; or of a family: "),
+                               HasSubstr("virtual_joint_<place>_<axis> (place: base, link1..linkN"),
+                               HasSubstr("load_stiffness_j<joint> (joint: 1..N)")));
 }
 
 TEST(EffectParameters, AreExposedWithThePrefixAndChecked) {

@@ -8,6 +8,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "robomach/io/prediction_files.h"
 #include "test_support.h"
 
 namespace robomach::io {
@@ -66,6 +67,28 @@ TEST(HammerRecords, ResponseRangesByChannelName) {
               HasSubstr("acc=50: no response channel 'acc'"));
   EXPECT_THAT(CaptureError([&] { ResponseRanges(r, {{"tip_x", -1.0}}); }),
               HasSubstr("tip_x=-1: expected a finite range >= 0"));
+}
+
+// Issue #36, one axis parser: a channel name's direction suffix and the
+// direction pairs go through ParseAxis, so a capital is taken as ParseAxis
+// takes it ("tip_X", "XY"); anything else is refused with the messages of
+// before.
+TEST(HammerRecords, DirectionSuffixAndPairsTakeCapitalsAsParseAxis) {
+  const std::string dir = TempDir("hammer_records_capitals");
+  const HammerRecords r = ReadHammerRecords(
+      {WriteText(dir + "/run.csv", "hit,time_s,force_N,tip_X_m,acc_y_m_per_s2\n" + Rows("1", 20))});
+  const auto keys = ChannelKeys(r, "P1", Axis::kZ);
+  ASSERT_EQ(keys.size(), 2u);
+  EXPECT_EQ(keys[0].response, Axis::kX);
+  EXPECT_EQ(keys[1].response, Axis::kY);
+  const HammerRecords w = ReadHammerRecords(
+      {WriteText(dir + "/w.csv", "hit,time_s,force_N,tip_w_m,acc_y_m_per_s2\n" + Rows("1", 20))});
+  EXPECT_THAT(CaptureError([&] { ChannelKeys(w, "P1", Axis::kZ); }),
+              HasSubstr("tip_w: response channel 'tip_w' has no direction in its name"));
+  EXPECT_EQ(ParseDirectionPairs("XY,yz"), (DirectionPairs{{0, 1}, {1, 2}}));
+  EXPECT_THAT(CaptureError([] { ParseDirectionPairs("xq"); }),
+              HasSubstr("direction pair 'xq': expected two of x, y, z such as xx or xy"));
+  EXPECT_THAT(CaptureError([] { ParseDirectionPairs("xx,XX"); }), HasSubstr("direction pair 'XX' is given twice"));
 }
 
 // A rate that is not a whole number of hertz stays as it is: 1/(1.0005 ms)

@@ -76,7 +76,7 @@ TEST(RobotConfig, BadValuesAreLocated) {
   EXPECT_THAT(CaptureError([&] {
                 LoadRobotConfig(Variant("effect", "\nhammer_test:", "\neffects:\n  - name: tip_mas\nhammer_test:"));
               }),
-              HasSubstr("unknown effect 'tip_mas'; available: "));
+              HasSubstr("unknown effect 'tip_mas': expected "));
 }
 
 // Issue #37: a config names parameter-uncertainty files relative to its

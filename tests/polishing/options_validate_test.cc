@@ -38,6 +38,8 @@ TEST(PolishingOptionsValidate, PolishableOptionsNameTheField) {
   ExpectOptionError([&] { bad(&PolishableOptions::sample_spacing, 0.0).Validate(); }, "sample_spacing",
                     "sample_spacing: expected a value > 0, got 0");
   ExpectOptionError([&] { bad(&PolishableOptions::sample_spacing, NAN).Validate(); }, "sample_spacing", "got nan");
+  ExpectOptionError([&] { bad(&PolishableOptions::sample_spacing, INFINITY).Validate(); }, "sample_spacing",
+                    "sample_spacing: expected a finite value, got inf");
   ExpectOptionError([&] { bad(&PolishableOptions::max_grid_points, 0.0).Validate(); }, "max_grid_points",
                     "max_grid_points: expected a value >= 1, got 0");
   ExpectOptionError([&] { bad(&PolishableOptions::max_path_rows, -5.0).Validate(); }, "max_path_rows",
@@ -54,6 +56,9 @@ TEST(PolishingOptionsValidate, OptimiseOptionsNameTheField) {
   o.offset_max = o.offset_min;
   ExpectOptionError([&] { o.Validate(); }, "offset_max",
                     "offset_max: expected a value > offset_min 0.004, got 0.004");
+  o = {};
+  o.offset_max = INFINITY;  // an open band is for Hz, not for offsets
+  ExpectOptionError([&] { o.Validate(); }, "offset_max", "offset_max: expected a finite value, got inf");
   o = {};
   o.global_evaluations = 0;
   ExpectOptionError([&] { o.Validate(); }, "global_evaluations", "global_evaluations: expected a value >= 1, got 0");
@@ -89,6 +94,9 @@ TEST(PolishingOptionsValidate, PlanOptimiseOptionsNameTheField) {
   o = {};
   o.offset_max = 0.001;
   ExpectOptionError([&] { o.Validate(); }, "offset_max", "offset_max: expected a value > offset_min 0.004, got 0.001");
+  o = {};
+  o.offset_max = INFINITY;
+  ExpectOptionError([&] { o.Validate(); }, "offset_max", "offset_max: expected a finite value, got inf");
   o = {};
   o.feasibility_margin = 0.0;
   ExpectOptionError([&] { o.Validate(); }, "feasibility_margin",

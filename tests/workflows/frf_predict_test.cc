@@ -42,6 +42,10 @@ TEST(FrequencyGrid, LinesEndsAndRefusals) {
   const std::string m = FieldOf([] { FrequencyGrid(0.625, 1e9, 0.625); });
   EXPECT_NE(m.find("more than the 200000 allowed"), std::string::npos) << m;
   EXPECT_NE(m.find("typed in the Hz option?"), std::string::npos) << m;
+  // A step wider than the band: one line, no FRF.
+  const std::string one = FieldOf([] { FrequencyGrid(0.625, 50.0, 1e30); });
+  EXPECT_EQ(one.rfind("df_hz: df_hz 1e+30: leaves 1 frequency line in fmin_hz 0.625 to fmax_hz 50 Hz", 0), 0u) << one;
+  EXPECT_EQ(FrequencyGrid(0.625, 50.0, 49.375).size(), 2);
 }
 
 TEST(ApplyAddsAndSets, ChangesTheConfigOrNamesTheField) {

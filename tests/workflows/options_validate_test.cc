@@ -7,6 +7,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -159,6 +160,18 @@ TEST(OptionsValidate, FrfCalibrateOptionsNameFieldValueAndBound) {
   const O d = Calibrate();
   ExpectRefused<O>(d, [](O& o) { o.max_iterations = 0; }, "max_iterations", {"[1, 100000]", "got 0"});
   ExpectRefused<O>(d, [](O& o) { o.robust_loss_sigma = -1; }, "robust_loss_sigma", {"[0, 1e+06]", "got -1"});
+  // The band is checked here, before the files are read, naming both ends.
+  ExpectRefused<O>(d, [](O& o) {
+    o.fmin_hz = 600;
+    o.fmax_hz = 500;
+  }, "fmax_hz", {"fmax_hz: expected a value > fmin_hz 600", "got 500"});
+  ExpectRefused<O>(d, [](O& o) { o.fmin_hz = -1; }, "fmin_hz", {"fmin_hz: expected a value >= 0", "got -1"});
+  EXPECT_NO_THROW([] {
+    O o = Calibrate();
+    o.fmin_hz = 5;
+    o.fmax_hz = std::numeric_limits<double>::infinity();  // all lines
+    o.Validate();
+  }());
   // The noise options are the tool's own (--min-snr): unprefixed.
   ExpectRefused<O>(d, [](O& o) { o.noise.min_snr = 0; }, "min_snr", {"[0.001, 1e+06]", "got 0"});
 }
@@ -189,6 +202,11 @@ TEST(OptionsValidate, FrfSynthOptionsNameFieldValueAndBound) {
                    {"block_samples: expected a value in [2, ", "got 1"});
   ExpectRefused<O>(d, [](O& o) { o.hammer.relative_noise = 20; }, "relative_noise", {"relative_noise 20", "at most 10"});
   ExpectRefused<O>(d, [](O& o) { o.hammer.fmax_hz = -1; }, "fmax_hz", {"fmax_hz -1", "[0, 1e9] Hz"});
+  ExpectRefused<O>(d, [](O& o) { o.hammer.fmin_hz = 1e30; }, "fmin_hz", {"fmin_hz 1e+30", "(0, 1e9] Hz"});
+  ExpectRefused<O>(d, [](O& o) { o.hammer.fmin_hz = 600; }, "fmin_hz", {"fmin_hz 600", "below fmax_hz 500 Hz"});
+  // NaN is "the config's rate"; infinity is a rate given, and refused.
+  ExpectRefused<O>(d, [](O& o) { o.hammer.sample_rate_hz = INFINITY; }, "sample_rate_hz",
+                   {"sample_rate_hz inf", "(0, 1e9] Hz"});
 }
 
 TEST(OptionsValidate, KqIdentifyOptionsNameFieldValueAndBound) {
@@ -205,6 +223,8 @@ TEST(OptionsValidate, KqPlanOptionsNameFieldValueAndBound) {
   ExpectRefused<O>(d, [](O& o) { o.noise_mm = -1; }, "noise_mm", {"> 0 mm", "got -1"});
   ExpectRefused<O>(d, [](O& o) { o.masses_kg = {10.0, -1.0}; }, "masses_kg", {"masses > 0 kg", "got -1"});
   ExpectRefused<O>(d, [](O& o) { o.target_half_width = 1; }, "target_half_width", {"[0, 1)", "got 1"});
+  ExpectRefused<O>(d, [](O& o) { o.max_rope_angle_deg = 0; }, "max_rope_angle_deg", {"(0, 90) deg", "got 0"});
+  ExpectRefused<O>(d, [](O& o) { o.max_rope_angle_deg = 90; }, "max_rope_angle_deg", {"(0, 90) deg", "got 90"});
 }
 
 TEST(OptionsValidate, MeasuredFrfOptionsNameFieldValueAndBound) {
@@ -248,6 +268,7 @@ TEST(OptionsValidate, StabilityMapOptionsNameFieldValueAndBound) {
   using O = StabilityMapOptions;
   const O d = Map();
   ExpectRefused<O>(d, [](O& o) { o.max_depth_mm = 0; }, "max_depth_mm", {"max_depth_mm 0", "> 0"});
+  ExpectRefused<O>(d, [](O& o) { o.max_depth_mm = 1e30; }, "max_depth_mm", {"max_depth_mm 1e+30", "at most 10000 mm"});
   ExpectRefused<O>(d, [](O& o) { o.speeds = -1; }, "speeds", {"speeds -1", "0 to 100000"});
   ExpectRefused<O>(d, [](O& o) { o.rotation_evaluations = 7; }, "rotation_evaluations",
                    {"rotation_evaluations 7", ">= 8"});

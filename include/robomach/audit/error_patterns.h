@@ -135,8 +135,9 @@ struct ErrorPatternOptions {
   /// (AuditOptions::significance_factor, same default).
   double significance_factor{AuditOptions{}.significance_factor};
 
-  /// 0 <= fmin_hz < fmax_hz; matching.min_relative_visibility in (0, 1];
-  /// matching.max_log_freq_ratio > 0; matching.direction_weight >= 0;
+  /// 0 <= fmin_hz < fmax_hz; matching valid (MatchOptions::Validate:
+  /// min_relative_visibility in (0, 1], max_log_freq_ratio > 0,
+  /// direction_weight >= 0 and finite; fields named "matching.FIELD");
   /// significance_factor >= 1; significance_level in (0, 1).
   /// @throws OptionError naming the field ("matching.direction_weight"), its
   ///   value and the bound.

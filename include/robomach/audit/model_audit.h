@@ -125,7 +125,8 @@ struct AuditOptions {
   /// clear_bic_gap >= 0; fit_line_stride, parameter_pairs_from and
   /// virtual_joints_fitted >= 0; identifiable_chi2 finite and >= 0;
   /// robust_scale finite and >= 0; uncertainty_confidence in (0, 1); the
-  /// parameter_uncertainty (if any) valid (dynamics::CheckValid).
+  /// parameter_uncertainty (if any) valid (dynamics::CheckValid: its
+  /// message, as an OptionError of field "parameter_uncertainty").
   /// @throws OptionError naming the field, its value and the bound
   ///   ("AuditOptions::num_bands must be >= 1, got 0").
   void Validate() const;

@@ -253,7 +253,7 @@ struct CalibrationOptions {
   /// free_parameters not empty (their names are checked against the model
   /// by Calibrate); matching and modal_fit valid (their fields named
   /// "matching.direction_weight", "modal_fit.max_order"); freq_sigma and
-  /// peak_sigma > 0; 0 <= fmin_hz < fmax_hz; max_iterations and
+  /// peak_sigma > 0 and finite; 0 <= fmin_hz < fmax_hz; max_iterations and
   /// max_match_rounds >= 1; weak_relative_std > 0; robust_scale finite and
   /// >= 0 (0: no robust loss).
   /// @throws OptionError naming the field, its value and the bound.

@@ -76,6 +76,14 @@ class NamedRegistry {
   /// "a, b or c".
   std::string NameList() const { return NameListOf(Names()); }
 
+  /// The entries in the order of Add (for a caller that lists them all).
+  std::vector<T> Values() const {
+    std::vector<T> values;
+    values.reserve(entries_.size());
+    for (const auto& [n, v] : entries_) values.push_back(v);
+    return values;
+  }
+
   /// The (name, entry) pairs in the order of Add.
   const std::vector<std::pair<std::string, T>>& entries() const { return entries_; }
   std::size_t size() const { return entries_.size(); }

@@ -115,7 +115,8 @@ class EffectRegistry {
   /// `pattern` is the family's names for people ("virtual_joint_<place>_<axis>
   /// (place: base, link1..linkN; axis: rx, ry, rz, tx, ty, tz)").
   void RegisterFamily(std::string pattern, FamilyFactory factory);
-  /// @throws std::invalid_argument "unknown effect 'x'; available: ...".
+  /// @throws std::invalid_argument "unknown effect 'x': expected a, b or c; or of a
+  /// family: <patterns>" (the registry's refusal, named_registry.h).
   std::shared_ptr<const Effect> Create(std::string_view name) const;
   /// The single effects (not the members of families): the audit's default
   /// candidates, Python's available_effects().

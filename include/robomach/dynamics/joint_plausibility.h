@@ -31,14 +31,16 @@ namespace robomach::dynamics {
 /// m g r over kq = m r² w² turns it by g / (w² r)).
 inline constexpr double kMinPlausibleJointFrequencyHz = 1.0;
 inline constexpr double kMaxPlausibleJointFrequencyHz = 2000.0;
-/// The turn of a joint under the robot's own weight, |G_j(q)| / kq_j, at the
-/// same posture: robot gearboxes (RV and harmonic reducers) deflect by 1 - 5
-/// arc-minutes under their rated torque (Nabtesco RV-E, Harmonic Drive CSG
-/// catalogues), and the KR 210's joints turn by at most 0.05 deg under its
-/// weight. Over 1 deg (20 times the catalogues) the tool would sag by
-/// centimetres: a stiffness typed per degree (N·m/deg, the value / 57.3) or
-/// in kN·m/rad. Frequencies alone miss the first: /57.3 moves them by only
-/// 7.6 (the KR 210's lowest to 1.3 Hz, inside the range above).
+/// The turn of a joint under the robot's own weight, |G_j(q)| / kq_j, the
+/// largest over each joint swept through its limits (9 angles, the others at
+/// the same posture): robot gearboxes (RV and harmonic reducers) deflect by
+/// 1 - 5 arc-minutes under their rated torque (Nabtesco RV-E, Harmonic Drive
+/// CSG catalogues), and the KR 210's joints turn by at most 0.09 deg (joint
+/// 2: 4760 N·m on 3.13e6 N·m/rad) under its weight. Over 1 deg (20 times
+/// the catalogues) the tool would sag by centimetres: a stiffness typed per
+/// degree (N·m/deg, the value / 57.3) or in kN·m/rad. Frequencies alone miss
+/// the first: /57.3 moves them by only 7.6 (the KR 210's lowest to 1.3 Hz,
+/// inside the range above).
 inline constexpr double kMaxPlausibleGravitySagRad = 0.017453292519943295;  // 1 deg
 /// Rayleigh damping ratio (alpha w + beta / w) / 2 at each joint frequency.
 inline constexpr double kMaxPlausibleDampingRatio = 0.5;

@@ -69,7 +69,7 @@ HammerRecords ReadHammerRecords(const std::vector<std::string>& paths);
 /// The FRF key of every response channel, in channel order: (pose_id, the
 /// channel's direction, excitation). A channel's direction is
 /// `directions[name]` ("x", "y" or "z") when given, else its name's: a name
-/// that is x, y or z or ends in _x, _y or _z.
+/// that is x, y or z or ends in _x, _y or _z (a capital too, as ParseAxis).
 /// @throws std::invalid_argument, a message that names the channel (and
 ///   reads after "--direction "): a direction for no channel ("acc=z: no
 ///   response channel 'acc'"), one that is not x, y or z, a channel without

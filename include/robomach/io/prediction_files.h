@@ -23,6 +23,7 @@ struct PosturePrediction {
 using DirectionPairs = std::vector<std::pair<int, int>>;
 /// All nine pairs.
 DirectionPairs AllDirectionPairs();
+/// "xx,yy,xy" (each letter as ParseAxis takes it, a capital too) or "all".
 /// @throws std::invalid_argument for a malformed list such as "xx,yq".
 DirectionPairs ParseDirectionPairs(const std::string& text);
 

@@ -49,7 +49,7 @@ struct PolishableOptions {
   double check_grid_points{2e4};
 
   /// The bounds (issue #36):
-  /// - sample_spacing > 0 [m]: a grid's spacing.
+  /// - sample_spacing > 0 and finite [m]: a grid's spacing.
   /// - max_grid_points, max_path_rows and check_grid_points >= 1: a count
   ///   of points or rows (check_grid_points divides the region).
   /// @throws OptionError(field, "FIELD: expected ..., got VALUE") naming the bound.

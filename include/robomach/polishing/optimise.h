@@ -27,6 +27,9 @@
 namespace robomach::polishing {
 
 enum class Optimiser { kNlopt, kPso };
+/// Every Optimiser, in the order its names are listed ("nlopt or pso"): the
+/// one list ParseOptimiser and PlanOptions::Validate name.
+inline constexpr Optimiser kOptimisers[] = {Optimiser::kNlopt, Optimiser::kPso};
 
 /// "nlopt", "pso" (the names polish-plan's --optimise and Python take).
 std::string ToString(Optimiser o);
@@ -50,7 +53,7 @@ struct OptimiseOptions {
 
   /// The bounds (issue #36), for either method:
   /// - offset_min > 0 [m]: a guide-line spacing.
-  /// - offset_max > offset_min: the search maps [offset_min, offset_max] onto
+  /// - offset_max > offset_min and finite: the search maps [offset_min, offset_max] onto
   ///   [0, 1] ("offset_max: expected a value > offset_min MIN, got VALUE").
   /// - global_evaluations, local_evaluations >= 1: NLopt takes a budget <= 0
   ///   as none.
@@ -180,7 +183,7 @@ struct PlanOptimiseOptions {
   std::function<void(int, double, double)> progress;
 
   /// The bounds (issue #36); starts and threads below 1 are taken as 1:
-  /// - offset_min > 0 [m] and offset_max > offset_min: the search is on
+  /// - offset_min > 0 [m] and offset_max > offset_min, finite: the search is on
   ///   log(d / offset_min) / log(offset_max / offset_min).
   /// - feasibility_margin in (0, 1]: the target is divided by it; above 1
   ///   the optimiser would hold its plans to more than the target.

@@ -37,6 +37,7 @@ enum class GuideLines { kBoundaryOffsets, kParallelLines };
 /// "cycloid", "parallel": the name of the pattern's PathPattern (polish-plan's
 /// --pattern, summaries).
 std::string ToString(Pattern p);
+/// The id of PathPatternRegistry()'s pattern `name` (path_patterns.h).
 /// @throws std::invalid_argument "unknown path pattern 'NAME': expected
 /// cycloid or parallel".
 Pattern ParsePattern(const std::string& name);

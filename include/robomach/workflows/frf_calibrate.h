@@ -85,7 +85,8 @@ struct FrfCalibrateOptions {
 
   /// @throws OptionError naming the field, its value and bound:
   ///   max_iterations outside [1, 100000], robust_loss_sigma outside
-  ///   [0, 1e6], no measured_files nor pose_files, an unknown objective, no
+  ///   [0, 1e6], fmin_hz below 0 or fmax_hz not above fmin_hz (both
+  ///   values named), no measured_files nor pose_files, an unknown objective, no
   ///   free parameter (only_free without frees).
   void Validate() const;
   /// The calibration's options: the objective, the free parameters

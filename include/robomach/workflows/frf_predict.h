@@ -48,8 +48,8 @@ std::optional<dynamics::ParameterUncertainty> UseUncertaintyFiles(const std::vec
 
 /// The lines fmin_hz, fmin_hz + df_hz, ... up to fmax_hz [Hz].
 /// @throws OptionError naming fmin_hz, fmax_hz and df_hz: not finite,
-///   0 <= fmin_hz < fmax_hz and df_hz > 0 violated, or more lines than
-///   dynamics::kMaxFrequencyLines (with the likely unit mistake when
+///   0 <= fmin_hz < fmax_hz and df_hz > 0 violated, fewer than 2 lines
+///   (df_hz), or more lines than dynamics::kMaxFrequencyLines (with the likely unit mistake when
 ///   fmax_hz is beyond dynamics::kMaxPlausibleFmaxHz).
 Eigen::VectorXd FrequencyGrid(double fmin_hz, double fmax_hz, double df_hz);
 

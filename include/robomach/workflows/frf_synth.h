@@ -40,8 +40,8 @@ struct FrfSynthOptions : FieldNames {
   std::string postures_path;  // posture file (formats.md §1)
   std::vector<std::string> adds;  // effects switched on with their default parameters
   std::vector<std::string> sets;  // "NAME=VALUE" in the parameter's unit
-  /// The test's grid, noise, directions and seed. sample_rate_hz not finite:
-  /// the config's hammer_test.sample_rate_hz, else 5120 Hz.
+  /// The test's grid, noise, directions and seed. sample_rate_hz NaN: the
+  /// config's hammer_test.sample_rate_hz, else 5120 Hz.
   calibration::VirtualHammerOptions hammer{.sample_rate_hz = NAN};
   // names, Name(field): how the unit findings name the fields (FieldNames;
   // the tool: its options, "--fmax-hz").
@@ -50,8 +50,9 @@ struct FrfSynthOptions : FieldNames {
   /// @throws OptionError naming the field: block_samples outside
   ///   [2, 2^22], averages outside [1 (2 with coherence), 100000],
   ///   relative_noise infinite or above kMaxRelativeNoise, fmax_hz or
-  ///   hammer_cutoff_hz outside [0, 1e9] Hz, a finite sample_rate_hz outside
-  ///   (0, 1e9] Hz, an absolute noise negative or not finite.
+  ///   hammer_cutoff_hz outside [0, 1e9] Hz, fmin_hz outside (0, 1e9] Hz or
+  ///   not below fmax_hz, a sample_rate_hz other than NaN outside (0, 1e9]
+  ///   Hz, an absolute noise negative or not finite.
   void Validate() const;
   /// The options that look like a unit mistake (docs/plausibility.md),
   /// "implausible (unit mistake?): ..." each: they flag the run.

@@ -114,7 +114,7 @@ struct KqPlanOptions {
   unsigned seed{1};
   std::optional<Eigen::Vector3d> load_point_m, target_m;  // in the tip frame [m]; none: the TCP
   std::vector<double> masses_kg{10.0, 20.0, 30.0};          // each > 0
-  double max_rope_angle_deg{45.0};
+  double max_rope_angle_deg{45.0};  // rope from vertical [deg], in (0, 90): 0 leaves one direction
   /// How the warnings name the options to change (the tool: "--plan N" and
   /// "--load-point-mm, --target-mm").
   std::string num_postures_name{"num_postures"};
@@ -123,6 +123,9 @@ struct KqPlanOptions {
   /// "--masses-kg", "--load-point-mm", "--target-mm", in their units).
   std::string noise_mm_name{"noise_mm"}, masses_name{"masses_kg"}, load_point_name{"load_point_m"},
       target_name{"target_m"};
+  /// How the message of a robot with too few feasible postures names
+  /// max_rope_angle_deg (the tool: "--max-rope-angle-deg").
+  std::string max_rope_angle_name{"max_rope_angle_deg"};
   /// A targeted plan (issue #37 §5): the posture file (formats.md §1) of the work region whose
   /// `target_quantity` must be known well — "frequency" (the lowest natural
   /// frequency) or "safe-depth" (the ZOA lobes' smallest critical depth of

@@ -33,6 +33,12 @@ struct SurfaceChoice {
   int cad_face{0};
   bool cad_face_given{false};
   double cad_unit_scale{1.0};
+
+  /// The values alone, before any file is read (a face beyond the file's
+  /// count is the reader's).
+  /// @throws OptionError "cad_face" below 0, "cad_unit_scale" not finite
+  ///   and > 0, naming the value.
+  void Validate() const;
 };
 
 /// A NURBS YAML, or face `choice.cad_face` of a STEP/IGES file (formats.md

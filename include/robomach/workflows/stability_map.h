@@ -37,7 +37,7 @@ struct StabilityMapOptions {
   dynamics::PropagationOptions uncertainty;
 
   /// @throws OptionError naming the field: region_path empty, max_depth_mm
-  ///   not > 0, speeds outside [0, 100000], rotation_evaluations under 8,
+  ///   outside (0, 10000], speeds outside [0, 100000], rotation_evaluations under 8,
   ///   threads outside [0, 256], the uncertainty's options.
   void Validate() const;
   /// Validate's checks but region_path's: those of the settings, which
